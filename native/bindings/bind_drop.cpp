@@ -1,0 +1,102 @@
+// Python binding of the drop-cutter: spatial index and batch drop, numpy in and out.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <sstream>
+
+#include "tmm/drop_cutter.hpp"
+#include "tmm/mesh_index.hpp"
+
+namespace py = pybind11;
+
+namespace {
+
+using XY = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Wraps a Python callable `cb(fraction) -> bool` for the kernel: called with the GIL taken; a Python
+// exception in it cancels the batch and propagates.
+std::function<bool(double)> python_progress(const py::object& cb) {
+  if (cb.is_none()) return {};
+  return [cb](double fraction) {
+    py::gil_scoped_acquire gil;
+    py::object r = cb(fraction);
+    return r.is_none() || r.cast<bool>();
+  };
+}
+
+py::array_t<double> drop_cutter(const tmm::MeshIndex& index, double radius, double corner_radius,
+                                const XY& xy, double floor_z, int threads, const py::object& progress,
+                                py::dict* stats_out) {
+  if (xy.ndim() != 2 || xy.shape(1) != 2) {
+    std::ostringstream msg;
+    msg << "points must have shape (n, 2), got ndim " << xy.ndim();
+    throw std::invalid_argument(msg.str());
+  }
+  const tmm::Cutter cutter(radius, corner_radius);
+  const std::size_t n = static_cast<std::size_t>(xy.shape(0));
+  py::array_t<double> z(static_cast<py::ssize_t>(n));
+  tmm::BatchOptions options;
+  options.threads = threads;
+  options.progress = python_progress(progress);
+  tmm::DropStats stats;
+  {
+    py::gil_scoped_release release;
+    tmm::drop_batch(index, cutter, xy.data(), n, floor_z, z.mutable_data(), options, &stats);
+  }
+  if (stats_out) (*stats_out)["triangles_tested"] = stats.triangles_tested;
+  return z;
+}
+
+}  // namespace
+
+void bind_drop(py::module_& m) {
+  py::register_exception<tmm::Cancelled>(m, "Cancelled");
+
+  py::class_<tmm::MeshIndex, std::shared_ptr<tmm::MeshIndex>>(m, "MeshIndex",
+      "Spatial index (XY bounding volume hierarchy with heights) over a triangle mesh for drop-cutter.")
+      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const Eigen::Ref<const tmm::Triangles>& F) {
+             py::gil_scoped_release release;
+             return std::make_shared<tmm::MeshIndex>(V, F);
+           }),
+           py::arg("vertices"), py::arg("triangles"))
+      .def_property_readonly("triangle_count", &tmm::MeshIndex::triangle_count)
+      .def_property_readonly("node_count", [](const tmm::MeshIndex& i) { return i.nodes().size(); })
+      .def_property_readonly("memory_bytes", &tmm::MeshIndex::memory_bytes)
+      .def_property_readonly("zmin", &tmm::MeshIndex::zmin)
+      .def_property_readonly("zmax", &tmm::MeshIndex::zmax);
+
+  m.def("drop_cutter",
+        [](const tmm::MeshIndex& index, double radius, double corner_radius, const XY& xy, double floor_z,
+           int threads, const py::object& progress) {
+          return drop_cutter(index, radius, corner_radius, xy, floor_z, threads, progress, nullptr);
+        },
+        py::arg("index"), py::arg("radius"), py::arg("corner_radius"), py::arg("xy"), py::arg("floor_z"),
+        py::arg("threads") = 0, py::arg("progress") = py::none(),
+        "Tip heights (n,) of a cutter (radius, corner radius: 0 flat, = radius ball) dropped along -Z at the "
+        "(n, 2) points, never below floor_z. progress(fraction) -> bool; False cancels (raises Cancelled).");
+
+  m.def("drop_cutter_stats",
+        [](const tmm::MeshIndex& index, double radius, double corner_radius, const XY& xy, double floor_z,
+           int threads) {
+          py::dict stats;
+          py::array_t<double> z = drop_cutter(index, radius, corner_radius, xy, floor_z, threads, py::none(), &stats);
+          return py::make_tuple(z, stats);
+        },
+        py::arg("index"), py::arg("radius"), py::arg("corner_radius"), py::arg("xy"), py::arg("floor_z"),
+        py::arg("threads") = 0, "drop_cutter that also returns counters (triangles tested).");
+
+  m.def("drop_on_triangle",
+        [](double radius, double corner_radius, double x, double y, const Eigen::Matrix3d& corners) {
+          const tmm::Cutter cutter(radius, corner_radius);
+          tmm::Vertices V = corners;
+          tmm::Triangles F(1, 3);
+          F << 0, 1, 2;
+          const tmm::MeshIndex index(V, F);
+          return tmm::drop_on_triangle(cutter, x, y, index.triangles()[0]);
+        },
+        py::arg("radius"), py::arg("corner_radius"), py::arg("x"), py::arg("y"), py::arg("corners"),
+        "Exact contact height of the cutter with one triangle (rows: corners), -inf if none.");
+}

@@ -1,0 +1,13 @@
+// The one Python module over the kernel. Each part of the kernel binds itself in its own file.
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void bind_mesh(py::module_& m);   // bind_mesh.cpp: STL reading, indexed mesh, vertex normals
+void bind_drop(py::module_& m);   // bind_drop.cpp: cutters, spatial index, batch drop-cutter
+
+PYBIND11_MODULE(_native, m) {
+  m.doc() = "TMM geometry kernel (C++17, Eigen)";
+  bind_mesh(m);
+  bind_drop(m);
+}

@@ -1,0 +1,42 @@
+// Drop-cutter along -Z: for each (x, y), the lowest tip height at which the cutter touches the mesh without
+// penetrating it (the highest of all vertex, edge and facet contacts), never below a floor.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <stdexcept>
+
+#include "tmm/cutter.hpp"
+#include "tmm/mesh_index.hpp"
+
+namespace tmm {
+
+// Thrown by batch calls when the progress callback asks to stop.
+class Cancelled : public std::runtime_error {
+ public:
+  Cancelled() : std::runtime_error("cancelled") {}
+};
+
+struct DropStats {
+  std::size_t triangles_tested = 0;  // triangles whose contacts were computed
+};
+
+// One point. `stats` may be null.
+double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double y, double floor_z,
+                  DropStats* stats = nullptr);
+
+// Exact contact of the cutter with one triangle (max of facet, edge and vertex contacts), or -inf.
+double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t);
+
+struct BatchOptions {
+  int threads = 0;  // 0: all hardware threads
+  // Called now and then from the calling thread with the fraction done; return false to cancel.
+  std::function<bool(double)> progress;
+};
+
+// xy: n points (x0, y0, x1, y1, ...); z_out: n tip heights. Throws Cancelled if progress returns false.
+void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                double floor_z, double* z_out, const BatchOptions& options,
+                DropStats* stats = nullptr);
+
+}  // namespace tmm

@@ -1,0 +1,106 @@
+#include "tmm/drop_contacts.hpp"
+
+#include <algorithm>
+
+namespace tmm {
+
+double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
+                  const double* p2, const double* n) {
+  const double nz = n[2];
+  if (nz <= 1e-12) return kNoContact;  // vertical or downward facing: edges give the contact
+  const double nxy = std::sqrt(n[0] * n[0] + n[1] * n[1]);
+  double cx = x, cy = y, rho = 0.0;
+  if (nxy > 1e-15) {
+    rho = c.facet_contact_radius(nxy);
+    cx -= rho * n[0] / nxy;  // uphill: the plane rises against n_xy
+    cy -= rho * n[1] / nxy;
+  }
+  // Is the contact point inside the triangle (in XY)? Barycentric signs with a relative tolerance.
+  const double ax = p0[0] - cx, ay = p0[1] - cy;
+  const double bx = p1[0] - cx, by = p1[1] - cy;
+  const double qx = p2[0] - cx, qy = p2[1] - cy;
+  const double w0 = bx * qy - by * qx;
+  const double w1 = qx * ay - qy * ax;
+  const double w2 = ax * by - ay * bx;
+  const double area = w0 + w1 + w2;
+  const double eps = 1e-12 * std::fabs(area);
+  if (area > 0) {
+    if (w0 < -eps || w1 < -eps || w2 < -eps) return kNoContact;
+  } else {
+    if (w0 > eps || w1 > eps || w2 > eps) return kNoContact;
+  }
+  // Plane height at the contact point, then down by the cutter profile there.
+  const double zc = p0[2] - (n[0] * (cx - p0[0]) + n[1] * (cy - p0[1])) / nz;
+  return zc - c.height(rho);
+}
+
+namespace {
+
+// Maximum of g(u) = z0 + m u - h(sqrt(d2 + u^2)) on [lo, hi] for the torus profile. g is concave, so
+// g' = m - u h'(rho) / rho decreases: the maximum is at an end or at the root of g'.
+double torus_edge_max(const Cutter& c, double d2, double z0, double m, double lo, double hi) {
+  auto g = [&](double u) { return z0 + m * u - c.height(std::sqrt(d2 + u * u)); };
+  auto dg = [&](double u) {
+    const double rho = std::sqrt(d2 + u * u);
+    if (rho <= c.flat_radius()) return m;
+    return m - u * c.slope(rho) / rho;
+  };
+  const double glo = dg(lo), ghi = dg(hi);
+  if (!(glo > 0)) return g(lo);
+  if (!(ghi < 0)) return g(hi);
+  double a = lo, b = hi;
+  double u = 0.5 * (a + b);
+  for (int it = 0; it < 100 && b - a > 1e-12; ++it) {
+    const double du = dg(u);
+    if (du > 0) a = u; else b = u;
+    if (du == 0) break;
+    // Newton step on g' with g'' = -(h'' (u/rho)^2 + h' d^2 / rho^3); bisect when it leaves (a, b).
+    const double rho = std::sqrt(d2 + u * u);
+    double next = 0.5 * (a + b);
+    if (rho > c.flat_radius()) {
+      const double d2g = -(c.curvature(rho) * u * u / (rho * rho) + c.slope(rho) * d2 / (rho * rho * rho));
+      if (d2g < 0 && std::isfinite(d2g)) {
+        const double newton = u - du / d2g;
+        if (newton > a && newton < b) next = newton;
+      }
+    }
+    if (std::fabs(next - u) < 1e-13) { u = next; break; }
+    u = next;
+  }
+  return g(u);
+}
+
+}  // namespace
+
+double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2) {
+  const double ex = p2[0] - p1[0], ey = p2[1] - p1[1];
+  const double L = std::sqrt(ex * ex + ey * ey);
+  const double R = c.radius();
+  if (L < 1e-12) {  // vertical edge: its top vertex is the contact
+    return std::max(vertex_drop(c, x, y, p1), vertex_drop(c, x, y, p2));
+  }
+  const double wx = ex / L, wy = ey / L;
+  const double sx = p1[0] - x, sy = p1[1] - y;
+  const double u1 = sx * wx + sy * wy;      // position of p1 along the edge, 0 at the foot of the axis
+  const double d = wx * sy - wy * sx;       // signed distance of the axis from the edge line (XY)
+  const double d2 = d * d;
+  if (d2 > R * R) return kNoContact;
+  const double s = std::sqrt(R * R - d2);   // half-chord of the cutter's shadow along the edge
+  const double lo = std::max(u1, -s), hi = std::min(u1 + L, s);
+  if (lo > hi) return kNoContact;
+  const double m = (p2[2] - p1[2]) / L;     // slope of the edge
+  const double z0 = p1[2] - m * u1;         // edge height at u = 0
+  switch (c.kind()) {
+    case CutterKind::Flat:                  // the line's highest point over the flat disc chord
+      return z0 + m * (m > 0 ? hi : lo);
+    case CutterKind::Ball: {                // g = z0 + m u - R + sqrt(s^2 - u^2): g' = 0 in closed form
+      const double u = std::clamp(m * s / std::sqrt(1.0 + m * m), lo, hi);
+      return z0 + m * u - R + std::sqrt(std::fmax(s * s - u * u, 0.0));
+    }
+    case CutterKind::Bull:
+      return torus_edge_max(c, d2, z0, m, lo, hi);
+  }
+  return kNoContact;
+}
+
+}  // namespace tmm

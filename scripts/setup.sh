@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# One-shot set-up for a Debian 12 machine (run as root, or with sudo available).
+# Installs what is missing, builds the native kernel for Debian's /usr/bin/python3 (the one FreeCAD runs),
+# creates a venv (with system packages) for the test-only pip packages, and links the add-on into FreeCAD.
+# Quick when everything is already in place.
+set -euo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+
+DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
+      python3-pip python3-matplotlib xvfb xauth cmake g++ make ninja-build libgtest-dev)
+missing=()
+for p in "${DEBS[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "[setup] installing Debian packages: ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
+fi
+
+# Test-only Python packages (OpenCAMLib as the peer) go into a venv on top of Debian's python3.
+if [ ! -x .venv/bin/python ]; then
+  /usr/bin/python3 -m venv --system-site-packages .venv
+fi
+if ! .venv/bin/python -c "import opencamlib" >/dev/null 2>&1; then
+  echo "[setup] pip install opencamlib (test peer)"
+  .venv/bin/python -m pip install -q opencamlib
+fi
+
+# Native kernel for /usr/bin/python3 (FreeCAD's interpreter).
+cmake -S native -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
+cmake --build build -j"$(nproc)"
+
+# Make the add-on visible to FreeCAD 0.20 (user Mod folder).
+MOD="${HOME}/.local/share/FreeCAD/Mod"
+mkdir -p "$MOD"
+ln -sfn "$ROOT" "$MOD/TMM"
+echo "[setup] ready: kernel built, add-on linked at $MOD/TMM"

@@ -1,0 +1,1 @@
+"""Pure-Python core of TMM: no FreeCAD import anywhere below this package."""

@@ -1,0 +1,37 @@
+"""Drop-cutter over a mesh: the kernel's spatial index and batch query, with core errors."""
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+import numpy as np
+
+from .cutters import Cutter
+from .errors import Cancelled, TmmError
+from .kernel import native
+from .mesh import TriMesh
+
+Progress = Callable[[float], bool]
+
+
+class DropSurface:
+    """A mesh indexed for drop-cutter queries along -Z. Build once, drop many cutters and points."""
+
+    def __init__(self, mesh: TriMesh) -> None:
+        self.mesh = mesh
+        try:
+            self._index = native.MeshIndex(mesh.vertices, mesh.triangles)
+        except ValueError as exc:
+            raise TmmError(f"{mesh.name}: {exc}") from exc
+
+    def drop(self, cutter: Cutter, xy: np.ndarray, floor_z: float,
+             progress: Optional[Progress] = None, threads: int = 0) -> np.ndarray:
+        """Tip heights (n,) of `cutter` dropped at the (n, 2) points `xy`: the lowest tip position on or
+        above `floor_z` where the cutter touches the mesh without penetrating it."""
+        pts = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
+        if not np.isfinite(pts).all():
+            raise TmmError("drop points contain a non-finite coordinate")
+        try:
+            return native.drop_cutter(self._index, cutter.radius, cutter.corner_radius, pts,
+                                      float(floor_z), threads, progress)
+        except native.Cancelled as exc:
+            raise Cancelled("tool path computation cancelled") from exc

@@ -1,0 +1,9 @@
+"""Errors the core raises; the App layer shows them on the operation."""
+
+
+class TmmError(ValueError):
+    """Bad input: the message names what is wrong (file, parameter, value)."""
+
+
+class Cancelled(Exception):
+    """The user cancelled a long computation through the progress callback."""

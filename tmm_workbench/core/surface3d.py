@@ -1,0 +1,131 @@
+"""3-axis surface finishing: a raster footprint dropped on the mesh, linked into one tool path."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from .cutters import Cutter
+from .drop import DropSurface, Progress
+from .errors import TmmError
+from .footprint import Rect, raster_lines, sample_segment
+from .mesh import TriMesh
+from .toolpath import MoveKind, Toolpath
+
+ZIGZAG = "zigzag"
+ONEWAY = "oneway"
+_COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
+
+
+@dataclass
+class SurfaceParams:
+    boundary: Rect                   # xmin, ymin, xmax, ymax of the tip positions (mm)
+    stepover: float                  # distance between passes (mm)
+    sample_step: float               # forward sampling step along a pass (mm)
+    safe_height: float               # retract height between passes (mm)
+    clearance_height: float          # height at start and end (mm)
+    angle_deg: float = 0.0           # raster angle from +X
+    pattern: str = ZIGZAG            # ZIGZAG or ONEWAY
+    stock_to_leave: float = 0.0      # material left on the surface (mm)
+    floor_z: Optional[float] = None  # the tip never goes below; default: the model's lowest point
+
+    def validate(self) -> None:
+        for name in ("stepover", "sample_step"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise TmmError(f"{name.replace('_', ' ')} must be a positive length, got {v!r}")
+        for name in ("safe_height", "clearance_height", "angle_deg", "stock_to_leave"):
+            v = getattr(self, name)
+            if not (isinstance(v, (int, float)) and math.isfinite(v)):
+                raise TmmError(f"{name.replace('_', ' ')} must be a finite number, got {v!r}")
+        if self.pattern not in (ZIGZAG, ONEWAY):
+            raise TmmError(f"pattern must be '{ZIGZAG}' or '{ONEWAY}', got {self.pattern!r}")
+        if self.clearance_height < self.safe_height:
+            raise TmmError(f"clearance height {self.clearance_height:g} mm is below the safe height "
+                           f"{self.safe_height:g} mm")
+        if len(self.boundary) != 4 or not all(math.isfinite(b) for b in self.boundary):
+            raise TmmError(f"boundary must be four finite numbers xmin, ymin, xmax, ymax, got {self.boundary!r}")
+
+
+def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams,
+                             progress: Optional[Progress] = None,
+                             surface: Optional[DropSurface] = None) -> Toolpath:
+    """Gouge-free raster finishing of `mesh` with `cutter` (tip positions; Z up).
+
+    Every cutting move, including the links between zig-zag passes, is made of dropped CL points,
+    so straight moves only join positions no more than `sample_step` apart.
+    """
+    params.validate()
+    lo, hi = mesh.bounds
+    b = params.boundary
+    if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
+        raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
+                       f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
+    floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
+
+    lines = raster_lines(b, params.stepover, params.angle_deg)
+    if params.pattern == ZIGZAG:
+        lines = [ln if i % 2 == 0 else ln[::-1] for i, ln in enumerate(lines)]
+    # Runs of XY points: passes, and for zig-zag the links between them, dropped in one batch.
+    runs: list[tuple[bool, np.ndarray]] = []  # (is_link, xy)
+    for i, ln in enumerate(lines):
+        if i > 0 and params.pattern == ZIGZAG:
+            link = sample_segment(lines[i - 1][1], ln[0], params.sample_step)[1:-1]
+            runs.append((True, link))
+        runs.append((False, sample_segment(ln[0], ln[1], params.sample_step)))
+    xy = np.concatenate([r for _, r in runs])
+    if len(xy) > 50_000_000:
+        raise TmmError(f"{len(xy)} CL points: sampling step {params.sample_step:g} mm is too fine")
+
+    s = params.stock_to_leave
+    surface = surface or DropSurface(mesh)
+    z = surface.drop(cutter.offset(s), xy, floor_z + s, progress) - s
+
+    top = float(z.max())
+    if params.safe_height <= top:
+        raise TmmError(f"safe height {params.safe_height:g} mm is not above the highest tool position "
+                       f"{top:.4g} mm")
+    return _link(runs, z, params)
+
+
+def _link(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, params: SurfaceParams) -> Toolpath:
+    tp = Toolpath()
+    k = 0
+    for is_link, xy in runs:
+        pts = np.column_stack([xy, z[k:k + len(xy)]])
+        k += len(xy)
+        if len(pts) == 0:
+            continue
+        if not is_link:
+            pts = _drop_collinear(pts)
+        plunged = False
+        if not tp.moves or params.pattern == ONEWAY:
+            x0, y0, z0 = pts[0]
+            if tp.moves:  # one-way: lift straight up, cross over at the safe height
+                last = tp.moves[-1]
+                tp.add(MoveKind.RAPID, last.x, last.y, params.safe_height)
+            else:
+                tp.add(MoveKind.RAPID, x0, y0, params.clearance_height)
+            tp.add(MoveKind.RAPID, x0, y0, params.safe_height)
+            tp.add(MoveKind.PLUNGE, x0, y0, z0)
+            plunged = True
+        for p in pts[1:] if plunged else pts:
+            tp.add(MoveKind.FEED, *p)
+    last = tp.moves[-1]
+    tp.add(MoveKind.RAPID, last.x, last.y, params.clearance_height)
+    return tp
+
+
+def _drop_collinear(pts: np.ndarray) -> np.ndarray:
+    """Remove interior points lying on the chord of their neighbours (flat stretches)."""
+    if len(pts) < 3:
+        return pts
+    a, p, c = pts[:-2], pts[1:-1], pts[2:]
+    ac = c - a
+    ap = p - a
+    cross = np.linalg.norm(np.cross(ac, ap), axis=1)
+    dist = cross / np.maximum(np.linalg.norm(ac, axis=1), 1e-300)
+    keep = np.concatenate([[True], dist > _COLLINEAR_MM, [True]])
+    return pts[keep]
