@@ -50,8 +50,9 @@ class Cutter:
         return "bull"
 
     def offset(self, distance: float) -> "Cutter":
-        """The cutter grown by `distance` all round: dropping it on a mesh and lowering the tip by `distance`
-        gives the exact drop of this cutter on the mesh offset by `distance` (stock to leave)."""
+        """The cutter grown by `distance` all round. Its lower surface lies `distance` below this cutter's, so
+        dropping it on a mesh and raising the tip by `distance` gives the exact drop of this cutter on the
+        mesh offset by `distance` (stock to leave)."""
         if distance == 0:
             return self
         if distance < 0 and -distance > self.corner_radius:

@@ -17,6 +17,7 @@ from .toolpath import MoveKind, Toolpath
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
+_LABEL = {"stepover": "step-over", "sample_step": "sample step"}
 
 
 @dataclass
@@ -35,7 +36,7 @@ class SurfaceParams:
         for name in ("stepover", "sample_step"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise TmmError(f"{name.replace('_', ' ')} must be a positive length, got {v!r}")
+                raise TmmError(f"{_LABEL[name]} must be a positive length, got {v!r}")
         for name in ("safe_height", "clearance_height", "angle_deg", "stock_to_leave"):
             v = getattr(self, name)
             if not (isinstance(v, (int, float)) and math.isfinite(v)):
@@ -81,7 +82,7 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
 
     s = params.stock_to_leave
     surface = surface or DropSurface(mesh)
-    z = surface.drop(cutter.offset(s), xy, floor_z + s, progress) - s
+    z = surface.drop(cutter.offset(s), xy, floor_z - s, progress) + s
 
     top = float(z.max())
     if params.safe_height <= top:

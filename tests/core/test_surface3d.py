@@ -1,0 +1,95 @@
+"""3-axis raster finishing: path structure, gouge-free cutting moves, stock to leave, errors, cancel."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.conftest import closest_distances, grid_mesh
+from tmm_workbench.core.cutters import Cutter
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.surface3d import ONEWAY, ZIGZAG, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.toolpath import MoveKind
+
+
+def params(**kw) -> SurfaceParams:
+    base = dict(boundary=(2.0, 2.0, 38.0, 28.0), stepover=2.0, sample_step=0.5, safe_height=10.0,
+                clearance_height=15.0)
+    base.update(kw)
+    return SurfaceParams(**base)
+
+
+def test_zigzag_structure_and_gouge_free(wavy_mesh):
+    cutter = Cutter.ball(4.0)
+    tp = compute_surface_toolpath(wavy_mesh, cutter, params())
+    kinds = [m.kind for m in tp]
+    assert kinds[:3] == [MoveKind.RAPID, MoveKind.RAPID, MoveKind.PLUNGE]
+    assert tp.moves[0].z == 15.0 and tp.moves[1].z == 10.0 and tp.moves[-1].z == 15.0
+    assert kinds.count(MoveKind.PLUNGE) == 1  # zig-zag: one plunge, linked passes
+    cut = tp.cutting_points()
+    assert cut[:, 0].min() == pytest.approx(2.0) and cut[:, 0].max() == pytest.approx(38.0)
+    assert cut[:, 1].min() == pytest.approx(2.0) and cut[:, 1].max() == pytest.approx(28.0)
+    # Consecutive cutting moves are never further apart than the sampling step (nothing unchecked).
+    steps = np.linalg.norm(np.diff(cut[:, :2], axis=0), axis=1)
+    assert steps.max() <= 0.5 + 1e-9
+    # Every CL point: the ball centre lies exactly one radius from the mesh (touching, no gouge).
+    centres = cut + [0, 0, cutter.radius]
+    np.testing.assert_allclose(closest_distances(centres, wavy_mesh), cutter.radius, atol=1e-9)
+
+
+def test_oneway_retracts_between_passes(wavy_mesh):
+    tp = compute_surface_toolpath(wavy_mesh, Cutter.flat(4.0), params(pattern=ONEWAY, stepover=3.0))
+    plunges = [i for i, m in enumerate(tp.moves) if m.kind is MoveKind.PLUNGE]
+    passes = int(np.ceil((28.0 - 2.0) / 3.0)) + 1
+    assert len(plunges) == passes
+    for i in plunges[1:]:  # lift to the safe height, cross over, plunge
+        assert tp.moves[i - 1].kind is MoveKind.RAPID and tp.moves[i - 1].z == 10.0
+        assert tp.moves[i - 2].kind is MoveKind.RAPID and tp.moves[i - 2].z == 10.0
+    # All passes run the same way (+X).
+    for i in plunges:
+        assert tp.moves[i + 1].x > tp.moves[i].x
+
+
+def test_raster_angle_rotates_passes(wavy_mesh):
+    tp = compute_surface_toolpath(wavy_mesh, Cutter.ball(3.0), params(angle_deg=90.0, pattern=ONEWAY))
+    i = next(i for i, m in enumerate(tp.moves) if m.kind is MoveKind.PLUNGE)
+    assert tp.moves[i + 1].x == pytest.approx(tp.moves[i].x) and tp.moves[i + 1].y > tp.moves[i].y
+
+
+def test_stock_to_leave_offsets_the_surface():
+    plate = grid_mesh(lambda x, y: 0 * x + 5.0, 10, 10, (0, 0, 20, 20), "plate")
+    for cutter in (Cutter.ball(4.0), Cutter.flat(4.0), Cutter.bull(6.0, 1.0)):
+        tp = compute_surface_toolpath(plate, cutter, params(boundary=(4, 4, 16, 16), stock_to_leave=0.3))
+        np.testing.assert_allclose(tp.cutting_points()[:, 2], 5.3, atol=1e-12)
+
+
+def test_stock_to_leave_on_a_slope_is_a_normal_offset():
+    # Plane at 30 degrees: the ball centre must be R + s from the plane, i.e. tip raised by s / cos(30).
+    t = np.tan(np.radians(30))
+    slope = grid_mesh(lambda x, y: t * x, 20, 20, (0, 0, 40, 40), "slope")
+    a = compute_surface_toolpath(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), safe_height=40,
+                                                                 clearance_height=45))
+    b = compute_surface_toolpath(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), stock_to_leave=0.5,
+                                                                 safe_height=40, clearance_height=45))
+    np.testing.assert_allclose(b.cutting_points()[:, 2] - a.cutting_points()[:, 2],
+                               0.5 / np.cos(np.radians(30)), atol=1e-9)
+
+
+@pytest.mark.parametrize("change,message", [
+    (dict(stepover=0.0), "step-over must be a positive length"),
+    (dict(stepover=-1.0), "step-over must be a positive length"),
+    (dict(sample_step=0.0), "sample step must be a positive length"),
+    (dict(sample_step=float("nan")), "sample step must be a positive length"),
+    (dict(boundary=(100, 100, 120, 120)), "lies outside the model"),
+    (dict(safe_height=1.0, clearance_height=15.0), "safe height 1 mm is not above the highest tool position"),
+    (dict(clearance_height=5.0), "clearance height 5 mm is below the safe height 10 mm"),
+    (dict(pattern="spiral"), "pattern must be"),
+])
+def test_bad_parameters_raise_clear_errors(wavy_mesh, change, message):
+    with pytest.raises(TmmError, match=message):
+        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(**change))
+
+
+def test_cancel(wavy_mesh):
+    with pytest.raises(Cancelled):
+        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(sample_step=0.001),
+                                 progress=lambda f: False)
