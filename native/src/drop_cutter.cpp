@@ -19,14 +19,32 @@ double drop_on_triangle(const Cutter& c, double x, double y, const IndexedTriang
 }
 
 double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double y, double floor_z,
-                  DropStats* stats) {
+                  DropStats* stats, int32_t* hint) {
   double best = floor_z;
+  int32_t winner = -1;
   std::size_t tested = 0;
-  index.walk(x, y, cutter.radius(), best, [&](const IndexedTriangle& t) {
+  const auto& tris = index.triangles();
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) {
     ++tested;
-    best = std::max(best, drop_on_triangle(cutter, x, y, t));
-  });
+    const double z = drop_on_triangle(cutter, x, y, tris[*hint]);
+    if (z > best) {
+      best = z;
+      winner = *hint;
+    }
+  }
+  const int32_t skip = winner;
+  index.walk(x, y, cutter.radius(), best, [&cutter](double rho) { return cutter.height(rho); },
+             [&](const IndexedTriangle& t, int32_t i) {
+               if (i == skip) return;
+               ++tested;
+               const double z = drop_on_triangle(cutter, x, y, t);
+               if (z > best) {
+                 best = z;
+                 winner = i;
+               }
+             });
   if (stats) stats->triangles_tested += tested;
+  if (hint) *hint = winner;
   return best;
 }
 
@@ -59,12 +77,13 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
   std::atomic<bool> cancel{false};
   auto work = [&] {
     DropStats local;
+    int32_t hint = -1;  // consecutive points of a chunk are neighbours along the footprint
     for (;;) {
       const std::size_t k = next.fetch_add(1);
       if (k >= chunks || cancel.load(std::memory_order_relaxed)) break;
       const std::size_t e = std::min(n, (k + 1) * chunk);
       for (std::size_t i = k * chunk; i < e; ++i) {
-        z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_z, &local);
+        z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_z, &local, &hint);
       }
       done.fetch_add(e - k * chunk);
     }

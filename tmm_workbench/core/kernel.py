@@ -6,7 +6,7 @@ try:
 except ImportError as exc:  # pragma: no cover - exercised only on a broken install
     raise ImportError(
         "TMM's native kernel (tmm_workbench/_native*.so) is not built or was built for another Python; "
-        "run scripts/setup.sh (or `make setup`) with Debian's /usr/bin/python3. Cause: %s" % exc
+        "run `bash scripts/setup.sh` (it builds for Debian's /usr/bin/python3, the one FreeCAD runs). Cause: %s" % exc
     ) from exc
 
 native = _native

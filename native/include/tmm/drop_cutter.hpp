@@ -21,9 +21,11 @@ struct DropStats {
   std::size_t triangles_tested = 0;  // triangles whose contacts were computed
 };
 
-// One point. `stats` may be null.
+// One point. `stats` may be null. `hint`, if given, is the position in index.triangles() of a triangle
+// likely to hold the cutter (the previous point's winner): tested first, its contact is a true lower
+// bound that prunes most of the walk; on return it holds this point's winner (or -1).
 double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double y, double floor_z,
-                  DropStats* stats = nullptr);
+                  DropStats* stats = nullptr, int32_t* hint = nullptr);
 
 // Exact contact of the cutter with one triangle (max of facet, edge and vertex contacts), or -inf.
 double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t);

@@ -4,7 +4,9 @@
 // is never above the triangle's highest point, so such nodes cannot raise the cutter.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -41,10 +43,13 @@ class MeshIndex {
   double zmin() const { return zmin_; }
   double zmax() const { return nodes_.empty() ? zmin_ : nodes_[0].zmax; }
 
-  // Calls visit(triangle) for every triangle whose XY bounds come within `radius` of (x, y) and whose
-  // zmax exceeds `floor` at the time it is reached; `floor` may rise during the walk (visit raises it).
-  template <class Visit>
-  void walk(double x, double y, double radius, const double& floor, Visit&& visit) const;
+  // Visits, best-first, the triangles whose XY bounds come within `radius` of (x, y) and whose bound
+  // exceeds `floor`; `floor` may rise during the walk (visit raises it). The bound of a box is
+  // zmax - lift(d), d its XY distance from (x, y): with lift = the cutter profile h, no triangle in the box
+  // can hold the cutter's tip higher (every point of it is at least d from the axis, and h increases).
+  // visit(triangle, position) gets the triangle's position in triangles().
+  template <class Lift, class Visit>
+  void walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const;
 
  private:
   void build(int32_t self, int32_t begin, int32_t end, std::vector<int32_t>& order,
@@ -56,31 +61,49 @@ class MeshIndex {
   double zmin_ = 0.0;
 };
 
-template <class Visit>
-void MeshIndex::walk(double x, double y, double radius, const double& floor, Visit&& visit) const {
+template <class Lift, class Visit>
+void MeshIndex::walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const {
   const double r2 = radius * radius;
-  int32_t stack[128];
+  auto box_bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
+    const double dx = std::fmax(std::fmax(xmin - x, x - xmax), 0.0);
+    const double dy = std::fmax(std::fmax(ymin - y, y - ymax), 0.0);
+    const double d2 = dx * dx + dy * dy;
+    if (d2 > r2) return -std::numeric_limits<double>::infinity();
+    return zmax - lift(std::sqrt(d2));
+  };
+  struct Entry {
+    int32_t node;
+    double bound;
+  };
+  Entry stack[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = {0, INFINITY};
   while (top > 0) {
-    const BvhNode& node = nodes_[stack[--top]];
-    if (node.zmax <= floor) continue;
-    const double dx = std::fmax(std::fmax(node.xmin - x, x - node.xmax), 0.0);
-    const double dy = std::fmax(std::fmax(node.ymin - y, y - node.ymax), 0.0);
-    if (dx * dx + dy * dy > r2) continue;
+    const Entry e = stack[--top];
+    if (e.bound <= floor) continue;
+    const BvhNode& node = nodes_[e.node];
     if (node.count > 0) {
-      for (int32_t i = node.first, e = node.first + node.count; i < e; ++i) {
-        if (tris_[i].zmax > floor) visit(tris_[i]);
+      for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
+        const IndexedTriangle& t = tris_[i];
+        if (t.zmax <= floor) continue;
+        const double b = box_bound(std::fmin(std::fmin(t.p[0][0], t.p[1][0]), t.p[2][0]),
+                                   std::fmin(std::fmin(t.p[0][1], t.p[1][1]), t.p[2][1]),
+                                   std::fmax(std::fmax(t.p[0][0], t.p[1][0]), t.p[2][0]),
+                                   std::fmax(std::fmax(t.p[0][1], t.p[1][1]), t.p[2][1]), t.zmax);
+        if (b > floor) visit(t, i);
       }
     } else {
-      const int32_t l = node.first, r = node.first + 1;
-      // Higher child last so it is popped first: its contacts prune more of the other.
-      if (nodes_[l].zmax > nodes_[r].zmax) {
-        stack[top++] = r;
-        stack[top++] = l;
+      const BvhNode& l = nodes_[node.first];
+      const BvhNode& r = nodes_[node.first + 1];
+      const double bl = l.zmax > floor ? box_bound(l.xmin, l.ymin, l.xmax, l.ymax, l.zmax) : -INFINITY;
+      const double br = r.zmax > floor ? box_bound(r.xmin, r.ymin, r.xmax, r.ymax, r.zmax) : -INFINITY;
+      // The more promising child last, so it is popped first: its contacts prune more of the other.
+      if (bl > br) {
+        if (br > floor) stack[top++] = {node.first + 1, br};
+        if (bl > floor) stack[top++] = {node.first, bl};
       } else {
-        stack[top++] = l;
-        stack[top++] = r;
+        if (bl > floor) stack[top++] = {node.first, bl};
+        if (br > floor) stack[top++] = {node.first + 1, br};
       }
     }
   }
