@@ -1,0 +1,44 @@
+"""Running FreeCAD in a subprocess from pytest: command lookup, environment, readable output."""
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+from typing import Optional, Sequence
+
+ROOT = Path(__file__).resolve().parents[2]
+_NOISE = re.compile(r"\(\s*\d+ %\)|^\s*(Recompute|Importing project files|Postprocessing|create mesh "
+                    r"structure)\.+\s*$", re.M)
+
+
+def find(*names: str) -> Optional[str]:
+    for n in names:
+        path = shutil.which(n)
+        if path:
+            return path
+    return None
+
+
+def environment(**extra: str) -> dict[str, str]:
+    """FreeCAD embeds Debian's python3: no venv or PYTHONHOME leaking into it."""
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONHOME", "VIRTUAL_ENV", "PYTHONSTARTUP")}
+    env.update(extra)
+    return env
+
+
+def readable(text: str) -> str:
+    """FreeCAD's console progress ('(42 %)' with tabs, no newlines) stripped for assertion messages."""
+    text = _NOISE.sub("", text.replace("\t", " "))
+    return "\n".join(line.rstrip() for line in text.splitlines() if line.strip())
+
+
+def run(cmd: Sequence[str], cwd: Path, timeout: float, **env: str) -> tuple[int, str]:
+    try:
+        proc = subprocess.run(list(cmd), cwd=cwd, env=environment(**env), capture_output=True, text=True,
+                              timeout=timeout)
+    except subprocess.TimeoutExpired as exc:
+        out = (exc.stdout or b"").decode() if isinstance(exc.stdout, bytes) else (exc.stdout or "")
+        return -1, f"timed out after {timeout} s\n" + readable(out)
+    return proc.returncode, readable(proc.stdout + "\n" + proc.stderr)

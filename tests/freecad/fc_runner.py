@@ -1,0 +1,52 @@
+"""Runs TMM's FreeCAD-side unittest modules inside `freecadcmd` and exits non-zero on failure.
+
+freecadcmd returns 0 even when a script raises, but SystemExit(n) propagates, so every outcome ends
+in an explicit SystemExit. Modules to run: env TMM_FC_MODULES (comma-separated names of fc_test_*.py
+files in this folder). Scratch files go to env TMM_TEST_OUT (a temporary folder by default).
+Usage: TMM_FC_MODULES=fc_test_op freecadcmd tests/freecad/fc_runner.py
+(pytest does this per module: tests/freecad/test_freecad_app.py). FreeCAD's own runner works too,
+with the add-on linked into its Mod folder: freecadcmd -t fc_test_op -M <repo>/tests/freecad
+"""
+import os
+import sys
+import traceback
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+def main() -> int:
+    # Did the add-on's Init.py run (FreeCAD's Mod link) and wrap the post search path? Recorded
+    # before the tests' helpers install the wrapper themselves.
+    prefs = sys.modules.get("PathScripts.PathPreferences")
+    wrapped = bool(prefs and getattr(prefs.searchPathsPost, "_tmm_wrapped", False))
+    os.environ["TMM_FC_INIT_WRAPPED_POSTS"] = "1" if wrapped else "0"
+    for p in (HERE, ROOT):
+        if p not in sys.path:
+            sys.path.insert(0, p)
+    import tmm_workbench
+
+    origin = os.path.realpath(os.path.dirname(os.path.dirname(tmm_workbench.__file__)))
+    if origin != os.path.realpath(ROOT):
+        sys.stderr.write(f"tmm_workbench comes from {origin}, not from this checkout {ROOT}: FreeCAD's Mod "
+                         f"folder links another copy (ln -sfn {ROOT} ~/.local/share/FreeCAD/Mod/TMM)\n")
+        return 1
+    names = [n.strip() for n in os.environ.get("TMM_FC_MODULES", "").split(",") if n.strip()]
+    if not names:
+        names = sorted(f[:-3] for f in os.listdir(HERE) if f.startswith("fc_test_") and f.endswith(".py"))
+    suite = unittest.defaultTestLoader.loadTestsFromNames(names)
+    result = unittest.TextTestRunner(stream=sys.stderr, verbosity=2).run(suite)
+    sys.stderr.write(f"TMM-FC-RESULT {'PASS' if result.wasSuccessful() else 'FAIL'} "
+                     f"run={result.testsRun} failures={len(result.failures)} errors={len(result.errors)}\n")
+    return 0 if result.wasSuccessful() and result.testsRun > 0 else 1
+
+
+try:
+    code = main()
+except BaseException:  # noqa: B902 - anything, including import errors, is a failure
+    traceback.print_exc()
+    code = 1
+sys.stderr.flush()
+sys.stdout.flush()
+raise SystemExit(code)

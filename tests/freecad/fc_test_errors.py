@@ -1,0 +1,108 @@
+"""Bad input gives a clear error on the op, an empty Path (no partial path), and no crash."""
+from __future__ import annotations
+
+import unittest
+
+import FreeCAD
+import Part
+
+from fc_helpers import OUT, FreeCADTestCase, bump_stl, bump_triangles, job_with_op, new_doc, write_ascii_stl
+from tmm_workbench.app import job as jobs
+from tmm_workbench.core.errors import TmmError
+
+
+class BadInput(FreeCADTestCase):
+    def setUp(self) -> None:
+        self.doc = new_doc("TmmErrors")
+        self.job, self.tc, self.op = job_with_op(self.doc, str(bump_stl()), values={"BoundaryShape": "Model"})
+        self.assertTrue(self.op.isValid(), self.op.getStatusString())
+        self.assertGreater(len(self.op.Path.Commands), 10)
+
+    def assertFails(self, *fragments: str) -> None:
+        self.op.touch()
+        self.doc.recompute()
+        status = self.op.getStatusString()
+        self.assertFalse(self.op.isValid(), "op should be invalid")
+        for f in fragments:
+            self.assertIn(f.lower(), status.lower())
+        self.assertEqual(len(self.op.Path.Commands), 0, "no partial path")
+        self.assertIsNone(self.op.Proxy.toolpath)
+
+    def recovers(self) -> None:
+        self.op.StlFile = str(bump_stl())
+        self.doc.recompute()
+        self.assertTrue(self.op.isValid(), self.op.getStatusString())
+        self.assertGreater(len(self.op.Path.Commands), 10)
+
+    def test_missing_stl(self) -> None:
+        self.op.StlFile = str(OUT / "no_such_file.stl")
+        self.assertFails("STL file not found", "no_such_file.stl")
+        self.recovers()
+
+    def test_empty_stl(self) -> None:
+        empty = OUT / "empty.stl"
+        empty.write_bytes(b"")
+        self.op.StlFile = str(empty)
+        self.assertFails("empty.stl")
+
+    def test_malformed_stl(self) -> None:
+        bad = OUT / "malformed.stl"
+        bad.write_text("solid x\n  facet normal 0 0 1\n    outer loop\n      vertex 1 2\n")
+        self.op.StlFile = str(bad)
+        self.assertFails("malformed.stl")
+
+    def test_nan_coordinates(self) -> None:
+        tris = bump_triangles(4)
+        tris[3] = ((float("nan"), 0.0, 0.0), tris[3][1], tris[3][2])
+        nan = write_ascii_stl(OUT / "nan.stl", tris)
+        self.op.StlFile = str(nan)
+        self.assertFails("nan.stl", "finite")
+
+    def test_corner_radius_larger_than_radius(self) -> None:
+        bit = jobs.make_tool_bit(self.doc, "bullnose", 4.0, 3.0)  # FlatRadius -1
+        self.tc.Tool = bit
+        self.assertFails("corner radius 3 mm is larger than the tool radius 2 mm")
+
+    def test_stepover_not_positive(self) -> None:
+        self.op.StepOver = 0.0
+        self.assertFails("step", "must be a positive length, got 0")
+        self.op.StepOver = -1.0
+        self.assertFails("step", "must be a positive length, got -1")
+
+    def test_sample_step_not_positive(self) -> None:
+        self.op.SampleStep = 0.0
+        self.assertFails("sampl", "must be a positive length, got 0")
+
+    def test_boundary_outside_model(self) -> None:
+        stock = self.job.Stock  # model box + 1 mm; moved 50 mm past the model's +X side
+        stock.ExtXneg = -(20.0 + 50.0)
+        stock.ExtXpos = 100.0
+        self.op.BoundaryShape = "Stock"
+        self.assertFails("outside the model")
+
+    def test_boundary_shrunk_to_nothing(self) -> None:
+        self.op.BoundaryMargin = -15.0
+        self.assertFails("boundary is empty")
+
+    def test_safe_height_below_model(self) -> None:
+        self.op.setExpression("SafeHeight", None)
+        self.op.SafeHeight = 1.0  # the bump is 5 mm high
+        self.assertFails("safe height")
+
+    def test_model_without_faces(self) -> None:
+        wire = self.doc.addObject("Part::Feature", "Wire")
+        wire.Shape = Part.makeLine(FreeCAD.Vector(0, 0, 0), FreeCAD.Vector(10, 0, 0))
+        self.op.StlFile = ""
+        self.op.Model = wire
+        self.assertFails("has no faces")
+
+    def test_prepare_model_errors(self) -> None:
+        with self.assertRaises(TmmError) as ctx:
+            jobs.prepare_model(self.doc, OUT / "missing.stl")
+        self.assertIn("STL file not found", str(ctx.exception))
+        with self.assertRaises(TmmError):
+            jobs.prepare_model(self.doc, 42)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,81 @@
+"""FreeCAD ToolBits -> core cutters: endmill, ballend, bullnose (0.20's FlatRadius), others refused."""
+from __future__ import annotations
+
+import unittest
+from pathlib import Path
+
+import FreeCAD
+import Path as FCPath
+
+from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
+from tmm_workbench.app import job as jobs
+from tmm_workbench.app.compat import PathToolBit
+from tmm_workbench.app.tools import cutter_from_tool, shape_name
+from tmm_workbench.core.errors import TmmError
+
+BITS = Path(FreeCAD.getHomePath()) / "Mod" / "Path" / "Tools" / "Bit"
+
+
+def stock_bit(doc, file_name: str):
+    """One of the ToolBits FreeCAD ships (Mod/Path/Tools/Bit/*.fctb)."""
+    FreeCAD.setActiveDocument(doc.Name)
+    return PathToolBit.Factory.CreateFrom(str(BITS / file_name))
+
+
+class ToolMapping(FreeCADTestCase):
+    def test_stock_bits(self) -> None:
+        doc = new_doc()
+        flat = cutter_from_tool(stock_bit(doc, "5mm_Endmill.fctb"))
+        self.assertEqual((flat.kind, flat.diameter, flat.corner_radius), ("flat", 5.0, 0.0))
+        ball = cutter_from_tool(stock_bit(doc, "6mm_Ball_End.fctb"))
+        self.assertEqual((ball.kind, ball.diameter, ball.corner_radius), ("ball", 6.0, 3.0))
+        # 0.20's bullnose stores the flat bottom's radius (1.5 of 3): the corner radius is 3 - 1.5
+        bull = cutter_from_tool(stock_bit(doc, "6mm_Bullnose.fctb"))
+        self.assertEqual((bull.kind, bull.diameter, bull.corner_radius), ("bull", 6.0, 1.5))
+
+    def test_made_bits(self) -> None:
+        doc = new_doc()
+        bit = jobs.make_tool_bit(doc, "bullnose", 10.0, 2.0)
+        self.assertEqual(shape_name(bit), "bullnose")
+        self.assertAlmostEqual(bit.FlatRadius.Value, 3.0)
+        c = cutter_from_tool(bit)
+        self.assertEqual((c.kind, c.diameter, c.corner_radius), ("bull", 10.0, 2.0))
+        c = cutter_from_tool(jobs.make_tool_bit(doc, "endmill", 3.175))
+        self.assertEqual((c.kind, c.diameter), ("flat", 3.175))
+
+    def test_other_shapes_are_refused_by_name(self) -> None:
+        doc = new_doc()
+        for file_name, shape in (("45degree_chamfer.fctb", "chamfer"), ("60degree_Vbit.fctb", "v-bit"),
+                                 ("5mm_Drill.fctb", "drill")):
+            with self.assertRaises(TmmError) as ctx:
+                cutter_from_tool(stock_bit(doc, file_name))
+            self.assertIn(f"'{shape}'", str(ctx.exception))
+            self.assertIn("ballend", str(ctx.exception))
+
+    def test_legacy_tools(self) -> None:
+        t = FCPath.Tool()
+        t.Diameter, t.ToolType = 8.0, "BallEndMill"
+        self.assertEqual(cutter_from_tool(t).kind, "ball")
+        t.ToolType, t.CornerRadius = "EndMill", 1.0
+        c = cutter_from_tool(t)
+        self.assertEqual((c.kind, c.corner_radius), ("bull", 1.0))
+        t.ToolType = "Drill"
+        self.assertRaises(TmmError, cutter_from_tool, t)
+
+    def test_op_with_a_vbit_fails_clearly(self) -> None:
+        doc = new_doc()
+        job, tc, op = job_with_op(doc, str(bump_stl()))
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertTrue(op.Proxy.isToolSupported(op, tc.Tool))
+        vbit = stock_bit(doc, "60degree_Vbit.fctb")
+        self.assertFalse(op.Proxy.isToolSupported(op, vbit))
+        tc.Tool = vbit
+        op.touch()
+        doc.recompute()
+        self.assertFalse(op.isValid())
+        self.assertIn("'v-bit'", op.getStatusString())
+        self.assertEqual(len(op.Path.Commands), 0)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,146 @@
+"""GUI smoke test, run by FreeCAD itself: `xvfb-run -a freecad tests/gui/gui_smoke.py`.
+
+FreeCAD starts, the TMM workbench activates (TMM and Path commands registered), the API makes a Job
+with a TMM Surface op, the TMM Surface command adds a second op and opens its task panel, the main
+window (with the 3D view rendered offscreen) is grabbed into a PNG; then a document saved headless
+(env TMM_GUI_REOPEN, made by make_headless_doc.py) is reopened and its op's panel opens; the GUI
+progress dialog reports a Cancel; FreeCAD quits. The outcome goes to env TMM_GUI_RESULT (a JSON file)
+and the exit code (os._exit: the GUI would otherwise swallow SystemExit). Screenshot: env
+TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
+"""
+import json
+import os
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtCore, QtGui
+
+ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
+PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui_smoke.png")
+RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_smoke.json")
+STL = os.environ.get("TMM_GUI_STL") or "/work/shared/benchmarks/stl/sphere_on_plate.stl"
+
+
+def pump(seconds: float) -> None:
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+        time.sleep(0.02)
+
+
+def find_panel() -> QtGui.QWidget:
+    for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, "TmmSurfaceOpPage"):
+        if w.isVisible():
+            return w
+    raise AssertionError("the TMM Surface task panel page is not visible")
+
+
+def smoke() -> dict:
+    info: dict = {}
+    if str(ROOT) not in sys.path:
+        sys.path.insert(0, str(ROOT))
+    FreeCADGui.activateWorkbench("TMMWorkbench")
+    pump(0.5)
+    info["workbench"] = FreeCADGui.activeWorkbench().name()
+    assert info["workbench"] == "TMMWorkbench", info["workbench"]
+    from tmm_workbench.gui import workbench
+
+    commands = set(FreeCADGui.listCommands())
+    for cmd in ["Path_TMM_Surface", "TMM_JobFromModel"] + workbench.PATH_JOB_TOOLS + workbench.PATH_TOOL_TOOLS:
+        assert cmd in commands, f"command {cmd} missing"
+
+    from tmm_workbench.app.api import run_surface
+    from tmm_workbench.gui.op_surface_gui import ViewProvider
+
+    r = run_surface(STL, stepover=2.0, sample_step=1.0, doc_name="TmmGuiSmoke", progress=True)
+    info["api_moves"] = len(r.toolpath)
+    assert isinstance(r.op.ViewObject.Proxy, ViewProvider), "API op lacks the TMM view provider"
+    assert Path(r.op.ViewObject.Proxy.getIcon()).is_file(), "the op's tree icon is not a file"
+    assert r.job.ViewObject.Proxy is not None, "API Job lacks PathJobGui's view provider"
+    r.job.ViewObject.Visibility = True
+    FreeCADGui.SendMsgToActiveView("ViewFit")
+    FreeCADGui.activeDocument().activeView().viewIsometric()
+
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.runCommand("Path_TMM_Surface")  # the op command: new op + its task panel
+    pump(1.5)
+    ops = [o for o in r.job.Operations.Group if o is not r.op]
+    assert ops, "the command made no op"
+    info["panel_open"] = FreeCADGui.Control.activeDialog()
+    assert info["panel_open"], "no task dialog open"
+    page = find_panel()
+    info["panel_step_over"] = page.findChild(QtGui.QWidget, "stepOver").property("rawValue")
+    mw = FreeCADGui.getMainWindow()
+    for dock in mw.findChildren(QtGui.QDockWidget):
+        if dock.isVisible() and dock.isAncestorOf(page):
+            mw.resizeDocks([dock], [430], QtCore.Qt.Horizontal)  # the whole panel in the picture
+    FreeCADGui.SendMsgToActiveView("ViewFit")
+    pump(1.0)
+
+    PNG.parent.mkdir(parents=True, exist_ok=True)
+    shot = mw.grab()
+    # the 3D view draws with OpenGL, which a widget grab misses under Xvfb: render it offscreen
+    # and paint it where the view is
+    view = mw.findChild(QtGui.QMdiArea).activeSubWindow().widget()
+    rect = QtCore.QRect(view.mapTo(mw, QtCore.QPoint(0, 0)), view.size())
+    png3d = PNG.with_name(PNG.stem + "_3d.png")
+    FreeCADGui.activeDocument().activeView().saveImage(str(png3d), rect.width(), rect.height(), "White")
+    painter = QtGui.QPainter(shot)
+    painter.drawImage(rect, QtGui.QImage(str(png3d)))
+    painter.end()
+    assert shot.save(str(PNG)), f"could not write {PNG}"
+    info["png"] = str(PNG)
+    FreeCADGui.Control.closeDialog()
+    pump(0.3)
+
+    reopen = os.environ.get("TMM_GUI_REOPEN")
+    if reopen:  # a document saved headless: op and Job get their view providers, the panel opens
+        doc = FreeCAD.openDocument(reopen)
+        op = doc.getObject("TMM_Surface")
+        assert op is not None and len(op.Path.Commands) > 10, "reopened op has no path"
+        assert isinstance(op.ViewObject.Proxy, ViewProvider), type(op.ViewObject.Proxy)
+        assert doc.getObject("Job").ViewObject.Proxy is not None, "reopened Job lacks a view provider"
+        op.ViewObject.Document.setEdit(op.ViewObject, 0)
+        pump(0.5)
+        info["reopened_panel"] = FreeCADGui.Control.activeDialog()
+        assert info["reopened_panel"], "no task panel for the reopened op"
+        FreeCADGui.Control.closeDialog()
+        FreeCAD.closeDocument(doc.Name)
+        pump(0.3)
+
+    # the GUI progress: a dialog with Cancel that turns into a False from the callback
+    from tmm_workbench.app import progress
+    from tmm_workbench.gui import progress_dialog
+
+    reporter = progress.reporter("smoke")
+    assert isinstance(reporter, progress_dialog.DialogProgress), type(reporter)
+    reporter.t0 -= 10  # as if the computation had run a while: the dialog shows
+    assert reporter(0.25) is True
+    reporter.dialog.cancel()
+    info["cancel_seen"] = reporter(0.5) is False
+    reporter.finish()
+    assert info["cancel_seen"], "cancel in the progress dialog was not reported"
+    return info
+
+
+def main() -> None:
+    code, info = 1, {}
+    try:
+        info = smoke()
+        code = 0
+    except BaseException:  # noqa: B902 - every failure must reach the exit code
+        info["error"] = traceback.format_exc()
+        sys.stderr.write(info["error"])
+    info["ok"] = code == 0
+    RESULT.parent.mkdir(parents=True, exist_ok=True)
+    RESULT.write_text(json.dumps(info, indent=1, default=str))
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)  # quit now: no save-changes dialog, a reliable exit code
+
+
+QtCore.QTimer.singleShot(500, main)  # run once the main window and its event loop are up

@@ -1,0 +1,49 @@
+"""GUI smoke test: FreeCAD under Xvfb runs tests/gui/gui_smoke.py (workbench, Job, op, task panel,
+screenshot) and must exit 0 within the time limit, leaving a non-blank PNG."""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.freecad import fc_process
+
+HERE = Path(__file__).resolve().parent
+PNG = fc_process.ROOT / "out" / "gui_smoke.png"
+FREECAD = fc_process.find("freecad", "FreeCAD")
+XVFB_RUN = fc_process.find("xvfb-run")
+TIMEOUT_S = 120
+
+
+@pytest.mark.skipif(FREECAD is None or XVFB_RUN is None, reason="needs freecad and xvfb-run")
+def test_gui_smoke(tmp_path: Path) -> None:
+    result, headless_doc = tmp_path / "gui_smoke.json", tmp_path / "headless.FCStd"
+    PNG.unlink(missing_ok=True)
+    freecadcmd = fc_process.find("freecadcmd", "FreeCADCmd")
+    if freecadcmd:  # a document saved without the GUI, for the GUI to reopen
+        code, out = fc_process.run([freecadcmd, str(HERE / "make_headless_doc.py")], cwd=tmp_path, timeout=120,
+                                   TMM_GUI_REOPEN=str(headless_doc))
+        assert code == 0 and headless_doc.is_file(), out
+    code, out = fc_process.run(
+        [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", FREECAD, str(HERE / "gui_smoke.py")],
+        cwd=tmp_path, timeout=TIMEOUT_S, TMM_GUI_PNG=str(PNG), TMM_GUI_RESULT=str(result),
+        TMM_GUI_REOPEN=str(headless_doc) if freecadcmd else "",
+        QTWEBENGINE_DISABLE_SANDBOX="1")  # FreeCAD's start page uses QtWebEngine, which refuses root
+    info = json.loads(result.read_text()) if result.is_file() else {}
+    assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
+    assert info["workbench"] == "TMMWorkbench" and info["panel_open"] and info["cancel_seen"]
+    assert info.get("reopened_panel") or not freecadcmd
+    assert PNG.is_file() and PNG.stat().st_size > 10_000
+    assert not _blank(PNG), "the screenshot is blank"
+
+
+def _blank(png: Path) -> bool:
+    """A blank grab has (almost) one colour; a window with a panel and a 3D view has many."""
+    try:
+        from PIL import Image
+    except ImportError:  # no Pillow: the size check above has to do
+        return False
+    with Image.open(png) as im:
+        colours = im.convert("RGB").resize((320, 256)).getcolors(maxcolors=1 << 16)
+    return colours is not None and len(colours) < 16

@@ -1,0 +1,210 @@
+"""'TMM 3-axis Surface': a Path operation that finishes a mesh (or a tessellated Part) with a
+drop-cutter raster computed by the TMM kernel.
+
+What is machined, first match wins:
+  1. `StlFile`: an STL file read by the core;
+  2. `Model`: a Mesh::Feature (its triangles) or a Part object (tessellated within `LinearDeflection`);
+  3. the Job's Model: Part solids are tessellated; TMM's stand-in boxes for meshes
+     (`model_proxy.ModelBounds`, 0.20 Jobs cannot hold meshes) are replaced by the mesh they stand for.
+
+The tool comes from the op's tool controller (`tools.cutter_from_tool`), feeds from ObjectOp.execute
+(mm/s in properties: `self.horizFeed` on cutting moves, `self.vertFeed` on plunges; rapids carry no F).
+Errors (TmmError, cancel, anything unexpected) never leave a partial path: the Path is emptied, the
+message goes to the report view and the op is marked invalid with that message (its status string).
+"""
+from __future__ import annotations
+
+import traceback
+from typing import Any, Optional
+
+import FreeCAD
+import Path
+
+from tmm_workbench.app import geometry, hooks, model_proxy, progress
+from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
+from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool, shape_name
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.mesh import TriMesh
+from tmm_workbench.core.surface3d import ONEWAY, ZIGZAG, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
+
+OP_NAME = "TMM_Surface"
+PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY}
+BOUNDARIES = ("Stock", "Model")
+
+# (type, name, group, tooltip)
+PROPERTIES: list[tuple[str, str, str, str]] = [
+    ("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
+    ("App::PropertyLink", "Model", "Model",
+     "Mesh or Part object to machine; empty: the Job's model"),
+    ("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+    ("App::PropertyEnumeration", "BoundaryShape", "Boundary",
+     "Area covered by the tool tip: the Stock's or the Model's XY bounding box"),
+    ("App::PropertyDistance", "BoundaryMargin", "Boundary",
+     "Grows (positive) or shrinks (negative) the boundary on every side"),
+    ("App::PropertyDistance", "StepOver", "Surface", "Distance between raster passes"),
+    ("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass"),
+    ("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X"),
+    ("App::PropertyEnumeration", "Pattern", "Surface",
+     "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes"),
+    ("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface"),
+]
+DEFAULTS: dict[str, Any] = {
+    "LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock", "BoundaryMargin": 0.0,
+    "StepOver": 1.0, "SampleStep": 0.5, "RasterAngle": 0.0, "Pattern": "ZigZag", "StockToLeave": 0.0,
+}
+ENUMERATIONS = {"BoundaryShape": list(BOUNDARIES), "Pattern": list(PATTERNS)}
+
+
+class ObjectTmmSurface(PathOp.ObjectOp):
+    """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
+
+    toolpath: Optional[Toolpath] = None
+    mesh: Optional[TriMesh] = None
+    progress_enabled: bool = True
+
+    def __init__(self, obj: Any, name: str, parentJob: Any = None,
+                 values: Optional[dict[str, Any]] = None) -> None:
+        # `values` are applied with the defaults, before ObjectOp's first recompute
+        self._initial_values = dict(values or {})
+        super().__init__(obj, name, parentJob)
+
+    def opFeatures(self, obj: Any) -> int:
+        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
+
+    def initOperation(self, obj: Any) -> None:
+        self._ensure_properties(obj, restoring=False)
+
+    def opOnDocumentRestored(self, obj: Any) -> None:
+        self._ensure_properties(obj, restoring=True)  # documents from older versions get new properties
+        # a document saved headless has no view providers for the op and its Job
+        hooks.attach_view("op", obj)
+        job = PathUtils.findParentJob(obj)
+        if job is not None:
+            hooks.attach_view("job", job)
+
+    def _ensure_properties(self, obj: Any, restoring: bool) -> None:
+        for typ, name, group, tip in PROPERTIES:
+            if not hasattr(obj, name):
+                obj.addProperty(typ, name, group, tip)
+                if name in ENUMERATIONS:
+                    setattr(obj, name, ENUMERATIONS[name])
+                if restoring and name in DEFAULTS:
+                    setattr(obj, name, DEFAULTS[name])
+
+    def opSetDefaultValues(self, obj: Any, job: Any) -> None:
+        for name, value in DEFAULTS.items():
+            setattr(obj, name, value)
+        for name, value in getattr(self, "_initial_values", {}).items():
+            obj.setExpression(name, None)  # a given value replaces the SetupSheet's expression
+            setattr(obj, name, value)
+        self._initial_values = {}
+
+    def isToolSupported(self, obj: Any, tool: Any) -> bool:
+        return shape_name(tool) in SUPPORTED_SHAPES
+
+    # --- computation -------------------------------------------------------------------------
+    def opExecute(self, obj: Any) -> None:
+        self.mesh = self.toolpath = None
+        try:
+            mesh = self.model_mesh(obj)
+            cutter = cutter_from_tool(self.tool)
+            params = self.surface_params(obj, mesh)
+            with progress.reporter(obj.Label, getattr(self, "progress_enabled", True)) as cb:
+                toolpath = compute_surface_toolpath(mesh, cutter, params, cb)
+        except Cancelled:
+            self._fail(obj, "tool path computation cancelled")
+        except TmmError as exc:
+            self._fail(obj, str(exc))
+        except Exception as exc:  # a kernel failure or a bug: report it, still no crash, no partial path
+            FreeCAD.Console.PrintLog(traceback.format_exc())
+            self._fail(obj, f"unexpected {type(exc).__name__}: {exc}")
+        else:
+            self.mesh, self.toolpath = mesh, toolpath
+            self.commandlist.extend(self.commands(toolpath))
+
+    def _fail(self, obj: Any, message: str) -> None:
+        """Empty Path, message in the report view, and an exception: FreeCAD marks the op invalid
+        and keeps the message as its status (tree tooltip, `obj.getStatusString()`)."""
+        self.commandlist = []
+        obj.Path = Path.Path()
+        FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
+        raise TmmError(message) from None
+
+    def model_mesh(self, obj: Any) -> TriMesh:
+        deflection = obj.LinearDeflection.Value
+        if obj.StlFile:
+            return geometry.mesh_from_stl(obj.StlFile)
+        if obj.Model is not None:
+            return _mesh_of(obj.Model, deflection)
+        models = list(self.model or [])
+        if not models:
+            raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
+        return geometry.combine([_mesh_of(m, deflection) for m in models])
+
+    def boundary(self, obj: Any, mesh: TriMesh) -> tuple[float, float, float, float]:
+        if obj.BoundaryShape == "Stock":
+            if self.stock is None or self.stock.Shape.isNull():
+                raise TmmError("boundary 'Stock': the Job has no stock")
+            bb = self.stock.Shape.BoundBox
+            x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
+        else:
+            lo, hi = mesh.bounds
+            x0, y0, x1, y1 = float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+        m = obj.BoundaryMargin.Value
+        return (x0 - m, y0 - m, x1 + m, y1 + m)
+
+    def surface_params(self, obj: Any, mesh: TriMesh) -> SurfaceParams:
+        return SurfaceParams(
+            boundary=self.boundary(obj, mesh),
+            stepover=obj.StepOver.Value,
+            sample_step=obj.SampleStep.Value,
+            safe_height=obj.SafeHeight.Value,
+            clearance_height=obj.ClearanceHeight.Value,
+            angle_deg=obj.RasterAngle.Value,
+            pattern=PATTERNS[obj.Pattern],
+            stock_to_leave=obj.StockToLeave.Value,
+        )
+
+    def commands(self, toolpath: Toolpath) -> list[Any]:
+        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and the
+        horizontal feed for cutting moves."""
+        feed = {MoveKind.PLUNGE: self.vertFeed, MoveKind.FEED: self.horizFeed}
+        out = []
+        for m in toolpath:
+            if m.kind is MoveKind.RAPID:
+                out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
+            else:
+                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed[m.kind]}))
+        return out
+
+
+def _mesh_of(obj: Any, deflection: float) -> TriMesh:
+    """The mesh to machine for a model object; TMM's stand-in boxes give what they stand for."""
+    source = model_proxy.source_of(obj)
+    if source is None:
+        return geometry.mesh_from_object(obj, deflection)
+    if isinstance(source, str):
+        return geometry.mesh_from_stl(source)
+    return geometry.mesh_from_object(source, deflection)
+
+
+def SetupProperties() -> list[str]:
+    """Properties the Job's SetupSheet may hold defaults for."""
+    return [name for _, name, _, _ in PROPERTIES if name not in ("StlFile", "Model")]
+
+
+def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
+           values: Optional[dict[str, Any]] = None) -> Any:
+    """A new op in `parentJob` (or the only Job of the active document), with property `values`."""
+    if obj is None:
+        doc = parentJob.Document if parentJob is not None else FreeCAD.ActiveDocument
+        obj = doc.addObject("Path::FeaturePython", name)
+    obj.Proxy = ObjectTmmSurface(obj, name, parentJob, values)
+    if obj.Proxy is not None:  # not for the SetupSheet's prototypes
+        hooks.attach_view("op", obj)
+    return obj
+
+
+# Lets the Job's SetupSheet hold defaults for this op, headless too (the GUI's SetupOperation repeats it).
+PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)
