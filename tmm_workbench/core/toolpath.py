@@ -1,4 +1,8 @@
-"""The toolpath model: ordered moves of the tool tip, before any FreeCAD or G-code concern."""
+"""The toolpath model: ordered moves of the tool tip and tool axis, before any FreeCAD or G-code concern.
+
+A move's position is the tool tip (the CL point of seed 000) in work coordinates, mm; its axis is the unit
+vector from the tip towards the spindle, (0, 0, 1) for 3-axis work.
+"""
 from __future__ import annotations
 
 import enum
@@ -14,12 +18,16 @@ class MoveKind(enum.Enum):
     FEED = "feed"      # G1 at the horizontal feed, cutting
 
 
+Z_AXIS = (0.0, 0.0, 1.0)
+
+
 @dataclass(frozen=True)
 class Move:
     kind: MoveKind
     x: float
     y: float
     z: float
+    axis: tuple[float, float, float] = Z_AXIS
 
 
 @dataclass
@@ -32,12 +40,21 @@ class Toolpath:
     def __len__(self) -> int:
         return len(self.moves)
 
-    def add(self, kind: MoveKind, x: float, y: float, z: float) -> None:
-        self.moves.append(Move(kind, float(x), float(y), float(z)))
+    def add(self, kind: MoveKind, x: float, y: float, z: float,
+            axis: tuple[float, float, float] = Z_AXIS) -> None:
+        self.moves.append(Move(kind, float(x), float(y), float(z),
+                               (float(axis[0]), float(axis[1]), float(axis[2]))))
 
     def points(self) -> np.ndarray:
         """Tip positions as an (n, 3) array."""
         return np.array([(m.x, m.y, m.z) for m in self.moves], dtype=float).reshape(-1, 3)
+
+    def axes(self) -> np.ndarray:
+        """Tool axes as an (n, 3) array."""
+        return np.array([m.axis for m in self.moves], dtype=float).reshape(-1, 3)
+
+    def is_five_axis(self) -> bool:
+        return any(m.axis != Z_AXIS for m in self.moves)
 
     def cutting_points(self) -> np.ndarray:
         """Tip positions of FEED and PLUNGE moves, (n, 3)."""
