@@ -1,0 +1,96 @@
+"""Indexed triangle meshes for the kernel: float64 vertices (n, 3), int32 triangles (m, 3)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from .errors import TmmError
+from .kernel import native
+
+WELD_TOLERANCE_MM = 1e-6
+NORMAL_WEIGHTINGS = ("angle", "area", "meyer")
+
+
+class TriMesh:
+    """An indexed triangle mesh. Construction validates shapes, indices and finiteness.
+
+    `degenerate_removed` counts the triangles dropped as degenerate when the mesh was welded from a
+    triangle soup (0 for a mesh built from vertices and triangles)."""
+
+    def __init__(self, vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -> None:
+        v = np.ascontiguousarray(vertices, dtype=np.float64)
+        f = np.ascontiguousarray(triangles, dtype=np.int32)
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise TmmError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3:
+            raise TmmError(f"{name}: triangles must have shape (m, 3), got {f.shape}")
+        if len(f) == 0:
+            raise TmmError(f"{name}: the mesh has no triangles")
+        bad = ~np.isfinite(v).all(axis=1)
+        if bad.any():
+            raise TmmError(f"{name}: vertex {int(np.argmax(bad))} has a non-finite coordinate "
+                           f"{v[int(np.argmax(bad))].tolist()}")
+        if f.min() < 0 or f.max() >= len(v):
+            raise TmmError(f"{name}: triangle indices out of range 0..{len(v) - 1}")
+        self.vertices = v
+        self.triangles = f
+        self.name = name
+        self.degenerate_removed = 0
+
+    @classmethod
+    def from_corners(cls, corners: np.ndarray, name: str = "mesh",
+                     weld_tolerance: float = WELD_TOLERANCE_MM) -> "TriMesh":
+        """From a triangle soup (m, 3, 3): corners welded within `weld_tolerance` mm; triangles that become
+        degenerate (a repeated vertex or zero area) are dropped and counted in `degenerate_removed`."""
+        c = np.ascontiguousarray(corners, dtype=np.float64)
+        if c.ndim != 3 or c.shape[1:] != (3, 3):
+            raise TmmError(f"{name}: triangle corners must have shape (m, 3, 3), got {c.shape}")
+        if len(c) == 0:
+            raise TmmError(f"{name}: the mesh has no triangles")
+        try:  # the kernel also rejects non-finite corners, naming the triangle
+            v, f, removed = native.weld(c.reshape(-1, 9), float(weld_tolerance))
+        except ValueError as exc:
+            raise TmmError(f"{name}: {exc}") from exc
+        mesh = cls(v, f, name)
+        mesh.degenerate_removed = int(removed)
+        return mesh
+
+    def face_normals(self) -> np.ndarray:
+        """Unit normal (m, 3) of each triangle, from its winding; zero for a zero-area triangle."""
+        return native.face_normals(self.vertices, self.triangles)
+
+    def vertex_normals(self, weighting: str = "angle") -> np.ndarray:
+        """Unit normal (n, 3) of each vertex; `weighting` is one of NORMAL_WEIGHTINGS (seed 000, 3.2)."""
+        if weighting not in NORMAL_WEIGHTINGS:
+            raise TmmError(f"{self.name}: unknown vertex normal weighting {weighting!r} "
+                           f"(allowed: {', '.join(NORMAL_WEIGHTINGS)})")
+        return native.vertex_normals(self.vertices, self.triangles, weighting)
+
+    def adjacency(self) -> np.ndarray:
+        """(m, 3) int32: the triangle across edge i = (t[i], t[(i + 1) % 3]) of each triangle t, or -1 for a
+        boundary or non-manifold edge."""
+        return native.triangle_adjacency(self.triangles)
+
+    @property
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.vertices.min(axis=0), self.vertices.max(axis=0)
+
+    def __len__(self) -> int:
+        return len(self.triangles)
+
+    def __repr__(self) -> str:
+        return f"TriMesh({self.name!r}, {len(self.vertices)} vertices, {len(self.triangles)} triangles)"
+
+
+def load_stl(path: str | Path, weld_tolerance: float = WELD_TOLERANCE_MM) -> TriMesh:
+    """Read an ASCII or binary STL file (detected by content) into a welded mesh.
+
+    A missing, empty, truncated or garbled file raises TmmError naming the file and the line (ASCII) or
+    triangle (binary) where it is wrong."""
+    p = Path(path)
+    try:
+        soup = native.read_stl(str(p))
+    except (ValueError, RuntimeError) as exc:  # native.StlError is a ValueError
+        raise TmmError(str(exc)) from exc
+    return TriMesh.from_corners(soup.reshape(-1, 3, 3), name=p.name, weld_tolerance=weld_tolerance)
