@@ -36,7 +36,7 @@ class BadInput(FreeCADTestCase):
 
     def test_missing_stl(self) -> None:
         self.op.StlFile = str(OUT / "no_such_file.stl")
-        self.assertFails("STL file not found", "no_such_file.stl")
+        self.assertFails("file not found", "no_such_file.stl")
         self.recovers()
 
     def test_empty_stl(self) -> None:
@@ -99,7 +99,7 @@ class BadInput(FreeCADTestCase):
     def test_prepare_model_errors(self) -> None:
         with self.assertRaises(TmmError) as ctx:
             jobs.prepare_model(self.doc, OUT / "missing.stl")
-        self.assertIn("STL file not found", str(ctx.exception))
+        self.assertIn("file not found", str(ctx.exception))
         with self.assertRaises(TmmError):
             jobs.prepare_model(self.doc, 42)
 

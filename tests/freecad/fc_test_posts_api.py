@@ -187,7 +187,7 @@ class Api(FreeCADTestCase):
     def test_bad_arguments(self) -> None:
         with self.assertRaises(TmmError) as ctx:
             run_surface(OUT / "nowhere.stl")
-        self.assertIn("STL file not found", str(ctx.exception))
+        self.assertIn("file not found", str(ctx.exception))
         for kwargs, text in (({"tool": "chamfer"}, "tool must be one of"), ({"pattern": "spiral"}, "pattern"),
                              ({"boundary": "custom"}, "boundary"),
                              ({"tool": "bullnose", "corner_radius": 4.0}, "larger than the tool radius"),

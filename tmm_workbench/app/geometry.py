@@ -26,7 +26,7 @@ def mesh_from_stl(path: str | os.PathLike) -> TriMesh:
     if not str(path).strip():
         raise TmmError("no STL file given")
     if not p.is_file():
-        raise TmmError(f"STL file not found: {p}")
+        return load_stl(p)  # the kernel names what is wrong: not found, a directory, ...
     st = p.stat()
     key = (str(p.resolve()), st.st_mtime_ns, st.st_size)
     mesh = _stl_cache.get(key)

@@ -1,0 +1,193 @@
+"""TMM's main job, headless: three models finished with a 3-axis surface raster.
+
+    freecadcmd scripts/demo.py            # G-code (.ngc), FreeCAD document (.FCStd) and picture (.png)
+    /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
+
+Inputs: the OpenCAMLib meshes sphere_on_plate.stl (ball cutter) and mount_rush.stl (bull-nose cutter)
+from ../shared/benchmarks/stl, and the convex bicubic Bézier patch of seed 001 tessellated (the seed's
+toroidal cutter). Output folder: $TMM_OUT, default <repo>/out. Exit code 1 on any failure (freecadcmd
+itself returns 0 even when a script raises, so the script exits explicitly).
+"""
+from __future__ import annotations
+
+import os
+import sys
+import time
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+# freecadcmd runs this file with __name__ == "demo" (the file's stem) and sets __file__.
+REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[1]
+BENCH = REPO.parent / "shared" / "benchmarks"
+BEZIER_TOLERANCE_MM = 0.01  # chordal tolerance of the patch tessellation
+
+
+@dataclass
+class Case:
+    name: str
+    what: str                                            # shown in the table and the picture title
+    model: str = ""                                      # STL path (filled in for the Bézier patch)
+    params: dict[str, Any] = field(default_factory=dict)  # keyword arguments of run_surface
+
+
+def cases(out: Path) -> list[Case]:
+    """One case per input, parameters chosen from each model's size (mm) for a ~1 minute demo."""
+    return [
+        # 76 x 76 x 32 mm: a half sphere on a plate; ball D6, 0.5 mm step-over (scallop ~0.01 mm).
+        Case("sphere_on_plate", "sphere_on_plate.stl", str(BENCH / "stl" / "sphere_on_plate.stl"),
+             dict(tool="ballend", diameter=6.0, stepover=0.5, sample_step=0.25, angle_deg=0.0)),
+        # 86 x 43 x 27 mm relief: small bull-nose for the faces' detail, passes along the long side.
+        Case("mount_rush", "mount_rush.stl", str(BENCH / "stl" / "mount_rush.stl"),
+             dict(tool="bullnose", diameter=4.0, corner_radius=1.0, stepover=0.3, sample_step=0.2,
+                  angle_deg=0.0)),
+        # 150 x 150 mm patch: seed 001's toroidal cutter (Ro 6.7 + Ri 6.0 -> D25.4 r6), feed along Y
+        # as in the paper; a 3-axis step-over (scallop ~0.02 mm) instead of the paper's 5-axis 18 mm.
+        Case("bezier_convex", f"seed 001 convex Bezier, tol {BEZIER_TOLERANCE_MM:g} mm", "",
+             dict(tool="bullnose", diameter=25.4, corner_radius=6.0, stepover=1.0, sample_step=0.5,
+                  angle_deg=90.0)),
+    ]
+
+
+def write_binary_stl(vertices, triangles, path: Path, name: str = "tmm") -> None:
+    """A binary STL (facet normals from the corners) - enough for FreeCAD and any CAM reader."""
+    import numpy as np
+
+    c = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles)]
+    n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    rec = np.zeros(len(c), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
+    rec["n"], rec["v"] = n, c
+    with open(path, "wb") as fh:
+        fh.write(name.encode("ascii", "replace")[:80].ljust(80, b" "))
+        fh.write(np.uint32(len(rec)).tobytes())
+        fh.write(rec.tobytes())
+
+
+def bezier_stl(out: Path) -> Path:
+    from tmm_workbench.core import bezier
+
+    net = bezier.load_seed_patch(BENCH / "seed_surfaces.json", "convex")
+    mesh = bezier.tessellate_to_tolerance(net, BEZIER_TOLERANCE_MM, name="bezier_convex")
+    path = out / "bezier_convex.stl"
+    write_binary_stl(mesh.vertices, mesh.triangles, path, "TMM seed 001 convex Bezier patch (mm)")
+    return path
+
+
+def run_freecad(case: Case, out: Path) -> dict[str, Any]:
+    """The headless API: Job, operation, G-code and document, as a macro would do it."""
+    import FreeCAD
+    from tmm_workbench.app.api import run_surface
+
+    t0 = time.perf_counter()
+    res = run_surface(case.model, gcode_path=str(out / f"{case.name}.ngc"),
+                      fcstd_path=str(out / f"{case.name}.FCStd"), doc_name=case.name, **case.params)
+    dt = time.perf_counter() - t0
+    row = dict(mesh=res.mesh, toolpath=res.toolpath, seconds=dt,
+               files=[out / f"{case.name}.ngc", out / f"{case.name}.FCStd"])
+    try:
+        FreeCAD.closeDocument(res.doc.Name)  # saved already; keep memory flat across cases
+    except Exception:  # noqa: BLE001 - closing is a courtesy, never a failure
+        pass
+    return row
+
+
+def run_core(case: Case, out: Path) -> dict[str, Any]:
+    """Without FreeCAD: the same raster from the core, for the picture only."""
+    from tmm_workbench.core.cutters import Cutter
+    from tmm_workbench.core.mesh import load_stl
+    from tmm_workbench.core.surface3d import SurfaceParams, compute_surface_toolpath
+
+    p = case.params
+    cutter = {"ballend": lambda: Cutter.ball(p["diameter"]),
+              "endmill": lambda: Cutter.flat(p["diameter"]),
+              "bullnose": lambda: Cutter.bull(p["diameter"], p["corner_radius"])}[p["tool"]]()
+    t0 = time.perf_counter()
+    mesh = load_stl(case.model)
+    lo, hi = mesh.bounds
+    params = SurfaceParams(boundary=(lo[0], lo[1], hi[0], hi[1]), stepover=p["stepover"],
+                           sample_step=p["sample_step"], safe_height=float(hi[2]) + 5,
+                           clearance_height=float(hi[2]) + 15, angle_deg=p.get("angle_deg", 0.0))
+    tp = compute_surface_toolpath(mesh, cutter, params)
+    return dict(mesh=mesh, toolpath=tp, seconds=time.perf_counter() - t0, files=[])
+
+
+def describe_tool(p: dict[str, Any]) -> str:
+    if p["tool"] == "ballend":
+        return f"ball D{p['diameter']:g}"
+    if p["tool"] == "bullnose":
+        return f"bull-nose D{p['diameter']:g} r{p['corner_radius']:g}"
+    return f"{p['tool']} D{p['diameter']:g}"
+
+
+def main() -> None:
+    sys.path.insert(0, str(REPO))
+    from tmm_workbench.core.preview import path_statistics, render_toolpath_png
+
+    out = Path(os.environ.get("TMM_OUT") or REPO / "out").resolve()
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        import FreeCAD
+        with_freecad = True
+        mode = "FreeCAD " + ".".join(FreeCAD.Version()[:3])
+    except ImportError:
+        with_freecad = False
+        mode = "core only (no FreeCAD: pictures, no G-code)"
+    print(f"TMM demo with {mode}; output in {out}", flush=True)
+
+    rows = []
+    t_all = time.perf_counter()
+    for case in cases(out):
+        written = []
+        if not case.model:
+            case.model = str(bezier_stl(out))
+            written.append(Path(case.model))
+        print(f"--- {case.name}: {case.what}, {describe_tool(case.params)}, step-over "
+              f"{case.params['stepover']:g} mm", flush=True)
+        row = (run_freecad if with_freecad else run_core)(case, out)
+        stats = path_statistics(row["toolpath"])
+        png = out / f"{case.name}.png"
+        t0 = time.perf_counter()
+        p = case.params
+        render_toolpath_png(row["mesh"], row["toolpath"], str(png),
+                            title=f"TMM 3-axis surface: {case.what} - {describe_tool(p)}, step-over "
+                                  f"{p['stepover']:g} mm, sample {p['sample_step']:g} mm, "
+                                  f"angle {p.get('angle_deg', 0):g} deg")
+        row["files"] = written + row["files"]
+        row.update(name=case.name, png=png, png_seconds=time.perf_counter() - t0, stats=stats,
+                   tool=describe_tool(p))
+        rows.append(row)
+
+    print_table(rows, time.perf_counter() - t_all)
+
+
+def print_table(rows: list[dict[str, Any]], total: float) -> None:
+    head = f"{'case':<16} {'tool':<20} {'triangles':>9} {'CL points':>9} {'cut mm':>9} {'rapids':>6} " \
+           f"{'compute s':>9} {'png s':>6}"
+    print("\n" + head)
+    print("-" * len(head))
+    for r in rows:
+        s = r["stats"]
+        print(f"{r['name']:<16} {r['tool']:<20} {len(r['mesh'].triangles):>9} "
+              f"{s['feed_count'] + s['plunge_count']:>9} {s['cutting_length']:>9.0f} {s['rapid_count']:>6} "
+              f"{r['seconds']:>9.2f} {r['png_seconds']:>6.2f}")
+    print("\nwritten:")
+    for r in rows:
+        for f in [*r["files"], r["png"]]:
+            size = f.stat().st_size if f.exists() else -1
+            print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print(f"total {total:.1f} s", flush=True)
+
+
+def _entry() -> None:
+    try:
+        main()
+    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
+        traceback.print_exc()
+        sys.stdout.flush()
+        raise SystemExit(1)
+
+
+if __name__ in ("__main__", "demo"):
+    _entry()
