@@ -90,7 +90,7 @@ def run_case(mesh, surf, index, name, R, r, make_ocl, xy, threads, ocl_budget_s,
     best = np.inf
     for _ in range(reps):
         t0 = time.perf_counter()
-        z, stats = native.drop_cutter_stats(index, R, r, xy, zmin, threads)
+        z, stats = native.drop_cutter_stats(index, native.Cutter(R, r), xy, zmin, threads)
         best = min(best, time.perf_counter() - t0)
     ours_pps = len(xy) / best
     tested = stats["triangles_tested"] / len(xy)

@@ -11,7 +11,7 @@ double facet_drop(const Cutter& c, double x, double y, const double* p0, const d
   const double nxy = std::sqrt(n[0] * n[0] + n[1] * n[1]);
   double cx = x, cy = y, rho = 0.0;
   if (nxy > 1e-15) {
-    rho = c.facet_contact_radius(nxy);
+    rho = c.facet_contact_radius(nxy, nz);
     cx -= rho * n[0] / nxy;  // uphill: the plane rises against n_xy
     cy -= rho * n[1] / nxy;
   }
@@ -36,28 +36,28 @@ double facet_drop(const Cutter& c, double x, double y, const double* p0, const d
 
 namespace {
 
-// Maximum of g(u) = z0 + m u - h(sqrt(d2 + u^2)) on [lo, hi] for the torus profile. g is concave, so
-// g' = m - u h'(rho) / rho decreases: the maximum is at an end or at the root of g'.
-double torus_edge_max(const Cutter& c, double d2, double z0, double m, double lo, double hi) {
+// Maximum of g(u) = z0 + m u - h(sqrt(d2 + u^2)) on [lo, hi] for any convex non-decreasing profile h.
+// g is concave, so g' = m - u h'(rho) / rho decreases: the maximum is at an end or at the root of g'
+// (at rho = 0 a cone's kink makes g' jump; the subgradient m is used there and bisection converges).
+double profile_edge_max(const Cutter& c, double d2, double z0, double m, double lo, double hi) {
   auto g = [&](double u) { return z0 + m * u - c.height(std::sqrt(d2 + u * u)); };
   auto dg = [&](double u) {
     const double rho = std::sqrt(d2 + u * u);
-    if (rho <= c.flat_radius()) return m;
+    if (rho == 0.0) return m;
     return m - u * c.slope(rho) / rho;
   };
-  const double glo = dg(lo), ghi = dg(hi);
-  if (!(glo > 0)) return g(lo);
-  if (!(ghi < 0)) return g(hi);
+  if (!(dg(lo) > 0)) return g(lo);
+  if (!(dg(hi) < 0)) return g(hi);
   double a = lo, b = hi;
   double u = 0.5 * (a + b);
-  for (int it = 0; it < 100 && b - a > 1e-12; ++it) {
+  for (int it = 0; it < 200 && b - a > 1e-12; ++it) {
     const double du = dg(u);
     if (du > 0) a = u; else b = u;
     if (du == 0) break;
     // Newton step on g' with g'' = -(h'' (u/rho)^2 + h' d^2 / rho^3); bisect when it leaves (a, b).
     const double rho = std::sqrt(d2 + u * u);
     double next = 0.5 * (a + b);
-    if (rho > c.flat_radius()) {
+    if (rho > 0.0) {
       const double d2g = -(c.curvature(rho) * u * u / (rho * rho) + c.slope(rho) * d2 / (rho * rho * rho));
       if (d2g < 0 && std::isfinite(d2g)) {
         const double newton = u - du / d2g;
@@ -75,7 +75,7 @@ double torus_edge_max(const Cutter& c, double d2, double z0, double m, double lo
 double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2) {
   const double ex = p2[0] - p1[0], ey = p2[1] - p1[1];
   const double L = std::sqrt(ex * ex + ey * ey);
-  const double R = c.radius();
+  const double R = c.max_radius();
   if (L < 1e-12) {  // vertical edge: its top vertex is the contact
     return std::max(vertex_drop(c, x, y, p1), vertex_drop(c, x, y, p2));
   }
@@ -98,7 +98,8 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
       return z0 + m * u - R + std::sqrt(std::fmax(s * s - u * u, 0.0));
     }
     case CutterKind::Bull:
-      return torus_edge_max(c, d2, z0, m, lo, hi);
+    case CutterKind::General:
+      return profile_edge_max(c, d2, z0, m, lo, hi);
   }
   return kNoContact;
 }

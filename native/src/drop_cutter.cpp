@@ -33,7 +33,7 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
     }
   }
   const int32_t skip = winner;
-  index.walk(x, y, cutter.radius(), best, [&cutter](double rho) { return cutter.height(rho); },
+  index.walk(x, y, cutter.max_radius(), best, [&cutter](double rho) { return cutter.height(rho); },
              [&](const IndexedTriangle& t, int32_t i) {
                if (i == skip) return;
                ++tested;

@@ -99,7 +99,11 @@ def test_bad_inputs_give_clear_errors(wavy_mesh):
     with pytest.raises(TmmError, match="diameter"):
         Cutter.ball(0.0)
     with pytest.raises(ValueError, match="corner radius"):
-        native.drop_cutter(surface._index, 1.0, 2.0, np.zeros((1, 2)), 0.0)
+        native.Cutter(1.0, 2.0)
+    with pytest.raises(TmmError, match="taper angle beta2 must be in"):
+        Cutter(6.0, 0.0, 0.0, 95.0, 10.0)
+    with pytest.raises(TmmError, match="stock to leave is not supported"):
+        Cutter.vbit(6.0, 90.0).offset(0.2)
     with pytest.raises(ValueError, match="outside"):
         native.MeshIndex(np.zeros((3, 3)), np.array([[0, 1, 5]], dtype=np.int32))
     with pytest.raises(ValueError, match="non-finite"):

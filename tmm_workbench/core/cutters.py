@@ -1,6 +1,9 @@
-"""Cutters as the kernel sees them: convex solids of revolution given by diameter and corner radius.
+"""Cutters as the kernel sees them: convex solids of revolution, the generalized APT cutter of seed 000
+(section 3.5.2.2): diameter 2R at the cutting-edge height L_C, corner radius r, bottom angle beta1 (from the
+horizontal) and taper angle beta2 (from the axis, positive when the side widens upwards).
 
-ball: corner_radius == diameter / 2; flat (cylindrical): corner_radius == 0; bull-nose (toroidal): in between.
+ball: r = R; flat (cylindrical): r = 0; bull-nose (toroidal): 0 < r < R; all with beta1 = beta2 = 0.
+V-bits and chamfers: r = 0 with a bottom cone (beta1) or a taper (beta2); tapered ball and bull: beta2 > 0.
 """
 from __future__ import annotations
 
@@ -8,22 +11,43 @@ import math
 from dataclasses import dataclass
 
 from .errors import TmmError
+from .kernel import native
+
+
+def _number(name: str, v: object) -> float:
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or math.isnan(v):
+        raise TmmError(f"cutter {name} must be a number, got {v!r}")
+    return float(v)
 
 
 @dataclass(frozen=True)
 class Cutter:
     diameter: float
     corner_radius: float = 0.0
+    bottom_angle_deg: float = 0.0     # beta1
+    taper_angle_deg: float = 0.0      # beta2
+    cutting_length: float = math.inf  # L_C; needed when the cutter has a cone or a taper
 
     def __post_init__(self) -> None:
-        d, r = self.diameter, self.corner_radius
-        if not (isinstance(d, (int, float)) and math.isfinite(d) and d > 0):
+        d = _number("diameter", self.diameter)
+        r = _number("corner radius", self.corner_radius)
+        if not (math.isfinite(d) and d > 0):
             raise TmmError(f"cutter diameter must be a positive finite number, got {d!r}")
-        if not (isinstance(r, (int, float)) and math.isfinite(r) and r >= 0):
+        if not (math.isfinite(r) and r >= 0):
             raise TmmError(f"cutter corner radius must be zero or positive, got {r!r}")
-        if r > d / 2 + 1e-12:
-            raise TmmError(
-                f"cutter corner radius {r:g} mm is larger than the cutter radius {d / 2:g} mm")
+        if self.is_plain and r > d / 2 + 1e-12:
+            raise TmmError(f"cutter corner radius {r:g} mm is larger than the cutter radius {d / 2:g} mm")
+        try:
+            object.__setattr__(self, "_native", self._make_native())
+        except ValueError as exc:
+            raise TmmError(f"impossible cutter {self.describe()}: {exc}") from exc
+
+    def _make_native(self) -> "native.Cutter":
+        if self.is_plain:
+            return native.Cutter(self.radius, self.corner_radius)
+        return native.Cutter.apt(self.radius, self.corner_radius, _number("cutting length", self.cutting_length),
+                                 math.radians(_number("bottom angle", self.bottom_angle_deg)),
+                                 math.radians(_number("taper angle", self.taper_angle_deg)))
 
     @classmethod
     def ball(cls, diameter: float) -> "Cutter":
@@ -37,17 +61,40 @@ class Cutter:
     def bull(cls, diameter: float, corner_radius: float) -> "Cutter":
         return cls(diameter, corner_radius)
 
+    @classmethod
+    def vbit(cls, diameter: float, included_angle_deg: float, tip_diameter: float = 0.0) -> "Cutter":
+        """A cone of `included_angle_deg` from a flat tip of `tip_diameter` up to `diameter`."""
+        half = _number("included angle", included_angle_deg) / 2
+        if not 0 < half < 90:
+            raise TmmError(f"V-bit included angle must be between 0 and 180 degrees, got {included_angle_deg!r}")
+        if not 0 <= tip_diameter < diameter:
+            raise TmmError(f"V-bit tip diameter {tip_diameter!r} must be at least 0 and below the diameter "
+                           f"{diameter!r}")
+        height = (diameter - tip_diameter) / 2 / math.tan(math.radians(half))
+        return cls(diameter, 0.0, 0.0, half, height)
+
     @property
     def radius(self) -> float:
         return self.diameter / 2
 
     @property
+    def is_plain(self) -> bool:
+        """Ball, flat or bull-nose: no cone, no taper."""
+        return self.bottom_angle_deg == 0 and self.taper_angle_deg == 0
+
+    @property
     def kind(self) -> str:
+        if not self.is_plain:
+            return "general"
         if self.corner_radius == 0:
             return "flat"
         if abs(self.corner_radius - self.radius) <= 1e-12:
             return "ball"
         return "bull"
+
+    @property
+    def native(self) -> "native.Cutter":
+        return self._native  # type: ignore[attr-defined]
 
     def offset(self, distance: float) -> "Cutter":
         """The cutter grown by `distance` all round. Its lower surface lies `distance` below this cutter's, so
@@ -55,12 +102,20 @@ class Cutter:
         mesh offset by `distance` (stock to leave)."""
         if distance == 0:
             return self
+        if not self.is_plain:
+            # The offset of a cone or taper is no longer an APT cutter (a cone's point becomes a sphere).
+            raise TmmError(f"stock to leave is not supported with the {self.describe()} cutter; "
+                           "use a ball, flat or bull-nose cutter")
         if distance < 0 and -distance > self.corner_radius:
             raise TmmError(
                 f"negative stock to leave {distance:g} mm exceeds the corner radius {self.corner_radius:g} mm")
         return Cutter(self.diameter + 2 * distance, self.corner_radius + distance)
 
     def describe(self) -> str:
-        if self.kind == "bull":
+        k = self.kind
+        if k == "bull":
             return f"bull-nose D{self.diameter:g} r{self.corner_radius:g}"
-        return f"{self.kind} D{self.diameter:g}"
+        if k == "general":
+            return (f"APT D{self.diameter:g} r{self.corner_radius:g} beta1 {self.bottom_angle_deg:g} deg "
+                    f"beta2 {self.taper_angle_deg:g} deg L_C {self.cutting_length:g}")
+        return f"{k} D{self.diameter:g}"

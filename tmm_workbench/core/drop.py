@@ -31,7 +31,6 @@ class DropSurface:
         if not np.isfinite(pts).all():
             raise TmmError("drop points contain a non-finite coordinate")
         try:
-            return native.drop_cutter(self._index, cutter.radius, cutter.corner_radius, pts,
-                                      float(floor_z), threads, progress)
+            return native.drop_cutter(self._index, cutter.native, pts, float(floor_z), threads, progress)
         except native.Cancelled as exc:
             raise Cancelled("tool path computation cancelled") from exc

@@ -1,57 +1,90 @@
-// A convex cutter of revolution, described by its lower profile h(rho): the height of the cutting surface
-// above the tool tip at distance rho from the axis (0 <= rho <= radius). Drop-cutter needs nothing else:
+// A convex cutter of revolution: the generalized APT cutter of seed 000 (section 3.5.2.2, Figure 3-14,
+// eq. 3.34-3.42), described by its lower profile h(rho): the height of the cutting surface above the tool
+// tip at distance rho from the axis (0 <= rho <= max_radius). From the axis outwards the profile is
+//   a bottom cone  h = rho tan(beta1)                       (beta1 = 0: flat bottom),
+//   a corner arc   centre (e, f), radius r                  (r = 0: sharp corner),
+//   a taper side   at beta2 from the axis, up to (R, L_C)   (beta2 > 0 widening upwards; <= 0: the widest
+//                                                            point of the arc ends the profile).
+// h is convex and non-decreasing, which is all drop-cutter needs:
 //   vertex contact: tip = v.z - h(rho)
-//   facet contact:  the cutter point whose outward normal is -n (rho where h'(rho) = |n_xy| / n_z)
+//   facet contact:  the cutter point whose outward normal is -n: rho where h'(rho) = tan(slope)
 //   edge contact:   the maximum of the concave function z_edge(u) - h(rho(u)) along the edge.
-// Ball (r = R), flat (r = 0) and bull-nose (0 < r < R) are the corner-radius family of seed 000's
-// generalized APT cutter; the cone and taper regions extend this class later (same profile interface).
+// Ball (r = R), flat (r = 0) and bull-nose (0 < r < R) with beta1 = beta2 = 0 keep closed-form fast paths.
 #pragma once
 
 #include <cmath>
 
 namespace tmm {
 
-enum class CutterKind { Flat, Ball, Bull };
+enum class CutterKind { Flat, Ball, Bull, General };
 
 class Cutter {
  public:
-  // radius R > 0, corner radius 0 <= r <= R; throws std::invalid_argument otherwise.
+  // Ball, flat or bull-nose: radius R > 0, corner radius 0 <= r <= R. Throws std::invalid_argument.
   Cutter(double radius, double corner_radius);
+  // The generalized APT cutter: R the radius at the cutting-edge height L_C, corner radius r, bottom angle
+  // beta1 in [0, 90) degrees from the horizontal, taper angle beta2 in (-90, 90) degrees from the axis
+  // (positive when the side widens upwards). Angles in radians. Throws std::invalid_argument naming the
+  // impossible parameter.
+  static Cutter apt(double radius, double corner_radius, double cutting_length, double beta1, double beta2);
 
-  double radius() const { return R_; }
+  double radius() const { return R_; }              // R: radius at the cutting-edge height
   double corner_radius() const { return r_; }
-  // Radius of the flat bottom (the torus' ring radius): R - r.
-  double flat_radius() const { return a_; }
+  double cutting_length() const { return Lc_; }
+  double beta1() const { return beta1_; }
+  double beta2() const { return beta2_; }
+  double max_radius() const { return rho_max_; }    // extent of the lower profile (the shadow radius)
+  double flat_radius() const { return rho_a_; }     // end of the bottom cone/flat (start of the arc)
+  double arc_centre_radius() const { return e_; }   // e
+  double arc_centre_height() const { return f_; }   // f
   CutterKind kind() const { return kind_; }
 
-  // h(rho): height of the cutting surface above the tip at distance rho from the axis (rho <= R).
+  // h(rho), 0 <= rho <= max_radius().
   double height(double rho) const {
-    if (rho <= a_) return 0.0;
-    const double t = rho - a_;
-    return r_ - std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+    if (rho <= rho_a_) return k1_ * rho;
+    if (rho <= rho_b_) {
+      const double t = rho - e_;
+      return f_ - std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+    }
+    return h_b_ + (rho - rho_b_) * k2_;
   }
-  // h'(rho); +inf at the rim of a ball or bull-nose.
+  // h'(rho); +inf where the arc turns vertical.
   double slope(double rho) const {
-    if (rho <= a_) return 0.0;
-    const double t = rho - a_;
-    return t / std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+    if (rho <= rho_a_) return k1_;
+    if (rho <= rho_b_) {
+      const double t = rho - e_;
+      return t / std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+    }
+    return k2_;
   }
-  // h''(rho) (0 on the flat bottom).
+  // h''(rho) (0 on the cone and taper).
   double curvature(double rho) const {
-    if (rho <= a_) return 0.0;
-    const double t = rho - a_;
+    if (rho <= rho_a_ || rho > rho_b_) return 0.0;
+    const double t = rho - e_;
     const double q = std::fmax(r_ * r_ - t * t, 0.0);
     return r_ * r_ / (q * std::sqrt(q));
   }
-  // Distance from the axis of the point touching a plane whose unit normal has horizontal length nxy
-  // (nxy = sin of the plane's slope): h'(rho) = tan(slope). For the flat cutter, the rim.
-  double facet_contact_radius(double nxy) const { return a_ + r_ * nxy; }
+  // Distance from the axis of the point touching a plane whose unit normal has horizontal length nxy and
+  // vertical component nz > 0 (the plane's slope is atan(nxy / nz)): where h' equals that slope.
+  double facet_contact_radius(double nxy, double nz) const {
+    if (nxy * k1_den_ <= k1_num_ * nz) return 0.0;           // no steeper than the bottom cone: the tip
+    if (arc_ends_vertical_ || nxy * k2_den_ <= k2_num_ * nz)  // on the arc: rho = e + r sin(slope)
+      return std::fmin(e_ + r_ * nxy, rho_b_);
+    return rho_max_;                                          // steeper than the taper: its top edge
+  }
 
  private:
-  double R_;
-  double r_;
-  double a_;
-  CutterKind kind_;
+  Cutter() = default;
+  void finish();
+
+  double R_ = 0, r_ = 0, Lc_ = 0, beta1_ = 0, beta2_ = 0;
+  double e_ = 0, f_ = 0;             // corner arc centre
+  double k1_ = 0, k2_ = 0;           // slopes of the bottom cone and the taper (k2 = cot beta2)
+  double k1_num_ = 0, k1_den_ = 1;   // tan(beta1) = sin / cos, compared without division
+  double k2_num_ = 1, k2_den_ = 0;   // cot(beta2) = cos / sin
+  double rho_a_ = 0, rho_b_ = 0, h_b_ = 0, rho_max_ = 0;
+  bool arc_ends_vertical_ = true;
+  CutterKind kind_ = CutterKind::General;
 };
 
 }  // namespace tmm

@@ -16,21 +16,21 @@ constexpr double kNoContact = -std::numeric_limits<double>::infinity();
 inline double vertex_drop(const Cutter& c, double x, double y, const double* p) {
   const double dx = p[0] - x, dy = p[1] - y;
   const double rho2 = dx * dx + dy * dy;
-  const double R = c.radius();
+  const double R = c.max_radius();
   if (rho2 > R * R) return kNoContact;
   return p[2] - c.height(std::sqrt(rho2));
 }
 
 // Facet with corners p0, p1, p2 and unit normal n (n_z > 0 faces up). The contact point is where the
-// cutter's outward normal is -n: rho = facet_contact_radius(|n_xy|) uphill of the axis. Valid only if
+// cutter's outward normal is -n: rho = facet_contact_radius(|n_xy|, n_z) uphill of the axis. Valid only if
 // that point lies inside the triangle; otherwise an edge or vertex gives the contact.
 double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
                   const double* p2, const double* n);
 
 // Edge p1-p2: the maximum over the edge of z_edge(u) - h(rho(u)), a concave function of the
 // position u along the edge (h is convex and increasing, rho(u) is convex), endpoints included, so
-// this also covers both vertices. Ball and flat have closed forms; the torus is solved by safeguarded
-// Newton on the derivative to 1e-12 mm in u.
+// this also covers both vertices. Ball and flat have closed forms; other profiles are solved by
+// safeguarded Newton on the derivative to 1e-12 mm in u.
 double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2);
 
 }  // namespace tmm
