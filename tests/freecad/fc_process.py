@@ -4,6 +4,7 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import signal
 import subprocess
 from pathlib import Path
 from typing import Optional, Sequence
@@ -35,10 +36,14 @@ def readable(text: str) -> str:
 
 
 def run(cmd: Sequence[str], cwd: Path, timeout: float, **env: str) -> tuple[int, str]:
+    """Runs `cmd` in its own process group; on timeout the whole group (xvfb-run, Xvfb, FreeCAD) is killed,
+    so a hung GUI never outlives its test."""
+    proc = subprocess.Popen(list(cmd), cwd=cwd, env=environment(**env), stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
-        proc = subprocess.run(list(cmd), cwd=cwd, env=environment(**env), capture_output=True, text=True,
-                              timeout=timeout)
-    except subprocess.TimeoutExpired as exc:
-        out = (exc.stdout or b"").decode() if isinstance(exc.stdout, bytes) else (exc.stdout or "")
-        return -1, f"timed out after {timeout} s\n" + readable(out)
-    return proc.returncode, readable(proc.stdout + "\n" + proc.stderr)
+        out, err = proc.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        out, err = proc.communicate()
+        return -1, f"timed out after {timeout} s\n" + readable((out or "") + "\n" + (err or ""))
+    return proc.returncode, readable(out + "\n" + err)

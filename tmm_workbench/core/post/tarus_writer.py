@@ -1,0 +1,286 @@
+"""G-code for the Tarus 5-axis mill from TMM's 5-axis Path representation (core.path5).
+
+Two output modes:
+* joints (default; a control without tool-centre-point mode): every motion line is the machine position
+  X Y Z A C from `TarusMachine.inverse`: X, Y, Z are the pivot point (pivot-compensated: the tip plus
+  (pivot length + tool length) along the tool axis), so tool length compensation stays off (G49).
+* TCP (`tcp=True`; a control with tool-centre-point mode, e.g. Fanuc G43.4): X, Y, Z are the tool tip,
+  A, C the joint angles; TCP is switched on with `G43.4 H<tool>` after each tool change, off with G49.
+A and C are printed in degrees, A unwrapped (continuous, may pass 360), never scaled by `inches`.
+Feeds: a G1 at a constant orientation uses G94 with F in mm/min (in/min); a G1 that turns A or C uses
+inverse time (G93, F = 1 / minutes = tip feed / tip distance; a pure re-orientation takes the joint motion
+time of eq. 3.123). Rapids carry no F. Arcs (G2/G3) are allowed at a constant orientation.
+A move out of the joint limits raises `JointLimitError` (a TmmError) naming the operation, the command,
+the joint and its value: nothing is written.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.machine.tarus import JointLimitError, Joints, TarusMachine
+from tmm_workbench.core.path5 import AXIS_WORDS, MOTION_NAMES, TIP_WORDS, Pose, decode
+from tmm_workbench.core.post import (MM_PER_INCH, Operation, Program, ToolInfo, comment_text, is_comment, number,
+                                     strip_comment)
+
+_CANONICAL = {"G00": "G0", "G01": "G1", "G02": "G2", "G03": "G3"}
+_INT_WORDS = ("T", "H", "D", "S", "L", "P")
+
+
+@dataclass
+class TarusOptions:
+    """tcp: tip coordinates for a control in TCP mode (else pivot-compensated joints). inches: G20, lengths
+    and linear feeds in inches (rotary words and inverse-time feeds unchanged). precision / angle_precision:
+    decimals of lengths (and F) and of angles. comments: operation and tool comments. line_numbers: N words.
+    program_end: 'M2' or 'M30'."""
+    tcp: bool = False
+    inches: bool = False
+    precision: int = 4
+    angle_precision: int = 6
+    comments: bool = True
+    line_numbers: bool = False
+    program_end: str = "M2"
+
+
+@dataclass
+class TarusResult:
+    text: str
+    cycle_time: float  # seconds, estimated from the joint speeds and feeds
+    moves: int
+
+
+class _Writer:
+    def __init__(self, machine: TarusMachine, options: TarusOptions) -> None:
+        self.m, self.o = machine, options
+        self.lines: list[str] = []
+        self.n = 0
+        self.joints: Optional[Joints] = None  # machine position after the last motion
+        self.tip: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+        self.feed_mode = "G94"
+        self.tool: Optional[ToolInfo] = None
+        self.coolant = "None"
+        self.time = 0.0
+        self.moves = 0
+
+    # --- formatting --------------------------------------------------------------------------
+    def emit(self, text: str) -> None:
+        if self.o.line_numbers and not text.startswith("%"):
+            self.n += 10
+            text = f"N{self.n} {text}"
+        self.lines.append(text)
+
+    def comment(self, text: str) -> None:
+        if self.o.comments:
+            self.emit(f"({comment_text(text)})")
+
+    def length(self, v: float) -> str:
+        return number(v / MM_PER_INCH if self.o.inches else v, self.o.precision)
+
+    def angle(self, rad: float) -> str:
+        return number(math.degrees(rad), self.o.angle_precision)
+
+    def linear_feed(self, mm_s: float) -> str:
+        per_min = mm_s * 60.0
+        return number(per_min / MM_PER_INCH if self.o.inches else per_min, self.o.precision)
+
+    # --- program parts -----------------------------------------------------------------------
+    def header(self) -> None:
+        m, o = self.m, self.o
+        self.emit("%")
+        self.comment(f"TMM Tarus post - {m.name}")
+        self.comment(f"head: A rotates about Z and carries the tilt C; pivot length {m.pivot_length:.3f} mm, "
+                     f"tool length {m.tool_length:.3f} mm")
+        if o.tcp:
+            self.comment("output: X Y Z = tool tip, A C = joints; the control's TCP mode (G43.4) on")
+        else:
+            self.comment("output: X Y Z = pivot point (pivot-compensated joints), A C = joints; no TCP")
+        self.comment(f"units: {'inch' if o.inches else 'mm'}; A and C in degrees")
+        self.emit(f"G17 {'G20' if o.inches else 'G21'} G40 G49 G80 G90 G94")
+
+    def tool_change(self, t: ToolInfo) -> None:
+        shape = t.shape if t.shape and t.shape not in t.label else ""
+        desc = " ".join(x for x in (t.label, shape, f"D{t.diameter:g}" if t.diameter else "") if x)
+        self.comment(f"tool change: T{t.number} {desc}".rstrip())
+        self.emit("M5")
+        self.emit(f"T{int(t.number)} M6")
+        if self.o.tcp:
+            self.emit(f"G43.4 H{int(t.number)}")
+        if t.spindle_dir != "OFF" and t.spindle_rpm > 0:
+            self.emit(f"S{int(round(t.spindle_rpm))} {'M4' if t.spindle_dir == 'CCW' else 'M3'}")
+        self.tool = t
+
+    def footer(self) -> None:
+        if self.coolant != "None":
+            self.emit("M9")
+        self.emit("M5")
+        if self.feed_mode != "G94":
+            self.emit("G94")
+        if self.o.tcp:
+            self.emit("G49")
+        minutes, seconds = divmod(self.time, 60.0)
+        self.comment(f"estimated cycle time {int(minutes)} min {seconds:.1f} s ({self.moves} moves, "
+                     f"joint speeds and feeds)")
+        self.emit(self.o.program_end)
+        self.emit("%")
+
+    def operation(self, op: Operation) -> None:
+        self.comment(f"operation: {op.label}")
+        if op.coolant in ("Flood", "Mist") and op.coolant != self.coolant:
+            self.emit("M8" if op.coolant == "Flood" else "M7")
+        elif op.coolant == "None" and self.coolant != "None":
+            self.emit("M9")
+        self.coolant = op.coolant if op.coolant in ("Flood", "Mist") else "None"
+        pose = Pose()  # axis words are modal per Path, starting vertical (core.path5)
+        pose.tip = self.tip  # coordinates not given yet are where the machine is
+        for i, (name, params) in enumerate(op.commands):
+            up = str(name).upper()
+            if is_comment(up):
+                self.comment(strip_comment(str(name)))
+                continue
+            if up not in MOTION_NAMES:
+                self.other(op, i, str(name), params)
+                continue
+            try:
+                pose = decode(up, params, pose)
+                self.motion(_CANONICAL.get(up, up), pose, params, i)
+            except JointLimitError as exc:
+                raise JointLimitError(f"operation '{op.label}', command {i} ({name}): {exc}", exc.joint,
+                                      exc.value, exc.limits, i) from None
+            except TmmError as exc:
+                raise TmmError(f"operation '{op.label}', command {i} ({name}): {exc}") from None
+
+    def other(self, op: Operation, i: int, name: str, params: Mapping[str, Any]) -> None:
+        if any(w in params for w in TIP_WORDS + AXIS_WORDS + ("A", "B", "C")):
+            raise TmmError(f"operation '{op.label}', command {i}: '{name}' with coordinates is not supported "
+                           f"by the Tarus post (only G0, G1, G2, G3 move the tool)")
+        if name.upper() in ("G91", "G20", "G21", "G93", "G94"):
+            raise TmmError(f"operation '{op.label}', command {i}: '{name}' would change the post's modes")
+        words = [name]
+        for k, v in params.items():
+            words.append(f"{k}{int(v)}" if k in _INT_WORDS else f"{k}{number(float(v), self.o.precision)}")
+        self.emit(" ".join(words))
+
+    def motion(self, name: str, pose: Pose, params: Mapping[str, Any], index: int) -> None:
+        m = self.m
+        tip = np.array(pose.tip, dtype=float)
+        known = ~np.isnan(tip)
+        vertical = math.hypot(pose.axis[0], pose.axis[1]) <= m.singular_tol and pose.axis[2] > 0
+        if not known.all() and not vertical:
+            raise TmmError(f"the tool position {tuple(tip)} is not fully known for a tilted tool axis")
+        j = m.inverse(tip, pose.axis, self.joints, index=index)
+        prev = self.joints
+        turns = prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
+        first = prev is None
+        xyz = pose.tip if self.o.tcp else (j.x, j.y, j.z)
+        words = [f"{w}{self.length(v)}" for w, v, k in zip("XYZ", xyz, known) if k]
+        words += [f"A{self.angle(j.a)}", f"C{self.angle(j.c)}"]
+        dist = float(np.linalg.norm(tip - np.array(self.tip))) if not np.isnan(self.tip).any() and known.all() \
+            else math.nan
+        joint_time = m.motion_time(prev, j) if prev is not None else 0.0  # unknown coordinates left out
+        if name == "G0":
+            line = "G0 " + " ".join(words)
+            seconds = joint_time
+        else:
+            feed = pose.feed
+            if feed is None or not feed > 0:
+                raise TmmError(f"{name} without a feed rate (F {feed})")
+            if name in ("G2", "G3"):
+                if turns or first:
+                    raise TmmError("an arc must keep the tool orientation (A and C) of the move before it")
+                for w in ("I", "J", "K", "R"):
+                    if w in params:
+                        words.append(f"{w}{self.length(float(params[w]))}")
+            if turns:
+                if dist > 1e-9:
+                    minutes = dist / (feed * 60.0)
+                else:  # a re-orientation on the spot: as fast as the joints go
+                    minutes = max(joint_time, 1e-6) / 60.0
+                mode_words = self.set_feed_mode("G93")
+                line = f"{mode_words}{name} " + " ".join(words) + f" F{number(1.0 / minutes, self.o.precision)}"
+                seconds = max(minutes * 60.0, joint_time)
+            else:
+                mode_words = self.set_feed_mode("G94")
+                line = f"{mode_words}{name} " + " ".join(words) + f" F{self.linear_feed(feed)}"
+                seconds = max(dist / feed if math.isfinite(dist) else 0.0, joint_time)
+        self.emit(line)
+        self.time += seconds
+        self.moves += 1
+        self.joints = j
+        self.tip = tuple(float(v) for v in tip)  # type: ignore[assignment]
+
+    def set_feed_mode(self, mode: str) -> str:
+        if mode == self.feed_mode:
+            return ""
+        self.feed_mode = mode
+        return mode + " "
+
+
+def write_tarus(program: Program, machine: Optional[TarusMachine] = None,
+                options: Optional[TarusOptions] = None) -> TarusResult:
+    """Tarus G-code for `program` (tool changes and operations in order). Raises TmmError (JointLimitError
+    for limits) before anything is returned."""
+    w = _Writer(machine or TarusMachine(), options or TarusOptions())
+    w.header()
+    for item in program:
+        if isinstance(item, ToolInfo):
+            w.tool_change(item)
+        elif isinstance(item, Operation):
+            w.operation(item)
+        else:
+            raise TmmError(f"unexpected program item {type(item).__name__}")
+    w.footer()
+    return TarusResult("\n".join(w.lines) + "\n", w.time, w.moves)
+
+
+def argument_parser() -> "ArgumentParser":
+    from tmm_workbench.core.post import ArgumentParser
+    p = ArgumentParser(prog="tarus", add_help=False)
+    p.add_argument("--tcp", action="store_true",
+                   help="tool-centre-point mode: X Y Z = tool tip (control with TCP, G43.4); default: "
+                        "pivot-compensated joint coordinates")
+    p.add_argument("--inches", action="store_true", help="G20, lengths in inches (A and C stay in degrees)")
+    p.add_argument("--show-editor", action="store_true", help="accepted; TMM posts never open an editor")
+    p.add_argument("--no-show-editor", action="store_true", help="do not show the output in an editor")
+    p.add_argument("--no-comments", action="store_true", help="no comments in the output")
+    p.add_argument("--line-numbers", action="store_true", help="N words on every line")
+    p.add_argument("--precision", type=int, default=4, help="decimals of lengths and feeds (default 4)")
+    p.add_argument("--angle-precision", type=int, default=6, help="decimals of A and C degrees (default 6)")
+    p.add_argument("--pivot-length", type=float, help="pivot point to spindle gauge line, mm (default 150)")
+    p.add_argument("--tool-length", type=float, help="spindle gauge line to tool tip, mm (default 100)")
+    p.add_argument("--c-min", type=float, help="tilt limit, degrees (default 0)")
+    p.add_argument("--c-max", type=float, help="tilt limit, degrees (default 45)")
+    p.add_argument("--a-min", type=float, help="rotation limit, degrees (default: continuous A)")
+    p.add_argument("--a-max", type=float, help="rotation limit, degrees (default: continuous A)")
+    p.add_argument("--program-end", choices=("M2", "M30"), default="M2", help="program end word")
+    return p
+
+
+def parse_args(argstring: Optional[str]) -> tuple[TarusMachine, TarusOptions]:
+    """Machine settings and options from a post argument string (TmmError for bad arguments)."""
+    a = argument_parser().parse_post_args(argstring)
+    base = TarusMachine()
+    kw: dict[str, Any] = {}
+    if a.pivot_length is not None:
+        kw["pivot_length"] = a.pivot_length
+    if a.tool_length is not None:
+        kw["tool_length"] = a.tool_length
+    c_lo = math.radians(a.c_min) if a.c_min is not None else base.c_limits[0]
+    c_hi = math.radians(a.c_max) if a.c_max is not None else base.c_limits[1]
+    kw["c_limits"] = (c_lo, c_hi)
+    if (a.a_min is None) != (a.a_max is None):
+        raise TmmError("tarus post arguments: give both --a-min and --a-max, or neither")
+    if a.a_min is not None:
+        kw["a_limits"] = (math.radians(a.a_min), math.radians(a.a_max))
+    if not (0 <= a.precision <= 12 and 0 <= a.angle_precision <= 12):
+        raise TmmError("tarus post arguments: --precision and --angle-precision must be 0..12")
+    machine = TarusMachine(**kw)
+    options = TarusOptions(tcp=a.tcp, inches=a.inches, precision=a.precision, angle_precision=a.angle_precision,
+                           comments=not a.no_comments, line_numbers=a.line_numbers, program_end=a.program_end)
+    return machine, options
+
+
+TOOLTIP_ARGS = argument_parser().format_help()
