@@ -1,4 +1,5 @@
-"""FreeCAD ToolBits -> core cutters: endmill, ballend, bullnose (0.20's FlatRadius), others refused."""
+"""FreeCAD ToolBits -> core cutters: endmill, ballend, bullnose (0.20's FlatRadius), chamfer and v-bit
+(cones), others refused."""
 from __future__ import annotations
 
 import unittest
@@ -32,6 +33,18 @@ class ToolMapping(FreeCADTestCase):
         # 0.20's bullnose stores the flat bottom's radius (1.5 of 3): the corner radius is 3 - 1.5
         bull = cutter_from_tool(stock_bit(doc, "6mm_Bullnose.fctb"))
         self.assertEqual((bull.kind, bull.diameter, bull.corner_radius), ("bull", 6.0, 1.5))
+        # Cones: included angle from a flat tip; the profile rises (D - tip)/2 / tan(angle/2) to the rim.
+        import math
+        for file_name, d, angle, tip in (("60degree_Vbit.fctb", 10.0, 60.0, 1.0),
+                                         ("45degree_chamfer.fctb", 12.3323, 45.0, 5.0)):
+            c = cutter_from_tool(stock_bit(doc, file_name))
+            self.assertEqual(c.kind, "general")
+            self.assertAlmostEqual(c.diameter, d, places=4)
+            self.assertAlmostEqual(c.taper_angle_deg, angle / 2, places=9)
+            n = c.native
+            self.assertAlmostEqual(float(n.height(tip / 2)), 0.0, places=9)
+            rise = (d - tip) / 2 / math.tan(math.radians(angle / 2))
+            self.assertAlmostEqual(float(n.height(d / 2)), rise, places=6)
 
     def test_made_bits(self) -> None:
         doc = new_doc()
@@ -45,8 +58,8 @@ class ToolMapping(FreeCADTestCase):
 
     def test_other_shapes_are_refused_by_name(self) -> None:
         doc = new_doc()
-        for file_name, shape in (("45degree_chamfer.fctb", "chamfer"), ("60degree_Vbit.fctb", "v-bit"),
-                                 ("5mm_Drill.fctb", "drill")):
+        for file_name, shape in (("5mm_Drill.fctb", "drill"), ("probe.fctb", "probe"),
+                                 ("slittingsaw.fctb", "slittingsaw")):
             with self.assertRaises(TmmError) as ctx:
                 cutter_from_tool(stock_bit(doc, file_name))
             self.assertIn(f"'{shape}'", str(ctx.exception))
@@ -62,20 +75,25 @@ class ToolMapping(FreeCADTestCase):
         t.ToolType = "Drill"
         self.assertRaises(TmmError, cutter_from_tool, t)
 
-    def test_op_with_a_vbit_fails_clearly(self) -> None:
+    def test_op_with_a_vbit_cuts_and_one_with_a_drill_fails_clearly(self) -> None:
         doc = new_doc()
         job, tc, op = job_with_op(doc, str(bump_stl()))
         self.assertTrue(op.isValid(), op.getStatusString())
-        self.assertTrue(op.Proxy.isToolSupported(op, tc.Tool))
         vbit = stock_bit(doc, "60degree_Vbit.fctb")
-        self.assertFalse(op.Proxy.isToolSupported(op, vbit))
+        self.assertTrue(op.Proxy.isToolSupported(op, vbit))
         tc.Tool = vbit
         op.touch()
         doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertGreater(len(op.Path.Commands), 10)
+        drill = stock_bit(doc, "5mm_Drill.fctb")
+        self.assertFalse(op.Proxy.isToolSupported(op, drill))
+        tc.Tool = drill
+        op.touch()
+        doc.recompute()
         self.assertFalse(op.isValid())
-        self.assertIn("'v-bit'", op.getStatusString())
+        self.assertIn("'drill'", op.getStatusString())
         self.assertEqual(len(op.Path.Commands), 0)
-
 
 if __name__ == "__main__":
     unittest.main()

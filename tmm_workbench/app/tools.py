@@ -1,6 +1,9 @@
 """FreeCAD tools (ToolBits, and 0.20's legacy Path.Tool) -> core cutters.
 
-ToolBit shapes: endmill -> flat, ballend -> ball, bullnose -> bull-nose. FreeCAD 0.20's bullnose
+ToolBit shapes: endmill -> flat, ballend -> ball, bullnose -> bull-nose, chamfer and v-bit -> a cone
+(the generalized APT cutter with a taper): `CuttingEdgeAngle` is the included tip angle (180: flat, as in
+FreeCAD's PathSurfaceSupport), from a flat tip of `TipDiameter` up to `Diameter`; the cone height follows
+from these three (the shipped bits' `CuttingEdgeHeight` does not always agree with them). FreeCAD 0.20's bullnose
 shape has no corner radius parameter: it stores `FlatRadius`, the radius of the flat bottom, so the
 corner radius is Diameter/2 - FlatRadius (FreeCAD issue #19050; later versions migrate to
 `CornerRadius`, PR #18724 / #25438). A bit that carries `CornerRadius` (or the old torus shape's
@@ -14,7 +17,7 @@ from typing import Any
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.errors import TmmError
 
-SUPPORTED_SHAPES = ("endmill", "ballend", "bullnose")
+SUPPORTED_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")
 _LEGACY_TYPES = {"EndMill": "endmill", "BallEndMill": "ballend"}  # 0.20's deprecated Path.Tool
 
 
@@ -55,6 +58,12 @@ def cutter_from_tool(tool: Any) -> Cutter:
         return Cutter.bull(d, corner) if corner > 0 else Cutter.flat(d)
     if name == "ballend":
         return Cutter.ball(d)
+    if name in ("chamfer", "v-bit"):
+        angle = float(getattr(tool, "CuttingEdgeAngle", 0.0))
+        tip = _mm(getattr(tool, "TipDiameter", 0.0))
+        if not 0 < angle < 180:
+            raise TmmError(f"tool '{label}': cutting edge angle {angle:g} deg must be between 0 and 180")
+        return Cutter.vbit(d, angle, tip)
     return Cutter.bull(d, bull_corner_radius(tool, d))
 
 
