@@ -4,8 +4,9 @@
 
 namespace tmm {
 
-double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
-                  const double* p2, const double* n) {
+double plane_drop(const Cutter& c, double x, double y, const double* p0, const double* p1, const double* p2,
+                  const double* n, bool& inside) {
+  inside = false;
   const double nz = n[2];
   if (nz <= 1e-12) return kNoContact;  // vertical or downward facing: edges give the contact
   const double nxy = std::sqrt(n[0] * n[0] + n[1] * n[1]);
@@ -24,14 +25,17 @@ double facet_drop(const Cutter& c, double x, double y, const double* p0, const d
   const double w2 = ax * by - ay * bx;
   const double area = w0 + w1 + w2;
   const double eps = 1e-12 * std::fabs(area);
-  if (area > 0) {
-    if (w0 < -eps || w1 < -eps || w2 < -eps) return kNoContact;
-  } else {
-    if (w0 > eps || w1 > eps || w2 > eps) return kNoContact;
-  }
+  inside = area > 0 ? (w0 >= -eps && w1 >= -eps && w2 >= -eps) : (w0 <= eps && w1 <= eps && w2 <= eps);
   // Plane height at the contact point, then down by the cutter profile there.
   const double zc = p0[2] - (n[0] * (cx - p0[0]) + n[1] * (cy - p0[1])) / nz;
   return zc - c.height(rho);
+}
+
+double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
+                  const double* p2, const double* n, double zmax, double above) {
+  bool inside = false;
+  const double z = plane_drop(c, x, y, p0, p1, p2, n, inside);
+  return inside && z > above ? z : kNoContact;
 }
 
 namespace {
@@ -72,7 +76,7 @@ double profile_edge_max(const Cutter& c, double d2, double z0, double m, double 
 
 }  // namespace
 
-double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2) {
+double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2, double above) {
   const double ex = p2[0] - p1[0], ey = p2[1] - p1[1];
   const double L = std::sqrt(ex * ex + ey * ey);
   const double R = c.max_radius();
@@ -85,6 +89,7 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
   const double d = wx * sy - wy * sx;       // signed distance of the axis from the edge line (XY)
   const double d2 = d * d;
   if (d2 > R * R) return kNoContact;
+  if (maxd(p1[2], p2[2]) - c.height(std::fabs(d)) <= above) return kNoContact;
   const double s = std::sqrt(R * R - d2);   // half-chord of the cutter's shadow along the edge
   const double lo = std::max(u1, -s), hi = std::min(u1 + L, s);
   if (lo > hi) return kNoContact;
@@ -95,7 +100,7 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
       return z0 + m * (m > 0 ? hi : lo);
     case CutterKind::Ball: {                // g = z0 + m u - R + sqrt(s^2 - u^2): g' = 0 in closed form
       const double u = std::clamp(m * s / std::sqrt(1.0 + m * m), lo, hi);
-      return z0 + m * u - R + std::sqrt(std::fmax(s * s - u * u, 0.0));
+      return z0 + m * u - R + std::sqrt(maxd(s * s - u * u, 0.0));
     }
     case CutterKind::Bull:
     case CutterKind::General:

@@ -10,8 +10,39 @@
 namespace tmm {
 
 namespace {
-constexpr int32_t kLeafSize = 4;
+
+constexpr int32_t kLeafSize = 8;
+
+// Sets IndexedTriangle::owned_edges: edge (a, b) of triangle t is owned by t unless a lower-numbered
+// triangle also has both a and b. Triangles around each vertex in compressed rows: O(m * valence).
+void mark_owned_edges(const Eigen::Ref<const Triangles>& F, Eigen::Index nv, std::vector<IndexedTriangle>& tris) {
+  const Eigen::Index nt = F.rows();
+  std::vector<int32_t> start(static_cast<std::size_t>(nv) + 1, 0);
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) ++start[F(t, k) + 1];
+  for (Eigen::Index v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<int32_t> fill(start.begin(), start.end() - 1), around(static_cast<std::size_t>(3 * nt));
+  for (Eigen::Index t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) around[fill[F(t, k)]++] = static_cast<int32_t>(t);  // ascending t per vertex
+  for (Eigen::Index t = 0; t < nt; ++t) {
+    uint8_t owned = 0;
+    for (int k = 0; k < 3; ++k) {
+      const int32_t a = F(t, k), b = F(t, (k + 1) % 3);
+      bool earlier = false;
+      for (int32_t i = start[a]; i < start[a + 1] && around[i] < t; ++i) {
+        const int32_t u = around[i];
+        if (F(u, 0) == b || F(u, 1) == b || F(u, 2) == b) {
+          earlier = true;
+          break;
+        }
+      }
+      if (!earlier) owned |= static_cast<uint8_t>(1u << k);
+    }
+    tris[static_cast<std::size_t>(t)].owned_edges = owned;
+  }
 }
+
+}  // namespace
 
 MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F) {
   const Eigen::Index nv = V.rows(), nt = F.rows();
@@ -45,9 +76,14 @@ MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const
     if (n.z() < 0) n = -n;  // drop-cutter sees the top side of every facet
     for (int j = 0; j < 3; ++j) tri.n[j] = n[j];
     tri.zmax = std::max({a.z(), b.z(), c.z()});
+    tri.xmin = std::min({a.x(), b.x(), c.x()});
+    tri.xmax = std::max({a.x(), b.x(), c.x()});
+    tri.ymin = std::min({a.y(), b.y(), c.y()});
+    tri.ymax = std::max({a.y(), b.y(), c.y()});
     cx[t] = (std::min({a.x(), b.x(), c.x()}) + std::max({a.x(), b.x(), c.x()})) * 0.5;
     cy[t] = (std::min({a.y(), b.y(), c.y()}) + std::max({a.y(), b.y(), c.y()})) * 0.5;
   }
+  mark_owned_edges(F, nv, src);
   std::vector<int32_t> order(src.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int32_t>(i);
   nodes_.reserve(2 * (src.size() / kLeafSize + 1));
@@ -67,12 +103,10 @@ void MeshIndex::build(int32_t self, int32_t begin, int32_t end, std::vector<int3
                  end - begin};
     for (int32_t i = begin; i < end; ++i) {
       const IndexedTriangle& t = src[order[i]];
-      for (int k = 0; k < 3; ++k) {
-        node.xmin = std::min(node.xmin, t.p[k][0]);
-        node.xmax = std::max(node.xmax, t.p[k][0]);
-        node.ymin = std::min(node.ymin, t.p[k][1]);
-        node.ymax = std::max(node.ymax, t.p[k][1]);
-      }
+      node.xmin = std::min(node.xmin, t.xmin);
+      node.xmax = std::max(node.xmax, t.xmax);
+      node.ymin = std::min(node.ymin, t.ymin);
+      node.ymax = std::max(node.ymax, t.ymax);
       node.zmax = std::max(node.zmax, t.zmax);
       tris_.push_back(t);
     }

@@ -16,6 +16,10 @@
 
 namespace tmm {
 
+// max/min that compile to one instruction (std::fmax/fmin are libm calls, for NaN semantics not needed here).
+inline double maxd(double a, double b) { return a > b ? a : b; }
+inline double mind(double a, double b) { return a < b ? a : b; }
+
 enum class CutterKind { Flat, Ball, Bull, General };
 
 class Cutter {
@@ -44,7 +48,7 @@ class Cutter {
     if (rho <= rho_a_) return k1_ * rho;
     if (rho <= rho_b_) {
       const double t = rho - e_;
-      return f_ - std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+      return f_ - std::sqrt(maxd(r_ * r_ - t * t, 0.0));
     }
     return h_b_ + (rho - rho_b_) * k2_;
   }
@@ -53,7 +57,7 @@ class Cutter {
     if (rho <= rho_a_) return k1_;
     if (rho <= rho_b_) {
       const double t = rho - e_;
-      return t / std::sqrt(std::fmax(r_ * r_ - t * t, 0.0));
+      return t / std::sqrt(maxd(r_ * r_ - t * t, 0.0));
     }
     return k2_;
   }
@@ -61,7 +65,7 @@ class Cutter {
   double curvature(double rho) const {
     if (rho <= rho_a_ || rho > rho_b_) return 0.0;
     const double t = rho - e_;
-    const double q = std::fmax(r_ * r_ - t * t, 0.0);
+    const double q = maxd(r_ * r_ - t * t, 0.0);
     return r_ * r_ / (q * std::sqrt(q));
   }
   // Distance from the axis of the point touching a plane whose unit normal has horizontal length nxy and
@@ -69,7 +73,7 @@ class Cutter {
   double facet_contact_radius(double nxy, double nz) const {
     if (nxy * k1_den_ <= k1_num_ * nz) return 0.0;           // no steeper than the bottom cone: the tip
     if (arc_ends_vertical_ || nxy * k2_den_ <= k2_num_ * nz)  // on the arc: rho = e + r sin(slope)
-      return std::fmin(e_ + r_ * nxy, rho_b_);
+      return mind(e_ + r_ * nxy, rho_b_);
     return rho_max_;                                          // steeper than the taper: its top edge
   }
 

@@ -11,6 +11,7 @@
 namespace tmm {
 
 constexpr double kNoContact = -std::numeric_limits<double>::infinity();
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Vertex p: tip = p.z - h(rho).
 inline double vertex_drop(const Cutter& c, double x, double y, const double* p) {
@@ -24,13 +25,23 @@ inline double vertex_drop(const Cutter& c, double x, double y, const double* p) 
 // Facet with corners p0, p1, p2 and unit normal n (n_z > 0 faces up). The contact point is where the
 // cutter's outward normal is -n: rho = facet_contact_radius(|n_xy|, n_z) uphill of the axis. Valid only if
 // that point lies inside the triangle; otherwise an edge or vertex gives the contact.
+// `above`: a height the caller already has; the contact is only computed when its cheap upper bound
+// (the facet's highest corner `zmax` lowered by h at the contact radius) exceeds it, else -inf.
 double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
-                  const double* p2, const double* n);
+                  const double* p2, const double* n, double zmax = kInf, double above = kNoContact);
+
+// The drop onto the whole plane of a facet (unit normal n, n_z > 0), which bounds the drop onto the facet
+// from above; `inside` tells whether the contact point lies in the triangle, in which case it is the facet's
+// (and the whole triangle's) contact. -inf for vertical or downward-facing planes.
+double plane_drop(const Cutter& c, double x, double y, const double* p0, const double* p1, const double* p2,
+                  const double* n, bool& inside);
 
 // Edge p1-p2: the maximum over the edge of z_edge(u) - h(rho(u)), a concave function of the
 // position u along the edge (h is convex and increasing, rho(u) is convex), endpoints included, so
 // this also covers both vertices. Ball and flat have closed forms; other profiles are solved by
 // safeguarded Newton on the derivative to 1e-12 mm in u.
-double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2);
+// `above`: as for facet_drop; the bound is the higher end lowered by h at the axis' distance to the edge.
+double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2,
+                 double above = kNoContact);
 
 }  // namespace tmm

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <stdexcept>
 
 #include "tmm/cutter.hpp"
@@ -27,8 +28,10 @@ struct DropStats {
 double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double y, double floor_z,
                   DropStats* stats = nullptr, int32_t* hint = nullptr);
 
-// Exact contact of the cutter with one triangle (max of facet, edge and vertex contacts), or -inf.
-double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t);
+// Exact contact of the cutter with one triangle (max of facet, edge and vertex contacts), or -inf. With
+// `above`, only a contact higher than it is computed (the rest is pruned by cheap bounds) and returned.
+double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t,
+                        double above = -std::numeric_limits<double>::infinity());
 
 struct BatchOptions {
   int threads = 0;  // 0: all hardware threads

@@ -11,15 +11,22 @@
 
 #include <Eigen/Core>
 
+#include "tmm/cutter.hpp"
 #include "tmm/mesh.hpp"
 
 namespace tmm {
 
 // A triangle with what every query needs, stored in leaf order for locality.
 struct IndexedTriangle {
-  double p[3][3];   // corners
-  double n[3];      // unit normal (0 if degenerate)
-  double zmax;      // highest corner
+  double p[3][3];                 // corners
+  double n[3];                    // unit normal (0 if degenerate)
+  double zmax;                    // highest corner
+  double xmin, ymin, xmax, ymax;  // XY bounds
+  // Bit k set: this triangle solves edge k (corner k to k + 1). An edge shared by several triangles is
+  // solved by the lowest-numbered one only. Skipping it in the others is safe under pruning: every
+  // triangle holding the edge bounds it (the edge lies in its box and below its zmax), so when the owner
+  // is pruned the edge cannot raise the cutter either.
+  uint8_t owned_edges;
 };
 
 struct BvhNode {
@@ -65,8 +72,8 @@ template <class Lift, class Visit>
 void MeshIndex::walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const {
   const double r2 = radius * radius;
   auto box_bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
-    const double dx = std::fmax(std::fmax(xmin - x, x - xmax), 0.0);
-    const double dy = std::fmax(std::fmax(ymin - y, y - ymax), 0.0);
+    const double dx = maxd(maxd(xmin - x, x - xmax), 0.0);
+    const double dy = maxd(maxd(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
     if (d2 > r2) return -std::numeric_limits<double>::infinity();
     return zmax - lift(std::sqrt(d2));
@@ -86,10 +93,7 @@ void MeshIndex::walk(double x, double y, double radius, const double& floor, Lif
       for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
         const IndexedTriangle& t = tris_[i];
         if (t.zmax <= floor) continue;
-        const double b = box_bound(std::fmin(std::fmin(t.p[0][0], t.p[1][0]), t.p[2][0]),
-                                   std::fmin(std::fmin(t.p[0][1], t.p[1][1]), t.p[2][1]),
-                                   std::fmax(std::fmax(t.p[0][0], t.p[1][0]), t.p[2][0]),
-                                   std::fmax(std::fmax(t.p[0][1], t.p[1][1]), t.p[2][1]), t.zmax);
+        const double b = box_bound(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax);
         if (b > floor) visit(t, i);
       }
     } else {
