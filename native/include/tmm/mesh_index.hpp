@@ -59,9 +59,8 @@ class MeshIndex {
   void walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const;
 
  private:
-  void build(int32_t self, int32_t begin, int32_t end, std::vector<int32_t>& order,
-             const std::vector<double>& cx, const std::vector<double>& cy,
-             const std::vector<IndexedTriangle>& src);
+  void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads);
+  static int32_t descendants(int32_t triangles);
 
   std::vector<IndexedTriangle> tris_;
   std::vector<BvhNode> nodes_;
