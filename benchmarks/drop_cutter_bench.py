@@ -27,10 +27,16 @@ from tmm_workbench.core.mesh import TriMesh, load_stl  # noqa: E402
 from opencamlib import ocl  # noqa: E402
 
 STL_DIR = ROOT.parent / "shared" / "benchmarks" / "stl"
-CUTTERS = [  # name, radius, corner radius, OpenCAMLib factory
-    ("ball d6", 3.0, 3.0, lambda: ocl.BallCutter(6.0, 50.0)),
-    ("flat d6", 3.0, 0.0, lambda: ocl.CylCutter(6.0, 50.0)),
-    ("bull d10 r2", 5.0, 2.0, lambda: ocl.BullCutter(10.0, 2.0, 50.0)),
+# name, kernel cutter, OpenCAMLib factory (None: OpenCAMLib has no such cutter)
+TAPER_DEG = 3.0
+CUTTERS = [
+    ("ball d6", native.Cutter(3.0, 3.0), lambda: ocl.BallCutter(6.0, 50.0)),
+    ("flat d6", native.Cutter(3.0, 0.0), lambda: ocl.CylCutter(6.0, 50.0)),
+    ("bull d10 r2", native.Cutter(5.0, 2.0), lambda: ocl.BullCutter(10.0, 2.0, 50.0)),
+    # Tapered ball: tip radius 1.5, 3 degree taper, cutting length 20 (ours alone).
+    ("taper ball r1.5 3deg",
+     native.Cutter.apt(1.5 / np.cos(np.radians(TAPER_DEG)) + 18.5 * np.tan(np.radians(TAPER_DEG)), 1.5, 20.0, 0.0,
+                       np.radians(TAPER_DEG)), None),
 ]
 
 
@@ -84,16 +90,19 @@ def ocl_surface(mesh: TriMesh):
     return s
 
 
-def run_case(mesh, surf, index, name, R, r, make_ocl, xy, threads, ocl_budget_s, zmin):
+def run_case(mesh, surf, index, name, cutter, make_ocl, xy, threads, ocl_budget_s, zmin):
     # Ours: all points (best of 3 short runs when quick).
     reps = 3 if len(xy) < 200_000 else 1
     best = np.inf
     for _ in range(reps):
         t0 = time.perf_counter()
-        z, stats = native.drop_cutter_stats(index, native.Cutter(R, r), xy, zmin, threads)
+        z, stats = native.drop_cutter_stats(index, cutter, xy, zmin, threads)
         best = min(best, time.perf_counter() - t0)
     ours_pps = len(xy) / best
     tested = stats["triangles_tested"] / len(xy)
+    if make_ocl is None:
+        return dict(cutter=name, ours=ours_pps, ocl=float("nan"), ratio=float("nan"), n=len(xy), n_ocl=0,
+                    diff=float("nan"), tested=tested, ocl_index_s=float("nan"))
     # OpenCAMLib: an evenly spaced subset sized to the time budget (estimated from a small probe).
     def ocl_run(sub):
         bdc = ocl.BatchDropCutter()
@@ -137,7 +146,7 @@ def main() -> None:
             meshes.append(lambda n=n, jit=jit: height_field(n, jit))
 
     print(f"# drop-cutter, TMM vs OpenCAMLib {ocl.version()}, {args.threads} threads, CL raster {args.step} mm")
-    hdr = (f"{'mesh':32} {'tris':>8} {'build s':>8} {'B/tri':>6} {'ocl build s':>11} {'cutter':>12} "
+    hdr = (f"{'mesh':32} {'tris':>8} {'build s':>8} {'B/tri':>6} {'ocl build s':>11} {'cutter':>20} "
            f"{'TMM pts/s':>11} {'OCL pts/s':>10} {'ratio':>7} {'ocl n':>7} {'max |dz| mm':>11} "
            f"{'tested':>7} {'shadow':>7}")
     print(hdr)
@@ -151,16 +160,31 @@ def main() -> None:
         surf = ocl_surface(mesh)
         xy = raster(mesh, args.step)
         zmin = float(mesh.bounds[0][2]) - 10
-        for name, R, r, make_ocl in CUTTERS:
-            res = run_case(mesh, surf, index, name, R, r, make_ocl, xy, args.threads, args.ocl_seconds, zmin)
-            shadow = shadow_candidates(mesh, xy, R)
+        for name, cutter, make_ocl in CUTTERS:
+            res = run_case(mesh, surf, index, name, cutter, make_ocl, xy, args.threads, args.ocl_seconds, zmin)
+            shadow = shadow_candidates(mesh, xy, cutter.max_radius)
             print(f"{mesh.name[:32]:32} {len(mesh):8d} {t_build:8.3f} {index.memory_bytes / len(mesh):6.0f} "
-                  f"{res['ocl_index_s']:11.3f} {name:>12} {res['ours']:11.0f} {res['ocl']:10.0f} "
+                  f"{res['ocl_index_s']:11.3f} {name:>20} {res['ours']:11.0f} {res['ocl']:10.0f} "
                   f"{res['ratio']:7.1f} {res['n_ocl']:7d} {res['diff']:11.2e} {res['tested']:7.1f} {shadow:7.1f}",
                   flush=True)
         del surf, index
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(f"# peak RSS of the whole run (both programs, all meshes): {peak_mb:.0f} MB")
+    linearity(args.threads)
+
+
+def linearity(threads: int) -> None:
+    """Time per CL point at three raster densities on the jittered 80k mesh: flat if linear."""
+    mesh = height_field(200, True)
+    index = native.MeshIndex(mesh.vertices, mesh.triangles)
+    cutter = CUTTERS[0][1]
+    row = []
+    for step in (1.0, 0.5, 0.25):
+        xy = raster(mesh, step)
+        t0 = time.perf_counter()
+        native.drop_cutter(index, cutter, xy, -50.0, threads)
+        row.append(f"{step} mm: {len(xy)} pts {1e6 * (time.perf_counter() - t0) / len(xy):.2f} us/pt")
+    print("# linearity (ball d6, jittered 80k): " + "; ".join(row))
 
 
 if __name__ == "__main__":
