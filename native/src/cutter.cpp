@@ -97,6 +97,7 @@ void Cutter::finish() {
   }
   h_b_ = f_ - r_ * (arc_ends_vertical_ ? 0.0 : std::sin(beta2_));
   rho_max_ = arc_ends_vertical_ ? rho_b_ : R_;
+  h_max_ = height(rho_max_);
   const bool plain = beta1_ == 0.0 && beta2_ == 0.0;
   if (!plain) {
     kind_ = CutterKind::General;

@@ -55,7 +55,7 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
     }
   }
   const int32_t skip = winner;
-  index.walk(x, y, cutter.max_radius(), best, [&cutter](double rho) { return cutter.height(rho); },
+  index.walk(x, y, cutter.max_radius(), best, [&cutter](double lift) { return cutter.reach2(lift); },
              [&](const IndexedTriangle& t, int32_t i) {
                if (i == skip) return;
                ++tested;

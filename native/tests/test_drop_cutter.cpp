@@ -411,3 +411,25 @@ TEST(DropReference, RandomTrianglesSharpVBitByTaper) {
   check_against_references(v, 400, 26);
 }
 }  // namespace
+
+namespace {
+// reach2 inverts the profile: h(rho) < lift exactly when rho^2 < reach2(lift).
+TEST(Cutter, Reach2InvertsTheProfile) {
+  const double deg = M_PI / 180;
+  for (const Cutter& c : {Cutter(3, 3), Cutter(3, 0), Cutter(5, 2), Cutter::apt(4, 0, 4 * std::tan(60 * deg), 60 * deg, 0),
+                          Cutter::apt(5, 0, 4, 0, 45 * deg), Cutter::apt(5, 1.2, 8, 10 * deg, 8 * deg),
+                          Cutter::apt(3.5, 1.0, 6, 0, -5 * deg)}) {
+    for (int i = 0; i <= 400; ++i) {
+      const double rho = c.max_radius() * i / 400.0;
+      const double h = c.height(rho);
+      for (const double lift : {h + 1e-6, h + 0.3, h - 1e-6}) {
+        const bool below = h < lift;
+        const double r2 = c.reach2(lift);
+        if (std::fabs(rho * rho - r2) > 1e-9 * (1 + r2)) EXPECT_EQ(rho * rho < r2, below) << rho << " " << lift;
+      }
+    }
+    EXPECT_LT(c.reach2(0.0), 0.0);
+    EXPECT_EQ(c.reach2(c.height(c.max_radius()) + 1), INFINITY);
+  }
+}
+}  // namespace

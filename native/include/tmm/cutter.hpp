@@ -68,6 +68,26 @@ class Cutter {
     const double q = maxd(r_ * r_ - t * t, 0.0);
     return r_ * r_ / (q * std::sqrt(q));
   }
+  // Squared radius within which the profile stays below `lift`: h(rho) < lift exactly when
+  // rho^2 < reach2(lift). Pruning compares squared distances with it: no square roots for the ball.
+  double reach2(double lift) const {
+    if (!(lift > 0.0)) return -1.0;
+    if (lift >= h_max_) return INFINITY;
+    if (lift <= k1_ * rho_a_) {  // on the bottom cone, or anywhere on a flat bottom
+      if (k1_ == 0.0) return rho_a_ * rho_a_;
+      const double rho = lift / k1_;
+      return rho * rho;
+    }
+    if (lift <= h_b_) {  // on the arc: (rho - e)^2 = r^2 - (f - lift)^2
+      const double q = r_ * r_ - (f_ - lift) * (f_ - lift);
+      if (e_ == 0.0) return q;
+      const double rho = e_ + std::sqrt(maxd(q, 0.0));
+      return rho * rho;
+    }
+    const double rho = rho_b_ + (lift - h_b_) / k2_;  // on the taper
+    return rho * rho;
+  }
+
   // Distance from the axis of the point touching a plane whose unit normal has horizontal length nxy and
   // vertical component nz > 0 (the plane's slope is atan(nxy / nz)): where h' equals that slope.
   double facet_contact_radius(double nxy, double nz) const {
@@ -86,7 +106,7 @@ class Cutter {
   double k1_ = 0, k2_ = 0;           // slopes of the bottom cone and the taper (k2 = cot beta2)
   double k1_num_ = 0, k1_den_ = 1;   // tan(beta1) = sin / cos, compared without division
   double k2_num_ = 1, k2_den_ = 0;   // cot(beta2) = cos / sin
-  double rho_a_ = 0, rho_b_ = 0, h_b_ = 0, rho_max_ = 0;
+  double rho_a_ = 0, rho_b_ = 0, h_b_ = 0, rho_max_ = 0, h_max_ = 0;
   bool arc_ends_vertical_ = true;
   CutterKind kind_ = CutterKind::General;
 };

@@ -50,13 +50,13 @@ class MeshIndex {
   double zmin() const { return zmin_; }
   double zmax() const { return nodes_.empty() ? zmin_ : nodes_[0].zmax; }
 
-  // Visits, best-first, the triangles whose XY bounds come within `radius` of (x, y) and whose bound
-  // exceeds `floor`; `floor` may rise during the walk (visit raises it). The bound of a box is
-  // zmax - lift(d), d its XY distance from (x, y): with lift = the cutter profile h, no triangle in the box
-  // can hold the cutter's tip higher (every point of it is at least d from the axis, and h increases).
-  // visit(triangle, position) gets the triangle's position in triangles().
-  template <class Lift, class Visit>
-  void walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const;
+  // Visits, best-first, the triangles whose XY bounds come within `radius` of (x, y) and could hold the
+  // cutter above `floor`; `floor` may rise during the walk (visit raises it). A box at XY distance d whose
+  // highest point is zmax can only hold the tip above floor if h(d) < zmax - floor, i.e.
+  // d^2 < reach2(zmax - floor) (see Cutter::reach2): every point of it is at least d from the axis and h
+  // increases. visit(triangle, position) gets the triangle's position in triangles().
+  template <class Reach2, class Visit>
+  void walk(double x, double y, double radius, const double& floor, Reach2&& reach2, Visit&& visit) const;
 
  private:
   void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads);
@@ -67,46 +67,35 @@ class MeshIndex {
   double zmin_ = 0.0;
 };
 
-template <class Lift, class Visit>
-void MeshIndex::walk(double x, double y, double radius, const double& floor, Lift&& lift, Visit&& visit) const {
+template <class Reach2, class Visit>
+void MeshIndex::walk(double x, double y, double radius, const double& floor, Reach2&& reach2, Visit&& visit) const {
   const double r2 = radius * radius;
-  auto box_bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
+  auto may_hold = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
     const double dx = maxd(maxd(xmin - x, x - xmax), 0.0);
     const double dy = maxd(maxd(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
-    if (d2 > r2) return -std::numeric_limits<double>::infinity();
-    return zmax - lift(std::sqrt(d2));
+    return d2 <= r2 && d2 < reach2(zmax - floor);
   };
-  struct Entry {
-    int32_t node;
-    double bound;
-  };
-  Entry stack[128];
+  int32_t stack[128];
   int top = 0;
-  stack[top++] = {0, INFINITY};
+  stack[top++] = 0;
   while (top > 0) {
-    const Entry e = stack[--top];
-    if (e.bound <= floor) continue;
-    const BvhNode& node = nodes_[e.node];
+    const BvhNode& node = nodes_[stack[--top]];
+    if (!may_hold(node.xmin, node.ymin, node.xmax, node.ymax, node.zmax)) continue;
     if (node.count > 0) {
       for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
         const IndexedTriangle& t = tris_[i];
-        if (t.zmax <= floor) continue;
-        const double b = box_bound(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax);
-        if (b > floor) visit(t, i);
+        if (may_hold(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax)) visit(t, i);
       }
     } else {
-      const BvhNode& l = nodes_[node.first];
-      const BvhNode& r = nodes_[node.first + 1];
-      const double bl = l.zmax > floor ? box_bound(l.xmin, l.ymin, l.xmax, l.ymax, l.zmax) : -INFINITY;
-      const double br = r.zmax > floor ? box_bound(r.xmin, r.ymin, r.xmax, r.ymax, r.zmax) : -INFINITY;
-      // The more promising child last, so it is popped first: its contacts prune more of the other.
-      if (bl > br) {
-        if (br > floor) stack[top++] = {node.first + 1, br};
-        if (bl > floor) stack[top++] = {node.first, bl};
+      // The higher child last, so it is popped first: its contacts prune more of the other.
+      const int32_t l = node.first, r = node.first + 1;
+      if (nodes_[l].zmax > nodes_[r].zmax) {
+        stack[top++] = r;
+        stack[top++] = l;
       } else {
-        if (bl > floor) stack[top++] = {node.first, bl};
-        if (br > floor) stack[top++] = {node.first + 1, br};
+        stack[top++] = l;
+        stack[top++] = r;
       }
     }
   }
