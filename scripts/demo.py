@@ -1,4 +1,5 @@
-"""TMM's main job, headless: three models finished with a 3-axis surface raster.
+"""TMM's main job, headless: three models finished with a 3-axis surface raster, then seed 001's convex
+Bézier patch finished 5-axis by multipoint positioning (tarus G-code, APT CL, document, pictures).
 
     freecadcmd scripts/demo.py            # G-code (.ngc), FreeCAD document (.FCStd) and picture (.png)
     /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
@@ -160,6 +161,106 @@ def main() -> None:
         rows.append(row)
 
     print_table(rows, time.perf_counter() - t_all)
+
+    # 5-axis part: seed 001's convex patch, multipoint positioning (the 3-axis part above is unchanged)
+    t5 = time.perf_counter()
+    row5 = run_multipoint_case(out, with_freecad)
+    print_table5(row5, time.perf_counter() - t5)
+
+
+# --- 5-axis part -------------------------------------------------------------------------------------
+MP_NAME = "multipoint_convex"
+MP_PARAMS = dict(Ro=6.7, Ri=6.0, method="vcrf", side_step=18.0, forward_step=2.0)  # the seed's tool and footprint
+
+
+def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
+    """Seed 001's convex patch as a FreeCAD Bézier face through `run_multipoint` (Job, bull-nose ToolBit,
+    'TMM 5-axis Multipoint' op, tarus and apt_cl posts, document), a picture of the tool axes, and (when
+    core.seed_experiment is there) the seed's section-deviation plot at y = 27 mm."""
+    from tmm_workbench.core import bezier
+    from tmm_workbench.core.multipoint import BezierFace, MultipointParams, compute_multipoint_toolpath
+    from tmm_workbench.core.preview5 import face_grid, render_axes_png
+
+    net = bezier.load_seed_patch(BENCH / "seed_surfaces.json", "convex")
+    p = MP_PARAMS
+    print(f"--- {MP_NAME}: seed 001 convex Bezier face, 5-axis multipoint {p['method'].upper()}, torus Ro "
+          f"{p['Ro']:g} Ri {p['Ri']:g}, side step {p['side_step']:g} mm, forward step {p['forward_step']:g} mm",
+          flush=True)
+    t0 = time.perf_counter()
+    files: list[Path] = []
+    if with_freecad:
+        import FreeCAD
+        import Part
+        from tmm_workbench.app.api import run_multipoint
+
+        surf = Part.BezierSurface()
+        surf.increase(3, 3)
+        for i in range(4):
+            for j in range(4):
+                surf.setPole(i + 1, j + 1, FreeCAD.Vector(*map(float, net[i, j])))
+        r = run_multipoint(surf, **p, out_dir=out, name=MP_NAME, fcstd_path=out / f"{MP_NAME}.FCStd",
+                           doc_name=MP_NAME)
+        face, results, core_tp = r.op.Proxy.face, r.results, r.core_toolpath
+        n_commands, summary = len(r.op.Path.Commands), r.op.ContactSummary
+        files += [r.files["tarus"], r.files["apt_cl"], r.files["fcstd"]]
+        try:
+            FreeCAD.closeDocument(r.doc.Name)
+        except Exception:  # noqa: BLE001 - closing is a courtesy
+            pass
+    else:
+        face = BezierFace.from_net(net, name="seed convex")
+        core_tp, results = compute_multipoint_toolpath(
+            face, p["Ro"], p["Ri"], MultipointParams(side_step=p["side_step"], forward_step=p["forward_step"]),
+            p["method"])
+        n_commands, summary = 0, ""
+    seconds = time.perf_counter() - t0
+
+    import numpy as np
+
+    png = out / f"{MP_NAME}_axes.png"
+    t1 = time.perf_counter()
+    render_axes_png(face_grid(face), results, str(png), toolpath=core_tp,
+                    title=f"TMM 5-axis multipoint ({p['method'].upper()}): seed 001 convex Bezier patch - torus "
+                          f"Ro {p['Ro']:g} Ri {p['Ri']:g}, side step {p['side_step']:g} mm, forward step "
+                          f"{p['forward_step']:g} mm")
+    files.append(png)
+    png_seconds = time.perf_counter() - t1
+
+    section_note = ""
+    try:
+        from tmm_workbench.core.seed_experiment import run_experiment, section_plot
+    except ImportError:
+        section_note = "section plot skipped (tmm_workbench.core.seed_experiment not available)"
+    else:
+        t2 = time.perf_counter()
+        sec = run_experiment("convex", p["method"])
+        sec_png = out / f"{MP_NAME}_section.png"
+        section_plot([sec], sec_png)
+        files.append(sec_png)
+        section_note = (f"section y = {sec.section_y:g} mm ({sec.n_positions} positions at the seed's footprint): max "
+                        f"deviation {sec.max_dev:.3f} mm (seed, simulated: 0.53 mm), {time.perf_counter() - t2:.1f} s")
+    counts = results.counts()
+    tilt = np.degrees(np.arccos(np.clip(results["axis"][results.status != 2][:, 2], -1, 1)))
+    return dict(name=MP_NAME, counts=counts, points=len(results), commands=n_commands, summary=summary,
+                cut_moves=sum(1 for m in core_tp if m.kind.name != "RAPID"), max_tilt=float(tilt.max()),
+                seconds=seconds, png_seconds=png_seconds, files=files, section=section_note)
+
+
+def print_table5(r: dict[str, Any], total: float) -> None:
+    head = f"{'case (5-axis)':<18} {'points':>6} {'two':>5} {'one':>5} {'failed':>6} {'cut moves':>9} " \
+           f"{'commands':>8} {'max tilt':>8} {'compute s':>9} {'png s':>6}"
+    print("\n" + head)
+    print("-" * len(head))
+    c = r["counts"]
+    print(f"{r['name']:<18} {r['points']:>6} {c['two']:>5} {c['one']:>5} {c['failed']:>6} {r['cut_moves']:>9} "
+          f"{r['commands']:>8} {r['max_tilt']:>7.1f}d {r['seconds']:>9.2f} {r['png_seconds']:>6.2f}")
+    if r["section"]:
+        print(r["section"])
+    print("\nwritten (5-axis):")
+    for f in r["files"]:
+        size = f.stat().st_size if f.exists() else -1
+        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print(f"5-axis part {total:.1f} s", flush=True)
 
 
 def print_table(rows: list[dict[str, Any]], total: float) -> None:

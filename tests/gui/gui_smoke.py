@@ -52,6 +52,7 @@ def smoke() -> dict:
     commands = set(FreeCADGui.listCommands())
     for cmd in ["Path_TMM_Surface", "TMM_JobFromModel"] + workbench.PATH_JOB_TOOLS + workbench.PATH_TOOL_TOOLS:
         assert cmd in commands, f"command {cmd} missing"
+    assert "Path_TMM_Multipoint" in commands, "command Path_TMM_Multipoint (5-axis Multipoint) missing"
 
     from tmm_workbench.app.api import run_surface
     from tmm_workbench.gui.op_surface_gui import ViewProvider

@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Optional, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import FreeCAD
 
@@ -142,3 +142,170 @@ class _CallbackProgress(progress_mod.ProgressReporter):
 
     def __call__(self, fraction: float) -> bool:
         return bool(self.callback(fraction))
+
+
+# --- 5-axis multipoint ---------------------------------------------------------------------------
+POST_SUFFIXES = {"tarus": ".tarus.ngc", "apt_cl": ".apt"}
+
+
+@dataclass
+class MultipointResult:
+    doc: Any                  # App.Document holding everything
+    job: Any                  # the Path Job
+    op: Any                   # the TMM_Multipoint operation
+    face: tuple[Any, str]     # (object, "FaceN") the op machines (the Job's model clone)
+    toolpath: Toolpath        # the op's linked tool path (what its Path encodes)
+    core_toolpath: Toolpath   # the core's tool path (cut moves identical to the op's)
+    results: Any              # core.multipoint.MultipointResults (per footprint point)
+    gcode: dict               # post name -> text
+    files: dict               # post name -> written file (when out_dir is given), "fcstd" -> document
+
+
+def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
+                   side_step: float = 18.0, forward_step: float = 2.0, feed_angle_deg: float = 90.0,
+                   margin: float = 0.0, zigzag: bool = True, tilt_limit_deg: Optional[float] = None,
+                   tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
+                   safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
+                   horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                   posts: Sequence[str] = ("tarus", "apt_cl"), out_dir: Optional[Union[str, os.PathLike]] = None,
+                   name: str = "multipoint", fcstd_path: Optional[Union[str, os.PathLike]] = None,
+                   doc_name: str = "TMM5", progress: Union[bool, Callable[[float], bool]] = True
+                   ) -> MultipointResult:
+    """5-axis multipoint finishing (seed 001) of one Bézier/B-spline face, to G-code for each post.
+
+    face_source: a Bézier control net (array (m+1, n+1, 3), mm), a Part.BezierSurface / BSplineSurface
+    (both machined in a new document `doc_name`), or an (object, "FaceN") pair (machined in the object's
+    document). Tool: Ro, Ri of the torus (Ro = 0: ball end mill D = 2 Ri; the ToolBit is a bull-nose
+    D = 2 (Ro + Ri), corner Ri). method 'vcrf' | 'drd'; tool_shape 'round_insert' (the seed's
+    torus, hollow centre) | 'bull_nose' (plus its flat bottom).
+    tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm).
+    Heights default to the face's top + 5 mm (safe, for the tool's lowest point) and + 10 mm (clearance).
+    Feeds in mm/min. Each post's output goes to out_dir/<name><suffix> (tarus: .tarus.ngc, apt_cl: .apt,
+    others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
+    document opened by the call is closed first).
+    """
+    from tmm_workbench.app import op_multipoint
+    from tmm_workbench.app import posts as posts_mod
+
+    method_name = {"vcrf": "VCRF", "drd": "DRD"}.get(str(method).lower())
+    if method_name is None:
+        raise TmmError(f"method must be 'vcrf' or 'drd', got {method!r}")
+    shape_name = {v: k for k, v in op_multipoint.TOOL_SHAPES.items()}.get(str(tool_shape).lower())
+    if shape_name is None:
+        raise TmmError(f"tool_shape must be one of {', '.join(op_multipoint.TOOL_SHAPES.values())}, "
+                       f"got {tool_shape!r}")
+    for label, v in (("Ro", Ro), ("Ri", Ri)):
+        if not isinstance(v, (int, float)) or not v >= 0:
+            raise TmmError(f"{label} must be a length >= 0 mm, got {v!r}")
+    if Ro + Ri <= 0:
+        raise TmmError("the tool has no size: Ro + Ri must be > 0")
+
+    source_obj, sub = _face_pair(face_source)
+    own_doc = source_obj is None
+    doc = FreeCAD.newDocument(doc_name) if own_doc else source_obj.Document
+    try:
+        if own_doc:
+            source_obj, sub = _surface_feature(doc, face_source), "Face1"
+        doc.recompute()
+        try:
+            surf = op_multipoint.face_surface(source_obj, sub)
+            top = op_multipoint.face_top(op_multipoint.BezierFace.from_freecad_surface(surf))
+        except TmmError:  # the op reports it (and keeps its message as its status)
+            top = source_obj.Shape.BoundBox.ZMax
+        safe = top + 5.0 if safe_height is None else float(safe_height)
+        clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
+
+        job = jobs.create_job(doc, source_obj, name="Job")
+        clone = job.Model.Group[-1]
+        if Ro > 0 and Ri > 0:
+            bit = jobs.make_tool_bit(doc, "bullnose", 2 * (Ro + Ri), Ri)
+        elif Ri > 0:
+            bit = jobs.make_tool_bit(doc, "ballend", 2 * Ri)
+        else:
+            bit = jobs.make_tool_bit(doc, "endmill", 2 * Ro)
+        tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
+        values: dict[str, Any] = {
+            "Base": [(clone, (sub,))], "Method": method_name, "ToolShape": shape_name, "SideStep": side_step,
+            "ForwardStep": forward_step, "FeedAngle": feed_angle_deg, "BoundaryMargin": margin,
+            "ZigZag": bool(zigzag), "AxisRetract": axis_retract, "SafeHeight": safe, "ClearanceHeight": clearance}
+        if tilt_limit_deg is not None:
+            values["TiltLimit"] = tilt_limit_deg
+        if tolerance is not None:
+            values["Tolerance"] = tolerance
+        op = op_multipoint.Create(op_multipoint.OP_NAME, parentJob=job, values=values)
+        if posts and posts[0] in _job_posts(job):
+            job.PostProcessor = posts[0]
+            job.PostProcessorArgs = posts_mod.DEFAULT_ARGS.get(posts[0], "--no-show-editor")
+
+        factory = None
+        if callable(progress):
+            factory = lambda label: _CallbackProgress(progress)  # noqa: E731
+        op.Proxy.progress_enabled = bool(progress)
+        with progress_mod.using(factory):
+            op.touch()
+            doc.recompute()
+        if not op.isValid() or op.Proxy.toolpath is None:
+            raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
+
+        gcode: dict[str, str] = {}
+        files: dict[str, Path] = {}
+        out = Path(out_dir) if out_dir else None
+        if out is not None:
+            out.mkdir(parents=True, exist_ok=True)
+        for post in posts:
+            target = out / f"{name}{POST_SUFFIXES.get(post, f'.{post}.ngc')}" if out is not None else None
+            gcode[post] = posts_mod.export(post, [tc, op], target)
+            if target is not None:
+                files[post] = target
+    except BaseException:
+        if own_doc:
+            FreeCAD.closeDocument(doc.Name)
+        raise
+    if fcstd_path:
+        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
+        doc.saveAs(str(fcstd_path))
+        files["fcstd"] = Path(fcstd_path)
+    p = op.Proxy
+    return MultipointResult(doc, job, op, (clone, sub), p.toolpath, p.core_toolpath, p.results, gcode, files)
+
+
+def _face_pair(source: Any) -> tuple[Any, str]:
+    """(object, "FaceN") for a pair input, (None, "") for a net or a surface."""
+    if isinstance(source, (tuple, list)) and len(source) == 2 and hasattr(source[0], "TypeId"):
+        obj, sub = source
+        if not isinstance(sub, str) or not sub.startswith("Face"):
+            raise TmmError(f"face_source: the element of {obj.Label} must be named 'FaceN', got {sub!r}")
+        return obj, sub
+    return None, ""
+
+
+def _surface_feature(doc: Any, source: Any) -> Any:
+    """A Part::Feature holding the face of a surface or of a Bézier control net."""
+    import Part
+
+    kind = type(source).__name__
+    if kind in ("BezierSurface", "BSplineSurface"):
+        surf = source
+    else:
+        import numpy as np
+
+        try:
+            net = np.asarray(source, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise TmmError(f"face_source must be a control net, a Part surface or (object, 'FaceN'); "
+                           f"got {type(source).__name__}") from exc
+        if net.ndim != 3 or net.shape[2] != 3 or net.shape[0] < 2 or net.shape[1] < 2:
+            raise TmmError(f"a Bézier control net must have shape (m+1, n+1, 3), m, n >= 1; got {net.shape}")
+        if not np.isfinite(net).all():
+            raise TmmError("the Bézier control net has a non-finite coordinate")
+        if max(net.shape[:2]) > 26:
+            raise TmmError(f"a Bézier net of shape {net.shape} exceeds FreeCAD's degree limit (25)")
+        surf = Part.BezierSurface()
+        surf.increase(net.shape[0] - 1, net.shape[1] - 1)
+        for i in range(net.shape[0]):
+            for j in range(net.shape[1]):
+                surf.setPole(i + 1, j + 1, FreeCAD.Vector(*map(float, net[i, j])))
+    obj = doc.addObject("Part::Feature", "Surface")
+    obj.Shape = surf.toShape()
+    obj.Label = "Bezier surface" if type(surf).__name__ == "BezierSurface" else "B-spline surface"
+    return obj

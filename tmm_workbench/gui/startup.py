@@ -16,6 +16,12 @@ def _lazy_view(kind: str) -> Callable[[Any], None]:
     return attach
 
 
+def _multipoint_view(obj: Any) -> None:
+    from tmm_workbench.gui import op_multipoint_gui  # Path's Gui modules load here, not at start-up
+
+    op_multipoint_gui.attach_view_provider(obj)
+
+
 def _dialog_progress(label: str) -> Any:
     from tmm_workbench.gui import progress_dialog
 
@@ -27,4 +33,5 @@ def install_hooks() -> None:
 
     hooks.view_hooks.setdefault("op", _lazy_view("op"))
     hooks.view_hooks.setdefault("job", _lazy_view("job"))
+    hooks.view_hooks.setdefault("multipoint_op", _multipoint_view)
     progress.progress_factory = _dialog_progress

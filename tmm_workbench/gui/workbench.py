@@ -28,9 +28,10 @@ class TMMWorkbench(FreeCADGui.Workbench):
         import_gui("tool_bit_library_cmd")
         import_gui("commands")
         from tmm_workbench.gui import job_cmd, op_surface_gui
+        from tmm_workbench.gui import op_multipoint_gui
 
         posts.install_post_dir()
-        tmm = [job_cmd.COMMAND_NAME, op_surface_gui.COMMAND_NAME]
+        tmm = [job_cmd.COMMAND_NAME, op_surface_gui.COMMAND_NAME, op_multipoint_gui.COMMAND_NAME]
         self.appendToolbar("TMM", tmm)
         self.appendToolbar("TMM Path", PATH_JOB_TOOLS)
         self.appendToolbar("TMM Tools", PATH_TOOL_TOOLS)
