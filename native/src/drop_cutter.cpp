@@ -99,11 +99,13 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
   std::atomic<bool> cancel{false};
   auto work = [&] {
     DropStats local;
-    int32_t hint = -1;  // consecutive points of a chunk are neighbours along the footprint
     for (;;) {
       const std::size_t k = next.fetch_add(1);
       if (k >= chunks || cancel.load(std::memory_order_relaxed)) break;
       const std::size_t e = std::min(n, (k + 1) * chunk);
+      // Consecutive points of a chunk are neighbours along the footprint. The hint starts afresh with each
+      // chunk so every result depends on its chunk only: the same bits whatever the thread count.
+      int32_t hint = -1;
       for (std::size_t i = k * chunk; i < e; ++i) {
         z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_z, &local, &hint);
       }

@@ -392,8 +392,9 @@ TEST(DropBatch, ThreadsAgreeAndCancel) {
   tmm::drop_batch(index, cut, xy.data(), 5000, -1, z2.data(), two);
   EXPECT_EQ(last, 1.0);
   for (int i = 0; i < 5000; ++i) {
-    EXPECT_EQ(z1[i], z2[i]);
-    EXPECT_EQ(z1[i], tmm::drop_point(index, cut, xy[2 * i], xy[2 * i + 1], -1));
+    EXPECT_EQ(z1[i], z2[i]);  // deterministic: the same bits whatever the thread count
+    // A single query may reach the same contact through another element: equal up to rounding.
+    EXPECT_NEAR(z1[i], tmm::drop_point(index, cut, xy[2 * i], xy[2 * i + 1], -1), 1e-12);
   }
   tmm::BatchOptions cancel;
   cancel.progress = [](double) { return false; };

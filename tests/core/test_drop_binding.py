@@ -67,7 +67,9 @@ def test_threads_agree_and_progress_reports(wavy_mesh):
     seen = []
     z1 = surface.drop(cutter, xy, -50, threads=1)
     z2 = surface.drop(cutter, xy, -50, threads=2, progress=lambda f: seen.append(f) or True)
-    np.testing.assert_array_equal(z1, z2)
+    z3 = surface.drop(cutter, xy, -50, threads=3)
+    np.testing.assert_array_equal(z1, z2)  # deterministic: the same bits whatever the thread count
+    np.testing.assert_array_equal(z1, z3)
     assert seen and seen[-1] == 1.0 and all(b >= a for a, b in zip(seen, seen[1:]))
 
 
