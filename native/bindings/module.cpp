@@ -5,11 +5,13 @@ namespace py = pybind11;
 
 void bind_mesh(py::module_& m);   // bind_mesh.cpp: STL reading, indexed mesh, vertex normals
 void bind_drop(py::module_& m);   // bind_drop.cpp: cutters, spatial index, batch drop-cutter
+void bind_direction(py::module_& m);  // bind_direction.cpp: drop along any direction, any axis
 void bind_surface(py::module_& m);
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "TMM geometry kernel (C++17, Eigen)";
   bind_mesh(m);
   bind_drop(m);
+  bind_direction(m);
   bind_surface(m);
 }
