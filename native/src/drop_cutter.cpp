@@ -55,16 +55,15 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
     }
   }
   const int32_t skip = winner;
-  index.walk(x, y, cutter.max_radius(), best, [&cutter](double lift) { return cutter.reach2(lift); },
-             [&](const IndexedTriangle& t, int32_t i) {
-               if (i == skip) return;
-               ++tested;
-               const double z = drop_on_owned(cutter, x, y, t, best);
-               if (z > best) {
-                 best = z;
-                 winner = i;
-               }
-             });
+  index.walk(x, y, cutter, best, [&](const IndexedTriangle& t, int32_t i) {
+    if (i == skip) return;
+    ++tested;
+    const double z = drop_on_owned(cutter, x, y, t, best);
+    if (z > best) {
+      best = z;
+      winner = i;
+    }
+  });
   if (stats) stats->triangles_tested += tested;
   if (hint) *hint = winner;
   return best;

@@ -50,13 +50,13 @@ class MeshIndex {
   double zmin() const { return zmin_; }
   double zmax() const { return nodes_.empty() ? zmin_ : nodes_[0].zmax; }
 
-  // Visits, best-first, the triangles whose XY bounds come within `radius` of (x, y) and could hold the
+  // Visits, best-first, the triangles whose XY bounds come within the cutter's radius of (x, y) and could hold the
   // cutter above `floor`; `floor` may rise during the walk (visit raises it). A box at XY distance d whose
   // highest point is zmax can only hold the tip above floor if h(d) < zmax - floor, i.e.
   // d^2 < reach2(zmax - floor) (see Cutter::reach2): every point of it is at least d from the axis and h
   // increases. visit(triangle, position) gets the triangle's position in triangles().
-  template <class Reach2, class Visit>
-  void walk(double x, double y, double radius, const double& floor, Reach2&& reach2, Visit&& visit) const;
+  template <class Visit>
+  void walk(double x, double y, const Cutter& cutter, const double& floor, Visit&& visit) const;
 
  private:
   void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads);
@@ -67,14 +67,14 @@ class MeshIndex {
   double zmin_ = 0.0;
 };
 
-template <class Reach2, class Visit>
-void MeshIndex::walk(double x, double y, double radius, const double& floor, Reach2&& reach2, Visit&& visit) const {
-  const double r2 = radius * radius;
+template <class Visit>
+void MeshIndex::walk(double x, double y, const Cutter& cutter, const double& floor, Visit&& visit) const {
+  const double r2 = cutter.max_radius() * cutter.max_radius();
   auto may_hold = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
     const double dx = maxd(maxd(xmin - x, x - xmax), 0.0);
     const double dy = maxd(maxd(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
-    return d2 <= r2 && d2 < reach2(zmax - floor);
+    return d2 <= r2 && d2 < cutter.reach2(zmax - floor);
   };
   int32_t stack[128];
   int top = 0;
