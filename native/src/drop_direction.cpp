@@ -48,19 +48,6 @@ void require_unit(const Vector3d& v, const char* what) {
   }
 }
 
-// Joins its threads on every exit path.
-class ThreadGroup {
- public:
-  ~ThreadGroup() {
-    for (auto& t : threads_) t.join();
-  }
-  template <class F>
-  void spawn(F&& f) { threads_.emplace_back(std::forward<F>(f)); }
-
- private:
-  std::vector<std::thread> threads_;
-};
-
 }  // namespace
 
 ToolFrame::ToolFrame(const Vector3d& axis) : a(axis.normalized()) {
@@ -507,50 +494,18 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
     if ((index.rotation() * ax.normalized() - Vector3d::UnitZ()).norm() > kParallelAxisTol)
       require_finite_length(cutter);
   }
-  int threads = options.threads > 0 ? options.threads
-                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const std::size_t chunk = 128;
-  const std::size_t chunks = (n + chunk - 1) / chunk;
-  threads = static_cast<int>(std::min<std::size_t>(threads, std::max<std::size_t>(chunks, 1)));
-  std::atomic<std::size_t> next{0}, done{0}, tested{0};
-  std::atomic<bool> cancel{false};
-  auto work = [&] {
+  std::atomic<std::size_t> tested{0};
+  // The hint starts afresh with each chunk, so results do not depend on the thread count.
+  parallel_chunks(n, 128, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
     int32_t hint = -1;
-    for (;;) {
-      const std::size_t k = next.fetch_add(1);
-      if (k >= chunks || cancel.load(std::memory_order_relaxed)) break;
-      const std::size_t e = std::min(n, (k + 1) * chunk);
-      for (std::size_t i = k * chunk; i < e; ++i) {
-        const double* ax = axes + (axes_per_point ? 3 * i : 0);
-        travel_out[i] = drop_along_point(index, cutter, Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]),
-                                         Vector3d(ax[0], ax[1], ax[2]), max_travel, &local, &hint);
-      }
-      done.fetch_add(e - k * chunk);
+    for (std::size_t i = begin; i < end; ++i) {
+      const double* ax = axes + (axes_per_point ? 3 * i : 0);
+      travel_out[i] = drop_along_point(index, cutter, Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]),
+                                       Vector3d(ax[0], ax[1], ax[2]), max_travel, &local, &hint);
     }
     tested.fetch_add(local.triangles_tested);
-  };
-  {
-    ThreadGroup group;
-    if (!options.progress) {
-      for (int t = 1; t < threads; ++t) group.spawn(work);
-      work();
-    } else {
-      // The caller's thread reports progress (a Python callback needs it); workers compute.
-      for (int t = 0; t < threads; ++t) group.spawn(work);
-      try {
-        while (done.load() < n && !cancel.load()) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(20));
-          if (!options.progress(static_cast<double>(done.load()) / static_cast<double>(n))) cancel.store(true);
-        }
-      } catch (...) {
-        cancel.store(true);
-        throw;
-      }
-    }
-  }
-  if (cancel.load()) throw Cancelled();
-  if (options.progress) options.progress(1.0);
+  });
   if (stats) stats->triangles_tested += tested.load();
 }
 

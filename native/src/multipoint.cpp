@@ -1058,69 +1058,12 @@ MultipointResult MultipointPositioner::position(double x, double y) const {
   return res;
 }
 
-namespace {
-
-class ThreadGroup {
- public:
-  ~ThreadGroup() {
-    for (auto& t : threads_) t.join();
-  }
-  template <class F>
-  void spawn(F&& f) { threads_.emplace_back(std::forward<F>(f)); }
-
- private:
-  std::vector<std::thread> threads_;
-};
-
-}  // namespace
-
 void MultipointPositioner::position_batch(const double* xy, std::size_t n, MultipointResult* out,
                                           const BatchOptions& options) const {
-  int threads = options.threads > 0 ? options.threads
-                                    : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  const std::size_t chunk = opt_.method == MultipointMethod::DRD ? 1 : 16;
-  const std::size_t chunks = (n + chunk - 1) / chunk;
-  threads = static_cast<int>(std::min<std::size_t>(threads, std::max<std::size_t>(chunks, 1)));
-  std::atomic<std::size_t> next{0}, done{0};
-  std::atomic<bool> cancel{false};
-  std::exception_ptr error;
-  std::atomic<bool> failed{false};
-  auto work = [&] {
-    try {
-      for (;;) {
-        const std::size_t k = next.fetch_add(1);
-        if (k >= chunks || cancel.load(std::memory_order_relaxed)) break;
-        const std::size_t e = std::min(n, (k + 1) * chunk);
-        for (std::size_t i = k * chunk; i < e; ++i) out[i] = position(xy[2 * i], xy[2 * i + 1]);
-        done.fetch_add(e - k * chunk);
-      }
-    } catch (...) {
-      if (!failed.exchange(true)) error = std::current_exception();
-      cancel.store(true);
-    }
-  };
-  {
-    ThreadGroup group;
-    if (!options.progress) {
-      for (int t = 1; t < threads; ++t) group.spawn(work);
-      work();
-    } else {
-      for (int t = 0; t < threads; ++t) group.spawn(work);
-      try {
-        while (done.load() < n && !cancel.load()) {
-          std::this_thread::sleep_for(std::chrono::milliseconds(20));
-          const double fraction = static_cast<double>(done.load()) / static_cast<double>(n);
-          if (!options.progress(fraction)) cancel.store(true);
-        }
-      } catch (...) {
-        cancel.store(true);
-        throw;
-      }
-    }
-  }
-  if (failed.load()) std::rethrow_exception(error);
-  if (cancel.load()) throw Cancelled();
-  if (options.progress) options.progress(1.0);
+  const std::size_t chunk = opt_.method == MultipointMethod::DRD ? 1 : 16;  // DRD points are slow: balance
+  parallel_chunks(n, chunk, options, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = position(xy[2 * i], xy[2 * i + 1]);
+  });
 }
 
 }  // namespace tmm

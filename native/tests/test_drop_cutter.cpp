@@ -290,7 +290,9 @@ TEST(CutterApt, GeometryOfSpecialCases) {
     const double h = g.height(rho), sl = g.slope(rho);
     EXPECT_GE(h, last_h - 1e-12);
     EXPECT_GE(sl, last_s - 1e-9);
-    if (last_h >= 0) EXPECT_LT(h - last_h, 0.02);
+    if (last_h >= 0) {
+      EXPECT_LT(h - last_h, 0.02);
+    }
     last_h = h;
     last_s = sl;
   }
@@ -426,7 +428,9 @@ TEST(Cutter, Reach2InvertsTheProfile) {
       for (const double lift : {h + 1e-6, h + 0.3, h - 1e-6}) {
         const bool below = h < lift;
         const double r2 = c.reach2(lift);
-        if (std::fabs(rho * rho - r2) > 1e-9 * (1 + r2)) EXPECT_EQ(rho * rho < r2, below) << rho << " " << lift;
+        if (std::fabs(rho * rho - r2) > 1e-9 * (1 + r2)) {
+          EXPECT_EQ(rho * rho < r2, below) << rho << " " << lift;
+        }
       }
     }
     EXPECT_LT(c.reach2(0.0), 0.0);

@@ -9,14 +9,9 @@
 
 #include "tmm/cutter.hpp"
 #include "tmm/mesh_index.hpp"
+#include "tmm/parallel.hpp"
 
 namespace tmm {
-
-// Thrown by batch calls when the progress callback asks to stop.
-class Cancelled : public std::runtime_error {
- public:
-  Cancelled() : std::runtime_error("cancelled") {}
-};
 
 struct DropStats {
   std::size_t triangles_tested = 0;  // triangles whose contacts were computed
@@ -32,12 +27,6 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
 // `above`, only a contact higher than it is computed (the rest is pruned by cheap bounds) and returned.
 double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t,
                         double above = -std::numeric_limits<double>::infinity());
-
-struct BatchOptions {
-  int threads = 0;  // 0: all hardware threads
-  // Called now and then from the calling thread with the fraction done; return false to cancel.
-  std::function<bool(double)> progress;
-};
 
 // xy: n points (x0, y0, x1, y1, ...); z_out: n tip heights. Throws Cancelled if progress returns false.
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
