@@ -10,22 +10,14 @@
 #include <sstream>
 
 #include "tmm/drop_direction.hpp"
+#include "progress.hpp"
 
 namespace py = pybind11;
+using tmm_bindings::python_progress;
 
 namespace {
 
 using Array = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// As bind_drop.cpp: the callback runs with the GIL taken; a Python exception in it cancels and propagates.
-std::function<bool(double)> python_progress(const py::object& cb) {
-  if (cb.is_none()) return {};
-  return [cb](double fraction) {
-    py::gil_scoped_acquire gil;
-    py::object r = cb(fraction);
-    return r.is_none() || r.cast<bool>();
-  };
-}
 
 Eigen::Vector3d vec3(const Array& a, const char* what) {
   if (a.size() != 3) {

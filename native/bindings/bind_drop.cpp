@@ -9,23 +9,14 @@
 
 #include "tmm/drop_cutter.hpp"
 #include "tmm/mesh_index.hpp"
+#include "progress.hpp"
 
 namespace py = pybind11;
+using tmm_bindings::python_progress;
 
 namespace {
 
 using XY = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// Wraps a Python callable `cb(fraction) -> bool` for the kernel: called with the GIL taken; a Python
-// exception in it cancels the batch and propagates.
-std::function<bool(double)> python_progress(const py::object& cb) {
-  if (cb.is_none()) return {};
-  return [cb](double fraction) {
-    py::gil_scoped_acquire gil;
-    py::object r = cb(fraction);
-    return r.is_none() || r.cast<bool>();
-  };
-}
 
 py::array_t<double> drop_cutter(const tmm::MeshIndex& index, const tmm::Cutter& cutter,
                                 const XY& xy, double floor_z, int threads, const py::object& progress,

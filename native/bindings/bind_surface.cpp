@@ -11,8 +11,10 @@
 
 #include "tmm/bezier.hpp"
 #include "tmm/multipoint.hpp"
+#include "progress.hpp"
 
 namespace py = pybind11;
+using tmm_bindings::python_progress;
 
 namespace {
 
@@ -46,15 +48,6 @@ Arr check_points(const Arr& a, py::ssize_t cols, const char* what) {
     throw std::invalid_argument(msg.str());
   }
   return a;
-}
-
-std::function<bool(double)> python_progress(const py::object& cb) {
-  if (cb.is_none()) return {};
-  return [cb](double fraction) {
-    py::gil_scoped_acquire gil;
-    py::object r = cb(fraction);
-    return r.is_none() || r.cast<bool>();
-  };
 }
 
 py::array_t<double> rows3(std::size_t n) { return py::array_t<double>({static_cast<py::ssize_t>(n), py::ssize_t{3}}); }
