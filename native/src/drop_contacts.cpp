@@ -16,16 +16,7 @@ double plane_drop(const Cutter& c, double x, double y, const double* p0, const d
     cx -= rho * n[0] / nxy;  // uphill: the plane rises against n_xy
     cy -= rho * n[1] / nxy;
   }
-  // Is the contact point inside the triangle (in XY)? Barycentric signs with a relative tolerance.
-  const double ax = p0[0] - cx, ay = p0[1] - cy;
-  const double bx = p1[0] - cx, by = p1[1] - cy;
-  const double qx = p2[0] - cx, qy = p2[1] - cy;
-  const double w0 = bx * qy - by * qx;
-  const double w1 = qx * ay - qy * ax;
-  const double w2 = ax * by - ay * bx;
-  const double area = w0 + w1 + w2;
-  const double eps = 1e-12 * std::fabs(area);
-  inside = area > 0 ? (w0 >= -eps && w1 >= -eps && w2 >= -eps) : (w0 <= eps && w1 <= eps && w2 <= eps);
+  inside = inside_xy(p0, p1, p2, cx, cy);
   // Plane height at the contact point, then down by the cutter profile there.
   const double zc = p0[2] - (n[0] * (cx - p0[0]) + n[1] * (cy - p0[1])) / nz;
   return zc - c.height(rho);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <utility>
@@ -355,6 +356,78 @@ TEST(MeshIndex, QueryEqualsBruteForce) {
       double brute = -100;
       for (const auto& tri : index.triangles()) brute = std::max(brute, tmm::drop_on_triangle(cut, x, y, tri));
       EXPECT_NEAR(tmm::drop_point(index, cut, x, y, -100), brute, 1e-12);
+    }
+  }
+}
+
+// Batches are solved tile by tile over sorted candidate lists (drop_cutter.cpp): dense rasters take that
+// path. Every height equals the maximum over all triangles, for every kind of cutter, with sparse and
+// non-finite points mixed in; the same bits whatever the thread count; whatever the order of the points up
+// to rounding (a vertex contact is reached through whichever of its edges the pruning leaves).
+TEST(DropBatch, TiledRasterEqualsBruteForce) {
+  const int n = 24;
+  tmm::Vertices V((n + 1) * (n + 1), 3);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double x = i + jitter(rng), y = j + jitter(rng);
+      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / 4) * std::cos(y / 5) + jitter(rng);
+    }
+  tmm::Triangles F(2 * n * n, 3);
+  int t = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int v = i * (n + 1) + j;
+      F.row(t++) << v, v + n + 1, v + 1;
+      F.row(t++) << v + 1, v + n + 1, v + n + 2;
+    }
+  const tmm::MeshIndex index(V, F);
+  std::vector<double> xy;
+  for (int i = 0; i < 41; ++i)
+    for (int j = 0; j < 41; ++j) {
+      xy.push_back(-2 + 0.35 * j);  // rows along X, off the mesh on two sides
+      xy.push_back(-2 + 0.35 * i);
+    }
+  std::uniform_real_distribution<double> far(-10, n + 10);
+  for (int k = 0; k < 40; ++k) {  // sparse points: tiles of one or two points
+    xy.push_back(far(rng));
+    xy.push_back(far(rng));
+  }
+  xy.push_back(NAN);
+  xy.push_back(3.0);
+  const std::size_t m = xy.size() / 2;
+  std::vector<std::size_t> perm(m);
+  for (std::size_t i = 0; i < m; ++i) perm[i] = i;
+  std::shuffle(perm.begin(), perm.end(), rng);
+  std::vector<double> xy_shuffled(2 * m);
+  for (std::size_t i = 0; i < m; ++i) {
+    xy_shuffled[2 * i] = xy[2 * perm[i]];
+    xy_shuffled[2 * i + 1] = xy[2 * perm[i] + 1];
+  }
+  const double floor_z = -50;
+  for (const Cutter& cut : {Cutter(2, 2), Cutter(2, 0), Cutter(3, 1), Cutter::apt(2, 0.5, 6, 0, 0.1),
+                            Cutter::apt(3, 0, 3 * std::tan(M_PI / 3), M_PI / 3, 0)}) {
+    std::vector<double> z(m), z2(m), zs(m);
+    tmm::BatchOptions one, two;
+    one.threads = 1;
+    two.threads = 2;
+    tmm::DropStats stats;
+    tmm::drop_batch(index, cut, xy.data(), m, floor_z, z.data(), one, &stats);
+    tmm::drop_batch(index, cut, xy.data(), m, floor_z, z2.data(), two);
+    tmm::drop_batch(index, cut, xy_shuffled.data(), m, floor_z, zs.data(), two);
+    EXPECT_GT(stats.triangles_tested, 0u);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double x = xy[2 * i], y = xy[2 * i + 1];
+      EXPECT_EQ(z[i], z2[i]);
+      EXPECT_NEAR(zs[std::find(perm.begin(), perm.end(), i) - perm.begin()], z[i], 1e-12);
+      if (!std::isfinite(x)) {
+        EXPECT_EQ(z[i], floor_z);
+        continue;
+      }
+      double brute = floor_z;
+      for (const auto& tri : index.triangles()) brute = std::max(brute, tmm::drop_on_triangle(cut, x, y, tri));
+      ASSERT_NEAR(z[i], brute, 1e-12) << "point " << i << " at (" << x << ", " << y << ")";
     }
   }
 }

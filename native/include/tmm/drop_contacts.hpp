@@ -13,6 +13,20 @@ namespace tmm {
 constexpr double kNoContact = -std::numeric_limits<double>::infinity();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
+// Does (cx, cy) lie in the XY projection of triangle p0 p1 p2 (either orientation)? Barycentric signs with a
+// relative tolerance, so a point on an edge counts as inside.
+inline bool inside_xy(const double* p0, const double* p1, const double* p2, double cx, double cy) {
+  const double ax = p0[0] - cx, ay = p0[1] - cy;
+  const double bx = p1[0] - cx, by = p1[1] - cy;
+  const double qx = p2[0] - cx, qy = p2[1] - cy;
+  const double w0 = bx * qy - by * qx;
+  const double w1 = qx * ay - qy * ax;
+  const double w2 = ax * by - ay * bx;
+  const double area = w0 + w1 + w2;
+  const double eps = 1e-12 * std::fabs(area);
+  return area > 0 ? (w0 >= -eps && w1 >= -eps && w2 >= -eps) : (w0 <= eps && w1 <= eps && w2 <= eps);
+}
+
 // Vertex p: tip = p.z - h(rho).
 inline double vertex_drop(const Cutter& c, double x, double y, const double* p) {
   const double dx = p[0] - x, dy = p[1] - y;

@@ -58,6 +58,12 @@ class MeshIndex {
   template <class Visit>
   void walk(double x, double y, const Cutter& cutter, const double& floor, Visit&& visit) const;
 
+  // Visits the triangles whose XY bounds come within `radius` of the rectangle [x0, x1] x [y0, y1] and whose
+  // highest point is above `floor`: every triangle a cutter of that radius centred in the rectangle can
+  // rest on. visit(triangle, position) as for walk.
+  template <class Visit>
+  void near_rect(double x0, double y0, double x1, double y1, double radius, double floor, Visit&& visit) const;
+
  private:
   void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads);
   static int32_t descendants(int32_t triangles);
@@ -97,6 +103,33 @@ void MeshIndex::walk(double x, double y, const Cutter& cutter, const double& flo
         stack[top++] = l;
         stack[top++] = r;
       }
+    }
+  }
+}
+
+template <class Visit>
+void MeshIndex::near_rect(double x0, double y0, double x1, double y1, double radius, double floor,
+                          Visit&& visit) const {
+  const double r2 = radius * radius;
+  auto near = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
+    const double dx = maxd(maxd(xmin - x1, x0 - xmax), 0.0);
+    const double dy = maxd(maxd(ymin - y1, y0 - ymax), 0.0);
+    return dx * dx + dy * dy <= r2 && zmax > floor;
+  };
+  int32_t stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const BvhNode& node = nodes_[stack[--top]];
+    if (!near(node.xmin, node.ymin, node.xmax, node.ymax, node.zmax)) continue;
+    if (node.count > 0) {
+      for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
+        const IndexedTriangle& t = tris_[i];
+        if (near(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax)) visit(t, i);
+      }
+    } else {
+      stack[top++] = node.first + 1;
+      stack[top++] = node.first;
     }
   }
 }
