@@ -34,17 +34,34 @@ namespace {
 // Maximum of g(u) = z0 + m u - h(sqrt(d2 + u^2)) on [lo, hi] for any convex non-decreasing profile h.
 // g is concave, so g' = m - u h'(rho) / rho decreases: the maximum is at an end or at the root of g'
 // (at rho = 0 a cone's kink makes g' jump; the subgradient m is used there and bisection converges).
-double profile_edge_max(const Cutter& c, double d2, double z0, double m, double lo, double hi) {
+// Being concave, g lies below its tangents at both ends: where they meet bounds the maximum (a contact no
+// higher than `above` is not solved) and starts the Newton iteration close to the root.
+double profile_edge_max(const Cutter& c, double d2, double z0, double m, double lo, double hi, double above) {
   auto g = [&](double u) { return z0 + m * u - c.height(std::sqrt(d2 + u * u)); };
   auto dg = [&](double u) {
     const double rho = std::sqrt(d2 + u * u);
     if (rho == 0.0) return m;
     return m - u * c.slope(rho) / rho;
   };
-  if (!(dg(lo) > 0)) return g(lo);
-  if (!(dg(hi) < 0)) return g(hi);
+  const double slope_lo = dg(lo), slope_hi = dg(hi);
+  if (!(slope_lo > 0)) return g(lo);
+  if (!(slope_hi < 0)) return g(hi);
   double a = lo, b = hi;
   double u = 0.5 * (a + b);
+  {
+    const double g_lo = g(lo), g_hi = g(hi);
+    double bound = kInf;  // a vertical tangent (the arc turning vertical at an end) bounds nothing
+    if (std::isfinite(slope_lo) && std::isfinite(slope_hi)) {
+      u = std::clamp((g_hi - g_lo + slope_lo * lo - slope_hi * hi) / (slope_lo - slope_hi), lo, hi);
+      bound = g_lo + slope_lo * (u - lo);
+    } else if (std::isfinite(slope_lo)) {
+      bound = g_lo + slope_lo * (hi - lo);
+    } else if (std::isfinite(slope_hi)) {
+      bound = g_hi + slope_hi * (lo - hi);
+    }
+    if (bound + 1e-12 <= above) return kNoContact;  // margin: the bound's own rounding
+    if (!(u > lo && u < hi)) u = 0.5 * (lo + hi);
+  }
   for (int it = 0; it < 200 && b - a > 1e-12; ++it) {
     const double du = dg(u);
     if (du > 0) a = u; else b = u;
@@ -69,18 +86,25 @@ double profile_edge_max(const Cutter& c, double d2, double z0, double m, double 
 
 double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2, double above) {
   const double ex = p2[0] - p1[0], ey = p2[1] - p1[1];
-  const double L = std::sqrt(ex * ex + ey * ey);
+  const double L2 = ex * ex + ey * ey;
   const double R = c.max_radius();
-  if (L < 1e-12) {  // vertical edge: its top vertex is the contact
+  if (L2 < 1e-24) {  // vertical edge: its top vertex is the contact
     return std::max(vertex_drop(c, x, y, p1), vertex_drop(c, x, y, p2));
   }
-  const double wx = ex / L, wy = ey / L;
   const double sx = p1[0] - x, sy = p1[1] - y;
+  // Rejections before any root: the axis' distance from the edge line is d = cross / L. Beyond R, no
+  // contact; and the contact is at most the higher end lowered by h(|d|), which is no higher than `above`
+  // exactly when d^2 >= reach2(top - above).
+  const double cross = ex * sy - ey * sx;
+  const double cross2 = cross * cross;
+  if (cross2 > R * R * L2) return kNoContact;
+  if (!(cross2 < c.reach2(maxd(p1[2], p2[2]) - above) * L2)) return kNoContact;
+  const double L = std::sqrt(L2);
+  const double wx = ex / L, wy = ey / L;
   const double u1 = sx * wx + sy * wy;      // position of p1 along the edge, 0 at the foot of the axis
   const double d = wx * sy - wy * sx;       // signed distance of the axis from the edge line (XY)
   const double d2 = d * d;
   if (d2 > R * R) return kNoContact;
-  if (maxd(p1[2], p2[2]) - c.height(std::fabs(d)) <= above) return kNoContact;
   const double s = std::sqrt(R * R - d2);   // half-chord of the cutter's shadow along the edge
   const double lo = std::max(u1, -s), hi = std::min(u1 + L, s);
   if (lo > hi) return kNoContact;
@@ -95,7 +119,7 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
     }
     case CutterKind::Bull:
     case CutterKind::General:
-      return profile_edge_max(c, d2, z0, m, lo, hi);
+      return profile_edge_max(c, d2, z0, m, lo, hi, above);
   }
   return kNoContact;
 }
