@@ -149,11 +149,19 @@ struct TileCandidates {
   }
 };
 
+// How the block filter tests reach (Cutter::reach2) for the cutters with a flat bottom and a corner arc
+// of radius r centred e from the axis: d^2 < reach2(lift) is lift >= r or d < e + sqrt(r^2 - (r - lift)^2).
+enum class Reach {
+  Scalar,  // any other profile: Cutter::reach2 on the survivors
+  Flat,    // r = 0: anything within the radius is within reach
+  Ball,    // e = 0: d^2 < r^2 - (r - lift)^2, no root
+  Bull,
+};
+
 // Bit j set: candidate k + j may hold the cutter above `best` at (x, y): top above best, box within the
-// cutter's radius, plane bound above best, and for ball, flat and bull-nose (kTorus) the box within
-// reach: d^2 < reach2(top - best) (Cutter::reach2 on a flat bottom and a corner arc of radius r centred e
-// from the axis). Two lanes at a time where SSE2 is there (every x86-64).
-template <bool kTorus>
+// cutter's radius, plane bound above best, and (but for Reach::Scalar) box within reach. Two lanes at a
+// time where SSE2 is there (every x86-64).
+template <Reach kReach>
 inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, double y, double r2, double best,
                            double r, double e) {
   unsigned mask = 0;
@@ -173,12 +181,16 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
                                      _mm_add_pd(_mm_loadu_pd(&c.plane_c[q]), margin));
     const __m128d top = _mm_loadu_pd(&c.zmax[q]);
     __m128d pass = _mm_and_pd(_mm_and_pd(_mm_cmpgt_pd(top, B), _mm_cmple_pd(d2, R2)), _mm_cmpgt_pd(plane, B));
-    if (kTorus) {
+    if (kReach == Reach::Ball || kReach == Reach::Bull) {
       const __m128d lift = _mm_sub_pd(top, B);
       const __m128d below = _mm_sub_pd(Rc, lift);
       const __m128d arc = _mm_max_pd(_mm_sub_pd(Rc2, _mm_mul_pd(below, below)), zero);
-      const __m128d rho = _mm_add_pd(E, _mm_sqrt_pd(arc));
-      pass = _mm_and_pd(pass, _mm_or_pd(_mm_cmpge_pd(lift, Rc), _mm_cmplt_pd(d2, _mm_mul_pd(rho, rho))));
+      __m128d reach2 = arc;
+      if (kReach == Reach::Bull) {
+        const __m128d rho = _mm_add_pd(E, _mm_sqrt_pd(arc));
+        reach2 = _mm_mul_pd(rho, rho);
+      }
+      pass = _mm_and_pd(pass, _mm_or_pd(_mm_cmpge_pd(lift, Rc), _mm_cmplt_pd(d2, reach2)));
     }
     mask |= static_cast<unsigned>(_mm_movemask_pd(pass)) << j;
   }
@@ -190,7 +202,7 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
     const double d2 = dx * dx + dy * dy;
     const double plane = c.plane_a[q] * x + c.plane_b[q] * y + (c.plane_c[q] + kPlaneMargin);
     bool pass = (c.zmax[q] > best) & (d2 <= r2) & (plane > best);
-    if (kTorus) {
+    if (kReach == Reach::Ball || kReach == Reach::Bull) {
       const double lift = c.zmax[q] - best, below = r - lift;
       const double rho = e + std::sqrt(maxd(r * r - below * below, 0.0));
       pass = pass & ((lift >= r) | (d2 < rho * rho));
@@ -204,7 +216,7 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
 // drop_point over a tile's candidate list; same result as the walk (the same bounds, a different order).
 // Candidates are filtered in blocks without branches (top above best, box within reach, plane bound above
 // best): most fail, and a mispredicted branch per candidate cost more than the exact tests.
-template <bool kTorus>
+template <Reach kReach>
 double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x,
                           double y, double floor_z, std::size_t& tested, int32_t& hint) {
   const auto& tris = index.triangles();
@@ -233,13 +245,13 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
   const std::size_t m = c.zmax.size();  // a multiple of kBlock
   for (std::size_t k = 0; k < m; k += kBlock) {
     if (c.zmax[k] <= best) break;  // sorted: nothing from here on can hold the cutter above best
-    unsigned mask = block_mask<kTorus>(c, k, x, y, r2, best, cutter.corner_radius(), cutter.arc_centre_radius());
+    unsigned mask = block_mask<kReach>(c, k, x, y, r2, best, cutter.corner_radius(), cutter.arc_centre_radius());
     while (mask) {
       const std::size_t q = k + static_cast<std::size_t>(__builtin_ctz(mask));
       mask &= mask - 1;
       const double top = c.zmax[q];
       if (!(top > best) || q == skip) continue;  // best may have risen within the block
-      if (kTorus) {
+      if (kReach != Reach::Scalar) {
         test(q);  // within reach of a lower best: the exact test prunes with its own bounds
         continue;
       }
@@ -296,7 +308,10 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
   run_start.push_back(n);
   const std::size_t runs = run_start.size() - 1;
 
-  const bool torus = cutter.kind() != CutterKind::General;
+  const Reach reach = cutter.kind() == CutterKind::Flat   ? Reach::Flat
+                      : cutter.kind() == CutterKind::Ball ? Reach::Ball
+                      : cutter.kind() == CutterKind::Bull ? Reach::Bull
+                                                          : Reach::Scalar;
   std::atomic<std::size_t> tested{0};
   parallel_chunks(runs, 16, options, [&](std::size_t begin, std::size_t end) {
     std::size_t local = 0;
@@ -324,8 +339,21 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
       cands.gather(index, cutter, tx0, ty0, tx1, ty1, floor_z);
       for (std::size_t k = a; k < b; ++k) {
         const std::uint32_t i = order[k];
-        z_out[i] = torus ? drop_point_in_tile<true>(index, cutter, cands, xy[2 * i], xy[2 * i + 1], floor_z, local, hint)
-                         : drop_point_in_tile<false>(index, cutter, cands, xy[2 * i], xy[2 * i + 1], floor_z, local, hint);
+        const double x = xy[2 * i], y = xy[2 * i + 1];
+        switch (reach) {
+          case Reach::Flat:
+            z_out[i] = drop_point_in_tile<Reach::Flat>(index, cutter, cands, x, y, floor_z, local, hint);
+            break;
+          case Reach::Ball:
+            z_out[i] = drop_point_in_tile<Reach::Ball>(index, cutter, cands, x, y, floor_z, local, hint);
+            break;
+          case Reach::Bull:
+            z_out[i] = drop_point_in_tile<Reach::Bull>(index, cutter, cands, x, y, floor_z, local, hint);
+            break;
+          case Reach::Scalar:
+            z_out[i] = drop_point_in_tile<Reach::Scalar>(index, cutter, cands, x, y, floor_z, local, hint);
+            break;
+        }
       }
     }
     tested.fetch_add(local);
