@@ -269,7 +269,8 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {
   // Tiles: points sorted by tile (stable within a tile, so a raster keeps its order and the warm-start
-  // hint its value); points with a non-finite coordinate go alone through drop_point.
+  // hint its value); points with a non-finite coordinate go alone through drop_point (the floor). Heights
+  // do not depend on the thread count: tiles and their hints do not.
   const double tile = kTileFactor * cutter.max_radius();
   double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
   for (std::size_t i = 0; i < n; ++i) {
@@ -293,9 +294,10 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
       key[i] = (iy << 27) | ix;
     }
   }
-  std::vector<std::uint32_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<std::uint32_t>(i);
-  if (tiled) std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  if (tiled)
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
   // Runs of one key; untiled points (and tiles too sparse for a list) are runs of one point.
   std::vector<std::size_t> run_start;
   for (std::size_t k = 0; k < n;) {
@@ -322,7 +324,7 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
       if (b - a < kMinTilePoints || key[order[a]] == ~std::uint64_t{0}) {
         DropStats s;
         for (std::size_t k = a; k < b; ++k) {
-          const std::uint32_t i = order[k];
+          const std::size_t i = order[k];
           z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_z, &s, &hint);
         }
         local += s.triangles_tested;
@@ -330,7 +332,7 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
       }
       double tx0 = INFINITY, ty0 = INFINITY, tx1 = -INFINITY, ty1 = -INFINITY;
       for (std::size_t k = a; k < b; ++k) {
-        const std::uint32_t i = order[k];
+        const std::size_t i = order[k];
         tx0 = std::min(tx0, xy[2 * i]);
         tx1 = std::max(tx1, xy[2 * i]);
         ty0 = std::min(ty0, xy[2 * i + 1]);
@@ -338,7 +340,7 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
       }
       cands.gather(index, cutter, tx0, ty0, tx1, ty1, floor_z);
       for (std::size_t k = a; k < b; ++k) {
-        const std::uint32_t i = order[k];
+        const std::size_t i = order[k];
         const double x = xy[2 * i], y = xy[2 * i + 1];
         switch (reach) {
           case Reach::Flat:
