@@ -17,21 +17,14 @@
 #include "tmm/drop_contacts.hpp"
 #include "tmm/drop_cutter.hpp"
 #include "tmm/mesh_index.hpp"
+#include "test_meshes.hpp"
 
 namespace {
 
 using tmm::Cutter;
 using Eigen::Vector3d;
 
-tmm::MeshIndex one_triangle(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  tmm::Vertices V(3, 3);
-  V.row(0) = a.transpose();
-  V.row(1) = b.transpose();
-  V.row(2) = c.transpose();
-  tmm::Triangles F(1, 3);
-  F << 0, 1, 2;
-  return tmm::MeshIndex(V, F);
-}
+using tmm_test::one_triangle;
 
 double drop1(const Cutter& c, double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& p) {
   const auto index = one_triangle(a, b, p);
@@ -329,16 +322,15 @@ TEST(DropReference, RandomCutterSizes) {
   }
 }
 
-// The index finds exactly the maximum over all triangles, on a bumpy random mesh.
-TEST(MeshIndex, QueryEqualsBruteForce) {
-  const int n = 60;
+// A bumpy random mesh: n x n unit cells, vertices jittered by up to 0.3 in X, Y and Z over the wave
+// z = 3 sin(x / wx) cos(y / wy).
+std::pair<tmm::Vertices, tmm::Triangles> bumpy_grid(int n, double wx, double wy, std::mt19937_64& rng) {
   tmm::Vertices V((n + 1) * (n + 1), 3);
-  std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> jitter(-0.3, 0.3);
   for (int i = 0; i <= n; ++i)
     for (int j = 0; j <= n; ++j) {
       const double x = i + jitter(rng), y = j + jitter(rng);
-      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / 5) * std::cos(y / 7) + jitter(rng);
+      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / wx) * std::cos(y / wy) + jitter(rng);
     }
   tmm::Triangles F(2 * n * n, 3);
   int t = 0;
@@ -348,6 +340,14 @@ TEST(MeshIndex, QueryEqualsBruteForce) {
       F.row(t++) << v, v + n + 1, v + 1;
       F.row(t++) << v + 1, v + n + 1, v + n + 2;
     }
+  return {V, F};
+}
+
+// The index finds exactly the maximum over all triangles, on a bumpy random mesh.
+TEST(MeshIndex, QueryEqualsBruteForce) {
+  const int n = 60;
+  std::mt19937_64 rng(7);
+  const auto [V, F] = bumpy_grid(n, 5, 7, rng);
   const tmm::MeshIndex index(V, F);
   std::uniform_real_distribution<double> pos(-2, n + 2);
   for (const Cutter& cut : {Cutter(2, 2), Cutter(2, 0), Cutter(3, 1)}) {
@@ -366,22 +366,8 @@ TEST(MeshIndex, QueryEqualsBruteForce) {
 // to rounding (a vertex contact is reached through whichever of its edges the pruning leaves).
 TEST(DropBatch, TiledRasterEqualsBruteForce) {
   const int n = 24;
-  tmm::Vertices V((n + 1) * (n + 1), 3);
   std::mt19937_64 rng(11);
-  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const double x = i + jitter(rng), y = j + jitter(rng);
-      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / 4) * std::cos(y / 5) + jitter(rng);
-    }
-  tmm::Triangles F(2 * n * n, 3);
-  int t = 0;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int v = i * (n + 1) + j;
-      F.row(t++) << v, v + n + 1, v + 1;
-      F.row(t++) << v + 1, v + n + 1, v + n + 2;
-    }
+  const auto [V, F] = bumpy_grid(n, 4, 5, rng);
   const tmm::MeshIndex index(V, F);
   std::vector<double> xy;
   for (int i = 0; i < 41; ++i)

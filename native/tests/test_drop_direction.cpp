@@ -18,6 +18,7 @@
 #include "tmm/drop_cutter.hpp"
 #include "tmm/drop_direction.hpp"
 #include "tmm/mesh_index.hpp"
+#include "test_meshes.hpp"
 
 namespace {
 
@@ -26,15 +27,7 @@ using tmm::Cutter;
 
 constexpr double kDeg = M_PI / 180;
 
-tmm::MeshIndex one_triangle(const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  tmm::Vertices V(3, 3);
-  V.row(0) = a.transpose();
-  V.row(1) = b.transpose();
-  V.row(2) = c.transpose();
-  tmm::Triangles F(1, 3);
-  F << 0, 1, 2;
-  return tmm::MeshIndex(V, F);
-}
+using tmm_test::one_triangle;
 
 Vector3d random_unit(std::mt19937_64& rng) {
   std::normal_distribution<double> g;
