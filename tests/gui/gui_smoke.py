@@ -2,7 +2,8 @@
 
 FreeCAD starts, the TMM workbench activates (TMM and Path commands registered), the API makes a Job
 with a TMM Surface op, the TMM Surface command adds a second op and opens its task panel, the main
-window (with the 3D view rendered offscreen) is grabbed into a PNG; then a document saved headless
+window (with the 3D view rendered offscreen) is grabbed into a PNG; the API's 5-axis Multipoint op opens
+its panel and the 5-axis command adds an op on the selected face; then a document saved headless
 (env TMM_GUI_REOPEN, made by make_headless_doc.py) is reopened and its op's panel opens; the GUI
 progress dialog reports a Cancel; FreeCAD quits. The outcome goes to env TMM_GUI_RESULT (a JSON file)
 and the exit code (os._exit: the GUI would otherwise swallow SystemExit). Screenshot: env
@@ -32,11 +33,55 @@ def pump(seconds: float) -> None:
         time.sleep(0.02)
 
 
-def find_panel() -> QtGui.QWidget:
-    for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, "TmmSurfaceOpPage"):
+def find_panel(name: str = "TmmSurfaceOpPage") -> QtGui.QWidget:
+    for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, name):
         if w.isVisible():
             return w
-    raise AssertionError("the TMM Surface task panel page is not visible")
+    raise AssertionError(f"the task panel page {name} is not visible")
+
+
+def close_panel(op) -> None:
+    """Closes the op's task panel as its Cancel button does. (Control.closeDialog() would skip PathOpGui's
+    clean-up, and its leftover observers crash FreeCAD when a later document makes a tool controller.)"""
+    op.ViewObject.Proxy.panel.reject()
+    pump(0.3)
+    assert not FreeCADGui.Control.activeDialog(), "the task panel stayed open"
+
+
+def multipoint_panel(info: dict) -> None:
+    """The 5-axis op: the API's op has our view provider and its panel shows the contact summary; the
+    command, with the op's face selected, adds a second op and opens its panel."""
+    from tmm_workbench.app.api import run_multipoint
+    from tmm_workbench.core import bezier
+    from tmm_workbench.gui.op_multipoint_gui import ViewProvider as MultipointViewProvider
+
+    net = bezier.load_seed_patch(ROOT.parent / "shared" / "benchmarks" / "seed_surfaces.json", "convex")
+    r = run_multipoint(net, side_step=36.0, forward_step=6.0, posts=(), doc_name="TmmGuiMultipoint",
+                       progress=True)
+    assert isinstance(r.op.ViewObject.Proxy, MultipointViewProvider), type(r.op.ViewObject.Proxy)
+    assert Path(r.op.ViewObject.Proxy.getIcon()).is_file(), "the 5-axis op's tree icon is not a file"
+    r.op.ViewObject.Document.setEdit(r.op.ViewObject, 0)
+    pump(1.0)
+    page = find_panel("TmmMultipointOpPage")
+    info["multipoint_side_step"] = page.findChild(QtGui.QWidget, "sideStep").property("rawValue")
+    info["multipoint_contacts"] = page.findChild(QtGui.QLabel, "contacts").text()
+    assert abs(info["multipoint_side_step"] - 36.0) < 1e-9, info["multipoint_side_step"]
+    assert info["multipoint_contacts"] == r.op.ContactSummary and "two" in info["multipoint_contacts"], \
+        info["multipoint_contacts"]
+    close_panel(r.op)
+    obj, face = r.face
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(obj, face)
+    FreeCADGui.runCommand("Path_TMM_Multipoint")
+    pump(1.5)
+    ops = [o for o in r.job.Operations.Group if o is not r.op]
+    assert ops, "the 5-axis command made no op"
+    assert ops[0].Base and ops[0].Base[0][1] == (face,), ops[0].Base
+    find_panel("TmmMultipointOpPage")
+    info["multipoint_command_panel"] = True
+    close_panel(ops[0])  # Cancel: the new op goes again
+    FreeCAD.closeDocument(r.doc.Name)
+    pump(0.3)
 
 
 def smoke() -> dict:
@@ -95,8 +140,9 @@ def smoke() -> dict:
     painter.end()
     assert shot.save(str(PNG)), f"could not write {PNG}"
     info["png"] = str(PNG)
-    FreeCADGui.Control.closeDialog()
-    pump(0.3)
+    close_panel(ops[0])  # Cancel: the new op goes again
+
+    multipoint_panel(info)
 
     reopen = os.environ.get("TMM_GUI_REOPEN")
     if reopen:  # a document saved headless: op and Job get their view providers, the panel opens
@@ -109,7 +155,7 @@ def smoke() -> dict:
         pump(0.5)
         info["reopened_panel"] = FreeCADGui.Control.activeDialog()
         assert info["reopened_panel"], "no task panel for the reopened op"
-        FreeCADGui.Control.closeDialog()
+        close_panel(op)
         FreeCAD.closeDocument(doc.Name)
         pump(0.3)
 

@@ -33,6 +33,7 @@ def test_gui_smoke(tmp_path: Path) -> None:
     info = json.loads(result.read_text()) if result.is_file() else {}
     assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
     assert info["workbench"] == "TMMWorkbench" and info["panel_open"] and info["cancel_seen"]
+    assert info["multipoint_command_panel"] and "two" in info["multipoint_contacts"]
     assert info.get("reopened_panel") or not freecadcmd
     assert PNG.is_file() and PNG.stat().st_size > 10_000
     assert not _blank(PNG), "the screenshot is blank"

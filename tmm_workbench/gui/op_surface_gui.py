@@ -1,24 +1,14 @@
-"""GUI of the 'TMM 3-axis Surface' operation: its task panel page, view provider and command.
-
-The command is registered by PathOpGui.SetupOperation like FreeCAD's own ops. PathOpGui assumes
-icons inside FreeCAD's compiled Qt resources (":/icons/<pixmap>.svg"); an add-on has files instead,
-so the view provider and the page give the icon's file path, and the command creates the op with
-that view provider (same steps as PathOpGui.Create otherwise).
-"""
+"""GUI of the 'TMM 3-axis Surface' operation: its task panel page, view provider and command (the
+pattern shared with the other TMM ops is in op_page)."""
 from __future__ import annotations
 
 from typing import Any
 
-import FreeCAD
-import FreeCADGui
-from PySide import QtCore, QtGui
+from PySide import QtGui
 
 from tmm_workbench.app import model_proxy, op_surface
-from tmm_workbench.app.compat import PathOp, PathUtils, import_gui
-from tmm_workbench.gui import resources
-
-PathOpGui = import_gui("op_gui")
-PathGui = import_gui("path_gui")
+from tmm_workbench.app.compat import PathUtils
+from tmm_workbench.gui import op_page, resources
 
 ICON = resources.icon("TMM_Surface")
 JOB_MODEL = "(Job model)"
@@ -29,22 +19,15 @@ SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampl
 COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern"}
 
 
-class TaskPanelOpPage(PathOpGui.TaskPanelPage):
+class TaskPanelOpPage(op_page.OpPage):
     """Tool controller, coolant, model, boundary and raster parameters of the op."""
 
-    def getForm(self) -> Any:
-        return FreeCADGui.PySideUic.loadUi(resources.panel("surface_op"))
+    PANEL = "surface_op"
+    ICON = ICON
+    SPIN_BOXES = SPIN_BOXES
+    COMBOS = COMBOS
 
-    def setIcon(self, icon: Any) -> None:
-        super().setIcon(ICON)  # the view provider hands over a Qt resource path we do not ship
-
-    def initPage(self, obj: Any) -> None:
-        self.spins = {prop: PathGui.QuantitySpinBox(getattr(self.form, widget), obj, prop)
-                      for widget, prop in SPIN_BOXES.items()}
-        for widget, prop in COMBOS.items():
-            combo = getattr(self.form, widget)
-            combo.clear()
-            combo.addItems(obj.getEnumerationsOfProperty(prop))
+    def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)
 
     def model_candidates(self, obj: Any) -> list[Any]:
@@ -73,13 +56,7 @@ class TaskPanelOpPage(PathOpGui.TaskPanelPage):
             self.form.stlFile.setText(name)
             self.pageGetFields()
 
-    def getFields(self, obj: Any) -> None:
-        for spin in self.spins.values():
-            spin.updateProperty()
-        for widget, prop in COMBOS.items():
-            value = getattr(self.form, widget).currentText()
-            if value and getattr(obj, prop) != value:
-                setattr(obj, prop, value)
+    def get_extra(self, obj: Any) -> None:
         stl = self.form.stlFile.text().strip()
         if obj.StlFile != stl:
             obj.StlFile = stl
@@ -87,14 +64,8 @@ class TaskPanelOpPage(PathOpGui.TaskPanelPage):
         target = obj.Document.getObject(model) if model else None
         if obj.Model != target:
             obj.Model = target
-        self.updateToolController(obj, self.form.toolController)
-        self.updateCoolant(obj, self.form.coolantController)
 
-    def setFields(self, obj: Any) -> None:
-        for spin in self.spins.values():
-            spin.updateSpinBox()
-        for widget, prop in COMBOS.items():
-            self.selectInComboBox(getattr(obj, prop), getattr(self.form, widget))
+    def set_extra(self, obj: Any) -> None:
         self.form.stlFile.setText(obj.StlFile)
         combo = self.form.model
         combo.blockSignals(True)
@@ -105,86 +76,26 @@ class TaskPanelOpPage(PathOpGui.TaskPanelPage):
         index = combo.findData(obj.Model.Name) if obj.Model is not None else 0
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
-        self.setupToolController(obj, self.form.toolController)
-        self.setupCoolant(obj, self.form.coolantController)
-        self.showStatus(obj)
 
-    def showStatus(self, obj: Any) -> None:
-        if obj.isValid():
-            moves = len(obj.Path.Commands)
-            self.form.status.setStyleSheet("")
-            self.form.status.setText(f"{moves} path commands" if moves else "")
-        else:
-            self.form.status.setStyleSheet("color: #c00000")
-            self.form.status.setText(obj.getStatusString())
-
-    def getSignalsForUpdate(self, obj: Any) -> list[Any]:
-        signals = [getattr(self.form, w).editingFinished for w in SPIN_BOXES]
-        signals += [getattr(self.form, w).currentIndexChanged for w in COMBOS]
-        signals += [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged,
-                    self.form.toolController.currentIndexChanged,
-                    self.form.coolantController.currentIndexChanged]
-        return signals
-
-    def updateData(self, obj: Any, prop: str) -> None:
-        if prop in self.spins:
-            self.spins[prop].updateSpinBox()
-        elif prop == "Path":
-            self.showStatus(obj)
+    def extra_signals(self) -> list[Any]:
+        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged]
 
 
-class ViewProvider(PathOpGui.ViewProvider):
-    """PathOpGui's view provider with the op icon read from the add-on's file, and no selection gate
-    (PathSelection only knows FreeCAD's own ops; this op has no base geometry to pick)."""
+class ViewProvider(op_page.OpViewProvider):
+    """The TMM op view provider with this op's icon."""
 
-    def getSelectionFactory(self) -> Any:
-        return lambda: None
-
-    def getIcon(self) -> str:
-        if self.Object is not None and not self.Object.Active:
-            return ":/icons/Path_OpActive.svg"
-        return ICON
+    ICON = ICON
 
 
 def attach_view_provider(obj: Any) -> None:
     """Gives an op created from Python (macro, API) the same view provider as the command's."""
-    if not isinstance(getattr(obj.ViewObject, "Proxy", None), ViewProvider):
-        obj.ViewObject.Proxy = ViewProvider(obj.ViewObject, Command.res)
-        obj.ViewObject.Proxy.deleteOnReject = False
+    op_page.attach_view_provider(obj, ViewProvider, Command.res)
 
 
 def create(res: Any) -> Any:
-    """PathOpGui.Create with our view provider."""
-    doc = FreeCAD.ActiveDocument
-    doc.openTransaction(f"Create {res.name}")
-    try:
-        obj = res.objFactory(res.name, obj=None, parentJob=res.job)
-        if obj.Proxy:
-            vp = obj.ViewObject.Proxy  # usually attached already by op_surface.view_provider_hook
-            if not isinstance(vp, ViewProvider):
-                obj.ViewObject.Proxy = vp = ViewProvider(obj.ViewObject, res)
-            vp.deleteOnReject = True  # Cancel in the first edit session removes the new op
-            obj.ViewObject.Visibility = True
-            doc.commitTransaction()
-            obj.ViewObject.Document.setEdit(obj.ViewObject, 0)
-            return obj
-    except PathUtils.PathNoTCExistsException:
-        QtGui.QMessageBox.warning(FreeCADGui.getMainWindow(), "TMM",
-                                  "No suitable tool controller found.\nAborting op creation")
-    except PathOp.PathNoTCException:
-        FreeCAD.Console.PrintWarning("TMM: no tool controller, aborting op creation\n")
-    doc.abortTransaction()
-    doc.recompute()
-    return None
+    return op_page.create(res, ViewProvider, "")
 
 
-Command = PathOpGui.SetupOperation(
-    op_surface.OP_NAME, op_surface.Create, TaskPanelOpPage, ICON,
-    QtCore.QT_TRANSLATE_NOOP("TMM_Surface", "TMM 3-axis Surface"),
-    QtCore.QT_TRANSLATE_NOOP("TMM_Surface", "3-axis raster finishing of a mesh or a Part model "
-                                            "(drop-cutter, TMM kernel)"),
-    op_surface.SetupProperties)
+Command = op_page.command(op_surface, TaskPanelOpPage, ICON, "TMM 3-axis Surface",
+                          "3-axis raster finishing of a mesh or a Part model (drop-cutter, TMM kernel)", create)
 COMMAND_NAME = "Path_" + op_surface.OP_NAME
-# SetupOperation's command would attach PathOpGui's own view provider; keep its resources and
-# registration, create through ours.
-Command.Activated = lambda: create(Command.res)

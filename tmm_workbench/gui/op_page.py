@@ -1,0 +1,174 @@
+"""What the TMM operations' GUIs share: the task panel page pattern, the view provider and the command's
+create step.
+
+PathOpGui assumes icons inside FreeCAD's compiled Qt resources (":/icons/<pixmap>.svg"); an add-on has files
+instead, so the view provider and the page give the icon's file path, and the command creates the op with
+that view provider (same steps as PathOpGui.Create otherwise).
+"""
+from __future__ import annotations
+
+from typing import Any, Callable
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtGui
+
+from tmm_workbench.app.compat import PathOp, PathUtils, import_gui
+from tmm_workbench.gui import resources
+
+PathOpGui = import_gui("op_gui")
+PathGui = import_gui("path_gui")
+
+
+class OpPage(PathOpGui.TaskPanelPage):
+    """A page of quantity spin boxes, combo boxes and check boxes bound to the op's properties (widget
+    name -> property), plus tool controller, coolant and a status line. Subclasses set the class
+    attributes and add their own widgets through the *_extra hooks."""
+
+    PANEL = ""                # resources/panels/<PANEL>.ui
+    ICON = ""
+    SPIN_BOXES: dict[str, str] = {}
+    COMBOS: dict[str, str] = {}
+    CHECKS: dict[str, str] = {}
+    STATUS_PROPS: tuple[str, ...] = ("Path",)  # a change of these refreshes the status line
+
+    def getForm(self) -> Any:
+        return FreeCADGui.PySideUic.loadUi(resources.panel(self.PANEL))
+
+    def setIcon(self, icon: Any) -> None:
+        super().setIcon(self.ICON)  # the view provider hands over a Qt resource path we do not ship
+
+    def initPage(self, obj: Any) -> None:
+        self.spins = {prop: PathGui.QuantitySpinBox(getattr(self.form, widget), obj, prop)
+                      for widget, prop in self.SPIN_BOXES.items()}
+        for widget, prop in self.COMBOS.items():
+            combo = getattr(self.form, widget)
+            combo.clear()
+            combo.addItems(obj.getEnumerationsOfProperty(prop))
+        self.init_extra(obj)
+
+    def getFields(self, obj: Any) -> None:
+        for spin in self.spins.values():
+            spin.updateProperty()
+        for widget, prop in self.COMBOS.items():
+            value = getattr(self.form, widget).currentText()
+            if value and getattr(obj, prop) != value:
+                setattr(obj, prop, value)
+        for widget, prop in self.CHECKS.items():
+            checked = getattr(self.form, widget).isChecked()
+            if bool(getattr(obj, prop)) != checked:
+                setattr(obj, prop, checked)
+        self.get_extra(obj)
+        self.updateToolController(obj, self.form.toolController)
+        self.updateCoolant(obj, self.form.coolantController)
+
+    def setFields(self, obj: Any) -> None:
+        for spin in self.spins.values():
+            spin.updateSpinBox()
+        for widget, prop in self.COMBOS.items():
+            self.selectInComboBox(getattr(obj, prop), getattr(self.form, widget))
+        for widget, prop in self.CHECKS.items():
+            getattr(self.form, widget).setChecked(bool(getattr(obj, prop)))
+        self.set_extra(obj)
+        self.setupToolController(obj, self.form.toolController)
+        self.setupCoolant(obj, self.form.coolantController)
+        self.showStatus(obj)
+
+    def showStatus(self, obj: Any) -> None:
+        try:
+            self.show_status(obj)
+        except RuntimeError:  # the panel was closed (its widgets are gone) while the op recomputed
+            pass
+
+    def show_status(self, obj: Any) -> None:
+        if obj.isValid():
+            moves = len(obj.Path.Commands)
+            self.form.status.setStyleSheet("")
+            self.form.status.setText(f"{moves} path commands" if moves else "")
+        else:
+            self.form.status.setStyleSheet("color: #c00000")
+            self.form.status.setText(obj.getStatusString())
+
+    def getSignalsForUpdate(self, obj: Any) -> list[Any]:
+        signals = [getattr(self.form, w).editingFinished for w in self.SPIN_BOXES]
+        signals += [getattr(self.form, w).currentIndexChanged for w in self.COMBOS]
+        signals += [getattr(self.form, w).stateChanged for w in self.CHECKS]
+        signals += self.extra_signals()
+        signals += [self.form.toolController.currentIndexChanged, self.form.coolantController.currentIndexChanged]
+        return signals
+
+    def updateData(self, obj: Any, prop: str) -> None:
+        if prop in self.spins:
+            self.spins[prop].updateSpinBox()
+        elif prop in self.STATUS_PROPS:
+            self.showStatus(obj)
+
+    # Hooks for a page's own widgets.
+    def init_extra(self, obj: Any) -> None:
+        pass
+
+    def get_extra(self, obj: Any) -> None:
+        pass
+
+    def set_extra(self, obj: Any) -> None:
+        pass
+
+    def extra_signals(self) -> list[Any]:
+        return []
+
+
+class OpViewProvider(PathOpGui.ViewProvider):
+    """PathOpGui's view provider with the op icon read from the add-on's file (class attribute ICON), and
+    no selection gate (PathSelection only knows FreeCAD's own ops; each TMM op checks its own input)."""
+
+    ICON = ""
+
+    def getSelectionFactory(self) -> Any:
+        return lambda: None
+
+    def getIcon(self) -> str:
+        if self.Object is not None and not self.Object.Active:
+            return ":/icons/Path_OpActive.svg"
+        return self.ICON
+
+
+def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:
+    """Gives an op created from Python (macro, API) the same view provider as the command's."""
+    if not isinstance(getattr(obj.ViewObject, "Proxy", None), view_provider):
+        obj.ViewObject.Proxy = view_provider(obj.ViewObject, res)
+        obj.ViewObject.Proxy.deleteOnReject = False
+
+
+def create(res: Any, view_provider: type, no_tool_text: str) -> Any:
+    """PathOpGui.Create with our view provider: the new op in one undo step, its task panel open."""
+    doc = FreeCAD.ActiveDocument
+    doc.openTransaction(f"Create {res.name}")
+    try:
+        obj = res.objFactory(res.name, obj=None, parentJob=res.job)
+        if obj.Proxy:
+            vp = obj.ViewObject.Proxy  # usually attached already by the op's view-provider hook
+            if not isinstance(vp, view_provider):
+                obj.ViewObject.Proxy = vp = view_provider(obj.ViewObject, res)
+            vp.deleteOnReject = True  # Cancel in the first edit session removes the new op
+            obj.ViewObject.Visibility = True
+            doc.commitTransaction()
+            obj.ViewObject.Document.setEdit(obj.ViewObject, 0)
+            return obj
+    except PathUtils.PathNoTCExistsException:
+        QtGui.QMessageBox.warning(FreeCADGui.getMainWindow(), "TMM",
+                                  f"No suitable tool controller found{no_tool_text}.\nAborting op creation")
+    except PathOp.PathNoTCException:
+        FreeCAD.Console.PrintWarning("TMM: no tool controller, aborting op creation\n")
+    doc.abortTransaction()
+    doc.recompute()
+    return None
+
+
+def command(op_module: Any, page: type, icon: str, menu_text: str, tooltip: str,
+            create_op: Callable[[Any], Any]) -> Any:
+    """PathOpGui.SetupOperation's command (resources and registration), creating through `create_op`:
+    its own would attach PathOpGui's view provider."""
+    cmd = PathOpGui.SetupOperation(op_module.OP_NAME, op_module.Create, page, icon, menu_text, tooltip,
+                                   op_module.SetupProperties)
+    cmd.Activated = lambda: create_op(cmd.res)
+    return cmd
