@@ -28,18 +28,17 @@ goes to the report view and the op is marked invalid with that message (as op_su
 from __future__ import annotations
 
 import math
-import traceback
 from typing import Any, Optional
 
 import FreeCAD
 import Path
 
-from tmm_workbench.app import hooks, progress
+from tmm_workbench.app import hooks, op_base, progress
 from tmm_workbench.app.compat import PathOp, PathSetupSheet
 from tmm_workbench.app.tools import _mm, bull_corner_radius, shape_name
 from tmm_workbench.core import path5
-from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.multipoint import (STATUS_FAILED, STATUS_NAMES, BezierFace, MultipointParams,
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.multipoint import (STATUS_FAILED, BezierFace, MultipointParams,
                                            MultipointResults, compute_multipoint_toolpath)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
 
@@ -202,53 +201,27 @@ def summary(res: MultipointResults) -> str:
     return text
 
 
-class ObjectTmmMultipoint(PathOp.ObjectOp):
+class ObjectTmmMultipoint(op_base.TmmOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath` (the op's linked
     tool path), `core_toolpath` (the core's), `results` (per footprint point), `face`, `radii` (Ro, Ri)."""
 
+    PROPERTIES = PROPERTIES
+    ENUMERATIONS = ENUMERATIONS
+    DEFAULTS = DEFAULTS
+    READ_ONLY = ("ContactSummary",)
+    SUPPORTED_SHAPES = SUPPORTED_SHAPES
     toolpath: Optional[Toolpath] = None
     core_toolpath: Optional[Toolpath] = None
     results: Optional[MultipointResults] = None
     face: Optional[BezierFace] = None
     radii: Optional[tuple[float, float]] = None
-    progress_enabled: bool = True
-
-    def __init__(self, obj: Any, name: str, parentJob: Any = None,
-                 values: Optional[dict[str, Any]] = None) -> None:
-        self._initial_values = dict(values or {})
-        super().__init__(obj, name, parentJob)
 
     def opFeatures(self, obj: Any) -> int:
         return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant | PathOp.FeatureBaseFaces
 
-    def initOperation(self, obj: Any) -> None:
-        self._ensure_properties(obj, restoring=False)
-
     def opOnDocumentRestored(self, obj: Any) -> None:
-        self._ensure_properties(obj, restoring=True)
+        self.ensure_properties(obj, restoring=True)
         hooks.attach_view("multipoint_op", obj)
-
-    def _ensure_properties(self, obj: Any, restoring: bool) -> None:
-        for typ, name, group, tip in PROPERTIES:
-            if not hasattr(obj, name):
-                obj.addProperty(typ, name, group, tip)
-                if name in ENUMERATIONS:
-                    setattr(obj, name, ENUMERATIONS[name])
-                if restoring and name in DEFAULTS:
-                    setattr(obj, name, DEFAULTS[name])
-        obj.setEditorMode("ContactSummary", 1)  # read-only
-
-    def opSetDefaultValues(self, obj: Any, job: Any) -> None:
-        for name, value in DEFAULTS.items():
-            setattr(obj, name, value)
-        for name, value in getattr(self, "_initial_values", {}).items():
-            obj.setExpression(name, None)  # a given value replaces the SetupSheet's expression
-            setattr(obj, name, value)
-        self._initial_values = {}
-
-    def isToolSupported(self, obj: Any, tool: Any) -> bool:
-        # an end mill is offered too: computing then stops with the core's clear message (Ri = 0)
-        return shape_name(tool) in SUPPORTED_SHAPES
 
     def opRejectAddBase(self, obj: Any, base: Any, sub: str) -> bool:
         return not str(sub).startswith("Face")
@@ -256,7 +229,8 @@ class ObjectTmmMultipoint(PathOp.ObjectOp):
     # --- computation -------------------------------------------------------------------------
     def opExecute(self, obj: Any) -> None:
         self.toolpath = self.core_toolpath = self.results = self.face = self.radii = None
-        try:
+
+        def compute() -> None:
             base, sub = self.base_face(obj)
             surf = face_surface(base, sub)
             face = BezierFace.from_freecad_surface(surf, name=f"{base.Label}.{sub}")
@@ -268,19 +242,11 @@ class ObjectTmmMultipoint(PathOp.ObjectOp):
                 raise TmmError(f"safe height {safe:g} mm must be above the face's top {top:g} mm")
             if clearance < safe:
                 raise TmmError(f"clearance height {clearance:g} mm is below the safe height {safe:g} mm")
-            with progress.reporter(obj.Label, getattr(self, "progress_enabled", True)) as cb:
+            with progress.reporter(obj.Label, self.progress_enabled) as cb:
                 core_tp, res = compute_multipoint_toolpath(face, Ro, Ri, params, METHODS[obj.Method], cb)
             toolpath = link_toolpath(res, Ro, Ri, safe, clearance, obj.AxisRetract.Value)
             if not len(toolpath):
                 raise TmmError(f"no tool position found on the face ({summary(res)})")
-        except Cancelled:
-            self._fail(obj, "tool path computation cancelled")
-        except TmmError as exc:
-            self._fail(obj, str(exc))
-        except Exception as exc:  # a kernel failure or a bug: report it, still no crash, no partial path
-            FreeCAD.Console.PrintLog(traceback.format_exc())
-            self._fail(obj, f"unexpected {type(exc).__name__}: {exc}")
-        else:
             self.face, self.radii, self.results = face, (Ro, Ri), res
             self.core_toolpath, self.toolpath = core_tp, toolpath
             text = summary(res)
@@ -290,13 +256,11 @@ class ObjectTmmMultipoint(PathOp.ObjectOp):
             self.commandlist.extend(Path.Command(n, p) for n, p in
                                     path5.encode_toolpath(toolpath, self.horizFeed, self.vertFeed))
 
-    def _fail(self, obj: Any, message: str) -> None:
-        self.commandlist = []
-        obj.Path = Path.Path()
+        self.guarded(obj, compute)
+
+    def on_fail(self, obj: Any) -> None:
         if obj.ContactSummary:
             obj.ContactSummary = ""
-        FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
-        raise TmmError(message) from None
 
     def base_face(self, obj: Any) -> tuple[Any, str]:
         pairs = [(o, s) for o, subs in (obj.Base or []) for s in (subs or ())]
@@ -323,13 +287,7 @@ def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
            values: Optional[dict[str, Any]] = None) -> Any:
     """A new op in `parentJob` (or the only Job of the active document), with property `values`
     (e.g. {"Base": [(clone, ("Face1",))], "SideStep": 18.0})."""
-    if obj is None:
-        doc = parentJob.Document if parentJob is not None else FreeCAD.ActiveDocument
-        obj = doc.addObject("Path::FeaturePython", name)
-    obj.Proxy = ObjectTmmMultipoint(obj, name, parentJob, values)
-    if obj.Proxy is not None:
-        hooks.attach_view("multipoint_op", obj)
-    return obj
+    return op_base.create(ObjectTmmMultipoint, "multipoint_op", name, obj, parentJob, values)
 
 
 PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)

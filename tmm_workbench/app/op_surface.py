@@ -14,16 +14,14 @@ message goes to the report view and the op is marked invalid with that message (
 """
 from __future__ import annotations
 
-import traceback
 from typing import Any, Optional
 
-import FreeCAD
 import Path
 
-from tmm_workbench.app import geometry, hooks, model_proxy, progress
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
-from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool, shape_name
-from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool
+from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.mesh import TriMesh
 from tmm_workbench.core.surface3d import ONEWAY, ZIGZAG, SurfaceParams, compute_surface_toolpath
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
@@ -56,80 +54,41 @@ DEFAULTS: dict[str, Any] = {
 ENUMERATIONS = {"BoundaryShape": list(BOUNDARIES), "Pattern": list(PATTERNS)}
 
 
-class ObjectTmmSurface(PathOp.ObjectOp):
+class ObjectTmmSurface(op_base.TmmOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
 
+    PROPERTIES = PROPERTIES
+    ENUMERATIONS = ENUMERATIONS
+    DEFAULTS = DEFAULTS
+    SUPPORTED_SHAPES = SUPPORTED_SHAPES
     toolpath: Optional[Toolpath] = None
     mesh: Optional[TriMesh] = None
-    progress_enabled: bool = True
-
-    def __init__(self, obj: Any, name: str, parentJob: Any = None,
-                 values: Optional[dict[str, Any]] = None) -> None:
-        # `values` are applied with the defaults, before ObjectOp's first recompute
-        self._initial_values = dict(values or {})
-        super().__init__(obj, name, parentJob)
 
     def opFeatures(self, obj: Any) -> int:
         return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
 
-    def initOperation(self, obj: Any) -> None:
-        self._ensure_properties(obj, restoring=False)
-
     def opOnDocumentRestored(self, obj: Any) -> None:
-        self._ensure_properties(obj, restoring=True)  # documents from older versions get new properties
+        self.ensure_properties(obj, restoring=True)
         # a document saved headless has no view providers for the op and its Job
         hooks.attach_view("op", obj)
         job = PathUtils.findParentJob(obj)
         if job is not None:
             hooks.attach_view("job", job)
 
-    def _ensure_properties(self, obj: Any, restoring: bool) -> None:
-        for typ, name, group, tip in PROPERTIES:
-            if not hasattr(obj, name):
-                obj.addProperty(typ, name, group, tip)
-                if name in ENUMERATIONS:
-                    setattr(obj, name, ENUMERATIONS[name])
-                if restoring and name in DEFAULTS:
-                    setattr(obj, name, DEFAULTS[name])
-
-    def opSetDefaultValues(self, obj: Any, job: Any) -> None:
-        for name, value in DEFAULTS.items():
-            setattr(obj, name, value)
-        for name, value in getattr(self, "_initial_values", {}).items():
-            obj.setExpression(name, None)  # a given value replaces the SetupSheet's expression
-            setattr(obj, name, value)
-        self._initial_values = {}
-
-    def isToolSupported(self, obj: Any, tool: Any) -> bool:
-        return shape_name(tool) in SUPPORTED_SHAPES
-
     # --- computation -------------------------------------------------------------------------
     def opExecute(self, obj: Any) -> None:
         self.mesh = self.toolpath = None
-        try:
+
+        def compute() -> None:
             mesh = self.model_mesh(obj)
             cutter = cutter_from_tool(self.tool)
             params = self.surface_params(obj, mesh)
-            with progress.reporter(obj.Label, getattr(self, "progress_enabled", True)) as cb:
+            with progress.reporter(obj.Label, self.progress_enabled) as cb:
                 toolpath = compute_surface_toolpath(mesh, cutter, params, cb)
-        except Cancelled:
-            self._fail(obj, "tool path computation cancelled")
-        except TmmError as exc:
-            self._fail(obj, str(exc))
-        except Exception as exc:  # a kernel failure or a bug: report it, still no crash, no partial path
-            FreeCAD.Console.PrintLog(traceback.format_exc())
-            self._fail(obj, f"unexpected {type(exc).__name__}: {exc}")
-        else:
             self.mesh, self.toolpath = mesh, toolpath
             self.commandlist.extend(self.commands(toolpath))
 
-    def _fail(self, obj: Any, message: str) -> None:
-        """Empty Path, message in the report view, and an exception: FreeCAD marks the op invalid
-        and keeps the message as its status (tree tooltip, `obj.getStatusString()`)."""
-        self.commandlist = []
-        obj.Path = Path.Path()
-        FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
-        raise TmmError(message) from None
+        self.guarded(obj, compute)
 
     def model_mesh(self, obj: Any) -> TriMesh:
         deflection = obj.LinearDeflection.Value
@@ -197,13 +156,7 @@ def SetupProperties() -> list[str]:
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
            values: Optional[dict[str, Any]] = None) -> Any:
     """A new op in `parentJob` (or the only Job of the active document), with property `values`."""
-    if obj is None:
-        doc = parentJob.Document if parentJob is not None else FreeCAD.ActiveDocument
-        obj = doc.addObject("Path::FeaturePython", name)
-    obj.Proxy = ObjectTmmSurface(obj, name, parentJob, values)
-    if obj.Proxy is not None:  # not for the SetupSheet's prototypes
-        hooks.attach_view("op", obj)
-    return obj
+    return op_base.create(ObjectTmmSurface, "op", name, obj, parentJob, values)
 
 
 # Lets the Job's SetupSheet hold defaults for this op, headless too (the GUI's SetupOperation repeats it).

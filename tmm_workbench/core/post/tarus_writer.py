@@ -236,7 +236,7 @@ def write_tarus(program: Program, machine: Optional[TarusMachine] = None,
     return TarusResult("\n".join(w.lines) + "\n", w.time, w.moves)
 
 
-def argument_parser() -> "ArgumentParser":
+def argument_parser() -> "ArgumentParser":  # noqa: F821 (imported here: the package imports this module)
     from tmm_workbench.core.post import ArgumentParser
     p = ArgumentParser(prog="tarus", add_help=False)
     p.add_argument("--tcp", action="store_true",
