@@ -281,8 +281,10 @@ def options_plot(results: Sequence[SectionResult], path, method: str = "vcrf") -
         for r in sel:
             if r.which != w:
                 continue
-            c = colours[labels.index(r.label) % len(colours)]
-            ax.plot(r.x, r.deviation, lw=1.0, color=c, alpha=0.9,
+            k = labels.index(r.label)
+            c = colours[k % len(colours)]
+            # earlier configurations drawn wider underneath: where two coincide both show
+            ax.plot(r.x, r.deviation, lw=max(0.9, 2.6 - 0.8 * k), color=c, alpha=0.9, zorder=2 + k,
                     label=f"{r.label}: max {r.max_dev:.3f} mm (x {r.interior[0]:g}..{r.interior[1]:g}: "
                           f"{r.max_dev_interior:.3f}), min {r.min_dev:+.4f} mm")
         ax.axhline(SEED_SIMULATED_MAX[(w, method)], color="k", ls="--", lw=0.8,
