@@ -32,11 +32,11 @@ def pump(seconds: float) -> None:
         time.sleep(0.02)
 
 
-def find_panel() -> QtGui.QWidget:
-    for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, "TmmSurfaceOpPage"):
+def find_panel(name: str = "TmmSurfaceOpPage") -> QtGui.QWidget:
+    for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, name):
         if w.isVisible():
             return w
-    raise AssertionError("the TMM Surface task panel page is not visible")
+    raise AssertionError(f"the task panel page {name} is not visible")
 
 
 def smoke() -> dict:
@@ -112,6 +112,29 @@ def smoke() -> dict:
         FreeCADGui.Control.closeDialog()
         FreeCAD.closeDocument(doc.Name)
         pump(0.3)
+
+    # the 5-axis Multipoint op's panel: its surface extension and footprint anchor fields show the op's values
+    import numpy as np
+
+    from tmm_workbench.app.api import run_multipoint
+
+    net = np.zeros((4, 4, 3))
+    net[..., 0] = 50.0 * np.arange(4)[:, None]
+    net[..., 1] = 50.0 * np.arange(4)[None, :]
+    net[..., 2] = np.array([80, 90, 90, 80, 90, 105, 105, 90, 90, 105, 105, 90, 80, 90, 90, 80.0]).reshape(4, 4)
+    m = run_multipoint(net, side_step=37.5, forward_step=10.0, progress=False, posts=(), doc_name="TmmGuiMp",
+                       surface_extension=12.7, footprint_anchor="tip")
+    m.op.ViewObject.Document.setEdit(m.op.ViewObject, 0)
+    pump(1.0)
+    page = find_panel("TmmMultipointOpPage")
+    info["mp_extension"] = page.findChild(QtGui.QWidget, "surfaceExtension").property("rawValue")
+    anchor = page.findChild(QtGui.QComboBox, "footprintAnchor")
+    info["mp_anchor"] = [anchor.currentText(), [anchor.itemText(i) for i in range(anchor.count())]]
+    assert abs(info["mp_extension"] - 12.7) < 1e-9, info["mp_extension"]
+    assert info["mp_anchor"] == ["Tip", ["Axis", "Tip"]], info["mp_anchor"]
+    FreeCADGui.Control.closeDialog()
+    FreeCAD.closeDocument(m.op.Document.Name)
+    pump(0.3)
 
     # the GUI progress: a dialog with Cancel that turns into a False from the callback
     from tmm_workbench.app import progress
