@@ -126,7 +126,8 @@ void bind_surface(py::module_& m) {
       .def(py::init([](std::shared_ptr<PatchSurface> surface, double Ro, double Ri, const std::string& shape,
                        const std::string& method, const std::string& rotation, double beta_max, double tol,
                        double sample_spacing, int divisions, int refinements, int drd_divisions,
-                       int drd_refinements, int drd_bisections) {
+                       int drd_refinements, int drd_bisections, double extend, const std::string& anchor,
+                       int anchor_iterations) {
              tmm::TorusTool tool;
              tool.Ro = Ro;
              tool.Ri = Ri;
@@ -140,6 +141,11 @@ void bind_surface(py::module_& m) {
              if (rotation == "pseudo_insert") o.rotation = tmm::TiltRotation::PseudoInsert;
              else if (rotation == "global_x") o.rotation = tmm::TiltRotation::GlobalX;
              else throw std::invalid_argument("rotation must be 'pseudo_insert' or 'global_x', got '" + rotation + "'");
+             if (anchor == "axis") o.anchor = tmm::FootprintAnchor::Axis;
+             else if (anchor == "tip") o.anchor = tmm::FootprintAnchor::Tip;
+             else throw std::invalid_argument("anchor must be 'axis' or 'tip', got '" + anchor + "'");
+             o.extend = extend;
+             o.anchor_iterations = anchor_iterations;
              o.beta_max = beta_max;
              o.tol = tol;
              o.sample_spacing = sample_spacing;
@@ -155,7 +161,8 @@ void bind_surface(py::module_& m) {
            py::arg("method") = "vcrf", py::arg("rotation") = "pseudo_insert",
            py::arg("beta_max") = 0.7853981633974483, py::arg("tol") = 1e-3, py::arg("sample_spacing") = 0.0,
            py::arg("divisions") = 6, py::arg("refinements") = 1, py::arg("drd_divisions") = 10,
-           py::arg("drd_refinements") = 5, py::arg("drd_bisections") = 16)
+           py::arg("drd_refinements") = 5, py::arg("drd_bisections") = 16, py::arg("extend") = 0.0,
+           py::arg("anchor") = "axis", py::arg("anchor_iterations") = 12)
       .def("position_batch",
            [](const tmm::MultipointPositioner& mp, const Arr& xy_in, int threads, const py::object& progress) {
              const Arr xy = check_points(xy_in, 2, "footprint points");
@@ -172,9 +179,12 @@ void bind_surface(py::module_& m) {
                  evals(static_cast<py::ssize_t>(n));
              py::array_t<double> beta(static_cast<py::ssize_t>(n)), drop_z(static_cast<py::ssize_t>(n)),
                  gap_P(static_cast<py::ssize_t>(n)), gap_Q(static_cast<py::ssize_t>(n)),
-                 pen(static_cast<py::ssize_t>(n)), seed_angle(static_cast<py::ssize_t>(n));
+                 pen(static_cast<py::ssize_t>(n)), seed_angle(static_cast<py::ssize_t>(n)),
+                 anchor_error(static_cast<py::ssize_t>(n)), pen_real(static_cast<py::ssize_t>(n));
+             py::array_t<int> on_ext(static_cast<py::ssize_t>(n));
              py::array_t<double> tip = rows3(n), axis = rows3(n), centre = rows3(n), P = rows3(n), nP = rows3(n),
                                  Q = rows3(n), nQ = rows3(n), seed_axis = rows3(n);
+             py::array_t<double> axis_xy({static_cast<py::ssize_t>(n), py::ssize_t{2}});
              py::array_t<double> uvP({static_cast<py::ssize_t>(n), py::ssize_t{2}}),
                  uvQ({static_cast<py::ssize_t>(n), py::ssize_t{2}});
              auto put3 = [](py::array_t<double>& a, std::size_t i, const Eigen::Vector3d& v) {
@@ -192,6 +202,11 @@ void bind_surface(py::module_& m) {
                gap_Q.mutable_data()[i] = r.gap_Q;
                pen.mutable_data()[i] = r.penetration;
                seed_angle.mutable_data()[i] = r.seed_axis_angle;
+               anchor_error.mutable_data()[i] = r.anchor_error;
+               pen_real.mutable_data()[i] = r.penetration_real;
+               on_ext.mutable_data()[i] = (r.P_extension ? 1 : 0) | (r.Q_extension ? 2 : 0);
+               axis_xy.mutable_data()[2 * i] = r.axis_xy.x();
+               axis_xy.mutable_data()[2 * i + 1] = r.axis_xy.y();
                put3(tip, i, r.tip);
                put3(axis, i, r.axis);
                put3(centre, i, r.centre);
@@ -225,11 +240,17 @@ void bind_surface(py::module_& m) {
              out["seed_axis"] = seed_axis;
              out["uvP"] = uvP;
              out["uvQ"] = uvQ;
+             out["axis_xy"] = axis_xy;
+             out["anchor_error"] = anchor_error;
+             out["penetration_real"] = pen_real;
+             out["on_extension"] = on_ext;
              return out;
            },
            py::arg("xy"), py::arg("threads") = 0, py::arg("progress") = py::none(),
            "Position the tool at the (n, 2) footprint points; dict of arrays (status 0 two contacts, 1 one "
-           "contact, 2 failed; reason codes: multipoint_reasons()). progress(fraction) -> bool; False cancels.")
+           "contact, 2 failed; reason codes: multipoint_reasons(); axis_xy: the pre-tilt axis point positioned; "
+           "anchor_error: |tip_xy - footprint point| for anchor 'tip'; penetration_real: into the real face; "
+           "on_extension: bit 1 P, bit 2 Q on the surface extension). progress(fraction) -> bool; False cancels.")
       .def("tool_distance",
            [](const tmm::MultipointPositioner& mp, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis,
               const Arr& pts_in) {

@@ -58,24 +58,33 @@ void bernstein(int n, double t, int order, double* b, double* db, double* ddb) {
   }
 }
 
-// Control points of the piece [a, b] of a Bezier curve, in place (de Casteljau at b, then at a / b).
+// Control points of the piece [a, b] of a Bezier curve, in place: de Casteljau at b (the piece [0, b]),
+// then at a / b of that (its piece [a / b, 1]). The polynomial identity holds for any a < b, also outside
+// [0, 1]: a piece reaching past the ends is the curve's polynomial continuation (extrapolation). When b is
+// near 0 (a piece left of 0) the order is swapped: [a, 1] first, then [0, (b - a) / (1 - a)] of that.
 void sub_curve(std::vector<Vector3d>& c, double a, double b) {
   const int n = static_cast<int>(c.size()) - 1;
   if (n == 0) return;
-  if (b < 1.0) {  // left piece [0, b]: first point of each column
+  auto left = [&](double t) {  // piece [0, t]: first point of each column
     std::vector<Vector3d> w = c;
     for (int k = 1; k <= n; ++k) {
-      for (int j = 0; j <= n - k; ++j) w[j] = (1.0 - b) * w[j] + b * w[j + 1];
+      for (int j = 0; j <= n - k; ++j) w[j] = (1.0 - t) * w[j] + t * w[j + 1];
       c[k] = w[0];
     }
-  }
-  if (a > 0.0) {  // right piece [a / b, 1] of that: last point of each column
-    const double t = b > 0.0 ? a / b : 0.0;
+  };
+  auto right = [&](double t) {  // piece [t, 1]: last point of each column
     std::vector<Vector3d> w = c;
     for (int k = 1; k <= n; ++k) {
       for (int j = 0; j <= n - k; ++j) w[j] = (1.0 - t) * w[j] + t * w[j + 1];
       c[n - k] = w[n - k];
     }
+  };
+  if (std::abs(b) >= std::abs(1.0 - a)) {
+    if (b != 1.0) left(b);
+    if (a != 0.0) right(a / b);
+  } else {
+    if (a != 0.0) right(a);
+    if (b != 1.0) left((b - a) / (1.0 - a));
   }
 }
 
@@ -246,6 +255,43 @@ Vector3d PatchSurface::point(double U, double V) const {
   double u, v;
   const int k = locate(U, V, &u, &v);
   return patches_[static_cast<std::size_t>(k)].point(u, v);
+}
+
+PatchSurface PatchSurface::extended(double distance) const {
+  if (!(distance >= 0.0) || !std::isfinite(distance)) throw std::invalid_argument("extension distance must be >= 0");
+  if (distance == 0.0) return *this;
+  // Local parameter reach of each side: distance over the smallest speed across the boundary (sampled).
+  constexpr int kSamples = 33;
+  constexpr double kMaxReach = 0.5;
+  auto reach = [&](bool along_u, bool high) {
+    double speed = std::numeric_limits<double>::infinity();
+    const int n = along_u ? nv_ : nu_;
+    for (int k = 0; k < n; ++k) {
+      const BezierPatch& p = along_u ? patch(high ? nu_ - 1 : 0, k) : patch(k, high ? nv_ - 1 : 0);
+      for (int s = 0; s < kSamples; ++s) {
+        const double t = static_cast<double>(s) / (kSamples - 1);
+        const SurfacePoint sp = along_u ? p.eval(high ? 1.0 : 0.0, t, 1) : p.eval(t, high ? 1.0 : 0.0, 1);
+        speed = std::min(speed, (along_u ? sp.Su : sp.Sv).norm());
+      }
+    }
+    return speed > 0.0 ? std::min(distance / speed, kMaxReach) : kMaxReach;
+  };
+  const double ulo = reach(true, false), uhi = reach(true, true), vlo = reach(false, false), vhi = reach(false, true);
+  std::vector<BezierPatch> out;
+  out.reserve(patches_.size());
+  for (int i = 0; i < nu_; ++i) {
+    for (int j = 0; j < nv_; ++j) {
+      const double u0 = i == 0 ? -ulo : 0.0, u1 = i == nu_ - 1 ? 1.0 + uhi : 1.0;
+      const double v0 = j == 0 ? -vlo : 0.0, v1 = j == nv_ - 1 ? 1.0 + vhi : 1.0;
+      out.push_back(patch(i, j).sub(u0, u1, v0, v1));
+    }
+  }
+  std::vector<double> bu = bu_, bv = bv_;
+  bu.front() -= ulo * (bu_[1] - bu_[0]);
+  bu.back() += uhi * (bu_[nu_] - bu_[nu_ - 1]);
+  bv.front() -= vlo * (bv_[1] - bv_[0]);
+  bv.back() += vhi * (bv_[nv_] - bv_[nv_ - 1]);
+  return PatchSurface(std::move(out), nu_, nv_, std::move(bu), std::move(bv));
 }
 
 PatchSurface PatchSurface::transformed(const Eigen::Matrix3d& R, const Vector3d& t) const {

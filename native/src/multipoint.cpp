@@ -312,9 +312,21 @@ Local minimize_box(Fn&& fn, Vector2d& x, const Vector2d& lo, const Vector2d& hi,
 // ---------------------------------------------------------------------------------------------------------
 // Positioner
 
+namespace {
+
+std::shared_ptr<const PatchSurface> extended_or_same(const std::shared_ptr<const PatchSurface>& s, double d) {
+  if (!s) throw std::invalid_argument("no surface");
+  if (!(d >= 0.0) || !std::isfinite(d)) throw std::invalid_argument("extension distance must be >= 0");
+  if (d == 0.0) return s;
+  return std::make_shared<const PatchSurface>(s->extended(d));
+}
+
+}  // namespace
+
 MultipointPositioner::MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool,
                                            MultipointOptions options)
-    : surface_(std::move(surface)),
+    : real_(surface),
+      surface_(extended_or_same(surface, options.extend)),
       tool_((tool.validate(), tool)),
       opt_(options),
       samples_(*surface_,
@@ -323,8 +335,11 @@ MultipointPositioner::MultipointPositioner(std::shared_ptr<const PatchSurface> s
   if (!(opt_.beta_max > 0.0 && opt_.beta_max < kPi / 2)) throw std::invalid_argument("beta_max must be in (0, pi/2)");
   if (!(opt_.tol > 0.0)) throw std::invalid_argument("tolerance must be > 0");
   if (opt_.divisions < 1 || opt_.refinements < 0 || opt_.drd_divisions < 2 || opt_.drd_refinements < 1 ||
-      opt_.drd_bisections < 1)
-    throw std::invalid_argument("grid divisions / refinements / bisections out of range");
+      opt_.drd_bisections < 1 || opt_.anchor_iterations < 1)
+    throw std::invalid_argument("grid divisions / refinements / bisections / anchor iterations out of range");
+  if (opt_.extend > 0.0) {
+    real_samples_ = std::make_unique<SurfaceSamples>(*real_, samples_.spacing(), std::max((tool.Ro + tool.Ri) * 0.5, 1e-3));
+  }
 }
 
 namespace {
@@ -580,17 +595,28 @@ MultipointPositioner::Drop MultipointPositioner::drop_drd(const PatchSurface& s,
 
 double MultipointPositioner::penetration(const Vector3d& tip, const Vector3d& axis, Vector2d* where,
                                          int* evals) const {
-  const PatchSurface& s = *surface_;
+  return penetration_on(*surface_, samples_, tip, axis, where, evals);
+}
+
+double MultipointPositioner::penetration_real(const Vector3d& tip, const Vector3d& axis, Vector2d* where,
+                                              int* evals) const {
+  if (!real_samples_) return penetration_on(*surface_, samples_, tip, axis, where, evals);
+  return penetration_on(*real_, *real_samples_, tip, axis, where, evals);
+}
+
+double MultipointPositioner::penetration_on(const PatchSurface& s, const SurfaceSamples& samples,
+                                            const Vector3d& tip, const Vector3d& axis, Vector2d* where,
+                                            int* evals) const {
   const Vector3d C = tip + tool_.Ri * axis;
   // The tilted tool's torus lies within Ro + Ri of C; the margin covers the shank's foot.
   const double r = tool_.radius() + 0.5 * tool_.Ri;
-  const auto& pts = samples_.points();
+  const auto& pts = samples.points();
   // The lowest few samples, kept apart from each other, are polished by Newton.
   constexpr int K = 6;
   std::pair<double, std::size_t> low[K];
   int nlow = 0;
-  const double sep2 = std::pow(2.0 * samples_.spacing(), 2);
-  samples_.within(C.x(), C.y(), r, [&](std::size_t k) {
+  const double sep2 = std::pow(2.0 * samples.spacing(), 2);
+  samples.within(C.x(), C.y(), r, [&](std::size_t k) {
     const double d = tool_distance(tool_, tip, axis, pts[k]);
     if (evals) ++*evals;
     if (d > tool_.Ri) return;
@@ -613,13 +639,13 @@ double MultipointPositioner::penetration(const Vector3d& tip, const Vector3d& ax
   double best = kInf;
   Vector2d at = Vector2d::Zero();
   for (int i = 0; i < nlow; ++i) {
-    Vector2d uv = samples_.params()[low[i].second];
+    Vector2d uv = samples.params()[low[i].second];
     const Local L = minimize_box([&](const Vector2d& p) { return distance_objective(s, tool_, tip, axis, p); }, uv,
                                  s.lo(), s.hi(), 30, evals);
     const double d = std::min(L.f, low[i].first);
     if (d < best) {
       best = d;
-      at = L.f <= low[i].first ? uv : samples_.params()[low[i].second];
+      at = L.f <= low[i].first ? uv : samples.params()[low[i].second];
     }
   }
   if (where) *where = at;
@@ -689,7 +715,7 @@ double pseudo_to_angle(double p) {
 
 }  // namespace
 
-MultipointResult MultipointPositioner::position(double x, double y) const {
+MultipointResult MultipointPositioner::position_core(double x, double y) const {
   MultipointResult res;
   const PatchSurface& s = *surface_;
   int evals = 0;
@@ -1056,6 +1082,72 @@ MultipointResult MultipointPositioner::position(double x, double y) const {
   if (opt_.rotation == TiltRotation::GlobalX && res.penetration > opt_.tol) res.status = ContactStatus::Failed;
   res.evaluations = evals;
   return res;
+}
+
+MultipointResult MultipointPositioner::position_axis(double x, double y) const {
+  MultipointResult r = position_core(x, y);
+  r.axis_xy = Vector2d(x, y);
+  r.penetration_real = r.penetration;
+  if (real_samples_ && r.status != ContactStatus::Failed) {
+    // Positioned against the extended face, which holds the real one: the real face is checked on its own
+    // (its samples and Newton), a position that enters it beyond tolerance fails.
+    int evals = 0;
+    r.penetration_real = penetration_real(r.tip, r.axis, nullptr, &evals);
+    r.evaluations += evals;
+    if (r.penetration_real > opt_.tol) {
+      r.status = ContactStatus::Failed;
+      r.reason = ContactReason::Gouge;
+    }
+  }
+  if (real_samples_) {
+    const Vector2d lo = real_->lo(), hi = real_->hi();
+    auto outside = [&](const Vector2d& uv) {
+      return uv.x() < lo.x() || uv.x() > hi.x() || uv.y() < lo.y() || uv.y() > hi.y();
+    };
+    r.P_extension = outside(r.uvP);
+    r.Q_extension = outside(r.uvQ);
+  }
+  return r;
+}
+
+MultipointResult MultipointPositioner::position(double x, double y) const {
+  if (opt_.anchor == FootprintAnchor::Axis) return position_axis(x, y);
+  // Tip anchor: find the pre-tilt axis point q whose tilted tip lands on (x, y). The tip moves with q almost
+  // by translation (the tilt changes slowly along the face), so q += (target - tip_xy) converges in a few
+  // steps; where the position switches between one and two contacts the map jumps and the iteration may
+  // cycle: the iterate nearest the target is kept (anchor_error says how near). Failed iterates are not
+  // kept; the step is halved back from them.
+  const Vector2d target(x, y);
+  Vector2d q = target, last_step = Vector2d::Zero();
+  MultipointResult best;
+  bool have = false;
+  double best_err = kInf;
+  int evals = 0;
+  const double goal = std::min(opt_.tol, 1e-3);
+  for (int k = 0; k < opt_.anchor_iterations; ++k) {
+    MultipointResult r = position_axis(q.x(), q.y());
+    evals += r.evaluations;
+    if (r.status == ContactStatus::Failed) {
+      if (!have && k == 0) best = r;
+      if (last_step.norm() < 1e-9) break;
+      last_step *= 0.5;
+      q -= last_step;
+      continue;
+    }
+    const Vector2d err = target - r.tip.head<2>();
+    const double e = err.norm();
+    if (e < best_err) {
+      best_err = e;
+      best = r;
+      have = true;
+    }
+    if (e <= goal) break;
+    last_step = err;
+    q += err;
+  }
+  best.anchor_error = have ? best_err : 0.0;
+  best.evaluations = evals;
+  return best;
 }
 
 void MultipointPositioner::position_batch(const double* xy, std::size_t n, MultipointResult* out,

@@ -99,6 +99,60 @@ TEST(Bezier, SubdivisionIsExactAndBoundsHoldThePatch) {
     }
 }
 
+TEST(Bezier, SubdivisionExtrapolatesOutsideTheUnitSquare) {
+  // Intervals reaching past 0 or 1 (or lying wholly outside) give the polynomial's continuation: the
+  // explicit Bernstein sum evaluated at parameters outside [0, 1].
+  const BezierPatch b = random_patch(3, 4, 11);
+  const double iv[][2] = {{-0.3, 1.2}, {-0.5, -0.1}, {1.1, 1.6}, {0.9, 1.4}, {-0.2, 0.4}, {0.3, 0.8}};
+  for (const auto& I : iv) {
+    for (const auto& J : iv) {
+      const BezierPatch s = b.sub(I[0], I[1], J[0], J[1]);
+      for (double a : {0.0, 0.3, 0.7, 1.0})
+        for (double c : {0.0, 0.45, 1.0}) {
+          const Vector3d ref = explicit_point(b, I[0] + a * (I[1] - I[0]), J[0] + c * (J[1] - J[0]));
+          EXPECT_LT((s.point(a, c) - ref).norm(), 1e-9 * (1.0 + ref.norm()))
+              << "[" << I[0] << ", " << I[1] << "] x [" << J[0] << ", " << J[1] << "] at " << a << ", " << c;
+        }
+    }
+  }
+}
+
+TEST(Bezier, ExtendedFaceKeepsTheFaceAndContinuesItsPolynomial) {
+  // The seed's concave patch (x = 150 u, y = 150 v) cut into 2 x 2 pieces, extended by 12.7 mm: over the old
+  // domain the same surface (derivatives too), outside it the polynomial's continuation, reaching between
+  // 12.7 / |dS/du|max and 12.7 / 150 mm in x (the speed across the boundary is at least 150).
+  const BezierPatch b = seed_patch(false);
+  const std::vector<double> bu = {0.0, 0.4, 1.0}, bv = {0.0, 0.55, 1.0};
+  std::vector<BezierPatch> pieces;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j) pieces.push_back(b.sub(bu[i], bu[i + 1], bv[j], bv[j + 1]));
+  const PatchSurface face(pieces, 2, 2, bu, bv);
+  const PatchSurface ext = face.extended(12.7);
+  EXPECT_EQ(ext.patch_count(), 4);
+  for (double lo : {-ext.umin(), -ext.vmin(), ext.umax() - 1.0, ext.vmax() - 1.0}) {
+    EXPECT_LE(lo * 150.0, 12.7 + 1e-9);
+    EXPECT_GE(lo * 150.0, 12.7 * 150.0 / std::hypot(150.0, 45.0));
+  }
+  EXPECT_NEAR(ext.breaks_u()[1], 0.4, 1e-15);  // inner breakpoints unchanged
+  EXPECT_NEAR(ext.breaks_v()[1], 0.55, 1e-15);
+  for (double U : {0.0, 0.13, 0.4, 0.77, 1.0})
+    for (double V : {0.0, 0.3, 0.55, 1.0}) {
+      const auto a = ext.eval(U, V), r = b.eval(U, V);
+      EXPECT_LT((a.S - r.S).norm(), 1e-10);
+      EXPECT_LT((a.Su - r.Su).norm(), 1e-8);
+      EXPECT_LT((a.Svv - r.Svv).norm(), 1e-6);
+    }
+  for (double U : {ext.umin(), -0.05, 0.5, 1.04, ext.umax()})
+    for (double V : {ext.vmin(), -0.02, 0.5, ext.vmax()}) {
+      const Vector3d r = explicit_point(b, U, V);
+      EXPECT_LT((ext.point(U, V) - r).norm(), 1e-9 * (1.0 + r.norm())) << U << ", " << V;
+    }
+  // The concave bowl keeps rising past its rim x = 0 (the boundary curve is no longer the highest line).
+  EXPECT_GT(ext.point(ext.umin(), 0.18).z(), face.point(0.0, 0.18).z() + 1.0);
+  EXPECT_EQ(face.extended(0.0).umin(), 0.0);
+  EXPECT_THROW(face.extended(-1.0), std::invalid_argument);
+}
+
 TEST(Bezier, MultiPatchSurfaceIsSeamlessAcrossItsPieces) {
   // One patch cut into 3 x 2 pieces with non-uniform breakpoints: the face must be the same surface,
   // derivatives included (C-infinity across every seam).

@@ -173,6 +173,76 @@ TEST(Multipoint, SeedGlobalXRotationLosesTheContacts) {
   EXPECT_GT(worst_angle, 1e-3);
 }
 
+// Surface extension: on the concave patch the rim x = 0 is the highest line of the section; a tool centred
+// on it rests on the boundary curve (P and Q at u = 0) and leaves a wedge of material beside the rim. Against
+// the face continued past the rim the tool lies on the continued bowl, leans into the patch and cuts the
+// wedge down; it penetrates neither the extended nor the real face.
+TEST(Multipoint, ExtensionRestsOnTheContinuedSurfaceNotOnTheRim) {
+  const auto surface = seed_surface(false);
+  const auto& patch = surface->patch(0, 0);
+  const TorusTool tool{kRo, kRi, tmm::ToolShape::RoundInsert};
+  MultipointOptions o;
+  const MultipointPositioner plain(surface, tool, o);
+  o.extend = kRo + kRi;
+  const MultipointPositioner ext(surface, tool, o);
+  EXPECT_LT(ext.surface().umin(), -0.08);
+  EXPECT_EQ(ext.real_surface().umin(), 0.0);
+  const Vector3d wedge = bicubic(patch, 6.44 / 150.0, 27.0 / 150.0);  // the uncut wedge at the section
+  for (double x : {0.0, 150.0}) {
+    SCOPED_TRACE(testing::Message() << "x = " << x);
+    const MultipointResult a = plain.position(x, 28.0), b = ext.position(x, 28.0);
+    ASSERT_EQ(a.status, ContactStatus::TwoContacts);
+    ASSERT_EQ(b.status, ContactStatus::TwoContacts);
+    EXPECT_NEAR(a.uvP.x(), x / 150.0, 1e-12);  // on the rim
+    EXPECT_NEAR(a.uvQ.x(), x / 150.0, 1e-12);
+    EXPECT_FALSE(a.P_extension || a.Q_extension);
+    EXPECT_TRUE(b.P_extension && b.Q_extension);  // both on the continued bowl
+    EXPECT_LT(std::abs(torus_distance(b.tip, b.axis, b.P)), 1e-3);
+    EXPECT_LT(std::abs(torus_distance(b.tip, b.axis, b.Q)), 1e-3);
+    EXPECT_GT(std::abs(b.axis.x()), 0.15);  // leans into the patch
+    const Vector3d w = x == 0.0 ? wedge : bicubic(patch, 1.0 - 6.44 / 150.0, 27.0 / 150.0);
+    EXPECT_GT(torus_distance(a.tip, a.axis, w), 1.4);  // the wedge left by the tool on the rim
+    EXPECT_LT(torus_distance(b.tip, b.axis, w), 0.5);  // cut down by the tool on the extension
+    EXPECT_LE(b.penetration_real, 1e-3);
+    EXPECT_LT(sampled_penetration(patch, b, 0.05), 1e-3);  // the real patch, sampled independently
+  }
+  // Away from the edges the extension changes nothing.
+  const MultipointResult a = plain.position(72.0, 60.0), b = ext.position(72.0, 60.0);
+  EXPECT_LT((a.tip - b.tip).norm(), 1e-6);
+  EXPECT_LT((a.axis - b.axis).norm(), 1e-6);
+  EXPECT_FALSE(b.P_extension || b.Q_extension);
+}
+
+// Footprint anchor: with Axis the tilt about the pseudo-insert axis moves the tip off the footprint point
+// (about 0.8 mm on the concave patch); with Tip the tilted tip lands on it, and the position is exactly the
+// Axis position of the pre-tilt point it reports.
+TEST(Multipoint, TipAnchorPutsTheTiltedTipOnTheFootprintPoint) {
+  const auto surface = seed_surface(false);
+  const TorusTool tool{kRo, kRi, tmm::ToolShape::RoundInsert};
+  MultipointOptions o;
+  const MultipointPositioner axis(surface, tool, o);
+  o.anchor = tmm::FootprintAnchor::Tip;
+  const MultipointPositioner tip(surface, tool, o);
+  double moved = 0.0;
+  for (double x : {18.0, 36.0, 90.0, 126.0}) {
+    for (double y : {28.0, 60.0}) {
+      SCOPED_TRACE(testing::Message() << "at " << x << ", " << y);
+      const MultipointResult a = axis.position(x, y), t = tip.position(x, y);
+      ASSERT_NE(a.status, ContactStatus::Failed);
+      ASSERT_NE(t.status, ContactStatus::Failed);
+      moved = std::max(moved, (a.tip.head<2>() - Eigen::Vector2d(x, y)).norm());
+      EXPECT_EQ(a.axis_xy, Eigen::Vector2d(x, y));
+      EXPECT_LT((t.tip.head<2>() - Eigen::Vector2d(x, y)).norm(), 1e-3);
+      EXPECT_NEAR(t.anchor_error, (t.tip.head<2>() - Eigen::Vector2d(x, y)).norm(), 1e-12);
+      const MultipointResult again = axis.position(t.axis_xy.x(), t.axis_xy.y());
+      EXPECT_LT((again.tip - t.tip).norm(), 1e-9);
+      EXPECT_LT((again.axis - t.axis).norm(), 1e-9);
+      EXPECT_LT(sampled_penetration(surface->patch(0, 0), t, 0.05), 1e-3);
+    }
+  }
+  EXPECT_GT(moved, 0.5);
+}
+
 TEST(Multipoint, BallIsOneContactFlatIsRefused) {
   const auto surface = seed_surface(true);
   const MultipointPositioner ball(surface, TorusTool{0.0, 5.0, tmm::ToolShape::RoundInsert}, MultipointOptions{});

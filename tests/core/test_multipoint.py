@@ -272,3 +272,58 @@ def test_seed_saddle_surface_no_failures_no_gouge():
         assert dense_penetration(net, res["tip"][i], res["axis"][i], 0.1) < 1e-3, res.xy[i]
     sub = xy[::9]
     assert_same_positions(position_points(face, RO, RI, sub), position_points(face, RO, RI, sub, method="drd"))
+
+
+def test_extend_and_anchor_options_are_validated():
+    face = BezierFace.from_net(seed_net("concave"))
+    for bad in (MultipointParams(extend=-1.0), MultipointParams(extend=float("nan")),
+                MultipointParams(anchor="cc"), MultipointParams(anchor_iterations=0)):
+        with pytest.raises(TmmError):
+            position_points(face, RO, RI, np.array([[50.0, 50.0]]), bad)
+
+
+@pytest.mark.parametrize("method", ["vcrf", "drd"])
+def test_extension_on_the_concave_rim_touches_the_continued_bowl_without_gouging_the_patch(method):
+    """A pass on the concave patch's rim x = 0: without extension the tool rests on the boundary curve
+    (u = 0 at both contacts); with the face extended by Ro + Ri the first contact lies on the continuation
+    (u < 0; at the section both do), both touch the tool, and the real patch, sampled densely and
+    independently, is not entered."""
+    net = seed_net("concave")
+    face = BezierFace.from_net(net)
+    xy = np.array([[0.0, 26.0], [0.0, 28.0], [0.0, 60.0]])
+    plain = position_points(face, RO, RI, xy, MultipointParams(), method)
+    ext = position_points(face, RO, RI, xy, MultipointParams(extend=RO + RI), method)
+    assert (plain.status == STATUS_TWO).all() and (ext.status == STATUS_TWO).all()
+    np.testing.assert_allclose(plain["uvP"][:, 0], 0.0, atol=1e-12)
+    np.testing.assert_allclose(plain["uvQ"][:, 0], 0.0, atol=1e-12)
+    assert (ext["on_extension"][:2] == 3).all() and (plain["on_extension"] == 0).all()
+    assert (ext["on_extension"] & 1).all() and (ext["uvP"][:, 0] < 0).all() and (ext["uvQ"][:2, 0] < 0).all()
+    Pext = bezier.evaluate(net, ext["uvP"][:, 0], ext["uvP"][:, 1])      # the polynomial, continued
+    np.testing.assert_allclose(Pext, ext["P"], atol=1e-9)
+    for i in range(len(xy)):
+        tip, axis = ext["tip"][i], ext["axis"][i]
+        assert abs(torus_distance(tip, axis, ext["P"][i:i + 1])[0]) < 1e-3
+        assert abs(torus_distance(tip, axis, ext["Q"][i:i + 1])[0]) < 1e-3
+        assert dense_penetration(net, tip, axis) < 1e-3
+        assert ext["penetration_real"][i] <= 1e-3
+        # the wedge beside the rim (x = 6.44 at the section): material left by the tool on the rim, cut by
+        # the tool on the extension
+        w = bezier.evaluate(net, np.array([6.44 / 150]), np.array([xy[i, 1] / 150]))
+        assert torus_distance(plain["tip"][i], plain["axis"][i], w)[0] > 1.2
+        assert torus_distance(tip, axis, w)[0] < 0.6
+
+
+def test_tip_anchor_lands_the_tilted_tip_on_the_footprint():
+    net = seed_net("concave")
+    face = BezierFace.from_net(net)
+    xy = np.array([[18.0, 27.0], [36.0, 27.0], [108.0, 90.0]])
+    a = position_points(face, RO, RI, xy, MultipointParams(anchor="axis"))
+    t = position_points(face, RO, RI, xy, MultipointParams(anchor="tip"))
+    assert np.linalg.norm(a["tip"][:, :2] - xy, axis=1).max() > 0.5     # the tilt moves the tip
+    np.testing.assert_allclose(a["axis_xy"], xy)
+    assert np.linalg.norm(t["tip"][:, :2] - xy, axis=1).max() < 1e-3
+    np.testing.assert_allclose(t["anchor_error"], np.linalg.norm(t["tip"][:, :2] - xy, axis=1), atol=1e-12)
+    again = position_points(face, RO, RI, t["axis_xy"], MultipointParams(anchor="axis"))
+    np.testing.assert_allclose(again["tip"], t["tip"], atol=1e-9)
+    for i in range(len(xy)):
+        assert dense_penetration(net, t["tip"][i], t["axis"][i]) < 1e-3

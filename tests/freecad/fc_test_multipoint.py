@@ -109,6 +109,24 @@ class MultipointOp(FreeCADTestCase):
         text = processor.export([r.job.Tools.Group[0], op], str(OUT / "mp_direct.ngc"), "--no-show-editor")
         self.assertIn(" A", text if isinstance(text, str) else (OUT / "mp_direct.ngc").read_text())
 
+    def test_surface_extension_and_tip_anchor(self) -> None:
+        """The op's SurfaceExtension and FootprintAnchor reach the core: on the concave patch the passes on
+        the rims touch the continued bowl, and the tilted tips lie on the footprint points."""
+        net = bezier.load_seed_patch(SEED, "concave")
+        r = run_multipoint(net, out_dir=OUT, name="mp_extend", surface_extension=12.7, footprint_anchor="tip",
+                           posts=("apt_cl",), **FAST)
+        op = r.op
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertAlmostEqual(op.SurfaceExtension.Value, 12.7)
+        self.assertEqual(op.FootprintAnchor, "Tip")
+        res = r.results
+        self.assertEqual(res.counts()["failed"], 0)
+        self.assertGreater(int((res["on_extension"] > 0).sum()), 0)
+        self.assertLessEqual(float(res["penetration_real"].max()), 1e-3)
+        np.testing.assert_allclose(res["tip"][:, :2], res.xy, atol=5e-3)
+        with self.assertRaises(TmmError):
+            run_multipoint(net, footprint_anchor="contact", **FAST)
+
     def test_bspline_face_gives_the_same_path(self) -> None:
         """DRD: the same tips within 1e-6. VCRF: the kernel's surface samples follow the patches (4 after the
         knot insertion instead of 1), so a few positions land elsewhere within the search's resolution

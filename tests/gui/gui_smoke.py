@@ -57,7 +57,7 @@ def multipoint_panel(info: dict) -> None:
 
     net = bezier.load_seed_patch(ROOT.parent / "shared" / "benchmarks" / "seed_surfaces.json", "convex")
     r = run_multipoint(net, side_step=36.0, forward_step=6.0, posts=(), doc_name="TmmGuiMultipoint",
-                       progress=True)
+                       progress=True, surface_extension=12.7, footprint_anchor="tip")
     assert isinstance(r.op.ViewObject.Proxy, MultipointViewProvider), type(r.op.ViewObject.Proxy)
     assert Path(r.op.ViewObject.Proxy.getIcon()).is_file(), "the 5-axis op's tree icon is not a file"
     r.op.ViewObject.Document.setEdit(r.op.ViewObject, 0)
@@ -68,6 +68,12 @@ def multipoint_panel(info: dict) -> None:
     assert abs(info["multipoint_side_step"] - 36.0) < 1e-9, info["multipoint_side_step"]
     assert info["multipoint_contacts"] == r.op.ContactSummary and "two" in info["multipoint_contacts"], \
         info["multipoint_contacts"]
+    # the surface extension and footprint anchor fields show the op's values
+    info["mp_extension"] = page.findChild(QtGui.QWidget, "surfaceExtension").property("rawValue")
+    anchor = page.findChild(QtGui.QComboBox, "footprintAnchor")
+    info["mp_anchor"] = [anchor.currentText(), [anchor.itemText(i) for i in range(anchor.count())]]
+    assert abs(info["mp_extension"] - 12.7) < 1e-9, info["mp_extension"]
+    assert info["mp_anchor"] == ["Tip", ["Axis", "Tip"]], info["mp_anchor"]
     close_panel(r.op)
     obj, face = r.face
     FreeCADGui.Selection.clearSelection()

@@ -165,6 +165,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
                    side_step: float = 18.0, forward_step: float = 2.0, feed_angle_deg: float = 90.0,
                    margin: float = 0.0, zigzag: bool = True, tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
+                   surface_extension: float = 0.0, footprint_anchor: str = "axis",
                    safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                    horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                    posts: Sequence[str] = ("tarus", "apt_cl"), out_dir: Optional[Union[str, os.PathLike]] = None,
@@ -179,6 +180,9 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     D = 2 (Ro + Ri), corner Ri). method 'vcrf' | 'drd'; tool_shape 'round_insert' (the seed's
     torus, hollow centre) | 'bull_nose' (plus its flat bottom).
     tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm).
+    surface_extension (mm, 0: off): position against the face continued past its edges (checked against
+    the real face); footprint_anchor 'axis' (seed 001: the pre-tilt axis on the footprint point) | 'tip'
+    (the tilted tip on it).
     Heights default to the face's top + 5 mm (safe, for the tool's lowest point) and + 10 mm (clearance).
     Feeds in mm/min. Each post's output goes to out_dir/<name><suffix> (tarus: .tarus.ngc, apt_cl: .apt,
     others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
@@ -194,6 +198,10 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     if shape_name is None:
         raise TmmError(f"tool_shape must be one of {', '.join(op_multipoint.TOOL_SHAPES.values())}, "
                        f"got {tool_shape!r}")
+    anchor_name = {v: k for k, v in op_multipoint.ANCHORS.items()}.get(str(footprint_anchor).lower())
+    if anchor_name is None:
+        raise TmmError(f"footprint_anchor must be one of {', '.join(op_multipoint.ANCHORS.values())}, "
+                       f"got {footprint_anchor!r}")
     for label, v in (("Ro", Ro), ("Ri", Ri)):
         if not isinstance(v, (int, float)) or not v >= 0:
             raise TmmError(f"{label} must be a length >= 0 mm, got {v!r}")
@@ -227,7 +235,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         values: dict[str, Any] = {
             "Base": [(clone, (sub,))], "Method": method_name, "ToolShape": shape_name, "SideStep": side_step,
             "ForwardStep": forward_step, "FeedAngle": feed_angle_deg, "BoundaryMargin": margin,
-            "ZigZag": bool(zigzag), "AxisRetract": axis_retract, "SafeHeight": safe, "ClearanceHeight": clearance}
+            "ZigZag": bool(zigzag), "AxisRetract": axis_retract, "SafeHeight": safe, "ClearanceHeight": clearance,
+            "SurfaceExtension": surface_extension, "FootprintAnchor": anchor_name}
         if tilt_limit_deg is not None:
             values["TiltLimit"] = tilt_limit_deg
         if tolerance is not None:

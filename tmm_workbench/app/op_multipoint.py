@@ -45,6 +45,7 @@ from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
 OP_NAME = "TMM_Multipoint"
 METHODS = {"VCRF": "vcrf", "DRD": "drd"}
 TOOL_SHAPES = {"RoundInsert": "round_insert", "BullNose": "bull_nose"}
+ANCHORS = {"Axis": "axis", "Tip": "tip"}
 SUPPORTED_SHAPES = ("bullnose", "ballend", "endmill")  # endmill only to get the core's clear refusal
 _DEFAULT = MultipointParams()
 
@@ -63,6 +64,13 @@ PROPERTIES: list[tuple[str, str, str, str]] = [
     ("App::PropertyBool", "ZigZag", "Footprint", "Alternate the direction of the passes"),
     ("App::PropertyAngle", "TiltLimit", "Multipoint", "Largest tilt of the tool axis from the vertical"),
     ("App::PropertyDistance", "Tolerance", "Multipoint", "Contact and gouge tolerance"),
+    ("App::PropertyDistance", "SurfaceExtension", "Multipoint",
+     "Position the tool against the face continued past its edges by this distance (0: off), so a pass over "
+     "an edge rests on the continued surface instead of on the edge; every position is still checked "
+     "against the real face. The tool radius (Ro + Ri) covers a pass centred on the edge"),
+    ("App::PropertyEnumeration", "FootprintAnchor", "Footprint",
+     "Axis: the tool axis before tilting passes through the footprint point (seed 001; the tilt moves the tip "
+     "sideways); Tip: the tilted tool's tip lies on the footprint point (passes exactly one side step apart)"),
     ("App::PropertyDistance", "AxisRetract", "Linking",
      "Entry and exit distance along the tool axis (then straight up/down to the safe height)"),
     ("App::PropertyString", "ContactSummary", "Multipoint",
@@ -72,8 +80,9 @@ DEFAULTS: dict[str, Any] = {
     "Method": "VCRF", "ToolShape": "RoundInsert", "SideStep": _DEFAULT.side_step,
     "ForwardStep": _DEFAULT.forward_step, "FeedAngle": _DEFAULT.feed_angle_deg, "BoundaryMargin": _DEFAULT.margin,
     "ZigZag": _DEFAULT.zigzag, "TiltLimit": _DEFAULT.beta_max_deg, "Tolerance": _DEFAULT.tol, "AxisRetract": 5.0,
+    "SurfaceExtension": _DEFAULT.extend, "FootprintAnchor": "Axis",
 }
-ENUMERATIONS = {"Method": list(METHODS), "ToolShape": list(TOOL_SHAPES)}
+ENUMERATIONS = {"Method": list(METHODS), "ToolShape": list(TOOL_SHAPES), "FootprintAnchor": list(ANCHORS)}
 
 
 def torus_radii(tool: Any) -> tuple[float, float]:
@@ -276,7 +285,8 @@ class ObjectTmmMultipoint(op_base.TmmOp):
         return MultipointParams(
             side_step=obj.SideStep.Value, forward_step=obj.ForwardStep.Value,
             feed_angle_deg=obj.FeedAngle.Value, margin=obj.BoundaryMargin.Value, zigzag=bool(obj.ZigZag),
-            shape=TOOL_SHAPES[obj.ToolShape], beta_max_deg=obj.TiltLimit.Value, tol=obj.Tolerance.Value)
+            shape=TOOL_SHAPES[obj.ToolShape], beta_max_deg=obj.TiltLimit.Value, tol=obj.Tolerance.Value,
+            extend=obj.SurfaceExtension.Value, anchor=ANCHORS[obj.FootprintAnchor])
 
 
 def SetupProperties() -> list[str]:

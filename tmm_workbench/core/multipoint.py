@@ -32,6 +32,7 @@ STATUS_NAMES = ("two", "one", "failed")
 METHODS = ("vcrf", "drd")
 SHAPES = ("round_insert", "bull_nose")
 ROTATIONS = ("pseudo_insert", "global_x")
+ANCHORS = ("axis", "tip")
 
 
 class BezierFace:
@@ -137,6 +138,9 @@ class MultipointParams:
     shape: str = "round_insert"      # tool solid: the seed's torus with a hollow centre, or a bull-nose
     rotation: str = "pseudo_insert"  # exact tilt; "global_x" reproduces the seed's pseudo-code
     beta_max_deg: float = 45.0       # tilt limit (seed: pi/4)
+    extend: float = 0.0              # mm: position against the face continued past its edges (0: off)
+    anchor: str = "axis"             # footprint point = pre-tilt tool axis ("axis", seed) or tilted tip ("tip")
+    anchor_iterations: int = 12      # "tip": at most this many positions per footprint point
     tol: float = 1e-3                # contact and gouge tolerance, mm
     sample_spacing: float = 0.0      # surface samples (0: (Ro + Ri) / 8)
     divisions: int = 6               # VCRF zoom grid (seed 32)
@@ -208,6 +212,12 @@ def _check_params(p: MultipointParams) -> None:
         raise TmmError(f"tool shape must be one of {SHAPES}, got {p.shape!r}")
     if p.rotation not in ROTATIONS:
         raise TmmError(f"rotation must be one of {ROTATIONS}, got {p.rotation!r}")
+    if p.anchor not in ANCHORS:
+        raise TmmError(f"footprint anchor must be one of {ANCHORS}, got {p.anchor!r}")
+    if not (isinstance(p.extend, (int, float)) and math.isfinite(p.extend) and p.extend >= 0):
+        raise TmmError(f"surface extension must be a length >= 0, got {p.extend!r}")
+    if not (isinstance(p.anchor_iterations, int) and p.anchor_iterations >= 1):
+        raise TmmError(f"anchor iterations must be an integer >= 1, got {p.anchor_iterations!r}")
     if not (0 < p.beta_max_deg < 90):
         raise TmmError(f"tilt limit must be in (0, 90) degrees, got {p.beta_max_deg!r}")
     if not (p.tol > 0):
@@ -253,7 +263,8 @@ def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[Mul
             face.native, float(Ro), float(Ri), params.shape, method, params.rotation,
             math.radians(params.beta_max_deg), float(params.tol), float(params.sample_spacing),
             int(params.divisions), int(params.refinements), int(params.drd_divisions),
-            int(params.drd_refinements), int(params.drd_bisections))
+            int(params.drd_refinements), int(params.drd_bisections), float(params.extend), params.anchor,
+            int(params.anchor_iterations))
     except ValueError as exc:
         raise TmmError(str(exc)) from exc
 

@@ -49,6 +49,17 @@ SEED_MACHINED_MAX = {("convex", "drd"): 0.57, ("concave", "drd"): 1.00,
                      ("convex", "vcrf"): 0.51, ("concave", "vcrf"): 0.70}
 GOUGE_LIMIT = -0.01
 
+# Kernel option sets measured by benchmarks/seed_experiment.py (MultipointParams fields; everything else
+# default). "seed": as the seed describes it. "extend": the face continued past its edges by the tool's
+# radius Ro + Ri (a pass over the boundary rests on the continued surface, not on the boundary curve).
+# "extend+tip": that, and the tilted tool's tip (not its pre-tilt axis) on the footprint point, so the
+# passes' tips lie exactly on x = 0, 18, ..., 144, 150.
+CONFIGS = {
+    "seed": {},
+    "extend": {"extend": RO + RI},
+    "extend+tip": {"extend": RO + RI, "anchor": "tip"},
+}
+
 
 def seed_json_path() -> Path:
     for p in (SEED_JSON, REPO.parent / "shared" / "benchmarks" / "seed_surfaces.json"):
@@ -107,6 +118,7 @@ class SectionResult:
     max_dev_interior: float = float("nan")           # patch; the max deviation there (edge strips excluded)
     x_at_max_interior: float = float("nan")
     results: Optional[MultipointResults] = field(default=None, repr=False)
+    label: str = "seed"              # the configuration (kernel options) the positions were computed with
 
     @property
     def seed_max(self) -> float:
@@ -245,6 +257,46 @@ def section_plot(results: Sequence[SectionResult], path) -> Path:
         ax.set_ylabel("deviation (mm)")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="upper right")
+    fig.tight_layout()
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=130)
+    plt.close(fig)
+    return out
+
+
+def options_plot(results: Sequence[SectionResult], path, method: str = "vcrf") -> Path:
+    """Deviation along x at the section for each surface (one panel each), one line per configuration
+    (SectionResult.label), for one method; the seed's simulated maximum dashed."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sel = [r for r in results if r.method == method]
+    surfaces = [w for w in ("convex", "concave") if any(r.which == w for r in sel)]
+    fig, axs = plt.subplots(len(surfaces), 1, figsize=(10, 3.8 * len(surfaces)), squeeze=False)
+    colours = ["tab:blue", "tab:green", "tab:red", "tab:purple", "tab:orange"]
+    for ax, w in zip(axs[:, 0], surfaces):
+        labels = [r.label for r in sel if r.which == w]
+        for r in sel:
+            if r.which != w:
+                continue
+            k = labels.index(r.label)
+            c = colours[k % len(colours)]
+            # earlier configurations drawn wider underneath: where two coincide both show
+            ax.plot(r.x, r.deviation, lw=max(0.9, 2.6 - 0.8 * k), color=c, alpha=0.9, zorder=2 + k,
+                    label=f"{r.label}: max {r.max_dev:.3f} mm (x {r.interior[0]:g}..{r.interior[1]:g}: "
+                          f"{r.max_dev_interior:.3f}), min {r.min_dev:+.4f} mm")
+        ax.axhline(SEED_SIMULATED_MAX[(w, method)], color="k", ls="--", lw=0.8,
+                   label=f"seed {method.upper()} simulated max {SEED_SIMULATED_MAX[(w, method)]:.2f} mm")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.axhline(GOUGE_LIMIT, color="red", lw=0.6, ls=":", label="gouge limit -0.01 mm")
+        ax.set_title(f"{w} patch, {method.upper()}, section y = {sel[0].section_y:g} mm: simulated minus design")
+        ax.set_xlabel("x (mm)")
+        ax.set_ylabel("deviation (mm)")
+        ax.set_ylim(-0.1, max(1.0, max(r.max_dev for r in sel if r.which == w) + 0.1))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper center")
     fig.tight_layout()
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -16,8 +16,8 @@ ICON = resources.icon("TMM_Multipoint")
 # widget name -> property
 SPIN_BOXES = {"sideStep": "SideStep", "forwardStep": "ForwardStep", "feedAngle": "FeedAngle",
               "boundaryMargin": "BoundaryMargin", "tiltLimit": "TiltLimit", "tolerance": "Tolerance",
-              "axisRetract": "AxisRetract"}
-COMBOS = {"method": "Method", "toolShape": "ToolShape"}
+              "axisRetract": "AxisRetract", "surfaceExtension": "SurfaceExtension"}
+COMBOS = {"method": "Method", "toolShape": "ToolShape", "footprintAnchor": "FootprintAnchor"}
 
 
 class TaskPanelOpPage(op_page.OpPage):

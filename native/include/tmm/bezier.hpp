@@ -60,7 +60,8 @@ class BezierPatch {
   // Bounding box of the control net: it holds the patch (convex hull property).
   const Box3& bounds() const { return box_; }
 
-  // The piece over [u0, u1] x [v0, v1], reparametrised to the unit square (de Casteljau, exact).
+  // The piece over [u0, u1] x [v0, v1], reparametrised to the unit square (de Casteljau, exact). The
+  // interval may reach outside [0, 1]: that part is the polynomial's continuation (extrapolation).
   BezierPatch sub(double u0, double u1, double v0, double v1) const;
   // x -> R x + t applied to the poles (exact for a polynomial patch).
   BezierPatch transformed(const Eigen::Matrix3d& R, const Vector3d& t) const;
@@ -109,6 +110,15 @@ class PatchSurface {
   const Box3& bounds() const { return box_; }
 
   PatchSurface transformed(const Eigen::Matrix3d& R, const Vector3d& t) const;
+
+  // The face continued past its four boundary curves by about `distance` (model units, >= 0) measured on
+  // the surface: each boundary patch is replaced by its polynomial continuation (BezierPatch::sub over an
+  // interval reaching outside [0, 1]; the natural extension of the polynomial, C-infinity across the old
+  // boundary), and the outer breakpoints move out so that the global parameters of the original face are
+  // unchanged: over the old domain the extended face is the same surface. The parameter reach of a side
+  // is distance / (smallest speed |dS/du| along that boundary), at most half the boundary patch (a
+  // polynomial far outside its domain can fold). distance = 0 returns a copy.
+  PatchSurface extended(double distance) const;
 
   // First intersection with the ray origin + s dir, s >= 0 (dir need not be unit). Patches and then
   // sub-patches are culled by their control-hull boxes (slab test) and visited nearest first; on a leaf

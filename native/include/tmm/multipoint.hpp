@@ -56,6 +56,13 @@ enum class MultipointMethod { VCRF = 0, DRD = 1 };
 // PseudoInsert: the exact rotation about u1 at O1. GlobalX: the seed's pseudo-code (4.9 / 4.12), the tool
 // axis rotated about the global X axis by beta (the tip pivoting about O1), kept to measure the error.
 enum class TiltRotation { PseudoInsert = 0, GlobalX = 1 };
+// What the footprint point (x, y) fixes. Axis (the seed): the vertical tool axis through (x, y) before the
+// drop and the tilt; the tilt about the pseudo-insert axis then moves the tip sideways (up to ~1.5 mm on the
+// seed patches, towards the face's centre on a convex face, away from it on a concave one, so the passes'
+// tips end up closer or wider apart than the footprint's side step). Tip: the tilted tool's tip (the CL
+// point) lies at (x, y): the pre-tilt axis point is found by a fixed-point iteration (tip offset fed back),
+// every iterate being a full, gouge-checked multipoint position of its own axis point.
+enum class FootprintAnchor { Axis = 0, Tip = 1 };
 
 struct TorusTool {
   double Ro = 0.0;  // major radius (centre of the pseudo-insert to the axis)
@@ -103,6 +110,13 @@ struct MultipointOptions {
   int drd_divisions = 10; // DRD: rays per direction (seed 10)
   int drd_refinements = 5;// DRD: zoom levels (seed 5)
   int drd_bisections = 16;// DRD: bisection steps on beta (seed: 10 repeats of the same Q)
+  // Surface extension ("machine past the edge"): > 0 positions the tool against the face continued past
+  // its boundary curves by this distance (mm; PatchSurface::extended, the polynomial continuation), so a
+  // tool over the boundary rests on the continued surface instead of on the boundary curve. Every position
+  // is then also checked for penetration against the real face (penetration_real). 0: the face only.
+  double extend = 0.0;
+  FootprintAnchor anchor = FootprintAnchor::Axis;
+  int anchor_iterations = 12;  // Tip: at most this many positions per footprint point
 };
 
 struct MultipointResult {
@@ -118,6 +132,10 @@ struct MultipointResult {
   Vector3d seed_axis = Vector3d::UnitZ();  // the seed's axis: Z rotated by beta about global X
   double seed_axis_angle = 0.0;            // angle between seed_axis and the exact axis, rad
   int evaluations = 0;        // surface evaluations spent (cost counter)
+  Vector2d axis_xy = Vector2d::Zero();  // the pre-tilt axis point positioned (the footprint point for Axis)
+  double anchor_error = 0.0;  // Tip: |tip_xy - footprint point| of the kept iterate (0 for Axis)
+  double penetration_real = 0.0;  // extend > 0: penetration into the real face (else = penetration)
+  bool P_extension = false, Q_extension = false;  // extend > 0: the contact lies on the extension
 };
 
 // Dense-enough samples of a surface and an XY bucket grid over them: the "rays from the surface" of VCRF
@@ -151,12 +169,17 @@ class MultipointPositioner {
   // Throws std::invalid_argument on an invalid tool or options.
   MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool, MultipointOptions options);
 
-  // Position the tool whose axis, before tilting, is the vertical through footprint point (x, y).
+  // Position the tool at footprint point (x, y): Axis anchor, the tool whose axis before tilting is the
+  // vertical through (x, y); Tip anchor, the tool whose tilted tip lies at (x, y) (see FootprintAnchor).
   MultipointResult position(double x, double y) const;
+  // The Axis anchor's position, whatever the option.
+  MultipointResult position_axis(double x, double y) const;
   // Many points (x0, y0, x1, y1, ...), threads, progress/cancel (throws Cancelled).
   void position_batch(const double* xy, std::size_t n, MultipointResult* out, const BatchOptions& batch) const;
 
+  // The surface positioned against (the extended face when extend > 0) and the real face.
   const PatchSurface& surface() const { return *surface_; }
+  const PatchSurface& real_surface() const { return *real_; }
   const TorusTool& tool() const { return tool_; }
   const MultipointOptions& options() const { return opt_; }
   const SurfaceSamples& samples() const { return samples_; }
@@ -172,12 +195,19 @@ class MultipointPositioner {
   // Deepest penetration (>= 0) of the surface into the tool placed at (tip, axis), by the samples and a
   // Newton polish of the lowest ones; `where` receives its parameters.
   double penetration(const Vector3d& tip, const Vector3d& axis, Vector2d* where, int* evals) const;
+  // The same against the real face (differs from penetration() only when extend > 0).
+  double penetration_real(const Vector3d& tip, const Vector3d& axis, Vector2d* where, int* evals) const;
 
  private:
+  MultipointResult position_core(double x, double y) const;
+  double penetration_on(const PatchSurface& s, const SurfaceSamples& samples, const Vector3d& tip,
+                        const Vector3d& axis, Vector2d* where, int* evals) const;
+  std::shared_ptr<const PatchSurface> real_;
   std::shared_ptr<const PatchSurface> surface_;
   TorusTool tool_;
   MultipointOptions opt_;
   SurfaceSamples samples_;
+  std::unique_ptr<SurfaceSamples> real_samples_;  // extend > 0 only
 };
 
 template <class F>
