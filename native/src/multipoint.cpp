@@ -483,7 +483,9 @@ MultipointPositioner::Drop MultipointPositioner::drop_vcrf(double x, double y, i
     d.uv = uv;
     return d;
   }
-  std::sort(top, top + ntop);
+  // Insertion sort of the K candidates (std::sort's unrolled small-array path warns on a fixed K array).
+  for (int i = 1; i < ntop; ++i)
+    for (int j = i; j > 0 && top[j] < top[j - 1]; --j) std::swap(top[j], top[j - 1]);
   // Candidates far below the best cannot win: a sample misses its local maximum by at most the rise of
   // the tool's profile over one sample spacing, taken here as Ri / 2 (the final check is the safety net).
   while (ntop > 1 && top[ntop - 1].first > top[0].first + 0.5 * tool_.Ri) --ntop;
