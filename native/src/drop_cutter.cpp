@@ -24,10 +24,8 @@ double drop_on_triangle(const Cutter& c, double x, double y, const IndexedTriang
 
 namespace {
 
-// drop_on_triangle for the walk. The drop onto the triangle's plane bounds the triangle's contact; when its
-// contact point lies inside the triangle it is that contact (no edge can be higher), otherwise only the
-// edges this triangle owns are solved (see IndexedTriangle::owned_edges), and only if the plane bound
-// exceeds `above`.
+// The highest contact above `above` of the edges (and so the vertices) this triangle owns (see
+// IndexedTriangle::owned_edges), or -inf.
 double owned_edges_drop(const Cutter& c, double x, double y, const IndexedTriangle& t, double above) {
   double z = above;
   if (t.owned_edges & 1u) z = std::max(z, edge_drop(c, x, y, t.p[0], t.p[1], z));
@@ -36,6 +34,9 @@ double owned_edges_drop(const Cutter& c, double x, double y, const IndexedTriang
   return z > above ? z : kNoContact;
 }
 
+// drop_on_triangle for the walk. The drop onto the triangle's plane bounds the triangle's contact; when its
+// contact point lies inside the triangle it is that contact (no edge can be higher), otherwise only the
+// edges this triangle owns are solved, and only if the plane bound exceeds `above`.
 double drop_on_owned(const Cutter& c, double x, double y, const IndexedTriangle& t, double above) {
   bool inside = false;
   const double zp = plane_drop(c, x, y, t.p[0], t.p[1], t.p[2], t.n, inside);
@@ -229,8 +230,8 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
   const double r2 = cutter.max_radius() * cutter.max_radius();
   double best = floor_z;
   int32_t winner = -1;  // position in the tile's list
-  // drop_on_owned with the tile's plane drop: every contact through this one expression, so a point's
-  // height does not depend on which candidate the warm start tried first.
+  // drop_on_owned with the tile's precomputed plane drop (the same value up to rounding), for the warm start
+  // and the scan alike.
   auto test = [&](std::size_t q) {
     ++tested;
     const double zp = c.plane_a[q] * x + c.plane_b[q] * y + c.plane_c[q];
