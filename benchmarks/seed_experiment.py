@@ -73,7 +73,7 @@ def main() -> int:
               f"| {'yes' if r.max_dev <= SEED_SIMULATED_MAX[key] else 'no'} / "
               f"{'yes' if r.max_dev_interior <= SEED_SIMULATED_MAX[key] else 'no'} "
               f"| {'yes' if r.min_dev >= GOUGE_LIMIT else 'no'} | {r.time_s:.2f} |")
-    print(f"\n(seed machined max: " + ", ".join(f"{w} {m.upper()} {v:.2f}" for (w, m), v in SEED_MACHINED_MAX.items())
+    print("\n(seed machined max: " + ", ".join(f"{w} {m.upper()} {v:.2f}" for (w, m), v in SEED_MACHINED_MAX.items())
           + ")")
     print("\nlargest deviation (mm) in each strip between consecutive passes:")
     edges = list(PASSES_X)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.conftest import closest_distances, grid_mesh
+from tests.conftest import closest_distances
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.drop import DropSurface
 from tmm_workbench.core.errors import Cancelled, TmmError
@@ -28,7 +28,6 @@ def test_flat_and_bull_never_gouge_dense_cutter_sampling(wavy_mesh):
     surface = DropSurface(wavy_mesh)
     rng = np.random.default_rng(2)
     xy = rng.uniform([6, 6], [34, 24], size=(40, 2))
-    v = wavy_mesh.vertices
     for cutter in (Cutter.flat(5.0), Cutter.bull(8.0, 2.0)):
         z = surface.drop(cutter, xy, floor_z=-100)
         a, r = cutter.radius - cutter.corner_radius, cutter.corner_radius

@@ -7,7 +7,7 @@ import pytest
 from tests.conftest import closest_distances, grid_mesh
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.surface3d import ONEWAY, ZIGZAG, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.surface3d import ONEWAY, SurfaceParams, compute_surface_toolpath
 from tmm_workbench.core.toolpath import MoveKind
 
 

@@ -2,7 +2,6 @@
 kernel against OCC's own evaluation (Part.BSplineSurface.value / normal, Part.BezierSurface.value)."""
 from __future__ import annotations
 
-import math
 import unittest
 
 import FreeCAD
@@ -10,7 +9,7 @@ import numpy as np
 import Part
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.multipoint import BezierFace, MultipointParams, position_points
+from tmm_workbench.core.multipoint import BezierFace, position_points
 
 V = FreeCAD.Vector
 
