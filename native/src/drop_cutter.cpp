@@ -273,8 +273,13 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
 
 }  // namespace
 
-void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
-                double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {
+namespace {
+
+// drop_batch with the floor of point i = floors ? floors[i] : floor_z.
+void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                       const double* floors, double floor_z, double* z_out, const BatchOptions& options,
+                       DropStats* stats) {
+  auto floor_of = [&](std::size_t i) { return floors ? floors[i] : floor_z; };
   // Tiles: points sorted by tile (stable within a tile, so a raster keeps its order and the warm-start
   // hint its value); points with a non-finite coordinate go alone through drop_point (the floor). Heights
   // do not depend on the thread count: tiles and their hints do not.
@@ -338,32 +343,34 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
           ty0 = std::min(ty0, xy[2 * i + 1]);
           ty1 = std::max(ty1, xy[2 * i + 1]);
         }
-        listed = cands.gather(index, cutter, tx0, ty0, tx1, ty1, floor_z, kMaxCandidatesPerPoint * (b - a));
+        double tile_floor = INFINITY;  // the lowest floor of the tile's points bounds the list
+        for (std::size_t k = a; k < b; ++k) tile_floor = std::min(tile_floor, floor_of(order[k]));
+        listed = cands.gather(index, cutter, tx0, ty0, tx1, ty1, tile_floor, kMaxCandidatesPerPoint * (b - a));
       }
       if (!listed) {
         DropStats s;
         for (std::size_t k = a; k < b; ++k) {
           const std::size_t i = order[k];
-          z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_z, &s, &hint);
+          z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_of(i), &s, &hint);
         }
         local += s.triangles_tested;
         continue;
       }
       for (std::size_t k = a; k < b; ++k) {
         const std::size_t i = order[k];
-        const double x = xy[2 * i], y = xy[2 * i + 1];
+        const double x = xy[2 * i], y = xy[2 * i + 1], floor_i = floor_of(i);
         switch (reach) {
           case Reach::Flat:
-            z_out[i] = drop_point_in_tile<Reach::Flat>(index, cutter, cands, x, y, floor_z, local, hint);
+            z_out[i] = drop_point_in_tile<Reach::Flat>(index, cutter, cands, x, y, floor_i, local, hint);
             break;
           case Reach::Ball:
-            z_out[i] = drop_point_in_tile<Reach::Ball>(index, cutter, cands, x, y, floor_z, local, hint);
+            z_out[i] = drop_point_in_tile<Reach::Ball>(index, cutter, cands, x, y, floor_i, local, hint);
             break;
           case Reach::Bull:
-            z_out[i] = drop_point_in_tile<Reach::Bull>(index, cutter, cands, x, y, floor_z, local, hint);
+            z_out[i] = drop_point_in_tile<Reach::Bull>(index, cutter, cands, x, y, floor_i, local, hint);
             break;
           case Reach::Scalar:
-            z_out[i] = drop_point_in_tile<Reach::Scalar>(index, cutter, cands, x, y, floor_z, local, hint);
+            z_out[i] = drop_point_in_tile<Reach::Scalar>(index, cutter, cands, x, y, floor_i, local, hint);
             break;
         }
       }
@@ -371,6 +378,18 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
     tested.fetch_add(local);
   });
   if (stats) stats->triangles_tested += tested.load();
+}
+
+}  // namespace
+
+void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {
+  drop_batch_floors(index, cutter, xy, n, nullptr, floor_z, z_out, options, stats);
+}
+
+void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                const double* floors, double* z_out, const BatchOptions& options, DropStats* stats) {
+  drop_batch_floors(index, cutter, xy, n, floors, 0.0, z_out, options, stats);
 }
 
 }  // namespace tmm

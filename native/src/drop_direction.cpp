@@ -494,6 +494,25 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
     if ((index.rotation() * ax.normalized() - Vector3d::UnitZ()).norm() > kParallelAxisTol)
       require_finite_length(cutter);
   }
+  if (!axes_per_point && n > 0) {
+    const Vector3d a = index.rotation() * Vector3d(axes[0], axes[1], axes[2]).normalized();
+    if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
+      // V = -axis for every point: the tiled -Z batch in the rotated frame, each point's floor max_travel
+      // below its start (as drop_along_point's fast path, point by point).
+      std::vector<double> xy(2 * n), floors(n), z(n);
+      std::vector<double> start_z(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+        xy[2 * i] = s.x();
+        xy[2 * i + 1] = s.y();
+        start_z[i] = s.z();
+        floors[i] = s.z() - max_travel;
+      }
+      drop_batch(index.index(), cutter, xy.data(), n, floors.data(), z.data(), options, stats);
+      for (std::size_t i = 0; i < n; ++i) travel_out[i] = z[i] <= floors[i] ? max_travel : start_z[i] - z[i];
+      return;
+    }
+  }
   std::atomic<std::size_t> tested{0};
   // The hint starts afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 128, options, [&](std::size_t begin, std::size_t end) {

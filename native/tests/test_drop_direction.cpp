@@ -409,6 +409,50 @@ TEST(DropDirection, MinusZMeshIsDropPoint) {
   EXPECT_THROW(tmm::drop_along_point(index, cut, Vector3d(1, 1, 50), Vector3d(0, 0.6, 0.8)), std::invalid_argument);
 }
 
+// With axis = -V for every point the batch runs the tiled -Z batch in the rotated frame, each point with its
+// own floor: the same travels as point by point, on a dense raster of starts at different heights, with a
+// finite travel (some starts miss) and an endless one.
+TEST(DropDirection, AxisAlongVBatchIsPointByPoint) {
+  const Grid g = bumpy_grid(40);
+  const Vector3d V = Vector3d(0.2, -0.3, -1).normalized();
+  const tmm::DirectionalIndex index(g.V, g.F, V);
+  const Vector3d axis = -V;
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> height(6, 30);
+  const int n = 4000;
+  std::vector<double> starts;
+  for (int i = 0; i < n; ++i) {
+    starts.push_back(2 + (i % 80) * 0.45);
+    starts.push_back(2 + (i / 80) * 0.7);
+    starts.push_back(height(rng));
+  }
+  for (const Cutter& cut : {Cutter(2, 2), Cutter(2.5, 1), Cutter::apt(2, 0.5, 6, 0, 0.1)}) {
+    for (const double max_travel : {22.0, tmm::kNoTravel}) {
+      std::vector<double> t(n);
+      tmm::BatchOptions two;
+      two.threads = 2;
+      tmm::DropStats stats;
+      tmm::drop_along_batch(index, cut, starts.data(), axis.data(), false, n, max_travel, t.data(), two, &stats);
+      EXPECT_GT(stats.triangles_tested, 0u);
+      int contacts = 0, misses = 0;
+      for (int i = 0; i < n; ++i) {
+        const double tp = tmm::drop_along_point(index, cut, Vector3d(&starts[3 * i]), axis, max_travel);
+        contacts += t[i] < max_travel;
+        misses += t[i] == max_travel;
+        if (tp == max_travel) {
+          EXPECT_EQ(t[i], max_travel) << i;
+        } else {
+          EXPECT_NEAR(t[i], tp, 1e-12) << i;
+        }
+      }
+      EXPECT_GT(contacts, n / 2);
+      if (max_travel == 22.0) {
+        EXPECT_GT(misses, 0);
+      }
+    }
+  }
+}
+
 TEST(DropDirection, BatchThreadsAgreeAndCancel) {
   const Grid g = bumpy_grid(30);
   const Vector3d V = Vector3d(0.3, -0.2, -1).normalized();

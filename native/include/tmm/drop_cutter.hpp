@@ -33,4 +33,9 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
                 double floor_z, double* z_out, const BatchOptions& options,
                 DropStats* stats = nullptr);
 
+// As above with a floor per point (floors: n heights), e.g. starts at different heights.
+void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                const double* floors, double* z_out, const BatchOptions& options,
+                DropStats* stats = nullptr);
+
 }  // namespace tmm
