@@ -93,7 +93,9 @@ constexpr std::size_t kMinTilePoints = 8;
 // (measured on the benchmark's height fields: 2M triangles, 0.5 mm raster).
 constexpr std::size_t kMaxCandidatesPerPoint = 40;
 constexpr double kPlaneMargin = 1e-9;
-constexpr int kBlock = 8;
+// Candidates per filter block, a bit each in an unsigned mask: 32 measured faster than 8 or 16 (fewer
+// breaks and mask loops; the few entries filtered past the break are cheap).
+constexpr int kBlock = 32;
 
 // Candidates of one tile, structure of arrays in order of decreasing zmax.
 struct TileCandidates {
