@@ -116,15 +116,7 @@ def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: flo
         job.PostProcessor = post
         job.PostProcessorArgs = posts.DEFAULT_ARGS.get(post, "")
 
-    factory = None
-    if callable(progress):
-        factory = lambda label: _CallbackProgress(progress)  # noqa: E731
-    op.Proxy.progress_enabled = bool(progress)
-    with progress_mod.using(factory):
-        op.touch()
-        doc.recompute()
-    if not op.isValid() or op.Proxy.toolpath is None:
-        raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
+    _compute(op, progress)
     gcode = posts.export(post, [tc, op], gcode_path)
     return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
 
@@ -134,6 +126,20 @@ def _job_posts(job: Any) -> list[str]:
         return list(job.getEnumerationsOfProperty("PostProcessor") or [])
     except Exception:
         return []
+
+
+def _compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
+    """Recomputes the op with the caller's progress (a callback, True for the default reporter, False for
+    none); raises TmmError with the op's status when it fails or computes no tool path."""
+    factory = None
+    if callable(progress):
+        factory = lambda label: _CallbackProgress(progress)  # noqa: E731
+    op.Proxy.progress_enabled = bool(progress)
+    with progress_mod.using(factory):
+        op.touch()
+        op.Document.recompute()
+    if not op.isValid() or op.Proxy.toolpath is None:
+        raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
 
 
 class _CallbackProgress(progress_mod.ProgressReporter):
@@ -246,15 +252,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             job.PostProcessor = posts[0]
             job.PostProcessorArgs = posts_mod.DEFAULT_ARGS.get(posts[0], "--no-show-editor")
 
-        factory = None
-        if callable(progress):
-            factory = lambda label: _CallbackProgress(progress)  # noqa: E731
-        op.Proxy.progress_enabled = bool(progress)
-        with progress_mod.using(factory):
-            op.touch()
-            doc.recompute()
-        if not op.isValid() or op.Proxy.toolpath is None:
-            raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
+        _compute(op, progress)
 
         gcode: dict[str, str] = {}
         files: dict[str, Path] = {}
