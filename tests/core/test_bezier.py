@@ -44,8 +44,7 @@ def bernstein_sum(net: np.ndarray, u: float, v: float) -> np.ndarray:
 
 @pytest.fixture
 def seed_json() -> Path:
-    if not SEED_JSON.is_file():
-        pytest.skip(f"shared benchmark data not found at {SEED_JSON}")
+    assert SEED_JSON.is_file(), f"shared benchmark data not found at {SEED_JSON}"
     return SEED_JSON
 
 

@@ -21,8 +21,7 @@ STL = Path("/work/shared/benchmarks/stl/sphere_on_plate.stl")
 
 @pytest.fixture(scope="module")
 def mesh():
-    if not STL.exists():
-        pytest.skip(f"{STL} not available")
+    assert STL.exists(), f"{STL} missing: the shared benchmark files are part of the test set-up"
     return load_stl(STL)
 
 
