@@ -324,10 +324,11 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
   run_start.push_back(n);
   const std::size_t runs = run_start.size() - 1;
 
-  const Reach reach = cutter.kind() == CutterKind::Flat   ? Reach::Flat
-                      : cutter.kind() == CutterKind::Ball ? Reach::Ball
-                      : cutter.kind() == CutterKind::Bull ? Reach::Bull
-                                                          : Reach::Scalar;
+  // The tile scan specialised for the cutter's reach test, chosen once.
+  const auto drop_in_tile = cutter.kind() == CutterKind::Flat   ? &drop_point_in_tile<Reach::Flat>
+                            : cutter.kind() == CutterKind::Ball ? &drop_point_in_tile<Reach::Ball>
+                            : cutter.kind() == CutterKind::Bull ? &drop_point_in_tile<Reach::Bull>
+                                                                : &drop_point_in_tile<Reach::Scalar>;
   std::atomic<std::size_t> tested{0};
   parallel_chunks(runs, 16, options, [&](std::size_t begin, std::size_t end) {
     std::size_t local = 0;
@@ -361,20 +362,7 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
       for (std::size_t k = a; k < b; ++k) {
         const std::size_t i = order[k];
         const double x = xy[2 * i], y = xy[2 * i + 1], floor_i = floor_of(i);
-        switch (reach) {
-          case Reach::Flat:
-            z_out[i] = drop_point_in_tile<Reach::Flat>(index, cutter, cands, x, y, floor_i, local, hint);
-            break;
-          case Reach::Ball:
-            z_out[i] = drop_point_in_tile<Reach::Ball>(index, cutter, cands, x, y, floor_i, local, hint);
-            break;
-          case Reach::Bull:
-            z_out[i] = drop_point_in_tile<Reach::Bull>(index, cutter, cands, x, y, floor_i, local, hint);
-            break;
-          case Reach::Scalar:
-            z_out[i] = drop_point_in_tile<Reach::Scalar>(index, cutter, cands, x, y, floor_i, local, hint);
-            break;
-        }
+        z_out[i] = drop_in_tile(index, cutter, cands, x, y, floor_i, local, hint);
       }
     }
     tested.fetch_add(local);
