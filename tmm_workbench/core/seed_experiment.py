@@ -224,6 +224,27 @@ def run_experiment(which: str = "convex", method: str = "vcrf", section_y: float
                          spacing, interior, float(dev[j]), float(xs[j]), res)
 
 
+def _finish_axes(ax, title: str, legend_loc: str) -> None:
+    """The zero line, the gouge limit, title, labels, grid and legend of a section panel."""
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.axhline(GOUGE_LIMIT, color="red", lw=0.6, ls=":", label="gouge limit -0.01 mm")
+    ax.set_title(title)
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("deviation (mm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc=legend_loc)
+
+
+def _save(fig, path) -> Path:
+    fig.tight_layout()
+    out = Path(path)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=130)
+    import matplotlib.pyplot as plt
+    plt.close(fig)
+    return out
+
+
 def section_plot(results: Sequence[SectionResult], path) -> Path:
     """Deviation along x at the section for each surface (one panel each) and method, with the seed's
     published simulated maxima as reference lines."""
@@ -249,20 +270,9 @@ def section_plot(results: Sequence[SectionResult], path) -> Path:
         if np.isfinite(r0.interior[0]):
             for xb in r0.interior:
                 ax.axvline(xb, color="grey", lw=0.6, ls="-.")
-        ax.axhline(0.0, color="k", lw=0.6)
-        ax.axhline(GOUGE_LIMIT, color="red", lw=0.6, ls=":", label="gouge limit -0.01 mm")
-        y = results[0].section_y
-        ax.set_title(f"{w} patch, section y = {y:g} mm: simulated (z-map) minus design height")
-        ax.set_xlabel("x (mm)")
-        ax.set_ylabel("deviation (mm)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right")
-    fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130)
-    plt.close(fig)
-    return out
+        _finish_axes(ax, f"{w} patch, section y = {results[0].section_y:g} mm: simulated (z-map) minus design "
+                         f"height", "upper right")
+    return _save(fig, path)
 
 
 def options_plot(results: Sequence[SectionResult], path, method: str = "vcrf") -> Path:
@@ -289,17 +299,7 @@ def options_plot(results: Sequence[SectionResult], path, method: str = "vcrf") -
                           f"{r.max_dev_interior:.3f}), min {r.min_dev:+.4f} mm")
         ax.axhline(SEED_SIMULATED_MAX[(w, method)], color="k", ls="--", lw=0.8,
                    label=f"seed {method.upper()} simulated max {SEED_SIMULATED_MAX[(w, method)]:.2f} mm")
-        ax.axhline(0.0, color="k", lw=0.6)
-        ax.axhline(GOUGE_LIMIT, color="red", lw=0.6, ls=":", label="gouge limit -0.01 mm")
-        ax.set_title(f"{w} patch, {method.upper()}, section y = {sel[0].section_y:g} mm: simulated minus design")
-        ax.set_xlabel("x (mm)")
-        ax.set_ylabel("deviation (mm)")
         ax.set_ylim(-0.1, max(1.0, max(r.max_dev for r in sel if r.which == w) + 0.1))
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper center")
-    fig.tight_layout()
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=130)
-    plt.close(fig)
-    return out
+        _finish_axes(ax, f"{w} patch, {method.upper()}, section y = {sel[0].section_y:g} mm: simulated minus "
+                         f"design", "upper center")
+    return _save(fig, path)
