@@ -7,10 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.conftest import SEED_JSON
 from tmm_workbench.core import bezier
 from tmm_workbench.core.errors import TmmError
 
-SEED_JSON = Path(__file__).resolve().parents[2].parent / "shared" / "benchmarks" / "seed_surfaces.json"
 DEGREES = [(1, 1), (2, 3), (3, 3), (5, 2), (0, 4)]
 
 

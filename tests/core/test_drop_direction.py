@@ -4,11 +4,11 @@ dense samples of the nearby triangles against the cutter solid in the tool frame
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import SHARED_STL
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.drop import DropSurface
 from tmm_workbench.core.drop_direction import DirectionalDrop, drop_along
@@ -16,7 +16,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.mesh import load_stl
 
-STL = Path("/work/shared/benchmarks/stl/sphere_on_plate.stl")
+STL = SHARED_STL / "sphere_on_plate.stl"
 
 
 @pytest.fixture(scope="module")

@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.conftest import SHARED_STL
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.mesh import TriMesh, load_stl
 
-SHARED_STL = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "stl"
 SHARED_COUNTS = {
     "beet_mm.stl": 4630, "demo.stl": 1894, "ktoolcav.stl": 4090, "mount_rush.stl": 15592,
     "pycam-textbox.stl": 1444, "sphere_on_plate.stl": 7570, "wheel_in_box.stl": 6102,

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import SEED_JSON
 from tmm_workbench.core import bezier
 from tmm_workbench.core.bspline import bspline_point, bspline_to_bezier, flat_knots
 from tmm_workbench.core.errors import Cancelled, TmmError
@@ -17,7 +17,7 @@ from tmm_workbench.core.multipoint import (STATUS_FAILED, STATUS_ONE, STATUS_TWO
                                            compute_multipoint_toolpath, multipoint_footprint, position_points)
 from tmm_workbench.core.toolpath import MoveKind
 
-SEEDS = Path("/work/shared/benchmarks/seed_surfaces.json")
+SEEDS = SEED_JSON
 RO, RI = 6.7, 6.0
 
 

@@ -1,18 +1,18 @@
 """Cross-check of the drop-cutter with OpenCAMLib (the open reference) on the shared real STL files."""
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from tests.conftest import SHARED_STL
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.drop import DropSurface
 from tmm_workbench.core.mesh import load_stl
 
 from opencamlib import ocl  # noqa: E402  (installed by scripts/setup.sh into .venv; a missing peer fails)
 
-STL_DIR = Path(__file__).resolve().parents[3] / "shared" / "benchmarks" / "stl"
+STL_DIR = SHARED_STL
 FILES = ["sphere_on_plate.stl", "mount_rush.stl", "demo.stl", "ktoolcav.stl", "wheel_in_box.stl"]
 # (our cutter, OpenCAMLib cutter factory, tolerance in mm) — tolerances from the issue.
 CUTTERS = [

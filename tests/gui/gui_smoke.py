@@ -53,9 +53,10 @@ def multipoint_panel(info: dict) -> None:
     command, with the op's face selected, adds a second op and opens its panel."""
     from tmm_workbench.app.api import run_multipoint
     from tmm_workbench.core import bezier
+    from tmm_workbench.core.seed_experiment import seed_json_path
     from tmm_workbench.gui.op_multipoint_gui import ViewProvider as MultipointViewProvider
 
-    net = bezier.load_seed_patch(ROOT.parent / "shared" / "benchmarks" / "seed_surfaces.json", "convex")
+    net = bezier.load_seed_patch(seed_json_path(), "convex")
     r = run_multipoint(net, side_step=36.0, forward_step=6.0, posts=(), doc_name="TmmGuiMultipoint",
                        progress=True, surface_extension=12.7, footprint_anchor="tip")
     assert isinstance(r.op.ViewObject.Proxy, MultipointViewProvider), type(r.op.ViewObject.Proxy)
