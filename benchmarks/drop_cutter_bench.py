@@ -23,10 +23,11 @@ sys.path.insert(0, str(ROOT))
 
 from tmm_workbench.core.kernel import native  # noqa: E402
 from tmm_workbench.core.mesh import TriMesh, load_stl  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 
 from opencamlib import ocl  # noqa: E402
 
-STL_DIR = ROOT.parent / "shared" / "benchmarks" / "stl"
+STL_DIR = shared_dir() / "benchmarks" / "stl"
 # name, kernel cutter, OpenCAMLib factory (None: OpenCAMLib has no such cutter)
 TAPER_DEG = 3.0
 CUTTERS = [

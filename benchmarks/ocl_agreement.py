@@ -18,10 +18,11 @@ sys.path.insert(0, str(ROOT))
 from tmm_workbench.core.cutters import Cutter  # noqa: E402
 from tmm_workbench.core.drop import DropSurface  # noqa: E402
 from tmm_workbench.core.mesh import load_stl  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 
 from opencamlib import ocl  # noqa: E402
 
-STL_DIR = ROOT.parent / "shared" / "benchmarks" / "stl"
+STL_DIR = shared_dir() / "benchmarks" / "stl"
 CUTTERS = [("ball d6", Cutter.ball(6.0), lambda: ocl.BallCutter(6.0, 50.0)),
            ("flat d6", Cutter.flat(6.0), lambda: ocl.CylCutter(6.0, 50.0)),
            ("bull d10 r2", Cutter.bull(10.0, 2.0), lambda: ocl.BullCutter(10.0, 2.0, 50.0))]

@@ -5,7 +5,7 @@ Bézier patch finished 5-axis by multipoint positioning (tarus G-code, APT CL, d
     /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
 
 Inputs: the OpenCAMLib meshes sphere_on_plate.stl (ball cutter) and mount_rush.stl (bull-nose cutter)
-from ../shared/benchmarks/stl, and the convex bicubic Bézier patch of seed 001 tessellated (the seed's
+from shared/benchmarks/stl, and the convex bicubic Bézier patch of seed 001 tessellated (the seed's
 toroidal cutter). Output folder: $TMM_OUT, default <repo>/out. Exit code 1 on any failure (freecadcmd
 itself returns 0 even when a script raises, so the script exits explicitly).
 """
@@ -21,7 +21,6 @@ from typing import Any
 
 # freecadcmd runs this file with __name__ == "demo" (the file's stem) and sets __file__.
 REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[1]
-BENCH = REPO.parent / "shared" / "benchmarks"
 BEZIER_TOLERANCE_MM = 0.01  # chordal tolerance of the patch tessellation
 
 
@@ -33,14 +32,21 @@ class Case:
     params: dict[str, Any] = field(default_factory=dict)  # keyword arguments of run_surface
 
 
+def bench() -> Path:
+    """shared/benchmarks (core.shared_data finds it; main() has put the repository on sys.path)."""
+    from tmm_workbench.core.shared_data import shared_dir
+
+    return shared_dir() / "benchmarks"
+
+
 def cases(out: Path) -> list[Case]:
     """One case per input, parameters chosen from each model's size (mm) for a ~1 minute demo."""
     return [
         # 76 x 76 x 32 mm: a half sphere on a plate; ball D6, 0.5 mm step-over (scallop ~0.01 mm).
-        Case("sphere_on_plate", "sphere_on_plate.stl", str(BENCH / "stl" / "sphere_on_plate.stl"),
+        Case("sphere_on_plate", "sphere_on_plate.stl", str(bench() / "stl" / "sphere_on_plate.stl"),
              dict(tool="ballend", diameter=6.0, stepover=0.5, sample_step=0.25, angle_deg=0.0)),
         # 86 x 43 x 27 mm relief: small bull-nose for the faces' detail, passes along the long side.
-        Case("mount_rush", "mount_rush.stl", str(BENCH / "stl" / "mount_rush.stl"),
+        Case("mount_rush", "mount_rush.stl", str(bench() / "stl" / "mount_rush.stl"),
              dict(tool="bullnose", diameter=4.0, corner_radius=1.0, stepover=0.3, sample_step=0.2,
                   angle_deg=0.0)),
         # 150 x 150 mm patch: seed 001's toroidal cutter (Ro 6.7 + Ri 6.0 -> D25.4 r6), feed along Y
@@ -69,7 +75,7 @@ def write_binary_stl(vertices, triangles, path: Path, name: str = "tmm") -> None
 def bezier_stl(out: Path) -> Path:
     from tmm_workbench.core import bezier
 
-    net = bezier.load_seed_patch(BENCH / "seed_surfaces.json", "convex")
+    net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
     mesh = bezier.tessellate_to_tolerance(net, BEZIER_TOLERANCE_MM, name="bezier_convex")
     path = out / "bezier_convex.stl"
     write_binary_stl(mesh.vertices, mesh.triangles, path, "TMM seed 001 convex Bezier patch (mm)")
@@ -181,7 +187,7 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     from tmm_workbench.core.multipoint import BezierFace, MultipointParams, compute_multipoint_toolpath
     from tmm_workbench.core.preview5 import face_grid, render_axes_png
 
-    net = bezier.load_seed_patch(BENCH / "seed_surfaces.json", "convex")
+    net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
     p = MP_PARAMS
     print(f"--- {MP_NAME}: seed 001 convex Bezier face, 5-axis multipoint {p['method'].upper()}, torus Ro "
           f"{p['Ro']:g} Ri {p['Ri']:g}, side step {p['side_step']:g} mm, forward step {p['forward_step']:g} mm",

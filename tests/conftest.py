@@ -1,18 +1,16 @@
 """Shared test helpers: small analytic meshes built from arrays (no file I/O)."""
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
 import pytest
 
 from tmm_workbench.core.mesh import TriMesh
+from tmm_workbench.core.shared_data import shared_dir
 
-# The shared benchmark files (seed surfaces, STL files): beside the checkout, else at /work/shared, so a clone
-# anywhere finds them.
-_BESIDE = Path(__file__).resolve().parents[2] / "shared"
-SHARED = _BESIDE if (_BESIDE / "benchmarks").is_dir() else Path("/work/shared")
+# The shared benchmark files (seed surfaces, STL files), wherever core.shared_data finds them.
+SHARED = shared_dir()
 SHARED_STL = SHARED / "benchmarks" / "stl"
 SEED_JSON = SHARED / "benchmarks" / "seed_surfaces.json"
 

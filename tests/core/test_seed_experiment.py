@@ -9,14 +9,6 @@ from tmm_workbench.core.seed_experiment import (CONFIGS, GOUGE_LIMIT, PASSES_X, 
                                                 seed_footprint, seed_json_path)
 from tmm_workbench.core.bezier import evaluate, load_seed_patch
 
-pytest.importorskip("tmm_workbench._native")
-
-try:
-    seed_json_path()
-    HAVE_SEED = True
-except TmmError:
-    HAVE_SEED = False
-needs_seed = pytest.mark.skipif(not HAVE_SEED, reason="shared/benchmarks/seed_surfaces.json not available")
 
 
 def test_seed_footprint_is_the_seeds():
@@ -29,7 +21,6 @@ def test_seed_footprint_is_the_seeds():
     assert np.allclose(np.diff(passes[1][:, 1]), -2.0)      # zigzag
 
 
-@needs_seed
 @pytest.mark.parametrize("which", ["convex", "concave"])
 def test_design_height_is_exact(which):
     net = load_seed_patch(seed_json_path(), which)
@@ -44,7 +35,6 @@ def test_design_height_is_exact(which):
         design_height(bent, S[:, 0], S[:, 1])
 
 
-@needs_seed
 @pytest.mark.parametrize("which,method,bound", [("convex", "vcrf", 0.53), ("concave", "drd", 0.65)])
 def test_reduced_experiment_no_gouge(which, method, bound, tmp_path):
     """Three interior passes (x = 18, 36, 54), feed y = 0..60: between them, at the section y = 27, the scallop
@@ -64,7 +54,6 @@ def test_reduced_experiment_no_gouge(which, method, bound, tmp_path):
     assert png.exists() and png.stat().st_size > 1000
 
 
-@needs_seed
 def test_extension_cuts_the_concave_rim_wedge(tmp_path):
     """The concave edge strip (passes x = 0 and 18, feed y = 0..60, section x 0..18): the pass on the rim
     leaves a wedge (1.56 mm in the full run) unless the face is extended past the rim (0.68 mm in the full
@@ -85,7 +74,6 @@ def test_extension_cuts_the_concave_rim_wedge(tmp_path):
     assert png.exists() and png.stat().st_size > 1000
 
 
-@needs_seed
 def test_tip_anchor_interior_concave_scallop():
     """Three interior passes on the concave patch with the tilted tips on x = 18, 36, 54 (anchor "tip"): the
     passes' tips no longer spread apart (18.36 mm with the seed's anchor), the scallop at y = 27 falls from

@@ -147,7 +147,6 @@ def test_tilted_torus_single_position_vs_brute_force():
 def test_lowest_point_lies_on_the_kernel_tool_solid():
     """Against the kernel's signed distance to the same tool solid: the found point is on the boundary and the
     line below it is outside; missed lines stay outside the solid."""
-    pytest.importorskip("tmm_workbench._native")
     from tmm_workbench.core.multipoint import BezierFace, make_positioner
     net = np.zeros((2, 2, 3))
     net[..., 0] = [[0, 0], [100, 100]]

@@ -15,10 +15,11 @@ import Mesh
 
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app import op_surface, posts
+from tmm_workbench.core.shared_data import shared_dir
 
 posts.install_post_dir()  # Init.py does it when the add-on is linked into FreeCAD's Mod folder
 
-BENCH_STL = Path("/work/shared/benchmarks/stl")
+BENCH_STL = shared_dir() / "benchmarks" / "stl"
 SPHERE_ON_PLATE = BENCH_STL / "sphere_on_plate.stl"
 OUT = Path(os.environ.get("TMM_TEST_OUT") or tempfile.mkdtemp(prefix="tmm_fc_"))
 OUT.mkdir(parents=True, exist_ok=True)

@@ -18,8 +18,9 @@ from tmm_workbench.app.op_multipoint import ObjectTmmMultipoint
 from tmm_workbench.core import bezier, path5
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.multipoint import STATUS_TWO
+from tmm_workbench.core.shared_data import benchmark_file
 
-SEED = "/work/shared/benchmarks/seed_surfaces.json"
+SEED = benchmark_file("seed_surfaces.json")
 FAST = dict(side_step=18.0, forward_step=4.0, progress=False)
 DRD = dict(side_step=37.5, forward_step=10.0, progress=False, method="drd")  # DRD is ~20x slower than VCRF
 

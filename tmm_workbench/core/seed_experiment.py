@@ -30,10 +30,10 @@ import numpy as np
 from .bezier import evaluate, load_seed_patch
 from .errors import TmmError
 from .multipoint import STATUS_FAILED, BezierFace, MultipointParams, MultipointResults, position_points
+from .shared_data import benchmark_file
 from .zmap import ZTool, simulate
 
 REPO = Path(__file__).resolve().parents[2]
-SEED_JSON = Path("/work/shared/benchmarks/seed_surfaces.json")
 
 RO, RI = 6.7, 6.0
 PASSES_X = tuple([18.0 * k for k in range(9)] + [150.0])
@@ -62,10 +62,7 @@ CONFIGS = {
 
 
 def seed_json_path() -> Path:
-    for p in (SEED_JSON, REPO.parent / "shared" / "benchmarks" / "seed_surfaces.json"):
-        if p.exists():
-            return p
-    raise TmmError("seed_surfaces.json not found (expected /work/shared/benchmarks/seed_surfaces.json)")
+    return benchmark_file("seed_surfaces.json")
 
 
 def seed_footprint(passes_x: Sequence[float] = PASSES_X, y_range=Y_RANGE, forward_step: float = FORWARD_STEP,
