@@ -95,3 +95,27 @@ class ArgumentParser(__import__("argparse").ArgumentParser):
     def parse_post_args(self, argstring: str | None):
         import shlex
         return self.parse_args(shlex.split(argstring or ""))
+
+
+def post_argument_parser(prog: str, inches_help: str, comments_help: str) -> ArgumentParser:
+    """A post's parser with the arguments every TMM post takes (units, FreeCAD's editor flags, comments)."""
+    p = ArgumentParser(prog=prog, add_help=False)
+    p.add_argument("--inches", action="store_true", help=inches_help)
+    p.add_argument("--show-editor", action="store_true", help="accepted; TMM posts never open an editor")
+    p.add_argument("--no-show-editor", action="store_true", help="do not show the output in an editor")
+    p.add_argument("--no-comments", action="store_true", help=comments_help)
+    return p
+
+
+def write_program(writer: Any, program: Program) -> None:
+    """The walk every writer makes: header, the tool changes and operations in order, footer."""
+    from tmm_workbench.core.errors import TmmError
+    writer.header()
+    for item in program:
+        if isinstance(item, ToolInfo):
+            writer.tool_change(item)
+        elif isinstance(item, Operation):
+            writer.operation(item)
+        else:
+            raise TmmError(f"unexpected program item {type(item).__name__}")
+    writer.footer()

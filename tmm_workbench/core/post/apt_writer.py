@@ -12,8 +12,8 @@ from typing import Optional
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.path5 import MOTION_NAMES, Pose, decode
-from tmm_workbench.core.post import (MM_PER_INCH, Operation, Program, ToolInfo, arc_points, is_comment, number,
-                                     strip_comment)
+from tmm_workbench.core.post import (MM_PER_INCH, ArgumentParser, Operation, Program, ToolInfo, arc_points,
+                                     is_comment, number, post_argument_parser, strip_comment, write_program)
 
 _CANONICAL = {"G00": "G0", "G01": "G1", "G02": "G2", "G03": "G3"}
 
@@ -139,25 +139,12 @@ class _AptWriter:
 def write_apt(program: Program, options: Optional[AptOptions] = None) -> str:
     """The APT CL text for `program`; TmmError (naming operation and command) for what it cannot write."""
     w = _AptWriter(options or AptOptions())
-    w.header()
-    for item in program:
-        if isinstance(item, ToolInfo):
-            w.tool_change(item)
-        elif isinstance(item, Operation):
-            w.operation(item)
-        else:
-            raise TmmError(f"unexpected program item {type(item).__name__}")
-    w.footer()
+    write_program(w, program)
     return "\n".join(w.lines) + "\n"
 
 
-def argument_parser():
-    from tmm_workbench.core.post import ArgumentParser
-    p = ArgumentParser(prog="apt_cl", add_help=False)
-    p.add_argument("--inches", action="store_true", help="UNITS/INCHES, lengths in inches, FEDRAT in IPM")
-    p.add_argument("--show-editor", action="store_true", help="accepted; TMM posts never open an editor")
-    p.add_argument("--no-show-editor", action="store_true", help="do not show the output in an editor")
-    p.add_argument("--no-comments", action="store_true", help="no $$ remarks")
+def argument_parser() -> ArgumentParser:
+    p = post_argument_parser("apt_cl", "UNITS/INCHES, lengths in inches, FEDRAT in IPM", "no $$ remarks")
     p.add_argument("--precision", type=int, default=6, help="decimals of coordinates (default 6)")
     p.add_argument("--axis-precision", type=int, default=6, help="decimals of i, j, k (default 6)")
     p.add_argument("--partno", default="PART TO BE MACHINED", help="PARTNO text")

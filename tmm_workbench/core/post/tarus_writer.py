@@ -24,8 +24,8 @@ import numpy as np
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine.tarus import JointLimitError, Joints, TarusMachine
 from tmm_workbench.core.path5 import AXIS_WORDS, MOTION_NAMES, TIP_WORDS, Pose, decode
-from tmm_workbench.core.post import (MM_PER_INCH, Operation, Program, ToolInfo, comment_text, is_comment, number,
-                                     strip_comment)
+from tmm_workbench.core.post import (MM_PER_INCH, ArgumentParser, Operation, Program, ToolInfo, comment_text,
+                                     is_comment, number, post_argument_parser, strip_comment, write_program)
 
 _CANONICAL = {"G00": "G0", "G01": "G1", "G02": "G2", "G03": "G3"}
 _INT_WORDS = ("T", "H", "D", "S", "L", "P")
@@ -224,28 +224,16 @@ def write_tarus(program: Program, machine: Optional[TarusMachine] = None,
     """Tarus G-code for `program` (tool changes and operations in order). Raises TmmError (JointLimitError
     for limits) before anything is returned."""
     w = _Writer(machine or TarusMachine(), options or TarusOptions())
-    w.header()
-    for item in program:
-        if isinstance(item, ToolInfo):
-            w.tool_change(item)
-        elif isinstance(item, Operation):
-            w.operation(item)
-        else:
-            raise TmmError(f"unexpected program item {type(item).__name__}")
-    w.footer()
+    write_program(w, program)
     return TarusResult("\n".join(w.lines) + "\n", w.time, w.moves)
 
 
-def argument_parser() -> "ArgumentParser":  # noqa: F821 (imported here: the package imports this module)
-    from tmm_workbench.core.post import ArgumentParser
-    p = ArgumentParser(prog="tarus", add_help=False)
+def argument_parser() -> ArgumentParser:
+    p = post_argument_parser("tarus", "G20, lengths in inches (A and C stay in degrees)",
+                             "no comments in the output")
     p.add_argument("--tcp", action="store_true",
                    help="tool-centre-point mode: X Y Z = tool tip (control with TCP, G43.4); default: "
                         "pivot-compensated joint coordinates")
-    p.add_argument("--inches", action="store_true", help="G20, lengths in inches (A and C stay in degrees)")
-    p.add_argument("--show-editor", action="store_true", help="accepted; TMM posts never open an editor")
-    p.add_argument("--no-show-editor", action="store_true", help="do not show the output in an editor")
-    p.add_argument("--no-comments", action="store_true", help="no comments in the output")
     p.add_argument("--line-numbers", action="store_true", help="N words on every line")
     p.add_argument("--precision", type=int, default=4, help="decimals of lengths and feeds (default 4)")
     p.add_argument("--angle-precision", type=int, default=6, help="decimals of A and C degrees (default 6)")
