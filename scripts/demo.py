@@ -45,10 +45,11 @@ def cases(out: Path) -> list[Case]:
         # 76 x 76 x 32 mm: a half sphere on a plate; ball D6, 0.5 mm step-over (scallop ~0.01 mm).
         Case("sphere_on_plate", "sphere_on_plate.stl", str(bench() / "stl" / "sphere_on_plate.stl"),
              dict(tool="ballend", diameter=6.0, stepover=0.5, sample_step=0.25, angle_deg=0.0)),
-        # 86 x 43 x 27 mm relief: small bull-nose for the faces' detail, passes along the long side.
+        # 86 x 43 x 27 mm relief without a base: small bull-nose for the faces' detail, passes along the
+        # long side, lifting over the corners of the box where no part of the relief is under the tool.
         Case("mount_rush", "mount_rush.stl", str(bench() / "stl" / "mount_rush.stl"),
              dict(tool="bullnose", diameter=4.0, corner_radius=1.0, stepover=0.3, sample_step=0.2,
-                  angle_deg=0.0)),
+                  angle_deg=0.0, off_model="skip")),
         # 150 x 150 mm patch: seed 001's toroidal cutter (Ro 6.7 + Ri 6.0 -> D25.4 r6), feed along Y
         # as in the paper; a 3-axis step-over (scallop ~0.02 mm) instead of the paper's 5-axis 18 mm.
         Case("bezier_convex", f"seed 001 convex Bezier, tol {BEZIER_TOLERANCE_MM:g} mm", "",
@@ -115,7 +116,8 @@ def run_core(case: Case, out: Path) -> dict[str, Any]:
     lo, hi = mesh.bounds
     params = SurfaceParams(boundary=(lo[0], lo[1], hi[0], hi[1]), stepover=p["stepover"],
                            sample_step=p["sample_step"], safe_height=float(hi[2]) + 5,
-                           clearance_height=float(hi[2]) + 15, angle_deg=p.get("angle_deg", 0.0))
+                           clearance_height=float(hi[2]) + 15, angle_deg=p.get("angle_deg", 0.0),
+                           off_model=p.get("off_model", "floor"))
     tp = compute_surface_toolpath(mesh, cutter, params)
     return dict(mesh=mesh, toolpath=tp, seconds=time.perf_counter() - t0, files=[])
 

@@ -7,7 +7,8 @@ import pytest
 from tests.conftest import closest_distances, grid_mesh
 from tmm_workbench.core.cutters import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.surface3d import ONEWAY, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.mesh import TriMesh
+from tmm_workbench.core.surface3d import OFF_MODEL_SKIP, ONEWAY, SurfaceParams, compute_surface_toolpath
 from tmm_workbench.core.toolpath import MoveKind
 
 
@@ -93,3 +94,57 @@ def test_cancel(wavy_mesh):
     with pytest.raises(Cancelled):
         compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(sample_step=0.001),
                                  progress=lambda f: False)
+
+
+def two_islands() -> TriMesh:
+    """Two bumpy plates with 10 mm of air between them: x 0..10 and 20..30 (y 0..20), no base."""
+    left = grid_mesh(lambda x, y: 4.0 + 0.3 * np.sin(x) * np.cos(y / 2), 10, 20, (0, 0, 10, 20))
+    right = grid_mesh(lambda x, y: 6.0 + 0.3 * np.cos(x / 2) * np.sin(y), 10, 20, (20, 0, 30, 20))
+    v = np.vstack([left.vertices, right.vertices])
+    f = np.vstack([left.triangles, right.triangles + len(left.vertices)])
+    return TriMesh(v, f, "two islands")
+
+
+@pytest.mark.parametrize("pattern", ["zigzag", ONEWAY])
+def test_off_model_skip_cuts_only_over_the_model(pattern):
+    mesh, cutter = two_islands(), Cutter.ball(4.0)
+    p = params(boundary=(0.0, 1.0, 30.0, 19.0), stepover=3.0, sample_step=0.5, pattern=pattern)
+    floor = compute_surface_toolpath(mesh, cutter, p)
+    skip = compute_surface_toolpath(mesh, cutter, params(**{**p.__dict__, "off_model": OFF_MODEL_SKIP}))
+    # Floor: the tool runs along the model's lowest point between the islands (the ball touches nothing there).
+    across = [(a, b) for a, b in zip(floor.moves, floor.moves[1:]) if b.kind is MoveKind.FEED
+              and min(a.x, b.x) < 12.5 and max(a.x, b.x) > 17.0]
+    assert across and all(a.z == b.z == mesh.bounds[0][2] for a, b in across)
+    # Skip: no cutting point where the ball's footprint misses both islands (x 12..18); every one touches the
+    # model (the ball's centre one radius from it) or, over an island's edge below the floor, rests on the
+    # floor clear of it.
+    moves = skip.moves
+    cut = skip.cutting_points()
+    assert len(cut) and not ((cut[:, 0] > 12.0) & (cut[:, 0] < 18.0)).any()
+    d = closest_distances(cut + [0, 0, cutter.radius], mesh)
+    on_floor = cut[:, 2] == mesh.bounds[0][2]
+    np.testing.assert_allclose(d[~on_floor], cutter.radius, atol=1e-9)
+    assert (d[on_floor] >= cutter.radius - 1e-9).all() and on_floor.sum() < 0.1 * len(cut)
+    # ... no cutting move crosses the gap ...
+    assert not [b for a, b in zip(moves, moves[1:]) if b.kind is not MoveKind.RAPID
+                and min(a.x, b.x) < 12.0 and max(a.x, b.x) > 18.0]
+    # ... and every island piece is reached by a vertical lift, a rapid at the safe height and a plunge.
+    plunges = [i for i, m in enumerate(moves) if m.kind is MoveKind.PLUNGE]
+    passes = int(np.ceil((19.0 - 1.0) / 3.0)) + 1
+    assert len(plunges) == (2 * passes if pattern == ONEWAY else passes + 1)
+    for i in plunges[1:]:
+        lift, over, down = moves[i - 2], moves[i - 1], moves[i]
+        before = moves[i - 3]
+        assert lift.kind is over.kind is MoveKind.RAPID and lift.z == over.z == 10.0
+        assert (lift.x, lift.y) == (before.x, before.y) and (over.x, over.y) == (down.x, down.y)
+
+
+def test_off_model_skip_with_no_model_under_the_boundary_is_an_error():
+    p = params(boundary=(13.0, 1.0, 17.0, 19.0), off_model=OFF_MODEL_SKIP)
+    with pytest.raises(TmmError, match="over no part of the model"):
+        compute_surface_toolpath(two_islands(), Cutter.ball(4.0), p)
+
+
+def test_off_model_must_be_floor_or_skip(wavy_mesh):
+    with pytest.raises(TmmError, match="off-model must be"):
+        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(off_model="air"))

@@ -98,6 +98,28 @@ class OpInJob(FreeCADTestCase):
                 xs.append(p1["X"] - p0["X"])
         self.assertTrue(all(dx >= -1e-9 for dx in xs))
 
+    def test_off_model_skip_lifts_over_the_gap(self) -> None:
+        """Two bumps 10 mm apart, no base: Floor runs the ball along the lowest point between them, Skip
+        lifts over the gap and plunges again (one more plunge than passes, zig-zag)."""
+        doc = new_doc()
+        tris = [tuple((x + dx, y, z) for x, y, z in t) for dx in (-15.0, 15.0) for t in bump_triangles()]
+        _, _, op = job_with_op(doc, mesh_feature(doc, tris, "TwoBumps"), values={"BoundaryShape": "Model"})
+        self.assertEqual(op.OffModel, "Floor")
+        self.assertEqual(op.getEnumerationsOfProperty("OffModel"), ["Floor", "Skip"])
+        plunges = lambda mv: [p for n, p in mv if n == "G1" and round(p["F"] * 60, 6) == V_FEED]  # noqa
+        in_gap = lambda mv: [b for (_, a), (n, b) in zip(mv, mv[1:])  # noqa: E731  (G1 over |x| < 2.5)
+                             if n == "G1" and min(a["X"], b["X"]) < 2.5 and max(a["X"], b["X"]) > -2.5]
+        floor = moves(op)
+        self.assertEqual(len(plunges(floor)), 1)
+        self.assertTrue(in_gap(floor))
+        op.OffModel = "Skip"
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        skip = moves(op)
+        passes = 11  # 20 mm / 2 mm step-over + 1
+        self.assertEqual(len(plunges(skip)), passes + 1)
+        self.assertEqual(in_gap(skip), [])
+
     def test_raster_angle(self) -> None:
         doc = new_doc()
         _, _, op = job_with_op(doc, str(bump_stl()), values={"BoundaryShape": "Model", "RasterAngle": 90.0})
@@ -153,7 +175,7 @@ class SaveAndReopen(FreeCADTestCase):
     def test_save_reopen_keeps_op_properties_and_path(self) -> None:
         doc = new_doc("TmmSave")
         values = {"StepOver": 2.5, "SampleStep": 0.8, "Pattern": "OneWay", "RasterAngle": 30.0,
-                  "StockToLeave": 0.2, "BoundaryShape": "Model", "BoundaryMargin": 1.0}
+                  "StockToLeave": 0.2, "BoundaryShape": "Model", "BoundaryMargin": 1.0, "OffModel": "Skip"}
         _, _, op = job_with_op(doc, str(bump_stl()), values=values)
         self.assertTrue(op.isValid(), op.getStatusString())
         before = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]

@@ -34,6 +34,7 @@ TOOL_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "
                 "bullnose": "bullnose", "bull": "bullnose"}
 PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
+OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 
 
 @dataclass
@@ -49,7 +50,7 @@ class SurfaceResult:
 def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", diameter: float = 6.0,
                 corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
-                boundary: str = "model", margin: float = 0.0, safe_height: Optional[float] = None,
+                boundary: str = "model", margin: float = 0.0, off_model: str = "floor", safe_height: Optional[float] = None,
                 clearance_height: Optional[float] = None, horiz_feed: float = 1000.0,
                 vert_feed: float = 300.0, spindle_speed: float = 10000.0, post: str = "linuxcnc",
                 gcode_path: Optional[Union[str, os.PathLike]] = None,
@@ -59,6 +60,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
 
     tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose).
     pattern: 'zigzag' | 'oneway'; boundary: 'model' | 'stock' XY box grown by `margin` (mm).
+    off_model: 'floor' (cut along the model's lowest point where no part of it is under the tool) | 'skip'
+    (lift over such places, cut only over the model).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -71,6 +74,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
     boundary_name = BOUNDARY_NAMES.get(str(boundary).lower())
     if boundary_name is None:
         raise TmmError(f"boundary must be 'model' or 'stock', got {boundary!r}")
+    off_model_name = OFF_MODEL_NAMES.get(str(off_model).lower())
+    if off_model_name is None:
+        raise TmmError(f"off_model must be 'floor' or 'skip', got {off_model!r}")
 
     own_doc = isinstance(model, (str, os.PathLike))
     if own_doc and not Path(model).expanduser().is_file():
@@ -78,7 +84,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
     doc = FreeCAD.newDocument(doc_name) if own_doc else model.Document
     try:
         result = _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
-                        pattern_name, stock_to_leave, boundary_name, margin, safe_height, clearance_height,
+                        pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height, clearance_height,
                         horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress)
     except BaseException:
         if own_doc:
@@ -92,7 +98,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
 
 def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: float, stepover: float,
            sample_step: float, angle_deg: float, pattern: str, stock_to_leave: float, boundary: str,
-           margin: float, safe_height: Optional[float], clearance_height: Optional[float],
+           margin: float, off_model: str, safe_height: Optional[float], clearance_height: Optional[float],
            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str,
            gcode_path: Any, progress: Any) -> SurfaceResult:
     jm = jobs.prepare_model(doc, model)
@@ -106,7 +112,7 @@ def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: flo
     tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
     values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
               "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
-              "BoundaryMargin": margin, "SafeHeight": safe, "ClearanceHeight": clearance}
+              "BoundaryMargin": margin, "OffModel": off_model, "SafeHeight": safe, "ClearanceHeight": clearance}
     if jm.stl_file:
         values["StlFile"] = jm.stl_file
     else:

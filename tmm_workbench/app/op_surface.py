@@ -23,11 +23,13 @@ from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.mesh import TriMesh
-from tmm_workbench.core.surface3d import ONEWAY, ZIGZAG, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.surface3d import (OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams,
+                                          compute_surface_toolpath)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
 PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY}
+OFF_MODEL = {"Floor": OFF_MODEL_FLOOR, "Skip": OFF_MODEL_SKIP}
 BOUNDARIES = ("Stock", "Model")
 
 # (type, name, group, tooltip)
@@ -46,12 +48,16 @@ PROPERTIES: list[tuple[str, str, str, str]] = [
     ("App::PropertyEnumeration", "Pattern", "Surface",
      "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes"),
     ("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface"),
+    ("App::PropertyEnumeration", "OffModel", "Surface",
+     "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
+     "floor (the model's lowest point); Skip lifts over it and cuts only over the model"),
 ]
 DEFAULTS: dict[str, Any] = {
     "LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock", "BoundaryMargin": 0.0,
     "StepOver": 1.0, "SampleStep": 0.5, "RasterAngle": 0.0, "Pattern": "ZigZag", "StockToLeave": 0.0,
+    "OffModel": "Floor",
 }
-ENUMERATIONS = {"BoundaryShape": list(BOUNDARIES), "Pattern": list(PATTERNS)}
+ENUMERATIONS = {"BoundaryShape": list(BOUNDARIES), "Pattern": list(PATTERNS), "OffModel": list(OFF_MODEL)}
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -123,6 +129,7 @@ class ObjectTmmSurface(op_base.TmmOp):
             angle_deg=obj.RasterAngle.Value,
             pattern=PATTERNS[obj.Pattern],
             stock_to_leave=obj.StockToLeave.Value,
+            off_model=OFF_MODEL[obj.OffModel],
         )
 
     def commands(self, toolpath: Toolpath) -> list[Any]:

@@ -16,6 +16,12 @@ from .toolpath import MoveKind, Toolpath
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
+# Where no triangle lies under the cutter ("air": beside an open surface or a relief without a base, in a
+# hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
+# is split, the tool lifts to the safe height and plunges again where the model resumes.
+OFF_MODEL_FLOOR = "floor"
+OFF_MODEL_SKIP = "skip"
+_AIR_DEPTH_MM = 1e6  # SKIP drops onto a floor this far below the model: only air points end there
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
 _LABEL = {"stepover": "step-over", "sample_step": "sample step"}
 
@@ -31,6 +37,7 @@ class SurfaceParams:
     pattern: str = ZIGZAG            # ZIGZAG or ONEWAY
     stock_to_leave: float = 0.0      # material left on the surface (mm)
     floor_z: Optional[float] = None  # the tip never goes below; default: the model's lowest point
+    off_model: str = OFF_MODEL_FLOOR  # OFF_MODEL_FLOOR or OFF_MODEL_SKIP (see above)
 
     def validate(self) -> None:
         for name in ("stepover", "sample_step"):
@@ -43,6 +50,8 @@ class SurfaceParams:
                 raise TmmError(f"{name.replace('_', ' ')} must be a finite number, got {v!r}")
         if self.pattern not in (ZIGZAG, ONEWAY):
             raise TmmError(f"pattern must be '{ZIGZAG}' or '{ONEWAY}', got {self.pattern!r}")
+        if self.off_model not in (OFF_MODEL_FLOOR, OFF_MODEL_SKIP):
+            raise TmmError(f"off-model must be '{OFF_MODEL_FLOOR}' or '{OFF_MODEL_SKIP}', got {self.off_model!r}")
         if self.clearance_height < self.safe_height:
             raise TmmError(f"clearance height {self.clearance_height:g} mm is below the safe height "
                            f"{self.safe_height:g} mm")
@@ -82,29 +91,59 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
 
     s = params.stock_to_leave
     surface = surface or DropSurface(mesh)
-    z = surface.drop(cutter.offset(s), xy, floor_z - s, progress) + s
+    skip = params.off_model == OFF_MODEL_SKIP
+    air_floor = float(lo[2]) - _AIR_DEPTH_MM
+    z = surface.drop(cutter.offset(s), xy, (air_floor if skip else floor_z) - s, progress) + s
+    air = z <= air_floor + 1.0 if skip else np.zeros(len(z), dtype=bool)
+    if air.all():
+        raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
+    z = np.maximum(z, floor_z)
 
-    top = float(z.max())
+    top = float(z[~air].max())
     if params.safe_height <= top:
         raise TmmError(f"safe height {params.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    return _link(runs, z, params)
+    return _link(_pieces(runs, z, air, params.pattern), params)
 
 
-def _link(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, params: SurfaceParams) -> Toolpath:
-    tp = Toolpath()
+def _pieces(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray,
+            pattern: str) -> list[tuple[bool, bool, np.ndarray]]:
+    """(is_link, detached, points) in cutting order. A pass is split where it crosses air; a zig-zag link
+    that crosses air is left out. `detached`: the tool gets there by retract, rapid and plunge."""
+    out: list[tuple[bool, bool, np.ndarray]] = []
+    detach = True
     k = 0
     for is_link, xy in runs:
-        pts = np.column_stack([xy, z[k:k + len(xy)]])
+        pts, gap = np.column_stack([xy, z[k:k + len(xy)]]), air[k:k + len(xy)]
         k += len(xy)
-        if len(pts) == 0:
+        if is_link:
+            if gap.any():
+                detach = True
+            elif len(pts):
+                out.append((True, detach, pts))
+                detach = False
             continue
+        if pattern == ONEWAY:
+            detach = True
+        # consecutive on-model points: [start, end) index pairs
+        edges = np.flatnonzero(np.diff(np.concatenate([[True], gap, [True]]).astype(np.int8)))
+        for start, end in zip(edges[::2], edges[1::2]):
+            out.append((False, detach or start > 0, pts[start:end]))
+            detach = False
+        if len(gap) and gap[-1]:
+            detach = True
+    return out
+
+
+def _link(pieces: list[tuple[bool, bool, np.ndarray]], params: SurfaceParams) -> Toolpath:
+    tp = Toolpath()
+    for is_link, detached, pts in pieces:
         if not is_link:
             pts = _drop_collinear(pts)
         plunged = False
-        if not tp.moves or params.pattern == ONEWAY:
+        if not tp.moves or detached:
             x0, y0, z0 = pts[0]
-            if tp.moves:  # one-way: lift straight up, cross over at the safe height
+            if tp.moves:  # lift straight up, cross over at the safe height
                 last = tp.moves[-1]
                 tp.add(MoveKind.RAPID, last.x, last.y, params.safe_height)
             else:

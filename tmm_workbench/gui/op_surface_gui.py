@@ -16,7 +16,7 @@ JOB_MODEL = "(Job model)"
 SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampleStep": "SampleStep",
               "rasterAngle": "RasterAngle", "stockToLeave": "StockToLeave",
               "linearDeflection": "LinearDeflection"}
-COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern"}
+COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel"}
 
 
 class TaskPanelOpPage(op_page.OpPage):
