@@ -82,6 +82,25 @@ double profile_edge_max(const Cutter& c, double d2, double z0, double m, double 
   return g(u);
 }
 
+// The ball's edge contact, g(u) = z0 + m u - R + sqrt(s^2 - u^2) at its maximum u* = s m / sqrt(1 + m^2) on
+// the edge's chord through the shadow, in lengths scaled by the edge's XY length L (U = u L) so that the
+// three roots (L, the 3D length L3 and s L) are independent and the only division is 1 / L^2; inside the
+// chord g(u*) = z0 - R + s L3 / L. dz: p2 - p1 in z; dot: (p1 - axis) . e_xy; cross2: the squared cross
+// product (s L)^2 = R^2 L^2 - cross2.
+double ball_edge_drop(double R, double z1, double dz, double dot, double L2, double cross2) {
+  const double Q = R * R * L2 - cross2;
+  if (!(Q >= 0)) return kNoContact;
+  const double sL = std::sqrt(Q), L = std::sqrt(L2), L3 = std::sqrt(L2 + dz * dz);
+  const double lo = maxd(dot, -sL), hi = std::min(dot + L2, sL);  // the chord within the edge, scaled
+  if (lo > hi) return kNoContact;
+  const double inv_L2 = 1.0 / L2;
+  const double z0 = z1 - dz * dot * inv_L2;  // the edge's height at the foot of the axis
+  const double top = sL * dz;                // u* L3, scaled
+  if (top >= lo * L3 && top <= hi * L3) return z0 - R + sL * L3 * inv_L2;
+  const double U = top < lo * L3 ? lo : hi;
+  return z0 + dz * U * inv_L2 - R + std::sqrt(maxd(Q - U * U, 0.0)) * L * inv_L2;
+}
+
 }  // namespace
 
 double edge_drop(const Cutter& c, double x, double y, const double* p1, const double* p2, double above) {
@@ -99,6 +118,7 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
   const double cross2 = cross * cross;
   if (cross2 > R * R * L2) return kNoContact;
   if (!(cross2 < c.reach2(maxd(p1[2], p2[2]) - above) * L2)) return kNoContact;
+  if (c.kind() == CutterKind::Ball) return ball_edge_drop(R, p1[2], p2[2] - p1[2], ex * sx + ey * sy, L2, cross2);
   const double L = std::sqrt(L2);
   const double wx = ex / L, wy = ey / L;
   const double u1 = sx * wx + sy * wy;      // position of p1 along the edge, 0 at the foot of the axis
@@ -113,10 +133,7 @@ double edge_drop(const Cutter& c, double x, double y, const double* p1, const do
   switch (c.kind()) {
     case CutterKind::Flat:                  // the line's highest point over the flat disc chord
       return z0 + m * (m > 0 ? hi : lo);
-    case CutterKind::Ball: {                // g = z0 + m u - R + sqrt(s^2 - u^2): g' = 0 in closed form
-      const double u = std::clamp(m * s / std::sqrt(1.0 + m * m), lo, hi);
-      return z0 + m * u - R + std::sqrt(maxd(s * s - u * u, 0.0));
-    }
+    case CutterKind::Ball:                  // solved above
     case CutterKind::Bull:
     case CutterKind::General:
       return profile_edge_max(c, d2, z0, m, lo, hi, above);
