@@ -127,6 +127,9 @@ def smoke() -> dict:
     assert info["panel_open"], "no task dialog open"
     page = find_panel()
     info["panel_step_over"] = page.findChild(QtGui.QWidget, "stepOver").property("rawValue")
+    off = page.findChild(QtGui.QComboBox, "offModel")
+    info["panel_off_model"] = [off.currentText(), [off.itemText(i) for i in range(off.count())]]
+    assert info["panel_off_model"] == [ops[0].OffModel, ["Floor", "Skip"]], info["panel_off_model"]
     mw = FreeCADGui.getMainWindow()
     for dock in mw.findChildren(QtGui.QDockWidget):
         if dock.isVisible() and dock.isAncestorOf(page):
