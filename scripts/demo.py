@@ -178,7 +178,8 @@ def main() -> None:
 
 # --- 5-axis part -------------------------------------------------------------------------------------
 MP_NAME = "multipoint_convex"
-MP_PARAMS = dict(Ro=6.7, Ri=6.0, method="vcrf", side_step=18.0, forward_step=2.0)  # the seed's tool and footprint
+# The seed's tool and footprint: passes 18 mm apart from x = 0, the last at x = 150; 2 mm forward steps.
+MP_PARAMS = dict(Ro=6.7, Ri=6.0, method="vcrf", side_step=18.0, pass_spacing="fixed", forward_step=2.0)
 
 
 def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
@@ -218,7 +219,8 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     else:
         face = BezierFace.from_net(net, name="seed convex")
         core_tp, results = compute_multipoint_toolpath(
-            face, p["Ro"], p["Ri"], MultipointParams(side_step=p["side_step"], forward_step=p["forward_step"]),
+            face, p["Ro"], p["Ri"], MultipointParams(side_step=p["side_step"], pass_spacing=p["pass_spacing"],
+                                               forward_step=p["forward_step"]),
             p["method"])
         n_commands, summary = 0, ""
     seconds = time.perf_counter() - t0

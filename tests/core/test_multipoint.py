@@ -138,6 +138,29 @@ def test_seed_footprint_matches_the_seed():
     assert all(np.diff(p[:, 1]).max() <= 2.0 + 1e-9 for p in passes)
 
 
+def test_fixed_pass_spacing_is_the_seeds_footprint():
+    """pass_spacing "fixed": 18 mm from the start edge and a last pass on the far edge - the seed's 760 points
+    (core.seed_experiment.seed_footprint, written out independently), whatever the side the feed starts."""
+    from tmm_workbench.core.seed_experiment import seed_footprint
+    face = BezierFace.from_net(seed_net("convex"))
+    passes = multipoint_footprint(face, MultipointParams(pass_spacing="fixed"))
+    seed = seed_footprint()
+    assert len(passes) == len(seed) == 10
+    for got, want in zip(passes, seed):
+        np.testing.assert_allclose(got, want, atol=1e-9)
+    # Feed along X (side step along Y), and a side step that divides the extent: no doubled last pass.
+    for angle, step, count in ((0.0, 18.0, 10), (0.0, 15.0, 11), (180.0, 18.0, 10)):
+        passes = multipoint_footprint(face, MultipointParams(feed_angle_deg=angle, side_step=step,
+                                                             pass_spacing="fixed", zigzag=False))
+        across = np.array([p[0, 1] for p in passes])
+        assert len(passes) == count, (angle, step, across)
+        expected = np.minimum(np.arange(count) * step, 150.0)
+        np.testing.assert_allclose(np.sort(across), expected, atol=1e-9)
+        np.testing.assert_allclose(across[0], 0.0, atol=1e-9)  # from the (xmin, ymin) corner's side
+    with pytest.raises(TmmError, match="pass spacing"):
+        multipoint_footprint(face, MultipointParams(pass_spacing="tight"))
+
+
 def test_seed_surfaces_contacts_touch_and_nothing_penetrates(seed_run):
     kind, net, face, path, res = seed_run
     st = res.status

@@ -128,6 +128,24 @@ class MultipointOp(FreeCADTestCase):
         with self.assertRaises(TmmError):
             run_multipoint(net, footprint_anchor="contact", **FAST)
 
+    def test_fixed_pass_spacing_machines_the_seeds_footprint(self) -> None:
+        """PassSpacing Fixed, 18 / 2 mm: the op positions the tool at the seed's 760 footprint points
+        (x = 0, 18, ..., 144, 150), with the same contacts as the core at that footprint."""
+        from tmm_workbench.core.multipoint import BezierFace, MultipointParams, position_points
+        from tmm_workbench.core.seed_experiment import RI, RO, seed_footprint
+        r = run_multipoint(seed_net(), side_step=18.0, forward_step=2.0, pass_spacing="fixed", posts=(),
+                           progress=False)
+        self.assertTrue(r.op.isValid(), r.op.getStatusString())
+        self.assertEqual(r.op.PassSpacing, "Fixed")
+        self.assertEqual(r.op.getEnumerationsOfProperty("PassSpacing"), ["Even", "Fixed"])
+        seed = np.vstack(seed_footprint())
+        np.testing.assert_allclose(r.results.xy, seed, atol=1e-6)
+        core = position_points(BezierFace.from_net(seed_net()), RO, RI, seed, MultipointParams())
+        self.assertEqual(r.results.counts(), core.counts())
+        np.testing.assert_allclose(r.results["tip"], core["tip"], atol=1e-6)
+        with self.assertRaises(TmmError):
+            run_multipoint(seed_net(), pass_spacing="tight", **FAST)
+
     def test_bspline_face_gives_the_same_path(self) -> None:
         """DRD: the same tips within 1e-6. VCRF: the kernel's surface samples follow the patches (4 after the
         knot insertion instead of 1), so a few positions land elsewhere within the search's resolution
@@ -168,7 +186,7 @@ class MultipointOp(FreeCADTestCase):
 
     def test_save_and_reopen(self) -> None:
         path = OUT / "multipoint_reopen.FCStd"
-        r = run_multipoint(seed_net(), fcstd_path=path, doc_name="MpSave", **DRD)
+        r = run_multipoint(seed_net(), fcstd_path=path, doc_name="MpSave", pass_spacing="fixed", **DRD)
         op = r.op
         self.assertTrue(op.isValid(), op.getStatusString())
         before = commands(op)
@@ -179,6 +197,7 @@ class MultipointOp(FreeCADTestCase):
         self.assertIsInstance(op.Proxy, ObjectTmmMultipoint)
         self.assertEqual(op.Method, "DRD")
         self.assertAlmostEqual(op.ForwardStep.Value, 10.0)
+        self.assertEqual(op.PassSpacing, "Fixed")
         self.assertEqual(op.Base[0][1], ("Face1",))
         self.assertEqual(op.ContactSummary, summary)
         self.assertSamePath(commands(op), before, 1e-5)  # a saved Path keeps 6 decimals

@@ -58,7 +58,8 @@ def multipoint_panel(info: dict) -> None:
 
     net = bezier.load_seed_patch(seed_json_path(), "convex")
     r = run_multipoint(net, side_step=36.0, forward_step=6.0, posts=(), doc_name="TmmGuiMultipoint",
-                       progress=True, surface_extension=12.7, footprint_anchor="tip")
+                       progress=True, surface_extension=12.7, footprint_anchor="tip",
+                       pass_spacing="fixed")
     assert isinstance(r.op.ViewObject.Proxy, MultipointViewProvider), type(r.op.ViewObject.Proxy)
     assert Path(r.op.ViewObject.Proxy.getIcon()).is_file(), "the 5-axis op's tree icon is not a file"
     r.op.ViewObject.Document.setEdit(r.op.ViewObject, 0)
@@ -75,6 +76,9 @@ def multipoint_panel(info: dict) -> None:
     info["mp_anchor"] = [anchor.currentText(), [anchor.itemText(i) for i in range(anchor.count())]]
     assert abs(info["mp_extension"] - 12.7) < 1e-9, info["mp_extension"]
     assert info["mp_anchor"] == ["Tip", ["Axis", "Tip"]], info["mp_anchor"]
+    spacing = page.findChild(QtGui.QComboBox, "passSpacing")
+    info["mp_pass_spacing"] = [spacing.currentText(), [spacing.itemText(i) for i in range(spacing.count())]]
+    assert info["mp_pass_spacing"] == ["Fixed", ["Even", "Fixed"]], info["mp_pass_spacing"]
     close_panel(r.op)
     obj, face = r.face
     FreeCADGui.Selection.clearSelection()

@@ -174,8 +174,8 @@ class MultipointResult:
 
 
 def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
-                   side_step: float = 18.0, forward_step: float = 2.0, feed_angle_deg: float = 90.0,
-                   margin: float = 0.0, zigzag: bool = True, tilt_limit_deg: Optional[float] = None,
+                   side_step: float = 18.0, pass_spacing: str = "even", forward_step: float = 2.0,
+                   feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True, tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
                    surface_extension: float = 0.0, footprint_anchor: str = "axis",
                    safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
@@ -191,6 +191,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     document). Tool: Ro, Ri of the torus (Ro = 0: ball end mill D = 2 Ri; the ToolBit is a bull-nose
     D = 2 (Ro + Ri), corner Ri). method 'vcrf' | 'drd'; tool_shape 'round_insert' (the seed's
     torus, hollow centre) | 'bull_nose' (plus its flat bottom).
+    pass_spacing 'even' (passes spread evenly, at most side_step apart) | 'fixed' (side_step apart from the
+    start edge, a last pass on the far edge: the seed's footprint).
     tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm).
     surface_extension (mm, 0: off): position against the face continued past its edges (checked against
     the real face); footprint_anchor 'axis' (seed 001: the pre-tilt axis on the footprint point) | 'tip'
@@ -214,6 +216,9 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     if anchor_name is None:
         raise TmmError(f"footprint_anchor must be one of {', '.join(op_multipoint.ANCHORS.values())}, "
                        f"got {footprint_anchor!r}")
+    spacing_name = {v: k for k, v in op_multipoint.PASS_SPACINGS.items()}.get(str(pass_spacing).lower())
+    if spacing_name is None:
+        raise TmmError(f"pass_spacing must be 'even' or 'fixed', got {pass_spacing!r}")
     for label, v in (("Ro", Ro), ("Ri", Ri)):
         if not isinstance(v, (int, float)) or not v >= 0:
             raise TmmError(f"{label} must be a length >= 0 mm, got {v!r}")
@@ -248,7 +253,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             "Base": [(clone, (sub,))], "Method": method_name, "ToolShape": shape_name, "SideStep": side_step,
             "ForwardStep": forward_step, "FeedAngle": feed_angle_deg, "BoundaryMargin": margin,
             "ZigZag": bool(zigzag), "AxisRetract": axis_retract, "SafeHeight": safe, "ClearanceHeight": clearance,
-            "SurfaceExtension": surface_extension, "FootprintAnchor": anchor_name}
+            "SurfaceExtension": surface_extension, "FootprintAnchor": anchor_name, "PassSpacing": spacing_name}
         if tilt_limit_deg is not None:
             values["TiltLimit"] = tilt_limit_deg
         if tolerance is not None:

@@ -46,6 +46,7 @@ OP_NAME = "TMM_Multipoint"
 METHODS = {"VCRF": "vcrf", "DRD": "drd"}
 TOOL_SHAPES = {"RoundInsert": "round_insert", "BullNose": "bull_nose"}
 ANCHORS = {"Axis": "axis", "Tip": "tip"}
+PASS_SPACINGS = {"Even": "even", "Fixed": "fixed"}
 SUPPORTED_SHAPES = ("bullnose", "ballend", "endmill")  # endmill only to get the core's clear refusal
 _DEFAULT = MultipointParams()
 
@@ -56,7 +57,10 @@ PROPERTIES: list[tuple[str, str, str, str]] = [
     ("App::PropertyEnumeration", "ToolShape", "Multipoint",
      "RoundInsert: the seed's torus (round-insert cutter, hollow centre); BullNose: the torus plus its flat "
      "bottom disc (a solid bull-nose end mill; on convex faces its bottom keeps most positions at one contact)"),
-    ("App::PropertyDistance", "SideStep", "Footprint", "Distance between passes (at most)"),
+    ("App::PropertyDistance", "SideStep", "Footprint", "Distance between passes (see PassSpacing)"),
+    ("App::PropertyEnumeration", "PassSpacing", "Footprint",
+     "Even: passes spread evenly over the boundary, at most SideStep apart; Fixed: passes exactly SideStep "
+     "apart from the start edge and a last one on the far edge (seed 001's footprint: x = 0, 18, ..., 144, 150)"),
     ("App::PropertyDistance", "ForwardStep", "Footprint", "Distance between tool positions along a pass (at most)"),
     ("App::PropertyAngle", "FeedAngle", "Footprint", "Direction of the passes in XY, from +X"),
     ("App::PropertyDistance", "BoundaryMargin", "Footprint",
@@ -80,9 +84,10 @@ DEFAULTS: dict[str, Any] = {
     "Method": "VCRF", "ToolShape": "RoundInsert", "SideStep": _DEFAULT.side_step,
     "ForwardStep": _DEFAULT.forward_step, "FeedAngle": _DEFAULT.feed_angle_deg, "BoundaryMargin": _DEFAULT.margin,
     "ZigZag": _DEFAULT.zigzag, "TiltLimit": _DEFAULT.beta_max_deg, "Tolerance": _DEFAULT.tol, "AxisRetract": 5.0,
-    "SurfaceExtension": _DEFAULT.extend, "FootprintAnchor": "Axis",
+    "SurfaceExtension": _DEFAULT.extend, "FootprintAnchor": "Axis", "PassSpacing": "Even",
 }
-ENUMERATIONS = {"Method": list(METHODS), "ToolShape": list(TOOL_SHAPES), "FootprintAnchor": list(ANCHORS)}
+ENUMERATIONS = {"Method": list(METHODS), "ToolShape": list(TOOL_SHAPES), "FootprintAnchor": list(ANCHORS),
+                "PassSpacing": list(PASS_SPACINGS)}
 
 
 def torus_radii(tool: Any) -> tuple[float, float]:
@@ -283,7 +288,8 @@ class ObjectTmmMultipoint(op_base.TmmOp):
 
     def params(self, obj: Any) -> MultipointParams:
         return MultipointParams(
-            side_step=obj.SideStep.Value, forward_step=obj.ForwardStep.Value,
+            side_step=obj.SideStep.Value, pass_spacing=PASS_SPACINGS[obj.PassSpacing],
+            forward_step=obj.ForwardStep.Value,
             feed_angle_deg=obj.FeedAngle.Value, margin=obj.BoundaryMargin.Value, zigzag=bool(obj.ZigZag),
             shape=TOOL_SHAPES[obj.ToolShape], beta_max_deg=obj.TiltLimit.Value, tol=obj.Tolerance.Value,
             extend=obj.SurfaceExtension.Value, anchor=ANCHORS[obj.FootprintAnchor])

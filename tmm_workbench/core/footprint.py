@@ -10,12 +10,20 @@ from .errors import TmmError
 Rect = tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
 
 
-def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0) -> list[np.ndarray]:
-    """Parallel passes `stepover` apart at `angle_deg` from +X, clipped to the rectangle `boundary`.
+EVEN, FIXED = "even", "fixed"
+
+
+def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0, spacing: str = EVEN) -> list[np.ndarray]:
+    """Parallel passes at `angle_deg` from +X, clipped to the rectangle `boundary`.
 
     Returns one (2, 2) array [start, end] per pass, all running the same way, ordered across the
     rectangle. The first and last passes lie on the boundary so the whole rectangle is covered.
+    spacing EVEN: the passes spread evenly, at most `stepover` apart. FIXED: exactly `stepover` apart from
+    the side of the rectangle nearest its (xmin, ymin) corner, the last strip narrower (seed 001's footprint:
+    x = 0, 18, ..., 144 and 150).
     """
+    if spacing not in (EVEN, FIXED):
+        raise TmmError(f"pass spacing must be '{EVEN}' or '{FIXED}', got {spacing!r}")
     xmin, ymin, xmax, ymax = boundary
     if not (xmax > xmin and ymax > ymin):
         raise TmmError(f"boundary is empty: x {xmin:g}..{xmax:g}, y {ymin:g}..{ymax:g}")
@@ -30,7 +38,15 @@ def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0) -> lis
     count = max(1, math.ceil((hi - lo) / stepover - 1e-9)) + 1
     if count > 200000:
         raise TmmError(f"step-over {stepover:g} mm gives {count} passes over the boundary: too many")
-    offsets = np.linspace(lo, hi, count) if count > 1 else np.array([(lo + hi) / 2])
+    if count == 1:
+        offsets = np.array([(lo + hi) / 2])
+    elif spacing == EVEN:
+        offsets = np.linspace(lo, hi, count)
+    else:  # from the corner's side; a pass closer than 1e-9 mm to the far edge is that edge's
+        corner = np.array([xmin, ymin]) @ n
+        start, end = (lo, hi) if abs(corner - lo) <= abs(corner - hi) else (hi, lo)
+        steps = np.arange(count - 1) * stepover
+        offsets = np.concatenate([start + math.copysign(1.0, end - start) * steps[steps < (hi - lo) - 1e-9], [end]])
     lines = []
     for c in offsets:
         seg = _clip_line_to_rect(c * n, d, boundary)

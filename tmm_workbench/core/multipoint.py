@@ -21,7 +21,7 @@ import numpy as np
 
 from .bspline import BezierPieces, bspline_to_bezier
 from .errors import Cancelled, TmmError
-from .footprint import Rect, raster_lines, sample_segment
+from .footprint import EVEN, FIXED, Rect, raster_lines, sample_segment
 from .kernel import native
 from .toolpath import MoveKind, Toolpath
 
@@ -129,6 +129,8 @@ class BezierFace:
 @dataclass
 class MultipointParams:
     side_step: float = 18.0          # mm between passes (seed: 18)
+    pass_spacing: str = EVEN         # EVEN: spread evenly, at most side_step apart; FIXED: side_step apart from
+                                     # the start edge, the last pass on the far edge (the seed's footprint)
     forward_step: float = 2.0        # mm between positions along a pass (seed: 2)
     feed_angle_deg: float = 90.0     # feed direction from +X (seed: along Y, side step along X)
     margin: float = 0.0              # the boundary is the face's XY extent grown by this (mm; < 0 shrinks)
@@ -208,6 +210,8 @@ def _check_params(p: MultipointParams) -> None:
         v = getattr(p, name)
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise TmmError(f"{name.replace('_', ' ')} must be a positive length, got {v!r}")
+    if p.pass_spacing not in (EVEN, FIXED):
+        raise TmmError(f"pass spacing must be '{EVEN}' or '{FIXED}', got {p.pass_spacing!r}")
     if p.shape not in SHAPES:
         raise TmmError(f"tool shape must be one of {SHAPES}, got {p.shape!r}")
     if p.rotation not in ROTATIONS:
@@ -226,9 +230,11 @@ def _check_params(p: MultipointParams) -> None:
 
 def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.ndarray]:
     """XY parallel passes over the boundary (the face's XY extent grown by `margin`, or `boundary`):
-    passes at most `side_step` apart running along `feed_angle_deg`, points at most `forward_step` apart,
-    evenly spread with the first and last passes on the boundary (the seed keeps 18 mm and squeezes the last
-    pass in at x = 150: uneven strips); zigzag optional. One (k, 2) array per pass."""
+    passes running along `feed_angle_deg`, the first and last on the boundary, spread evenly at most
+    `side_step` apart (pass_spacing EVEN) or exactly `side_step` apart from the start edge with the last
+    strip narrower (FIXED: the seed keeps 18 mm and squeezes the last pass in at x = 150); points at most
+    `forward_step` apart; zigzag optional. One (k, 2) array per pass, the first nearest the boundary's
+    (xmin, ymin) corner."""
     _check_params(params)
     if params.boundary is not None:
         rect = tuple(map(float, params.boundary))
@@ -236,7 +242,7 @@ def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.
         x0, y0, x1, y1 = face.xy_extent()
         m = float(params.margin)
         rect = (x0 - m, y0 - m, x1 + m, y1 + m)
-    lines = raster_lines(rect, params.side_step, params.feed_angle_deg)
+    lines = raster_lines(rect, params.side_step, params.feed_angle_deg, params.pass_spacing)
     # Start with the pass nearest the boundary's (xmin, ymin) corner.
     corner = np.array(rect[:2])
     if lines and np.linalg.norm(lines[-1].mean(0) - corner) < np.linalg.norm(lines[0].mean(0) - corner):

@@ -17,7 +17,8 @@ ICON = resources.icon("TMM_Multipoint")
 SPIN_BOXES = {"sideStep": "SideStep", "forwardStep": "ForwardStep", "feedAngle": "FeedAngle",
               "boundaryMargin": "BoundaryMargin", "tiltLimit": "TiltLimit", "tolerance": "Tolerance",
               "axisRetract": "AxisRetract", "surfaceExtension": "SurfaceExtension"}
-COMBOS = {"method": "Method", "toolShape": "ToolShape", "footprintAnchor": "FootprintAnchor"}
+COMBOS = {"method": "Method", "toolShape": "ToolShape", "footprintAnchor": "FootprintAnchor",
+          "passSpacing": "PassSpacing"}
 
 
 class TaskPanelOpPage(op_page.OpPage):
