@@ -50,10 +50,10 @@ class SurfaceResult:
 def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", diameter: float = 6.0,
                 corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
-                boundary: str = "model", margin: float = 0.0, off_model: str = "floor", safe_height: Optional[float] = None,
-                clearance_height: Optional[float] = None, horiz_feed: float = 1000.0,
-                vert_feed: float = 300.0, spindle_speed: float = 10000.0, post: str = "linuxcnc",
-                gcode_path: Optional[Union[str, os.PathLike]] = None,
+                boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
+                safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
+                horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
@@ -65,18 +65,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
-    shape = TOOL_ALIASES.get(str(tool).lower())
-    if shape is None:
-        raise TmmError(f"tool must be one of {', '.join(sorted(set(TOOL_ALIASES.values())))}, got {tool!r}")
-    pattern_name = PATTERN_NAMES.get(str(pattern).lower())
-    if pattern_name is None:
-        raise TmmError(f"pattern must be 'zigzag' or 'oneway', got {pattern!r}")
-    boundary_name = BOUNDARY_NAMES.get(str(boundary).lower())
-    if boundary_name is None:
-        raise TmmError(f"boundary must be 'model' or 'stock', got {boundary!r}")
-    off_model_name = OFF_MODEL_NAMES.get(str(off_model).lower())
-    if off_model_name is None:
-        raise TmmError(f"off_model must be 'floor' or 'skip', got {off_model!r}")
+    shape = _option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
+    pattern_name = _option("pattern", pattern, PATTERN_NAMES)
+    boundary_name = _option("boundary", boundary, BOUNDARY_NAMES)
+    off_model_name = _option("off_model", off_model, OFF_MODEL_NAMES)
 
     own_doc = isinstance(model, (str, os.PathLike))
     if own_doc and not Path(model).expanduser().is_file():
@@ -84,8 +76,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
     doc = FreeCAD.newDocument(doc_name) if own_doc else model.Document
     try:
         result = _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
-                        pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height, clearance_height,
-                        horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress)
+                        pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height,
+                        clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress)
     except BaseException:
         if own_doc:
             FreeCAD.closeDocument(doc.Name)
@@ -94,6 +86,22 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
         Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
         doc.saveAs(str(fcstd_path))
     return result
+
+
+def _option(label: str, value: Any, names: dict[str, str], shown: Optional[Sequence[str]] = None) -> str:
+    """The op's property value for an API option (`names`: lower-case API name -> property value); a TmmError
+    listing the choices (`shown`, default the API names) for anything else."""
+    prop = names.get(str(value).lower())
+    if prop is None:
+        choices = list(shown or names)
+        listed = f"'{choices[0]}' or '{choices[1]}'" if len(choices) == 2 else "one of " + ", ".join(choices)
+        raise TmmError(f"{label} must be {listed}, got {value!r}")
+    return prop
+
+
+def _by_core_name(props: dict[str, str]) -> dict[str, str]:
+    """An op's enumeration table (property value -> core name) turned round: core name -> property value."""
+    return {core: prop for prop, core in props.items()}
 
 
 def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: float, stepover: float,
@@ -175,7 +183,8 @@ class MultipointResult:
 
 def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
                    side_step: float = 18.0, pass_spacing: str = "even", forward_step: float = 2.0,
-                   feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True, tilt_limit_deg: Optional[float] = None,
+                   feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True,
+                   tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
                    surface_extension: float = 0.0, footprint_anchor: str = "axis",
                    safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
@@ -205,20 +214,10 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     from tmm_workbench.app import op_multipoint
     from tmm_workbench.app import posts as posts_mod
 
-    method_name = {"vcrf": "VCRF", "drd": "DRD"}.get(str(method).lower())
-    if method_name is None:
-        raise TmmError(f"method must be 'vcrf' or 'drd', got {method!r}")
-    shape_name = {v: k for k, v in op_multipoint.TOOL_SHAPES.items()}.get(str(tool_shape).lower())
-    if shape_name is None:
-        raise TmmError(f"tool_shape must be one of {', '.join(op_multipoint.TOOL_SHAPES.values())}, "
-                       f"got {tool_shape!r}")
-    anchor_name = {v: k for k, v in op_multipoint.ANCHORS.items()}.get(str(footprint_anchor).lower())
-    if anchor_name is None:
-        raise TmmError(f"footprint_anchor must be one of {', '.join(op_multipoint.ANCHORS.values())}, "
-                       f"got {footprint_anchor!r}")
-    spacing_name = {v: k for k, v in op_multipoint.PASS_SPACINGS.items()}.get(str(pass_spacing).lower())
-    if spacing_name is None:
-        raise TmmError(f"pass_spacing must be 'even' or 'fixed', got {pass_spacing!r}")
+    method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
+    shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))
+    anchor_name = _option("footprint_anchor", footprint_anchor, _by_core_name(op_multipoint.ANCHORS))
+    spacing_name = _option("pass_spacing", pass_spacing, _by_core_name(op_multipoint.PASS_SPACINGS))
     for label, v in (("Ro", Ro), ("Ri", Ri)):
         if not isinstance(v, (int, float)) or not v >= 0:
             raise TmmError(f"{label} must be a length >= 0 mm, got {v!r}")

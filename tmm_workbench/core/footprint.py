@@ -35,18 +35,17 @@ def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0, spacin
     corners = np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
     across = corners @ n
     lo, hi = across.min(), across.max()
-    count = max(1, math.ceil((hi - lo) / stepover - 1e-9)) + 1
+    count = max(1, math.ceil((hi - lo) / stepover - 1e-9)) + 1  # >= 2: both edges
     if count > 200000:
         raise TmmError(f"step-over {stepover:g} mm gives {count} passes over the boundary: too many")
-    if count == 1:
-        offsets = np.array([(lo + hi) / 2])
-    elif spacing == EVEN:
+    if spacing == EVEN:
         offsets = np.linspace(lo, hi, count)
     else:  # from the corner's side; a pass closer than 1e-9 mm to the far edge is that edge's
         corner = np.array([xmin, ymin]) @ n
         start, end = (lo, hi) if abs(corner - lo) <= abs(corner - hi) else (hi, lo)
         steps = np.arange(count - 1) * stepover
-        offsets = np.concatenate([start + math.copysign(1.0, end - start) * steps[steps < (hi - lo) - 1e-9], [end]])
+        inside = steps[steps < (hi - lo) - 1e-9]
+        offsets = np.concatenate([start + math.copysign(1.0, end - start) * inside, [end]])
     lines = []
     for c in offsets:
         seg = _clip_line_to_rect(c * n, d, boundary)

@@ -21,7 +21,7 @@ import numpy as np
 
 from .bspline import BezierPieces, bspline_to_bezier
 from .errors import Cancelled, TmmError
-from .footprint import EVEN, FIXED, Rect, raster_lines, sample_segment
+from .footprint import EVEN, Rect, raster_lines, sample_segment
 from .kernel import native
 from .toolpath import MoveKind, Toolpath
 
@@ -210,8 +210,6 @@ def _check_params(p: MultipointParams) -> None:
         v = getattr(p, name)
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
             raise TmmError(f"{name.replace('_', ' ')} must be a positive length, got {v!r}")
-    if p.pass_spacing not in (EVEN, FIXED):
-        raise TmmError(f"pass spacing must be '{EVEN}' or '{FIXED}', got {p.pass_spacing!r}")
     if p.shape not in SHAPES:
         raise TmmError(f"tool shape must be one of {SHAPES}, got {p.shape!r}")
     if p.rotation not in ROTATIONS:

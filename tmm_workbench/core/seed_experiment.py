@@ -33,7 +33,6 @@ from .multipoint import STATUS_FAILED, BezierFace, MultipointParams, MultipointR
 from .shared_data import benchmark_file
 from .zmap import ZTool, simulate
 
-REPO = Path(__file__).resolve().parents[2]
 
 RO, RI = 6.7, 6.0
 PASSES_X = tuple([18.0 * k for k in range(9)] + [150.0])
