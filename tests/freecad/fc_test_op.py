@@ -14,6 +14,11 @@ from tmm_workbench.app.op_surface import ObjectTmmSurface
 H_FEED, V_FEED = 1200.0, 240.0  # mm/min, as the tool controller gets them
 
 
+def plunges(mv: list) -> list:
+    """The G1 moves at the vertical feed (plunges) among `moves(op)`."""
+    return [p for n, p in mv if n == "G1" and round(p["F"] * 60, 6) == V_FEED]
+
+
 class OpInJob(FreeCADTestCase):
     def test_moves_feeds_and_heights(self) -> None:
         doc = new_doc()
@@ -85,7 +90,6 @@ class OpInJob(FreeCADTestCase):
         one = moves(op)
         self.assertTrue(op.isValid(), op.getStatusString())
         passes = 11  # 20 mm / 2 mm step-over + 1
-        plunges = lambda mv: [p for n, p in mv if n == "G1" and round(p["F"] * 60, 6) == V_FEED]  # noqa
         self.assertEqual(len(plunges(zig)), 1)
         self.assertEqual(len(plunges(one)), passes)
         safe = op.SafeHeight.Value
@@ -106,7 +110,6 @@ class OpInJob(FreeCADTestCase):
         _, _, op = job_with_op(doc, mesh_feature(doc, tris, "TwoBumps"), values={"BoundaryShape": "Model"})
         self.assertEqual(op.OffModel, "Floor")
         self.assertEqual(op.getEnumerationsOfProperty("OffModel"), ["Floor", "Skip"])
-        plunges = lambda mv: [p for n, p in mv if n == "G1" and round(p["F"] * 60, 6) == V_FEED]  # noqa
         in_gap = lambda mv: [b for (_, a), (n, b) in zip(mv, mv[1:])  # noqa: E731  (G1 over |x| < 2.5)
                              if n == "G1" and min(a["X"], b["X"]) < 2.5 and max(a["X"], b["X"]) > -2.5]
         floor = moves(op)
