@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from tmm_workbench.core.kernel import native  # noqa: E402
-from tmm_workbench.core.mesh import TriMesh, load_stl  # noqa: E402
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 
 from opencamlib import ocl  # noqa: E402

@@ -23,7 +23,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from tmm_workbench.core.multipoint import (BezierFace, MultipointParams, make_positioner,  # noqa: E402
+from tmm_workbench.core.strategies.multipoint import (BezierFace, MultipointParams, make_positioner,  # noqa: E402
                                            STATUS_NAMES)
 
 Z = {"convex": [80, 90, 90, 80, 90, 105, 105, 90, 90, 105, 105, 90, 80, 90, 90, 80],

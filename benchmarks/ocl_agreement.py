@@ -15,9 +15,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from tmm_workbench.core.cutters import Cutter  # noqa: E402
-from tmm_workbench.core.drop import DropSurface  # noqa: E402
-from tmm_workbench.core.mesh import load_stl  # noqa: E402
+from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
+from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
+from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 
 from opencamlib import ocl  # noqa: E402

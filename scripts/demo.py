@@ -74,7 +74,7 @@ def write_binary_stl(vertices, triangles, path: Path, name: str = "tmm") -> None
 
 
 def bezier_stl(out: Path) -> Path:
-    from tmm_workbench.core import bezier
+    from tmm_workbench.core.geometry import bezier
 
     net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
     mesh = bezier.tessellate_to_tolerance(net, BEZIER_TOLERANCE_MM, name="bezier_convex")
@@ -103,9 +103,9 @@ def run_freecad(case: Case, out: Path) -> dict[str, Any]:
 
 def run_core(case: Case, out: Path) -> dict[str, Any]:
     """Without FreeCAD: the same raster from the core, for the picture only."""
-    from tmm_workbench.core.cutters import Cutter
-    from tmm_workbench.core.mesh import load_stl
-    from tmm_workbench.core.surface3d import SurfaceParams, compute_surface_toolpath
+    from tmm_workbench.core.tools.cutter import Cutter
+    from tmm_workbench.core.geometry.mesh import load_stl
+    from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute_surface_toolpath
 
     p = case.params
     cutter = {"ballend": lambda: Cutter.ball(p["diameter"]),
@@ -132,7 +132,7 @@ def describe_tool(p: dict[str, Any]) -> str:
 
 def main() -> None:
     sys.path.insert(0, str(REPO))
-    from tmm_workbench.core.preview import path_statistics, render_toolpath_png
+    from tmm_workbench.core.preview.toolpath_png import path_statistics, render_toolpath_png
 
     out = Path(os.environ.get("TMM_OUT") or REPO / "out").resolve()
     out.mkdir(parents=True, exist_ok=True)
@@ -185,10 +185,10 @@ MP_PARAMS = dict(Ro=6.7, Ri=6.0, method="vcrf", side_step=18.0, pass_spacing="fi
 def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     """Seed 001's convex patch as a FreeCAD Bézier face through `run_multipoint` (Job, bull-nose ToolBit,
     'TMM 5-axis Multipoint' op, tarus and apt_cl posts, document), a picture of the tool axes, and (when
-    core.seed_experiment is there) the seed's section-deviation plot at y = 27 mm."""
-    from tmm_workbench.core import bezier
-    from tmm_workbench.core.multipoint import BezierFace, MultipointParams, compute_multipoint_toolpath
-    from tmm_workbench.core.preview5 import face_grid, render_axes_png
+    benchmarks.seed.experiment is there) the seed's section-deviation plot at y = 27 mm."""
+    from tmm_workbench.core.geometry import bezier
+    from tmm_workbench.core.strategies.multipoint import BezierFace, MultipointParams, compute_multipoint_toolpath
+    from tmm_workbench.core.preview.axes_png import face_grid, render_axes_png
 
     net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
     p = MP_PARAMS
@@ -238,9 +238,9 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
 
     section_note = ""
     try:
-        from tmm_workbench.core.seed_experiment import run_experiment, section_plot
+        from benchmarks.seed.experiment import run_experiment, section_plot
     except ImportError:
-        section_note = "section plot skipped (tmm_workbench.core.seed_experiment not available)"
+        section_note = "section plot skipped (benchmarks.seed.experiment not available)"
     else:
         t2 = time.perf_counter()
         sec = run_experiment("convex", p["method"])

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.mesh import TriMesh
+from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.shared_data import shared_dir
 
 # The shared benchmark files (seed surfaces, STL files), wherever core.shared_data finds them. Absent, only

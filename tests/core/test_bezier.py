@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import SEED_JSON
-from tmm_workbench.core import bezier
+from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.errors import TmmError
 
 DEGREES = [(1, 1), (2, 3), (3, 3), (5, 2), (0, 4)]

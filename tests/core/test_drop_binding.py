@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import closest_distances
-from tmm_workbench.core.cutters import Cutter
-from tmm_workbench.core.drop import DropSurface
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
 

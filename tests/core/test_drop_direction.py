@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from tests.conftest import SHARED_STL
-from tmm_workbench.core.cutters import Cutter
-from tmm_workbench.core.drop import DropSurface
-from tmm_workbench.core.drop_direction import DirectionalDrop, drop_along
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop_direction import DirectionalDrop, drop_along
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
-from tmm_workbench.core.mesh import load_stl
+from tmm_workbench.core.geometry.mesh import load_stl
 
 STL = SHARED_STL / "sphere_on_plate.stl"
 

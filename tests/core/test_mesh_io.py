@@ -1,4 +1,4 @@
-"""STL reading and the indexed mesh through the binding and tmm_workbench.core.mesh: the shared benchmark
+"""STL reading and the indexed mesh through the binding and tmm_workbench.core.geometry.mesh: the shared benchmark
 files, ASCII/binary detection by content, and clear errors (file and place) for broken files."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import SHARED_STL
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.kernel import native
-from tmm_workbench.core.mesh import TriMesh, load_stl
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl
 
 SHARED_COUNTS = {
     "beet_mm.stl": 4630, "demo.stl": 1894, "ktoolcav.stl": 4090, "mount_rush.stl": 15592,

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from tests.conftest import SEED_JSON
-from tmm_workbench.core import bezier
-from tmm_workbench.core.bspline import bspline_point, bspline_to_bezier, flat_knots
+from tmm_workbench.core.geometry import bezier
+from tmm_workbench.core.geometry.bspline import bspline_point, bspline_to_bezier, flat_knots
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.multipoint import (STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointParams,
+from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointParams,
                                            compute_multipoint_toolpath, multipoint_footprint, position_points)
 from tmm_workbench.core.toolpath import MoveKind
 
@@ -140,8 +140,8 @@ def test_seed_footprint_matches_the_seed():
 
 def test_fixed_pass_spacing_is_the_seeds_footprint():
     """pass_spacing "fixed": 18 mm from the start edge and a last pass on the far edge - the seed's 760 points
-    (core.seed_experiment.seed_footprint, written out independently), whatever the side the feed starts."""
-    from tmm_workbench.core.seed_experiment import seed_footprint
+    (benchmarks.seed.experiment.seed_footprint, written out independently), whatever the side the feed starts."""
+    from benchmarks.seed.experiment import seed_footprint
     face = BezierFace.from_net(seed_net("convex"))
     passes = multipoint_footprint(face, MultipointParams(pass_spacing="fixed"))
     seed = seed_footprint()

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from tests.conftest import SHARED_STL
-from tmm_workbench.core.cutters import Cutter
-from tmm_workbench.core.drop import DropSurface
-from tmm_workbench.core.mesh import load_stl
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.geometry.mesh import load_stl
 
 from opencamlib import ocl  # noqa: E402  (installed by scripts/setup.sh into .venv; a missing peer fails)
 

@@ -12,7 +12,8 @@ import pytest
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine import JointLimitError, Joints, TarusMachine
-from tmm_workbench.core.post import Operation, ToolInfo, apt_writer, objects, tarus_writer
+from tmm_workbench.app import post_objects as objects
+from tmm_workbench.core.post import Operation, ToolInfo, apt_writer, tarus_writer
 from tmm_workbench.core.post.apt_writer import AptOptions, write_apt
 from tmm_workbench.core.post.tarus_writer import TarusOptions, write_tarus
 from tmm_workbench.core.toolpath import MoveKind, Toolpath

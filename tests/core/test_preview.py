@@ -9,7 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tmm_workbench.core import bezier, preview
+from tmm_workbench.core.geometry import bezier
+
+from tmm_workbench.core.preview import toolpath_png as preview
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 NET = np.array([[[50.0 * i, 40.0 * j, 10.0 * np.sin(i + j)] for j in range(4)] for i in range(4)])
@@ -44,7 +46,7 @@ def png_size(path: Path) -> tuple[int, int]:
 def test_importing_preview_does_not_import_matplotlib() -> None:
     # Choosing a backend at import time could fight FreeCAD's GUI: matplotlib loads only when drawing.
     repo = Path(__file__).resolve().parents[2]
-    code = ("import sys; sys.path.insert(0, %r); import tmm_workbench.core.preview; "
+    code = ("import sys; sys.path.insert(0, %r); import tmm_workbench.core.preview.toolpath_png; "
             "print('matplotlib' in sys.modules)" % str(repo))
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

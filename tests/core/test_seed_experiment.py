@@ -1,13 +1,13 @@
-"""Seed 001's experiment (core.seed_experiment), reduced: 3 passes, a shorter feed, the section y = 27."""
+"""Seed 001's experiment (benchmarks.seed.experiment), reduced: 3 passes, a shorter feed, the section y = 27."""
 import numpy as np
 import pytest
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.multipoint import MultipointParams
-from tmm_workbench.core.seed_experiment import (CONFIGS, GOUGE_LIMIT, PASSES_X, RI, RO, SectionResult,
+from tmm_workbench.core.strategies.multipoint import MultipointParams
+from benchmarks.seed.experiment import (CONFIGS, GOUGE_LIMIT, PASSES_X, RI, RO, SectionResult,
                                                 design_height, options_plot, run_experiment, section_plot,
                                                 seed_footprint, seed_json_path)
-from tmm_workbench.core.bezier import evaluate, load_seed_patch
+from tmm_workbench.core.geometry.bezier import evaluate, load_seed_patch
 
 
 

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 from tests.conftest import closest_distances, grid_mesh
-from tmm_workbench.core.cutters import Cutter
+from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.mesh import TriMesh
-from tmm_workbench.core.surface3d import OFF_MODEL_SKIP, ONEWAY, SurfaceParams, compute_surface_toolpath
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.strategies.raster_drop import OFF_MODEL_SKIP, ONEWAY, SurfaceParams, compute_surface_toolpath
 from tmm_workbench.core.toolpath import MoveKind
 
 

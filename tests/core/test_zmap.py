@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core import zmap
-from tmm_workbench.core.zmap import (ZTool, _torus_lowest, cut, interpolate_axis, lowest_z, move_instances,
+from tmm_workbench.core.verify import zmap
+from tmm_workbench.core.verify.zmap import (ZTool, _torus_lowest, cut, interpolate_axis, lowest_z, move_instances,
                                     simulate, substeps)
 
 Z = np.array([0.0, 0.0, 1.0])
@@ -147,7 +147,7 @@ def test_tilted_torus_single_position_vs_brute_force():
 def test_lowest_point_lies_on_the_kernel_tool_solid():
     """Against the kernel's signed distance to the same tool solid: the found point is on the boundary and the
     line below it is outside; missed lines stay outside the solid."""
-    from tmm_workbench.core.multipoint import BezierFace, make_positioner
+    from tmm_workbench.core.strategies.multipoint import BezierFace, make_positioner
     net = np.zeros((2, 2, 3))
     net[..., 0] = [[0, 0], [100, 100]]
     net[..., 1] = [[0, 100], [0, 100]]

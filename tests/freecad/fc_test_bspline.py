@@ -9,7 +9,7 @@ import numpy as np
 import Part
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.multipoint import BezierFace, position_points
+from tmm_workbench.core.strategies.multipoint import BezierFace, position_points
 
 V = FreeCAD.Vector
 

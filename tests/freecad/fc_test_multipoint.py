@@ -15,9 +15,10 @@ from fc_helpers import OUT, FreeCADTestCase, close_all, new_doc
 from tmm_workbench.app.api import run_multipoint
 from tmm_workbench.app.compat import PathPostProcessor
 from tmm_workbench.app.op_multipoint import ObjectTmmMultipoint
-from tmm_workbench.core import bezier, path5
+from tmm_workbench.core import path5
+from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.multipoint import STATUS_TWO
+from tmm_workbench.core.strategies.multipoint import STATUS_TWO
 from tmm_workbench.core.shared_data import benchmark_file
 
 SEED = benchmark_file("seed_surfaces.json")
@@ -131,8 +132,8 @@ class MultipointOp(FreeCADTestCase):
     def test_fixed_pass_spacing_machines_the_seeds_footprint(self) -> None:
         """PassSpacing Fixed, 18 / 2 mm: the op positions the tool at the seed's 760 footprint points
         (x = 0, 18, ..., 144, 150), with the same contacts as the core at that footprint."""
-        from tmm_workbench.core.multipoint import BezierFace, MultipointParams, position_points
-        from tmm_workbench.core.seed_experiment import RI, RO, seed_footprint
+        from tmm_workbench.core.strategies.multipoint import BezierFace, MultipointParams, position_points
+        from benchmarks.seed.experiment import RI, RO, seed_footprint
         r = run_multipoint(seed_net(), side_step=18.0, forward_step=2.0, pass_spacing="fixed", posts=(),
                            progress=False)
         self.assertTrue(r.op.isValid(), r.op.getStatusString())

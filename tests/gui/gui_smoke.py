@@ -52,8 +52,8 @@ def multipoint_panel(info: dict) -> None:
     """The 5-axis op: the API's op has our view provider and its panel shows the contact summary; the
     command, with the op's face selected, adds a second op and opens its panel."""
     from tmm_workbench.app.api import run_multipoint
-    from tmm_workbench.core import bezier
-    from tmm_workbench.core.seed_experiment import seed_json_path
+    from tmm_workbench.core.geometry import bezier
+    from benchmarks.seed.experiment import seed_json_path
     from tmm_workbench.gui.op_multipoint_gui import ViewProvider as MultipointViewProvider
 
     net = bezier.load_seed_patch(seed_json_path(), "convex")

@@ -27,7 +27,7 @@ from tmm_workbench.app import job as jobs
 from tmm_workbench.app import op_surface, posts
 from tmm_workbench.app import progress as progress_mod
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.mesh import TriMesh
+from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.toolpath import Toolpath
 
 TOOL_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "flat": "endmill",

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.mesh import TriMesh, load_stl
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl
 
 DEFAULT_DEFLECTION_MM = 0.01
 

@@ -38,7 +38,7 @@ from tmm_workbench.app.compat import PathOp, PathSetupSheet
 from tmm_workbench.app.tools import _mm, bull_corner_radius, shape_name
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.multipoint import (STATUS_FAILED, BezierFace, MultipointParams,
+from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, BezierFace, MultipointParams,
                                            MultipointResults, compute_multipoint_toolpath)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
 

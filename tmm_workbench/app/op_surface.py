@@ -22,8 +22,8 @@ from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.mesh import TriMesh
-from tmm_workbench.core.surface3d import (OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams,
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.strategies.raster_drop import (OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams,
                                           compute_surface_toolpath)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 

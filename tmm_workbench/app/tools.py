@@ -14,7 +14,7 @@ from __future__ import annotations
 import os
 from typing import Any
 
-from tmm_workbench.core.cutters import Cutter
+from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import TmmError
 
 SUPPORTED_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .errors import TmmError
+from tmm_workbench.core.errors import TmmError
 
 REPO = Path(__file__).resolve().parents[2]
 _CANDIDATES = (REPO.parent / "shared", Path("/work/shared"))

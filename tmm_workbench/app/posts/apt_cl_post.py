@@ -4,7 +4,7 @@ representation (X Y Z tip, U V W tool axis; docs/path5.md); plain 3-axis paths p
 All logic lives in tmm_workbench.core.post.apt_writer; this module keeps no state between exports.
 """
 from tmm_workbench.core.post import apt_writer as _writer
-from tmm_workbench.core.post import objects as _objects
+from tmm_workbench.app import post_objects as _objects
 
 TOOLTIP = """TMM APT CL post: GOTO/x,y,z,i,j,k (tool tip and tool axis), CUTTER, LOADTL, FEDRAT, SPINDL."""
 TOOLTIP_ARGS = _writer.TOOLTIP_ARGS

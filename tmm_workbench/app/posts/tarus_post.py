@@ -6,7 +6,7 @@ by --inches). Reads TMM's 5-axis Path representation (X Y Z tip, U V W tool axis
 All logic lives in tmm_workbench.core.post.tarus_writer; this module only adapts FreeCAD's post interface
 and keeps no state between exports (FreeCAD reloads posts, module globals would leak otherwise).
 """
-from tmm_workbench.core.post import objects as _objects
+from tmm_workbench.app import post_objects as _objects
 from tmm_workbench.core.post import tarus_writer as _writer
 
 TOOLTIP = """TMM Tarus 5-axis post: X Y Z A C joint moves (pivot-compensated, or tool tip with --tcp),

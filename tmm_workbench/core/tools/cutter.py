@@ -10,8 +10,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .errors import TmmError
-from .kernel import native
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.kernel import native
 
 
 def _number(name: str, v: object) -> float:

@@ -9,10 +9,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .toolpath import MoveKind, Toolpath
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 if TYPE_CHECKING:
-    from .mesh import TriMesh
+    from tmm_workbench.core.geometry.mesh import TriMesh
 
 MAX_DRAWN_TRIANGLES = 20_000      # above this the model is decimated for drawing (matplotlib 3D is slow)
 MAX_DRAWN_PATH_POINTS = 400_000   # above this cutting polylines are thinned for drawing
@@ -182,9 +182,9 @@ def hide_occluded(poly: np.ndarray, vertices: np.ndarray, triangles: np.ndarray,
     The model is turned so the viewer looks down -Z; a tiny ball dropped at each point's position
     finds the model's front-most surface there (the kernel's drop-cutter is a z-buffer query).
     """
-    from .cutters import Cutter
-    from .drop import DropSurface
-    from .mesh import TriMesh
+    from tmm_workbench.core.tools.cutter import Cutter
+    from tmm_workbench.core.query.drop import DropSurface
+    from tmm_workbench.core.geometry.mesh import TriMesh
 
     pts = poly[~np.isnan(poly[:, 0])]
     if len(pts) == 0:

@@ -16,7 +16,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .errors import TmmError
+from tmm_workbench.core.errors import TmmError
 
 
 @dataclass

@@ -5,8 +5,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import TmmError
-from .kernel import native
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.kernel import native
 
 WELD_TOLERANCE_MM = 1e-6
 NORMAL_WEIGHTINGS = ("angle", "area", "meyer")

@@ -19,11 +19,11 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from .bspline import BezierPieces, bspline_to_bezier
-from .errors import Cancelled, TmmError
-from .footprint import EVEN, Rect, raster_lines, sample_segment
-from .kernel import native
-from .toolpath import MoveKind, Toolpath
+from tmm_workbench.core.geometry.bspline import BezierPieces, bspline_to_bezier
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.footprint.raster import EVEN, Rect, raster_lines, sample_segment
+from tmm_workbench.core.kernel import native
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 Progress = Callable[[float], bool]
 

@@ -7,12 +7,12 @@ from typing import Optional
 
 import numpy as np
 
-from .cutters import Cutter
-from .drop import DropSurface, Progress
-from .errors import TmmError
-from .footprint import Rect, raster_lines, sample_segment
-from .mesh import TriMesh
-from .toolpath import MoveKind, Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.raster import Rect, raster_lines, sample_segment
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"

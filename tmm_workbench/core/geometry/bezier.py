@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .errors import TmmError
+from tmm_workbench.core.errors import TmmError
 
 if TYPE_CHECKING:  # mesh.py loads the native kernel; evaluation alone must not need it
-    from .mesh import TriMesh
+    from tmm_workbench.core.geometry.mesh import TriMesh
 
 MAX_TESSELLATION_TRIANGLES = 20_000_000
 
@@ -161,7 +161,7 @@ def grid_triangles(nu: int, nv: int) -> np.ndarray:
 
 def tessellate(patch: np.ndarray, nu: int, nv: int, name: str = "bezier") -> "TriMesh":
     """The patch sampled on a regular (nu+1) x (nv+1) parameter grid, each cell split in two triangles."""
-    from .mesh import TriMesh  # here, not at the top: see TYPE_CHECKING above
+    from tmm_workbench.core.geometry.mesh import TriMesh  # here, not at the top: see TYPE_CHECKING above
 
     if not (isinstance(nu, (int, np.integer)) and isinstance(nv, (int, np.integer)) and nu >= 1 and nv >= 1):
         raise TmmError(f"tessellation needs at least one cell each way, got nu={nu!r}, nv={nv!r}")

@@ -1,12 +1,12 @@
 """Independent check of the z-map's reading of a scallop cusp in seed 001's experiment.
 
-Two passes of the seed footprint (feed y = 0..60) are positioned and simulated by core.seed_experiment as in
+Two passes of the seed footprint (feed y = 0..60) are positioned and simulated by benchmarks.seed.experiment as in
 the full run; then, around the cusp between them on the section y = 27, the lowest point of the swept tool on
 each vertical needle is found another way: the motion re-interpolated here (tip linear, axis slerp, 100
 sub-steps per 2 mm move, 0.02 mm), and on each needle z scanned every 0.002 mm with the kernel's signed
 distance to the tool (not the z-map's closed-form line-torus solve), the first point inside bisected to 1e-9.
 
-    cd /work/wt-mp && .venv/bin/python benchmarks/seed_cusp_check.py concave 18 36 25.86 [axis|tip] [extend_mm]
+    cd /work/wt-mp && .venv/bin/python benchmarks/seed/cusp_check.py concave 18 36 25.86 [axis|tip] [extend_mm]
 """
 from __future__ import annotations
 
@@ -16,12 +16,12 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from tmm_workbench.core import seed_experiment as se  # noqa: E402
-from tmm_workbench.core.bezier import load_seed_patch  # noqa: E402
-from tmm_workbench.core.multipoint import BezierFace, MultipointParams, make_positioner  # noqa: E402
+from benchmarks.seed import experiment as se  # noqa: E402
+from tmm_workbench.core.geometry.bezier import load_seed_patch  # noqa: E402
+from tmm_workbench.core.strategies.multipoint import BezierFace, MultipointParams, make_positioner  # noqa: E402
 
 
 def slerp(a: np.ndarray, b: np.ndarray, t: float) -> np.ndarray:

@@ -5,10 +5,10 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from .cutters import Cutter
-from .errors import Cancelled, TmmError
-from .kernel import native
-from .mesh import TriMesh
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.kernel import native
+from tmm_workbench.core.geometry.mesh import TriMesh
 
 Progress = Callable[[float], bool]
 

@@ -10,8 +10,8 @@ from typing import Optional
 
 import numpy as np
 
-from .multipoint import STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointResults
-from .toolpath import MoveKind, Toolpath
+from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointResults
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 STATUS_COLOURS = {STATUS_TWO: "#1a9641", STATUS_ONE: "#f39c12", STATUS_FAILED: "#d7191c"}
 STATUS_LABELS = {STATUS_TWO: "two contacts", STATUS_ONE: "one contact", STATUS_FAILED: "failed"}

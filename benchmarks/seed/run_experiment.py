@@ -1,11 +1,11 @@
 """Seed 001's experiment (section 5.1) reproduced: VCRF and DRD multipoint tool paths on the convex and concave
 bicubic patches (Ro 6.7 mm, Ri 6.0 mm, 10 passes, 18 mm side step with the 10th pass at x = 150, 2 mm forward
 step), simulated with the z-map of core.zmap, deviations at the section y = 27 mm against the seed's Tables 2-3.
-Each case runs with the kernel option sets of core.seed_experiment.CONFIGS: "seed" (as the seed describes it),
+Each case runs with the kernel option sets of benchmarks.seed.experiment.CONFIGS: "seed" (as the seed describes it),
 "extend" (the face continued past its edges by Ro + Ri) and "extend+tip" (that, and the tilted tip on the
 footprint point).
 
-    cd /work/wt-mp && .venv/bin/python benchmarks/seed_experiment.py [--configs seed,extend,extend+tip]
+    cd /work/wt-mp && .venv/bin/python benchmarks/seed/run_experiment.py [--configs seed,extend,extend+tip]
 
 Prints the tables and writes docs/seed_experiment_section.png ("seed" options, DRD and VCRF) and
 docs/seed_experiment_options.png (VCRF, every option set).
@@ -21,11 +21,11 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from tmm_workbench.core.multipoint import MultipointParams  # noqa: E402
-from tmm_workbench.core.seed_experiment import (CONFIGS, GOUGE_LIMIT, PASSES_X, SEED_MACHINED_MAX,  # noqa: E402
+from tmm_workbench.core.strategies.multipoint import MultipointParams  # noqa: E402
+from benchmarks.seed.experiment import (CONFIGS, GOUGE_LIMIT, PASSES_X, SEED_MACHINED_MAX,  # noqa: E402
                                                 SEED_SIMULATED_MAX, options_plot, run_experiment,
                                                 section_plot)
 

@@ -14,7 +14,7 @@ B. The anchor, as the passes' tip spacing: the kernel (VCRF, tip anchor, face ex
    at x = 0 and the next one at x = s; the largest deviation between them on the section (the full experiment's
    z-map, feed y = 0..60). The seed's axis anchor puts the tips of passes 0 and 18 17.63 mm apart.
 
-    .venv/bin/python benchmarks/seed_pose_family.py [--part A|B|AB]     # about 7 min (A) + 1 min (B)
+    .venv/bin/python benchmarks/seed/pose_family.py [--part A|B|AB]     # about 7 min (A) + 1 min (B)
 """
 from __future__ import annotations
 
@@ -26,13 +26,13 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))
 
-from tmm_workbench.core import seed_experiment as se  # noqa: E402
-from tmm_workbench.core.bezier import load_seed_patch  # noqa: E402
-from tmm_workbench.core.multipoint import MultipointParams  # noqa: E402
-from tmm_workbench.core.zmap import ZTool, lowest_z, simulate  # noqa: E402
+from benchmarks.seed import experiment as se  # noqa: E402
+from tmm_workbench.core.geometry.bezier import load_seed_patch  # noqa: E402
+from tmm_workbench.core.strategies.multipoint import MultipointParams  # noqa: E402
+from tmm_workbench.core.verify.zmap import ZTool, lowest_z, simulate  # noqa: E402
 
 GRID = 0.12          # mm, design-surface samples under the tool
 NEAR_P = 1.5         # mm: a second contact must lie farther than this from P

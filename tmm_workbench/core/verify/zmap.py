@@ -53,7 +53,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .errors import TmmError
+from tmm_workbench.core.errors import TmmError
 
 TANGENT_TOL = 1e-7      # mm: a vertical line this close to the torus counts as touching it
 NEWTON_STEPS = 3        # Newton polish of each quartic root

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 
-from .errors import TmmError
+from tmm_workbench.core.errors import TmmError
 
 Rect = tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
 

@@ -27,11 +27,11 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .bezier import evaluate, load_seed_patch
-from .errors import TmmError
-from .multipoint import STATUS_FAILED, BezierFace, MultipointParams, MultipointResults, position_points
-from .shared_data import benchmark_file
-from .zmap import ZTool, simulate
+from tmm_workbench.core.geometry.bezier import evaluate, load_seed_patch
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, BezierFace, MultipointParams, MultipointResults, position_points
+from tmm_workbench.core.shared_data import benchmark_file
+from tmm_workbench.core.verify.zmap import ZTool, simulate
 
 
 RO, RI = 6.7, 6.0
@@ -48,7 +48,7 @@ SEED_MACHINED_MAX = {("convex", "drd"): 0.57, ("concave", "drd"): 1.00,
                      ("convex", "vcrf"): 0.51, ("concave", "vcrf"): 0.70}
 GOUGE_LIMIT = -0.01
 
-# Kernel option sets measured by benchmarks/seed_experiment.py (MultipointParams fields; everything else
+# Kernel option sets measured by benchmarks/seed/run_experiment.py (MultipointParams fields; everything else
 # default). "seed": as the seed describes it. "extend": the face continued past its edges by the tool's
 # radius Ro + Ri (a pass over the boundary rests on the continued surface, not on the boundary curve).
 # "extend+tip": that, and the tilted tool's tip (not its pre-tilt axis) on the footprint point, so the

@@ -1,0 +1,1 @@
+"""Benchmarks and research experiments (not shipped in the add-on)."""
