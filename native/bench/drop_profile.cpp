@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "tmm/drop_cutter.hpp"
+#include "tmm/query/drop_cutter.hpp"
 
 int main(int argc, char** argv) {
   const std::string kind = argc > 1 ? argv[1] : "ball";

@@ -1,0 +1,123 @@
+// Python binding of the drop-cutter: spatial index and batch drop, numpy in and out.
+#include <pybind11/eigen.h>
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <memory>
+#include <sstream>
+
+#include "tmm/query/drop_cutter.hpp"
+#include "tmm/mesh/mesh_index.hpp"
+#include "util/progress.hpp"
+
+namespace py = pybind11;
+using tmm_bindings::python_progress;
+
+namespace {
+
+using XY = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+py::array_t<double> drop_cutter(const tmm::MeshIndex& index, const tmm::Cutter& cutter,
+                                const XY& xy, double floor_z, int threads, const py::object& progress,
+                                py::dict* stats_out) {
+  if (xy.ndim() != 2 || xy.shape(1) != 2) {
+    std::ostringstream msg;
+    msg << "points must have shape (n, 2), got ndim " << xy.ndim();
+    throw std::invalid_argument(msg.str());
+  }
+  const std::size_t n = static_cast<std::size_t>(xy.shape(0));
+  py::array_t<double> z(static_cast<py::ssize_t>(n));
+  tmm::BatchOptions options;
+  options.threads = threads;
+  options.progress = python_progress(progress);
+  tmm::DropStats stats;
+  {
+    py::gil_scoped_release release;
+    tmm::drop_batch(index, cutter, xy.data(), n, floor_z, z.mutable_data(), options, &stats);
+  }
+  if (stats_out) (*stats_out)["triangles_tested"] = stats.triangles_tested;
+  return z;
+}
+
+}  // namespace
+
+void bind_drop(py::module_& m) {
+  py::register_exception<tmm::Cancelled>(m, "Cancelled");
+
+  py::class_<tmm::MeshIndex, std::shared_ptr<tmm::MeshIndex>>(m, "MeshIndex",
+      "Spatial index (XY bounding volume hierarchy with heights) over a triangle mesh for drop-cutter.")
+      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const Eigen::Ref<const tmm::Triangles>& F) {
+             py::gil_scoped_release release;
+             return std::make_shared<tmm::MeshIndex>(V, F);
+           }),
+           py::arg("vertices"), py::arg("triangles"))
+      .def_property_readonly("triangle_count", &tmm::MeshIndex::triangle_count)
+      .def_property_readonly("node_count", [](const tmm::MeshIndex& i) { return i.nodes().size(); })
+      .def_property_readonly("memory_bytes", &tmm::MeshIndex::memory_bytes)
+      .def_property_readonly("zmin", &tmm::MeshIndex::zmin)
+      .def_property_readonly("zmax", &tmm::MeshIndex::zmax);
+
+  py::enum_<tmm::CutterKind>(m, "CutterKind")
+      .value("Flat", tmm::CutterKind::Flat)
+      .value("Ball", tmm::CutterKind::Ball)
+      .value("Bull", tmm::CutterKind::Bull)
+      .value("General", tmm::CutterKind::General);
+
+  py::class_<tmm::Cutter>(m, "Cutter",
+      "Convex cutter of revolution: the generalized APT cutter of seed 000 (ball, flat, bull-nose, cone, taper).")
+      .def(py::init<double, double>(), py::arg("radius"), py::arg("corner_radius"),
+           "Ball (corner radius = radius), flat (0) or bull-nose.")
+      .def_static("apt", &tmm::Cutter::apt, py::arg("radius"), py::arg("corner_radius"),
+                  py::arg("cutting_length"), py::arg("beta1"), py::arg("beta2"),
+                  "Generalized APT cutter: radius R at the cutting-edge height L_C, corner radius r, bottom angle "
+                  "beta1 from the horizontal and taper angle beta2 from the axis (radians).")
+      .def_property_readonly("radius", &tmm::Cutter::radius)
+      .def_property_readonly("corner_radius", &tmm::Cutter::corner_radius)
+      .def_property_readonly("cutting_length", &tmm::Cutter::cutting_length)
+      .def_property_readonly("max_radius", &tmm::Cutter::max_radius)
+      .def_property_readonly("kind", &tmm::Cutter::kind)
+      .def("height",
+           [](const tmm::Cutter& c, const py::array_t<double, py::array::c_style | py::array::forcecast>& rho) {
+             py::array_t<double> out(rho.request().shape);
+             const double* in = rho.data();
+             double* o = out.mutable_data();
+             for (py::ssize_t i = 0; i < rho.size(); ++i) {
+               if (!(in[i] >= 0.0 && in[i] <= c.max_radius()))
+                 throw std::invalid_argument("rho outside 0..max_radius");
+               o[i] = c.height(in[i]);
+             }
+             return out;
+           },
+           py::arg("rho"), "Height h(rho) of the cutting surface above the tip.");
+
+  m.def("drop_cutter",
+        [](const tmm::MeshIndex& index, const tmm::Cutter& cutter, const XY& xy, double floor_z, int threads,
+           const py::object& progress) {
+          return drop_cutter(index, cutter, xy, floor_z, threads, progress, nullptr);
+        },
+        py::arg("index"), py::arg("cutter"), py::arg("xy"), py::arg("floor_z"), py::arg("threads") = 0,
+        py::arg("progress") = py::none(),
+        "Tip heights (n,) of the cutter dropped along -Z at the (n, 2) points, never below floor_z. "
+        "progress(fraction) -> bool; False cancels (raises Cancelled).");
+
+  m.def("drop_cutter_stats",
+        [](const tmm::MeshIndex& index, const tmm::Cutter& cutter, const XY& xy, double floor_z, int threads) {
+          py::dict stats;
+          py::array_t<double> z = drop_cutter(index, cutter, xy, floor_z, threads, py::none(), &stats);
+          return py::make_tuple(z, stats);
+        },
+        py::arg("index"), py::arg("cutter"), py::arg("xy"), py::arg("floor_z"), py::arg("threads") = 0,
+        "drop_cutter that also returns counters (triangles tested).");
+
+  m.def("drop_on_triangle",
+        [](const tmm::Cutter& cutter, double x, double y, const Eigen::Matrix3d& corners) {
+          tmm::Vertices V = corners;
+          tmm::Triangles F(1, 3);
+          F << 0, 1, 2;
+          const tmm::MeshIndex index(V, F);
+          return tmm::drop_on_triangle(cutter, x, y, index.triangles()[0]);
+        },
+        py::arg("cutter"), py::arg("x"), py::arg("y"), py::arg("corners"),
+        "Exact contact height of the cutter with one triangle (rows: corners), -inf if none.");
+}

@@ -1,0 +1,100 @@
+// Drop along any direction with the cutter axis in any orientation (seed 000 eq. 3.126-3.188: clean-up by
+// translating the cutter along a vector V; fixed tilted axes give 3+2 machining).
+//
+// The cutter solid is its cutting part only, in the tool frame (tip at the origin, axis +z):
+//   K = { h(rho) <= z <= L_C, rho <= max_radius }.
+// The shank and holder above L_C are NOT checked. For beta2 < 0 (inward taper) K is the cylinder of radius
+// max_radius above the arc's widest point: larger than the real tool there, so the answer is conservative.
+// K is convex (h is convex and non-decreasing), which is what makes every contact below exact and robust.
+//
+// The cutter moves with its tip at start + t V from t = -inf; the travel of the first contact is returned
+// (+inf when it never touches). For V = -Z the travel is start.z minus the usual drop-cutter tip height.
+// See docs/drop_direction.md for the method and the tolerances.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "tmm/cutter/cutter.hpp"
+#include "tmm/query/drop_cutter.hpp"
+#include "tmm/mesh/mesh.hpp"
+#include "tmm/mesh/mesh_index.hpp"
+
+namespace tmm {
+
+constexpr double kNoTravel = std::numeric_limits<double>::infinity();
+
+// Orthonormal tool frame (e1, e2, axis) for a unit axis.
+struct ToolFrame {
+  Eigen::Vector3d e1, e2, a;
+  explicit ToolFrame(const Eigen::Vector3d& axis);
+  Eigen::Vector3d to_tool(const Eigen::Vector3d& w) const { return {e1.dot(w), e2.dot(w), a.dot(w)}; }
+  Eigen::Vector3d to_world(const Eigen::Vector3d& q) const { return e1 * q.x() + e2 * q.y() + a * q.z(); }
+};
+
+// First-contact travel of the cutter against one triangle. axis and V must be unit vectors
+// (std::invalid_argument otherwise). When V = -axis the existing exact -Z contacts are used in the tool frame
+// (edge_drop's concave form); otherwise drop_along_general.
+double drop_along(const Cutter& cutter, const Eigen::Vector3d& tip_start, const Eigen::Vector3d& axis,
+                  const Eigen::Vector3d& V, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                  const Eigen::Vector3d& p2);
+double drop_along(const Cutter& cutter, const Eigen::Vector3d& tip_start, const Eigen::Vector3d& axis,
+                  const Eigen::Vector3d& V, const IndexedTriangle& t);
+// The convex formulation for any V and axis, without the V = -axis shortcut (exposed for cross-checks).
+double drop_along_general(const Cutter& cutter, const Eigen::Vector3d& tip_start, const Eigen::Vector3d& axis,
+                          const Eigen::Vector3d& V, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+                          const Eigen::Vector3d& p2);
+
+// Pieces of the general method, in the tool frame with the start tip at the origin; W = V in tool coordinates.
+namespace direction_detail {
+// Point of K extreme in direction d (maximising d . X); value = d . X (+inf when unbounded: L_C = inf).
+struct Support {
+  Eigen::Vector3d point;
+  double value;
+};
+Support support(const Cutter& c, const Eigen::Vector3d& d);
+// Each returns the first-contact travel if it is below `cap`, else kNoTravel (only earlier contacts matter
+// in a mesh query, which lets most candidates stop early).
+double vertex_travel(const Cutter& c, const Eigen::Vector3d& q, const Eigen::Vector3d& W, double cap = kNoTravel);
+double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2, const Eigen::Vector3d& W,
+                   double cap = kNoTravel);
+double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
+                    const Eigen::Vector3d& W, double cap = kNoTravel);
+}  // namespace direction_detail
+
+// A mesh indexed for drops along one direction V: the mesh rotated so that V = -Z' and indexed by MeshIndex
+// (XY' bounding volume hierarchy with heights). Built once per direction (3+2 jobs keep it fixed).
+class DirectionalIndex {
+ public:
+  // V must be a unit vector; std::invalid_argument otherwise or for a bad mesh. For V = -Z exactly the
+  // rotation is the identity and the index is the plain drop-cutter index.
+  DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Eigen::Vector3d& V);
+
+  const Eigen::Vector3d& direction() const { return V_; }
+  const Eigen::Matrix3d& rotation() const { return rot_; }  // world -> frame in which V = -Z'
+  const MeshIndex& index() const { return *index_; }
+
+ private:
+  Eigen::Vector3d V_;
+  Eigen::Matrix3d rot_;
+  std::shared_ptr<const MeshIndex> index_;
+};
+
+// One start point: the smallest travel of a contact with any triangle, capped at max_travel (returned when
+// nothing is touched before it). With axis = -V (any V) this is drop_point in the rotated frame; otherwise the
+// cutter must have a finite cutting length (std::invalid_argument). `hint` as for drop_point.
+double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Eigen::Vector3d& start,
+                        const Eigen::Vector3d& axis, double max_travel = kNoTravel, DropStats* stats = nullptr,
+                        int32_t* hint = nullptr);
+
+// starts: n points (x, y, z, ...); axes: one unit axis (axes_per_point = false) or n of them; travel_out: n.
+// Threads, progress and cancel (Cancelled) as drop_batch.
+void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const double* starts,
+                      const double* axes, bool axes_per_point, std::size_t n, double max_travel,
+                      double* travel_out, const BatchOptions& options, DropStats* stats = nullptr);
+
+}  // namespace tmm

@@ -1,0 +1,446 @@
+#include "tmm/mesh/mesh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace tmm {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+constexpr int32_t kNone = -1;
+
+std::string num(double x) {
+  std::ostringstream s;
+  s.precision(17);
+  s << x;
+  return s.str();
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Welding: a hash grid of cubic cells keyed by integer cell coordinates. Each occupied cell holds a
+// singly linked list of the vertices whose position lies in it (heads in an open-addressing table,
+// links in `next`), so building it allocates only a few flat arrays, never per vertex.
+
+// floor(x) for |x| < 2^62, without a libm call.
+int64_t floor_int(double x) {
+  const auto i = static_cast<int64_t>(x);
+  return i - (x < static_cast<double>(i));
+}
+
+struct Cell {
+  int64_t x, y, z;
+  bool operator==(const Cell& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+
+uint64_t hash_cell(const Cell& c) {
+  uint64_t h = static_cast<uint64_t>(c.x) * 0x9E3779B97F4A7C15ull;
+  h ^= static_cast<uint64_t>(c.y) * 0xC2B2AE3D27D4EB4Full + (h << 6) + (h >> 2);
+  h ^= static_cast<uint64_t>(c.z) * 0x165667B19E3779F9ull + (h << 6) + (h >> 2);
+  h ^= h >> 31;  // splitmix64 finaliser: the low bits index the table, so mix the high bits down
+  h *= 0xBF58476D1CE4E5B9ull;
+  h ^= h >> 27;
+  return h;
+}
+
+class WeldGrid {
+ public:
+  WeldGrid(double cell, Eigen::Index triangles) : inv_cell_(1.0 / cell) {
+    // A closed mesh has about m/2 vertices; both arrays grow if there are more.
+    std::size_t cap = 64;
+    while (cap < static_cast<std::size_t>(triangles)) cap *= 2;
+    slots_.assign(cap, Slot{});
+    pos_.resize(triangles / 2 + 64, 3);
+    next_.reserve(static_cast<std::size_t>(pos_.rows()));
+  }
+
+  // Cells are centred on multiples of the cell size, so round coordinates sit far from cell faces.
+  Cell cell_of(const Vec3& p) const {
+    return {floor_int(p.x() * inv_cell_ + 0.5), floor_int(p.y() * inv_cell_ + 0.5), floor_int(p.z() * inv_cell_ + 0.5)};
+  }
+
+  // Starts loading the table slot of p's own cell: for big meshes nearly every first lookup of a vertex
+  // misses the cache, so the caller asks a few corners ahead.
+  void prefetch(const Vec3& p) const {
+#if defined(__GNUC__) || defined(__clang__)
+    __builtin_prefetch(&slots_[hash_cell(cell_of(p)) & (slots_.size() - 1)]);
+#endif
+  }
+
+  Vec3 position(int32_t v) const { return pos_.row(v).transpose(); }
+
+  // Nearest vertex within sqrt(tol2) of p, or kNone. Looks at every cell the ball of radius `reach`
+  // (tol plus a rounding margin) around p touches: with cells 16*tol wide, usually just its own.
+  int32_t find(const Vec3& p, double tol2, double reach) const {
+    const Cell own = cell_of(p);
+    int32_t best = kNone;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    if (scan(own, p, tol2, best, best_d2)) return best;  // identical corners are by far the common case
+    const Cell lo = cell_of(p - Vec3::Constant(reach));
+    const Cell hi = cell_of(p + Vec3::Constant(reach));
+    for (int64_t cx = lo.x; cx <= hi.x; ++cx)
+      for (int64_t cy = lo.y; cy <= hi.y; ++cy)
+        for (int64_t cz = lo.z; cz <= hi.z; ++cz) {
+          const Cell c{cx, cy, cz};
+          if (!(c == own) && scan(c, p, tol2, best, best_d2)) return best;
+        }
+    return best;
+  }
+
+  int32_t add(const Vec3& p) {
+    const auto v = static_cast<int32_t>(next_.size());
+    if (v == pos_.rows()) pos_.conservativeResize(pos_.rows() + pos_.rows() / 2, 3);  // realloc, no copy
+    pos_.row(v) = p.transpose();
+    const Cell c = cell_of(p);
+    const uint64_t h = hash_cell(c);
+    Slot& s = slots_[probe(c, h)];
+    if (s.head == kNone) ++used_;
+    next_.push_back(s.head);
+    s = Slot{static_cast<uint32_t>(h >> 32), v};
+    if (2 * used_ > slots_.size()) grow();
+    return v;
+  }
+
+  // The vertex positions, in the order they were added; the grid is unusable afterwards.
+  Vertices take_positions() && {
+    pos_.conservativeResize(static_cast<Eigen::Index>(next_.size()), 3);
+    return std::move(pos_);
+  }
+
+ private:
+  struct Slot {
+    uint32_t tag = 0;      // high hash bits, to skip most foreign cells without touching their vertices
+    int32_t head = kNone;  // first vertex of the cell's list; kNone marks an empty slot
+  };
+
+  // Index of the slot holding cell c, or of the empty slot where it would go.
+  std::size_t probe(const Cell& c, uint64_t h) const {
+    const std::size_t mask = slots_.size() - 1;
+    const auto tag = static_cast<uint32_t>(h >> 32);
+    for (std::size_t i = h & mask;; i = (i + 1) & mask) {
+      const Slot& s = slots_[i];
+      if (s.head == kNone || (s.tag == tag && cell_of(position(s.head)) == c)) return i;
+    }
+  }
+
+  bool scan(const Cell& c, const Vec3& p, double tol2, int32_t& best, double& best_d2) const {
+    for (int32_t v = slots_[probe(c, hash_cell(c))].head; v != kNone; v = next_[static_cast<std::size_t>(v)]) {
+      const double d2 = (position(v) - p).squaredNorm();
+      if (d2 <= tol2 && d2 < best_d2) {
+        best = v;
+        best_d2 = d2;
+        if (d2 == 0) return true;
+      }
+    }
+    return false;
+  }
+
+  // Doubles the table. Walking the vertices in order (not the old slots) reads positions sequentially;
+  // the last vertex of each cell ends up as its head, as add() left it, so `next` stays valid.
+  void grow() {
+    slots_.assign(slots_.size() * 2, Slot{});
+    for (int32_t v = 0; v < static_cast<int32_t>(next_.size()); ++v) {
+      const Cell c = cell_of(position(v));
+      const uint64_t h = hash_cell(c);
+      slots_[probe(c, h)] = Slot{static_cast<uint32_t>(h >> 32), v};
+    }
+  }
+
+  double inv_cell_;
+  std::vector<Slot> slots_;
+  std::size_t used_ = 0;     // occupied slots
+  Vertices pos_;             // capacity rows; the first next_.size() are vertices
+  std::vector<int32_t> next_;  // next vertex in the same cell
+};
+
+// Zero area up to rounding: twice the area |e1 x e2| is below what the rounding of the coordinates
+// (magnitude `mag`) can produce for edges of length `len`.
+bool zero_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, e3 = c - b;
+  const double len = std::sqrt(std::max({e1.squaredNorm(), e2.squaredNorm(), e3.squaredNorm()}));
+  const double mag = std::max({a.cwiseAbs().maxCoeff(), b.cwiseAbs().maxCoeff(), c.cwiseAbs().maxCoeff(), len});
+  return e1.cross(e2).norm() <= 16 * std::numeric_limits<double>::epsilon() * len * mag;
+}
+
+Vec3 vertex(const VerticesRef& V, int32_t i) { return V.row(i).transpose(); }
+
+// Incident triangles of each vertex in compressed rows: triangles of v are tri[start[v] .. start[v+1]).
+// A triangle is listed once per distinct vertex, even if an index repeats in it.
+struct VertexTriangles {
+  std::vector<int32_t> start, tri;
+
+  VertexTriangles(const TrianglesRef& F, Eigen::Index n) : start(static_cast<std::size_t>(n) + 1, 0) {
+    auto distinct = [&](Eigen::Index t, int i) {
+      return (i < 1 || F(t, i) != F(t, 0)) && (i < 2 || F(t, i) != F(t, 1));
+    };
+    for (Eigen::Index t = 0; t < F.rows(); ++t)
+      for (int i = 0; i < 3; ++i)
+        if (distinct(t, i)) ++start[static_cast<std::size_t>(F(t, i)) + 1];
+    for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    tri.resize(static_cast<std::size_t>(start.back()));
+    std::vector<int32_t> fill(start.begin(), start.end() - 1);
+    for (Eigen::Index t = 0; t < F.rows(); ++t)
+      for (int i = 0; i < 3; ++i)
+        if (distinct(t, i)) tri[static_cast<std::size_t>(fill[static_cast<std::size_t>(F(t, i))]++)] = static_cast<int32_t>(t);
+  }
+};
+
+Eigen::Index vertex_count(const TrianglesRef& F) {
+  int32_t max_index = -1;
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i) {
+      if (F(t, i) < 0)
+        throw std::invalid_argument("triangle " + std::to_string(t) + " has a negative vertex index " +
+                                    std::to_string(F(t, i)));
+      max_index = std::max(max_index, F(t, i));
+    }
+  return static_cast<Eigen::Index>(max_index) + 1;
+}
+
+// Face normals without validation; zero rows for zero-area faces.
+Normals unit_face_normals(const VerticesRef& V, const TrianglesRef& F) {
+  Normals N(F.rows(), 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Vec3 a = vertex(V, F(t, 0));
+    const Vec3 c = (vertex(V, F(t, 1)) - a).cross(vertex(V, F(t, 2)) - a);
+    const double len = c.norm();
+    N.row(t) = (len > 0 ? Vec3(c / len) : Vec3::Zero()).transpose();
+  }
+  return N;
+}
+
+}  // namespace
+
+Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed) {
+  const Eigen::Index m = soup.rows();
+  if (m == 0) throw std::invalid_argument("no triangles to weld");
+  if (!std::isfinite(tol) || tol < 0)
+    throw std::invalid_argument("weld tolerance must be finite and >= 0, got " + num(tol));
+  if (m > std::numeric_limits<int32_t>::max() / 3)
+    throw std::invalid_argument("too many triangles for 32-bit indices: " + std::to_string(m));
+  double mag = 0;
+  for (Eigen::Index t = 0; t < m; ++t) {
+    if (!soup.row(t).allFinite())
+      throw std::invalid_argument("triangle " + std::to_string(t) + " has a non-finite coordinate");
+    mag = std::max(mag, soup.row(t).cwiseAbs().maxCoeff());
+  }
+
+  // Cells 16*tol wide, so a tol-ball around a corner usually stays in one cell (a neighbour is looked
+  // at along an axis only within tol of a cell face), and coarse enough that cell coordinates stay far
+  // inside int64 even for a tiny or zero tolerance.
+  const double cell = std::max({16 * tol, mag * 0x1p-40, std::numeric_limits<double>::min() * 0x1p60});
+  const double reach = tol + 8 * std::numeric_limits<double>::epsilon() * mag;  // rounding margin
+  const double tol2 = tol * tol;
+  WeldGrid grid(cell, m);
+
+  // Big meshes are bound by memory, not arithmetic: corner indices go straight into the result's F (then
+  // compacted in place), and each corner's table slot is prefetched a few triangles ahead.
+  Mesh mesh;
+  mesh.F.resize(m, 3);
+  constexpr Eigen::Index kAhead = 4;  // triangles
+  for (Eigen::Index t = 0; t < m; ++t) {
+    if (t + kAhead < m)
+      for (int k = 0; k < 3; ++k) grid.prefetch(soup.block<1, 3>(t + kAhead, 3 * k).transpose());
+    for (int k = 0; k < 3; ++k) {
+      const Vec3 p = soup.block<1, 3>(t, 3 * k).transpose();
+      int32_t v = grid.find(p, tol2, reach);
+      if (v == kNone) v = grid.add(p);
+      mesh.F(t, k) = v;
+    }
+  }
+  mesh.V = std::move(grid).take_positions();
+
+  Eigen::Index kept = 0;
+  for (Eigen::Index t = 0; t < m; ++t) {
+    const int32_t a = mesh.F(t, 0), b = mesh.F(t, 1), c = mesh.F(t, 2);
+    if (a == b || b == c || a == c || zero_area(mesh.V.row(a), mesh.V.row(b), mesh.V.row(c))) continue;
+    mesh.F.row(kept++) = mesh.F.row(t);
+  }
+  const auto removed = static_cast<std::size_t>(m - kept);
+  if (degenerate_removed) *degenerate_removed = removed;
+  if (kept == 0)
+    throw std::invalid_argument("no non-degenerate triangles (all " + std::to_string(m) +
+                                " collapse to a line or a point at weld tolerance " + num(tol) + ")");
+  mesh.F.conservativeResize(kept, 3);
+
+  // Vertices are numbered in order of first use; only if triangles were dropped can some be unused.
+  if (removed > 0) {
+    std::vector<int32_t> renumber(static_cast<std::size_t>(mesh.V.rows()), kNone);
+    int32_t n = 0;
+    for (Eigen::Index i = 0; i < mesh.F.size(); ++i) {
+      int32_t& r = renumber[static_cast<std::size_t>(mesh.F.data()[i])];
+      if (r == kNone) r = n++;
+      mesh.F.data()[i] = r;
+    }
+    Vertices V(n, 3);
+    for (std::size_t v = 0; v < renumber.size(); ++v)
+      if (renumber[v] != kNone) V.row(renumber[v]) = mesh.V.row(static_cast<Eigen::Index>(v));
+    mesh.V = std::move(V);
+  }
+  return mesh;
+}
+
+void validate(const VerticesRef& V, const TrianglesRef& F) {
+  for (Eigen::Index v = 0; v < V.rows(); ++v)
+    if (!V.row(v).allFinite()) throw std::invalid_argument("vertex " + std::to_string(v) + " has a non-finite coordinate");
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i)
+      if (F(t, i) < 0 || F(t, i) >= V.rows())
+        throw std::invalid_argument("triangle " + std::to_string(t) + " references vertex " + std::to_string(F(t, i)) +
+                                    ", but there are " + std::to_string(V.rows()) + " vertices");
+}
+
+Normals face_normals(const VerticesRef& V, const TrianglesRef& F) {
+  validate(V, F);
+  return unit_face_normals(V, F);
+}
+
+Adjacency triangle_adjacency(const TrianglesRef& F) {
+  const VertexTriangles vt(F, vertex_count(F));
+  Adjacency A(F.rows(), 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i) {
+      const int32_t a = F(t, i), b = F(t, (i + 1) % 3);
+      int32_t found = kNone;
+      int count = 0;
+      if (a != b) {  // an edge with equal endpoints has no neighbour
+        const auto va = static_cast<std::size_t>(a);
+        for (int32_t j = vt.start[va]; j < vt.start[va + 1]; ++j) {
+          const int32_t s = vt.tri[static_cast<std::size_t>(j)];
+          if (s != t && (F(s, 0) == b || F(s, 1) == b || F(s, 2) == b)) {
+            found = s;
+            ++count;
+          }
+        }
+      }
+      A(t, i) = count == 1 ? found : kNone;  // non-manifold (count > 1): no single neighbour
+    }
+  return A;
+}
+
+NormalWeighting parse_weighting(std::string_view name) {
+  if (name == "angle") return NormalWeighting::Angle;
+  if (name == "area") return NormalWeighting::Area;
+  if (name == "meyer") return NormalWeighting::Meyer;
+  throw std::invalid_argument("unknown vertex normal weighting '" + std::string(name) +
+                              "' (allowed: 'angle', 'area', 'meyer')");
+}
+
+const char* weighting_name(NormalWeighting w) {
+  switch (w) {
+    case NormalWeighting::Angle: return "angle";
+    case NormalWeighting::Area: return "area";
+    case NormalWeighting::Meyer: return "meyer";
+  }
+  return "?";
+}
+
+// Seed 000 section 3.2 and where it is vague:
+// - MWA (eq 3.1) and MWAAT (eq 3.2) are implemented as written, then normalised.
+// - Meyer (eq 3.3) is the cotangent discretisation of the mean-curvature normal K = 2 H n of Meyer et
+//   al. 2002, K(v) = 1/(2 A_mixed) * sum_j (cot a_ij + cot b_ij) (v - v_j). The seed calls K itself the
+//   normal, but K vanishes where H = 0 (planes; saddles with opposite principal curvatures), flips its
+//   sign between convex and concave regions, is only valid on a closed one-ring, and on irregular
+//   tessellations has a tangential error of the order of the principal curvatures (it does not converge
+//   pointwise). So only K's direction is used, oriented like the angle-weighted normal, and the
+//   angle-weighted normal is kept instead when
+//     * the vertex is on a boundary or non-manifold edge, or touches a zero-area triangle;
+//     * |K| * sqrt(A_mixed) < 1e-6: flat up to rounding;
+//     * |K| * sqrt(A_mixed) < the spread of the incident face normals around the angle-weighted normal
+//       (max |n_f - n_angle|, about principal curvature x ring size): the mean curvature is too small
+//       for K's direction to beat its tangential error (on a saddle it would be off by tens of degrees);
+//     * K's direction is more than 60 degrees from the angle-weighted normal (a last sanity check).
+// - The seed's A_mixed rule (eq 3.4 and text) says "the facet's area" for a non-obtuse triangle, where
+//   Meyer et al. use the Voronoi area (1/8) (|v-v_j|^2 cot(angle at k) + |v-v_k|^2 cot(angle at j)); the
+//   Voronoi area is used here; obtuse triangles contribute A/2 (obtuse at v) or A/4 as in the seed.
+//   A_mixed only scales K, so it matters for the tests above, not for the direction.
+namespace {
+
+// Eq 3.1 (angle) or eq 3.2 (area), normalised.
+Normals weighted_normals(const VerticesRef& V, const TrianglesRef& F, const Normals& FN, NormalWeighting w) {
+  Normals sum = Normals::Zero(V.rows(), 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Vec3 p[3] = {vertex(V, F(t, 0)), vertex(V, F(t, 1)), vertex(V, F(t, 2))};
+    const Vec3 c = (p[1] - p[0]).cross(p[2] - p[0]);
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 u = p[(i + 1) % 3] - p[i], x = p[(i + 2) % 3] - p[i];
+      if (w == NormalWeighting::Area)
+        sum.row(F(t, i)) += 0.5 * c.transpose();  // area x unit normal
+      else
+        sum.row(F(t, i)) += std::atan2(u.cross(x).norm(), u.dot(x)) * FN.row(t);  // robust for any angle
+    }
+  }
+  for (Eigen::Index v = 0; v < sum.rows(); ++v) {
+    const double len = sum.row(v).norm();
+    sum.row(v) = (len > 0 ? Vec3(sum.row(v).transpose() / len) : Vec3::Zero()).transpose();
+  }
+  return sum;
+}
+
+// Replaces the angle-weighted normals N by the direction of Meyer's K where it is meaningful.
+void apply_meyer(const VerticesRef& V, const TrianglesRef& F, const Normals& FN, Normals& N) {
+  const Eigen::Index n = V.rows();
+  Normals K = Normals::Zero(n, 3);
+  Eigen::VectorXd mixed_area = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd spread = Eigen::VectorXd::Zero(n);  // max |n_f - N(v)| over the incident faces
+  std::vector<char> usable(static_cast<std::size_t>(n), 1);
+
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    const Vec3 p[3] = {vertex(V, F(t, 0)), vertex(V, F(t, 1)), vertex(V, F(t, 2))};
+    const double twice_area = (p[1] - p[0]).cross(p[2] - p[0]).norm();
+    if (!(twice_area > 0)) {  // cotangents undefined
+      for (int i = 0; i < 3; ++i) usable[static_cast<std::size_t>(F(t, i))] = 0;
+      continue;
+    }
+    double dot[3], cot[3];
+    for (int i = 0; i < 3; ++i) {
+      dot[i] = (p[(i + 1) % 3] - p[i]).dot(p[(i + 2) % 3] - p[i]);
+      cot[i] = dot[i] / twice_area;  // |u x v| is twice the area at every corner
+    }
+    const bool obtuse = dot[0] < 0 || dot[1] < 0 || dot[2] < 0;
+    for (int i = 0; i < 3; ++i) {
+      const int j = (i + 1) % 3, k = (i + 2) % 3;
+      const int32_t v = F(t, i);
+      // Edge v-p[j] is opposite corner k in this triangle, edge v-p[k] opposite corner j.
+      K.row(v) += (cot[k] * (p[i] - p[j]) + cot[j] * (p[i] - p[k])).transpose();
+      mixed_area[v] += !obtuse ? ((p[j] - p[i]).squaredNorm() * cot[k] + (p[k] - p[i]).squaredNorm() * cot[j]) / 8
+                               : (dot[i] < 0 ? twice_area / 4 : twice_area / 8);
+      spread[v] = std::max(spread[v], (FN.row(t) - N.row(v)).norm());
+    }
+  }
+  const Adjacency adj = triangle_adjacency(F);
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i)
+      if (adj(t, i) == kNone) {  // both ends of a boundary or non-manifold edge
+        usable[static_cast<std::size_t>(F(t, i))] = 0;
+        usable[static_cast<std::size_t>(F(t, (i + 1) % 3))] = 0;
+      }
+
+  for (Eigen::Index v = 0; v < n; ++v) {
+    if (!usable[static_cast<std::size_t>(v)] || !(mixed_area[v] > 0) || N.row(v).isZero()) continue;
+    const Vec3 nv = N.row(v).transpose();
+    const Vec3 kv = K.row(v).transpose() / (2 * mixed_area[v]);
+    const double size = kv.norm() * std::sqrt(mixed_area[v]);  // ~ |H| x ring size, dimensionless
+    if (size < 1e-6 || size < spread[v]) continue;
+    const Vec3 dir = (kv.dot(nv) < 0 ? -kv : kv).normalized();
+    if (dir.dot(nv) >= 0.5) N.row(v) = dir.transpose();
+  }
+}
+
+}  // namespace
+
+Normals vertex_normals(const VerticesRef& V, const TrianglesRef& F, NormalWeighting w) {
+  validate(V, F);
+  const Normals FN = unit_face_normals(V, F);
+  Normals N = weighted_normals(V, F, FN, w == NormalWeighting::Area ? NormalWeighting::Area : NormalWeighting::Angle);
+  if (w == NormalWeighting::Meyer) apply_meyer(V, F, FN, N);
+  return N;
+}
+
+}  // namespace tmm

@@ -1,0 +1,531 @@
+// Drop along any direction V with the cutter axis in any orientation. Method (docs/drop_direction.md):
+// everything is worked in the tool frame with the start tip at the origin; a triangle point q touches the
+// cutter at travel t when q - t W lies in the convex solid K (W = V in tool coordinates).
+//   vertex: entry of the line q - t W into K. On the part of the line inside the cylinder rho <= max_radius
+//           and the slab 0 <= z <= L_C, f(t) = max(h(rho(t)) - z(t), z(t) - L_C) is convex; its first zero is
+//           found by golden section (down to a point with f <= 0) then Illinois regula falsi, 1e-12 in t.
+//   facet:  the support point of K against the plane (Cutter::facet_contact_radius, or the top rim) gives the
+//           travel in closed form; valid if that point, moved to the plane, lies inside the triangle.
+//   edge:   the first contact of the whole edge line, by projecting along the edge: the line becomes a point
+//           moving into the shadow of K, whose entry time is the maximum over the shadow's supporting lines
+//           (normals N perpendicular to the edge) of their crossing times — a quasi-concave function of the
+//           normal's direction, maximised by golden section. Every sampled crossing time is a lower bound, so the
+//           answer never lies past the true contact. Valid if the contact point lies on the segment; else the
+//           convex travel along the edge is smallest at an end, which the vertex case covers.
+#include "tmm/query/drop_direction.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+#include "tmm/query/drop_contacts.hpp"
+
+namespace tmm {
+
+using Eigen::Vector3d;
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+constexpr double kTravelTol = 1e-12;       // mm, bracket width of the vertex entry
+constexpr double kUnitTol = 1e-9;          // |norm - 1| accepted for axis and direction
+constexpr double kParallelAxisTol = 1e-12; // |axis + V| below which the -Z contacts are used in the tool frame
+
+void require_unit(const Vector3d& v, const char* what) {
+  const double n = v.norm();
+  if (!(std::isfinite(n) && std::fabs(n - 1.0) <= kUnitTol)) {
+    std::ostringstream msg;
+    msg << what << " must be a finite unit vector, got (" << v.x() << ", " << v.y() << ", " << v.z()
+        << ") of length " << n;
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+}  // namespace
+
+ToolFrame::ToolFrame(const Vector3d& axis) : a(axis.normalized()) {
+  // For axis = +Z exactly this is the world frame, so the -Z drop is reproduced bit for bit.
+  const Vector3d ref = std::fabs(a.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
+  e1 = (ref - ref.dot(a) * a).normalized();
+  e2 = a.cross(e1);
+}
+
+namespace direction_detail {
+
+Support support(const Cutter& c, const Vector3d& d_in) {
+  // (sqrt of sums of squares rather than hypot: this is the inner loop of the edge solver.)
+  const double h2 = d_in.x() * d_in.x() + d_in.y() * d_in.y();
+  const double inv = 1.0 / std::sqrt(h2 + d_in.z() * d_in.z());
+  const double hl = std::sqrt(h2);
+  const Vector3d d = d_in * inv;
+  const double nr = hl * inv;
+  const double ux = hl > 0 ? d_in.x() / hl : 1.0, uy = hl > 0 ? d_in.y() / hl : 0.0;
+  double rho, z;
+  if (d.z() > 0) {  // upwards: the top rim (the cap's centre when d is the axis itself)
+    const double Lc = c.cutting_length();
+    if (!std::isfinite(Lc)) return {Vector3d(0, 0, kInfinity), kInfinity};
+    rho = nr > 0 ? c.max_radius() : 0.0;
+    z = Lc;
+  } else if (d.z() == 0) {  // sideways: the widest circle (its lowest point when it is a cylinder band)
+    rho = c.max_radius();
+    z = c.height(rho);
+  } else {  // downwards: the profile point whose outward normal is d
+    rho = c.facet_contact_radius(nr, -d.z());
+    z = c.height(rho);
+  }
+  const Vector3d X(rho * ux, rho * uy, z);
+  return {X, d_in.dot(X)};
+}
+
+double vertex_travel(const Cutter& c, const Vector3d& q, const Vector3d& W, double cap) {
+  if (q.dot(W) - support(c, W).value >= cap) return kNoTravel;  // as in edge_travel
+  const double rmax = c.max_radius(), Lc = c.cutting_length();
+  const double wxy2 = W.x() * W.x() + W.y() * W.y();
+  if (wxy2 <= 1e-28) {  // moving along the axis: rho is constant
+    const double rho = std::hypot(q.x(), q.y());
+    if (rho > rmax) return kNoTravel;
+    double t;
+    if (W.z() < 0) t = (q.z() - c.height(rho)) / W.z();  // rises into the lower surface
+    else if (!std::isfinite(Lc)) t = -kInfinity;         // inside the endless cutter from the start
+    else t = (q.z() - Lc) / W.z();                       // falls through the top cap
+    return t < cap ? t : kNoTravel;
+  }
+  // The line's part inside the cylinder rho <= rmax...
+  const double tc = (q.x() * W.x() + q.y() * W.y()) / wxy2;
+  const double dx = q.x() - tc * W.x(), dy = q.y() - tc * W.y();
+  const double d2 = dx * dx + dy * dy;
+  if (d2 > rmax * rmax) return kNoTravel;
+  const double half = std::sqrt((rmax * rmax - d2) / wxy2);
+  double lo = tc - half, hi = tc + half;
+  // ...and the slab 0 <= z(t) <= L_C, z(t) = q.z - t W.z.
+  if (W.z() > 0) {
+    lo = std::max(lo, (q.z() - Lc) / W.z());
+    hi = std::min(hi, q.z() / W.z());
+  } else if (W.z() < 0) {
+    lo = std::max(lo, q.z() / W.z());
+    hi = std::min(hi, (q.z() - Lc) / W.z());
+  } else if (q.z() < 0 || q.z() > Lc) {
+    return kNoTravel;
+  }
+  hi = std::min(hi, cap);  // only an earlier contact matters
+  if (!(lo < hi)) return kNoTravel;
+  // f <= 0 exactly inside K; convex in t (h convex non-decreasing, rho convex, the cap linear).
+  auto f = [&](double t) {
+    const double z = q.z() - t * W.z();
+    const double x = q.x() - t * W.x(), y = q.y() - t * W.y();
+    const double rho = std::min(std::sqrt(x * x + y * y), rmax);
+    return std::max(c.height(rho) - z, z - Lc);
+  };
+  // Whether the left derivative of f at t is <= 0 (every active term non-increasing); false when unsure.
+  auto nonincreasing_at = [&](double t) {
+    const double z = q.z() - t * W.z();
+    const double x = q.x() - t * W.x(), y = q.y() - t * W.y();
+    const double rho = std::sqrt(x * x + y * y);
+    if (!(rho > 0)) return false;  // the cone's kink on the axis
+    const double rr = std::min(rho, rmax);
+    const double low = c.height(rr) - z, top = z - Lc;
+    bool ok = true;
+    if (low >= top) ok = c.slope(rr) * (-(x * W.x() + y * W.y()) / rho) + W.z() <= 0;  // NaN: false
+    if (top >= low) ok = ok && -W.z() <= 0;
+    return ok;
+  };
+  double flo = f(lo);
+  if (flo <= 0) return lo;  // enters through the side wall or the top cap
+  // A point inside: golden section on the convex f, stopping at the first f <= 0.
+  double inside = std::nan("");
+  const double fhi = f(hi);
+  if (fhi <= 0) {
+    inside = hi;
+  } else if (nonincreasing_at(hi)) {
+    // f'(hi-) <= 0: f >= f(hi) > 0 on the whole interval (convexity), no contact before hi.
+  } else {
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double a = lo, b = hi;
+    double x1 = b - g * (b - a), x2 = a + g * (b - a);
+    double f1 = f(x1), f2 = f(x2);
+    for (int it = 0; it < 200; ++it) {
+      if (f1 <= 0) { inside = x1; break; }
+      if (f2 <= 0) { inside = x2; break; }
+      if (b - a <= kTravelTol) break;
+      if (f1 < f2) {
+        b = x2; x2 = x1; f2 = f1;
+        x1 = b - g * (b - a); f1 = f(x1);
+      } else {
+        a = x1; x1 = x2; f1 = f2;
+        x2 = a + g * (b - a); f2 = f(x2);
+      }
+    }
+  }
+  if (std::isnan(inside)) return kNoTravel;  // the line passes K by (its minimum of f is > 0)
+  // The single crossing in (lo, inside]: Illinois regula falsi, keeping the outside end as the answer so
+  // the cutter never ends inside the triangle.
+  double a = lo, b = inside, fa = flo, fb = f(inside);
+  int side = 0;
+  for (int it = 0; it < 200 && b - a > kTravelTol + 4e-16 * std::fabs(a); ++it) {
+    double m = (fa * b - fb * a) / (fa - fb);
+    if (!(m > a && m < b)) m = 0.5 * (a + b);
+    if (it % 8 == 7) m = 0.5 * (a + b);  // guaranteed halving now and then
+    const double fm = f(m);
+    if (fm > 0) {
+      a = m; fa = fm;
+      if (side == -1) fb *= 0.5;
+      side = -1;
+    } else {
+      b = m; fb = fm;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+    }
+  }
+  return a;
+}
+
+double edge_travel(const Cutter& c, const Vector3d& q1, const Vector3d& q2, const Vector3d& W, double cap) {
+  // Cheap bound first: q(s) - t W = X in K gives t = (q(s) - X) . W >= min q . W - max_K X . W.
+  if (std::min(q1.dot(W), q2.dot(W)) - support(c, W).value >= cap) return kNoTravel;
+  const Vector3d E = q2 - q1;
+  const double L = E.norm();
+  if (!(L > 0)) return kNoTravel;
+  const Vector3d e = E / L;
+  const Vector3d Wp = W - W.dot(e) * e;  // the motion seen along the edge
+  const double wp = Wp.norm();
+  if (wp < 1e-13) return kNoTravel;  // sliding along itself: an end touches first (vertex case)
+  const Vector3d v = Wp / wp, w = e.cross(v);
+  // The path must pass between the shadow's two supporting lines parallel to the motion.
+  if (w.dot(q1) > support(c, w).value || -w.dot(q1) > support(c, -w).value) return kNoTravel;
+  // Crossing time of the supporting line with normal N(tau) = (1 - tau^2) v + 2 tau w, tau in (-1, 1): the
+  // half-angle tangent of theta in (-pi/2, pi/2), so no trigonometry; the ratio does not need |N| = 1.
+  auto normal = [&](double tau) { return Vector3d((1 - tau * tau) * v + (2 * tau) * w); };
+  auto crossing = [&](double tau, Support* s) {
+    const Vector3d N = normal(tau);
+    const Support sp = support(c, N);
+    if (s) *s = sp;
+    return (N.dot(q1) - sp.value) / (wp * (1 - tau * tau));
+  };
+  // Golden section to a bracket of ~1e-12 in tau: the crossing times are smooth at a maximum on a curved
+  // part of K and flat (a plateau) at a corner, so the travel is within ~1e-11 mm, and never late.
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double a = -1.0, b = 1.0;
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  double f1 = crossing(x1, nullptr), f2 = crossing(x2, nullptr);
+  double best_th = f1 >= f2 ? x1 : x2, best = std::max(f1, f2);
+  for (int it = 0; it < 60 && b - a > 1e-13; ++it) {
+    if (best >= cap) return kNoTravel;  // every crossing time bounds the contact from below
+    if (f1 >= f2) {
+      b = x2; x2 = x1; f2 = f1;
+      x1 = b - g * (b - a); f1 = crossing(x1, nullptr);
+      if (f1 > best) { best = f1; best_th = x1; }
+    } else {
+      a = x1; x1 = x2; f1 = f2;
+      x2 = a + g * (b - a); f2 = crossing(x2, nullptr);
+      if (f2 > best) { best = f2; best_th = x2; }
+    }
+  }
+  Support s;
+  const double t = crossing(best_th, &s);
+  if (!std::isfinite(t) || !std::isfinite(s.value)) return kNoTravel;
+  // Where along the edge the line touches. The contact lies in the meridian half-plane of N; where K's face
+  // for N is a segment (a cone or taper generator, the cylinder band) the support point is only one end of
+  // it, so the line's crossing with that meridian plane locates the contact. A line (nearly) parallel to the
+  // meridian plane falls back to the support point, which then lies on the contact set.
+  const Vector3d N = normal(best_th);
+  const double nr = std::sqrt(N.x() * N.x() + N.y() * N.y());
+  const Vector3d m = nr > 0 ? Vector3d(-N.y() / nr, N.x() / nr, 0.0) : Vector3d::Zero();
+  const Vector3d origin = q1 - t * W;  // the line at the contact travel: origin + lambda E
+  double u;
+  if (std::fabs(e.dot(m)) > 1e-3) u = -origin.dot(m) / E.dot(m);
+  else u = (s.point - origin).dot(E) / (L * L);
+  if (!(u >= 0 && u <= 1) || !(t < cap)) return kNoTravel;
+  // Guard against a lost contact (a line nearly parallel to the motion's plane): the contact must be in K's
+  // bounding ball about the tip (loosely: only garbage is to be caught).
+  const double reach = std::hypot(c.max_radius(), c.cutting_length());
+  return (origin + u * E).norm() <= 1.01 * reach ? t : kNoTravel;
+}
+
+double facet_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
+                    const Vector3d& W, double cap) {
+  Vector3d n = (q1 - q0).cross(q2 - q0);
+  const double len = n.norm();
+  if (!(len > 0)) return kNoTravel;
+  n /= len;
+  double nw = n.dot(W);
+  if (nw > 0) {  // the side facing the incoming cutter
+    n = -n;
+    nw = -nw;
+  }
+  if (nw > -1e-12) return kNoTravel;  // plane parallel to the motion: edges and vertices touch first
+  const Support s = support(c, -n);  // the point of K deepest towards the plane
+  if (!std::isfinite(s.value)) return kNoTravel;
+  const double t = n.dot(q0 - s.point) / nw;
+  if (!(t < cap)) return kNoTravel;
+  const Vector3d y = s.point + t * W;  // the contact point on the plane
+  const double w0 = n.dot((q1 - y).cross(q2 - y));
+  const double w1 = n.dot((q2 - y).cross(q0 - y));
+  const double w2 = n.dot((q0 - y).cross(q1 - y));
+  const double area = w0 + w1 + w2;
+  const double eps = 1e-12 * std::fabs(area);
+  if (area > 0 ? (w0 < -eps || w1 < -eps || w2 < -eps) : (w0 > eps || w1 > eps || w2 > eps)) return kNoTravel;
+  return t;
+}
+
+}  // namespace direction_detail
+
+namespace {
+
+// Triangle corners q0..q2 in tool coordinates (start tip at the origin), W = V in tool coordinates.
+// Each piece only looks for contacts earlier than the best so far (cheap closed forms first). Bit k of
+// `edges` selects edge k (corner k to k + 1); see IndexedTriangle::owned_edges.
+double general_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
+                          const Vector3d& W, double cap = kNoTravel, unsigned edges = 7u) {
+  using namespace direction_detail;
+  double t = std::min(cap, facet_travel(c, q0, q1, q2, W, cap));
+  t = std::min(t, vertex_travel(c, q0, W, t));
+  t = std::min(t, vertex_travel(c, q1, W, t));
+  t = std::min(t, vertex_travel(c, q2, W, t));
+  if (edges & 1u) t = std::min(t, edge_travel(c, q0, q1, W, t));
+  if (edges & 2u) t = std::min(t, edge_travel(c, q1, q2, W, t));
+  if (edges & 4u) t = std::min(t, edge_travel(c, q2, q0, W, t));
+  return t < cap ? t : kNoTravel;
+}
+
+// V = -axis: the exact -Z contacts (facet, concave edge form, vertices) in the tool frame; travel = -tip z.
+double along_axis_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2) {
+  Vector3d n = (q1 - q0).cross(q2 - q0);
+  const double len = n.norm();
+  n = len > 0 ? Vector3d(n / len) : Vector3d::Zero();
+  if (n.z() < 0) n = -n;
+  double z = facet_drop(c, 0.0, 0.0, q0.data(), q1.data(), q2.data(), n.data());
+  z = std::max(z, edge_drop(c, 0.0, 0.0, q0.data(), q1.data()));
+  z = std::max(z, edge_drop(c, 0.0, 0.0, q1.data(), q2.data()));
+  z = std::max(z, edge_drop(c, 0.0, 0.0, q2.data(), q0.data()));
+  return -z;
+}
+
+}  // namespace
+
+namespace {
+
+void require_finite_length(const Cutter& c) {
+  if (!std::isfinite(c.cutting_length()))
+    throw std::invalid_argument("a drop with the cutter axis not opposite to the direction needs a cutter with a "
+                                "finite cutting length (the shank is not modelled)");
+}
+
+}  // namespace
+
+double drop_along_general(const Cutter& cutter, const Vector3d& tip_start, const Vector3d& axis,
+                          const Vector3d& V, const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
+  require_unit(axis, "cutter axis");
+  require_unit(V, "drop direction");
+  require_finite_length(cutter);
+  const ToolFrame fr(axis);
+  return general_tool_frame(cutter, fr.to_tool(p0 - tip_start), fr.to_tool(p1 - tip_start),
+                            fr.to_tool(p2 - tip_start), fr.to_tool(V.normalized()));
+}
+
+double drop_along(const Cutter& cutter, const Vector3d& tip_start, const Vector3d& axis, const Vector3d& V,
+                  const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
+  require_unit(axis, "cutter axis");
+  require_unit(V, "drop direction");
+  const ToolFrame fr(axis);
+  const Vector3d q0 = fr.to_tool(p0 - tip_start), q1 = fr.to_tool(p1 - tip_start), q2 = fr.to_tool(p2 - tip_start);
+  if ((axis + V).norm() <= kParallelAxisTol) return along_axis_tool_frame(cutter, q0, q1, q2);
+  require_finite_length(cutter);
+  return general_tool_frame(cutter, q0, q1, q2, fr.to_tool(V.normalized()));
+}
+
+double drop_along(const Cutter& cutter, const Vector3d& tip_start, const Vector3d& axis, const Vector3d& V,
+                  const IndexedTriangle& t) {
+  return drop_along(cutter, tip_start, axis, V, Vector3d(t.p[0]), Vector3d(t.p[1]), Vector3d(t.p[2]));
+}
+
+// ---- mesh level ------------------------------------------------------------------------------------------
+
+namespace {
+
+// Best-first walk of the index's hierarchy for a cutter whose lowest point is `floor` high at best: visits
+// the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point, lowered by
+// lift(d) (d: the box's XY' distance from (x, y)), is above `floor`; `floor` may rise during the walk.
+// Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
+template <class Lift, class Visit>
+void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Lift&& lift,
+                 Visit&& visit) {
+  const auto& nodes = mi.nodes();
+  const auto& tris = mi.triangles();
+  const double r2 = radius * radius;
+  auto bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
+    const double dx = std::max(std::max(xmin - x, x - xmax), 0.0);
+    const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
+    const double d2 = dx * dx + dy * dy;
+    return d2 > r2 ? -kInfinity : zmax - lift(std::sqrt(d2));
+  };
+  struct Entry {
+    int32_t node;
+    double bound;
+  };
+  std::vector<Entry> stack;  // depth-first: at most ~2 entries per level
+  stack.reserve(128);
+  stack.push_back({0, kInfinity});
+  while (!stack.empty()) {
+    const Entry e = stack.back();
+    stack.pop_back();
+    if (e.bound <= floor) continue;
+    const BvhNode& node = nodes[e.node];
+    if (node.count > 0) {
+      for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
+        const IndexedTriangle& t = tris[i];
+        if (t.zmax <= floor) continue;
+        const double b = bound(std::min({t.p[0][0], t.p[1][0], t.p[2][0]}), std::min({t.p[0][1], t.p[1][1], t.p[2][1]}),
+                               std::max({t.p[0][0], t.p[1][0], t.p[2][0]}), std::max({t.p[0][1], t.p[1][1], t.p[2][1]}),
+                               t.zmax);
+        if (b > floor) visit(t, i);
+      }
+    } else {
+      const BvhNode& l = nodes[node.first];
+      const BvhNode& r = nodes[node.first + 1];
+      const double bl = bound(l.xmin, l.ymin, l.xmax, l.ymax, l.zmax);
+      const double br = bound(r.xmin, r.ymin, r.xmax, r.ymax, r.zmax);
+      // The more promising child last, so it is popped first: its contacts prune more of the other.
+      if (bl > br) {
+        if (br > floor) stack.push_back({node.first + 1, br});
+        if (bl > floor) stack.push_back({node.first, bl});
+      } else {
+        if (bl > floor) stack.push_back({node.first, bl});
+        if (br > floor) stack.push_back({node.first + 1, br});
+      }
+    }
+  }
+}
+
+Eigen::Matrix3d rotation_to_minus_z(const Vector3d& V) {
+  const Vector3d down(0, 0, -1);
+  if (V == down) return Eigen::Matrix3d::Identity();  // the plain drop-cutter frame, bit for bit
+  return Eigen::Quaterniond::FromTwoVectors(V, down).toRotationMatrix();
+}
+
+std::shared_ptr<const MeshIndex> rotated_index(const VerticesRef& vertices, const TrianglesRef& triangles,
+                                               const Eigen::Matrix3d& rot) {
+  if (rot.isIdentity(0.0)) return std::make_shared<const MeshIndex>(vertices, triangles);
+  const Vertices rotated = vertices * rot.transpose();
+  return std::make_shared<const MeshIndex>(rotated, triangles);
+}
+
+}  // namespace
+
+DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Vector3d& V)
+    : V_(V) {
+  require_unit(V, "drop direction");
+  V_ = V.normalized();
+  rot_ = rotation_to_minus_z(V_);
+  index_ = rotated_index(vertices, triangles, rot_);
+}
+
+double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& start,
+                        const Vector3d& axis, double max_travel, DropStats* stats, int32_t* hint) {
+  require_unit(axis, "cutter axis");
+  const Vector3d s = index.rotation() * start;
+  const Vector3d a = index.rotation() * axis.normalized();
+  const MeshIndex& mi = index.index();
+  if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
+    // V = -axis: the fast -Z drop-cutter in the rotated frame.
+    const double floor_z = s.z() - max_travel;
+    const double z = drop_point(mi, cutter, s.x(), s.y(), floor_z, stats, hint);
+    return z <= floor_z ? max_travel : s.z() - z;
+  }
+  require_finite_length(cutter);
+  const ToolFrame fr(a);
+  const Vector3d W = fr.to_tool(Vector3d(0, 0, -1));
+  // Lowest point of K along Z' below the tip: no triangle whose highest point is below the cutter's lowest
+  // point can touch it, so the index walks on that height in place of the tip's. An edge shared by several
+  // triangles is solved by its owner only (IndexedTriangle::owned_edges): the owner's bound covers the edge
+  // (the edge lies in its box and below its highest point), so when the owner is pruned so is the edge.
+  const double lowest = -direction_detail::support(cutter, -fr.to_tool(Vector3d::UnitZ())).value;
+  // K's shadow on the XY' plane lies within this distance of the tip.
+  const double rmax = cutter.max_radius();
+  const double ah = std::hypot(a.x(), a.y());
+  const double reach = (rmax + cutter.cutting_length() * ah) * (1 + 1e-12) + 1e-12;
+  // A point X = z a + r of K (|r| <= rmax, r perpendicular to a, z >= 0) at horizontal distance >= d from the
+  // tip has z >= (d - rmax) / ah, so its height is at least a.z (d - rmax) / ah - rmax ah (axis leaning up):
+  // boxes far from the tip can only meet the cutter's higher parts.
+  auto lift = [&](double d) {
+    if (!(a.z() > 0 && ah > 0 && d > rmax)) return 0.0;
+    return std::max(0.0, a.z() * (d - rmax) / ah - rmax * ah - lowest - 1e-9);
+  };
+  double best = max_travel;
+  int32_t winner = -1;
+  std::size_t tested = 0;
+  auto floor_of = [&](double t) { return s.z() - t + lowest - 1e-9; };  // margin against rounding
+  double floor_ref = floor_of(best);
+  auto test = [&](const IndexedTriangle& t, int32_t i) {
+    ++tested;
+    const double tr = general_tool_frame(cutter, fr.to_tool(Vector3d(t.p[0]) - s), fr.to_tool(Vector3d(t.p[1]) - s),
+                                         fr.to_tool(Vector3d(t.p[2]) - s), W, best, t.owned_edges);
+    if (tr < best) {
+      best = tr;
+      winner = i;
+      floor_ref = floor_of(best);
+    }
+  };
+  const auto& tris = mi.triangles();
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) test(tris[*hint], *hint);
+  const int32_t skip = hint ? *hint : -1;
+  walk_lowest(mi, s.x(), s.y(), reach, floor_ref, lift,
+          [&](const IndexedTriangle& t, int32_t i) {
+            if (i != skip) test(t, i);
+          });
+  if (stats) stats->triangles_tested += tested;
+  if (hint) *hint = winner;
+  return best;
+}
+
+void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const double* starts,
+                      const double* axes, bool axes_per_point, std::size_t n, double max_travel,
+                      double* travel_out, const BatchOptions& options, DropStats* stats) {
+  // Validate up front: workers must not throw.
+  for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}); ++i) {
+    const Vector3d ax(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]);
+    require_unit(ax, "cutter axis");
+    if ((index.rotation() * ax.normalized() - Vector3d::UnitZ()).norm() > kParallelAxisTol)
+      require_finite_length(cutter);
+  }
+  if (!axes_per_point && n > 0) {
+    const Vector3d a = index.rotation() * Vector3d(axes[0], axes[1], axes[2]).normalized();
+    if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
+      // V = -axis for every point: the tiled -Z batch in the rotated frame, each point's floor max_travel
+      // below its start (as drop_along_point's fast path, point by point).
+      std::vector<double> xy(2 * n), floors(n), z(n);
+      std::vector<double> start_z(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+        xy[2 * i] = s.x();
+        xy[2 * i + 1] = s.y();
+        start_z[i] = s.z();
+        floors[i] = s.z() - max_travel;
+      }
+      drop_batch(index.index(), cutter, xy.data(), n, floors.data(), z.data(), options, stats);
+      for (std::size_t i = 0; i < n; ++i) travel_out[i] = z[i] <= floors[i] ? max_travel : start_z[i] - z[i];
+      return;
+    }
+  }
+  std::atomic<std::size_t> tested{0};
+  // The hint starts afresh with each chunk, so results do not depend on the thread count.
+  parallel_chunks(n, 128, options, [&](std::size_t begin, std::size_t end) {
+    DropStats local;
+    int32_t hint = -1;
+    for (std::size_t i = begin; i < end; ++i) {
+      const double* ax = axes + (axes_per_point ? 3 * i : 0);
+      travel_out[i] = drop_along_point(index, cutter, Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]),
+                                       Vector3d(ax[0], ax[1], ax[2]), max_travel, &local, &hint);
+    }
+    tested.fetch_add(local.triangles_tested);
+  });
+  if (stats) stats->triangles_tested += tested.load();
+}
+
+}  // namespace tmm
