@@ -1,0 +1,63 @@
+// Samples of a face on a grid per Bezier patch, bucketed in XY: the "rays from the surface" of VCRF and the
+// candidates of the gouge check.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <vector>
+
+#include "tmm/surface/bezier.hpp"
+
+namespace tmm {
+
+// Dense-enough samples of a surface and an XY bucket grid over them: the "rays from the surface" of VCRF
+// and the candidates of the gouge check. Built once per surface and tool.
+class SurfaceSamples {
+ public:
+  // spacing: target distance between samples (mm); cell: XY bucket size (mm).
+  SurfaceSamples(const PatchSurface& surface, double spacing, double cell);
+  // The largest number of samples kept: beyond it the spacing is widened (spacing() tells by how much).
+  static constexpr std::size_t kMaxSamples = 4000000;
+  double spacing() const { return spacing_; }
+  // Calls f(index) for every sample within XY distance r of (x, y).
+  template <class F>
+  void within(double x, double y, double r, F&& f) const;
+  const std::vector<Vector3d>& points() const { return pts_; }
+  const std::vector<Vector2d>& params() const { return uv_; }
+  // Parameter step of the sample grid around sample k (half-width of a zoom window).
+  Vector2d step(std::size_t k) const { return step_[patch_[k]]; }
+
+ private:
+  std::vector<Vector3d> pts_;
+  std::vector<Vector2d> uv_;
+  std::vector<int> patch_;
+  std::vector<Vector2d> step_;
+  double spacing_ = 1, x0_ = 0, y0_ = 0, cell_ = 1;
+  int nx_ = 1, ny_ = 1;
+  std::vector<int> start_;   // bucket -> first entry in order_
+  std::vector<int> order_;   // sample indices by bucket
+};
+
+template <class F>
+void SurfaceSamples::within(double x, double y, double r, F&& f) const {
+  const int i0 = std::max(0, static_cast<int>(std::floor((x - r - x0_) / cell_)));
+  const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((x + r - x0_) / cell_)));
+  const int j0 = std::max(0, static_cast<int>(std::floor((y - r - y0_) / cell_)));
+  const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((y + r - y0_) / cell_)));
+  const double r2 = r * r;
+  for (int j = j0; j <= j1; ++j) {
+    for (int i = i0; i <= i1; ++i) {
+      const int b = j * nx_ + i;
+      for (int k = start_[b]; k < start_[b + 1]; ++k) {
+        const int s = order_[k];
+        const double dx = pts_[s].x() - x, dy = pts_[s].y() - y;
+        if (dx * dx + dy * dy <= r2) f(static_cast<std::size_t>(s));
+      }
+    }
+  }
+}
+
+}  // namespace tmm

@@ -1,0 +1,83 @@
+#include "tmm/position/surface_samples.hpp"
+
+#include <stdexcept>
+#include <utility>
+
+namespace tmm {
+
+SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, double cell) {
+  if (!(spacing > 0.0) || !(cell > 0.0)) throw std::invalid_argument("sample spacing must be > 0");
+  // Sample counts from the control polygon lengths (they bound the curve lengths).
+  std::vector<std::pair<int, int>> counts;
+  for (;;) {
+    counts.clear();
+    std::size_t total = 0;
+    for (int i = 0; i < surface.nu(); ++i) {
+      for (int j = 0; j < surface.nv(); ++j) {
+        const BezierPatch& p = surface.patch(i, j);
+        double lu = 0.0, lv = 0.0;
+        for (int b = 0; b <= p.degree_v(); ++b) {
+          double l = 0.0;
+          for (int a = 0; a < p.degree_u(); ++a) l += (p.pole(a + 1, b) - p.pole(a, b)).norm();
+          lu = std::max(lu, l);
+        }
+        for (int a = 0; a <= p.degree_u(); ++a) {
+          double l = 0.0;
+          for (int b = 0; b < p.degree_v(); ++b) l += (p.pole(a, b + 1) - p.pole(a, b)).norm();
+          lv = std::max(lv, l);
+        }
+        const int mu = std::clamp(static_cast<int>(std::ceil(lu / spacing)), 2, 4000);
+        const int mv = std::clamp(static_cast<int>(std::ceil(lv / spacing)), 2, 4000);
+        counts.emplace_back(mu, mv);
+        total += static_cast<std::size_t>(mu + 1) * static_cast<std::size_t>(mv + 1);
+      }
+    }
+    if (total <= kMaxSamples) break;
+    spacing *= 1.5;
+  }
+  spacing_ = spacing;
+  Box3 box;
+  int k = 0;
+  for (int i = 0; i < surface.nu(); ++i) {
+    for (int j = 0; j < surface.nv(); ++j, ++k) {
+      const auto [mu, mv] = counts[static_cast<std::size_t>(k)];
+      const double U0 = surface.breaks_u()[i], U1 = surface.breaks_u()[i + 1];
+      const double V0 = surface.breaks_v()[j], V1 = surface.breaks_v()[j + 1];
+      step_.emplace_back((U1 - U0) / mu, (V1 - V0) / mv);
+      const BezierPatch& p = surface.patch(i, j);
+      for (int a = 0; a <= mu; ++a) {
+        for (int b = 0; b <= mv; ++b) {
+          const double u = static_cast<double>(a) / mu, v = static_cast<double>(b) / mv;
+          pts_.push_back(p.point(u, v));
+          uv_.emplace_back(U0 + u * (U1 - U0), V0 + v * (V1 - V0));
+          patch_.push_back(k);
+          box.extend(pts_.back());
+        }
+      }
+    }
+  }
+  cell_ = cell;
+  x0_ = box.lo.x();
+  y0_ = box.lo.y();
+  nx_ = std::max(1, static_cast<int>(std::ceil((box.hi.x() - x0_) / cell_)) + 1);
+  ny_ = std::max(1, static_cast<int>(std::ceil((box.hi.y() - y0_) / cell_)) + 1);
+  if (static_cast<double>(nx_) * ny_ > 4e6) {  // huge face, tiny tool: coarser buckets
+    cell_ = std::max(box.hi.x() - x0_, box.hi.y() - y0_) / 1000.0;
+    nx_ = static_cast<int>(std::ceil((box.hi.x() - x0_) / cell_)) + 1;
+    ny_ = static_cast<int>(std::ceil((box.hi.y() - y0_) / cell_)) + 1;
+  }
+  std::vector<int> bucket(pts_.size());
+  start_.assign(static_cast<std::size_t>(nx_ * ny_ + 1), 0);
+  for (std::size_t s = 0; s < pts_.size(); ++s) {
+    const int i = std::clamp(static_cast<int>((pts_[s].x() - x0_) / cell_), 0, nx_ - 1);
+    const int j = std::clamp(static_cast<int>((pts_[s].y() - y0_) / cell_), 0, ny_ - 1);
+    bucket[s] = j * nx_ + i;
+    ++start_[static_cast<std::size_t>(bucket[s] + 1)];
+  }
+  for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
+  order_.resize(pts_.size());
+  std::vector<int> fill(start_.begin(), start_.end() - 1);
+  for (std::size_t s = 0; s < pts_.size(); ++s) order_[static_cast<std::size_t>(fill[bucket[s]]++)] = static_cast<int>(s);
+}
+
+}  // namespace tmm
