@@ -105,6 +105,7 @@ def run_core(case: Case, out: Path) -> dict[str, Any]:
     """Without FreeCAD: the same raster from the core, for the picture only."""
     from tmm_workbench.core.tools.cutter import Cutter
     from tmm_workbench.core.geometry.mesh import load_stl
+    from tmm_workbench.core.linking import LinkPolicy
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute_surface_toolpath
 
     p = case.params
@@ -115,10 +116,9 @@ def run_core(case: Case, out: Path) -> dict[str, Any]:
     mesh = load_stl(case.model)
     lo, hi = mesh.bounds
     params = SurfaceParams(boundary=(lo[0], lo[1], hi[0], hi[1]), stepover=p["stepover"],
-                           sample_step=p["sample_step"], safe_height=float(hi[2]) + 5,
-                           clearance_height=float(hi[2]) + 15, angle_deg=p.get("angle_deg", 0.0),
+                           sample_step=p["sample_step"], angle_deg=p.get("angle_deg", 0.0),
                            off_model=p.get("off_model", "floor"))
-    tp = compute_surface_toolpath(mesh, cutter, params)
+    tp = compute_surface_toolpath(mesh, cutter, params, LinkPolicy(float(hi[2]) + 5, float(hi[2]) + 15))
     return dict(mesh=mesh, toolpath=tp, seconds=time.perf_counter() - t0, files=[])
 
 
@@ -188,6 +188,7 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     benchmarks.seed.experiment is there) the seed's section-deviation plot at y = 27 mm."""
     from tmm_workbench.core.geometry import bezier
     from tmm_workbench.core.strategies.multipoint import BezierFace, MultipointParams, compute_multipoint_toolpath
+    from tmm_workbench.core.tools.cutter import Cutter
     from tmm_workbench.core.preview.axes_png import face_grid, render_axes_png
 
     net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
@@ -209,7 +210,7 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
                 surf.setPole(i + 1, j + 1, FreeCAD.Vector(*map(float, net[i, j])))
         r = run_multipoint(surf, **p, out_dir=out, name=MP_NAME, fcstd_path=out / f"{MP_NAME}.FCStd",
                            doc_name=MP_NAME)
-        face, results, core_tp = r.op.Proxy.face, r.results, r.core_toolpath
+        face, results, core_tp = r.op.Proxy.face, r.results, r.toolpath
         n_commands, summary = len(r.op.Path.Commands), r.op.ContactSummary
         files += [r.files["tarus"], r.files["apt_cl"], r.files["fcstd"]]
         try:
@@ -219,9 +220,9 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     else:
         face = BezierFace.from_net(net, name="seed convex")
         core_tp, results = compute_multipoint_toolpath(
-            face, p["Ro"], p["Ri"], MultipointParams(side_step=p["side_step"], pass_spacing=p["pass_spacing"],
-                                               forward_step=p["forward_step"]),
-            p["method"])
+            face, Cutter.torus(p["Ro"], p["Ri"]),
+            MultipointParams(side_step=p["side_step"], pass_spacing=p["pass_spacing"],
+                             forward_step=p["forward_step"], method=p["method"]))
         n_commands, summary = 0, ""
     seconds = time.perf_counter() - t0
 

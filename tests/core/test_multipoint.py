@@ -12,6 +12,7 @@ import pytest
 from tests.conftest import SEED_JSON
 from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.geometry.bspline import bspline_point, bspline_to_bezier, flat_knots
+from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointParams,
                                            compute_multipoint_toolpath, multipoint_footprint, position_points)
@@ -76,7 +77,7 @@ def seed_run(request):
     net = seed_net(request.param)
     face = BezierFace.from_net(net, name=request.param)
     params = MultipointParams(side_step=18.0, forward_step=2.0, margin=0.0)
-    path, res = compute_multipoint_toolpath(face, RO, RI, params, method="vcrf")
+    path, res = compute_multipoint_toolpath(face, Cutter.torus(RO, RI), params)
     return request.param, net, face, path, res
 
 
@@ -227,7 +228,7 @@ def test_ball_is_one_contact_flat_and_bad_radii_refused():
     with pytest.raises(TmmError, match="method"):
         position_points(face, 6.7, 6.0, np.array([[60.0, 70.0]]), method="newton")
     with pytest.raises(TmmError, match="side step"):
-        compute_multipoint_toolpath(face, 6.7, 6.0, MultipointParams(side_step=0.0))
+        compute_multipoint_toolpath(face, Cutter.torus(6.7, 6.0), MultipointParams(side_step=0.0))
 
 
 def test_bull_nose_on_convex_keeps_one_contact_without_gouge():
@@ -241,7 +242,7 @@ def test_bull_nose_on_convex_keeps_one_contact_without_gouge():
 def test_any_feed_direction_and_margin():
     face = BezierFace.from_net(seed_net("concave"))
     params = MultipointParams(side_step=25.0, forward_step=5.0, feed_angle_deg=30.0, margin=-10.0)
-    path, res = compute_multipoint_toolpath(face, RO, RI, params)
+    path, res = compute_multipoint_toolpath(face, Cutter.torus(RO, RI), params)
     assert len(res) > 20
     assert res.xy[:, 0].min() >= 10.0 - 1e-9 and res.xy[:, 0].max() <= 140.0 + 1e-9
     assert (res.status != STATUS_FAILED).all()
@@ -258,10 +259,10 @@ def test_progress_and_cancel():
         seen.append(f)
         return True
 
-    compute_multipoint_toolpath(face, RO, RI, MultipointParams(side_step=10.0, forward_step=1.0), progress=progress)
+    compute_multipoint_toolpath(face, Cutter.torus(RO, RI), MultipointParams(side_step=10.0, forward_step=1.0), progress=progress)
     assert seen and seen[-1] == 1.0
     with pytest.raises(Cancelled):
-        compute_multipoint_toolpath(face, RO, RI, MultipointParams(side_step=5.0, forward_step=0.5),
+        compute_multipoint_toolpath(face, Cutter.torus(RO, RI), MultipointParams(side_step=5.0, forward_step=0.5),
                                     progress=lambda f: False)
 
 

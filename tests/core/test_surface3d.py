@@ -8,20 +8,28 @@ from tests.conftest import closest_distances, grid_mesh
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies.raster_drop import OFF_MODEL_SKIP, ONEWAY, SurfaceParams, compute_surface_toolpath
 from tmm_workbench.core.toolpath import MoveKind
 
 
-def params(**kw) -> SurfaceParams:
+def params(**kw) -> dict:
+    """Strategy parameters and heights of a test case (run() splits them)."""
     base = dict(boundary=(2.0, 2.0, 38.0, 28.0), stepover=2.0, sample_step=0.5, safe_height=10.0,
                 clearance_height=15.0)
     base.update(kw)
-    return SurfaceParams(**base)
+    return base
+
+
+def run(mesh, cutter, case: dict, progress=None):
+    case = dict(case)
+    policy = LinkPolicy(case.pop("safe_height"), case.pop("clearance_height"))
+    return compute_surface_toolpath(mesh, cutter, SurfaceParams(**case), policy, progress)
 
 
 def test_zigzag_structure_and_gouge_free(wavy_mesh):
     cutter = Cutter.ball(4.0)
-    tp = compute_surface_toolpath(wavy_mesh, cutter, params())
+    tp = run(wavy_mesh, cutter, params())
     kinds = [m.kind for m in tp]
     assert kinds[:3] == [MoveKind.RAPID, MoveKind.RAPID, MoveKind.PLUNGE]
     assert tp.moves[0].z == 15.0 and tp.moves[1].z == 10.0 and tp.moves[-1].z == 15.0
@@ -38,7 +46,7 @@ def test_zigzag_structure_and_gouge_free(wavy_mesh):
 
 
 def test_oneway_retracts_between_passes(wavy_mesh):
-    tp = compute_surface_toolpath(wavy_mesh, Cutter.flat(4.0), params(pattern=ONEWAY, stepover=3.0))
+    tp = run(wavy_mesh, Cutter.flat(4.0), params(pattern=ONEWAY, stepover=3.0))
     plunges = [i for i, m in enumerate(tp.moves) if m.kind is MoveKind.PLUNGE]
     passes = int(np.ceil((28.0 - 2.0) / 3.0)) + 1
     assert len(plunges) == passes
@@ -51,7 +59,7 @@ def test_oneway_retracts_between_passes(wavy_mesh):
 
 
 def test_raster_angle_rotates_passes(wavy_mesh):
-    tp = compute_surface_toolpath(wavy_mesh, Cutter.ball(3.0), params(angle_deg=90.0, pattern=ONEWAY))
+    tp = run(wavy_mesh, Cutter.ball(3.0), params(angle_deg=90.0, pattern=ONEWAY))
     i = next(i for i, m in enumerate(tp.moves) if m.kind is MoveKind.PLUNGE)
     assert tp.moves[i + 1].x == pytest.approx(tp.moves[i].x) and tp.moves[i + 1].y > tp.moves[i].y
 
@@ -59,7 +67,7 @@ def test_raster_angle_rotates_passes(wavy_mesh):
 def test_stock_to_leave_offsets_the_surface():
     plate = grid_mesh(lambda x, y: 0 * x + 5.0, 10, 10, (0, 0, 20, 20), "plate")
     for cutter in (Cutter.ball(4.0), Cutter.flat(4.0), Cutter.bull(6.0, 1.0)):
-        tp = compute_surface_toolpath(plate, cutter, params(boundary=(4, 4, 16, 16), stock_to_leave=0.3))
+        tp = run(plate, cutter, params(boundary=(4, 4, 16, 16), stock_to_leave=0.3))
         np.testing.assert_allclose(tp.cutting_points()[:, 2], 5.3, atol=1e-12)
 
 
@@ -67,9 +75,9 @@ def test_stock_to_leave_on_a_slope_is_a_normal_offset():
     # Plane at 30 degrees: the ball centre must be R + s from the plane, i.e. tip raised by s / cos(30).
     t = np.tan(np.radians(30))
     slope = grid_mesh(lambda x, y: t * x, 20, 20, (0, 0, 40, 40), "slope")
-    a = compute_surface_toolpath(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), safe_height=40,
+    a = run(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), safe_height=40,
                                                                  clearance_height=45))
-    b = compute_surface_toolpath(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), stock_to_leave=0.5,
+    b = run(slope, Cutter.ball(6.0), params(boundary=(10, 10, 30, 30), stock_to_leave=0.5,
                                                                  safe_height=40, clearance_height=45))
     np.testing.assert_allclose(b.cutting_points()[:, 2] - a.cutting_points()[:, 2],
                                0.5 / np.cos(np.radians(30)), atol=1e-9)
@@ -87,12 +95,12 @@ def test_stock_to_leave_on_a_slope_is_a_normal_offset():
 ])
 def test_bad_parameters_raise_clear_errors(wavy_mesh, change, message):
     with pytest.raises(TmmError, match=message):
-        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(**change))
+        run(wavy_mesh, Cutter.ball(4.0), params(**change))
 
 
 def test_cancel(wavy_mesh):
     with pytest.raises(Cancelled):
-        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(sample_step=0.001),
+        run(wavy_mesh, Cutter.ball(4.0), params(sample_step=0.001),
                                  progress=lambda f: False)
 
 
@@ -109,8 +117,8 @@ def two_islands() -> TriMesh:
 def test_off_model_skip_cuts_only_over_the_model(pattern):
     mesh, cutter = two_islands(), Cutter.ball(4.0)
     p = params(boundary=(0.0, 1.0, 30.0, 19.0), stepover=3.0, sample_step=0.5, pattern=pattern)
-    floor = compute_surface_toolpath(mesh, cutter, p)
-    skip = compute_surface_toolpath(mesh, cutter, params(**{**p.__dict__, "off_model": OFF_MODEL_SKIP}))
+    floor = run(mesh, cutter, p)
+    skip = run(mesh, cutter, params(**{**p, "off_model": OFF_MODEL_SKIP}))
     # Floor: the tool runs along the model's lowest point between the islands (the ball touches nothing there).
     across = [(a, b) for a, b in zip(floor.moves, floor.moves[1:]) if b.kind is MoveKind.FEED
               and min(a.x, b.x) < 12.5 and max(a.x, b.x) > 17.0]
@@ -142,9 +150,9 @@ def test_off_model_skip_cuts_only_over_the_model(pattern):
 def test_off_model_skip_with_no_model_under_the_boundary_is_an_error():
     p = params(boundary=(13.0, 1.0, 17.0, 19.0), off_model=OFF_MODEL_SKIP)
     with pytest.raises(TmmError, match="over no part of the model"):
-        compute_surface_toolpath(two_islands(), Cutter.ball(4.0), p)
+        run(two_islands(), Cutter.ball(4.0), p)
 
 
 def test_off_model_must_be_floor_or_skip(wavy_mesh):
     with pytest.raises(TmmError, match="off-model must be"):
-        compute_surface_toolpath(wavy_mesh, Cutter.ball(4.0), params(off_model="air"))
+        run(wavy_mesh, Cutter.ball(4.0), params(off_model="air"))

@@ -14,6 +14,7 @@ import FreeCAD
 import Mesh
 
 from tmm_workbench.app import job as jobs
+from tmm_workbench.app import tools
 from tmm_workbench.app import op_surface, posts
 from tmm_workbench.core.shared_data import shared_dir
 
@@ -86,7 +87,7 @@ def job_with_op(doc: Any, model: Any, shape: str = "ballend", diameter: float = 
     jm = jobs.prepare_model(doc, model)
     doc.recompute()
     job = jobs.create_job(doc, jm.job_base)
-    bit = jobs.make_tool_bit(doc, shape, diameter, corner_radius)
+    bit = tools.make_tool_bit(doc, shape, diameter, corner_radius)
     tc = jobs.set_tool(job, bit, horiz_mm_min / 60, vert_mm_min / 60, 12000)
     vals = {"StepOver": 2.0, "SampleStep": 1.0}
     vals.update({"StlFile": jm.stl_file} if jm.stl_file else {"Model": jm.link})

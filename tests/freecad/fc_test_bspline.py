@@ -8,6 +8,7 @@ import FreeCAD
 import numpy as np
 import Part
 
+from tmm_workbench.app import geometry
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.strategies.multipoint import BezierFace, position_points
 
@@ -44,19 +45,19 @@ class BsplineExact(unittest.TestCase):
 
     def test_bspline_surface(self) -> None:
         s = bspline()
-        face = BezierFace.from_freecad_surface(s)
+        face = geometry.bezier_face(s)
         self.assertEqual((face.native.nu, face.native.nv), (4, 3))
         self.compare(s, face)
 
     def test_periodic_bspline_made_non_periodic(self) -> None:
         s = bspline(periodic=True)
         self.assertTrue(s.isUPeriodic())
-        face = BezierFace.from_freecad_surface(s)
+        face = geometry.bezier_face(s)
         self.compare(s, face)
 
     def test_rational_bspline_refused(self) -> None:
         with self.assertRaisesRegex(TmmError, "rational"):
-            BezierFace.from_freecad_surface(bspline(rational=True))
+            geometry.bezier_face(bspline(rational=True))
 
     def test_bezier_surface_and_positioning(self) -> None:
         z = [80, 70, 70, 80, 70, 55, 55, 70, 70, 55, 55, 70, 80, 70, 70, 80]
@@ -65,7 +66,7 @@ class BsplineExact(unittest.TestCase):
         for i in range(4):
             for j in range(4):
                 b.setPole(i + 1, j + 1, V(50.0 * i, 50.0 * j, float(z[4 * i + j])))
-        face = BezierFace.from_freecad_surface(b)
+        face = geometry.bezier_face(b)
         self.compare(b, face)
         res = position_points(face, 6.7, 6.0, np.array([[75.0, 75.0], [40.0, 110.0]]))
         self.assertTrue((res.status != 2).all(), res.reason_texts())

@@ -8,6 +8,7 @@ import Part
 
 from fc_helpers import OUT, FreeCADTestCase, bump_stl, bump_triangles, job_with_op, new_doc, write_ascii_stl
 from tmm_workbench.app import job as jobs
+from tmm_workbench.app import tools
 from tmm_workbench.core.errors import TmmError
 
 
@@ -59,7 +60,7 @@ class BadInput(FreeCADTestCase):
         self.assertFails("nan.stl", "finite")
 
     def test_corner_radius_larger_than_radius(self) -> None:
-        bit = jobs.make_tool_bit(self.doc, "bullnose", 4.0, 3.0)  # FlatRadius -1
+        bit = tools.make_tool_bit(self.doc, "bullnose", 4.0, 3.0)  # FlatRadius -1
         self.tc.Tool = bit
         self.assertFails("corner radius 3 mm is larger than the tool radius 2 mm")
 

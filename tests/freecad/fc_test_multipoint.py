@@ -72,13 +72,13 @@ class MultipointOp(FreeCADTestCase):
         self.assertEqual(decoded[-1].axis, (0.0, 0.0, 1.0))  # and ends upright
         self.assertAlmostEqual(decoded[0].tip[2], op.ClearanceHeight.Value, places=9)
 
-        # the cut moves are the core's tool path, tip and axis, within 1e-6
-        core = r.core_toolpath
-        cut_core = [m for m in core if m.kind.name != "RAPID"]
+        # the cut moves are the strategy's cut segments, tip and axis, within 1e-6 (linked once)
+        cut_tips = np.vstack([s.tips for s in r.segments])
+        cut_axes = np.vstack([s.axes for s in r.segments])
         cut_path = [m for m in decoded if m.name == "G1"]
-        self.assertEqual(len(cut_path), len(cut_core))
-        np.testing.assert_allclose([m.tip for m in cut_path], [(m.x, m.y, m.z) for m in cut_core], atol=1e-6)
-        np.testing.assert_allclose([m.axis for m in cut_path], [m.axis for m in cut_core], atol=1e-9)
+        self.assertEqual(len(cut_path), len(cut_tips))
+        np.testing.assert_allclose([m.tip for m in cut_path], cut_tips, atol=1e-6)
+        np.testing.assert_allclose([m.axis for m in cut_path], cut_axes, atol=1e-9)
         # tilted where the core reports two contacts
         two = r.results.status == STATUS_TWO
         tips = r.results["tip"][two]

@@ -10,6 +10,7 @@ import Path as FCPath
 
 from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
 from tmm_workbench.app import job as jobs
+from tmm_workbench.app import tools
 from tmm_workbench.app.compat import PathToolBit
 from tmm_workbench.app.tools import cutter_from_tool, shape_name
 from tmm_workbench.core.errors import TmmError
@@ -48,12 +49,12 @@ class ToolMapping(FreeCADTestCase):
 
     def test_made_bits(self) -> None:
         doc = new_doc()
-        bit = jobs.make_tool_bit(doc, "bullnose", 10.0, 2.0)
+        bit = tools.make_tool_bit(doc, "bullnose", 10.0, 2.0)
         self.assertEqual(shape_name(bit), "bullnose")
         self.assertAlmostEqual(bit.FlatRadius.Value, 3.0)
         c = cutter_from_tool(bit)
         self.assertEqual((c.kind, c.diameter, c.corner_radius), ("bull", 10.0, 2.0))
-        c = cutter_from_tool(jobs.make_tool_bit(doc, "endmill", 3.175))
+        c = cutter_from_tool(tools.make_tool_bit(doc, "endmill", 3.175))
         self.assertEqual((c.kind, c.diameter), ("flat", 3.175))
 
     def test_other_shapes_are_refused_by_name(self) -> None:

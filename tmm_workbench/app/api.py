@@ -24,14 +24,19 @@ from typing import Any, Callable, Optional, Sequence, Union
 import FreeCAD
 
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import op_surface, posts
+from tmm_workbench.app import posts, registry, tools
 from tmm_workbench.app import progress as progress_mod
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.toolpath import Toolpath
 
-TOOL_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "flat": "endmill",
-                "bullnose": "bullnose", "bull": "bullnose"}
+TOOL_ALIASES = tools.SHAPE_ALIASES
+_LENGTH = Spec("", "mm")
+_POSITIVE = Spec("", "mm", low=0, low_open=True, kind="length")
+_NON_NEGATIVE = Spec("", "mm", low=0, kind="length")
+_FEED = Spec("", "mm/min", low=0, low_open=True)
+_SPEED = Spec("", "rpm", low=0)
 PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
@@ -65,6 +70,15 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
+    from tmm_workbench.core.strategies.raster_drop import SurfaceParams
+
+    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+             stepover=(stepover, spec_of(SurfaceParams, "stepover")),
+             sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
+             angle_deg=(angle_deg, spec_of(SurfaceParams, "angle_deg")),
+             stock_to_leave=(stock_to_leave, spec_of(SurfaceParams, "stock_to_leave")), margin=(margin, _LENGTH),
+             safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
+             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
     shape = _option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)
     boundary_name = _option("boundary", boundary, BOUNDARY_NAMES)
@@ -99,6 +113,16 @@ def _option(label: str, value: Any, names: dict[str, str], shown: Optional[Seque
     return prop
 
 
+def _numbers(**values: tuple[Any, Spec]) -> None:
+    """Each API argument checked against its range by its own name (None: the default is derived)."""
+    from dataclasses import replace
+
+    for name, (value, spec) in values.items():
+        if value is None and name.endswith("_height"):
+            continue
+        check(replace(spec, label=name), value)
+
+
 def _by_core_name(props: dict[str, str]) -> dict[str, str]:
     """An op's enumeration table (property value -> core name) turned round: core name -> property value."""
     return {core: prop for prop, core in props.items()}
@@ -116,7 +140,7 @@ def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: flo
     clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
 
     job = jobs.create_job(doc, jm.job_base)
-    bit = jobs.make_tool_bit(doc, shape, diameter, corner_radius)
+    bit = tools.make_tool_bit(doc, shape, diameter, corner_radius)
     tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
     values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
               "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
@@ -125,7 +149,7 @@ def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: flo
         values["StlFile"] = jm.stl_file
     else:
         values["Model"] = jm.link
-    op = op_surface.Create(op_surface.OP_NAME, parentJob=job, values=values)
+    op = registry.create("TMM_Surface", job, values)
     if post in _job_posts(job):
         job.PostProcessor = post
         job.PostProcessorArgs = posts.DEFAULT_ARGS.get(post, "")
@@ -175,7 +199,7 @@ class MultipointResult:
     op: Any                   # the TMM_Multipoint operation
     face: tuple[Any, str]     # (object, "FaceN") the op machines (the Job's model clone)
     toolpath: Toolpath        # the op's linked tool path (what its Path encodes)
-    core_toolpath: Toolpath   # the core's tool path (cut moves identical to the op's)
+    segments: list            # the strategy's cut segments the tool path links (core.segments.CutSegment)
     results: Any              # core.multipoint.MultipointResults (per footprint point)
     gcode: dict               # post name -> text
     files: dict               # post name -> written file (when out_dir is given), "fcstd" -> document
@@ -211,18 +235,29 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
     document opened by the call is closed first).
     """
-    from tmm_workbench.app import op_multipoint
+    from tmm_workbench.app import geometry, op_multipoint
     from tmm_workbench.app import posts as posts_mod
+    from tmm_workbench.core.strategies.multipoint import MultipointParams, face_top
+    from tmm_workbench.core.tools.cutter import Cutter
 
     method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
     shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))
     anchor_name = _option("footprint_anchor", footprint_anchor, _by_core_name(op_multipoint.ANCHORS))
     spacing_name = _option("pass_spacing", pass_spacing, _by_core_name(op_multipoint.PASS_SPACINGS))
-    for label, v in (("Ro", Ro), ("Ri", Ri)):
-        if not isinstance(v, (int, float)) or not v >= 0:
-            raise TmmError(f"{label} must be a length >= 0 mm, got {v!r}")
+    _numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
+             side_step=(side_step, spec_of(MultipointParams, "side_step")),
+             forward_step=(forward_step, spec_of(MultipointParams, "forward_step")),
+             feed_angle_deg=(feed_angle_deg, spec_of(MultipointParams, "feed_angle_deg")), margin=(margin, _LENGTH),
+             tilt_limit_deg=(tilt_limit_deg if tilt_limit_deg is not None else 45.0,
+                             spec_of(MultipointParams, "beta_max_deg")),
+             tolerance=(tolerance if tolerance is not None else 1e-3, spec_of(MultipointParams, "tol")),
+             axis_retract=(axis_retract, _NON_NEGATIVE),
+             surface_extension=(surface_extension, spec_of(MultipointParams, "extend")),
+             safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
+             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
     if Ro + Ri <= 0:
         raise TmmError("the tool has no size: Ro + Ri must be > 0")
+    cutter = Cutter.flat(2 * Ro) if Ri == 0 else Cutter.torus(Ro, Ri)  # a flat one is refused by the op
 
     source_obj, sub = _face_pair(face_source)
     own_doc = source_obj is None
@@ -233,7 +268,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         doc.recompute()
         try:
             surf = op_multipoint.face_surface(source_obj, sub)
-            top = op_multipoint.face_top(op_multipoint.BezierFace.from_freecad_surface(surf))
+            top = face_top(geometry.bezier_face(surf))
         except TmmError:  # the op reports it (and keeps its message as its status)
             top = source_obj.Shape.BoundBox.ZMax
         safe = top + 5.0 if safe_height is None else float(safe_height)
@@ -241,12 +276,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
 
         job = jobs.create_job(doc, source_obj, name="Job")
         clone = job.Model.Group[-1]
-        if Ro > 0 and Ri > 0:
-            bit = jobs.make_tool_bit(doc, "bullnose", 2 * (Ro + Ri), Ri)
-        elif Ri > 0:
-            bit = jobs.make_tool_bit(doc, "ballend", 2 * Ri)
-        else:
-            bit = jobs.make_tool_bit(doc, "endmill", 2 * Ro)
+        bit = tools.bit_for_cutter(doc, cutter)
         tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
         values: dict[str, Any] = {
             "Base": [(clone, (sub,))], "Method": method_name, "ToolShape": shape_name, "SideStep": side_step,
@@ -257,7 +287,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             values["TiltLimit"] = tilt_limit_deg
         if tolerance is not None:
             values["Tolerance"] = tolerance
-        op = op_multipoint.Create(op_multipoint.OP_NAME, parentJob=job, values=values)
+        op = registry.create(op_multipoint.OP_NAME, job, values)
         if posts and posts[0] in _job_posts(job):
             job.PostProcessor = posts[0]
             job.PostProcessorArgs = posts_mod.DEFAULT_ARGS.get(posts[0], "--no-show-editor")
@@ -283,7 +313,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         doc.saveAs(str(fcstd_path))
         files["fcstd"] = Path(fcstd_path)
     p = op.Proxy
-    return MultipointResult(doc, job, op, (clone, sub), p.toolpath, p.core_toolpath, p.results, gcode, files)
+    return MultipointResult(doc, job, op, (clone, sub), p.toolpath, p.segments, p.results, gcode, files)
 
 
 def _face_pair(source: Any) -> tuple[Any, str]:

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl
 
 DEFAULT_DEFLECTION_MM = 0.01
@@ -82,3 +83,31 @@ def combine(meshes: list[TriMesh], name: str = "model") -> TriMesh:
         tris.append(m.triangles + offset)
         offset += len(m.vertices)
     return TriMesh(np.concatenate(verts), np.concatenate(tris), name=name)
+
+
+def bezier_face(surface: Any, name: str = "face") -> BezierFace:
+    """A Part.BSplineSurface or Part.BezierSurface as the core's face, exactly. Periodic B-splines are made
+    non-periodic on a copy first (same geometry); rational ones are refused unless all weights are 1."""
+    def weights_of(srf):
+        # OCC answers zeros for the weights of a non-rational surface made non-periodic: ask first.
+        rational = getattr(srf, "isURational", lambda: True)() or getattr(srf, "isVRational", lambda: True)()
+        return np.array(srf.getWeights(), dtype=float) if rational and hasattr(srf, "getWeights") else None
+
+    poles = np.array([[tuple(p) for p in row] for row in surface.getPoles()], dtype=float)
+    weights = weights_of(surface)
+    if hasattr(surface, "getUKnots"):  # B-spline
+        if surface.isUPeriodic() or surface.isVPeriodic():
+            surface = surface.copy()
+            if surface.isUPeriodic():
+                surface.setUNotPeriodic()
+            if surface.isVPeriodic():
+                surface.setVNotPeriodic()
+            poles = np.array([[tuple(p) for p in row] for row in surface.getPoles()], dtype=float)
+            weights = weights_of(surface)
+        return BezierFace.from_bspline(poles, surface.UDegree, surface.VDegree, surface.getUKnots(),
+                                      surface.getUMultiplicities(), surface.getVKnots(), surface.getVMultiplicities(),
+                                      weights, name=name)
+    if weights is not None and np.max(np.abs(weights - 1.0)) > 1e-12:
+        raise TmmError(f"{name}: rational Bézier surface (weights not all 1) is not supported")
+    return BezierFace.from_net(poles, name=name)
+

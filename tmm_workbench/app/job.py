@@ -1,4 +1,5 @@
-"""Job glue: a Path Job for a mesh, an STL file or a Part object, and its tool."""
+"""Job glue: a Path Job for a mesh, an STL file or a Part object, and its tool controller (ToolBits are
+made by app.tools, the one ToolBit map)."""
 from __future__ import annotations
 
 import os
@@ -9,14 +10,10 @@ from typing import Any, Optional, Union
 import FreeCAD
 
 from tmm_workbench.app import geometry, hooks, model_proxy
-from tmm_workbench.app.compat import PathJob, PathToolBit
+from tmm_workbench.app.compat import PathJob
 from tmm_workbench.core.errors import TmmError
 
 ModelInput = Union[str, os.PathLike, Any]  # STL path, Mesh::Feature or Part::Feature
-
-# ToolBit shape files shipped with FreeCAD (Mod/Path/Tools/Shape)
-BIT_SHAPES = {"endmill": "endmill.fcstd", "ballend": "ballend.fcstd", "bullnose": "bullnose.fcstd"}
-
 
 @dataclass
 class JobModel:
@@ -51,20 +48,6 @@ def create_job(doc: Any, base: Any, name: str = "Job") -> Any:
     job = PathJob.Create(name, [base])
     hooks.attach_view("job", job)
     return job
-
-
-def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 0.0, label: str = "") -> Any:
-    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape. For a bull-nose, the 0.20 shape stores
-    FlatRadius = diameter/2 - corner radius (see tools.py)."""
-    if shape not in BIT_SHAPES:
-        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPES)}")
-    params = {"Diameter": f"{diameter} mm"}
-    if shape == "bullnose":
-        params["FlatRadius"] = f"{diameter / 2 - corner_radius} mm"
-    label = label or f"{diameter:g} mm {shape}" + (f" r{corner_radius:g}" if shape == "bullnose" else "")
-    FreeCAD.setActiveDocument(doc.Name)
-    return PathToolBit.Factory.CreateFromAttrs(
-        {"name": label, "shape": BIT_SHAPES[shape], "parameter": params, "attribute": {}}, name="ToolBit")
 
 
 def set_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float,

@@ -1,30 +1,53 @@
-"""What the TMM Path operations share: properties declared as tables, values given at creation, the ToolBit
-shapes an op accepts, and the one way a computation fails (empty Path, message in the report view, op
-marked invalid with that message as its status: no partial path ever)."""
+"""What the TMM Path operations share: properties declared as one table that names the strategy's params
+fields (so properties map to params generically and defaults live in the params dataclass), values given at
+creation, the checks of the op's inputs before FreeCAD's own, and the one way a computation fails (empty
+Path, message in the report view, op marked invalid with that message as its status: no partial path and
+no stale path ever)."""
 from __future__ import annotations
 
+import math
 import traceback
-from typing import Any, Callable, Optional
+from dataclasses import MISSING, fields
+from typing import Any, Callable, NamedTuple, Optional
 
 import FreeCAD
 import Path
 
 from tmm_workbench.app import hooks
 from tmm_workbench.app.compat import PathOp
-from tmm_workbench.app.tools import shape_name
+from tmm_workbench.app.tools import TOOLBIT_SHAPES, cutter_from_tool, label_of, shape_name
+from tmm_workbench.core import kernel
 from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.tools.cutter import Cutter
+
+
+class Prop(NamedTuple):
+    """One row of an op's property table. `field`: the params dataclass field it sets ("" for none)."""
+    type: str
+    name: str
+    group: str
+    tooltip: str
+    field: str = ""
+
+
+def _plain(value: Any) -> Any:
+    """A property value as the core takes it: Quantities in mm / deg, booleans as bool."""
+    if hasattr(value, "Value"):
+        return float(value.Value)
+    return value
 
 
 class TmmOp(PathOp.ObjectOp):
-    """Base of the TMM op proxies. Subclasses set PROPERTIES ((type, name, group, tooltip) rows),
-    ENUMERATIONS (name -> choices), DEFAULTS (name -> value), READ_ONLY (names), SUPPORTED_SHAPES (ToolBit
-    shape names) and implement opExecute through `guarded`."""
+    """Base of the TMM op proxies. Subclasses set PARAMS (the strategy's params dataclass), PROPERTIES
+    (Prop rows), CHOICES (enumeration property -> {property value: core value}), DEFAULTS (values of
+    properties that name no params field), READ_ONLY, and implement `compute(obj)` (opExecute runs it
+    through `guarded`)."""
 
-    PROPERTIES: list[tuple[str, str, str, str]] = []
-    ENUMERATIONS: dict[str, list[str]] = {}
+    PARAMS: Optional[type] = None
+    PROPERTIES: list[Prop] = []
+    CHOICES: dict[str, dict[str, Any]] = {}
     DEFAULTS: dict[str, Any] = {}
     READ_ONLY: tuple[str, ...] = ()
-    SUPPORTED_SHAPES: tuple[str, ...] = ()
     progress_enabled: bool = True
 
     def __init__(self, obj: Any, name: str, parentJob: Any = None,
@@ -33,23 +56,57 @@ class TmmOp(PathOp.ObjectOp):
         self._initial_values = dict(values or {})
         super().__init__(obj, name, parentJob)
 
+    # --- the property table -------------------------------------------------------------------
+    @classmethod
+    def defaults(cls) -> dict[str, Any]:
+        """Every property's default: from the params dataclass for rows that name a field, else DEFAULTS."""
+        out = dict(cls.DEFAULTS)
+        by_name = {f.name: f for f in fields(cls.PARAMS)} if cls.PARAMS else {}
+        for row in cls.PROPERTIES:
+            f = by_name.get(row.field)
+            if f is None or f.default is MISSING or f.default is None:
+                continue
+            value = f.default
+            if row.name in cls.CHOICES:
+                value = {core: prop for prop, core in cls.CHOICES[row.name].items()}[value]
+            out[row.name] = value
+        return out
+
+    def params_from(self, obj: Any, **extra: Any) -> Any:
+        """The strategy's params from the op's properties (rows naming a field) and `extra`."""
+        values: dict[str, Any] = {}
+        for row in self.PROPERTIES:
+            if not row.field:
+                continue
+            value = _plain(getattr(obj, row.name))
+            if row.name in self.CHOICES:
+                value = self.CHOICES[row.name][value]
+            elif row.type == "App::PropertyBool":
+                value = bool(value)
+            values[row.field] = value
+        values.update(extra)
+        params = self.PARAMS(**values)
+        params.validate()
+        return params
+
     def initOperation(self, obj: Any) -> None:
         self.ensure_properties(obj, restoring=False)
 
     def ensure_properties(self, obj: Any, restoring: bool) -> None:
         """Adds missing properties; on restoring, documents from older versions get them with defaults."""
-        for typ, name, group, tip in self.PROPERTIES:
-            if not hasattr(obj, name):
-                obj.addProperty(typ, name, group, tip)
-                if name in self.ENUMERATIONS:
-                    setattr(obj, name, self.ENUMERATIONS[name])
-                if restoring and name in self.DEFAULTS:
-                    setattr(obj, name, self.DEFAULTS[name])
+        defaults = self.defaults()
+        for row in self.PROPERTIES:
+            if not hasattr(obj, row.name):
+                obj.addProperty(row.type, row.name, row.group, row.tooltip)
+                if row.name in self.CHOICES:
+                    setattr(obj, row.name, list(self.CHOICES[row.name]))
+                if restoring and row.name in defaults:
+                    setattr(obj, row.name, defaults[row.name])
         for name in self.READ_ONLY:
             obj.setEditorMode(name, 1)
 
     def opSetDefaultValues(self, obj: Any, job: Any) -> None:
-        for name, value in self.DEFAULTS.items():
+        for name, value in self.defaults().items():
             setattr(obj, name, value)
         for name, value in getattr(self, "_initial_values", {}).items():
             obj.setExpression(name, None)  # a given value replaces the SetupSheet's expression
@@ -57,7 +114,69 @@ class TmmOp(PathOp.ObjectOp):
         self._initial_values = {}
 
     def isToolSupported(self, obj: Any, tool: Any) -> bool:
-        return shape_name(tool) in self.SUPPORTED_SHAPES
+        # every shape TMM maps is offered; the strategy refuses the cutters it cannot use with its reason
+        return shape_name(tool) in TOOLBIT_SHAPES
+
+    # --- computation --------------------------------------------------------------------------
+    def execute(self, obj: Any) -> None:
+        """FreeCAD's ObjectOp.execute returns early, keeping the old Path and leaving the op valid, when the
+        tool controller is missing or the tool's diameter is 0; these and a missing kernel are checked
+        first here and fail the op. If ObjectOp still returns before computing, the op fails too."""
+        if not obj.Active:
+            super().execute(obj)
+            return
+        problem = self.input_problem(obj)
+        if problem:
+            self.fail(obj, problem)
+        self._computed = False
+        super().execute(obj)
+        if not self._computed:
+            self.fail(obj, "FreeCAD did not compute the operation (its Job, model or stock is missing; "
+                           "see the report view)")
+
+    def input_problem(self, obj: Any) -> str:
+        """What makes computing impossible, in the user's terms ('' when nothing)."""
+        from tmm_workbench.app.compat import PathUtils
+
+        if PathUtils.findParentJob(obj) is None:
+            return "the operation is not in a Job"
+        tc = getattr(obj, "ToolController", None)
+        if tc is None or getattr(tc, "ToolNumber", 0) == 0:
+            return "no tool controller: choose one in the operation's panel (ToolController)"
+        tool = getattr(tc, "Tool", None)
+        if tool is None:
+            return f"tool controller '{tc.Label}' has no tool"
+        try:
+            d = float(_plain(tool.Diameter))
+        except (AttributeError, TypeError, ValueError):
+            return f"tool '{label_of(tool)}' has no diameter"
+        if not (math.isfinite(d) and d > 0):
+            return f"tool '{label_of(tool)}': diameter must be a length > 0 mm, got {d:g} mm"
+        for name in ("HorizFeed", "VertFeed"):
+            v = float(_plain(getattr(tc, name, 0.0)))
+            if not math.isfinite(v) or v < 0:
+                return f"tool controller '{tc.Label}': {name} must be a feed >= 0, got {v:g}"
+        if not kernel.available():
+            try:
+                kernel.require()
+            except kernel.KernelMissing as exc:
+                return str(exc)
+        return ""
+
+    def opExecute(self, obj: Any) -> None:
+        self._computed = True
+        self.clear_results()
+        self.guarded(obj, lambda: self.compute(obj))
+
+    def compute(self, obj: Any) -> None:
+        raise NotImplementedError
+
+    def clear_results(self) -> None:
+        """Forgets the transient results of the last run (subclasses name theirs)."""
+
+    def cutter(self) -> Cutter:
+        """The op's tool as the core's cutter (the one ToolBit map)."""
+        return cutter_from_tool(self.tool)
 
     def guarded(self, obj: Any, compute: Callable[[], None]) -> None:
         """Runs the op's computation; a TmmError, a cancel or anything unexpected (a kernel failure, a
@@ -76,6 +195,7 @@ class TmmOp(PathOp.ObjectOp):
         """Empty Path, message in the report view, and an exception: FreeCAD marks the op invalid
         and keeps the message as its status (tree tooltip, `obj.getStatusString()`)."""
         self.commandlist = []
+        self.clear_results()
         obj.Path = Path.Path()
         self.on_fail(obj)
         FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
@@ -96,3 +216,8 @@ def create(proxy_class: type, view_kind: str, name: str, obj: Any = None, parent
     if obj.Proxy is not None:  # not for the SetupSheet's prototypes
         hooks.attach_view(view_kind, obj)
     return obj
+
+
+def setup_properties(proxy_class: type, exclude: tuple[str, ...] = ()) -> list[str]:
+    """Properties the Job's SetupSheet may hold defaults for."""
+    return [row.name for row in proxy_class.PROPERTIES if row.name not in exclude]

@@ -7,7 +7,7 @@ What is machined, first match wins:
   3. the Job's Model: Part solids are tessellated; TMM's stand-in boxes for meshes
      (`model_proxy.ModelBounds`, 0.20 Jobs cannot hold meshes) are replaced by the mesh they stand for.
 
-The tool comes from the op's tool controller (`tools.cutter_from_tool`), feeds from ObjectOp.execute
+The tool comes from the op's tool controller (`tools.cutter_from_tool`, the one ToolBit map), feeds from ObjectOp.execute
 (mm/s in properties: `self.horizFeed` on cutting moves, `self.vertFeed` on plunges; rapids carry no F).
 Errors (TmmError, cancel, anything unexpected) never leave a partial path: the Path is emptied, the
 message goes to the report view and the op is marked invalid with that message (its status string).
@@ -20,11 +20,12 @@ import Path
 
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
-from tmm_workbench.app.tools import SUPPORTED_SHAPES, cutter_from_tool
+from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.strategies.raster_drop import (OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams,
-                                          compute_surface_toolpath)
+from tmm_workbench.core.linking import LinkPolicy
+from tmm_workbench.core.strategies import raster_drop
+from tmm_workbench.core.strategies.raster_drop import OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
@@ -32,41 +33,36 @@ PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY}
 OFF_MODEL = {"Floor": OFF_MODEL_FLOOR, "Skip": OFF_MODEL_SKIP}
 BOUNDARIES = ("Stock", "Model")
 
-# (type, name, group, tooltip)
-PROPERTIES: list[tuple[str, str, str, str]] = [
-    ("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
-    ("App::PropertyLink", "Model", "Model",
-     "Mesh or Part object to machine; empty: the Job's model"),
-    ("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
-    ("App::PropertyEnumeration", "BoundaryShape", "Boundary",
-     "Area covered by the tool tip: the Stock's or the Model's XY bounding box"),
-    ("App::PropertyDistance", "BoundaryMargin", "Boundary",
-     "Grows (positive) or shrinks (negative) the boundary on every side"),
-    ("App::PropertyDistance", "StepOver", "Surface", "Distance between raster passes"),
-    ("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass"),
-    ("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X"),
-    ("App::PropertyEnumeration", "Pattern", "Surface",
-     "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes"),
-    ("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface"),
-    ("App::PropertyEnumeration", "OffModel", "Surface",
-     "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
-     "floor (the model's lowest point); Skip lifts over it and cuts only over the model"),
+PROPERTIES: list[Prop] = [
+    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
+    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
+    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+    Prop("App::PropertyEnumeration", "BoundaryShape", "Boundary",
+         "Area covered by the tool tip: the Stock's or the Model's XY bounding box"),
+    Prop("App::PropertyDistance", "BoundaryMargin", "Boundary",
+         "Grows (positive) or shrinks (negative) the boundary on every side"),
+    Prop("App::PropertyDistance", "StepOver", "Surface", "Distance between raster passes", "stepover"),
+    Prop("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass", "sample_step"),
+    Prop("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X", "angle_deg"),
+    Prop("App::PropertyEnumeration", "Pattern", "Surface",
+         "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes", "pattern"),
+    Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
+    Prop("App::PropertyEnumeration", "OffModel", "Surface",
+         "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
+         "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model"),
 ]
-DEFAULTS: dict[str, Any] = {
-    "LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock", "BoundaryMargin": 0.0,
-    "StepOver": 1.0, "SampleStep": 0.5, "RasterAngle": 0.0, "Pattern": "ZigZag", "StockToLeave": 0.0,
-    "OffModel": "Floor",
-}
-ENUMERATIONS = {"BoundaryShape": list(BOUNDARIES), "Pattern": list(PATTERNS), "OffModel": list(OFF_MODEL)}
+CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL}
+DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
+                            "BoundaryMargin": 0.0}
 
 
 class ObjectTmmSurface(op_base.TmmOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
 
+    PARAMS = SurfaceParams
     PROPERTIES = PROPERTIES
-    ENUMERATIONS = ENUMERATIONS
+    CHOICES = CHOICES
     DEFAULTS = DEFAULTS
-    SUPPORTED_SHAPES = SUPPORTED_SHAPES
     toolpath: Optional[Toolpath] = None
     mesh: Optional[TriMesh] = None
 
@@ -82,19 +78,18 @@ class ObjectTmmSurface(op_base.TmmOp):
             hooks.attach_view("job", job)
 
     # --- computation -------------------------------------------------------------------------
-    def opExecute(self, obj: Any) -> None:
+    def clear_results(self) -> None:
         self.mesh = self.toolpath = None
 
-        def compute() -> None:
-            mesh = self.model_mesh(obj)
-            cutter = cutter_from_tool(self.tool)
-            params = self.surface_params(obj, mesh)
-            with progress.reporter(obj.Label, self.progress_enabled) as cb:
-                toolpath = compute_surface_toolpath(mesh, cutter, params, cb)
-            self.mesh, self.toolpath = mesh, toolpath
-            self.commandlist.extend(self.commands(toolpath))
-
-        self.guarded(obj, compute)
+    def compute(self, obj: Any) -> None:
+        mesh = self.model_mesh(obj)
+        cutter = self.cutter()
+        params = self.params_from(obj, boundary=self.boundary(obj, mesh))
+        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
+        with progress.reporter(obj.Label, self.progress_enabled) as cb:
+            toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
+        self.mesh, self.toolpath = mesh, toolpath
+        self.commandlist.extend(self.commands(toolpath))
 
     def model_mesh(self, obj: Any) -> TriMesh:
         deflection = obj.LinearDeflection.Value
@@ -118,19 +113,6 @@ class ObjectTmmSurface(op_base.TmmOp):
             x0, y0, x1, y1 = float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
         m = obj.BoundaryMargin.Value
         return (x0 - m, y0 - m, x1 + m, y1 + m)
-
-    def surface_params(self, obj: Any, mesh: TriMesh) -> SurfaceParams:
-        return SurfaceParams(
-            boundary=self.boundary(obj, mesh),
-            stepover=obj.StepOver.Value,
-            sample_step=obj.SampleStep.Value,
-            safe_height=obj.SafeHeight.Value,
-            clearance_height=obj.ClearanceHeight.Value,
-            angle_deg=obj.RasterAngle.Value,
-            pattern=PATTERNS[obj.Pattern],
-            stock_to_leave=obj.StockToLeave.Value,
-            off_model=OFF_MODEL[obj.OffModel],
-        )
 
     def commands(self, toolpath: Toolpath) -> list[Any]:
         """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and the
@@ -157,7 +139,7 @@ def _mesh_of(obj: Any, deflection: float) -> TriMesh:
 
 def SetupProperties() -> list[str]:
     """Properties the Job's SetupSheet may hold defaults for."""
-    return [name for _, name, _, _ in PROPERTIES if name not in ("StlFile", "Model")]
+    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model"))
 
 
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,

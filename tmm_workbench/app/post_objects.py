@@ -2,12 +2,13 @@
 
 Duck-typed, no FreeCAD import: a tool controller has `ToolNumber` and `Tool`; anything else with a `Path` is
 an operation (inactive ones skipped, compounds with `Group` expanded). Quantities are read through `.Value`.
+What a ToolBit means (shape, corner radius) comes from the one ToolBit map, app.tools.
 """
 from __future__ import annotations
 
-import os
 from typing import Any, Iterable
 
+from tmm_workbench.app.tools import corner_radius_of, shape_name
 from tmm_workbench.core.post import Operation, Program, ToolInfo
 
 
@@ -28,18 +29,10 @@ def is_tool_controller(obj: Any) -> bool:
 
 def tool_info(tc: Any) -> ToolInfo:
     tool = getattr(tc, "Tool", None)
-    shape = ""
-    if tool is not None:
-        shape = os.path.splitext(os.path.basename(getattr(tool, "BitShape", "") or ""))[0] \
-            or str(getattr(tool, "ShapeName", "") or getattr(tool, "ToolType", "") or "")
+    shape = shape_name(tool) if tool is not None else ""
+    shape = "" if shape == "unknown" else shape
     d = _value(getattr(tool, "Diameter", None))
-    corner = _value(getattr(tool, "CornerRadius", None))
-    if corner is None and shape == "ballend" and d:
-        corner = d / 2
-    if corner is None and hasattr(tool, "FlatRadius") and d:  # 0.20 bull-nose: radius of the flat bottom
-        corner = d / 2 - _value(tool.FlatRadius, 0.0)
-    if corner is None and shape == "endmill":
-        corner = 0.0
+    corner = corner_radius_of(tool) if tool is not None else None
     direction = str(getattr(tc, "SpindleDir", "Forward"))
     spindle_power = getattr(tool, "SpindlePower", True) if tool is not None else True
     return ToolInfo(

@@ -1,4 +1,5 @@
-"""FreeCAD tools (ToolBits, and 0.20's legacy Path.Tool) -> core cutters.
+"""The one ToolBit map: FreeCAD tools (ToolBits of 0.20 and later, 0.20's legacy Path.Tool; duck-typed)
+<-> the core's one tool model (core.tools.Cutter). Nothing else in TMM reads or makes a ToolBit.
 
 ToolBit shapes: endmill -> flat, ballend -> ball, bullnose -> bull-nose, chamfer and v-bit -> a cone
 (the generalized APT cutter with a taper): `CuttingEdgeAngle` is the included tip angle (180: flat, as in
@@ -7,28 +8,38 @@ from these three (the shipped bits' `CuttingEdgeHeight` does not always agree wi
 shape has no corner radius parameter: it stores `FlatRadius`, the radius of the flat bottom, so the
 corner radius is Diameter/2 - FlatRadius (FreeCAD issue #19050; later versions migrate to
 `CornerRadius`, PR #18724 / #25438). A bit that carries `CornerRadius` (or the old torus shape's
-`TorusRadius`) is taken at its word. Legacy tools: EndMill (bull-nose when CornerRadius > 0), BallEndMill.
+`TorusRadius`) is taken at its word. The shape is the bit's shape file name (`BitShape`, 0.20 and 1.0),
+its `ShapeID` / `ShapeName` (1.1), or a legacy tool's `ToolType` (EndMill: bull-nose when CornerRadius
+> 0, BallEndMill). Which cutters a strategy takes is the strategy's data (`SUPPORTED_TOOLS`, Cutter kinds).
 """
 from __future__ import annotations
 
+import math
 import os
-from typing import Any
+from typing import Any, Optional
 
-from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.tools.cutter import Cutter
 
-SUPPORTED_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")
+TOOLBIT_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")  # shapes TMM maps to a cutter
+SUPPORTED_SHAPES = TOOLBIT_SHAPES
 _LEGACY_TYPES = {"EndMill": "endmill", "BallEndMill": "ballend"}  # 0.20's deprecated Path.Tool
+# ToolBit shape files shipped with FreeCAD (Mod/Path/Tools/Shape) that TMM creates bits from
+BIT_SHAPE_FILES = {"endmill": "endmill.fcstd", "ballend": "ballend.fcstd", "bullnose": "bullnose.fcstd"}
+# API names of the shapes TMM creates (lower case) -> ToolBit shape
+SHAPE_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "flat": "endmill",
+                 "bullnose": "bullnose", "bull": "bullnose"}
 
 
 def shape_name(tool: Any) -> str:
-    """'endmill', 'ballend', ... for a ToolBit (from its shape file) or a legacy tool (ToolType)."""
+    """'endmill', 'ballend', ... for a ToolBit (from its shape) or a legacy tool (ToolType)."""
     bit_shape = getattr(tool, "BitShape", "")
     if bit_shape:
-        return os.path.splitext(os.path.basename(bit_shape))[0]
-    shape = getattr(tool, "ShapeName", "")
-    if shape:
-        return shape
+        return os.path.splitext(os.path.basename(str(bit_shape)))[0]
+    for prop in ("ShapeID", "ShapeName"):
+        shape = getattr(tool, prop, "")
+        if shape:
+            return os.path.splitext(os.path.basename(str(shape)))[0]
     legacy = getattr(tool, "ToolType", "")
     return _LEGACY_TYPES.get(legacy, legacy or "unknown")
 
@@ -43,16 +54,28 @@ def _mm(value: Any) -> float:
     return float(value)
 
 
+def label_of(tool: Any) -> str:
+    return str(getattr(tool, "Label", "") or getattr(tool, "Name", "") or "tool")
+
+
+def diameter_of(tool: Any) -> float:
+    """The tool's diameter in mm; TmmError unless finite and > 0."""
+    d = _mm(getattr(tool, "Diameter", float("nan")))
+    if not (math.isfinite(d) and d > 0):
+        raise TmmError(f"tool '{label_of(tool)}': diameter must be a length > 0 mm, got {d:g} mm")
+    return d
+
+
 def cutter_from_tool(tool: Any) -> Cutter:
-    """The core cutter for `tool`; TmmError naming the shape for shapes TMM cannot drop."""
+    """The core cutter for `tool`; TmmError naming the shape for shapes TMM cannot map."""
     if tool is None:
         raise TmmError("the operation has no tool")
     name = shape_name(tool)
-    label = getattr(tool, "Label", getattr(tool, "Name", "tool"))
-    if name not in SUPPORTED_SHAPES:
-        raise TmmError(f"tool '{label}' has the shape '{name}', which TMM 3-axis Surface does not support; "
-                       f"use one of: {', '.join(SUPPORTED_SHAPES)}")
-    d = _mm(tool.Diameter)
+    label = label_of(tool)
+    if name not in TOOLBIT_SHAPES:
+        raise TmmError(f"tool '{label}' has the shape '{name}', which TMM does not support; "
+                       f"use one of: {', '.join(TOOLBIT_SHAPES)}")
+    d = diameter_of(tool)
     if name == "endmill":
         corner = _mm(getattr(tool, "CornerRadius", 0.0))  # legacy tools: an end mill with a corner radius
         return Cutter.bull(d, corner) if corner > 0 else Cutter.flat(d)
@@ -68,7 +91,7 @@ def cutter_from_tool(tool: Any) -> Cutter:
 
 
 def bull_corner_radius(tool: Any, diameter: float) -> float:
-    label = getattr(tool, "Label", "tool")
+    label = label_of(tool)
     for prop in ("CornerRadius", "TorusRadius"):
         if hasattr(tool, prop):
             return _mm(getattr(tool, prop))
@@ -83,3 +106,43 @@ def bull_corner_radius(tool: Any, diameter: float) -> float:
                            f"{diameter / 2:g} mm")
         return corner
     raise TmmError(f"bull-nose tool '{label}' has neither CornerRadius nor FlatRadius")
+
+
+def corner_radius_of(tool: Any) -> Optional[float]:
+    """The corner radius for reports (the post's tool list): from the same map, None where unknown."""
+    try:
+        cutter = cutter_from_tool(tool)
+    except (TmmError, TypeError, ValueError):
+        return None
+    return cutter.corner_radius
+
+
+def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 0.0, label: str = "") -> Any:
+    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape in `doc`. For a bull-nose, the 0.20 shape stores
+    FlatRadius = diameter/2 - corner radius (see the module doc)."""
+    import FreeCAD
+
+    from tmm_workbench.app.compat import PathToolBit
+
+    if shape not in BIT_SHAPE_FILES:
+        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPE_FILES)}")
+    for name, v in (("diameter", diameter), ("corner radius", corner_radius)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v)):
+            raise TmmError(f"tool {name} must be a finite number of mm, got {v!r}")
+    if not diameter > 0:
+        raise TmmError(f"tool diameter must be a length > 0 mm, got {diameter:g}")
+    params = {"Diameter": f"{diameter} mm"}
+    if shape == "bullnose":
+        params["FlatRadius"] = f"{diameter / 2 - corner_radius} mm"
+    label = label or f"{diameter:g} mm {shape}" + (f" r{corner_radius:g}" if shape == "bullnose" else "")
+    FreeCAD.setActiveDocument(doc.Name)
+    return PathToolBit.Factory.CreateFromAttrs(
+        {"name": label, "shape": BIT_SHAPE_FILES[shape], "parameter": params, "attribute": {}}, name="ToolBit")
+
+
+def bit_for_cutter(doc: Any, cutter: Cutter, label: str = "") -> Any:
+    """The ToolBit standing for a core cutter (ball, flat or bull-nose)."""
+    shape = {"ball": "ballend", "flat": "endmill", "bull": "bullnose"}.get(cutter.kind)
+    if shape is None:
+        raise TmmError(f"no FreeCAD ToolBit shape is made for the {cutter.describe()} cutter")
+    return make_tool_bit(doc, shape, cutter.diameter, cutter.corner_radius, label)

@@ -9,10 +9,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from tmm_workbench.app import op_multipoint
+from tmm_workbench.app import registry
 from tmm_workbench.gui import op_page, resources
 
-ICON = resources.icon("TMM_Multipoint")
+ENTRY = registry.entry("TMM_Multipoint")
+ICON = resources.icon(ENTRY.icon)
 # widget name -> property
 SPIN_BOXES = {"sideStep": "SideStep", "forwardStep": "ForwardStep", "feedAngle": "FeedAngle",
               "boundaryMargin": "BoundaryMargin", "tiltLimit": "TiltLimit", "tolerance": "Tolerance",
@@ -42,16 +43,7 @@ class ViewProvider(op_page.OpViewProvider):
     ICON = ICON
 
 
-def attach_view_provider(obj: Any) -> None:
-    """Gives an op created from Python (macro, API) the same view provider as the command's."""
-    op_page.attach_view_provider(obj, ViewProvider, Command.res)
-
-
-def create(res: Any) -> Any:
-    return op_page.create(res, ViewProvider, " (a bullnose or ballend tool is needed)")
-
-
-Command = op_page.command(op_multipoint, TaskPanelOpPage, ICON, "TMM 5-axis Multipoint",
-                          "5-axis finishing of a Bézier or B-spline face with a toroidal cutter by multipoint "
-                          "positioning (select the face first)", create)
-COMMAND_NAME = "Path_" + op_multipoint.OP_NAME
+GUI = op_page.OpGui(ENTRY, TaskPanelOpPage, ViewProvider, " (a bullnose or ballend tool is needed)")
+Command = GUI.command
+attach_view_provider = GUI.attach_view_provider
+COMMAND_NAME = ENTRY.command_name

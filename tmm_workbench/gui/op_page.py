@@ -164,11 +164,26 @@ def create(res: Any, view_provider: type, no_tool_text: str) -> Any:
     return None
 
 
-def command(op_module: Any, page: type, icon: str, menu_text: str, tooltip: str,
-            create_op: Callable[[Any], Any]) -> Any:
-    """PathOpGui.SetupOperation's command (resources and registration), creating through `create_op`:
-    its own would attach PathOpGui's view provider."""
-    cmd = PathOpGui.SetupOperation(op_module.OP_NAME, op_module.Create, page, icon, menu_text, tooltip,
-                                   op_module.SetupProperties)
+def command(entry: Any, page: type, create_op: Callable[[Any], Any]) -> Any:
+    """PathOpGui.SetupOperation's command for a registry entry (resources and registration), creating
+    through `create_op`: its own would attach PathOpGui's view provider."""
+    op_module = entry.app()
+    cmd = PathOpGui.SetupOperation(entry.name, op_module.Create, page, resources.icon(entry.icon),
+                                   entry.menu_text, entry.tooltip, op_module.SetupProperties)
     cmd.Activated = lambda: create_op(cmd.res)
     return cmd
+
+
+class OpGui:
+    """What one op's GUI module registers: its command (from the op registry entry), its view provider for
+    ops made by the command and by Python (API, macros)."""
+
+    def __init__(self, entry: Any, page: type, view_provider: type, no_tool_text: str = "") -> None:
+        self.entry, self.view_provider, self.no_tool_text = entry, view_provider, no_tool_text
+        self.command = command(entry, page, self.create)
+
+    def create(self, res: Any) -> Any:
+        return create(res, self.view_provider, self.no_tool_text)
+
+    def attach_view_provider(self, obj: Any) -> None:
+        attach_view_provider(obj, self.view_provider, self.command.res)

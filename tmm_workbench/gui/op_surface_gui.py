@@ -6,11 +6,12 @@ from typing import Any
 
 from PySide import QtGui
 
-from tmm_workbench.app import model_proxy, op_surface
+from tmm_workbench.app import model_proxy, registry
 from tmm_workbench.app.compat import PathUtils
 from tmm_workbench.gui import op_page, resources
 
-ICON = resources.icon("TMM_Surface")
+ENTRY = registry.entry("TMM_Surface")
+ICON = resources.icon(ENTRY.icon)
 JOB_MODEL = "(Job model)"
 # widget name -> property
 SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampleStep": "SampleStep",
@@ -87,15 +88,7 @@ class ViewProvider(op_page.OpViewProvider):
     ICON = ICON
 
 
-def attach_view_provider(obj: Any) -> None:
-    """Gives an op created from Python (macro, API) the same view provider as the command's."""
-    op_page.attach_view_provider(obj, ViewProvider, Command.res)
-
-
-def create(res: Any) -> Any:
-    return op_page.create(res, ViewProvider, "")
-
-
-Command = op_page.command(op_surface, TaskPanelOpPage, ICON, "TMM 3-axis Surface",
-                          "3-axis raster finishing of a mesh or a Part model (drop-cutter, TMM kernel)", create)
-COMMAND_NAME = "Path_" + op_surface.OP_NAME
+GUI = op_page.OpGui(ENTRY, TaskPanelOpPage, ViewProvider)
+Command = GUI.command
+attach_view_provider = GUI.attach_view_provider
+COMMAND_NAME = ENTRY.command_name

@@ -8,18 +8,16 @@ from __future__ import annotations
 from typing import Any, Callable
 
 
-def _lazy_view(kind: str) -> Callable[[Any], None]:
+def _job_view(obj: Any) -> None:
+    from tmm_workbench.gui import view_providers  # Path's Gui modules load here, not at start-up
+
+    view_providers.attach_job(obj)
+
+
+def _op_view(entry: Any) -> Callable[[Any], None]:
     def attach(obj: Any) -> None:
-        from tmm_workbench.gui import view_providers  # Path's Gui modules load here, not at start-up
-
-        getattr(view_providers, "attach_" + kind)(obj)
+        entry.gui().attach_view_provider(obj)  # Path's Gui modules load here, not at start-up
     return attach
-
-
-def _multipoint_view(obj: Any) -> None:
-    from tmm_workbench.gui import op_multipoint_gui  # Path's Gui modules load here, not at start-up
-
-    op_multipoint_gui.attach_view_provider(obj)
 
 
 def _dialog_progress(label: str) -> Any:
@@ -29,9 +27,9 @@ def _dialog_progress(label: str) -> Any:
 
 
 def install_hooks() -> None:
-    from tmm_workbench.app import hooks, progress
+    from tmm_workbench.app import hooks, progress, registry
 
-    hooks.view_hooks.setdefault("op", _lazy_view("op"))
-    hooks.view_hooks.setdefault("job", _lazy_view("job"))
-    hooks.view_hooks.setdefault("multipoint_op", _multipoint_view)
+    for entry in registry.OPS:
+        hooks.view_hooks.setdefault(entry.view_kind, _op_view(entry))
+    hooks.view_hooks.setdefault("job", _job_view)
     progress.progress_factory = _dialog_progress

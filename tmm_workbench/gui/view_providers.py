@@ -1,15 +1,10 @@
-"""View providers for objects made by App code (InitGui.py registers these in app.hooks, lazily)."""
+"""The Job's view provider for Jobs made by App code (InitGui.py registers it in app.hooks, lazily; each op's
+view provider comes from its GUI module, through the op registry)."""
 from __future__ import annotations
 
 from typing import Any
 
 from tmm_workbench.app.compat import import_gui
-
-
-def attach_op(obj: Any) -> None:
-    from tmm_workbench.gui import op_surface_gui
-
-    op_surface_gui.attach_view_provider(obj)
 
 
 def attach_job(job: Any) -> None:

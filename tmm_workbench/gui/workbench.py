@@ -27,11 +27,13 @@ class TMMWorkbench(FreeCADGui.Workbench):
         import_gui("tool_bit_cmd")
         import_gui("tool_bit_library_cmd")
         import_gui("commands")
-        from tmm_workbench.gui import job_cmd, op_surface_gui
-        from tmm_workbench.gui import op_multipoint_gui
+        from tmm_workbench.app import registry
+        from tmm_workbench.gui import job_cmd
 
         posts.install_post_dir()
-        tmm = [job_cmd.COMMAND_NAME, op_surface_gui.COMMAND_NAME, op_multipoint_gui.COMMAND_NAME]
+        for entry in registry.OPS:
+            entry.gui()  # registers the op's command
+        tmm = [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS]
         self.appendToolbar("TMM", tmm)
         self.appendToolbar("TMM Path", PATH_JOB_TOOLS)
         self.appendToolbar("TMM Tools", PATH_TOOL_TOOLS)

@@ -35,7 +35,7 @@ def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0, spacin
     corners = np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]])
     across = corners @ n
     lo, hi = across.min(), across.max()
-    count = max(1, math.ceil((hi - lo) / stepover - 1e-9)) + 1  # >= 2: both edges
+    count = pass_count(hi - lo, stepover)
     if count > 200000:
         raise TmmError(f"step-over {stepover:g} mm gives {count} passes over the boundary: too many")
     if spacing == EVEN:
@@ -52,6 +52,11 @@ def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0, spacin
         if seg is not None:
             lines.append(seg)
     return lines
+
+
+def pass_count(width: float, stepover: float) -> int:
+    """Passes at most `stepover` apart across `width`, both edges included (>= 2)."""
+    return max(1, math.ceil(width / stepover - 1e-9)) + 1
 
 
 def _clip_line_to_rect(p: np.ndarray, d: np.ndarray, r: Rect) -> np.ndarray | None:

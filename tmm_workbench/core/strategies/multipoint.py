@@ -5,25 +5,34 @@ passes (side step across, forward step along, any feed direction); at each footp
 drops the tool vertically to a first contact P, then tilts it about the pseudo-insert's axis until it
 touches a second point Q (methods "vcrf" and "drd" of the seed). Every position is checked for gouging.
 
-    face = BezierFace.from_net(net)                   # or from_bspline(...), from_patches(...)
-    path, res = compute_multipoint_toolpath(face, Ro=6.7, Ri=6.0, params=MultipointParams(side_step=18))
+    face = BezierFace.from_net(net)                   # or from_bspline(...), from_pieces(...)
+    result = compute(face, Cutter.torus(6.7, 6.0), MultipointParams(side_step=18))   # the strategy
+    path = link(result.segments, link_policy(tool, safe, clearance))                  # the one linker
+    path, res = compute_multipoint_toolpath(face, tool, params)                       # both in one call
 
-`res` holds per footprint point: status ("two" / "one" / "failed"), the reason, P, nP, Q, nQ, the tilt beta,
-tip, axis, centre. The Toolpath's moves carry the tip and the unit tool axis (tip -> spindle).
+`res` (result.diagnostics["results"]) holds per footprint point: status ("two" / "one" / "failed"), the
+reason, P, nP, Q, nQ, the tilt beta, tip, axis, centre. Segments are the runs of good positions of a pass
+(tips and unit tool axes, tip -> spindle); failed positions are not cut: the pass is left and re-entered.
+Work is estimated from the parameters before anything is allocated (core.limits).
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence
+from typing import Callable, Optional
 
 import numpy as np
 
-from tmm_workbench.core.geometry.bspline import BezierPieces, bspline_to_bezier
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.footprint.raster import EVEN, Rect, raster_lines, sample_segment
+from tmm_workbench.core.footprint.raster import EVEN, FIXED, Rect, pass_count, raster_lines, sample_segment
+from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.kernel import native
-from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.linking import ALONG_AXIS, LinkPolicy, link
+from tmm_workbench.core.params import StrategyParams, check_finite, param
+from tmm_workbench.core.segments import CutSegment, StrategyResult
+from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
 
@@ -33,124 +42,42 @@ METHODS = ("vcrf", "drd")
 SHAPES = ("round_insert", "bull_nose")
 ROTATIONS = ("pseudo_insert", "global_x")
 ANCHORS = ("axis", "tip")
-
-
-class BezierFace:
-    """A face of nu x nv Bézier patches (any degree) in the kernel, evaluated exactly."""
-
-    def __init__(self, nets: Sequence[np.ndarray], nu: int = 1, nv: int = 1,
-                 breaks_u: Optional[Sequence[float]] = None, breaks_v: Optional[Sequence[float]] = None,
-                 name: str = "face") -> None:
-        arrs = [np.ascontiguousarray(n, dtype=np.float64) for n in nets]
-        for a in arrs:
-            if a.ndim != 3 or a.shape[2] != 3 or a.shape[0] < 2 or a.shape[1] < 2:
-                raise TmmError(f"{name}: a Bézier control net must have shape (p+1, q+1, 3), p, q >= 1; got {a.shape}")
-            if not np.isfinite(a).all():
-                raise TmmError(f"{name}: Bézier control net has a non-finite coordinate")
-        bu = list(map(float, breaks_u)) if breaks_u is not None else list(np.linspace(0.0, float(nu), nu + 1))
-        bv = list(map(float, breaks_v)) if breaks_v is not None else list(np.linspace(0.0, float(nv), nv + 1))
-        self.name = name
-        try:
-            self._surface = native.PatchSurface(arrs, int(nu), int(nv), bu, bv)
-        except ValueError as exc:
-            raise TmmError(f"{name}: {exc}") from exc
-
-    @classmethod
-    def from_net(cls, net: np.ndarray, name: str = "face") -> "BezierFace":
-        return cls([net], 1, 1, [0.0, 1.0], [0.0, 1.0], name=name)
-
-    @classmethod
-    def from_pieces(cls, pieces: BezierPieces, name: str = "face") -> "BezierFace":
-        return cls(pieces.nets, pieces.nu, pieces.nv, pieces.breaks_u, pieces.breaks_v, name=name)
-
-    @classmethod
-    def from_bspline(cls, poles, degree_u: int, degree_v: int, knots_u, mults_u, knots_v, mults_v,
-                     weights=None, periodic_u: bool = False, periodic_v: bool = False,
-                     name: str = "face") -> "BezierFace":
-        """Exact: the B-spline split into its Bézier patches by knot insertion (see core.bspline)."""
-        return cls.from_pieces(bspline_to_bezier(poles, degree_u, degree_v, knots_u, mults_u, knots_v, mults_v,
-                                                 weights, periodic_u, periodic_v), name=name)
-
-    @classmethod
-    def from_freecad_surface(cls, surface, name: str = "face") -> "BezierFace":
-        """A Part.BSplineSurface or Part.BezierSurface, exactly (duck-typed: the core never imports FreeCAD).
-        Periodic B-splines are made non-periodic on a copy first (same geometry); rational ones are refused
-        unless all weights are 1."""
-        def weights_of(srf):
-            # OCC answers zeros for the weights of a non-rational surface made non-periodic: ask first.
-            rational = getattr(srf, "isURational", lambda: True)() or getattr(srf, "isVRational", lambda: True)()
-            return np.array(srf.getWeights(), dtype=float) if rational and hasattr(srf, "getWeights") else None
-
-        poles = np.array([[tuple(p) for p in row] for row in surface.getPoles()], dtype=float)
-        weights = weights_of(surface)
-        if hasattr(surface, "getUKnots"):  # B-spline
-            if surface.isUPeriodic() or surface.isVPeriodic():
-                surface = surface.copy()
-                if surface.isUPeriodic():
-                    surface.setUNotPeriodic()
-                if surface.isVPeriodic():
-                    surface.setVNotPeriodic()
-                poles = np.array([[tuple(p) for p in row] for row in surface.getPoles()], dtype=float)
-                weights = weights_of(surface)
-            return cls.from_bspline(poles, surface.UDegree, surface.VDegree, surface.getUKnots(),
-                                    surface.getUMultiplicities(), surface.getVKnots(), surface.getVMultiplicities(),
-                                    weights, name=name)
-        if weights is not None and np.max(np.abs(weights - 1.0)) > 1e-12:
-            raise TmmError(f"{name}: rational Bézier surface (weights not all 1) is not supported")
-        return cls.from_net(poles, name=name)
-
-    @property
-    def native(self):
-        return self._surface
-
-    @property
-    def domain(self) -> tuple[float, float, float, float]:
-        return self._surface.domain
-
-    @property
-    def bounds(self) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-        """Box of the control nets (it holds the face)."""
-        return self._surface.bounds
-
-    def evaluate(self, uv: np.ndarray) -> dict[str, np.ndarray]:
-        """S, Su, Sv, Suu, Suv, Svv at (n, 2) global parameters."""
-        return self._surface.evaluate(np.ascontiguousarray(uv, dtype=np.float64).reshape(-1, 2))
-
-    def xy_extent(self, samples: int = 64) -> Rect:
-        """XY extent of the face itself (sampled densely, not the control hull)."""
-        u0, u1, v0, v1 = self.domain
-        u = np.linspace(u0, u1, samples + 1)
-        v = np.linspace(v0, v1, samples + 1)
-        U, V = np.meshgrid(u, v, indexing="ij")
-        S = self.evaluate(np.column_stack([U.ravel(), V.ravel()]))["S"]
-        return float(S[:, 0].min()), float(S[:, 1].min()), float(S[:, 0].max()), float(S[:, 1].max())
+SUPPORTED_TOOLS = ("ball", "bull")  # Cutter.kind values: the toroidal view needs a corner radius > 0
+_BYTES_PER_POSITION = 1200  # kernel results (about 40 doubles) and their numpy copies, per footprint point
 
 
 @dataclass
-class MultipointParams:
-    side_step: float = 18.0          # mm between passes (seed: 18)
-    pass_spacing: str = EVEN         # EVEN: spread evenly, at most side_step apart; FIXED: side_step apart from
-                                     # the start edge, the last pass on the far edge (the seed's footprint)
-    forward_step: float = 2.0        # mm between positions along a pass (seed: 2)
-    feed_angle_deg: float = 90.0     # feed direction from +X (seed: along Y, side step along X)
-    margin: float = 0.0              # the boundary is the face's XY extent grown by this (mm; < 0 shrinks)
+class MultipointParams(StrategyParams):
+    side_step: float = param(18.0, "side step", "mm", low=0, low_open=True, kind="length")
+    # EVEN: spread evenly, at most side_step apart; FIXED: side_step apart from the start edge, the last
+    # pass on the far edge (the seed's footprint)
+    pass_spacing: str = param(EVEN, "pass spacing", choices=(EVEN, FIXED))
+    forward_step: float = param(2.0, "forward step", "mm", low=0, low_open=True, kind="length")
+    feed_angle_deg: float = param(90.0, "feed angle", "deg")  # from +X (seed: along Y, side step along X)
+    margin: float = param(0.0, "boundary margin", "mm")       # the face's XY extent grown by this (< 0 shrinks)
     boundary: Optional[Rect] = None  # explicit (xmin, ymin, xmax, ymax), overrides the face's extent
     zigzag: bool = True              # alternate pass directions
-    clearance: float = 5.0           # rapid height above the face's top, mm
-    shape: str = "round_insert"      # tool solid: the seed's torus with a hollow centre, or a bull-nose
-    rotation: str = "pseudo_insert"  # exact tilt; "global_x" reproduces the seed's pseudo-code
-    beta_max_deg: float = 45.0       # tilt limit (seed: pi/4)
-    extend: float = 0.0              # mm: position against the face continued past its edges (0: off)
-    anchor: str = "axis"             # footprint point = pre-tilt tool axis ("axis", seed) or tilted tip ("tip")
-    anchor_iterations: int = 12      # "tip": at most this many positions per footprint point
-    tol: float = 1e-3                # contact and gouge tolerance, mm
-    sample_spacing: float = 0.0      # surface samples (0: (Ro + Ri) / 8)
-    divisions: int = 6               # VCRF zoom grid (seed 32)
-    refinements: int = 1             # VCRF zoom levels (seed 4)
-    drd_divisions: int = 10          # DRD rays per direction (seed 10)
-    drd_refinements: int = 5         # DRD zoom levels (seed 5)
-    drd_bisections: int = 16         # DRD bisection steps on the tilt
-    threads: int = 0                 # 0: all cores
+    method: str = param("vcrf", "method", choices=METHODS)
+    shape: str = param("round_insert", "tool shape", choices=SHAPES)  # the seed's torus (hollow centre) or a bull-nose
+    rotation: str = param("pseudo_insert", "rotation", choices=ROTATIONS)  # exact tilt; global_x: the seed's code
+    beta_max_deg: float = param(45.0, "tilt limit", "deg", low=0, high=90, low_open=True, high_open=True)
+    extend: float = param(0.0, "surface extension", "mm", low=0, kind="length")  # position against the face
+    #                                                                       continued past its edges (0: off)
+    anchor: str = param("axis", "footprint anchor", choices=ANCHORS)  # pre-tilt axis (seed) or tilted tip
+    anchor_iterations: int = param(12, "anchor iterations", low=1, high=1000, integer=True)
+    tol: float = param(1e-3, "tolerance", "mm", low=1e-9, high=1.0)   # contact and gouge tolerance
+    sample_spacing: float = param(0.0, "sample spacing", "mm", low=0)  # surface samples (0: (Ro + Ri) / 8)
+    divisions: int = param(6, "VCRF divisions", low=2, high=1000, integer=True)       # zoom grid (seed 32)
+    refinements: int = param(1, "VCRF refinements", low=0, high=50, integer=True)     # zoom levels (seed 4)
+    drd_divisions: int = param(10, "DRD divisions", low=2, high=1000, integer=True)   # rays per direction
+    drd_refinements: int = param(5, "DRD refinements", low=0, high=50, integer=True)  # zoom levels (seed 5)
+    drd_bisections: int = param(16, "DRD bisections", low=1, high=200, integer=True)  # bisections of the tilt
+    threads: int = param(0, "threads", low=0, high=1024, integer=True)                # 0: all cores
+
+    def validate(self) -> None:
+        super().validate()
+        if self.boundary is not None:
+            check_finite("boundary", self.boundary)
 
 
 @dataclass
@@ -194,52 +121,21 @@ class MultipointResults:
         return out
 
 
-def _check_tool(Ro: float, Ri: float) -> None:
-    for name, v in (("Ro", Ro), ("Ri", Ri)):
-        if not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise TmmError(f"{name} must be a finite number of mm, got {v!r}")
-    if Ro < 0:
-        raise TmmError(f"major radius Ro must be >= 0 (0 is a ball end mill), got {Ro:g}")
-    if Ri <= 0:
-        raise TmmError("minor radius Ri must be > 0: a flat end mill (Ri = 0) has no pseudo-insert to tilt about; "
-                       f"multipoint positioning needs a toroidal or ball cutter (got Ri = {Ri:g})")
-
-
-def _check_params(p: MultipointParams) -> None:
-    for name in ("side_step", "forward_step"):
-        v = getattr(p, name)
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise TmmError(f"{name.replace('_', ' ')} must be a positive length, got {v!r}")
-    if p.shape not in SHAPES:
-        raise TmmError(f"tool shape must be one of {SHAPES}, got {p.shape!r}")
-    if p.rotation not in ROTATIONS:
-        raise TmmError(f"rotation must be one of {ROTATIONS}, got {p.rotation!r}")
-    if p.anchor not in ANCHORS:
-        raise TmmError(f"footprint anchor must be one of {ANCHORS}, got {p.anchor!r}")
-    if not (isinstance(p.extend, (int, float)) and math.isfinite(p.extend) and p.extend >= 0):
-        raise TmmError(f"surface extension must be a length >= 0, got {p.extend!r}")
-    if not (isinstance(p.anchor_iterations, int) and p.anchor_iterations >= 1):
-        raise TmmError(f"anchor iterations must be an integer >= 1, got {p.anchor_iterations!r}")
-    if not (0 < p.beta_max_deg < 90):
-        raise TmmError(f"tilt limit must be in (0, 90) degrees, got {p.beta_max_deg!r}")
-    if not (p.tol > 0):
-        raise TmmError(f"tolerance must be > 0, got {p.tol!r}")
-
-
 def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.ndarray]:
     """XY parallel passes over the boundary (the face's XY extent grown by `margin`, or `boundary`):
     passes running along `feed_angle_deg`, the first and last on the boundary, spread evenly at most
     `side_step` apart (pass_spacing EVEN) or exactly `side_step` apart from the start edge with the last
     strip narrower (FIXED: the seed keeps 18 mm and squeezes the last pass in at x = 150); points at most
     `forward_step` apart; zigzag optional. One (k, 2) array per pass, the first nearest the boundary's
-    (xmin, ymin) corner."""
-    _check_params(params)
+    (xmin, ymin) corner. The work is estimated first and refused above the limits (core.limits)."""
+    params.validate()
     if params.boundary is not None:
         rect = tuple(map(float, params.boundary))
     else:
         x0, y0, x1, y1 = face.xy_extent()
         m = float(params.margin)
         rect = (x0 - m, y0 - m, x1 + m, y1 + m)
+    estimate_work(rect, params)
     lines = raster_lines(rect, params.side_step, params.feed_angle_deg, params.pass_spacing)
     # Start with the pass nearest the boundary's (xmin, ymin) corner.
     corner = np.array(rect[:2])
@@ -254,34 +150,72 @@ def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.
     return passes
 
 
+def estimate_work(rect: Rect, params: MultipointParams) -> float:
+    """Footprint points over `rect` (an upper bound), refused above the limits before any is made."""
+    w, h = rect[2] - rect[0], rect[3] - rect[1]
+    if not (w > 0 and h > 0):
+        raise TmmError(f"boundary is empty: x {rect[0]:g}..{rect[2]:g}, y {rect[1]:g}..{rect[3]:g}")
+    diagonal = math.hypot(w, h)
+    count = pass_count(diagonal, params.side_step) * (diagonal / params.forward_step + 2)
+    check_work("tool positions", count, _BYTES_PER_POSITION,
+               f"side step {params.side_step:g} mm and forward step {params.forward_step:g} mm over a "
+               f"{w:.4g} x {h:.4g} mm boundary")
+    return count
+
+
+def _torus(tool: Cutter) -> tuple[float, float]:
+    if not isinstance(tool, Cutter):
+        raise TmmError(f"tool must be a core Cutter, got {type(tool).__name__}")
+    if tool.kind not in SUPPORTED_TOOLS:
+        tool.torus_radii  # raises the clear message for a flat end mill
+        raise TmmError(f"the {tool.describe()} cutter is not supported by multipoint positioning "
+                       f"(supported: {', '.join(SUPPORTED_TOOLS)})")
+    return tool.torus_radii
+
+
+def _check_torus(Ro: float, Ri: float) -> None:
+    Cutter.torus(Ro, Ri)  # the one place that checks a torus' radii
+
+
 def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[MultipointParams] = None,
-                    method: str = "vcrf"):
-    """The kernel's positioner (surface samples built once per face and tool)."""
+                    method: Optional[str] = None):
+    """The kernel's positioner for the torus (Ro, Ri) (surface samples built once per face and tool)."""
     params = params or MultipointParams()
-    _check_tool(Ro, Ri)
-    _check_params(params)
+    _check_torus(Ro, Ri)
+    params.validate()
+    method = params.method if method is None else method
     if method not in METHODS:
         raise TmmError(f"method must be 'vcrf' or 'drd', got {method!r}")
+    options = dict(
+        Ro=float(Ro), Ri=float(Ri), shape=params.shape, method=method, rotation=params.rotation,
+        beta_max=math.radians(params.beta_max_deg), tol=float(params.tol),
+        sample_spacing=float(params.sample_spacing), divisions=int(params.divisions),
+        refinements=int(params.refinements), drd_divisions=int(params.drd_divisions),
+        drd_refinements=int(params.drd_refinements), drd_bisections=int(params.drd_bisections),
+        extend=float(params.extend), anchor=params.anchor, anchor_iterations=int(params.anchor_iterations))
+    if not hasattr(native, "MultipointOptions"):  # TRANSITIONAL: kernel built before the options struct
+        try:
+            return native.MultipointPositioner(face.native, *options.values())
+        except ValueError as exc:
+            raise TmmError(str(exc)) from exc
+    options = native.MultipointOptions(**options)
     try:
-        return native.MultipointPositioner(
-            face.native, float(Ro), float(Ri), params.shape, method, params.rotation,
-            math.radians(params.beta_max_deg), float(params.tol), float(params.sample_spacing),
-            int(params.divisions), int(params.refinements), int(params.drd_divisions),
-            int(params.drd_refinements), int(params.drd_bisections), float(params.extend), params.anchor,
-            int(params.anchor_iterations))
+        return native.MultipointPositioner(face.native, options)
     except ValueError as exc:
         raise TmmError(str(exc)) from exc
 
 
 def position_points(face: BezierFace, Ro: float, Ri: float, xy: np.ndarray,
-                    params: Optional[MultipointParams] = None, method: str = "vcrf",
+                    params: Optional[MultipointParams] = None, method: Optional[str] = None,
                     progress: Optional[Progress] = None) -> MultipointResults:
-    """Multipoint positions at the (n, 2) footprint points."""
+    """Multipoint positions of the torus (Ro, Ri) at the (n, 2) footprint points (method: params.method
+    unless given)."""
     params = params or MultipointParams()
     mp = make_positioner(face, Ro, Ri, params, method)
     pts = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
     if not np.isfinite(pts).all():
         raise TmmError("footprint points contain a non-finite coordinate")
+    check_work("tool positions", len(pts), _BYTES_PER_POSITION, f"{len(pts)} footprint points")
     try:
         data = mp.position_batch(pts, int(params.threads), progress)
     except native.Cancelled as exc:
@@ -289,46 +223,59 @@ def position_points(face: BezierFace, Ro: float, Ri: float, xy: np.ndarray,
     return MultipointResults(pts, np.zeros(len(pts), dtype=int), data, list(native.multipoint_reasons()))
 
 
-def compute_multipoint_toolpath(surface: BezierFace, Ro: float, Ri: float,
-                                params: Optional[MultipointParams] = None, method: str = "vcrf",
-                                progress: Optional[Progress] = None) -> tuple[Toolpath, MultipointResults]:
-    """5-axis tool path over `surface` by multipoint positioning, and the per-point results.
-
-    Each pass: a rapid above its first good position, a plunge to it, feeds through the positions (tip and
-    axis), a rapid up at the end. Failed positions (no surface under the tool, gouge) are not cut: the pass
-    is left and re-entered around them. progress(fraction) -> bool; False cancels (raises Cancelled).
-    """
-    params = params or MultipointParams()
+def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
+            progress: Optional[Progress] = None) -> StrategyResult:
+    """The strategy: multipoint positions over the footprint, as cut segments (runs of good positions of
+    one pass); diagnostics: "results" (MultipointResults per footprint point), "counts"."""
     if not isinstance(surface, BezierFace):
         raise TmmError(f"surface must be a BezierFace, got {type(surface).__name__}")
+    Ro, Ri = _torus(tool)
     passes = multipoint_footprint(surface, params)
     if not passes:
         raise TmmError("the footprint is empty")
     xy = np.vstack(passes)
     pass_index = np.concatenate([np.full(len(p), k) for k, p in enumerate(passes)])
-    res = position_points(surface, Ro, Ri, xy, params, method, progress)
+    res = position_points(surface, Ro, Ri, xy, params, None, progress)
     res.passes = pass_index
-    top = surface.bounds[1][2] + Ri + float(params.clearance)
-    path = Toolpath()
-    tip, axis, status = res["tip"], res["axis"], res["status"]
-    inside = False
+    good = res.status != STATUS_FAILED
+    segments = []
+    run: list[int] = []  # a segment ends at a new pass or a failed position
     for i in range(len(xy)):
-        new_pass = i > 0 and pass_index[i] != pass_index[i - 1]
-        good = status[i] != STATUS_FAILED
-        if inside and (new_pass or not good):
-            last = path.moves[-1]
-            path.add(MoveKind.RAPID, last.x, last.y, top, last.axis)
-            inside = False
-        if not good:
-            continue
-        a = tuple(axis[i])
-        if not inside:
-            path.add(MoveKind.RAPID, tip[i, 0], tip[i, 1], top, a)
-            path.add(MoveKind.PLUNGE, *tip[i], a)
-            inside = True
-        else:
-            path.add(MoveKind.FEED, *tip[i], a)
-    if inside:
-        last = path.moves[-1]
-        path.add(MoveKind.RAPID, last.x, last.y, top, last.axis)
-    return path, res
+        if run and (pass_index[i] != pass_index[run[-1]] or not good[i]):
+            segments.append(run)
+            run = []
+        if good[i]:
+            run.append(i)
+    if run:
+        segments.append(run)
+    tip, axis = res["tip"], res["axis"]
+    cut = [CutSegment(tip[s], axes=axis[s], pass_index=int(pass_index[s[0]])) for s in segments]
+    return StrategyResult(cut, {"results": res, "counts": res.counts()})
+
+
+def link_policy(tool: Cutter, safe_height: float, clearance_height: float,
+                axis_retract: float = 5.0) -> LinkPolicy:
+    """5-axis linking: along the tool axis, transit heights from the tilted tool's lowest point."""
+    return LinkPolicy(safe_height, clearance_height, ALONG_AXIS, axis_retract,
+                      lowest_below_tip=tool.lowest_below_tip)
+
+
+def face_top(face: BezierFace, samples: int = 64) -> float:
+    """Highest point of the face (sampled densely; the control net's box is loose)."""
+    u0, u1, v0, v1 = face.domain
+    U, V = np.meshgrid(np.linspace(u0, u1, samples + 1), np.linspace(v0, v1, samples + 1), indexing="ij")
+    return float(face.evaluate(np.column_stack([U.ravel(), V.ravel()]))["S"][:, 2].max())
+
+
+def compute_multipoint_toolpath(surface: BezierFace, tool: Cutter, params: Optional[MultipointParams] = None,
+                                policy: Optional[LinkPolicy] = None, progress: Optional[Progress] = None
+                                ) -> tuple[Toolpath, MultipointResults]:
+    """The strategy and the linker in one call: the 5-axis tool path over `surface` and the per-point
+    results. `policy` defaults to linking along the tool axis with the safe height 5 mm above the face's
+    top. progress(fraction) -> bool; False cancels (raises Cancelled)."""
+    params = params or MultipointParams()
+    result = compute(surface, tool, params, progress)
+    if policy is None:
+        safe = face_top(surface) + 5.0
+        policy = link_policy(tool, safe, safe)
+    return link(result.segments, policy), result.diagnostics["results"]

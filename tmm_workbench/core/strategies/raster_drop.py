@@ -1,4 +1,14 @@
-"""3-axis surface finishing: a raster footprint dropped on the mesh, linked into one tool path."""
+"""3-axis raster finishing: a raster footprint dropped on the mesh (the strategy); the linker
+(core.linking) makes the tool path.
+
+    result = compute(mesh, Cutter.ball(6), SurfaceParams(boundary=(0, 0, 100, 80), stepover=0.5))
+    path = link(result.segments, LinkPolicy(safe_height=40, clearance_height=45))
+    path = compute_surface_toolpath(mesh, cutter, params, policy)       # both in one call
+
+Every cutting move, including the links between zig-zag passes, is made of dropped CL points, so straight
+moves only join positions no more than `sample_step` apart: a zig-zag link is a LINK segment joined to its
+passes (the tool stays down). Work is estimated from the parameters before anything is allocated.
+"""
 from __future__ import annotations
 
 import math
@@ -7,12 +17,16 @@ from typing import Optional
 
 import numpy as np
 
-from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.raster import Rect, raster_lines, sample_segment
+from tmm_workbench.core.footprint.raster import Rect, pass_count, raster_lines, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.params import StrategyParams, check_finite, param
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
+from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
@@ -21,58 +35,62 @@ ONEWAY = "oneway"
 # is split, the tool lifts to the safe height and plunges again where the model resumes.
 OFF_MODEL_FLOOR = "floor"
 OFF_MODEL_SKIP = "skip"
+SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 _AIR_DEPTH_MM = 1e6  # SKIP drops onto a floor this far below the model: only air points end there
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
-_LABEL = {"stepover": "step-over", "sample_step": "sample step"}
+# Per CL point: the xy, z and segment arrays, the kernel's copies and the tool path's moves after thinning.
+_BYTES_PER_POINT = 400
 
 
 @dataclass
-class SurfaceParams:
-    boundary: Rect                   # xmin, ymin, xmax, ymax of the tip positions (mm)
-    stepover: float                  # distance between passes (mm)
-    sample_step: float               # forward sampling step along a pass (mm)
-    safe_height: float               # retract height between passes (mm)
-    clearance_height: float          # height at start and end (mm)
-    angle_deg: float = 0.0           # raster angle from +X
-    pattern: str = ZIGZAG            # ZIGZAG or ONEWAY
-    stock_to_leave: float = 0.0      # material left on the surface (mm)
-    floor_z: Optional[float] = None  # the tip never goes below; default: the model's lowest point
-    off_model: str = OFF_MODEL_FLOOR  # OFF_MODEL_FLOOR or OFF_MODEL_SKIP (see above)
+class SurfaceParams(StrategyParams):
+    boundary: Rect = (0.0, 0.0, 0.0, 0.0)  # xmin, ymin, xmax, ymax of the tip positions (mm)
+    stepover: float = param(1.0, "step-over", "mm", low=0, low_open=True, kind="length")
+    sample_step: float = param(0.5, "sample step", "mm", low=0, low_open=True, kind="length")
+    angle_deg: float = param(0.0, "raster angle", "deg")                # from +X
+    pattern: str = param(ZIGZAG, "pattern", choices=(ZIGZAG, ONEWAY))
+    stock_to_leave: float = param(0.0, "stock to leave", "mm")        # material left on the surface
+    floor_z: Optional[float] = param(None, "floor", "mm", optional=True)  # default: the model's lowest point
+    off_model: str = param(OFF_MODEL_FLOOR, "off-model", choices=(OFF_MODEL_FLOOR, OFF_MODEL_SKIP))
 
     def validate(self) -> None:
-        for name in ("stepover", "sample_step"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise TmmError(f"{_LABEL[name]} must be a positive length, got {v!r}")
-        for name in ("safe_height", "clearance_height", "angle_deg", "stock_to_leave"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v)):
-                raise TmmError(f"{name.replace('_', ' ')} must be a finite number, got {v!r}")
-        if self.pattern not in (ZIGZAG, ONEWAY):
-            raise TmmError(f"pattern must be '{ZIGZAG}' or '{ONEWAY}', got {self.pattern!r}")
-        if self.off_model not in (OFF_MODEL_FLOOR, OFF_MODEL_SKIP):
-            raise TmmError(f"off-model must be '{OFF_MODEL_FLOOR}' or '{OFF_MODEL_SKIP}', got {self.off_model!r}")
-        if self.clearance_height < self.safe_height:
-            raise TmmError(f"clearance height {self.clearance_height:g} mm is below the safe height "
-                           f"{self.safe_height:g} mm")
-        if len(self.boundary) != 4 or not all(math.isfinite(b) for b in self.boundary):
+        super().validate()
+        if len(self.boundary) != 4:
             raise TmmError(f"boundary must be four finite numbers xmin, ymin, xmax, ymax, got {self.boundary!r}")
+        check_finite("boundary (xmin, ymin, xmax, ymax)", self.boundary)
 
 
-def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams,
-                             progress: Optional[Progress] = None,
-                             surface: Optional[DropSurface] = None) -> Toolpath:
-    """Gouge-free raster finishing of `mesh` with `cutter` (tip positions; Z up).
+def estimate_work(params: SurfaceParams) -> float:
+    """CL points of the raster (passes and zig-zag links, an upper bound), refused above the limits before
+    any is made."""
+    b = params.boundary
+    w, h = b[2] - b[0], b[3] - b[1]
+    if not (w > 0 and h > 0):
+        raise TmmError(f"boundary is empty: x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g}")
+    diagonal = math.hypot(w, h)
+    passes = pass_count(diagonal, params.stepover)
+    count = passes * (diagonal / params.sample_step + 2)
+    if params.pattern == ZIGZAG:
+        count += passes * (params.stepover / params.sample_step + 2)
+    check_work("CL points", count, _BYTES_PER_POINT,
+               f"sample step {params.sample_step:g} mm and step-over {params.stepover:g} mm over a "
+               f"{w:.4g} x {h:.4g} mm boundary")
+    return count
 
-    Every cutting move, including the links between zig-zag passes, is made of dropped CL points,
-    so straight moves only join positions no more than `sample_step` apart.
-    """
+
+def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Optional[Progress] = None,
+            surface: Optional[DropSurface] = None) -> StrategyResult:
+    """Gouge-free raster finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments.
+    diagnostics: "points" (CL points dropped), "passes", "top" (highest tip on the model)."""
     params.validate()
+    if cutter.kind not in SUPPORTED_TOOLS:
+        raise TmmError(f"the {cutter.describe()} cutter is not supported by 3-axis raster finishing")
     lo, hi = mesh.bounds
     b = params.boundary
     if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
         raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
+    estimate_work(params)
     floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
 
     lines = raster_lines(b, params.stepover, params.angle_deg)
@@ -82,12 +100,10 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     runs: list[tuple[bool, np.ndarray]] = []  # (is_link, xy)
     for i, ln in enumerate(lines):
         if i > 0 and params.pattern == ZIGZAG:
-            link = sample_segment(lines[i - 1][1], ln[0], params.sample_step)[1:-1]
-            runs.append((True, link))
+            link_xy = sample_segment(lines[i - 1][1], ln[0], params.sample_step)[1:-1]
+            runs.append((True, link_xy))
         runs.append((False, sample_segment(ln[0], ln[1], params.sample_step)))
     xy = np.concatenate([r for _, r in runs])
-    if len(xy) > 50_000_000:
-        raise TmmError(f"{len(xy)} CL points: sampling step {params.sample_step:g} mm is too fine")
 
     s = params.stock_to_leave
     surface = surface or DropSurface(mesh)
@@ -98,29 +114,38 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
     z = np.maximum(z, floor_z)
+    segments = _segments(runs, z, air, params.pattern)
+    return StrategyResult(segments, {"points": len(xy), "passes": len(lines), "top": float(z[~air].max())})
 
-    top = float(z[~air].max())
-    if params.safe_height <= top:
-        raise TmmError(f"safe height {params.safe_height:g} mm is not above the highest tool position "
+
+def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, policy: LinkPolicy,
+                             progress: Optional[Progress] = None,
+                             surface: Optional[DropSurface] = None) -> Toolpath:
+    """The strategy and the linker (3-axis: vertical retracts) in one call."""
+    policy.validate()
+    result = compute(mesh, cutter, params, progress, surface)
+    top = result.diagnostics["top"]
+    if policy.safe_height <= top:
+        raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    return _link(_pieces(runs, z, air, params.pattern), params)
+    return link(result.segments, policy)
 
 
-def _pieces(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray,
-            pattern: str) -> list[tuple[bool, bool, np.ndarray]]:
-    """(is_link, detached, points) in cutting order. A pass is split where it crosses air; a zig-zag link
-    that crosses air is left out. `detached`: the tool gets there by retract, rapid and plunge."""
-    out: list[tuple[bool, bool, np.ndarray]] = []
+def _segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray,
+              pattern: str) -> list[CutSegment]:
+    """Segments in cutting order. A pass is split where it crosses air; a zig-zag link that crosses air is
+    left out. A segment is `joined` when the tool reaches it without a retract."""
+    out: list[CutSegment] = []
     detach = True
     k = 0
-    for is_link, xy in runs:
+    for index, (is_link, xy) in enumerate(runs):
         pts, gap = np.column_stack([xy, z[k:k + len(xy)]]), air[k:k + len(xy)]
         k += len(xy)
         if is_link:
             if gap.any():
                 detach = True
             elif len(pts):
-                out.append((True, detach, pts))
+                out.append(CutSegment(pts, SegmentKind.LINK, joined=not detach, pass_index=index))
                 detach = False
             continue
         if pattern == ONEWAY:
@@ -128,34 +153,12 @@ def _pieces(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray,
         # consecutive on-model points: [start, end) index pairs
         edges = np.flatnonzero(np.diff(np.concatenate([[True], gap, [True]]).astype(np.int8)))
         for start, end in zip(edges[::2], edges[1::2]):
-            out.append((False, detach or start > 0, pts[start:end]))
+            out.append(CutSegment(_drop_collinear(pts[start:end]), joined=not (detach or start > 0),
+                                  pass_index=index))
             detach = False
         if len(gap) and gap[-1]:
             detach = True
     return out
-
-
-def _link(pieces: list[tuple[bool, bool, np.ndarray]], params: SurfaceParams) -> Toolpath:
-    tp = Toolpath()
-    for is_link, detached, pts in pieces:
-        if not is_link:
-            pts = _drop_collinear(pts)
-        plunged = False
-        if not tp.moves or detached:
-            x0, y0, z0 = pts[0]
-            if tp.moves:  # lift straight up, cross over at the safe height
-                last = tp.moves[-1]
-                tp.add(MoveKind.RAPID, last.x, last.y, params.safe_height)
-            else:
-                tp.add(MoveKind.RAPID, x0, y0, params.clearance_height)
-            tp.add(MoveKind.RAPID, x0, y0, params.safe_height)
-            tp.add(MoveKind.PLUNGE, x0, y0, z0)
-            plunged = True
-        for p in pts[1:] if plunged else pts:
-            tp.add(MoveKind.FEED, *p)
-    last = tp.moves[-1]
-    tp.add(MoveKind.RAPID, last.x, last.y, params.clearance_height)
-    return tp
 
 
 def _drop_collinear(pts: np.ndarray) -> np.ndarray:

@@ -1,9 +1,13 @@
-"""Cutters as the kernel sees them: convex solids of revolution, the generalized APT cutter of seed 000
-(section 3.5.2.2): diameter 2R at the cutting-edge height L_C, corner radius r, bottom angle beta1 (from the
+"""The one tool model: a convex solid of revolution, the generalized APT cutter of seed 000 (section 3.5.2.2): diameter 2R at the cutting-edge height L_C, corner radius r, bottom angle beta1 (from the
 horizontal) and taper angle beta2 (from the axis, positive when the side widens upwards).
 
 ball: r = R; flat (cylindrical): r = 0; bull-nose (toroidal): 0 < r < R; all with beta1 = beta2 = 0.
 V-bits and chamfers: r = 0 with a bottom cone (beta1) or a taper (beta2); tapered ball and bull: beta2 > 0.
+
+Views of the same tool for the strategies: `native` (the APT profile the drop-cutter and drop-along
+queries use), `torus_radii` (Ro, Ri: the toroidal view multipoint positioning and the 5-axis simulation
+use; a ball is Ro = 0), `lowest_below_tip(axis)` (how far the tilted tool reaches below its tip, for
+transit heights). `kind` is what strategies list as their supported tools (data, not code).
 """
 from __future__ import annotations
 
@@ -62,6 +66,17 @@ class Cutter:
         return cls(diameter, corner_radius)
 
     @classmethod
+    def torus(cls, Ro: float, Ri: float) -> "Cutter":
+        """The toroidal cutter of major radius Ro (axis to tube centre) and minor radius Ri (seed 001)."""
+        Ro, Ri = _number("major radius Ro", Ro), _number("minor radius Ri", Ri)
+        if not (math.isfinite(Ro) and Ro >= 0):
+            raise TmmError(f"major radius Ro must be >= 0 mm (0 is a ball end mill), got {Ro:g}")
+        if not (math.isfinite(Ri) and Ri > 0):
+            raise TmmError("minor radius Ri must be > 0: a flat end mill (Ri = 0) has no pseudo-insert to tilt "
+                           f"about; multipoint positioning needs a toroidal or ball cutter (got Ri = {Ri:g})")
+        return cls(2.0 * (Ro + Ri), Ri)
+
+    @classmethod
     def vbit(cls, diameter: float, included_angle_deg: float, tip_diameter: float = 0.0) -> "Cutter":
         """A cone of `included_angle_deg` from a flat tip of `tip_diameter` up to `diameter`."""
         half = _number("included angle", included_angle_deg) / 2
@@ -91,6 +106,23 @@ class Cutter:
         if abs(self.corner_radius - self.radius) <= 1e-12:
             return "ball"
         return "bull"
+
+    @property
+    def torus_radii(self) -> tuple[float, float]:
+        """(Ro, Ri) of the toroidal view: bull-nose (R - r, r), ball (0, R). Other tools have none."""
+        if self.kind == "ball":
+            return 0.0, self.radius
+        if self.kind == "bull":
+            return self.radius - self.corner_radius, self.corner_radius
+        raise TmmError(f"the {self.describe()} cutter is not toroidal: a flat end mill (Ri = 0) has no pseudo-insert "
+                       "to tilt about; multipoint positioning needs a toroidal (bull-nose) or ball cutter")
+
+    def lowest_below_tip(self, axis: tuple[float, float, float]) -> float:
+        """How far the lowest point of the cutter lies below its tip when its axis is `axis` (unit, tip ->
+        spindle): r (1 - cos t) + (R - r) sin t for a tilt t (ball, flat, bull-nose)."""
+        c = max(-1.0, min(1.0, axis[2]))
+        r = self.corner_radius
+        return r * (1.0 - c) + (self.radius - r) * math.sqrt(max(0.0, 1.0 - c * c))
 
     @property
     def native(self) -> "native.Cutter":
