@@ -16,9 +16,24 @@ import Path
 from tmm_workbench.app import hooks
 from tmm_workbench.app.compat import PathOp
 from tmm_workbench.app.tools import TOOLBIT_SHAPES, cutter_from_tool, label_of, shape_name
-from tmm_workbench.core import kernel
+from tmm_workbench.core import kernel, limits
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.tools.cutter import Cutter
+
+
+PREFERENCES = "User parameter:BaseApp/Preferences/Mod/TMM"
+
+
+def apply_work_limits() -> None:
+    """The user's work limits (FreeCAD preferences MaxPoints, MaxPositions, MaxMemoryGB under
+    Preferences/Mod/TMM; 0 or absent: the core's defaults) for the next computation."""
+    group = FreeCAD.ParamGet(PREFERENCES)
+    points, positions = group.GetInt("MaxPoints", 0), group.GetInt("MaxPositions", 0)
+    memory = group.GetFloat("MaxMemoryGB", 0.0)
+    defaults = limits.WorkLimits()
+    limits.set_limits(points if points > 0 else defaults.max_points,
+                      memory if memory > 0 else defaults.max_memory_bytes / 1e9,
+                      positions if positions > 0 else defaults.max_positions)
 
 
 class Prop(NamedTuple):
@@ -125,6 +140,7 @@ class TmmOp(PathOp.ObjectOp):
         if not obj.Active:
             super().execute(obj)
             return
+        apply_work_limits()
         problem = self.input_problem(obj)
         if problem:
             self.fail(obj, problem)

@@ -2,7 +2,9 @@
 refuses what this kind of machine (2 cores, 24 GB) cannot do in reasonable time and memory.
 
 The limits are a setting: `set_limits(...)` (the App layer applies the user's FreeCAD preferences), or the
-environment variables TMM_MAX_POINTS / TMM_MAX_MEMORY_GB for headless runs.
+environment variables TMM_MAX_POINTS / TMM_MAX_POSITIONS / TMM_MAX_MEMORY_GB for headless runs. CL points
+of a drop-cutter cost microseconds each; multipoint positions (two-contact searches) milliseconds, so they
+have a limit of their own.
 """
 from __future__ import annotations
 
@@ -22,7 +24,8 @@ def _env(name: str, default: float) -> float:
 
 @dataclass(frozen=True)
 class WorkLimits:
-    max_points: int = int(_env("TMM_MAX_POINTS", 20_000_000))        # CL points / positions of one op
+    max_points: int = int(_env("TMM_MAX_POINTS", 20_000_000))        # drop-cutter CL points of one op
+    max_positions: int = int(_env("TMM_MAX_POSITIONS", 500_000))     # multipoint positions of one op
     max_memory_bytes: float = _env("TMM_MAX_MEMORY_GB", 8.0) * 1e9   # what one computation may allocate
 
 
@@ -33,26 +36,31 @@ def current() -> WorkLimits:
     return _current
 
 
-def set_limits(max_points: int | None = None, max_memory_gb: float | None = None) -> WorkLimits:
+def set_limits(max_points: int | None = None, max_memory_gb: float | None = None,
+               max_positions: int | None = None) -> WorkLimits:
     """Changes the limits for the following computations; returns the previous ones."""
     global _current
     previous = _current
     changes: dict = {}
     if max_points is not None:
         changes["max_points"] = int(max_points)
+    if max_positions is not None:
+        changes["max_positions"] = int(max_positions)
     if max_memory_gb is not None:
         changes["max_memory_bytes"] = float(max_memory_gb) * 1e9
     _current = replace(_current, **changes)
     return previous
 
 
-def check_work(what: str, count: float, bytes_each: float, cause: str) -> None:
-    """Refuses `count` items of `what` (bytes_each each) above the limits; `cause` names the parameters
-    that set the count, with their values ("sample step 1e-06 mm, step-over 1 mm")."""
+def check_work(what: str, count: float, bytes_each: float, cause: str, limit: str = "max_points") -> None:
+    """Refuses `count` items of `what` (bytes_each each) above the limits (`limit`: the WorkLimits field
+    that bounds the count); `cause` names the parameters that set the count, with their values ("sample
+    step 1e-06 mm, step-over 1 mm")."""
     limits = _current
+    most = getattr(limits, limit)
     memory = count * bytes_each
-    if count > limits.max_points or memory > limits.max_memory_bytes:
+    if count > most or memory > limits.max_memory_bytes:
         raise TmmError(
             f"{cause} gives about {count:.3g} {what} ({memory / 1e9:.3g} GB): more than this machine's limit of "
-            f"{limits.max_points:.3g} {what} and {limits.max_memory_bytes / 1e9:.3g} GB; use coarser values or a "
-            "smaller boundary (limits: TMM preferences, or TMM_MAX_POINTS / TMM_MAX_MEMORY_GB)")
+            f"{most:.3g} {what} and {limits.max_memory_bytes / 1e9:.3g} GB; use coarser values or a smaller "
+            f"boundary (limits: TMM_{limit.upper()} / TMM_MAX_MEMORY_GB, or core.limits.set_limits)")

@@ -78,7 +78,8 @@ def check(spec: Spec, value: Any) -> None:
         if spec.kind == "length" and spec.low == 0 and spec.high is None:
             what = "a positive length" if spec.low_open else "a length >= 0"
             raise TmmError(f"{spec.label} must be {what}, got {shown} (allowed: {spec.range_text()})")
-        raise TmmError(f"{spec.label} must be {spec.range_text()}, got {shown}")
+        whole = "a whole number " if spec.integer else ""
+        raise TmmError(f"{spec.label} must be {whole}{spec.range_text()}, got {shown}")
 
 
 def check_finite(label: str, values: Sequence[Any], unit: str = "mm") -> None:

@@ -159,7 +159,7 @@ def estimate_work(rect: Rect, params: MultipointParams) -> float:
     count = pass_count(diagonal, params.side_step) * (diagonal / params.forward_step + 2)
     check_work("tool positions", count, _BYTES_PER_POSITION,
                f"side step {params.side_step:g} mm and forward step {params.forward_step:g} mm over a "
-               f"{w:.4g} x {h:.4g} mm boundary")
+               f"{w:.6g} x {h:.6g} mm boundary", "max_positions")
     return count
 
 
@@ -215,7 +215,7 @@ def position_points(face: BezierFace, Ro: float, Ri: float, xy: np.ndarray,
     pts = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
     if not np.isfinite(pts).all():
         raise TmmError("footprint points contain a non-finite coordinate")
-    check_work("tool positions", len(pts), _BYTES_PER_POSITION, f"{len(pts)} footprint points")
+    check_work("tool positions", len(pts), _BYTES_PER_POSITION, f"{len(pts)} footprint points", "max_positions")
     try:
         data = mp.position_batch(pts, int(params.threads), progress)
     except native.Cancelled as exc:

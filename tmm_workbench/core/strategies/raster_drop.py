@@ -74,7 +74,7 @@ def estimate_work(params: SurfaceParams) -> float:
         count += passes * (params.stepover / params.sample_step + 2)
     check_work("CL points", count, _BYTES_PER_POINT,
                f"sample step {params.sample_step:g} mm and step-over {params.stepover:g} mm over a "
-               f"{w:.4g} x {h:.4g} mm boundary")
+               f"{w:.6g} x {h:.6g} mm boundary")
     return count
 
 
