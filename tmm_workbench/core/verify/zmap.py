@@ -49,11 +49,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Optional, Sequence
+from typing import TYPE_CHECKING, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+
+if TYPE_CHECKING:
+    from tmm_workbench.core.tools.cutter import Cutter
 
 TANGENT_TOL = 1e-7      # mm: a vertical line this close to the torus counts as touching it
 NEWTON_STEPS = 3        # Newton polish of each quartic root
@@ -73,6 +76,12 @@ class ZTool:
             raise TmmError(f"tool radii must be finite with Ro >= 0, Ri > 0; got Ro={self.Ro!r}, Ri={self.Ri!r}")
         if self.shape not in SHAPES:
             raise TmmError(f"tool shape must be one of {SHAPES}, got {self.shape!r}")
+
+    @classmethod
+    def of(cls, cutter: "Cutter", shape: str = "round_insert") -> "ZTool":
+        """The simulated solid of the one tool model's toroidal view (core.tools.Cutter.torus_radii)."""
+        Ro, Ri = cutter.torus_radii
+        return cls(Ro, Ri, shape)
 
     @property
     def radius(self) -> float:

@@ -1,0 +1,97 @@
+"""The one linker: vertical retracts (3-axis), retracts along the tool axis (5-axis), joined segments kept
+down, the entry table, empty input; and the tool model's transit geometry it relies on."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.linking import ALONG_AXIS, ENTRIES, LinkPolicy, link
+from tmm_workbench.core.segments import CutSegment, SegmentKind
+from tmm_workbench.core.toolpath import MoveKind, Z_AXIS
+from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.verify.zmap import ZTool
+
+
+def seg(points, joined=False, kind=SegmentKind.PASS, axes=None):
+    return CutSegment(np.array(points, dtype=float), kind, axes=axes, joined=joined)
+
+
+def kinds(tp):
+    return [m.kind for m in tp]
+
+
+def test_vertical_retract_between_detached_segments():
+    a = seg([(0, 0, 1), (10, 0, 1)])
+    b = seg([(10, 5, 2), (0, 5, 2)])
+    tp = link([a, b], LinkPolicy(safe_height=8.0, clearance_height=12.0))
+    R, P, F = MoveKind.RAPID, MoveKind.PLUNGE, MoveKind.FEED
+    assert kinds(tp) == [R, R, P, F, R, R, P, F, R]
+    z = [m.z for m in tp]
+    assert z == [12.0, 8.0, 1.0, 1.0, 8.0, 8.0, 2.0, 2.0, 12.0]
+    # lift straight up from the end of a, cross at the safe height to above b's start, plunge
+    assert (tp.moves[4].x, tp.moves[4].y) == (10.0, 0.0) and (tp.moves[5].x, tp.moves[5].y) == (10.0, 5.0)
+
+
+def test_joined_segments_keep_the_tool_down():
+    a = seg([(0, 0, 1), (10, 0, 1)])
+    link_ = seg([(10, 2.5, 1.5)], joined=True, kind=SegmentKind.LINK)
+    b = seg([(10, 5, 2), (0, 5, 2)], joined=True)
+    tp = link([a, link_, b], LinkPolicy(8.0, 12.0))
+    assert kinds(tp).count(MoveKind.PLUNGE) == 1
+    cut = tp.cutting_points()
+    np.testing.assert_array_equal(cut, np.vstack([a.tips, link_.tips, b.tips]))
+
+
+def test_along_axis_retract_and_transit_height():
+    tool = Cutter.torus(6.7, 6.0)
+    t = math.radians(20)
+    axis = np.array([math.sin(t), 0.0, math.cos(t)])
+    a = seg([(0, 0, 0), (0, 10, 0)], axes=[axis, axis])
+    b = seg([(20, 10, 0), (20, 0, 0)], axes=[axis, axis])
+    policy = LinkPolicy(10.0, 15.0, ALONG_AXIS, 5.0, lowest_below_tip=tool.lowest_below_tip)
+    tp = link([a, b], policy)
+    m = tp.moves
+    assert m[0].axis == Z_AXIS and m[-1].axis == Z_AXIS        # upright at start and end
+    assert m[0].z == m[1].z >= 15.0 and m[-1].z >= 15.0
+    drop = tool.lowest_below_tip(tuple(axis))
+    assert drop == pytest.approx(6.0 * (1 - math.cos(t)) + 6.7 * math.sin(t))
+    for i, mv in enumerate(m):
+        if mv.kind is MoveKind.PLUNGE:   # entered along its axis from axis_retract above
+            d = np.subtract((mv.x, mv.y, mv.z), (m[i - 1].x, m[i - 1].y, m[i - 1].z))
+            np.testing.assert_allclose(-d / np.linalg.norm(d), axis, atol=1e-12)
+            assert np.linalg.norm(d) == pytest.approx(5.0)
+            assert m[i - 2].z == pytest.approx(max(mv.z + 5 * axis[2], 10.0 + drop))
+    assert kinds(tp).count(MoveKind.PLUNGE) == 2
+
+
+def test_along_axis_needs_the_tool_geometry():
+    with pytest.raises(TmmError, match="lowest_below_tip"):
+        link([seg([(0, 0, 0)])], LinkPolicy(10.0, 15.0, ALONG_AXIS))
+
+
+def test_policy_is_checked():
+    with pytest.raises(TmmError, match="clearance height 5 mm is below the safe height 10 mm"):
+        link([seg([(0, 0, 0)])], LinkPolicy(10.0, 5.0))
+    with pytest.raises(TmmError, match="entry must be one of plunge"):
+        link([seg([(0, 0, 0)])], LinkPolicy(10.0, 15.0, entry="helix"))
+    assert set(ENTRIES) == {"plunge"}
+
+
+def test_no_segments_no_path():
+    assert len(link([], LinkPolicy(10.0, 15.0))) == 0
+    assert len(link([seg(np.zeros((0, 3)))], LinkPolicy(10.0, 15.0))) == 0
+
+
+def test_one_tool_model_views():
+    bull = Cutter.bull(12.0, 2.0)
+    assert bull.torus_radii == (4.0, 2.0)
+    assert Cutter.ball(6.0).torus_radii == (0.0, 3.0)
+    with pytest.raises(TmmError, match="flat end mill"):
+        Cutter.flat(6.0).torus_radii
+    z = ZTool.of(bull, "bull_nose")
+    assert (z.Ro, z.Ri, z.shape) == (4.0, 2.0, "bull_nose")
+    assert bull.lowest_below_tip((0.0, 0.0, 1.0)) == 0.0
+    assert bull.lowest_below_tip((1.0, 0.0, 0.0)) == pytest.approx(2.0 + 4.0)

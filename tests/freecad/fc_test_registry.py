@@ -1,0 +1,54 @@
+"""The strategy house: every op in the registry is a strategy module (params dataclass, compute,
+supported tools), an op entry whose property table names params fields (defaults from the dataclass, one
+place), and a Create that the headless API reaches through the registry."""
+from __future__ import annotations
+
+import inspect
+import unittest
+from dataclasses import MISSING, fields
+
+from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
+from tmm_workbench.app import registry
+from tmm_workbench.core.params import StrategyParams
+
+
+class Registry(FreeCADTestCase):
+    def test_every_entry_is_a_complete_room(self) -> None:
+        self.assertEqual([e.name for e in registry.OPS], ["TMM_Surface", "TMM_Multipoint"])
+        for entry in registry.OPS:
+            with self.subTest(op=entry.name):
+                app, core = entry.app(), entry.core()
+                self.assertEqual(app.OP_NAME, entry.name)
+                self.assertTrue(callable(app.Create) and callable(app.SetupProperties))
+                proxy = next(c for _, c in inspect.getmembers(app, inspect.isclass)
+                             if c.__module__ == app.__name__ and getattr(c, "PARAMS", None) is not None)
+                params = proxy.PARAMS
+                self.assertTrue(issubclass(params, StrategyParams))
+                self.assertTrue(callable(core.compute))
+                self.assertTrue(set(core.SUPPORTED_TOOLS) <= {"ball", "flat", "bull", "general"})
+                by_name = {f.name: f for f in fields(params)}
+                defaults = proxy.defaults()
+                for row in proxy.PROPERTIES:
+                    if not row.field:
+                        continue
+                    self.assertIn(row.field, by_name, f"{row.name} names no field of {params.__name__}")
+                    f = by_name[row.field]
+                    if f.default is MISSING or f.default is None:
+                        continue
+                    value = defaults[row.name]
+                    if row.name in proxy.CHOICES:
+                        value = proxy.CHOICES[row.name][value]
+                    self.assertEqual(value, f.default, row.name)
+        with self.assertRaises(KeyError):
+            registry.entry("TMM_Nothing")
+
+    def test_properties_map_to_params(self) -> None:
+        doc = new_doc("TmmRegistry")
+        _, _, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 1.5, "Pattern": "OneWay",
+                                                            "BoundaryShape": "Model"})
+        params = op.Proxy.params_from(op, boundary=(0.0, 0.0, 1.0, 1.0))
+        self.assertEqual((params.stepover, params.pattern, params.sample_step), (1.5, "oneway", 1.0))
+
+
+if __name__ == "__main__":
+    unittest.main()
