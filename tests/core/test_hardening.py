@@ -152,3 +152,13 @@ def test_no_nan_reaches_a_path():
     p = SurfaceParams(boundary=(0, 0, 100, 100), stepover=5.0, sample_step=1.0)
     path = raster_drop.compute_surface_toolpath(PLATE, BALL, p, LinkPolicy(10.0, 20.0))
     assert np.isfinite(path.points()).all()
+
+
+def test_indices_beyond_int32_are_refused_not_wrapped():
+    """2**32 + 1 used to wrap silently to 1 (a valid index) in the cast to int32."""
+    from tmm_workbench.core.geometry.mesh import TriMesh
+
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
+    f = np.array([[0, 2**32 + 1, 2]], dtype=np.int64)
+    with pytest.raises(TmmError, match="4294967297 does not fit the kernel's 32-bit indices"):
+        TriMesh(v, f, "wrap")

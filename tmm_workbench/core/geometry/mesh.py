@@ -20,7 +20,11 @@ class TriMesh:
 
     def __init__(self, vertices: np.ndarray, triangles: np.ndarray, name: str = "mesh") -> None:
         v = np.ascontiguousarray(vertices, dtype=np.float64)
-        f = np.ascontiguousarray(triangles, dtype=np.int32)
+        f = np.asarray(triangles)
+        if f.size and f.max() > np.iinfo(np.int32).max:  # a cast would wrap it silently
+            raise TmmError(f"{name}: triangle index {int(f.max())} does not fit the kernel's 32-bit indices "
+                           f"(allowed 0..{np.iinfo(np.int32).max})")
+        f = np.ascontiguousarray(f, dtype=np.int32)
         if v.ndim != 2 or v.shape[1] != 3:
             raise TmmError(f"{name}: vertices must have shape (n, 3), got {v.shape}")
         if f.ndim != 2 or f.shape[1] != 3:
