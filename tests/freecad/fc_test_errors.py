@@ -1,6 +1,7 @@
 """Bad input gives a clear error on the op, an empty Path (no partial path), and no crash."""
 from __future__ import annotations
 
+import time
 import unittest
 
 import FreeCAD
@@ -19,14 +20,16 @@ class BadInput(FreeCADTestCase):
         self.assertTrue(self.op.isValid(), self.op.getStatusString())
         self.assertGreater(len(self.op.Path.Commands), 10)
 
-    def assertFails(self, *fragments: str) -> None:
+    def assertFails(self, *fragments: str, seconds: float = 5.0) -> None:
+        t0 = time.perf_counter()
         self.op.touch()
         self.doc.recompute()
+        self.assertLess(time.perf_counter() - t0, seconds)
         status = self.op.getStatusString()
         self.assertFalse(self.op.isValid(), "op should be invalid")
         for f in fragments:
             self.assertIn(f.lower(), status.lower())
-        self.assertEqual(len(self.op.Path.Commands), 0, "no partial path")
+        self.assertEqual(len(self.op.Path.Commands), 0, "no partial or stale path")
         self.assertIsNone(self.op.Proxy.toolpath)
 
     def recovers(self) -> None:
@@ -96,6 +99,27 @@ class BadInput(FreeCADTestCase):
         self.op.StlFile = ""
         self.op.Model = wire
         self.assertFails("has no faces")
+
+    def test_tool_diameter_zero(self) -> None:
+        """FreeCAD's ObjectOp returned early here, keeping the old path and the op valid."""
+        self.tc.Tool.Diameter = 0.0
+        self.assertFails("diameter must be a length > 0 mm, got 0")
+
+    def test_tool_controller_removed(self) -> None:
+        self.op.ToolController = None
+        self.assertFails("no tool controller")
+
+    def test_tiny_sample_step_is_refused_quickly(self) -> None:
+        self.op.SampleStep = 1e-6
+        self.assertFails("sample step 1e-06 mm", "CL points", seconds=2.0)
+
+    def test_huge_boundary_margin_is_refused_quickly(self) -> None:
+        self.op.BoundaryMargin = 5e4
+        self.assertFails("mm boundary gives about", seconds=2.0)
+
+    def test_nan_stepover(self) -> None:
+        self.op.StepOver = float("nan")
+        self.assertFails("step-over must be a positive length, got nan")
 
     def test_prepare_model_errors(self) -> None:
         with self.assertRaises(TmmError) as ctx:

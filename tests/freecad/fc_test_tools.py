@@ -9,7 +9,6 @@ import FreeCAD
 import Path as FCPath
 
 from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
-from tmm_workbench.app import job as jobs
 from tmm_workbench.app import tools
 from tmm_workbench.app.compat import PathToolBit
 from tmm_workbench.app.tools import cutter_from_tool, shape_name
