@@ -162,3 +162,8 @@ def test_indices_beyond_int32_are_refused_not_wrapped():
     f = np.array([[0, 2**32 + 1, 2]], dtype=np.int64)
     with pytest.raises(TmmError, match="4294967297 does not fit the kernel's 32-bit indices"):
         TriMesh(v, f, "wrap")
+
+
+def test_cone_cutter_is_refused_by_multipoint_with_its_reason(convex_face):
+    with pytest.raises(TmmError, match="not supported by multipoint positioning .supported: ball, bull"):
+        multipoint.compute(convex_face, Cutter.vbit(6.0, 90.0), MultipointParams())

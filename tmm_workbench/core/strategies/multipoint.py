@@ -167,21 +167,18 @@ def _torus(tool: Cutter) -> tuple[float, float]:
     if not isinstance(tool, Cutter):
         raise TmmError(f"tool must be a core Cutter, got {type(tool).__name__}")
     if tool.kind not in SUPPORTED_TOOLS:
-        tool.torus_radii  # raises the clear message for a flat end mill
+        if tool.kind == "flat":
+            tool.torus_radii  # raises its own message: no corner to tilt about
         raise TmmError(f"the {tool.describe()} cutter is not supported by multipoint positioning "
                        f"(supported: {', '.join(SUPPORTED_TOOLS)})")
     return tool.torus_radii
-
-
-def _check_torus(Ro: float, Ri: float) -> None:
-    Cutter.torus(Ro, Ri)  # the one place that checks a torus' radii
 
 
 def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[MultipointParams] = None,
                     method: Optional[str] = None):
     """The kernel's positioner for the torus (Ro, Ri) (surface samples built once per face and tool)."""
     params = params or MultipointParams()
-    _check_torus(Ro, Ri)
+    Cutter.torus(Ro, Ri)  # the one place that checks a torus' radii
     params.validate()
     method = params.method if method is None else method
     if method not in METHODS:
