@@ -6,7 +6,8 @@ namespace py = pybind11;
 void bind_mesh(py::module_& m);   // bind_mesh.cpp: STL reading, indexed mesh, vertex normals
 void bind_drop(py::module_& m);   // bind_drop.cpp: cutters, spatial index, batch drop-cutter
 void bind_direction(py::module_& m);  // bind_direction.cpp: drop along any direction, any axis
-void bind_surface(py::module_& m);
+void bind_surface(py::module_& m);    // bind_surface.cpp: Bezier/B-spline faces
+void bind_multipoint(py::module_& m);  // bind_multipoint.cpp: multipoint positioning of a torus
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "TMM geometry kernel (C++17, Eigen)";
@@ -14,4 +15,5 @@ PYBIND11_MODULE(_native, m) {
   bind_drop(m);
   bind_direction(m);
   bind_surface(m);
+  bind_multipoint(m);
 }

@@ -6,11 +6,14 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl/filesystem.h>
 
+#include "util/arrays.hpp"
+
 #include <cstddef>
 #include <filesystem>
 #include <string>
 
 namespace py = pybind11;
+using tmm_bindings::triangles_from;
 
 void bind_mesh(py::module_& m) {
   // A broken or unreadable STL is bad input: a ValueError subclass carrying the kernel's message.
@@ -43,16 +46,22 @@ void bind_mesh(py::module_& m) {
       "tolerance or when no non-degenerate triangle remains.");
 
   m.def(
-      "face_normals", [](const tmm::VerticesRef& V, const tmm::TrianglesRef& F) { return tmm::face_normals(V, F); },
-      py::arg("V"), py::arg("F"), Release(),
+      "face_normals",
+      [](const tmm::VerticesRef& V, const py::object& F) {
+        const tmm::Triangles T = triangles_from(F);
+        py::gil_scoped_release release;
+        return tmm::face_normals(V, T);
+      },
+      py::arg("V"), py::arg("F"),
       "Unit normal (m, 3) of each triangle from its winding; (0, 0, 0) for a zero-area triangle.");
 
   m.def(
       "vertex_normals",
-      [](const tmm::VerticesRef& V, const tmm::TrianglesRef& F, const std::string& weighting) {
+      [](const tmm::VerticesRef& V, const py::object& F, const std::string& weighting) {
         const tmm::NormalWeighting w = tmm::parse_weighting(weighting);
+        const tmm::Triangles T = triangles_from(F);
         py::gil_scoped_release release;
-        return tmm::vertex_normals(V, F, w);
+        return tmm::vertex_normals(V, T, w);
       },
       py::arg("V"), py::arg("F"), py::arg("weighting") = "angle",
       "Unit normal (n, 3) of each vertex: weighting 'angle' (MWA), 'area' (MWAAT) or 'meyer' (mean-curvature\n"
@@ -60,8 +69,13 @@ void bind_mesh(py::module_& m) {
       "used by no triangle of non-zero area.");
 
   m.def(
-      "triangle_adjacency", [](const tmm::TrianglesRef& F) { return tmm::triangle_adjacency(F); }, py::arg("F"),
-      Release(),
+      "triangle_adjacency",
+      [](const py::object& F) {
+        const tmm::Triangles T = triangles_from(F);
+        py::gil_scoped_release release;
+        return tmm::triangle_adjacency(T);
+      },
+      py::arg("F"),
       "(m, 3) int32: for triangle t and edge i = (F[t, i], F[t, (i + 1) % 3]) the other triangle sharing the\n"
       "edge, or -1 for a boundary or non-manifold edge (shared by more than two triangles).");
 }

@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "tmm/query/drop_direction.hpp"
+#include "util/arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -60,13 +61,14 @@ py::array_t<double> drop_along(const tmm::DirectionalIndex& index, const tmm::Cu
 void bind_direction(py::module_& m) {
   py::class_<tmm::DirectionalIndex, std::shared_ptr<tmm::DirectionalIndex>>(m, "DirectionalIndex",
       "A mesh indexed for drops along one unit direction V (the mesh rotated so that V = -Z', XY' hierarchy).")
-      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const Eigen::Ref<const tmm::Triangles>& F,
-                       const Array& direction) {
+      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const py::object& F, const Array& direction,
+                       int threads) {
              const Eigen::Vector3d d = vec3(direction, "direction");
+             const tmm::Triangles T = tmm_bindings::triangles_from(F);
              py::gil_scoped_release release;
-             return std::make_shared<tmm::DirectionalIndex>(V, F, d);
+             return std::make_shared<tmm::DirectionalIndex>(V, T, d, threads);
            }),
-           py::arg("vertices"), py::arg("triangles"), py::arg("direction"))
+           py::arg("vertices"), py::arg("triangles"), py::arg("direction"), py::kw_only(), py::arg("threads") = 0)
       .def_property_readonly("direction", [](const tmm::DirectionalIndex& i) { return Eigen::Vector3d(i.direction()); })
       .def_property_readonly("rotation", [](const tmm::DirectionalIndex& i) { return Eigen::Matrix3d(i.rotation()); })
       .def_property_readonly("triangle_count", [](const tmm::DirectionalIndex& i) { return i.index().triangle_count(); });

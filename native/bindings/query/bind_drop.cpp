@@ -9,6 +9,7 @@
 
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/mesh/mesh_index.hpp"
+#include "util/arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -47,11 +48,14 @@ void bind_drop(py::module_& m) {
 
   py::class_<tmm::MeshIndex, std::shared_ptr<tmm::MeshIndex>>(m, "MeshIndex",
       "Spatial index (XY bounding volume hierarchy with heights) over a triangle mesh for drop-cutter.")
-      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const Eigen::Ref<const tmm::Triangles>& F) {
+      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const py::object& F, int threads) {
+             const tmm::Triangles T = tmm_bindings::triangles_from(F);
              py::gil_scoped_release release;
-             return std::make_shared<tmm::MeshIndex>(V, F);
+             return std::make_shared<tmm::MeshIndex>(V, T, threads);
            }),
-           py::arg("vertices"), py::arg("triangles"))
+           py::arg("vertices"), py::arg("triangles"), py::kw_only(), py::arg("threads") = 0,
+           "threads: build threads (0: all cores; small meshes build on one).")
+      .def_property_readonly("build_threads", &tmm::MeshIndex::build_threads)
       .def_property_readonly("triangle_count", &tmm::MeshIndex::triangle_count)
       .def_property_readonly("node_count", [](const tmm::MeshIndex& i) { return i.nodes().size(); })
       .def_property_readonly("memory_bytes", &tmm::MeshIndex::memory_bytes)

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace tmm {
 
@@ -44,7 +46,13 @@ double circle_distance(double R, double rho, double h, const Vector3d& e, const 
 }  // namespace
 
 void TorusTool::validate() const {
-  if (!std::isfinite(Ro) || !std::isfinite(Ri)) throw std::invalid_argument("tool radii must be finite");
+  for (const auto& [name, value] : {std::pair<const char*, double>{"major radius Ro", Ro}, {"minor radius Ri", Ri}}) {
+    if (!std::isfinite(value)) {
+      std::ostringstream msg;
+      msg << name << " must be finite, got " << value;
+      throw std::invalid_argument(msg.str());
+    }
+  }
   if (Ro < 0.0) throw std::invalid_argument("major radius Ro must be >= 0 (0 is a ball end mill)");
   if (Ri <= 0.0) {
     throw std::invalid_argument(

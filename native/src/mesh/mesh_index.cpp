@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <string>
 #include <stdexcept>
 #include <thread>
 
@@ -98,8 +99,9 @@ std::vector<uint8_t> owned_edges(const Eigen::Ref<const Triangles>& F, Eigen::In
 
 }  // namespace
 
-MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F) {
+MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F, int threads) {
   const Eigen::Index nv = V.rows(), nt = F.rows();
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all hardware threads), got " + std::to_string(threads));
   if (nt == 0) throw std::invalid_argument("the mesh has no triangles");
   if (nt > (int64_t{1} << 30)) throw std::invalid_argument("the mesh has too many triangles");
   for (Eigen::Index i = 0; i < nv; ++i) {
@@ -153,8 +155,10 @@ MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const
   }
   const int32_t count = static_cast<int32_t>(order.size());
   nodes_.resize(1 + descendants(count));
-  const int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  build(0, 1, 0, count, threads);
+  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  std::atomic<int> used{1};
+  build(0, 1, 0, count, threads, used);
+  build_threads_ = used.load();
 }
 
 // Nodes below a subtree of n triangles: the median split fixes the tree's shape, so every subtree's node
@@ -169,7 +173,7 @@ int32_t MeshIndex::descendants(int32_t n) {
 // the children pair (below, below + 1), then the left child's descendants, then the right child's. Leaves
 // hold tris_[begin, end). Median splits of the Morton order keep the tree balanced on regular grids as on
 // scans. Large subtrees build their two halves on two threads (`threads` > 1).
-void MeshIndex::build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads) {
+void MeshIndex::build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads, std::atomic<int>& used) {
   if (end - begin <= kLeafSize) {
     BvhNode node{INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY, begin, end - begin};
     for (int32_t i = begin; i < end; ++i) {
@@ -186,13 +190,17 @@ void MeshIndex::build(int32_t self, int32_t below, int32_t begin, int32_t end, i
   const int32_t mid = begin + (end - begin) / 2;  // `order` is in Morton order: halves are compact
   const int32_t left = below, right = below + 1;
   const int32_t left_below = below + 2, right_below = left_below + descendants(mid - begin);
-  if (threads > 1 && end - begin > 100000) {
-    std::thread other([&] { build(right, right_below, mid, end, threads / 2); });
-    build(left, left_below, begin, mid, threads - threads / 2);
-    other.join();
+  if (threads > 1 && end - begin > kParallelBuild) {
+    ++used;
+    // Joined on every exit, an exception from this thread's half included.
+    struct Joined {
+      std::thread t;
+      ~Joined() { t.join(); }
+    } other{std::thread([&] { build(right, right_below, mid, end, threads / 2, used); })};
+    build(left, left_below, begin, mid, threads - threads / 2, used);
   } else {
-    build(left, left_below, begin, mid, 1);
-    build(right, right_below, mid, end, 1);
+    build(left, left_below, begin, mid, 1, used);
+    build(right, right_below, mid, end, 1, used);
   }
   const BvhNode& l = nodes_[left];
   const BvhNode& r = nodes_[right];

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "tmm/position/gouge_check.hpp"
 #include "tmm/position/pose.hpp"
@@ -37,7 +39,6 @@ namespace {
 
 std::shared_ptr<const PatchSurface> extended_or_same(const std::shared_ptr<const PatchSurface>& s, double d) {
   if (!s) throw std::invalid_argument("no surface");
-  if (!(d >= 0.0) || !std::isfinite(d)) throw std::invalid_argument("extension distance must be >= 0");
   if (d == 0.0) return s;
   return std::make_shared<const PatchSurface>(s->extended(d));
 }
@@ -45,16 +46,35 @@ std::shared_ptr<const PatchSurface> extended_or_same(const std::shared_ptr<const
 // The XY bucket size of the samples: half the tool's diameter.
 double bucket_size(const TorusTool& tool) { return std::max((tool.Ro + tool.Ri) * 0.5, 1e-3); }
 
+const MultipointOptions& checked(const MultipointOptions& options, const TorusTool& tool) {
+  validate(options, tool);
+  return options;
+}
+
+// The sample spacing for the face: the option, if the face can be sampled that finely (else refused), or
+// (Ro + Ri) / 8, widened if the face needs too many samples.
+double checked_spacing(const PatchSurface& s, const MultipointOptions& options, const TorusTool& tool) {
+  const double spacing = sample_spacing_for(options, tool);
+  if (options.sample_spacing == 0.0) return spacing;
+  bool capped = false;
+  if (SurfaceSamples::planned_spacing(s, spacing, &capped) == spacing && !capped) return spacing;
+  std::ostringstream msg;
+  msg << "sample_spacing " << spacing << " mm is finer than this face can be sampled at (at most "
+      << SurfaceSamples::kMaxSamples << " samples, " << SurfaceSamples::kMaxSide
+      << " per patch side): it must be 0 (auto: (Ro + Ri) / 8 = " << (tool.Ro + tool.Ri) / 8.0
+      << " mm) or >= " << SurfaceSamples::finest_spacing(s, spacing) << " mm";
+  throw std::invalid_argument(msg.str());
+}
+
 }  // namespace
 
 MultipointPositioner::MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool,
                                            MultipointOptions options)
-    : real_(surface),
-      surface_(extended_or_same(surface, options.extend)),
-      tool_((tool.validate(), tool)),
-      opt_(options),
-      samples_(*surface_, sample_spacing_for(options, tool), bucket_size(tool)) {
-  validate(opt_, tool_);
+    : tool_(tool),
+      opt_(checked(options, tool_)),
+      real_(std::move(surface)),
+      surface_(extended_or_same(real_, opt_.extend)),
+      samples_(*surface_, checked_spacing(*surface_, opt_, tool_), bucket_size(tool_)) {
   if (opt_.extend > 0.0) real_samples_ = std::make_unique<const SurfaceSamples>(*real_, samples_.spacing(), bucket_size(tool_));
 }
 

@@ -1,40 +1,95 @@
 #include "tmm/position/surface_samples.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <utility>
 
 namespace tmm {
 
-SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, double cell) {
-  if (!(spacing > 0.0) || !(cell > 0.0)) throw std::invalid_argument("sample spacing must be > 0");
-  // Sample counts from the control polygon lengths (they bound the curve lengths).
-  std::vector<std::pair<int, int>> counts;
-  for (;;) {
-    counts.clear();
-    std::size_t total = 0;
-    for (int i = 0; i < surface.nu(); ++i) {
-      for (int j = 0; j < surface.nv(); ++j) {
-        const BezierPatch& p = surface.patch(i, j);
-        double lu = 0.0, lv = 0.0;
-        for (int b = 0; b <= p.degree_v(); ++b) {
-          double l = 0.0;
-          for (int a = 0; a < p.degree_u(); ++a) l += (p.pole(a + 1, b) - p.pole(a, b)).norm();
-          lu = std::max(lu, l);
-        }
-        for (int a = 0; a <= p.degree_u(); ++a) {
-          double l = 0.0;
-          for (int b = 0; b < p.degree_v(); ++b) l += (p.pole(a, b + 1) - p.pole(a, b)).norm();
-          lv = std::max(lv, l);
-        }
-        const int mu = std::clamp(static_cast<int>(std::ceil(lu / spacing)), 2, 4000);
-        const int mv = std::clamp(static_cast<int>(std::ceil(lv / spacing)), 2, 4000);
-        counts.emplace_back(mu, mv);
-        total += static_cast<std::size_t>(mu + 1) * static_cast<std::size_t>(mv + 1);
+namespace {
+
+// The control polygon lengths of each patch in u and v (they bound the curve lengths), patch by patch.
+std::vector<std::pair<double, double>> polygon_lengths(const PatchSurface& surface) {
+  std::vector<std::pair<double, double>> lengths;
+  for (int i = 0; i < surface.nu(); ++i) {
+    for (int j = 0; j < surface.nv(); ++j) {
+      const BezierPatch& p = surface.patch(i, j);
+      double lu = 0.0, lv = 0.0;
+      for (int b = 0; b <= p.degree_v(); ++b) {
+        double l = 0.0;
+        for (int a = 0; a < p.degree_u(); ++a) l += (p.pole(a + 1, b) - p.pole(a, b)).norm();
+        lu = std::max(lu, l);
       }
+      for (int a = 0; a <= p.degree_u(); ++a) {
+        double l = 0.0;
+        for (int b = 0; b < p.degree_v(); ++b) l += (p.pole(a, b + 1) - p.pole(a, b)).norm();
+        lv = std::max(lv, l);
+      }
+      lengths.emplace_back(lu, lv);
     }
-    if (total <= kMaxSamples) break;
-    spacing *= 1.5;
   }
+  return lengths;
+}
+
+// Grid intervals along a patch side of the given length: ceil(length / spacing) within [2, kMaxSide],
+// clamped before the conversion (a huge quotient does not fit an int).
+int intervals(double length, double spacing, bool* capped) {
+  const double n = std::ceil(length / spacing);
+  if (n > SurfaceSamples::kMaxSide) {
+    *capped = true;
+    return SurfaceSamples::kMaxSide;
+  }
+  return n >= 2.0 ? static_cast<int>(n) : 2;
+}
+
+struct Plan {
+  double spacing;
+  bool capped = false;
+  std::vector<std::pair<int, int>> counts;  // per patch
+};
+
+// The spacing, widened by steps of 1.5 until the face needs at most kMaxSamples samples.
+Plan plan_for(const std::vector<std::pair<double, double>>& lengths, double spacing) {
+  Plan plan{spacing, false, {}};
+  for (;;) {
+    plan.counts.clear();
+    plan.capped = false;
+    std::size_t total = 0;
+    for (const auto& [lu, lv] : lengths) {
+      const int mu = intervals(lu, plan.spacing, &plan.capped);
+      const int mv = intervals(lv, plan.spacing, &plan.capped);
+      plan.counts.emplace_back(mu, mv);
+      total += static_cast<std::size_t>(mu + 1) * static_cast<std::size_t>(mv + 1);
+    }
+    if (total <= SurfaceSamples::kMaxSamples) return plan;
+    plan.spacing *= 1.5;
+  }
+}
+
+}  // namespace
+
+double SurfaceSamples::planned_spacing(const PatchSurface& surface, double spacing, bool* capped) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing)) throw std::invalid_argument("sample spacing must be finite and > 0");
+  const Plan p = plan_for(polygon_lengths(surface), spacing);
+  if (capped) *capped = p.capped;
+  return p.spacing;
+}
+
+double SurfaceSamples::finest_spacing(const PatchSurface& surface, double spacing) {
+  const auto lengths = polygon_lengths(surface);
+  double longest = 0.0;
+  for (const auto& [lu, lv] : lengths) longest = std::max({longest, lu, lv});
+  // Below longest / kMaxSide a side would be capped; a little above it, rounding cannot tip it over.
+  return plan_for(lengths, std::max(spacing, longest / (kMaxSide - 1))).spacing;
+}
+
+SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, double cell) {
+  if (!(spacing > 0.0) || !std::isfinite(spacing) || !(cell > 0.0) || !std::isfinite(cell))
+    throw std::invalid_argument("sample spacing and bucket size must be finite and > 0");
+  const Plan plan = plan_for(polygon_lengths(surface), spacing);
+  const std::vector<std::pair<int, int>>& counts = plan.counts;
+  spacing = plan.spacing;
   spacing_ = spacing;
   Box3 box;
   int k = 0;

@@ -1,8 +1,19 @@
 #include "tmm/query/drop_contacts.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace tmm {
+
+namespace {
+
+// Distance from the axis of the cutter point touching a plane whose unit normal has horizontal length nxy
+// and vertical component nz > 0.
+inline double plane_contact_radius(const Cutter& c, double nxy, double nz) {
+  return nxy > 1e-15 ? c.facet_contact_radius(nxy, nz) : 0.0;
+}
+
+}  // namespace
 
 double plane_drop(const Cutter& c, double x, double y, const double* p0, const double* p1, const double* p2,
                   const double* n, bool& inside) {
@@ -10,9 +21,9 @@ double plane_drop(const Cutter& c, double x, double y, const double* p0, const d
   const double nz = n[2];
   if (nz <= 1e-12) return kNoContact;  // vertical or downward facing: edges give the contact
   const double nxy = std::sqrt(n[0] * n[0] + n[1] * n[1]);
-  double cx = x, cy = y, rho = 0.0;
+  double cx = x, cy = y;
+  const double rho = plane_contact_radius(c, nxy, nz);
   if (nxy > 1e-15) {
-    rho = c.facet_contact_radius(nxy, nz);
     cx -= rho * n[0] / nxy;  // uphill: the plane rises against n_xy
     cy -= rho * n[1] / nxy;
   }
@@ -24,6 +35,12 @@ double plane_drop(const Cutter& c, double x, double y, const double* p0, const d
 
 double facet_drop(const Cutter& c, double x, double y, const double* p0, const double* p1,
                   const double* p2, const double* n, double zmax, double above) {
+  // The contact point lies in the triangle, so no higher than its highest corner: the tip is at most zmax
+  // lowered by h at the contact radius. The margin covers the rounding of the plane's height and of the
+  // inside test's tolerance, so a true contact is never cut.
+  if (n[2] > 1e-12 && zmax < kInf && above > kNoContact &&
+      zmax - c.height(plane_contact_radius(c, std::sqrt(n[0] * n[0] + n[1] * n[1]), n[2])) + 1e-9 * (1.0 + std::fabs(zmax)) <= above)
+    return kNoContact;
   bool inside = false;
   const double z = plane_drop(c, x, y, p0, p1, p2, n, inside);
   return inside && z > above ? z : kNoContact;

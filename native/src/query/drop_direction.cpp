@@ -410,20 +410,21 @@ Eigen::Matrix3d rotation_to_minus_z(const Vector3d& V) {
 }
 
 std::shared_ptr<const MeshIndex> rotated_index(const VerticesRef& vertices, const TrianglesRef& triangles,
-                                               const Eigen::Matrix3d& rot) {
-  if (rot.isIdentity(0.0)) return std::make_shared<const MeshIndex>(vertices, triangles);
+                                               const Eigen::Matrix3d& rot, int threads) {
+  if (rot.isIdentity(0.0)) return std::make_shared<const MeshIndex>(vertices, triangles, threads);
   const Vertices rotated = vertices * rot.transpose();
-  return std::make_shared<const MeshIndex>(rotated, triangles);
+  return std::make_shared<const MeshIndex>(rotated, triangles, threads);
 }
 
 }  // namespace
 
-DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Vector3d& V)
+DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Vector3d& V,
+                                   int threads)
     : V_(V) {
   require_unit(V, "drop direction");
   V_ = V.normalized();
   rot_ = rotation_to_minus_z(V_);
-  index_ = rotated_index(vertices, triangles, rot_);
+  index_ = rotated_index(vertices, triangles, rot_, threads);
 }
 
 double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& start,

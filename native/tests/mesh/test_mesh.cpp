@@ -394,7 +394,7 @@ TEST(VertexNormals, CurvedHeightFields) {
       {"saddle", [&](double x, double y) { return ((x - 10) * (x - 10) - (y - 10) * (y - 10)) / (2 * R); },
        [&](double x, double y) { return Vec3(-(x - 10) / R, (y - 10) / R, 1).normalized(); }},
       {"cylinder", [&](double x, double) { return std::sqrt(R * R - (x - 10) * (x - 10)); },
-       [&](double x, double y) { return Vec3((x - 10), 0, std::sqrt(R * R - (x - 10) * (x - 10))).normalized(); }},
+       [&](double x, double) { return Vec3((x - 10), 0, std::sqrt(R * R - (x - 10) * (x - 10))).normalized(); }},
   };
   for (const Case& k : cases) {
     const tmm::Mesh m = grid(20, 20, k.z, 0.25);

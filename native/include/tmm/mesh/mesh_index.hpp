@@ -4,6 +4,7 @@
 // is never above the triangle's highest point, so such nodes cannot raise the cutter.
 #pragma once
 
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -38,8 +39,14 @@ struct BvhNode {
 
 class MeshIndex {
  public:
-  // Throws std::invalid_argument on out-of-range indices, non-finite coordinates or an empty mesh.
-  MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F);
+  // threads: at most this many threads build the tree (0: all hardware threads; subtrees of more than
+  // kParallelBuild triangles are split between threads, so small meshes build on one). The tree does not
+  // depend on it. Throws std::invalid_argument on out-of-range indices, non-finite coordinates, an empty
+  // mesh or threads < 0.
+  MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F, int threads = 0);
+  static constexpr int32_t kParallelBuild = 100000;
+  // The number of threads the build ran on.
+  int build_threads() const { return build_threads_; }
 
   std::size_t triangle_count() const { return tris_.size(); }
   const std::vector<IndexedTriangle>& triangles() const { return tris_; }
@@ -65,12 +72,13 @@ class MeshIndex {
   void near_rect(double x0, double y0, double x1, double y1, double radius, double floor, Visit&& visit) const;
 
  private:
-  void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads);
+  void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads, std::atomic<int>& used);
   static int32_t descendants(int32_t triangles);
 
   std::vector<IndexedTriangle> tris_;
   std::vector<BvhNode> nodes_;
   double zmin_ = 0.0;
+  int build_threads_ = 1;
 };
 
 template <class Visit>

@@ -41,7 +41,8 @@ namespace tmm {
 
 class MultipointPositioner {
  public:
-  // Throws std::invalid_argument on an invalid tool or options.
+  // Throws std::invalid_argument naming the first invalid tool radius or option (NaN and infinities
+  // included; a sample_spacing finer than the face can be sampled at, with the finest it can).
   MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool, MultipointOptions options);
 
   // Position the tool at footprint point (x, y): Axis anchor, the tool whose axis before tilting is the
@@ -71,10 +72,10 @@ class MultipointPositioner {
 
  private:
   MultipointResult position_core(double x, double y) const;
-  std::shared_ptr<const PatchSurface> real_;
-  std::shared_ptr<const PatchSurface> surface_;
   TorusTool tool_;
   MultipointOptions opt_;
+  std::shared_ptr<const PatchSurface> real_;
+  std::shared_ptr<const PatchSurface> surface_;
   SurfaceSamples samples_;
   std::unique_ptr<const SurfaceSamples> real_samples_;  // extend > 0 only
 };

@@ -19,8 +19,15 @@ class SurfaceSamples {
  public:
   // spacing: target distance between samples (mm); cell: XY bucket size (mm).
   SurfaceSamples(const PatchSurface& surface, double spacing, double cell);
-  // The largest number of samples kept: beyond it the spacing is widened (spacing() tells by how much).
+  // The largest number of samples kept: beyond it the spacing is widened (spacing() tells by how much);
+  // at most kMaxSide intervals along a patch side (beyond it the side is sampled coarser).
   static constexpr std::size_t kMaxSamples = 4000000;
+  static constexpr int kMaxSide = 4000;
+  // The spacing the samples take for a requested one: widened by steps of 1.5 until the face needs at
+  // most kMaxSamples; *capped: some patch side would need more than kMaxSide intervals.
+  static double planned_spacing(const PatchSurface& surface, double spacing, bool* capped = nullptr);
+  // The finest spacing, from `spacing` up, that this face is sampled at exactly (no widening, no cap).
+  static double finest_spacing(const PatchSurface& surface, double spacing);
   double spacing() const { return spacing_; }
   // Calls f(index) for every sample within XY distance r of (x, y).
   template <class F>
@@ -43,10 +50,16 @@ class SurfaceSamples {
 
 template <class F>
 void SurfaceSamples::within(double x, double y, double r, F&& f) const {
-  const int i0 = std::max(0, static_cast<int>(std::floor((x - r - x0_) / cell_)));
-  const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((x + r - x0_) / cell_)));
-  const int j0 = std::max(0, static_cast<int>(std::floor((y - r - y0_) / cell_)));
-  const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((y + r - y0_) / cell_)));
+  // Bucket of coordinate t, clamped to [-1, n] before the conversion (NaN: -1, an empty range).
+  auto bucket = [](double t, int n) {
+    const double b = std::floor(t);
+    if (!(b >= -1.0)) return -1;
+    return b > n ? n : static_cast<int>(b);
+  };
+  const int i0 = std::max(0, bucket((x - r - x0_) / cell_, nx_));
+  const int i1 = std::min(nx_ - 1, bucket((x + r - x0_) / cell_, nx_));
+  const int j0 = std::max(0, bucket((y - r - y0_) / cell_, ny_));
+  const int j1 = std::min(ny_ - 1, bucket((y + r - y0_) / cell_, ny_));
   const double r2 = r * r;
   for (int j = j0; j <= j1; ++j) {
     for (int i = i0; i <= i1; ++i) {

@@ -7,11 +7,11 @@
 #include <limits>
 
 #include "tmm/cutter/cutter.hpp"
+#include "tmm/util/constants.hpp"
 
 namespace tmm {
 
 constexpr double kNoContact = -std::numeric_limits<double>::infinity();
-constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Does (cx, cy) lie in the XY projection of triangle p0 p1 p2 (either orientation)? Barycentric signs with a
 // relative tolerance, so a point on an edge counts as inside.

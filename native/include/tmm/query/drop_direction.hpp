@@ -71,8 +71,9 @@ double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vec
 class DirectionalIndex {
  public:
   // V must be a unit vector; std::invalid_argument otherwise or for a bad mesh. For V = -Z exactly the
-  // rotation is the identity and the index is the plain drop-cutter index.
-  DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Eigen::Vector3d& V);
+  // rotation is the identity and the index is the plain drop-cutter index. threads: as for MeshIndex.
+  DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Eigen::Vector3d& V,
+                   int threads = 0);
 
   const Eigen::Vector3d& direction() const { return V_; }
   const Eigen::Matrix3d& rotation() const { return rot_; }  // world -> frame in which V = -Z'
