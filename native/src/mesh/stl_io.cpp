@@ -248,12 +248,28 @@ class AsciiParser {
 
 }  // namespace
 
+namespace {
+
+std::string file_kind(fs::file_type t) {
+  switch (t) {
+    case fs::file_type::fifo: return "a FIFO";
+    case fs::file_type::character: return "a character device";
+    case fs::file_type::block: return "a block device";
+    case fs::file_type::socket: return "a socket";
+    default: return "not a file";
+  }
+}
+
+}  // namespace
+
 Soup read_stl(const std::string& path) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
   if (st.type() == fs::file_type::not_found) throw StlError(path, "file not found");
   if (ec) throw StlError(path, "cannot access: " + ec.message());
   if (fs::is_directory(st)) throw StlError(path, "is a directory, not an STL file");
+  // Only regular files: opening a FIFO blocks until a writer comes, a device (/dev/zero) never ends.
+  if (!fs::is_regular_file(st)) throw StlError(path, "not a regular file (" + file_kind(st.type()) + ")");
   errno = 0;
   File f(std::fopen(path.c_str(), "rb"));
   if (!f) throw StlError(path, "cannot open: " + std::string(std::strerror(errno)));

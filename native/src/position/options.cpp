@@ -12,7 +12,8 @@ namespace tmm {
 
 namespace {
 
-[[noreturn]] void refuse(const char* name, const std::string& rule, double value) {
+template <class T>
+[[noreturn]] void refuse(const char* name, const std::string& rule, T value) {
   std::ostringstream msg;
   msg << name << " must be " << rule << ", got " << value;
   throw std::invalid_argument(msg.str());

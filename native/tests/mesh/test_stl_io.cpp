@@ -6,15 +6,19 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -343,3 +347,23 @@ TEST(StlRead, BigBinary) {
     EXPECT_EQ(soup(t, 8), 1.0);
   }
 }
+
+namespace {
+
+TEST(StlRead, NotARegularFileIsRefusedAtOnce) {
+  TempDir tmp;
+  const std::string fifo = tmp.path("pipe.stl");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // Opening a FIFO for reading blocks until a writer comes: read on a thread, and if it has not returned
+  // after a second, be the writer (so the test fails instead of hanging).
+  auto reading = std::async(std::launch::async, [&] { return read_error(fifo); });
+  if (reading.wait_for(std::chrono::seconds(1)) != std::future_status::ready) {
+    ADD_FAILURE() << "read_stl blocked on a FIFO";
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd >= 0) ::close(fd);
+  }
+  EXPECT_EQ(reading.get(), fifo + ": not a regular file (a FIFO)");
+  EXPECT_EQ(read_error("/dev/zero"), "/dev/zero: not a regular file (a character device)");
+}
+
+}  // namespace

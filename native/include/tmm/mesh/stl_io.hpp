@@ -28,7 +28,8 @@ class StlError : public std::runtime_error {
 // (LF, CRLF, CR), several solids per file allowed. Facet normals must be numbers but are not returned
 // (they are often zero or wrong; compute them from the vertices). Binary: little-endian; normals and
 // attribute bytes ignored.
-// Throws StlError for a missing/unreadable file, an empty file, no triangles, a truncated or garbled
+// Throws StlError for a missing/unreadable file, a directory or anything else that is not a regular file
+// (FIFO, device, socket: refused before opening), an empty file, no triangles, a truncated or garbled
 // file, or a non-finite vertex coordinate.
 Soup read_stl(const std::string& path);
 
