@@ -19,7 +19,7 @@ ROOT = os.path.dirname(os.path.dirname(HERE))
 def main() -> int:
     # Did the add-on's Init.py run (FreeCAD's Mod link) and wrap the post search path? Recorded
     # before the tests' helpers install the wrapper themselves.
-    prefs = sys.modules.get("PathScripts.PathPreferences")
+    prefs = sys.modules.get("PathScripts.PathPreferences") or sys.modules.get("Path.Preferences")
     wrapped = bool(prefs and getattr(prefs.searchPathsPost, "_tmm_wrapped", False))
     os.environ["TMM_FC_INIT_WRAPPED_POSTS"] = "1" if wrapped else "0"
     for p in (HERE, ROOT):

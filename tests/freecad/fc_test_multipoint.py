@@ -13,7 +13,7 @@ import numpy as np
 
 from fc_helpers import OUT, FreeCADTestCase, close_all, new_doc
 from tmm_workbench.app.api import run_multipoint
-from tmm_workbench.app.compat import PathPostProcessor
+from tmm_workbench.app.compat import load_post
 from tmm_workbench.app.op_multipoint import ObjectTmmMultipoint
 from tmm_workbench.core import path5
 from tmm_workbench.core.geometry import bezier
@@ -97,7 +97,7 @@ class MultipointOp(FreeCADTestCase):
                 np.testing.assert_allclose(d / np.linalg.norm(d), a.axis, atol=1e-9)
                 self.assertAlmostEqual(float(np.linalg.norm(d)), op.AxisRetract.Value, places=9)
 
-        # posts (through PostProcessor.load): tarus -> A and C words, apt_cl -> GOTO/x,y,z,i,j,k
+        # posts (through compat.load_post): tarus -> A and C words, apt_cl -> GOTO/x,y,z,i,j,k
         tarus = r.gcode["tarus"]
         self.assertTrue(re.search(r"\bA-?\d", tarus) and re.search(r"\bC\d", tarus))
         self.assertTrue(r.files["tarus"].is_file())
@@ -107,7 +107,7 @@ class MultipointOp(FreeCADTestCase):
         np.testing.assert_allclose(np.linalg.norm(gotos[:, 3:], axis=1), 1.0, atol=1e-5)
         self.assertGreaterEqual(len(gotos), len(cut_path))
         self.assertTrue(r.files["apt_cl"].is_file())
-        processor = PathPostProcessor.PostProcessor.load("tarus")
+        processor = load_post("tarus")
         text = processor.export([r.job.Tools.Group[0], op], str(OUT / "mp_direct.ngc"), "--no-show-editor")
         self.assertIn(" A", text if isinstance(text, str) else (OUT / "mp_direct.ngc").read_text())
 

@@ -1,5 +1,5 @@
 """5-axis moves in a FreeCAD Path (X Y Z tip + U V W axis, core.path5) through FreeCAD's post chain:
-TMM's `tarus` and `apt_cl` posts found through the search-path hook and loaded by PostProcessor.load, their
+TMM's `tarus` and `apt_cl` posts found through the search-path hook and loaded by compat.load_post, their
 output parsed back (Tarus through forward kinematics) equal to the tool path; stock linuxcnc/grbl posts and
 Inspect-style reading accept the representation; a joint limit violation is an error and writes no file."""
 from __future__ import annotations
@@ -17,7 +17,8 @@ import numpy as np
 from fc_helpers import OUT, FreeCADTestCase, new_doc
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app import posts
-from tmm_workbench.app.compat import PathPostProcessor, PathPreferences
+from tmm_workbench.app import compat
+from tmm_workbench.app.compat import PathPreferences, load_post
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine import TarusMachine
@@ -92,11 +93,11 @@ class Posts5(FreeCADTestCase):
         for name in ("tarus", "apt_cl"):
             self.assertIn(name, available)
             self.assertIn(name, self.job.getEnumerationsOfProperty("PostProcessor"))
-            processor = PathPostProcessor.PostProcessor.load(name)
-            self.assertEqual(os.path.dirname(os.path.realpath(processor.script.__file__)),
+            processor = load_post(name)
+            self.assertEqual(os.path.dirname(os.path.realpath(processor.__file__)),
                              os.path.realpath(posts.POST_DIR))
-            self.assertTrue(processor.tooltip and processor.tooltipArgs)
-            self.assertEqual(processor.units, "Metric")
+            self.assertTrue(processor.TOOLTIP and processor.TOOLTIP_ARGS)
+            self.assertEqual(processor.UNITS, "G21")
 
     def test_representation_is_exact_in_the_document(self) -> None:
         moves = path5.decode_commands([(c.Name, c.Parameters) for c in self.op.Path.Commands])
@@ -112,7 +113,7 @@ class Posts5(FreeCADTestCase):
                 target = OUT / f"tarus_{'tcp' if tcp else 'joints'}.ngc"
                 args = "--no-show-editor --precision 10 --angle-precision 12 --tool-length 80" + \
                     (" --tcp" if tcp else "")
-                processor = PathPostProcessor.PostProcessor.load("tarus")
+                processor = load_post("tarus")
                 text = processor.export([self.tc, self.op], str(target), args)
                 self.assertEqual(target.read_text(), text)
                 self.assertIn("T1 M6", text)
@@ -132,7 +133,7 @@ class Posts5(FreeCADTestCase):
         self.assertTrue(any(ln.startswith("G93 G1") for ln in text.splitlines()))
 
     def test_apt_cl(self) -> None:
-        processor = PathPostProcessor.PostProcessor.load("apt_cl")
+        processor = load_post("apt_cl")
         target = OUT / "tilted.apt"
         text = processor.export([self.tc, self.op], str(target), "--no-show-editor --precision 9 --axis-precision 12")
         self.assertEqual(target.read_text(), text)
@@ -166,7 +167,7 @@ class Posts5(FreeCADTestCase):
         back = path5.decode_commands([(c.Name, c.Parameters) for c in again.Commands])
         self.assertLess(max(abs(a - b) for d, m in zip(back, self.tp) for a, b in zip(d.axis, m.axis)), 2e-6)
         # FreeCAD's geometry of a command: edges from X, Y, Z; the placement ignores U, V, W
-        from PathScripts import PathGeom
+        PathGeom = compat.import_app("geom")
         start = FreeCAD.Vector(-30, 0, 60)
         for c in cmds[3:20]:
             self.assertEqual(c.Placement.Rotation.Angle, 0.0)
@@ -214,14 +215,14 @@ class Posts5(FreeCADTestCase):
         for name in ("tarus",):
             target = OUT / "steep_tarus.ngc"
             target.unlink(missing_ok=True)
-            processor = PathPostProcessor.PostProcessor.load(name)
+            processor = load_post(name)
             with self.assertRaises(TmmError) as ctx:
                 processor.export([self.tc, steep], str(target), "--no-show-editor")
             self.assertIn("operation 'Steep'", str(ctx.exception))
             self.assertIn("joint C", str(ctx.exception))
             self.assertFalse(target.exists())
         # a wider tilt range on the command line makes it reachable
-        text = PathPostProcessor.PostProcessor.load("tarus").export([self.tc, steep], "-", "--c-max 70")
+        text = load_post("tarus").export([self.tc, steep], "-", "--c-max 70")
         self.assertIn("M2", text)
         self.assertFalse(FilePath("-").exists())
 

@@ -1,4 +1,4 @@
-"""FreeCAD 0.20 vs 0.21+ module names for the Path (CAM) workbench, in one place.
+"""FreeCAD 0.20, 1.0 and 1.1 differences for the Path (CAM) workbench, in one place.
 
 0.20 keeps everything in `PathScripts.Path*`; from 0.21 the same code lives in `Path.Op.Base`,
 `Path.Main.Job`, ... (and from 1.0 under the CAM module, with the same `Path.*` package names).
@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import importlib
 from types import ModuleType
+from typing import Any
 
 # role -> (0.20 module, 0.21+ module)
 _APP_MODULES: dict[str, tuple[str, str]] = {
@@ -21,6 +22,7 @@ _APP_MODULES: dict[str, tuple[str, str]] = {
     "preferences": ("PathScripts.PathPreferences", "Path.Preferences"),
     "utils": ("PathScripts.PathUtils", "PathScripts.PathUtils"),
     "setup_sheet": ("PathScripts.PathSetupSheet", "Path.Base.SetupSheet"),
+    "geom": ("PathScripts.PathGeom", "Path.Geom"),
 }
 _GUI_MODULES: dict[str, tuple[str, str]] = {
     "op_gui": ("PathScripts.PathOpGui", "Path.Op.Gui.Base"),
@@ -67,3 +69,66 @@ def __getattr__(name: str) -> ModuleType:
     module = import_app(role)
     globals()[name] = module
     return module
+
+
+def freecad_version() -> tuple[int, int]:
+    import FreeCAD
+
+    major, minor = FreeCAD.Version()[:2]
+    return int(major), int(minor)
+
+
+def command_prefix() -> str:
+    """PathOpGui.SetupOperation registers 'Path_<op>' on 0.20 and 'CAM_<op>' from 1.0 (the workbench was
+    renamed); FreeCAD's own commands follow the same rule (Path_Job / CAM_Job)."""
+    return "Path_" if freecad_version() < (1, 0) else "CAM_"
+
+
+def load_post(name: str) -> ModuleType:
+    """The script post `<name>_post.py` (a module with `export(objects, filename, args)`) from the post
+    search path, TMM's folder included. 0.20 has PostProcessor.load for this, 1.0 removed it (its factory
+    wraps a script post to export the Job's whole list); 1.1 renamed the stock script posts
+    `<name>_legacy_post.py` and made the plain names classes, so a module without `export` is looked up
+    again as the legacy script. ImportError when no script post of that name exists."""
+    import importlib.util
+    import os
+
+    preferences = import_app("preferences")
+    paths = list(preferences.searchPathsPost())
+    for module_name in (f"{name}_post", f"{name}_legacy_post"):
+        for folder in paths:
+            path = os.path.join(folder, module_name + ".py")
+            if not os.path.isfile(path):
+                continue
+            spec = importlib.util.spec_from_file_location(module_name, path)
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)  # type: ignore[union-attr]
+            if callable(getattr(module, "export", None)):
+                return module
+    raise ImportError(f"no script post '{name}' on the post search path ({', '.join(paths)})")
+
+
+def stock_bit_file(file_name: str) -> str:
+    """A ToolBit file FreeCAD ships ('5mm_Endmill.fctb'): Mod/Path/Tools/Bit on 0.20, Mod/CAM/Tools/Bit from
+    1.0, found through searchPathsTool("Bit") on both."""
+    import os
+
+    for folder in import_app("preferences").searchPathsTool("Bit"):
+        path = os.path.join(folder, file_name)
+        if os.path.isfile(path):
+            return path
+    raise FileNotFoundError(f"FreeCAD ships no ToolBit '{file_name}'")
+
+
+def toolbit_from_file(doc: Any, path: str) -> Any:
+    """A ToolBit object in `doc` from a .fctb file (0.20 and 1.0: Factory.CreateFrom; 1.1: ToolBit.from_file)."""
+    import FreeCAD
+
+    FreeCAD.setActiveDocument(doc.Name)
+    bit_module = import_app("tool_bit")
+    factory = getattr(bit_module, "Factory", None)
+    if factory is not None:
+        return factory.CreateFrom(path)
+    from Path.Tool.toolbit import ToolBit  # 1.1
+
+    return ToolBit.from_file(path).attach_to_doc(doc)

@@ -1,7 +1,7 @@
 """Post-processing headless: FreeCAD's post modules, plus TMM's own post folder.
 
 `Init.py` adds `POST_DIR` to `PathPreferences.searchPathsPost()` so TMM's posts are offered in a
-Job like the stock ones and load through the same `PostProcessor.load(name)`.
+Job like the stock ones and load like them (compat.load_post on every FreeCAD version).
 """
 from __future__ import annotations
 
@@ -42,11 +42,11 @@ def export(post: str, objects: Sequence[Any], gcode_path: Optional[str | os.Path
     Writes `gcode_path` when given. Some stock posts (grbl) only write a file and return None, so
     the text is always read back from the file written.
     """
-    from tmm_workbench.app.compat import PathPostProcessor
+    from tmm_workbench.app.compat import load_post
 
     install_post_dir()
     try:
-        processor = PathPostProcessor.PostProcessor.load(post)
+        processor = load_post(post)
     except ImportError as exc:
         raise TmmError(f"post-processor '{post}' not found ({exc})") from exc
     args = DEFAULT_ARGS.get(post, "--no-show-editor") if args is None else args
