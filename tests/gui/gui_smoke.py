@@ -53,10 +53,11 @@ def multipoint_panel(info: dict) -> None:
     command, with the op's face selected, adds a second op and opens its panel."""
     from tmm_workbench.app.api import run_multipoint
     from tmm_workbench.core.geometry import bezier
-    from benchmarks.seed.experiment import seed_json_path
+    from tmm_workbench.app import registry
+    from tmm_workbench.core.shared_data import benchmark_file
     from tmm_workbench.gui.op_multipoint_gui import ViewProvider as MultipointViewProvider
 
-    net = bezier.load_seed_patch(seed_json_path(), "convex")
+    net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex")
     r = run_multipoint(net, side_step=36.0, forward_step=6.0, posts=(), doc_name="TmmGuiMultipoint",
                        progress=True, surface_extension=12.7, footprint_anchor="tip",
                        pass_spacing="fixed")
@@ -83,7 +84,7 @@ def multipoint_panel(info: dict) -> None:
     obj, face = r.face
     FreeCADGui.Selection.clearSelection()
     FreeCADGui.Selection.addSelection(obj, face)
-    FreeCADGui.runCommand("Path_TMM_Multipoint")
+    FreeCADGui.runCommand(registry.entry("TMM_Multipoint").command_name)
     pump(1.5)
     ops = [o for o in r.job.Operations.Group if o is not r.op]
     assert ops, "the 5-axis command made no op"
@@ -103,12 +104,14 @@ def smoke() -> dict:
     pump(0.5)
     info["workbench"] = FreeCADGui.activeWorkbench().name()
     assert info["workbench"] == "TMMWorkbench", info["workbench"]
+    from tmm_workbench.app import registry
     from tmm_workbench.gui import workbench
 
     commands = set(FreeCADGui.listCommands())
-    for cmd in ["Path_TMM_Surface", "TMM_JobFromModel"] + workbench.PATH_JOB_TOOLS + workbench.PATH_TOOL_TOOLS:
+    ops = [e.command_name for e in registry.OPS]
+    for cmd in ops + ["TMM_JobFromModel"] + workbench.path_commands(workbench.JOB_TOOLS + workbench.TOOL_TOOLS):
         assert cmd in commands, f"command {cmd} missing"
-    assert "Path_TMM_Multipoint" in commands, "command Path_TMM_Multipoint (5-axis Multipoint) missing"
+    assert registry.entry("TMM_Multipoint").command_name in commands, "the 5-axis Multipoint command is missing"
 
     from tmm_workbench.app.api import run_surface
     from tmm_workbench.gui.op_surface_gui import ViewProvider
@@ -123,7 +126,7 @@ def smoke() -> dict:
     FreeCADGui.activeDocument().activeView().viewIsometric()
 
     FreeCADGui.Selection.clearSelection()
-    FreeCADGui.runCommand("Path_TMM_Surface")  # the op command: new op + its task panel
+    FreeCADGui.runCommand(registry.entry("TMM_Surface").command_name)  # the op command: new op + its task panel
     pump(1.5)
     ops = [o for o in r.job.Operations.Group if o is not r.op]
     assert ops, "the command made no op"

@@ -15,7 +15,7 @@ from typing import Any, Optional
 
 @dataclass(frozen=True)
 class OpEntry:
-    name: str          # the op's type name (OP_NAME), its command is "Path_<name>"
+    name: str          # the op's type name (OP_NAME), its command "Path_<name>" (0.20) / "CAM_<name>" (1.x)
     menu_text: str     # toolbar / menu text
     tooltip: str
     icon: str          # resources/icons/<icon>.svg
@@ -26,7 +26,9 @@ class OpEntry:
 
     @property
     def command_name(self) -> str:
-        return "Path_" + self.name
+        from tmm_workbench.app.compat import command_prefix
+
+        return command_prefix() + self.name
 
     def app(self) -> ModuleType:
         return importlib.import_module(self.app_module)

@@ -13,7 +13,7 @@ import FreeCAD
 import FreeCADGui
 from PySide import QtGui
 
-from tmm_workbench.app.compat import PathOp, PathUtils, import_gui
+from tmm_workbench.app.compat import PathOp, PathUtils, command_prefix, import_gui
 from tmm_workbench.gui import resources
 
 PathOpGui = import_gui("op_gui")
@@ -128,7 +128,7 @@ class OpViewProvider(PathOpGui.ViewProvider):
 
     def getIcon(self) -> str:
         if self.Object is not None and not self.Object.Active:
-            return ":/icons/Path_OpActive.svg"
+            return f":/icons/{command_prefix()}OpActive.svg"
         return self.ICON
 
 

@@ -6,9 +6,15 @@ import FreeCADGui
 
 from tmm_workbench.gui import resources
 
-PATH_JOB_TOOLS = ["Path_Job", "Path_Post", "Path_Inspect", "Path_Simulator"]
-PATH_TOOL_TOOLS = ["Path_ToolBitLibraryOpen", "Path_ToolBitDock", "Path_ToolBitCreate", "Path_ToolBitLoad",
-                   "Path_ToolController"]
+from tmm_workbench.app.compat import command_prefix
+
+# FreeCAD's own commands, without their prefix (Path_ on 0.20, CAM_ from 1.0)
+JOB_TOOLS = ["Job", "Post", "Inspect", "Simulator"]
+TOOL_TOOLS = ["ToolBitLibraryOpen", "ToolBitDock", "ToolBitCreate", "ToolBitLoad", "ToolController"]
+
+
+def path_commands(names: list[str]) -> list[str]:
+    return [command_prefix() + n for n in names]
 
 
 class TMMWorkbench(FreeCADGui.Workbench):
@@ -35,9 +41,10 @@ class TMMWorkbench(FreeCADGui.Workbench):
             entry.gui()  # registers the op's command
         tmm = [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS]
         self.appendToolbar("TMM", tmm)
-        self.appendToolbar("TMM Path", PATH_JOB_TOOLS)
-        self.appendToolbar("TMM Tools", PATH_TOOL_TOOLS)
-        self.appendMenu("&TMM", tmm + ["Separator"] + PATH_JOB_TOOLS + ["Separator"] + PATH_TOOL_TOOLS)
+        job_tools, tool_tools = path_commands(JOB_TOOLS), path_commands(TOOL_TOOLS)
+        self.appendToolbar("TMM Path", job_tools)
+        self.appendToolbar("TMM Tools", tool_tools)
+        self.appendMenu("&TMM", tmm + ["Separator"] + job_tools + ["Separator"] + tool_tools)
 
     def Activated(self) -> None:
         pass
@@ -48,7 +55,7 @@ class TMMWorkbench(FreeCADGui.Workbench):
     def ContextMenu(self, recipient: str) -> None:
         sel = FreeCADGui.Selection.getSelection()
         if len(sel) == 1 and sel[0].isDerivedFrom("Path::Feature"):
-            self.appendContextMenu("", ["Separator", "Path_Inspect"])
+            self.appendContextMenu("", ["Separator", command_prefix() + "Inspect"])
 
     def GetClassName(self) -> str:
         return "Gui::PythonWorkbench"
