@@ -30,7 +30,7 @@ def main() -> int:
     origin = os.path.realpath(os.path.dirname(os.path.dirname(tmm_workbench.__file__)))
     if origin != os.path.realpath(ROOT):
         sys.stderr.write(f"tmm_workbench comes from {origin}, not from this checkout {ROOT}: FreeCAD's Mod "
-                         f"folder links another copy (ln -sfn {ROOT} ~/.local/share/FreeCAD/Mod/TMM)\n")
+                         f"folder links another copy (scripts/setup.sh links this one)\n")
         return 1
     names = [n.strip() for n in os.environ.get("TMM_FC_MODULES", "").split(",") if n.strip()]
     if not names:

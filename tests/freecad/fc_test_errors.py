@@ -9,7 +9,7 @@ import Part
 
 from fc_helpers import OUT, FreeCADTestCase, bump_stl, bump_triangles, job_with_op, new_doc, write_ascii_stl
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import tools
+from tmm_workbench.app import compat, tools
 from tmm_workbench.core.errors import TmmError
 
 
@@ -63,7 +63,19 @@ class BadInput(FreeCADTestCase):
         self.assertFails("nan.stl", "finite")
 
     def test_corner_radius_larger_than_radius(self) -> None:
-        bit = tools.make_tool_bit(self.doc, "bullnose", 4.0, 3.0)  # FlatRadius -1
+        with self.assertRaises(TmmError) as ctx:  # TMM makes no such bit
+            tools.make_tool_bit(self.doc, "bullnose", 4.0, 3.0)
+        self.assertIn("corner radius 3 mm is larger than the tool radius 2 mm", str(ctx.exception))
+        bit = tools.make_tool_bit(self.doc, "bullnose", 4.0, 1.0)  # a user edits it into one
+        if compat.toolbits_are_assets():
+            # 1.1: the bit's own shape sketch fails, so FreeCAD recomputes nothing that depends on it; the
+            # map still refuses the bit
+            bit.CornerRadius = 3.0
+            with self.assertRaises(TmmError) as ctx:
+                tools.cutter_from_tool(bit)
+            self.assertIn("corner radius 3 mm is larger than the tool radius 2 mm", str(ctx.exception))
+            return
+        bit.FlatRadius = -1.0  # 0.20 and 1.0 store the flat bottom's radius: corner 3
         self.tc.Tool = bit
         self.assertFails("corner radius 3 mm is larger than the tool radius 2 mm")
 

@@ -11,6 +11,7 @@ import FreeCAD
 from fc_helpers import (OUT, SPHERE_ON_PLATE, FreeCADTestCase, bump_stl, bump_triangles, job_with_op,
                         mesh_feature, new_doc, parse_gcode)
 from tmm_workbench.app import posts
+from tmm_workbench.app import tools
 from tmm_workbench.app.api import SurfaceResult, run_surface
 from tmm_workbench.app.compat import PathPreferences
 from tmm_workbench.core.errors import TmmError
@@ -39,7 +40,7 @@ def dedupe(seq):
     return out
 
 
-ADDON_LINK = Path.home() / ".local" / "share" / "FreeCAD" / "Mod" / "TMM"
+ADDON_LINK = Path(FreeCAD.getUserAppDataDir()) / "Mod" / "TMM"  # versioned from 1.1 (v1-1/Mod)
 DUMMY_POST = '''"""TMM self-test post: one line per motion command."""
 TOOLTIP = "TMM self-test"
 
@@ -150,7 +151,7 @@ class Api(FreeCADTestCase):
         self.assertEqual(r.op.Pattern, "OneWay")
         self.assertIs(r.op.Model, mesh)
         self.assertEqual((r.op.SafeHeight.Value, r.op.ClearanceHeight.Value), (12.0, 20.0))
-        self.assertEqual(r.job.Tools.Group[0].Tool.BitShape.split("/")[-1], "bullnose.fcstd")
+        self.assertEqual(tools.shape_name(r.job.Tools.Group[0].Tool), "bullnose")
         g = parse_gcode(r.gcode)
         self.assertEqual({round(m[4]) for m in g if m[0] == "G1"}, {900, 150})
         self.assertAlmostEqual(max(m[3] for m in g), 20.0, places=3)
@@ -181,7 +182,7 @@ class Api(FreeCADTestCase):
         FreeCAD.closeDocument(r.doc.Name)
         docs = set(FreeCAD.listDocuments())
         with self.assertRaises(TmmError) as ctx:
-            run_surface(bump_stl(), stepover=0.5, sample_step=0.2, progress=lambda f: f < 0.3)
+            run_surface(bump_stl(), stepover=0.1, sample_step=0.05, progress=lambda f: f < 0.3)  # polled before the end
         self.assertIn("cancelled", str(ctx.exception))
         self.assertEqual(set(FreeCAD.listDocuments()), docs)  # the call's own document is closed again
 

@@ -11,8 +11,8 @@ import importlib
 from types import ModuleType
 from typing import Any
 
-# role -> (0.20 module, 0.21+ module)
-_APP_MODULES: dict[str, tuple[str, str]] = {
+# role -> (0.20 module, 0.21+ module[, 1.1 module])
+_APP_MODULES: dict[str, tuple[str, ...]] = {
     "op": ("PathScripts.PathOp", "Path.Op.Base"),
     "job": ("PathScripts.PathJob", "Path.Main.Job"),
     "stock": ("PathScripts.PathStock", "Path.Main.Stock"),
@@ -24,26 +24,28 @@ _APP_MODULES: dict[str, tuple[str, str]] = {
     "setup_sheet": ("PathScripts.PathSetupSheet", "Path.Base.SetupSheet"),
     "geom": ("PathScripts.PathGeom", "Path.Geom"),
 }
-_GUI_MODULES: dict[str, tuple[str, str]] = {
+_GUI_MODULES: dict[str, tuple[str, ...]] = {
     "op_gui": ("PathScripts.PathOpGui", "Path.Op.Gui.Base"),
     "gui_init": ("PathScripts.PathGuiInit", "Path.GuiInit"),
     "job_cmd": ("PathScripts.PathJobCmd", "Path.Main.Gui.JobCmd"),
-    "tool_bit_cmd": ("PathScripts.PathToolBitCmd", "Path.Tool.Gui.BitCmd"),
-    "tool_bit_library_cmd": ("PathScripts.PathToolBitLibraryCmd", "Path.Tool.Gui.BitLibraryCmd"),
+    "tool_bit_cmd": ("PathScripts.PathToolBitCmd", "Path.Tool.Gui.BitCmd", "Path.Tool.toolbit.ui.cmd"),
+    "tool_bit_library_cmd": ("PathScripts.PathToolBitLibraryCmd", "Path.Tool.Gui.BitLibraryCmd",
+                             "Path.Tool.library.ui.cmd"),
     "commands": ("PathCommands", "PathCommands"),
     "path_gui": ("PathScripts.PathGui", "Path.Base.Gui.Util"),
     "job_gui": ("PathScripts.PathJobGui", "Path.Main.Gui.Job"),
 }
 
 
-def _import(names: tuple[str, str]) -> ModuleType:
-    old, new = names
-    try:
-        return importlib.import_module(old)
-    except ImportError as exc:
-        if "Gui module in console" in str(exc):
-            raise
-        return importlib.import_module(new)
+def _import(names: tuple[str, ...]) -> ModuleType:
+    """The first of `names` that imports (FreeCAD versions moved the modules); the last one's error if none."""
+    for i, name in enumerate(names):
+        try:
+            return importlib.import_module(name)
+        except ImportError as exc:
+            if "Gui module in console" in str(exc) or i == len(names) - 1:
+                raise
+    raise ImportError(f"none of {names}")
 
 
 def import_app(role: str) -> ModuleType:
@@ -110,14 +112,49 @@ def load_post(name: str) -> ModuleType:
 
 def stock_bit_file(file_name: str) -> str:
     """A ToolBit file FreeCAD ships ('5mm_Endmill.fctb'): Mod/Path/Tools/Bit on 0.20, Mod/CAM/Tools/Bit from
-    1.0, found through searchPathsTool("Bit") on both."""
+    1.0 (searchPathsTool("Bit") on both; 1.1 removed it)."""
     import os
 
-    for folder in import_app("preferences").searchPathsTool("Bit"):
+    import FreeCAD
+
+    preferences = import_app("preferences")
+    folders = list(preferences.searchPathsTool("Bit")) if hasattr(preferences, "searchPathsTool") else []
+    folders.append(os.path.join(FreeCAD.getHomePath(), "Mod", "CAM", "Tools", "Bit"))
+    for folder in folders:
         path = os.path.join(folder, file_name)
         if os.path.isfile(path):
             return path
-    raise FileNotFoundError(f"FreeCAD ships no ToolBit '{file_name}'")
+    raise FileNotFoundError(f"FreeCAD ships no ToolBit '{file_name}' (looked in {', '.join(folders)})")
+
+
+def toolbits_are_assets() -> bool:
+    """FreeCAD 1.1 rewrote ToolBits (an asset manager, `ShapeID`, `CornerRadius` for bull-noses; no Factory)."""
+    return getattr(import_app("tool_bit"), "Factory", None) is None
+
+
+def make_toolbit(doc: Any, shape: str, parameters: dict[str, str], label: str) -> Any:
+    """A ToolBit object in `doc` of FreeCAD's shape `shape` ('ballend') with `parameters` (unit strings)."""
+    import FreeCAD
+
+    FreeCAD.setActiveDocument(doc.Name)
+    if not toolbits_are_assets():
+        return import_app("tool_bit").Factory.CreateFromAttrs(
+            {"name": label, "shape": shape + ".fcstd", "parameter": parameters, "attribute": {}}, name="ToolBit")
+    from Path.Tool.toolbit import ToolBit  # 1.1
+
+    bit = ToolBit.from_dict({"name": label, "shape": shape, "parameter": parameters, "attribute": {}})
+    return bit.attach_to_doc(doc, label)
+
+
+def remove_toolbit(bit: Any) -> None:
+    """Deletes a ToolBit object and its shape body (0.20/1.0: unloadBitBody; 1.1: _removeBitBody)."""
+    proxy = getattr(bit, "Proxy", None)
+    if getattr(bit, "BitBody", None) is not None and proxy is not None:
+        if hasattr(proxy, "unloadBitBody"):
+            proxy.unloadBitBody(bit)
+        elif hasattr(proxy, "_removeBitBody"):
+            proxy._removeBitBody()
+    bit.Document.removeObject(bit.Name)
 
 
 def toolbit_from_file(doc: Any, path: str) -> Any:

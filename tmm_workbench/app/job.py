@@ -10,6 +10,7 @@ from typing import Any, Optional, Union
 import FreeCAD
 
 from tmm_workbench.app import geometry, hooks, model_proxy
+from tmm_workbench.app import compat
 from tmm_workbench.app.compat import PathJob
 from tmm_workbench.core.errors import TmmError
 
@@ -57,9 +58,7 @@ def set_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float,
     old = tc.Tool
     tc.Tool = bit
     if old is not None and old is not bit and hasattr(old, "Proxy"):
-        if getattr(old, "BitBody", None) is not None:
-            old.Proxy.unloadBitBody(old)
-        old.Document.removeObject(old.Name)
+        compat.remove_toolbit(old)
     tc.Label = f"TC: {bit.Label}"
     tc.HorizFeed = horiz_feed_mm_s
     tc.VertFeed = vert_feed_mm_s

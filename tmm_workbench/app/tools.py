@@ -24,8 +24,8 @@ from tmm_workbench.core.tools.cutter import Cutter
 TOOLBIT_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")  # shapes TMM maps to a cutter
 SUPPORTED_SHAPES = TOOLBIT_SHAPES
 _LEGACY_TYPES = {"EndMill": "endmill", "BallEndMill": "ballend"}  # 0.20's deprecated Path.Tool
-# ToolBit shape files shipped with FreeCAD (Mod/Path/Tools/Shape) that TMM creates bits from
-BIT_SHAPE_FILES = {"endmill": "endmill.fcstd", "ballend": "ballend.fcstd", "bullnose": "bullnose.fcstd"}
+# ToolBit shapes shipped with FreeCAD (Mod/Path/Tools/Shape/<name>.fcstd) that TMM creates bits of
+BIT_SHAPES_BY_NAME = {"endmill": "endmill", "ballend": "ballend", "bullnose": "bullnose"}
 # API names of the shapes TMM creates (lower case) -> ToolBit shape
 SHAPE_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "flat": "endmill",
                  "bullnose": "bullnose", "bull": "bullnose"}
@@ -94,7 +94,11 @@ def bull_corner_radius(tool: Any, diameter: float) -> float:
     label = label_of(tool)
     for prop in ("CornerRadius", "TorusRadius"):
         if hasattr(tool, prop):
-            return _mm(getattr(tool, prop))
+            corner = _mm(getattr(tool, prop))
+            if corner > diameter / 2:
+                raise TmmError(f"bull-nose tool '{label}': corner radius {corner:g} mm is larger than the tool "
+                               f"radius {diameter / 2:g} mm")
+            return corner
     if hasattr(tool, "FlatRadius"):
         flat = _mm(tool.FlatRadius)
         corner = diameter / 2 - flat
@@ -118,26 +122,28 @@ def corner_radius_of(tool: Any) -> Optional[float]:
 
 
 def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 0.0, label: str = "") -> Any:
-    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape in `doc`. For a bull-nose, the 0.20 shape stores
-    FlatRadius = diameter/2 - corner radius (see the module doc)."""
-    import FreeCAD
+    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape in `doc`. For a bull-nose, the 0.20 and 1.0 shape
+    stores FlatRadius = diameter/2 - corner radius (see the module doc), 1.1's CornerRadius."""
+    from tmm_workbench.app import compat
 
-    from tmm_workbench.app.compat import PathToolBit
-
-    if shape not in BIT_SHAPE_FILES:
-        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPE_FILES)}")
+    if shape not in BIT_SHAPES_BY_NAME:
+        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPES_BY_NAME)}")
     for name, v in (("diameter", diameter), ("corner radius", corner_radius)):
         if not (isinstance(v, (int, float)) and math.isfinite(v)):
             raise TmmError(f"tool {name} must be a finite number of mm, got {v!r}")
     if not diameter > 0:
         raise TmmError(f"tool diameter must be a length > 0 mm, got {diameter:g}")
+    if shape == "bullnose" and not 0 <= corner_radius <= diameter / 2:
+        raise TmmError(f"bull-nose tool: corner radius {corner_radius:g} mm is larger than the tool radius "
+                       f"{diameter / 2:g} mm" if corner_radius > 0 else
+                       f"bull-nose tool: corner radius must be >= 0 mm, got {corner_radius:g}")
     params = {"Diameter": f"{diameter} mm"}
-    if shape == "bullnose":
+    if shape == "bullnose" and compat.toolbits_are_assets():
+        params["CornerRadius"] = f"{corner_radius} mm"
+    elif shape == "bullnose":
         params["FlatRadius"] = f"{diameter / 2 - corner_radius} mm"
     label = label or f"{diameter:g} mm {shape}" + (f" r{corner_radius:g}" if shape == "bullnose" else "")
-    FreeCAD.setActiveDocument(doc.Name)
-    return PathToolBit.Factory.CreateFromAttrs(
-        {"name": label, "shape": BIT_SHAPE_FILES[shape], "parameter": params, "attribute": {}}, name="ToolBit")
+    return compat.make_toolbit(doc, BIT_SHAPES_BY_NAME[shape], params, label)
 
 
 def bit_for_cutter(doc: Any, cutter: Cutter, label: str = "") -> Any:

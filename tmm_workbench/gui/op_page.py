@@ -20,6 +20,11 @@ PathOpGui = import_gui("op_gui")
 PathGui = import_gui("path_gui")
 
 
+def _show(spin: Any) -> None:
+    """The property's value into its spin box (1.1 renamed updateSpinBox to updateWidget)."""
+    (getattr(spin, "updateSpinBox", None) or spin.updateWidget)()
+
+
 class OpPage(PathOpGui.TaskPanelPage):
     """A page of quantity spin boxes, combo boxes and check boxes bound to the op's properties (widget
     name -> property), plus tool controller, coolant and a status line. Subclasses set the class
@@ -64,7 +69,7 @@ class OpPage(PathOpGui.TaskPanelPage):
 
     def setFields(self, obj: Any) -> None:
         for spin in self.spins.values():
-            spin.updateSpinBox()
+            _show(spin)
         for widget, prop in self.COMBOS.items():
             self.selectInComboBox(getattr(obj, prop), getattr(self.form, widget))
         for widget, prop in self.CHECKS.items():
@@ -99,7 +104,7 @@ class OpPage(PathOpGui.TaskPanelPage):
 
     def updateData(self, obj: Any, prop: str) -> None:
         if prop in self.spins:
-            self.spins[prop].updateSpinBox()
+            _show(self.spins[prop])
         elif prop in self.STATUS_PROPS:
             self.showStatus(obj)
 
