@@ -23,8 +23,8 @@ deb http://deb.debian.org/debian-security trixie-security main" ;;
 esac
 # What the tests need inside: FreeCAD, the kernel's build tools, the test runners, Xvfb for the GUI test.
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
-      python3-pip python3-matplotlib xvfb xauth cmake g++ ninja-build libgtest-dev ca-certificates)
-[ "$SUITE" = trixie ] && DEBS+=(python3-opencamlib)
+      python3-pip python3-matplotlib xvfb xauth cmake g++ ninja-build libgtest-dev ca-certificates
+      python3-opencamlib)
 
 MOUNTS=()
 cleanup() {
@@ -43,21 +43,23 @@ enter() {
   cp -L /etc/resolv.conf "$DIR/etc/resolv.conf" 2>/dev/null || true
 }
 
-if [ ! -f "$DIR/.tmm-ready" ]; then
+if [ ! -x "$DIR/usr/bin/apt-get" ] || [ ! -f "$DIR/.tmm-bootstrapped" ]; then
   command -v debootstrap >/dev/null || { $SUDO apt-get update -qq; $SUDO apt-get install -y -qq debootstrap; }
-  if [ ! -x "$DIR/usr/bin/apt-get" ]; then
-    echo "[fc_env] debootstrap $SUITE into $DIR"
-    $SUDO rm -rf "$DIR"; $SUDO mkdir -p "$DIR"
-    $SUDO debootstrap --variant=minbase "$SUITE" "$DIR" "$MIRROR" $SCRIPT >/dev/null
-  fi
-  enter
+  echo "[fc_env] debootstrap $SUITE into $DIR"
+  $SUDO rm -rf "$DIR"; $SUDO mkdir -p "$DIR"
+  $SUDO debootstrap --variant=minbase "$SUITE" "$DIR" "$MIRROR" $SCRIPT >/dev/null
   printf '%s\n' "$SOURCES" > "$DIR/etc/apt/sources.list"
   # the testing suite's Release files are sometimes past their Valid-Until on the mirror
   echo 'Acquire::Check-Valid-Until "false";' > "$DIR/etc/apt/apt.conf.d/99tmm"
-  echo "[fc_env] installing FreeCAD and the build tools in $SUITE"
+  touch "$DIR/.tmm-bootstrapped"
+fi
+missing=()
+for p in "${DEBS[@]}"; do $SUDO chroot "$DIR" dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
+if [ ${#missing[@]} -gt 0 ]; then
+  enter
+  echo "[fc_env] installing in $SUITE: ${missing[*]}"
   $SUDO chroot "$DIR" /usr/bin/env DEBIAN_FRONTEND=noninteractive bash -c \
-    "apt-get update -qq && apt-get install -y -qq --no-install-recommends ${DEBS[*]} >/dev/null && apt-get clean"
-  touch "$DIR/.tmm-ready"
+    "apt-get update -qq && apt-get install -y -qq --no-install-recommends ${missing[*]} >/dev/null && apt-get clean"
   echo "[fc_env] $SUITE ready: $(du -sh "$DIR" 2>/dev/null | cut -f1)"
 fi
 

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Sets up what is missing, then runs every test: the kernel's unit tests (ctest), then pytest over tests/
-# (core and binding, the OpenCAMLib cross-check, FreeCAD under freecadcmd, the GUI under Xvfb).
+# Sets up what is missing, then runs every test: the kernel's unit tests (ctest, also under UBSan), then pytest
+# over tests/ (core and binding, the OpenCAMLib cross-check, FreeCAD 0.20 under freecadcmd, the GUI under Xvfb),
+# then the binding, core, FreeCAD and GUI tests again under FreeCAD 1.0 (Debian 13) and 1.1 (Debian testing),
+# each in a Debian chroot made once and reused (scripts/fc_env.sh; TMM_ENVS names them, default both).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 bash scripts/setup.sh
@@ -8,3 +10,6 @@ ctest --test-dir build --output-on-failure
 # The kernel, its tests and the binding tests again under UBSan (build-ubsan; see TMM_SANITIZE in native/CMakeLists.txt).
 cmake -S native -B build-ubsan -G Ninja -DCMAKE_BUILD_TYPE=Release -DTMM_SANITIZE=undefined -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null; cmake --build build-ubsan -j"$(nproc)"; ctest --test-dir build-ubsan -j"$(nproc)" --output-on-failure; bash native/sanitize_bindings.sh
 .venv/bin/python -m pytest "$@"
+for env in ${TMM_ENVS-trixie forky}; do
+  bash scripts/fc_env.sh "$env" bash scripts/env_test.sh -q
+done

@@ -76,8 +76,9 @@ void parallel_chunks(std::size_t n, std::size_t chunk, const BatchOptions& optio
     }
   }
   if (error) std::rethrow_exception(error);
-  if (cancelled_by_caller) throw Cancelled();
-  if (options.progress) options.progress(1.0);
+  // The last report is the caller's last chance to cancel too (a batch done within the first poll
+  // reports only this one).
+  if (cancelled_by_caller || (options.progress && !options.progress(1.0))) throw Cancelled();
 }
 
 }  // namespace tmm

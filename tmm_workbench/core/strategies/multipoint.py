@@ -190,11 +190,6 @@ def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[Mul
         refinements=int(params.refinements), drd_divisions=int(params.drd_divisions),
         drd_refinements=int(params.drd_refinements), drd_bisections=int(params.drd_bisections),
         extend=float(params.extend), anchor=params.anchor, anchor_iterations=int(params.anchor_iterations))
-    if not hasattr(native, "MultipointOptions"):  # TRANSITIONAL: kernel built before the options struct
-        try:
-            return native.MultipointPositioner(face.native, *options.values())
-        except ValueError as exc:
-            raise TmmError(str(exc)) from exc
     options = native.MultipointOptions(**options)
     try:
         return native.MultipointPositioner(face.native, options)

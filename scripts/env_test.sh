@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Inside a FreeCAD environment made by scripts/fc_env.sh (run as `bash scripts/fc_env.sh SUITE bash
+# scripts/env_test.sh`): builds the kernel for this environment's python3 (its module has its own ABI tag,
+# so it sits beside the host's in tmm_workbench/), links the add-on into this FreeCAD's user Mod folder
+# (versioned from 1.1: FreeCAD says where), and runs the binding and core tests (OpenCAMLib from Debian's
+# python3-opencamlib), the FreeCAD tests and the GUI smoke test. Extra arguments go to pytest.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+ENV_NAME="${TMM_ENV:?run through scripts/fc_env.sh}"
+echo "[env_test] $ENV_NAME: $(freecadcmd --version 2>/dev/null | head -1), $(python3 --version)"
+cmake -S native -B "build-$ENV_NAME" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 \
+  >/dev/null
+cmake --build "build-$ENV_NAME" -j"$(nproc)" --target _native | tail -1
+USER_DIR="$(freecadcmd -c 'import FreeCAD; print("TMM_USER_DIR=" + FreeCAD.getUserAppDataDir())' 2>/dev/null \
+  | sed -n 's/^TMM_USER_DIR=//p' | tail -1)"
+[ -n "$USER_DIR" ] || { echo "[env_test] FreeCAD did not give its user folder" >&2; exit 1; }
+mkdir -p "$USER_DIR/Mod"
+ln -sfn "$PWD" "$USER_DIR/Mod/TMM"
+xvfb-run -a python3 -m pytest -p no:cacheprovider tests/core tests/freecad tests/gui "$@"
