@@ -4,19 +4,10 @@
 # one, pytest run there (so neither the checkout's package nor its module is imported), the sanitizer
 # runtime preloaded, any report fatal. Run after `cmake --build build-ubsan`.
 set -euo pipefail
-ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BUILD="$(cd "${1:-$ROOT/build-ubsan}" && pwd)"
+BUILD="$(cd "${1:-$(dirname "${BASH_SOURCE[0]}")/../build-ubsan}" && pwd)"
 MODULE="$(ls "$BUILD"/_native*.so)"
-TMP="$(mktemp -d)"
-trap 'rm -rf "$TMP"' EXIT
-cp -r "$ROOT/tmm_workbench" "$ROOT/benchmarks" "$TMP/"  # benchmarks: the seed's reference code some tests use
-rm -f "$TMP"/tmm_workbench/_native*.so*
+source "$(dirname "${BASH_SOURCE[0]}")/test_copy.sh"
 cp "$MODULE" "$TMP/tmm_workbench/"
-mkdir -p "$TMP/tests/core"
-cp "$ROOT/tests/__init__.py" "$ROOT/tests/conftest.py" "$TMP/tests/"
-cp "$ROOT/tests/core/__init__.py" "$TMP/tests/core/"
-TESTS=(test_drop_binding.py test_mesh_io.py test_multipoint.py test_native_hardening.py)
-for t in "${TESTS[@]}"; do cp "$ROOT/tests/core/$t" "$TMP/tests/core/"; done
 cd "$TMP"
 # The runtimes of the sanitizers the folder was built with (ASan's first: it must come first in the process).
 SANITIZE="$(sed -n 's/^TMM_SANITIZE:STRING=//p' "$BUILD/CMakeCache.txt")"
@@ -27,7 +18,6 @@ export LD_PRELOAD="${PRELOAD[*]}"
 export UBSAN_OPTIONS="halt_on_error=1:abort_on_error=1:print_stacktrace=1"
 # Python's own allocations are not ours to report as leaks.
 export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
-export TMM_SHARED_DIR="${TMM_SHARED_DIR:-$(cd "$ROOT" && "$ROOT/.venv/bin/python" -c 'from tmm_workbench.core.shared_data import shared_dir; print(shared_dir())' 2>/dev/null || echo /work/shared)}"
 # The module found must be the sanitized copy: checked before the tests run.
 "$ROOT/.venv/bin/python" -c "import tmm_workbench._native as n, sys; assert n.__file__.startswith('$TMP'), n.__file__"
 "$ROOT/.venv/bin/python" -m pytest -q -p no:cacheprovider "${TESTS[@]/#/tests/core/}"

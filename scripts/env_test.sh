@@ -2,7 +2,8 @@
 # Inside a FreeCAD environment made by scripts/fc_env.sh (run as `bash scripts/fc_env.sh SUITE bash
 # scripts/env_test.sh`): builds the kernel for this environment's python3 (its module has its own ABI tag,
 # so it sits beside the host's in tmm_workbench/), links the add-on into this FreeCAD's user Mod folder
-# (versioned from 1.1: FreeCAD says where), and runs the binding and core tests (OpenCAMLib from Debian's
+# (versioned from 1.1: FreeCAD says where), builds the kernel's wheel for this Python and runs the binding
+# tests against it, and runs the binding and core tests (OpenCAMLib from Debian's
 # python3-opencamlib), the FreeCAD tests and the GUI smoke test. Extra arguments go to pytest.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -16,4 +17,5 @@ USER_DIR="$(freecadcmd -c 'import FreeCAD; print("TMM_USER_DIR=" + FreeCAD.getUs
 [ -n "$USER_DIR" ] || { echo "[env_test] FreeCAD did not give its user folder" >&2; exit 1; }
 mkdir -p "$USER_DIR/Mod"
 ln -sfn "$PWD" "$USER_DIR/Mod/TMM"
+bash native/wheel_test.sh python3  # the wheel for this Python: built, installed in a venv, binding tests
 xvfb-run -a python3 -m pytest -p no:cacheprovider tests/core tests/freecad tests/gui "$@"

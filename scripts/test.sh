@@ -9,6 +9,8 @@ bash scripts/setup.sh
 ctest --test-dir build --output-on-failure
 # The kernel, its tests and the binding tests again under UBSan (build-ubsan; see TMM_SANITIZE in native/CMakeLists.txt).
 cmake -S native -B build-ubsan -G Ninja -DCMAKE_BUILD_TYPE=Release -DTMM_SANITIZE=undefined -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null; cmake --build build-ubsan -j"$(nproc)"; ctest --test-dir build-ubsan -j"$(nproc)" --output-on-failure; bash native/sanitize_bindings.sh
+# The kernel as a wheel (pip install ./native) for FreeCAD's Python, its binding tests run against it.
+bash native/wheel_test.sh /usr/bin/python3
 .venv/bin/python -m pytest "$@"
 for env in ${TMM_ENVS-trixie forky}; do
   bash scripts/fc_env.sh "$env" bash scripts/env_test.sh -q

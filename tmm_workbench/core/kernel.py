@@ -1,5 +1,8 @@
 """The compiled kernel, imported on first use, with a clear message when it is missing.
 
+It is either built in place by scripts/setup.sh (`tmm_workbench._native`) or installed as a wheel
+(`pip install ./native`: `tmm_kernel._native`); the first that imports is used.
+
 Nothing imports the kernel at module load: FreeCAD restores (and saves) documents with TMM objects on a
 machine where the kernel cannot be imported, because the op modules import without it; only a
 computation needs it, and it then fails with `KernelMissing` saying what is missing and the fix.
@@ -13,6 +16,8 @@ from typing import Any, Optional
 from tmm_workbench.core.errors import TmmError
 
 FIX = "bash scripts/setup.sh"  # builds the kernel for Debian's /usr/bin/python3, the one FreeCAD runs
+PIP_FIX = "python3 -m pip install ./native"  # the same kernel as a wheel, for the Python FreeCAD runs
+MODULES = ("tmm_workbench._native", "tmm_kernel._native")
 
 
 class KernelMissing(TmmError):
@@ -26,15 +31,20 @@ class _Kernel:
 
     def load(self) -> ModuleType:
         if self._module is None:
-            try:
-                self._module = importlib.import_module("tmm_workbench._native")
-            except ImportError as exc:
+            causes = []
+            for name in MODULES:
+                try:
+                    self._module = importlib.import_module(name)
+                    break
+                except ImportError as exc:
+                    causes.append(f"{name}: {exc}")
+            else:
                 import sys
 
                 raise KernelMissing(
-                    "TMM's native kernel (tmm_workbench/_native*.so) is not built or was built for another "
-                    f"Python (this is Python {sys.version_info.major}.{sys.version_info.minor}); run `{FIX}` in "
-                    f"the TMM folder. Cause: {exc}") from exc
+                    "TMM's native kernel is not installed, or was built for another Python (this is Python "
+                    f"{sys.version_info.major}.{sys.version_info.minor}): run `{FIX}` in the TMM folder, or "
+                    f"`{PIP_FIX}` with this Python. Tried {'; '.join(causes)}")
         return self._module
 
     def __getattr__(self, name: str) -> Any:

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# The kernel as a wheel for one Python (default python3, the one FreeCAD runs here): `pip wheel ./native`
+# (scikit-build-core + pybind11 from PyPI, the compiler and Eigen from the system), installed into a venv over
+# the system packages (numpy from Debian), the binding tests run against it from a copy of the package
+# without the in-place module. The wheel is left in dist/ (e.g. dist/tmm_kernel-0.1.0-cp313-...whl).
+set -euo pipefail
+PY="${1:-python3}"
+source "$(dirname "${BASH_SOURCE[0]}")/test_copy.sh"
+VENV="$TMP/venv"
+"$PY" -m venv --system-site-packages "$VENV"
+"$VENV/bin/python" -m pip wheel -q --no-deps "$ROOT/native" -w "$ROOT/dist"
+TAG="$("$VENV/bin/python" -c 'import sys; print(f"cp{sys.version_info.major}{sys.version_info.minor}")')"
+"$VENV/bin/python" -m pip install -q --no-deps --force-reinstall "$(ls "$ROOT"/dist/tmm_kernel-*-"$TAG"-*.whl)"
+cd "$TMP"
+"$VENV/bin/python" -c "from tmm_workbench.core.kernel import native; f = native.load().__file__; \
+assert '/site-packages/tmm_kernel/' in f, f; print('[wheel_test] kernel from the wheel:', f)"
+"$VENV/bin/python" -m pytest -q -p no:cacheprovider "${TESTS[@]/#/tests/core/}"
