@@ -100,6 +100,17 @@ def smoke() -> dict:
     info: dict = {}
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
+    from tmm_workbench.app.compat import freecad_version
+
+    if freecad_version() >= (1, 0):  # TMM's ops in FreeCAD's CAM workbench, before the TMM workbench loads
+        FreeCADGui.activateWorkbench("CAMWorkbench")
+        pump(1.0)
+        bars = [b for b in FreeCADGui.getMainWindow().findChildren(QtGui.QToolBar)
+                if b.objectName() == "New Operations"]
+        texts = {a.text() for b in bars for a in b.actions()}
+        info["cam_toolbar"] = sorted(t for t in texts if "TMM" in t)
+        for text in ("TMM 3-axis Surface", "TMM 5-axis Multipoint"):
+            assert text in texts, f"'{text}' is not in the CAM workbench's New Operations toolbar: {sorted(texts)}"
     FreeCADGui.activateWorkbench("TMMWorkbench")
     pump(0.5)
     info["workbench"] = FreeCADGui.activeWorkbench().name()

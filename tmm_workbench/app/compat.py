@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import importlib
 from types import ModuleType
-from typing import Any
+from typing import Any, Optional
 
 # role -> (0.20 module, 0.21+ module[, 1.1 module])
 _APP_MODULES: dict[str, tuple[str, ...]] = {
@@ -78,6 +78,30 @@ def freecad_version() -> tuple[int, int]:
 
     major, minor = FreeCAD.Version()[:2]
     return int(major), int(minor)
+
+
+MIN_VERSION = (0, 20)
+# Path modules TMM cannot work without, by role (the rest are looked up where used)
+REQUIRED_ROLES = ("op", "job", "tool_controller", "tool_bit", "preferences", "utils", "setup_sheet")
+
+
+def support_problem(version: Optional[tuple[int, int]] = None,
+                    modules: Optional[dict[str, tuple[str, ...]]] = None) -> str:
+    """Why this FreeCAD cannot run TMM ('' when it can): too old, or a Path module of a required role that
+    does not import (a newer FreeCAD whose CAM API moved). Says the version and what failed."""
+    major, minor = version or freecad_version()
+    if (major, minor) < MIN_VERSION:
+        return (f"FreeCAD {major}.{minor} is not supported: TMM needs FreeCAD {MIN_VERSION[0]}.{MIN_VERSION[1]} "
+                "or later (tested on 0.20, 1.0 and 1.1)")
+    table = _APP_MODULES if modules is None else modules
+    for role in REQUIRED_ROLES:
+        names = table.get(role, ())
+        try:
+            _import(names)
+        except ImportError as exc:
+            return (f"FreeCAD {major}.{minor} is not supported: its CAM module for '{role}' "
+                    f"({' / '.join(names)}) does not import ({exc}); TMM is tested on 0.20, 1.0 and 1.1")
+    return ""
 
 
 def command_prefix() -> str:

@@ -1,7 +1,8 @@
 """What InitGui.py installs at FreeCAD start: hooks that bring in Gui code only when first used.
 
 - view providers for Jobs and ops made from Python (API, macros), through app.hooks;
-- the GUI progress (a dialog with Cancel) for TMM computations, through app.progress.
+- the GUI progress (a dialog with Cancel) for TMM computations, through app.progress;
+- from FreeCAD 1.0, TMM's operations in the CAM workbench's toolbar (gui.cam_integration).
 """
 from __future__ import annotations
 
@@ -33,3 +34,9 @@ def install_hooks() -> None:
         hooks.view_hooks.setdefault(entry.view_kind, _op_view(entry))
     hooks.view_hooks.setdefault("job", _job_view)
     progress.progress_factory = _dialog_progress
+    from tmm_workbench.app.compat import freecad_version
+
+    if freecad_version() >= (1, 0):
+        from tmm_workbench.gui import cam_integration
+
+        cam_integration.install()

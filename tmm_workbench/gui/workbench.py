@@ -26,7 +26,7 @@ class TMMWorkbench(FreeCADGui.Workbench):
         from tmm_workbench.app.compat import import_gui
         from tmm_workbench.app import posts
 
-        import PathGui  # noqa: F401  (loads Path's icons and panels into Qt resources)
+        import PathGui  # noqa: F401 (loads Path's icons and panels into Qt resources)
         FreeCADGui.addIconPath(":/icons")
         import_gui("gui_init").Startup()  # registers the Path commands (ops, inspect, simulator, ...)
         import_gui("job_cmd")
@@ -37,6 +37,14 @@ class TMMWorkbench(FreeCADGui.Workbench):
         from tmm_workbench.gui import job_cmd
 
         posts.install_post_dir()
+        from tmm_workbench.core import kernel
+
+        try:
+            kernel.require()
+        except kernel.KernelMissing as exc:  # the workbench works; computing needs the kernel
+            import FreeCAD
+
+            FreeCAD.Console.PrintWarning(f"TMM: {exc}\n")
         for entry in registry.OPS:
             entry.gui()  # registers the op's command
         tmm = [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS]
