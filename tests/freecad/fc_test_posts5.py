@@ -17,7 +17,7 @@ import numpy as np
 from fc_helpers import OUT, FreeCADTestCase, new_doc
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app import posts
-from tmm_workbench.app import compat
+from tmm_workbench.app import compat, tools
 from tmm_workbench.app.compat import PathPreferences, load_post
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
@@ -64,6 +64,13 @@ def parse_goto(text: str) -> np.ndarray:
                      if ln.startswith("GOTO/")]).reshape(-1, 6)
 
 
+GOLDEN = FilePath(__file__).resolve().parents[1] / "data" / "posts"  # written on FreeCAD 0.20, the same on 1.0, 1.1
+
+
+def without_dates(text: str) -> str:
+    return "\n".join(ln for ln in text.splitlines() if "Generated on" not in ln)
+
+
 class Posts5(FreeCADTestCase):
     def setUp(self) -> None:
         self.doc = new_doc("TmmPosts5")
@@ -72,8 +79,8 @@ class Posts5(FreeCADTestCase):
         box.Placement.Base = FreeCAD.Vector(-30, -20, -10)
         self.doc.recompute()
         self.job = jobs.create_job(self.doc, box)
-        self.tc = self.job.Tools.Group[0]
-        self.tc.SpindleSpeed = 10000
+        # TMM's own bit, not the Job's default one (which differs between FreeCAD versions)
+        self.tc = jobs.set_tool(self.job, tools.make_tool_bit(self.doc, "endmill", 5.0), HORIZ, VERT, 10000)
         self.tp = tilted_toolpath()
         self.op = self.path_object("Tilted", self.tp)
 
@@ -98,6 +105,29 @@ class Posts5(FreeCADTestCase):
                              os.path.realpath(posts.POST_DIR))
             self.assertTrue(processor.TOOLTIP and processor.TOOLTIP_ARGS)
             self.assertEqual(processor.UNITS, "G21")
+
+    def test_the_same_gcode_on_every_freecad(self) -> None:
+        """tarus and apt_cl write byte for byte the files written on FreeCAD 0.20 (TMM_WRITE_GOLDEN=1 rewrites
+        them); from 1.0 also through FreeCAD's own post factory, as the CAM Post command runs them."""
+        for post, name in (("tarus", "tilted.tarus.ngc"), ("apt_cl", "tilted.apt")):
+            with self.subTest(post=post):
+                text = without_dates(load_post(post).export([self.tc, self.op], "-", "--no-show-editor"))
+                golden = GOLDEN / name
+                if os.environ.get("TMM_WRITE_GOLDEN") == "1":
+                    golden.parent.mkdir(parents=True, exist_ok=True)
+                    golden.write_text(text)
+                self.assertEqual(text, golden.read_text())
+                if compat.freecad_version() < (1, 0):
+                    continue
+                from Path.Post.Processor import PostProcessorFactory
+
+                self.job.PostProcessor = post
+                self.job.PostProcessorArgs = "--no-show-editor"
+                sections = PostProcessorFactory.get_post_processor(self.job, post).export()
+                ours = [ln for ln in text.splitlines() if ln.startswith(("G1", "G0", "GOTO/", "G93"))]
+                theirs = [ln for _, g in sections for ln in without_dates(g).splitlines()
+                          if ln.startswith(("G1", "G0", "GOTO/", "G93"))]
+                self.assertEqual(theirs, ours)
 
     def test_representation_is_exact_in_the_document(self) -> None:
         moves = path5.decode_commands([(c.Name, c.Parameters) for c in self.op.Path.Commands])
