@@ -1,1 +1,1 @@
-"""geometry."""
+"""Geometry the strategies machine: triangle meshes (TriMesh, STL), Bezier faces (BezierFace), B-spline to Bezier."""

@@ -1,1 +1,1 @@
-"""preview."""
+"""Pictures of tool paths for reports and the main job (matplotlib, imported inside the functions)."""

@@ -138,14 +138,16 @@ def _segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarra
     out: list[CutSegment] = []
     detach = True
     k = 0
-    for index, (is_link, xy) in enumerate(runs):
+    index = -1  # pass number (a link belongs to the pass it leads to)
+    for is_link, xy in runs:
+        index += 0 if is_link else 1
         pts, gap = np.column_stack([xy, z[k:k + len(xy)]]), air[k:k + len(xy)]
         k += len(xy)
         if is_link:
             if gap.any():
                 detach = True
             elif len(pts):
-                out.append(CutSegment(pts, SegmentKind.LINK, joined=not detach, pass_index=index))
+                out.append(CutSegment(pts, SegmentKind.LINK, joined=not detach, pass_index=index + 1))
                 detach = False
             continue
         if pattern == ONEWAY:
