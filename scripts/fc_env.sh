@@ -63,6 +63,14 @@ if [ ${#missing[@]} -gt 0 ]; then
   echo "[fc_env] $SUITE ready: $(du -sh "$DIR" 2>/dev/null | cut -f1)"
 fi
 
+# The host's own certificate authorities (a proxy's, for PyPI), so pip inside trusts what the host trusts.
+if compgen -G "/usr/local/share/ca-certificates/*.crt" >/dev/null && \
+   ! diff -rq /usr/local/share/ca-certificates "$DIR/usr/local/share/ca-certificates" >/dev/null 2>&1; then
+  $SUDO mkdir -p "$DIR/usr/local/share/ca-certificates"
+  $SUDO cp /usr/local/share/ca-certificates/*.crt "$DIR/usr/local/share/ca-certificates/"
+  $SUDO chroot "$DIR" update-ca-certificates >/dev/null 2>&1
+fi
+
 [ $# -eq 0 ] && exit 0
 enter
 mount_in "$ROOT" "$ROOT"
