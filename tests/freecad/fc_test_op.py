@@ -1,6 +1,7 @@
 """The TMM Surface op inside a Path Job: moves, feeds, heights, boundary, pattern, inputs, save/reopen."""
 from __future__ import annotations
 
+import math
 import unittest
 
 import FreeCAD
@@ -31,8 +32,8 @@ class OpInJob(FreeCADTestCase):
         self.assertLess(safe, clear)
         source = model_proxy.source_of(job.Model.Group[0])  # the STL the stand-in box stands for
         self.assertEqual(source, str(SPHERE_ON_PLATE))
-        # starts with a rapid at clearance height, ends at clearance height
-        self.assertEqual(mv[0][0], "G0")
+        # starts with a Z-only rapid to the clearance height (after the tool change: up before X/Y), ends there
+        self.assertEqual(mv[0], ("G0", {"Z": mv[0][1]["Z"]}))
         self.assertAlmostEqual(mv[0][1]["Z"], clear, places=6)
         self.assertEqual(mv[-1][0], "G0")
         self.assertAlmostEqual(mv[-1][1]["Z"], clear, places=6)
@@ -44,14 +45,26 @@ class OpInJob(FreeCADTestCase):
                 self.assertGreaterEqual(p["Z"], safe - 1e-9)
             else:
                 self.assertLess(p["Z"], safe)
-        # every plunge comes straight down from the safe height
+        # the vertical feed for every plunge (straight down from the safe height) and for every cutting move
+        # down more steeply than the op's PlungeAngle (45 deg); the horizontal feed for everything else
+        self.assertAlmostEqual(op.PlungeAngle.Value, 45.0)
+        tan = math.tan(math.radians(op.PlungeAngle.Value))
+        steep = 0
         for (n0, p0), (n1, p1) in zip(mv, mv[1:]):
-            if n1 == "G1" and round(p1["F"] * 60, 6) == V_FEED:
-                self.assertEqual(n0, "G0")
+            if n1 != "G1":
+                continue
+            slow = round(p1["F"] * 60, 6) == V_FEED
+            if n0 == "G0":
+                self.assertTrue(slow)
                 self.assertAlmostEqual(p0["Z"], safe, places=6)
                 self.assertAlmostEqual((p0["X"], p0["Y"]), (p1["X"], p1["Y"]))
+                continue
+            down = p0["Z"] - p1["Z"] > math.hypot(p1["X"] - p0["X"], p1["Y"] - p0["Y"]) * tan
+            self.assertEqual(slow, down, (p0, p1))
+            steep += down
+        self.assertGreater(steep, 0)  # the sphere's far side
         # the toolpath the op keeps for the API matches the Path
-        self.assertEqual(len(op.Proxy.toolpath), len(mv) - 1)  # + ObjectOp's final G0 to clearance
+        self.assertEqual(len(op.Proxy.toolpath), len(mv) - 2)  # + the Z-only start, ObjectOp's final G0
         self.assertTrue(op.CycleTime and op.CycleTime != "00:00:00")
         self.assertIn(op, job.Operations.Group)
 

@@ -47,13 +47,15 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "Pattern", "Surface",
          "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes", "pattern"),
     Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
+    Prop("App::PropertyAngle", "PlungeAngle", "Feeds",
+         "Cutting moves going down more steeply than this (below the horizontal) run at the vertical feed"),
     Prop("App::PropertyEnumeration", "OffModel", "Surface",
          "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
          "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model"),
 ]
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
-                            "BoundaryMargin": 0.0}
+                            "BoundaryMargin": 0.0, "PlungeAngle": 45.0}
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -89,7 +91,7 @@ class ObjectTmmSurface(op_base.TmmOp):
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
         self.mesh, self.toolpath = mesh, toolpath
-        self.commandlist.extend(self.commands(toolpath))
+        self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 
     def model_mesh(self, obj: Any) -> TriMesh:
         deflection = obj.LinearDeflection.Value
@@ -114,16 +116,24 @@ class ObjectTmmSurface(op_base.TmmOp):
         m = obj.BoundaryMargin.Value
         return (x0 - m, y0 - m, x1 + m, y1 + m)
 
-    def commands(self, toolpath: Toolpath) -> list[Any]:
-        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and the
-        horizontal feed for cutting moves."""
-        feed = {MoveKind.PLUNGE: self.vertFeed, MoveKind.FEED: self.horizFeed}
+    def commands(self, toolpath: Toolpath, plunge_angle_deg: float = 45.0,
+                 clearance: Optional[float] = None) -> list[Any]:
+        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and for cutting moves
+        going down more steeply than `plunge_angle_deg`, the horizontal feed for the other cutting moves.
+        With `clearance`, the path starts with a Z-only rapid to it: after a tool change the tool goes up
+        before it moves in X and Y."""
+        if not (0.0 <= plunge_angle_deg <= 90.0):
+            raise TmmError(f"plunge angle must be in [0, 90] deg, got {plunge_angle_deg:g}")
+        steep = toolpath.steep_descents(plunge_angle_deg)
         out = []
-        for m in toolpath:
+        if clearance is not None and len(toolpath):
+            out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
+        for m, down in zip(toolpath, steep):
             if m.kind is MoveKind.RAPID:
                 out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
             else:
-                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed[m.kind]}))
+                feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
+                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
         return out
 
 

@@ -60,3 +60,19 @@ class Toolpath:
         """Tip positions of FEED and PLUNGE moves, (n, 3)."""
         return np.array([(m.x, m.y, m.z) for m in self.moves if m.kind is not MoveKind.RAPID],
                         dtype=float).reshape(-1, 3)
+
+    def steep_descents(self, angle_deg: float) -> np.ndarray:
+        """(n,) bool: FEED moves going down more steeply than `angle_deg` below the horizontal (a machinist
+        runs these at the plunge feed); the first move and non-FEED moves are False."""
+        if not (0.0 <= angle_deg <= 90.0):
+            raise ValueError(f"plunge angle must be in [0, 90] degrees, got {angle_deg!r}")
+        p = self.points()
+        out = np.zeros(len(p), dtype=bool)
+        if len(p) < 2:
+            return out
+        d = np.diff(p, axis=0)
+        horizontal = np.hypot(d[:, 0], d[:, 1])
+        steep = (d[:, 2] < 0) & (-d[:, 2] > horizontal * np.tan(np.radians(angle_deg)))
+        feed = np.array([m.kind is MoveKind.FEED for m in self.moves[1:]])
+        out[1:] = steep & feed
+        return out
