@@ -93,7 +93,15 @@ double profile_edge_max(const Cutter& c, double d2, double z0, double m, double 
         if (newton > a && newton < b) next = newton;
       }
     }
-    if (std::fabs(next - u) < 1e-13) { u = next; break; }
+    if (std::fabs(next - u) < 1e-13) {
+      // A short Newton step means convergence, except on a bottom cone (k1 > 0) no flatter than the edge
+      // (|m| >= k1): there g' = m - k1 u / rho keeps the sign of m, the root lies beyond the cone, and the
+      // step is short only because the axis is (within rounding) on the edge's line, d ~ 1e-16, where
+      // g'' ~ -k1 d^2 / rho^3 is huge near the apex. Bisect on instead of stopping at the apex.
+      const double k1 = c.slope(0.0);
+      if (!(k1 > 0.0 && std::fabs(m) >= k1 && rho <= c.flat_radius())) { u = next; break; }
+      next = 0.5 * (a + b);
+    }
     u = next;
   }
   return g(u);
