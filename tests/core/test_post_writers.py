@@ -17,6 +17,7 @@ from tmm_workbench.core.post import Operation, ToolInfo, apt_writer, tarus_write
 from tmm_workbench.core.post.apt_writer import AptOptions, write_apt
 from tmm_workbench.core.post.tarus_writer import TarusOptions, write_tarus
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.verify import machine_view
 
 TOOL = ToolInfo(number=3, label="6 mm ball", shape="ballend", diameter=6.0, corner_radius=3.0, cutting_height=20.0,
                 spindle_rpm=12000, spindle_dir="CW")
@@ -81,6 +82,10 @@ def program(tp: Toolpath, label: str = "Surface") -> list:
     return [TOOL, Operation(label, [("(TMM 5-axis)", {})] + path5.encode_toolpath(tp, HORIZ, VERT), "Flood")]
 
 
+# joint-mode subdivision off: one line per programmed move (the subdivision has tests of its own)
+WHOLE = dict(tip_tolerance=1e9, axis_tolerance=1.5)
+
+
 def fk(machine: TarusMachine, rows: list[dict], tcp: bool) -> tuple[np.ndarray, np.ndarray]:
     j = np.array([[r["X"], r["Y"], r["Z"], r["A"], r["C"]] for r in rows])
     tips, axes = machine.forward_path(j)
@@ -93,7 +98,7 @@ def fk(machine: TarusMachine, rows: list[dict], tcp: bool) -> tuple[np.ndarray, 
 def test_tarus_gcode_round_trip_through_fk(tcp):
     m = TarusMachine(pivot_length=160.0, tool_length=90.0)
     tp = tilted_path()
-    res = write_tarus(program(tp), m, TarusOptions(tcp=tcp, precision=10, angle_precision=12))
+    res = write_tarus(program(tp), m, TarusOptions(tcp=tcp, precision=10, angle_precision=12, **WHOLE))
     rows = parse_tarus(res.text)
     assert len(rows) == len(tp) == res.moves
     tips, axes = fk(m, rows, tcp)
@@ -109,7 +114,7 @@ def test_tarus_gcode_round_trip_through_fk(tcp):
 def test_default_precision_round_trip():
     m = TarusMachine()
     tp = tilted_path(60)
-    rows = parse_tarus(write_tarus(program(tp), m).text)
+    rows = parse_tarus(write_tarus(program(tp), m, TarusOptions(**WHOLE)).text)
     tips, axes = fk(m, rows, False)
     # 4 decimals of mm, 6 of degrees on a 250 mm lever: 5e-5 + 250 * 2 * 8.7e-9 mm
     assert np.abs(tips - tp.points()).max() < 1e-4
@@ -119,10 +124,11 @@ def test_default_precision_round_trip():
 def test_inverse_time_feeds():
     m = TarusMachine()
     tp = tilted_path(80)
-    text = write_tarus(program(tp), m, EXACT).text
+    text = write_tarus(program(tp), m, TarusOptions(precision=10, angle_precision=12, **WHOLE)).text
     rows = parse_tarus(text)
     pts = tp.points()
-    n_g93 = 0
+    joints = np.array([[r["X"], r["Y"], r["Z"], r["A"], r["C"]] for r in rows])
+    n_g93, n_capped = 0, 0
     for k in range(1, len(rows)):
         r, p = rows[k], rows[k - 1]
         if r["G"] == "G0":
@@ -130,15 +136,18 @@ def test_inverse_time_feeds():
             continue
         turns = abs(r["A"] - p["A"]) > 1e-12 or abs(r["C"] - p["C"]) > 1e-12
         feed = VERT if tp.moves[k].kind is MoveKind.PLUNGE else HORIZ
+        dist = float(np.linalg.norm(pts[k] - pts[k - 1]))
+        # the move's time: the tip distance at the feed, or longer if the joints need longer
+        seconds = max(dist / feed, m.motion_time(joints[k - 1], joints[k]))
+        n_capped += seconds > dist / feed * (1 + 1e-9)
         if turns:
             n_g93 += 1
             assert r["mode"] == "G93"
-            dist = float(np.linalg.norm(pts[k] - pts[k - 1]))
-            assert r["F"] == pytest.approx(feed * 60 / dist, rel=1e-9)
+            assert r["F"] == pytest.approx(60.0 / seconds, rel=1e-6)
         else:
             assert r["mode"] == "G94"
-            assert r["F"] == pytest.approx(feed * 60)
-    assert n_g93 > 50
+            assert r["F"] == pytest.approx((dist / seconds if seconds > 0 else feed) * 60, rel=1e-6)
+    assert n_g93 > 50 and n_capped > 0  # some moves turn A faster than the head can: slowed down
     assert rows[-2]["mode"] == "G94" and rows[-2]["F"] == pytest.approx(HORIZ * 60)  # the plain linear move
     assert "G93 G1" in text and "G94 G1" in text
 
@@ -148,7 +157,7 @@ def test_pure_reorientation_uses_joint_time():
     tp = Toolpath()
     tp.add(MoveKind.FEED, 0, 0, 0)
     tp.add(MoveKind.FEED, 0, 0, 0, axis=(math.sin(0.3), 0, math.cos(0.3)))
-    rows = parse_tarus(write_tarus(program(tp), m, EXACT).text)
+    rows = parse_tarus(write_tarus(program(tp), m, TarusOptions(precision=10, angle_precision=12, **WHOLE)).text)
     t = m.motion_time(m.inverse((0, 0, 0), (0, 0, 1)), m.inverse((0, 0, 0), (math.sin(0.3), 0, math.cos(0.3))))
     assert t == pytest.approx(1.0)  # C 0.3 rad at 0.3 rad/s
     assert rows[1]["mode"] == "G93" and rows[1]["F"] == pytest.approx(60.0 / t)
@@ -157,8 +166,8 @@ def test_pure_reorientation_uses_joint_time():
 def test_inches_scale_lengths_not_angles():
     m = TarusMachine()
     tp = tilted_path(40)
-    mm = write_tarus(program(tp), m, EXACT).text
-    inch = write_tarus(program(tp), m, TarusOptions(inches=True, precision=10, angle_precision=12)).text
+    mm = write_tarus(program(tp), m, TarusOptions(precision=10, angle_precision=12, **WHOLE)).text
+    inch = write_tarus(program(tp), m, TarusOptions(inches=True, precision=10, angle_precision=12, **WHOLE)).text
     assert "G20" in inch and "G21" not in inch
     rmm, rin = parse_tarus(mm), parse_tarus(inch, inches=True)
     for a, b in zip(rmm, rin):
@@ -205,8 +214,8 @@ def test_header_tool_change_footer():
 def test_cycle_time_estimate():
     m = TarusMachine()
     tp = tilted_path(50)
-    res = write_tarus(program(tp), m, EXACT)
-    joints = m.solve_path(tp.points(), tp.axes())
+    res = write_tarus(program(tp), m, TarusOptions(precision=10, angle_precision=12, **WHOLE))
+    joints = m.solve_path(tp.points(), tp.axes(), rapid=[mv.kind is MoveKind.RAPID for mv in tp])
     feeds = [None if mv.kind is MoveKind.RAPID else (VERT if mv.kind is MoveKind.PLUNGE else HORIZ) for mv in tp]
     assert res.cycle_time == pytest.approx(m.cycle_time(joints, tp.points(), feeds), rel=1e-9)
 
@@ -361,3 +370,44 @@ def test_operations_continue_from_the_previous_position():
     tip, axis = m.forward(Joints(rows[1]["X"], rows[1]["Y"], rows[1]["Z"], rows[1]["A"], rows[1]["C"]))
     np.testing.assert_allclose(axis, [0, 0, 1])
     np.testing.assert_allclose(tip, [0, 0, 10], atol=1e-9)
+
+
+# --- the machine's view: linear joint interpolation, joint speeds, A limits (issue 11) ---------------
+def test_joint_mode_moves_stay_on_their_lines_and_in_time():
+    """A control without TCP interpolates X Y Z A C linearly: whole moves leave the straight line by far; the
+    default post splits them so the tip stays within 0.005 mm and the axis within 0.05 deg, every line
+    doable at the joint speeds, A inside +-360 deg and never 180 deg in one line."""
+    m = TarusMachine()
+    tp = tilted_path()
+    whole = machine_view.view(m, write_tarus(program(tp), m, TarusOptions(**WHOLE)).text)
+    text = write_tarus(program(tp), m).text
+    split = machine_view.view(m, text)
+    assert whole.largest_tip_deviation > 0.05
+    assert split.largest_tip_deviation <= 0.005 + 1e-4    # + the 4-decimal rounding of the words
+    assert split.largest_axis_deviation <= math.radians(0.05) + 1e-7
+    assert split.lines > whole.lines
+    assert not split.too_fast and not whole.too_fast
+    assert split.largest_a_step < math.pi
+    assert -2 * math.pi - 1e-9 <= split.a_min and split.a_max <= 2 * math.pi + 1e-9
+    # every programmed tip is on the path, in order
+    lines = machine_view.read_tarus(text)
+    tips = [m.forward(ln.joints)[0] for ln in lines if not np.isnan(ln.joints).any()]
+    k = 0
+    for p in tp.points()[1:]:
+        while k < len(tips) and np.linalg.norm(tips[k] - p) > 1e-3:
+            k += 1
+        assert k < len(tips), p
+    tcp_text = write_tarus(program(tp), m, TarusOptions(tcp=True)).text
+    tcp = machine_view.view(m, tcp_text, tcp=True)
+    assert tcp.lines == whole.lines and not tcp.too_fast  # TCP: the control keeps the tip on its line
+
+
+def test_tolerance_arguments():
+    m, o = tarus_writer.parse_args("--tip-tolerance 0.01 --axis-tolerance 0.2 --a-continuous")
+    assert o.tip_tolerance == 0.01 and o.axis_tolerance == pytest.approx(math.radians(0.2)) and m.a_limits is None
+    m, _ = tarus_writer.parse_args("")
+    assert m.a_limits == (-2 * math.pi, 2 * math.pi)
+    with pytest.raises(TmmError, match="tip-tolerance"):
+        tarus_writer.parse_args("--tip-tolerance 0")
+    with pytest.raises(TmmError, match="exclude"):
+        tarus_writer.parse_args("--a-continuous --a-min -10 --a-max 10")

@@ -9,6 +9,7 @@ import pytest
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine import JointLimitError, Joints, JointSpeeds, TarusMachine, ThreeAxisMachine
+from tmm_workbench.core.machine.rotary import RotaryPlanError
 
 RNG = np.random.default_rng(20261123)
 
@@ -49,7 +50,7 @@ def test_ik_then_fk_is_identity_on_random_orientations():
 
 
 def test_ik_fk_vectorised_and_with_negative_tilts():
-    m = TarusMachine(c_limits=(-math.radians(60), math.radians(60)))
+    m = TarusMachine(c_limits=(-math.radians(60), math.radians(60)), a_limits=None)  # random axes: A roams
     n = 3000
     tips = RNG.uniform(-300, 300, (n, 3))
     axes = random_axes(n, math.radians(60.0))
@@ -120,13 +121,17 @@ def test_near_vertical_noise_is_held():
     assert np.abs(axis - np.array([1e-12, -1e-12, 1.0])).max() < 1e-11
 
 
-def test_a_unwrapping_on_a_spiral_has_no_jumps():
-    m = TarusMachine()
-    n = 721  # three full turns of the axis azimuth, 1.5 deg per step
-    az = np.linspace(0.0, 6 * math.pi, n)
-    c = math.radians(20)
+def spiral(turns: float, n: int, tilt_deg: float = 20.0) -> tuple[np.ndarray, np.ndarray]:
+    az = np.linspace(0.0, turns * 2 * math.pi, n)
+    c = math.radians(tilt_deg)
     axes = np.column_stack([math.sin(c) * np.cos(az), math.sin(c) * np.sin(az), np.full(n, math.cos(c))])
-    tips = np.column_stack([30 * np.cos(az), 30 * np.sin(az), np.zeros(n)])
+    return np.column_stack([30 * np.cos(az), 30 * np.sin(az), np.zeros(n)]), axes
+
+
+def test_a_unwrapping_on_a_spiral_has_no_jumps():
+    m = TarusMachine(a_limits=None)  # a continuous A
+    tips, axes = spiral(3, 721)      # three full turns of the axis azimuth, 1.5 deg per step
+    c = math.radians(20)
     j = m.solve_path(tips, axes)
     assert np.abs(np.diff(j[:, 3])).max() < math.radians(1.5) + 1e-9
     assert j[-1, 3] == pytest.approx(6 * math.pi, abs=1e-9)
@@ -136,20 +141,41 @@ def test_a_unwrapping_on_a_spiral_has_no_jumps():
     assert j2[-1, 3] == pytest.approx(0.0, abs=1e-9)
 
 
-def test_a_limits_pick_the_turn_inside_or_fail():
-    m = TarusMachine(a_limits=(-math.pi, math.pi))
-    n = 400
-    az = np.linspace(0.0, 1.5 * math.pi, n)  # past +180 deg: must wrap inside the limits
-    c = math.radians(10)
-    axes = np.column_stack([math.sin(c) * np.cos(az), math.sin(c) * np.sin(az), np.full(n, math.cos(c))])
-    j = m.solve_path(np.zeros((n, 3)), axes)
-    assert j[:, 3].max() <= math.pi + 1e-12 and j[:, 3].min() >= -math.pi - 1e-12
-    narrow = TarusMachine(a_limits=(0.0, math.radians(90)))
-    with pytest.raises(JointLimitError) as err:
-        narrow.solve_path(np.zeros((n, 3)), axes)
-    e = err.value
-    assert e.joint == "A" and e.index is not None and e.index > 0
-    assert f"move {e.index}" in str(e) and "joint A" in str(e) and "outside its limits" in str(e)
+def test_a_limits_never_unwind_inside_a_cut():
+    """The old planner put a whole turn of A into a cutting move to stay inside the limits; now a cut that
+    cannot fit is refused, naming its moves, and one that fits gets the turn that keeps it inside."""
+    with pytest.raises(RotaryPlanError) as err:
+        TarusMachine().solve_path(*spiral(3, 721))   # 1080 deg of A, limits +-360
+    assert "moves 0..720" in str(err.value) and "1080 deg" in str(err.value)
+    narrow = TarusMachine(a_limits=(-math.pi, math.pi))
+    with pytest.raises(RotaryPlanError):
+        narrow.solve_path(*spiral(0.75, 400))          # 270 deg of A do not fit 360 deg that start at -180
+    start = Joints(0, 0, 0, math.radians(170), 0.2)
+    tips, axes = spiral(0.4, 200)                    # 144 deg, starting at azimuth 0
+    j = narrow.solve_path(tips, axes, start=start)
+    assert np.abs(np.diff(j[:, 3])).max() < math.radians(1.0)  # continuous: no wrap inside
+    assert j[:, 3].min() >= -math.pi - 1e-12 and j[:, 3].max() <= math.pi + 1e-12
+    fitted = TarusMachine(a_limits=(math.radians(300), math.radians(520)))
+    j = fitted.solve_path(tips, axes)                # moved up one whole turn to fit
+    assert j[0, 3] == pytest.approx(2 * math.pi)
+
+
+def test_a_unwinds_at_the_rapid_between_cuts():
+    """Two cuts of 300 deg each, the same way round, with an orientation-changing rapid between them: the
+    second cut gets its own turn, so A stays inside +-360 deg; A changes by whole turns only at the rapid."""
+    m = TarusMachine()
+    t1, a1 = spiral(300 / 360, 301)
+    t2, a2 = spiral(300 / 360, 301)
+    up = np.array([[0.0, 0.0, 80.0]])
+    tips = np.vstack([t1, up, t2])
+    axes = np.vstack([a1, [[0.0, 0.0, 1.0]], a2])
+    rapid = [False] * len(t1) + [True] + [True] + [False] * (len(t2) - 1)
+    j = m.solve_path(tips, axes, rapid=rapid)
+    assert j[:, 3].max() <= 2 * math.pi + 1e-12 and j[:, 3].min() >= -2 * math.pi - 1e-12
+    cut1, cut2 = j[:len(t1), 3], j[len(t1) + 1:, 3]
+    assert np.abs(np.diff(cut1)).max() < math.radians(1.5) and np.abs(np.diff(cut2)).max() < math.radians(1.5)
+    ft, fa = m.forward_path(j)
+    assert np.abs(fa - axes).max() < 1e-12
 
 
 def test_limit_violation_names_move_joint_and_value():

@@ -108,7 +108,8 @@ class TarusMachine:
     """Settings and kinematics of the Tarus head-head 5-axis mill (chain in the module docstring).
 
     pivot_length, tool_length: mm (pivot to gauge line, gauge line to tip). c_limits: tilt range (rad), the
-    seed's C-space range 0..45 degrees by default; a_limits: None for a continuous A, else (min, max) rad;
+    seed's C-space range 0..45 degrees by default; a_limits: (min, max) rad, +-360 degrees by default (the seed
+    gives none; a head's cables usually allow about two turns), None for a continuous A;
     x/y/z_limits: travel of the pivot point in the work frame (None: unlimited). speeds: joint speeds.
     singular_tol: |sin C| under which the axis counts as vertical and A is held. a_home: A before the
     first move.
@@ -116,7 +117,7 @@ class TarusMachine:
     pivot_length: float = 150.0
     tool_length: float = 100.0
     c_limits: tuple[float, float] = (0.0, math.radians(45.0))
-    a_limits: Limits = None
+    a_limits: Limits = (-2.0 * math.pi, 2.0 * math.pi)
     x_limits: Limits = None
     y_limits: Limits = None
     z_limits: Limits = None
@@ -239,20 +240,22 @@ class TarusMachine:
                 f"{u[2]:.6f}; {self.name})", joint, value, lim, index)
         return best
 
-    def solve_path(self, tips: np.ndarray, axes: np.ndarray, start: Optional[Joints] = None) -> np.ndarray:
-        """(n, 5) joints for a path of tips (n, 3) and axes (n, 3): each move continues from the one before
-        (branch, A unwrapping, A held through vertical axes). JointLimitError names the first move
-        (0-based index) that cannot be reached, the joint and its value."""
+    def solve_path(self, tips: np.ndarray, axes: np.ndarray, start: Optional[Joints] = None,
+                   rapid: Optional[Sequence[bool]] = None) -> np.ndarray:
+        """(n, 5) joints for a path of tips (n, 3) and axes (n, 3), planned as a post plans it
+        (core.machine.rotary): A continuous through each cut (branch, unwrapping, held through vertical
+        axes), the whole turns that keep each cut inside the A limits, unwinding only at rapids that turn
+        the tool (`rapid`: per move; default none, the whole path one cut). JointLimitError names the first
+        move (0-based index) out of the X/Y/Z/C limits; RotaryPlanError a cut A cannot follow."""
+        from tmm_workbench.core.machine import rotary
+
         tips = np.asarray(tips, dtype=float).reshape(-1, 3)
         axes = np.asarray(axes, dtype=float).reshape(-1, 3)
         if len(tips) != len(axes):
             raise TmmError(f"solve_path: {len(tips)} tips but {len(axes)} axes")
-        out = np.empty((len(tips), 5))
-        prev = start
-        for i in range(len(tips)):
-            prev = self.inverse(tips[i], axes[i], prev, index=i)
-            out[i] = prev.as_array()
-        return out
+        flags = [False] * len(tips) if rapid is None else [bool(r) for r in rapid]
+        moves = [rotary.Move(tuple(t), tuple(unit_axis(u)), r) for t, u, r in zip(tips, axes, flags)]
+        return rotary.plan(self, moves, start.a if start is not None else None)
 
     # --- time ----------------------------------------------------------------------------------
     def motion_time(self, j0: Joints | Sequence[float], j1: Joints | Sequence[float]) -> float:

@@ -6,10 +6,18 @@ Two output modes:
   (pivot length + tool length) along the tool axis), so tool length compensation stays off (G49).
 * TCP (`tcp=True`; a control with tool-centre-point mode, e.g. Fanuc G43.4): X, Y, Z are the tool tip,
   A, C the joint angles; TCP is switched on with `G43.4 H<tool>` after each tool change, off with G49.
-A and C are printed in degrees, A unwrapped (continuous, may pass 360), never scaled by `inches`.
+A and C are printed in degrees, never scaled by `inches`. A is planned per cut (core.machine.rotary): each
+cut, with its approach and retract, gets the whole turns (and C branch) that keep it inside the A limits
+(default +-360 deg) with the least A travel, so A unwinds only at the transits above the part, never inside
+a cut; a cut that cannot fit raises RotaryPlanError naming its commands.
+Joint mode: a G1 that turns A or C is split into pieces until a control interpolating the joints linearly
+keeps the tip within `tip_tolerance` (default 0.005 mm) of the straight line and the axis within
+`axis_tolerance` (default 0.05 deg) of its interpolation. TCP mode writes the tip and axis as given.
 Feeds: a G1 at a constant orientation uses G94 with F in mm/min (in/min); a G1 that turns A or C uses
-inverse time (G93, F = 1 / minutes = tip feed / tip distance; a pure re-orientation takes the joint motion
-time of eq. 3.123). Rapids carry no F. Arcs (G2/G3) are allowed at a constant orientation.
+inverse time (G93, F = 1 / minutes). Either way the move's time is the longer of tip distance / feed and
+the joint motion time at the machine's joint speeds (seed 000 eq. 3.121-3.123), so every move can be done
+in its programmed time; the estimated cycle time adds up the same times. Rapids carry no F. Arcs (G2/G3)
+are allowed at a constant orientation.
 A move out of the joint limits raises `JointLimitError` (a TmmError) naming the operation, the command,
 the joint and its value: nothing is written.
 """
@@ -22,6 +30,7 @@ from typing import Any, Mapping, Optional
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.machine import rotary
 from tmm_workbench.core.machine.tarus import JointLimitError, Joints, TarusMachine
 from tmm_workbench.core.path5 import AXIS_WORDS, MOTION_NAMES, TIP_WORDS, Pose, decode
 from tmm_workbench.core.post import (MM_PER_INCH, ArgumentParser, Operation, Program, ToolInfo, comment_text,
@@ -39,6 +48,8 @@ class TarusOptions:
     program_end: 'M2' or 'M30'."""
     tcp: bool = False
     inches: bool = False
+    tip_tolerance: float = 0.005                 # mm: joint-mode tip deviation from the straight line
+    axis_tolerance: float = math.radians(0.05)   # rad: joint-mode axis deviation from its interpolation
     precision: int = 4
     angle_precision: int = 6
     comments: bool = True
@@ -85,7 +96,12 @@ class _Writer:
 
     def linear_feed(self, mm_s: float) -> str:
         per_min = mm_s * 60.0
-        return number(per_min / MM_PER_INCH if self.o.inches else per_min, self.o.precision)
+        return self.feed_word(per_min / MM_PER_INCH if self.o.inches else per_min)
+
+    def feed_word(self, value: float) -> str:
+        """F rounded down at the precision: the programmed time is never shorter than the joints need."""
+        scale = 10.0 ** self.o.precision
+        return number(math.floor(value * scale * (1 + 1e-15)) / scale, self.o.precision)
 
     # --- program parts -----------------------------------------------------------------------
     def header(self) -> None:
@@ -136,22 +152,56 @@ class _Writer:
         self.coolant = op.coolant if op.coolant in ("Flood", "Mist") else "None"
         pose = Pose()  # axis words are modal per Path, starting vertical (core.path5)
         pose.tip = self.tip  # coordinates not given yet are where the machine is
+        items: list[tuple[int, str, Any, Optional[Pose]]] = []  # (index, name, params, pose of a motion)
         for i, (name, params) in enumerate(op.commands):
             up = str(name).upper()
-            if is_comment(up):
-                self.comment(strip_comment(str(name)))
-                continue
-            if up not in MOTION_NAMES:
-                self.other(op, i, str(name), params)
+            if is_comment(up) or up not in MOTION_NAMES:
+                items.append((i, str(name), params, None))
                 continue
             try:
                 pose = decode(up, params, pose)
-                self.motion(_CANONICAL.get(up, up), pose, params, i)
+            except TmmError as exc:
+                raise TmmError(f"operation '{op.label}', command {i} ({name}): {exc}") from None
+            items.append((i, _CANONICAL.get(up, up), params, pose))
+        motions = [(i, p) for i, name, _, p in items if p is not None]
+        planned = self.plan(op, [(i, name, p) for i, name, _, p in items if p is not None])
+        joints_of = {i: j for (i, _), j in zip(motions, planned)}
+        for i, name, params, p in items:
+            if p is None:
+                if is_comment(name.upper()):
+                    self.comment(strip_comment(name))
+                else:
+                    self.other(op, i, name, params)
+                continue
+            try:
+                self.motion(name, p, params, i, joints_of[i])
             except JointLimitError as exc:
                 raise JointLimitError(f"operation '{op.label}', command {i} ({name}): {exc}", exc.joint,
                                       exc.value, exc.limits, i) from None
             except TmmError as exc:
                 raise TmmError(f"operation '{op.label}', command {i} ({name}): {exc}") from None
+
+    def plan(self, op: Operation, motions: list[tuple[int, str, Pose]]) -> np.ndarray:
+        """Joints of the operation's motions, A planned per cut (core.machine.rotary)."""
+        for i, name, p in motions:  # a tilted axis needs the whole tip
+            tip = np.array(p.tip, dtype=float)
+            vertical = math.hypot(p.axis[0], p.axis[1]) <= self.m.singular_tol and p.axis[2] > 0
+            if np.isnan(tip).any() and not vertical:
+                raise TmmError(f"operation '{op.label}', command {i} ({name}): the tool position {tuple(tip)} "
+                               "is not fully known for a tilted tool axis")
+        moves = [rotary.Move(tuple(p.tip), tuple(p.axis), name == "G0") for _, name, p in motions]
+        a_start = self.joints.a if self.joints is not None else None
+        try:
+            return rotary.plan(self.m, moves, a_start)
+        except rotary.RotaryPlanError as exc:
+            first, last = motions[exc.first][0], motions[exc.last][0]
+            raise rotary.RotaryPlanError(f"operation '{op.label}', commands {first}..{last}: {exc}",
+                                         first, last) from None
+        except JointLimitError as exc:
+            i, name, _ = motions[exc.index] if exc.index is not None else (None, "?", None)
+            raise JointLimitError(f"operation '{op.label}', command {i} ({name}): "
+                                  f"{TarusMachine._limit_message(exc.joint, exc.value, exc.limits)} ({self.m.name})",
+                                  exc.joint, exc.value, exc.limits, i) from None
 
     def other(self, op: Operation, i: int, name: str, params: Mapping[str, Any]) -> None:
         if any(w in params for w in TIP_WORDS + AXIS_WORDS + ("A", "B", "C")):
@@ -164,49 +214,95 @@ class _Writer:
             words.append(f"{k}{int(v)}" if k in _INT_WORDS else f"{k}{number(float(v), self.o.precision)}")
         self.emit(" ".join(words))
 
-    def motion(self, name: str, pose: Pose, params: Mapping[str, Any], index: int) -> None:
+    def motion(self, name: str, pose: Pose, params: Mapping[str, Any], index: int, planned: np.ndarray) -> None:
         m = self.m
         tip = np.array(pose.tip, dtype=float)
         known = ~np.isnan(tip)
-        vertical = math.hypot(pose.axis[0], pose.axis[1]) <= m.singular_tol and pose.axis[2] > 0
-        if not known.all() and not vertical:
-            raise TmmError(f"the tool position {tuple(tip)} is not fully known for a tilted tool axis")
-        j = m.inverse(tip, pose.axis, self.joints, index=index)
+        j = Joints.from_array(planned)
         prev = self.joints
         turns = prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
-        first = prev is None
-        xyz = pose.tip if self.o.tcp else (j.x, j.y, j.z)
-        words = [f"{w}{self.length(v)}" for w, v, k in zip("XYZ", xyz, known) if k]
-        words += [f"A{self.angle(j.a)}", f"C{self.angle(j.c)}"]
-        dist = float(np.linalg.norm(tip - np.array(self.tip))) if not np.isnan(self.tip).any() and known.all() \
-            else math.nan
-        joint_time = m.motion_time(prev, j) if prev is not None else 0.0  # unknown coordinates left out
         if name == "G0":
-            line = "G0 " + " ".join(words)
-            seconds = joint_time
+            for step in self.a_steps(prev, j):  # an unwinding turn in steps of at most 90 degrees of A
+                step_tip = tip if step is j else m.forward(step.as_array())[0]
+                self.emit("G0 " + self.words(pose.tip if step is j else step_tip, step, known))
+                self.advance(step, step_tip, m.motion_time(self.joints, step) if self.joints is not None else 0.0)
+            return
+        feed = pose.feed
+        if feed is None or not feed > 0:
+            raise TmmError(f"{name} without a feed rate (F {feed})")
+        if name in ("G2", "G3"):
+            if turns or prev is None:
+                raise TmmError("an arc must keep the tool orientation (A and C) of the move before it")
+            extra = " ".join(f"{w}{self.length(float(params[w]))}" for w in ("I", "J", "K", "R") if w in params)
+            dist = self.distance(tip, known)
+            seconds = max(dist / feed if math.isfinite(dist) else 0.0, m.motion_time(prev, j))
+            self.emit(f"{self.set_feed_mode('G94')}{name} {self.words(pose.tip, j, known)} {extra} "
+                      f"F{self.linear_feed(feed)}")
+            self.advance(j, tip, seconds)
+            return
+        pieces = [planned]
+        if turns and not self.o.tcp and known.all() and not np.isnan(self.tip).any():
+            start = prev.as_array()
+            tip_dev, axis_dev = rotary.deviation(m, start, planned)
+            if tip_dev > self.o.tip_tolerance or axis_dev > self.o.axis_tolerance:
+                if abs(prev.c) <= m.singular_tol and abs(j.a - prev.a) > 1e-12:
+                    # leaving the vertical: turn A first, where it moves neither tip nor axis
+                    start = np.array([prev.x, prev.y, prev.z, j.a, prev.c])
+                    self.linear(name, Joints.from_array(start), np.array(self.tip), feed, known)
+                pieces = list(rotary.subdivide(m, start, planned, self.o.tip_tolerance, self.o.axis_tolerance))
+        for piece in pieces:
+            jp = Joints.from_array(piece)
+            piece_tip, _ = m.forward(piece)
+            piece_tip = tip if piece is pieces[-1] else piece_tip
+            self.linear(name, jp, piece_tip, feed, known)
+
+    def a_steps(self, prev: Optional[Joints], j: Joints) -> list[Joints]:
+        """The joints j reached in equal linear joint steps of at most 90 degrees of A (a control may take a
+        rotary move of 180 degrees or more the other way round); [j] for a smaller move."""
+        if prev is None or abs(j.a - prev.a) <= math.pi / 2:
+            return [j]
+        n = math.ceil(abs(j.a - prev.a) / (math.pi / 2))
+        p0, p1 = prev.as_array(), j.as_array()
+        if np.isnan(p0).any():
+            p0 = np.where(np.isnan(p0), p1, p0)
+        return [Joints.from_array(p0 + (p1 - p0) * k / n) for k in range(1, n)] + [j]
+
+    def linear(self, name: str, j: Joints, tip: np.ndarray, feed: float, known: np.ndarray) -> None:
+        """One G1 (or a piece of one) at `feed` mm/s, no faster than the joints can go; A turns of more than
+        90 degrees in steps (a_steps), along the same joint motion."""
+        steps = self.a_steps(self.joints, j)
+        if len(steps) > 1:
+            for step in steps:
+                self.linear(name, step, tip if step is j else self.m.forward(step.as_array())[0], feed, known)
+            return
+        prev = self.joints
+        joint_time = self.m.motion_time(prev, j) if prev is not None else 0.0
+        dist = self.distance(tip, known)
+        seconds = max(dist / feed if math.isfinite(dist) else 0.0, joint_time)
+        turns = prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
+        xyz = tuple(float(v) for v in tip) if self.o.tcp else (j.x, j.y, j.z)
+        words = self.words(xyz, j, known, joints_given=True)
+        if turns:
+            minutes = max(seconds, 1e-6) / 60.0
+            line = f"{self.set_feed_mode('G93')}{name} {words} F{self.feed_word(1.0 / minutes)}"
         else:
-            feed = pose.feed
-            if feed is None or not feed > 0:
-                raise TmmError(f"{name} without a feed rate (F {feed})")
-            if name in ("G2", "G3"):
-                if turns or first:
-                    raise TmmError("an arc must keep the tool orientation (A and C) of the move before it")
-                for w in ("I", "J", "K", "R"):
-                    if w in params:
-                        words.append(f"{w}{self.length(float(params[w]))}")
-            if turns:
-                if dist > 1e-9:
-                    minutes = dist / (feed * 60.0)
-                else:  # a re-orientation on the spot: as fast as the joints go
-                    minutes = max(joint_time, 1e-6) / 60.0
-                mode_words = self.set_feed_mode("G93")
-                line = f"{mode_words}{name} " + " ".join(words) + f" F{number(1.0 / minutes, self.o.precision)}"
-                seconds = max(minutes * 60.0, joint_time)
-            else:
-                mode_words = self.set_feed_mode("G94")
-                line = f"{mode_words}{name} " + " ".join(words) + f" F{self.linear_feed(feed)}"
-                seconds = max(dist / feed if math.isfinite(dist) else 0.0, joint_time)
+            speed = dist / seconds if seconds > 0 and math.isfinite(dist) else feed  # capped by the joints
+            line = f"{self.set_feed_mode('G94')}{name} {words} F{self.linear_feed(min(feed, speed))}"
         self.emit(line)
+        self.advance(j, tip, seconds)
+
+    def words(self, xyz: Any, j: Joints, known: np.ndarray, joints_given: bool = False) -> str:
+        if not joints_given:
+            xyz = xyz if self.o.tcp else (j.x, j.y, j.z)
+        out = [f"{w}{self.length(v)}" for w, v, k in zip("XYZ", xyz, known) if k]
+        return " ".join(out + [f"A{self.angle(j.a)}", f"C{self.angle(j.c)}"])
+
+    def distance(self, tip: np.ndarray, known: np.ndarray) -> float:
+        if np.isnan(self.tip).any() or not known.all():
+            return math.nan
+        return float(np.linalg.norm(tip - np.array(self.tip)))
+
+    def advance(self, j: Joints, tip: np.ndarray, seconds: float) -> None:
         self.time += seconds
         self.moves += 1
         self.joints = j
@@ -241,9 +337,15 @@ def argument_parser() -> ArgumentParser:
     p.add_argument("--tool-length", type=float, help="spindle gauge line to tool tip, mm (default 100)")
     p.add_argument("--c-min", type=float, help="tilt limit, degrees (default 0)")
     p.add_argument("--c-max", type=float, help="tilt limit, degrees (default 45)")
-    p.add_argument("--a-min", type=float, help="rotation limit, degrees (default: continuous A)")
-    p.add_argument("--a-max", type=float, help="rotation limit, degrees (default: continuous A)")
+    p.add_argument("--a-min", type=float, help="rotation limit, degrees (default -360)")
+    p.add_argument("--a-max", type=float, help="rotation limit, degrees (default 360)")
     p.add_argument("--program-end", choices=("M2", "M30"), default="M2", help="program end word")
+    p.add_argument("--tip-tolerance", type=float, default=0.005,
+                   help="joint mode: largest tip deviation from the straight line, mm (default 0.005)")
+    p.add_argument("--axis-tolerance", type=float, default=0.05,
+                   help="joint mode: largest tool axis deviation from its interpolation, degrees (default 0.05)")
+    p.add_argument("--a-continuous", action="store_true",
+                   help="A turns without limits (default: --a-min -360 --a-max 360)")
     return p
 
 
@@ -263,11 +365,18 @@ def parse_args(argstring: Optional[str]) -> tuple[TarusMachine, TarusOptions]:
         raise TmmError("tarus post arguments: give both --a-min and --a-max, or neither")
     if a.a_min is not None:
         kw["a_limits"] = (math.radians(a.a_min), math.radians(a.a_max))
+    if a.a_continuous:
+        if a.a_min is not None:
+            raise TmmError("tarus post arguments: --a-continuous and --a-min/--a-max exclude each other")
+        kw["a_limits"] = None
+    if not (a.tip_tolerance > 0 and 0 < a.axis_tolerance < 90):
+        raise TmmError("tarus post arguments: --tip-tolerance must be > 0 mm and --axis-tolerance in (0, 90) deg")
     if not (0 <= a.precision <= 12 and 0 <= a.angle_precision <= 12):
         raise TmmError("tarus post arguments: --precision and --angle-precision must be 0..12")
     machine = TarusMachine(**kw)
     options = TarusOptions(tcp=a.tcp, inches=a.inches, precision=a.precision, angle_precision=a.angle_precision,
-                           comments=not a.no_comments, line_numbers=a.line_numbers, program_end=a.program_end)
+                           comments=not a.no_comments, line_numbers=a.line_numbers, program_end=a.program_end,
+                           tip_tolerance=a.tip_tolerance, axis_tolerance=math.radians(a.axis_tolerance))
     return machine, options
 
 
