@@ -37,7 +37,7 @@ using tmm::Cutter;
 constexpr double kTol = 1e-9;
 constexpr double kNone = -INFINITY;
 
-// Maximum of a concave (or -inf outside nothing: f is finite on [lo, hi]) function on [lo, hi], ends included.
+// Maximum of a concave function, finite on [lo, hi], by golden section; both ends evaluated too.
 template <class F>
 double golden_max(F&& f, double lo, double hi, double* arg = nullptr) {
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
