@@ -211,6 +211,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
                    tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
                    surface_extension: float = 0.0, footprint_anchor: str = "axis",
+                   gouge_tolerance: Optional[float] = None,
                    safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                    horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                    posts: Sequence[str] = ("tarus", "apt_cl"), out_dir: Optional[Union[str, os.PathLike]] = None,
@@ -226,7 +227,9 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     torus, hollow centre) | 'bull_nose' (plus its flat bottom).
     pass_spacing 'even' (passes spread evenly, at most side_step apart) | 'fixed' (side_step apart from the
     start edge, a last pass on the far edge: the seed's footprint).
-    tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm).
+    tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm). gouge_tolerance: the deepest
+    cut allowed between consecutive positions, positions inserted where a move cuts deeper (None: 0.01 mm;
+    0: not checked).
     surface_extension (mm, 0: off): position against the face continued past its edges (checked against
     the real face); footprint_anchor 'axis' (seed 001: the pre-tilt axis on the footprint point) | 'tip'
     (the tilted tip on it).
@@ -253,6 +256,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
              tolerance=(tolerance if tolerance is not None else 1e-3, spec_of(MultipointParams, "tol")),
              axis_retract=(axis_retract, _NON_NEGATIVE),
              surface_extension=(surface_extension, spec_of(MultipointParams, "extend")),
+             gouge_tolerance=(gouge_tolerance if gouge_tolerance is not None else 0.01,
+                              spec_of(MultipointParams, "between_tol")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
     if Ro + Ri <= 0:
@@ -287,6 +292,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             values["TiltLimit"] = tilt_limit_deg
         if tolerance is not None:
             values["Tolerance"] = tolerance
+        if gouge_tolerance is not None:
+            values["GougeTolerance"] = gouge_tolerance
         op = registry.create(op_multipoint.OP_NAME, job, values)
         if posts and posts[0] in _job_posts(job):
             job.PostProcessor = posts[0]

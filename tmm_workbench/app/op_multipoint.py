@@ -80,6 +80,9 @@ PROPERTIES: list[Prop] = [
          "Axis: the tool axis before tilting passes through the footprint point (seed 001; the tilt moves the "
          "tip sideways); Tip: the tilted tool's tip lies on the footprint point (passes exactly one side step "
          "apart)", "anchor"),
+    Prop("App::PropertyDistance", "GougeTolerance", "Multipoint",
+         "Deepest cut allowed on the way from one position to the next (the tool moved in a straight line, its axis "
+         "turning evenly); where a move cuts deeper, positions are inserted halfway (0: not checked)", "between_tol"),
     Prop("App::PropertyDistance", "AxisRetract", "Linking",
          "Entry and exit distance along the tool axis (then straight up/down to the safe height)"),
     Prop("App::PropertyString", "ContactSummary", "Multipoint",

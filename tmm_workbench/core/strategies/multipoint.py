@@ -73,6 +73,10 @@ class MultipointParams(StrategyParams):
     drd_refinements: int = param(5, "DRD refinements", low=0, high=50, integer=True)  # zoom levels (seed 5)
     drd_bisections: int = param(16, "DRD bisections", low=1, high=200, integer=True)  # bisections of the tilt
     threads: int = param(0, "threads", low=0, high=1024, integer=True)                # 0: all cores
+    # no gouge between positions (multipoint_refine): the deepest cut allowed on the way from one position to
+    # the next (0: not checked), and how many times positions are inserted halfway
+    between_tol: float = param(0.01, "gouge tolerance between positions", "mm", low=0)
+    between_rounds: int = param(4, "refinement rounds", low=0, high=12, integer=True)
 
     def validate(self) -> None:
         super().validate()
@@ -230,19 +234,28 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     res = position_points(surface, Ro, Ri, xy, params, None, progress)
     res.passes = pass_index
     good = res.status != STATUS_FAILED
-    segments = []
+    runs: list[list[int]] = []
     run: list[int] = []  # a segment ends at a new pass or a failed position
     for i in range(len(xy)):
         if run and (pass_index[i] != pass_index[run[-1]] or not good[i]):
-            segments.append(run)
+            runs.append(run)
             run = []
         if good[i]:
             run.append(i)
     if run:
-        segments.append(run)
+        runs.append(run)
+    diagnostics: dict = {"results": res}
+    if params.between_tol > 0 and params.between_rounds > 0:
+        from tmm_workbench.core.strategies import multipoint_refine
+
+        positioner = make_positioner(surface, Ro, Ri, params)
+        diagnostics["between"] = multipoint_refine.refine(
+            surface, positioner, Ro, Ri, params, runs, res,
+            lambda pts: position_points(surface, Ro, Ri, pts, params))
+    diagnostics["counts"] = res.counts()
     tip, axis = res["tip"], res["axis"]
-    cut = [CutSegment(tip[s], axes=axis[s], pass_index=int(pass_index[s[0]])) for s in segments]
-    return StrategyResult(cut, {"results": res, "counts": res.counts()})
+    cut = [CutSegment(tip[r], axes=axis[r], pass_index=int(res.passes[r[0]])) for r in runs]
+    return StrategyResult(cut, diagnostics)
 
 
 def link_policy(tool: Cutter, safe_height: float, clearance_height: float,

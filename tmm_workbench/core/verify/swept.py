@@ -1,0 +1,76 @@
+"""How deep the tool cuts into a face along a motion: tool instances (tip, axis) checked against the face
+densely sampled, by the kernel's exact signed distance to the tool solid (the multipoint positioner's
+`tool_distance`: the torus, its core or the shank as positioned). Used between multipoint positions (the
+straight tip line, the axis by slerp) and on the motion a machine makes from the G-code (machine_view).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tmm_workbench.core.geometry.face import BezierFace
+
+_CELL_MM = 4.0
+
+
+@dataclass
+class FaceSamples:
+    """Points on a face at most `spacing` apart in parameter-scaled steps, bucketed in XY cells."""
+    points: np.ndarray       # (n, 3)
+    spacing: float
+    origin: np.ndarray       # (2,) of the cell grid
+    cells: dict              # (i, j) -> indices
+
+    @classmethod
+    def of(cls, face: BezierFace, spacing: float = 0.5) -> "FaceSamples":
+        x0, y0, x1, y1 = face.xy_extent()
+        count = int(min(2000, max(16, math.ceil(max(x1 - x0, y1 - y0) / spacing))))
+        u0, u1, v0, v1 = face.domain
+        U, V = np.meshgrid(np.linspace(u0, u1, count + 1), np.linspace(v0, v1, count + 1), indexing="ij")
+        pts = face.evaluate(np.column_stack([U.ravel(), V.ravel()]))["S"]
+        origin = pts[:, :2].min(0)
+        keys = np.floor((pts[:, :2] - origin) / _CELL_MM).astype(int)
+        cells: dict = {}
+        order = np.lexsort((keys[:, 1], keys[:, 0]))
+        k_sorted = keys[order]
+        breaks = np.flatnonzero(np.any(np.diff(k_sorted, axis=0) != 0, axis=1)) + 1
+        for chunk in np.split(order, breaks):
+            cells[tuple(keys[chunk[0]])] = chunk
+        return cls(pts, spacing, origin, cells)
+
+    def near(self, xy: np.ndarray, radius: float) -> np.ndarray:
+        """Indices of the points whose cell lies within `radius` of xy (a superset of the points there)."""
+        lo = np.floor((xy - radius - self.origin) / _CELL_MM).astype(int)
+        hi = np.floor((xy + radius - self.origin) / _CELL_MM).astype(int)
+        found = [self.cells[(i, j)] for i in range(lo[0], hi[0] + 1) for j in range(lo[1], hi[1] + 1)
+                 if (i, j) in self.cells]
+        return np.concatenate(found) if found else np.zeros(0, dtype=int)
+
+
+def penetration(positioner, samples: FaceSamples, reach: float, tips: np.ndarray, axes: np.ndarray
+                ) -> np.ndarray:
+    """(m,) how deep (mm, >= 0) each tool instance (tips[k], axes[k]) is inside the face samples; `reach`
+    bounds the tool's XY extent from its tip (for a torus Ro + Ri plus what the tilt adds)."""
+    out = np.zeros(len(tips))
+    for k, (t, a) in enumerate(zip(tips, axes)):
+        idx = samples.near(t[:2], reach)
+        if len(idx):
+            d = positioner.tool_distance(t, a, samples.points[idx])
+            out[k] = max(0.0, -float(d.min()))
+    return out
+
+
+def slerp_rows(a0: np.ndarray, a1: np.ndarray, s: np.ndarray) -> np.ndarray:
+    from tmm_workbench.core.machine.rotary import slerp
+
+    return slerp(np.asarray(a0, float), np.asarray(a1, float), s)
+
+
+def between(positioner, samples: FaceSamples, reach: float, tip0, axis0, tip1, axis1, checks: int = 8) -> float:
+    """The deepest cut (mm) at `checks` instances strictly between two positions: tip on its straight line,
+    axis by slerp (the motion a control with tool-centre-point mode makes)."""
+    s = np.arange(1, checks + 1) / (checks + 1)
+    tips = np.asarray(tip0, float)[None, :] * (1 - s[:, None]) + np.asarray(tip1, float)[None, :] * s[:, None]
+    return float(penetration(positioner, samples, reach, tips, slerp_rows(axis0, axis1, s)).max())
