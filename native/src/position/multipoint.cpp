@@ -125,7 +125,7 @@ MultipointResult MultipointPositioner::position_core(double x, double y) const {
     res.nP = sp.normal();
     if (res.nP.z() < 0.0) res.nP = -res.nP;
   }
-  // One contact, at P. known_penetration >= 0: the pose is already checked.
+  // One contact, at P. known_penetration >= 0: what the search's check found at the pose.
   auto finish_single = [&](ContactReason reason, const ToolPose& pose, double beta, double known_penetration) {
     res.status = ContactStatus::OneContact;
     res.reason = reason;
@@ -137,8 +137,11 @@ MultipointResult MultipointPositioner::position_core(double x, double y) const {
     res.nQ = res.nP;
     res.uvQ = res.uvP;
     res.gap_P = res.gap_Q = tool_distance(tool_, pose.tip, pose.axis, res.P);
-    res.penetration =
-        known_penetration >= 0.0 ? known_penetration : penetration(pose.tip, pose.axis, nullptr, &evals);
+    // The full check, unless the search ran it (DRD): VCRF's own check is partial (its earliest circular
+    // rays and beside P; issue 11), its finding is kept if deeper.
+    res.penetration = (drd && known_penetration >= 0.0)
+                          ? known_penetration
+                          : std::max(known_penetration, penetration(pose.tip, pose.axis, nullptr, &evals));
     if (res.penetration > opt_.tol) {
       res.status = ContactStatus::Failed;
       res.reason = ContactReason::Gouge;
@@ -197,6 +200,8 @@ MultipointResult MultipointPositioner::position_core(double x, double y) const {
     res.reason = ContactReason::SeedRotation;
     res.penetration = penetration(tip, axis, nullptr, &evals);
   }
+  if (opt_.rotation == TiltRotation::PseudoInsert && !drd)  // DRD's search already ran the full check
+    res.penetration = std::max(res.penetration, penetration(tip, axis, nullptr, &evals));
   res.tip = tip;
   res.axis = axis;
   res.centre = tip + Ri * axis;

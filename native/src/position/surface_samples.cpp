@@ -99,6 +99,8 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
       const double U0 = surface.breaks_u()[i], U1 = surface.breaks_u()[i + 1];
       const double V0 = surface.breaks_v()[j], V1 = surface.breaks_v()[j + 1];
       step_.emplace_back((U1 - U0) / mu, (V1 - V0) / mv);
+      grid_.push_back({static_cast<int>(pts_.size()), mu, mv, i == 0, i == surface.nu() - 1, j == 0,
+                       j == surface.nv() - 1});
       const BezierPatch& p = surface.patch(i, j);
       for (int a = 0; a <= mu; ++a) {
         for (int b = 0; b <= mv; ++b) {

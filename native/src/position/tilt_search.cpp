@@ -43,7 +43,22 @@ TiltSearch::TiltSearch(const PatchSurface& s, const SurfaceSamples& samples, con
   start_[1] = uvP_ - side;
 }
 
-bool TiltSearch::near_P(const Vector2d& uv) const { return (s_.point(uv.x(), uv.y()) - P_).norm() < near_; }
+bool TiltSearch::near_P(const Vector2d& uv, double beta) const {
+  if ((s_.point(uv.x(), uv.y()) - P_).norm() >= near_) return false;
+  // Close to P, but in a basin of its own? (issue 11: a second contact on the face's edge 2.6 mm from P,
+  // inside near_, was taken for P.) Along the parameter segment P -> uv the tool distance at this tilt
+  // rises above both ends by more than the osculation allowance: a ridge parts them, uv is not P.
+  const ToolPose pose = frame_.tilted(beta);
+  const double f = tool_distance(tool_, pose.tip, pose.axis, s_.point(uv.x(), uv.y()));
+  const double level = std::max(f, 0.0) + allowed_;
+  constexpr int kSteps = 16;
+  for (int i = 1; i < kSteps; ++i) {
+    const Vector2d w = uvP_ + (uv - uvP_) * (static_cast<double>(i) / kSteps);
+    ++*evals_;
+    if (tool_distance(tool_, pose.tip, pose.axis, s_.point(w.x(), w.y())) > level) return false;
+  }
+  return true;
+}
 
 bool TiltSearch::refine(double& beta, Vector2d& uv, double hi) const {
   double lo = 0.0;
@@ -53,7 +68,7 @@ bool TiltSearch::refine(double& beta, Vector2d& uv, double hi) const {
                                       uv, s_.lo(), s_.hi(), 40, evals_);
     const double m = L.f;
     if (std::abs(m) < 1e-10) return true;
-    if (near_P(uv)) return true;  // slid into P: the caller decides
+    if (near_P(uv, beta)) return true;  // slid into P: the caller decides
     if (m > 0.0) lo = std::max(lo, beta);
     else hi = std::min(hi, beta);
     Vector3d g;
@@ -156,21 +171,21 @@ TiltOutcome TiltSearch::safe_tilt(double b, ContactReason why) {
 TiltOutcome TiltSearch::run(const double beta0, Vector2d uvQ) {
   double beta = beta0, hi = kInf;
   for (int attempt = 0; attempt < 6; ++attempt) {
-    if (near_P(uvQ)) {
+    if (near_P(uvQ, beta)) {
       // The second contact runs into P: tilt until the tool osculates the surface at P. If the full check
       // then finds a contact elsewhere, that one is refined.
       const double a = curvature_limit(std::min({beta, hi, opt_.beta_max}));
       Vector2d where;
       const double pen = check(a, &where);
       if (pen <= allowed_) return single(ContactReason::CurvatureLimit, a, pen);
-      if (near_P(where)) return safe_tilt(a, ContactReason::CurvatureLimit);
+      if (near_P(where, a)) return safe_tilt(a, ContactReason::CurvatureLimit);
       hi = a;
       beta = a;
       uvQ = where;
       continue;
     }
     if (!refine(beta, uvQ, hi)) return safe_tilt(std::min({beta0, hi, opt_.beta_max}), ContactReason::NotConverged);
-    if (near_P(uvQ)) continue;
+    if (near_P(uvQ, beta)) continue;
     if (beta > opt_.beta_max) return single(ContactReason::TiltLimit, opt_.beta_max);
     Vector2d where;
     const double pen = check(beta, &where);

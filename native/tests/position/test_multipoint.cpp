@@ -104,7 +104,9 @@ void check_positions(bool convex, tmm::MultipointMethod method, double* max_seed
       ++two;
       EXPECT_LT((bicubic(patch, r.uvQ.x(), r.uvQ.y()) - r.Q).norm(), 1e-9);
       EXPECT_LT(std::abs(torus_distance(r.tip, r.axis, r.Q)), 1e-3);
-      EXPECT_GT((r.Q - r.P).norm(), 1.0);
+      // Q is not P: apart (at (42, 45) on the concave patch Q lies 0.98 mm from P, parted from it by a
+      // 25 um ridge of the tool distance: a contact of its own, which finer samples find too).
+      EXPECT_GT((r.Q - r.P).norm(), 0.5);
       EXPECT_GT(r.beta, 0.0);
       EXPECT_LE(r.beta, o.beta_max);
       if (max_seed_angle) *max_seed_angle = std::max(*max_seed_angle, r.seed_axis_angle);

@@ -11,7 +11,8 @@
 namespace tmm {
 
 // Deepest penetration (>= 0) of surface s into the tool at `pose`: the samples under the tool scanned,
-// the lowest few (kept apart) polished by Newton; `where` (if given) receives its parameters.
+// every discrete local minimum of the tool distance among them (in its patch's grid, and along the face's
+// boundary) polished by Newton (the lowest 16 at most); `where` (if given) receives its parameters.
 double penetration(const PatchSurface& s, const SurfaceSamples& samples, const TorusTool& tool,
                    const ToolPose& pose, Eigen::Vector2d* where, int* evals);
 

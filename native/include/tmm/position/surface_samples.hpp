@@ -36,12 +36,26 @@ class SurfaceSamples {
   const std::vector<Vector2d>& params() const { return uv_; }
   // Parameter step of the sample grid around sample k (half-width of a zoom window).
   Vector2d step(std::size_t k) const { return step_[patch_[k]]; }
+  // Calls f(index) for the (up to 4) samples next to k in its patch's grid (across a patch seam: none).
+  template <class F>
+  void grid_neighbours(std::size_t k, F&& f) const;
+  // Whether k lies on the face's outer boundary; and f(index) for its neighbours along that boundary
+  // (the face's edge curves sampled in their own right: a minimum of the tool distance there is a minimum
+  // on the edge, which the 2D grid neighbourhood does not show).
+  bool on_boundary(std::size_t k) const;
+  template <class F>
+  void boundary_neighbours(std::size_t k, F&& f) const;
 
  private:
   std::vector<Vector3d> pts_;
   std::vector<Vector2d> uv_;
   std::vector<int> patch_;
   std::vector<Vector2d> step_;
+  struct Grid {
+    int base = 0, mu = 0, mv = 0;
+    bool u0 = false, u1 = false, v0 = false, v1 = false;  // the grid's side lies on the face's boundary
+  };
+  std::vector<Grid> grid_;  // per patch
   double spacing_ = 1, x0_ = 0, y0_ = 0, cell_ = 1;
   int nx_ = 1, ny_ = 1;
   std::vector<int> start_;   // bucket -> first entry in order_
@@ -70,6 +84,36 @@ void SurfaceSamples::within(double x, double y, double r, F&& f) const {
         if (dx * dx + dy * dy <= r2) f(static_cast<std::size_t>(s));
       }
     }
+  }
+}
+
+template <class F>
+void SurfaceSamples::grid_neighbours(std::size_t k, F&& f) const {
+  const Grid& g = grid_[patch_[k]];
+  const int r = static_cast<int>(k) - g.base, a = r / (g.mv + 1), b = r % (g.mv + 1);
+  if (a > 0) f(static_cast<std::size_t>(k - (g.mv + 1)));
+  if (a < g.mu) f(static_cast<std::size_t>(k + (g.mv + 1)));
+  if (b > 0) f(k - 1);
+  if (b < g.mv) f(k + 1);
+}
+
+inline bool SurfaceSamples::on_boundary(std::size_t k) const {
+  const Grid& g = grid_[patch_[k]];
+  const int r = static_cast<int>(k) - g.base, a = r / (g.mv + 1), b = r % (g.mv + 1);
+  return (g.u0 && a == 0) || (g.u1 && a == g.mu) || (g.v0 && b == 0) || (g.v1 && b == g.mv);
+}
+
+template <class F>
+void SurfaceSamples::boundary_neighbours(std::size_t k, F&& f) const {
+  const Grid& g = grid_[patch_[k]];
+  const int r = static_cast<int>(k) - g.base, a = r / (g.mv + 1), b = r % (g.mv + 1);
+  if ((g.u0 && a == 0) || (g.u1 && a == g.mu)) {  // along an edge of constant U: neighbours in V
+    if (b > 0) f(k - 1);
+    if (b < g.mv) f(k + 1);
+  }
+  if ((g.v0 && b == 0) || (g.v1 && b == g.mv)) {  // along an edge of constant V: neighbours in U
+    if (a > 0) f(static_cast<std::size_t>(k - (g.mv + 1)));
+    if (a < g.mu) f(static_cast<std::size_t>(k + (g.mv + 1)));
   }
 }
 

@@ -54,7 +54,8 @@ class TiltSearch {
   double curvature_limit(double b);
 
  private:
-  bool near_P(const Eigen::Vector2d& uv) const;
+  // uv is P: within near_ of it and joined to it, at tilt beta, without a ridge of the tool distance.
+  bool near_P(const Eigen::Vector2d& uv, double beta) const;
   TiltOutcome safe_tilt(double b, ContactReason why);
   TiltOutcome single(ContactReason why, double beta, double known_penetration = -1.0) const;
 
@@ -69,7 +70,7 @@ class TiltSearch {
   std::vector<std::size_t> chosen_;  // VCRF: the hits polished by each check, kept apart
   bool scan_;                        // DRD: checks scan the samples
   int* evals_;
-  double near_;     // a contact closer than this to P is P
+  double near_;     // a contact closer than this to P (and not parted from it by a ridge) is P
   double allowed_;  // osculation, not a tolerated gouge
   // Newton starts of the local search beside P, one on each side along u1: where the last gouge was found
   // (the minimum moves little with beta). Once a side has gouged, only that side is searched.
