@@ -5,9 +5,10 @@ joints cannot do in their programmed time, cycle time; joint mode and TCP mode.
     .venv/bin/python benchmarks/tarus_machine_view.py                       # this checkout's post
     .venv/bin/python benchmarks/tarus_machine_view.py --post-tree /tmp/old  # another checkout's post (before)
 
-The tool paths always come from this checkout (VCRF, seed footprint: side step 18 mm Fixed, forward step
-2 mm, torus Ro 6.7 Ri 6, linked along the tool axis: safe height 5 mm above the face, retract 5 mm); only
-the post (tarus_writer and the machine model) comes from --post-tree. The machine view is this checkout's.
+The tool paths come from this checkout (VCRF, seed footprint: side step 18 mm Fixed, forward step 2 mm,
+torus Ro 6.7 Ri 6, linked along the tool axis: safe height 5 mm above the face, retract 5 mm; --no-refine:
+without the positions inserted between (GougeTolerance 0)); only the post (tarus_writer and the machine
+model) comes from --post-tree. The machine view is this checkout's.
 """
 from __future__ import annotations
 
@@ -26,9 +27,10 @@ from tmm_workbench.core.geometry import bezier  # noqa: E402
 from tmm_workbench.core.post import ToolInfo  # noqa: E402
 from tmm_workbench.core.shared_data import benchmark_file  # noqa: E402
 from tmm_workbench.core.strategies.multipoint import (BezierFace, MultipointParams,  # noqa: E402
-                                                      compute_multipoint_toolpath, face_top, link_policy)
+                                                      compute_multipoint_toolpath, face_top, link_policy,
+                                                      make_positioner)
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
-from tmm_workbench.core.verify import machine_view  # noqa: E402
+from tmm_workbench.core.verify import machine_view, swept  # noqa: E402
 
 TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter=25.4, corner_radius=6.0,
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")
@@ -73,22 +75,25 @@ def post_modules(tree: Path | None):
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--post-tree", type=Path, help="a checkout whose post to use")
+    ap.add_argument("--no-refine", action="store_true", help="no positions inserted between positions")
     args = ap.parse_args()
-    paths = {}
+    paths, gouges = {}, {}
     tool = Cutter.torus(6.7, 6.0)
     for which in ("convex", "concave", "saddle"):
         face = BezierFace.from_net(seed_net(which))
         safe = face_top(face) + 5.0
-        tp, res = compute_multipoint_toolpath(face, tool, MultipointParams(side_step=18.0, pass_spacing="fixed",
-                                                                            forward_step=2.0),
+        params = MultipointParams(side_step=18.0, pass_spacing="fixed", forward_step=2.0,
+                                  between_tol=0.0 if args.no_refine else 0.005)
+        tp, res = compute_multipoint_toolpath(face, tool, params,
                                               link_policy(tool, safe, safe + 5.0, 5.0))
         paths[which] = path5.encode_toolpath(tp, 1000 / 60, 300 / 60)
+        gouges[which] = swept.FaceGouge(make_positioner(face, 6.7, 6.0, MultipointParams()), face, 6.7 + 13.0)
     writer, Machine, post = post_modules(args.post_tree)
     view_machine = post_modules(None)[1](a_limits=None)  # the view reads A as written
     print(f"post from {args.post_tree or ROOT}")
     print("| patch | mode | lines | A range deg | A travel deg | largest A step deg | tip deviation mm | "
-          "too fast | cycle time s | post s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+          "too fast | deepest cut mm | cycle time s | post s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     tool = post.ToolInfo(**{k: getattr(TOOL, k) for k in TOOL.__dataclass_fields__})
     for which, commands in paths.items():
         program = [tool, post.Operation(which, commands)]
@@ -102,10 +107,11 @@ def main() -> None:
                 print(f"| {which} | {'TCP' if tcp else 'joints'} | refused: {exc} |")
                 continue
             seconds = time.perf_counter() - t0
-            v = machine_view.view(view_machine, text, tcp=tcp)
+            v = machine_view.view(view_machine, text, tcp=tcp, depth=gouges[which])
             print(f"| {which} | {'TCP' if tcp else 'joints'} | {v.lines} | {math.degrees(v.a_min):.1f}.."
                   f"{math.degrees(v.a_max):.1f} | {math.degrees(v.a_travel):.0f} | "
                   f"{math.degrees(v.largest_a_step):.1f} | {v.largest_tip_deviation:.4f} | {len(v.too_fast)} | "
+                  f"{v.deepest_cut:.4f} | "
                   f"{v.cycle_time:.0f} | {seconds:.2f} |")
 
 

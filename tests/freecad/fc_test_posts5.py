@@ -142,8 +142,8 @@ class Posts5(FreeCADTestCase):
             with self.subTest(tcp=tcp):
                 target = OUT / f"tarus_{'tcp' if tcp else 'joints'}.ngc"
                 # one line per move (joint-mode subdivision off; tests/core/test_post_writers.py checks it)
-                args = "--no-show-editor --precision 10 --angle-precision 12 --tool-length 80" + \
-                    (" --tcp" if tcp else " --tip-tolerance 1e9 --axis-tolerance 89")
+                args = "--no-show-editor --precision 10 --angle-precision 12 --tool-length 80 " \
+                    "--tip-tolerance 1e9 --axis-tolerance 89" + (" --tcp" if tcp else "")
                 processor = load_post("tarus")
                 text = processor.export([self.tc, self.op], str(target), args)
                 self.assertEqual(target.read_text(), text)

@@ -228,7 +228,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     pass_spacing 'even' (passes spread evenly, at most side_step apart) | 'fixed' (side_step apart from the
     start edge, a last pass on the far edge: the seed's footprint).
     tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm). gouge_tolerance: the deepest
-    cut allowed between consecutive positions, positions inserted where a move cuts deeper (None: 0.01 mm;
+    cut allowed between consecutive positions, positions inserted where a move cuts deeper (None: 0.005 mm;
     0: not checked).
     surface_extension (mm, 0: off): position against the face continued past its edges (checked against
     the real face); footprint_anchor 'axis' (seed 001: the pre-tilt axis on the footprint point) | 'tip'
@@ -256,7 +256,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
              tolerance=(tolerance if tolerance is not None else 1e-3, spec_of(MultipointParams, "tol")),
              axis_retract=(axis_retract, _NON_NEGATIVE),
              surface_extension=(surface_extension, spec_of(MultipointParams, "extend")),
-             gouge_tolerance=(gouge_tolerance if gouge_tolerance is not None else 0.01,
+             gouge_tolerance=(gouge_tolerance if gouge_tolerance is not None else 0.005,
                               spec_of(MultipointParams, "between_tol")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))

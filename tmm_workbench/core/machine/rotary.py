@@ -14,8 +14,8 @@ it (its first and last move) and nothing is emitted.
 Subdivision. Between two joint positions a control without tool-centre-point mode moves X Y Z A C linearly;
 the tip then leaves the straight line between the two programmed tips and the axis its interpolation (slerp).
 `subdivide` splits a move into 2, 4, 8, ... equal pieces (tip linear, axis slerp, joints by continuous
-unwrapping) until, at every piece, the tip stays within `tip_tol` of its chord and the axis within
-`axis_tol` of its slerp, checked at 8 points per piece.
+unwrapping) until, at every piece, the tip stays within `tip_tol` of where the straight line has it at the
+same fraction and the axis within `axis_tol` of its slerp, checked at 8 points per piece.
 """
 from __future__ import annotations
 
@@ -184,21 +184,17 @@ def slerp(a0: np.ndarray, a1: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 def deviation(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, checks: int = _CHECKS
               ) -> tuple[float, float]:
-    """(tip distance from the chord in mm, axis angle from the slerp in rad), the largest at `checks`
-    interior points of the linear joint move j0 -> j1."""
+    """(tip distance in mm, axis angle in rad) between the linear joint move j0 -> j1 and the ideal move
+    (tip on the straight line, axis by slerp) at the same fraction, the largest at `checks` interior
+    points. The same fraction, not the nearest point of the line: a tip that runs ahead along its line
+    while the axis lags is a pose the positions never checked (it can cut in)."""
     s = np.arange(1, checks + 1) / (checks + 1)
     js = j0[None, :] * (1 - s[:, None]) + j1[None, :] * s[:, None]
     tips, axes = machine.forward_path(js)
     t0, u0 = machine.forward(j0)
     t1, u1 = machine.forward(j1)
-    chord = t1 - t0
-    length2 = float(chord @ chord)
-    if length2 > 0:
-        q = np.clip(((tips - t0) @ chord) / length2, 0.0, 1.0)
-        near = t0 + q[:, None] * chord
-    else:
-        near = np.broadcast_to(t0, tips.shape)
-    tip_dev = float(np.linalg.norm(tips - near, axis=1).max())
+    ideal = t0[None, :] * (1 - s[:, None]) + t1[None, :] * s[:, None]
+    tip_dev = float(np.linalg.norm(tips - ideal, axis=1).max())
     ref = slerp(u0, u1, s)
     axis_dev = float(np.arccos(np.clip((axes * ref).sum(1), -1.0, 1.0)).max())
     return tip_dev, axis_dev

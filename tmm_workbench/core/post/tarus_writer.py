@@ -12,7 +12,8 @@ cut, with its approach and retract, gets the whole turns (and C branch) that kee
 a cut; a cut that cannot fit raises RotaryPlanError naming its commands.
 Joint mode: a G1 that turns A or C is split into pieces until a control interpolating the joints linearly
 keeps the tip within `tip_tolerance` (default 0.005 mm) of the straight line and the axis within
-`axis_tolerance` (default 0.05 deg) of its interpolation. TCP mode writes the tip and axis as given.
+`axis_tolerance` (default 0.05 deg) of its interpolation. TCP mode writes the tip and axis as given, split
+only where the control's linear A and C would leave the axis interpolation by more than `axis_tolerance`.
 Feeds: a G1 at a constant orientation uses G94 with F in mm/min (in/min); a G1 that turns A or C uses
 inverse time (G93, F = 1 / minutes). Either way the move's time is the longer of tip distance / feed and
 the joint motion time at the machine's joint speeds (seed 000 eq. 3.121-3.123), so every move can be done
@@ -241,18 +242,21 @@ class _Writer:
             self.advance(j, tip, seconds)
             return
         pieces = [planned]
-        if turns and not self.o.tcp and known.all() and not np.isnan(self.tip).any():
+        if turns and known.all() and not np.isnan(self.tip).any():
+            # TCP: the control keeps the tip on its line but turns A and C linearly, so only the axis is held
+            # to its tolerance; joint mode: both
+            tip_tol = math.inf if self.o.tcp else self.o.tip_tolerance
             start = prev.as_array()
             tip_dev, axis_dev = rotary.deviation(m, start, planned)
-            if tip_dev > self.o.tip_tolerance or axis_dev > self.o.axis_tolerance:
+            if tip_dev > tip_tol or axis_dev > self.o.axis_tolerance:
                 if abs(prev.c) <= m.singular_tol and abs(j.a - prev.a) > 1e-12:
                     # leaving the vertical: turn A first, where it moves neither tip nor axis
                     start = np.array([prev.x, prev.y, prev.z, j.a, prev.c])
                     self.linear(name, Joints.from_array(start), np.array(self.tip), feed, known)
-                pieces = list(rotary.subdivide(m, start, planned, self.o.tip_tolerance, self.o.axis_tolerance))
+                pieces = list(rotary.subdivide(m, start, planned, tip_tol, self.o.axis_tolerance))
         for piece in pieces:
             jp = Joints.from_array(piece)
-            piece_tip, _ = m.forward(piece)
+            piece_tip, _ = m.forward(piece)  # on the straight line (subdivide's targets)
             piece_tip = tip if piece is pieces[-1] else piece_tip
             self.linear(name, jp, piece_tip, feed, known)
 
@@ -272,8 +276,15 @@ class _Writer:
         90 degrees in steps (a_steps), along the same joint motion."""
         steps = self.a_steps(self.joints, j)
         if len(steps) > 1:
-            for step in steps:
-                self.linear(name, step, tip if step is j else self.m.forward(step.as_array())[0], feed, known)
+            start = np.array(self.tip)
+            for k, step in enumerate(steps, 1):
+                if step is j:
+                    step_tip = tip
+                elif self.o.tcp:  # the control keeps the tip on its line: the steps' tips are on it too
+                    step_tip = start + (tip - start) * k / len(steps)
+                else:
+                    step_tip = self.m.forward(step.as_array())[0]
+                self.linear(name, step, step_tip, feed, known)
             return
         prev = self.joints
         joint_time = self.m.motion_time(prev, j) if prev is not None else 0.0

@@ -63,12 +63,16 @@ class MachineView:
     largest_tip_deviation: float = 0.0      # mm, cutting lines, from the chord between programmed tips
     largest_axis_deviation: float = 0.0     # rad, from the slerp between programmed axes
     too_fast: list[int] = field(default_factory=list)  # lines the joints cannot do in the programmed time
+    deepest_cut: float = 0.0                # mm into the face along the cutting lines (with `depth`)
     cycle_time: float = 0.0                 # s, from the programmed feeds and the joint speeds
 
 
-def view(machine: TarusMachine, text: str, tcp: bool = False) -> MachineView:
+def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, samples: int = 8) -> MachineView:
     """The checks of the module doc on Tarus G-code written for `machine` (joint mode, or TCP mode where the
-    control keeps the tip on its line: no deviation is measured there)."""
+    control keeps the tip on its line: no deviation is measured there). With `depth` (tips, axes -> mm
+    inside the part, e.g. core.verify.swept.FaceGouge), the tool is also checked at `samples` instances
+    along every cutting line, moved as the control moves it (joints linear, or in TCP mode the tip linear
+    and A, C linear), and at its end."""
     lines = read_tarus(text)
     if tcp:  # X Y Z are the tip: the joints move the pivot point, tip + length along the axis
         for ln in lines:
@@ -104,7 +108,24 @@ def view(machine: TarusMachine, text: str, tcp: bool = False) -> MachineView:
                 tip_dev, axis_dev = deviation(machine, prev, j, checks=16)
                 v.largest_tip_deviation = max(v.largest_tip_deviation, tip_dev)
                 v.largest_axis_deviation = max(v.largest_axis_deviation, axis_dev)
+            if depth is not None:
+                v.deepest_cut = max(v.deepest_cut, float(depth(*_instances(machine, prev, j, tcp, samples)).max()))
         else:
             v.cycle_time += joint_time
         prev = j
     return v
+
+
+def _instances(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, tcp: bool, samples: int
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """(tips, axes) of the tool at `samples` points inside a line and at its end, as the control moves it:
+    all joints linear, or in TCP mode the tip linear and A, C linear (a TCP control keeps the tip on its line
+    and interpolates the rotary axes)."""
+    s = np.arange(1, samples + 2) / (samples + 1)
+    js = j0[None, :] * (1 - s[:, None]) + j1[None, :] * s[:, None]
+    tips, axes = machine.forward_path(js)
+    if tcp:
+        t0, _ = machine.forward(j0)
+        t1, _ = machine.forward(j1)
+        tips = t0[None, :] * (1 - s[:, None]) + t1[None, :] * s[:, None]
+    return tips, axes

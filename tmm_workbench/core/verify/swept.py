@@ -74,3 +74,21 @@ def between(positioner, samples: FaceSamples, reach: float, tip0, axis0, tip1, a
     s = np.arange(1, checks + 1) / (checks + 1)
     tips = np.asarray(tip0, float)[None, :] * (1 - s[:, None]) + np.asarray(tip1, float)[None, :] * s[:, None]
     return float(penetration(positioner, samples, reach, tips, slerp_rows(axis0, axis1, s)).max())
+
+
+class FaceGouge:
+    """Depths (mm) of tool instances in a face, exact to about 0.0013 mm for a torus of minor radius 6 mm:
+    every instance on samples 0.5 mm apart, those deeper there than `screen` again on samples 0.25 mm apart
+    (module functions above; the same screening as core.strategies.multipoint_refine)."""
+
+    def __init__(self, positioner, face: BezierFace, reach: float, screen: float = 0.005) -> None:
+        self.positioner, self.reach, self.screen = positioner, reach, screen
+        self.coarse = FaceSamples.of(face, 0.5)
+        self.fine = FaceSamples.of(face, 0.25)
+
+    def __call__(self, tips: np.ndarray, axes: np.ndarray) -> np.ndarray:
+        d = penetration(self.positioner, self.coarse, self.reach, tips, axes)
+        again = d > self.screen
+        if again.any():
+            d[again] = penetration(self.positioner, self.fine, self.reach, tips[again], axes[again])
+        return d
