@@ -63,7 +63,7 @@ class MachineView:
     largest_tip_deviation: float = 0.0      # mm, cutting lines, from the chord between programmed tips
     largest_axis_deviation: float = 0.0     # rad, from the slerp between programmed axes
     too_fast: list[int] = field(default_factory=list)  # lines the joints cannot do in the programmed time
-    deepest_cut: float = 0.0                # mm into the face along the cutting lines (with `depth`)
+    deepest_cut: float = 0.0                # mm into the face along every line, rapids too (with `depth`)
     cycle_time: float = 0.0                 # s, from the programmed feeds and the joint speeds
 
 
@@ -71,8 +71,8 @@ def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, sample
     """The checks of the module doc on Tarus G-code written for `machine` (joint mode, or TCP mode where the
     control keeps the tip on its line: no deviation is measured there). With `depth` (tips, axes -> mm
     inside the part, e.g. core.verify.swept.FaceGouge), the tool is also checked at `samples` instances
-    along every cutting line, moved as the control moves it (joints linear, or in TCP mode the tip linear
-    and A, C linear), and at its end."""
+    along every line (cuts, and the approach, retract and transit rapids), moved as the control moves it
+    (joints linear, or in TCP mode the tip linear and A, C linear), and at its end."""
     lines = read_tarus(text)
     if tcp:  # X Y Z are the tip: the joints move the pivot point, tip + length along the axis
         for ln in lines:
@@ -108,10 +108,10 @@ def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, sample
                 tip_dev, axis_dev = deviation(machine, prev, j, checks=16)
                 v.largest_tip_deviation = max(v.largest_tip_deviation, tip_dev)
                 v.largest_axis_deviation = max(v.largest_axis_deviation, axis_dev)
-            if depth is not None:
-                v.deepest_cut = max(v.deepest_cut, float(depth(*_instances(machine, prev, j, tcp, samples)).max()))
         else:
             v.cycle_time += joint_time
+        if depth is not None:  # cutting lines, and the approach, retract and transit rapids too
+            v.deepest_cut = max(v.deepest_cut, float(depth(*_instances(machine, prev, j, tcp, samples)).max()))
         prev = j
     return v
 
