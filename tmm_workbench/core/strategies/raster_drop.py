@@ -52,6 +52,9 @@ class SurfaceParams(StrategyParams):
     stock_to_leave: float = param(0.0, "stock to leave", "mm")        # material left on the surface
     floor_z: Optional[float] = param(None, "floor", "mm", optional=True)  # default: the model's lowest point
     off_model: str = param(OFF_MODEL_FLOOR, "off-model", choices=(OFF_MODEL_FLOOR, OFF_MODEL_SKIP))
+    # the deepest a straight move may pass below the exact drop height between its CL points (raster_refine;
+    # 0: not checked)
+    gouge_tol: float = param(0.005, "gouge tolerance between CL points", "mm", low=0)
 
     def validate(self) -> None:
         super().validate()
@@ -114,8 +117,20 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
     z = np.maximum(z, floor_z)
+    diagnostics: dict = {"points": len(xy), "passes": len(lines)}
+    if params.gouge_tol > 0:
+        from tmm_workbench.core.strategies import raster_refine
+
+        def drop(more: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            zz = surface.drop(cutter.offset(s), more, (air_floor if skip else floor_z) - s) + s
+            aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
+            return np.maximum(zz, floor_z), aa
+
+        runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
+                                                                    chained=params.pattern == ZIGZAG)
+    diagnostics["top"] = float(z[~air].max())
     segments = _segments(runs, z, air, params.pattern)
-    return StrategyResult(segments, {"points": len(xy), "passes": len(lines), "top": float(z[~air].max())})
+    return StrategyResult(segments, diagnostics)
 
 
 def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, policy: LinkPolicy,
