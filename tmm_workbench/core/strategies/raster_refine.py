@@ -56,7 +56,6 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
             todo = []
             break
         deepest = float(worst[bad].max())
-        mid_z, mid_air = zs.reshape(len(todo), -1)[:, 1:3], air_s.reshape(len(todo), -1)[:, 1:3]
         additions: dict[int, list[tuple[int, np.ndarray, bool]]] = {}
         for n in bad:
             r, i = todo[n]
