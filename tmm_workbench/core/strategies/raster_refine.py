@@ -1,7 +1,8 @@
 """No gouge between 3-axis CL points (issue 11 item 3, the 3-axis side): the straight move between two
 dropped points passes below the exact drop height where a ridge or an edge lies between them. Each move is
-checked at 4 interior points (dropped in one batch for all moves); where it passes more than `tol` below,
-the point halfway is dropped and inserted, and the two new moves are checked in turn. A move shorter than
+checked at 5 interior points (dropped in one batch for all moves); where it passes more than `tol` below,
+or where a steep move's middle lies far from its chord (a jump of the drop height between samples), the
+point halfway is dropped and inserted, and the two new moves are checked in turn. A move shorter than
 `min_step` that still cuts in crosses a cliff (the tool dropping off an open edge to the floor, or climbing
 onto one): it becomes a horizontal move at the upper height and a vertical one, the way a machinist would
 go down an edge. Deeper moves than `tol` left after `rounds` are counted in the diagnostics.
@@ -13,7 +14,8 @@ from typing import Callable
 import numpy as np
 
 Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy (n, 2) -> (z (n,), air (n,) bool)
-_FRACTIONS = np.array([0.2, 0.4, 0.6, 0.8])
+_FRACTIONS = np.array([0.2, 0.4, 0.5, 0.6, 0.8])
+_MID = 2  # the index of 0.5
 
 
 def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, drop: Drop, tol: float,
@@ -51,11 +53,15 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
         cut = (zs.reshape(len(todo), -1) - samples[:, :, 2])
         cut[air_s.reshape(len(todo), -1)] = -np.inf
         worst = cut.max(axis=1)
-        bad = np.flatnonzero(worst > tol)
+        # a jump of the drop height (an edge the tool falls off or climbs onto) can hide between the samples:
+        # a steep move whose middle is far from its chord, above or below, is split until the jump is found
+        steep = np.abs(b[:, 2] - a[:, 2]) > 10 * tol
+        jump = steep & (np.abs(cut[:, _MID]) > tol) & np.isfinite(cut[:, _MID])
+        bad = np.flatnonzero((worst > tol) | jump)
         if not len(bad):
             todo = []
             break
-        deepest = float(worst[bad].max())
+        deepest = float(max(worst[bad].max(), 0.0))
         additions: dict[int, list[tuple[int, np.ndarray, bool]]] = {}
         for n in bad:
             r, i = todo[n]
