@@ -114,13 +114,12 @@ def _option(label: str, value: Any, names: dict[str, str], shown: Optional[Seque
 
 
 def _numbers(**values: tuple[Any, Spec]) -> None:
-    """Each API argument checked against its range by its own name (None: the default is derived)."""
+    """Each API argument checked against its range by its own name (None: the op's default is used)."""
     from dataclasses import replace
 
     for name, (value, spec) in values.items():
-        if value is None and name.endswith("_height"):
-            continue
-        check(replace(spec, label=name), value)
+        if value is not None:
+            check(replace(spec, label=name), value)
 
 
 def _by_core_name(props: dict[str, str]) -> dict[str, str]:
@@ -251,13 +250,11 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
              side_step=(side_step, spec_of(MultipointParams, "side_step")),
              forward_step=(forward_step, spec_of(MultipointParams, "forward_step")),
              feed_angle_deg=(feed_angle_deg, spec_of(MultipointParams, "feed_angle_deg")), margin=(margin, _LENGTH),
-             tilt_limit_deg=(tilt_limit_deg if tilt_limit_deg is not None else 45.0,
-                             spec_of(MultipointParams, "beta_max_deg")),
-             tolerance=(tolerance if tolerance is not None else 1e-3, spec_of(MultipointParams, "tol")),
+             tilt_limit_deg=(tilt_limit_deg, spec_of(MultipointParams, "beta_max_deg")),
+             tolerance=(tolerance, spec_of(MultipointParams, "tol")),
              axis_retract=(axis_retract, _NON_NEGATIVE),
              surface_extension=(surface_extension, spec_of(MultipointParams, "extend")),
-             gouge_tolerance=(gouge_tolerance if gouge_tolerance is not None else 0.005,
-                              spec_of(MultipointParams, "between_tol")),
+             gouge_tolerance=(gouge_tolerance, spec_of(MultipointParams, "between_tol")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
     if Ro + Ri <= 0:

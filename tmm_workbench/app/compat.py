@@ -186,10 +186,8 @@ def toolbit_from_file(doc: Any, path: str) -> Any:
     import FreeCAD
 
     FreeCAD.setActiveDocument(doc.Name)
-    bit_module = import_app("tool_bit")
-    factory = getattr(bit_module, "Factory", None)
-    if factory is not None:
-        return factory.CreateFrom(path)
+    if not toolbits_are_assets():
+        return import_app("tool_bit").Factory.CreateFrom(path)
     from Path.Tool.toolbit import ToolBit  # 1.1
 
     return ToolBit.from_file(path).attach_to_doc(doc)

@@ -110,4 +110,3 @@ def bezier_face(surface: Any, name: str = "face") -> BezierFace:
     if weights is not None and np.max(np.abs(weights - 1.0)) > 1e-12:
         raise TmmError(f"{name}: rational Bézier surface (weights not all 1) is not supported")
     return BezierFace.from_net(poles, name=name)
-

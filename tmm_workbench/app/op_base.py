@@ -100,9 +100,7 @@ class TmmOp(PathOp.ObjectOp):
                 value = bool(value)
             values[row.field] = value
         values.update(extra)
-        params = self.PARAMS(**values)
-        params.validate()
-        return params
+        return self.PARAMS(**values)  # validated by the strategy's compute
 
     def initOperation(self, obj: Any) -> None:
         self.ensure_properties(obj, restoring=False)
@@ -172,11 +170,10 @@ class TmmOp(PathOp.ObjectOp):
             v = float(_plain(getattr(tc, name, 0.0)))
             if not math.isfinite(v) or v < 0:
                 return f"tool controller '{tc.Label}': {name} must be a feed >= 0, got {v:g}"
-        if not kernel.available():
-            try:
-                kernel.require()
-            except kernel.KernelMissing as exc:
-                return str(exc)
+        try:
+            kernel.require()
+        except kernel.KernelMissing as exc:
+            return str(exc)
         return ""
 
     def opExecute(self, obj: Any) -> None:

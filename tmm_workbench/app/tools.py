@@ -22,10 +22,9 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOOLBIT_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")  # shapes TMM maps to a cutter
-SUPPORTED_SHAPES = TOOLBIT_SHAPES
 _LEGACY_TYPES = {"EndMill": "endmill", "BallEndMill": "ballend"}  # 0.20's deprecated Path.Tool
 # ToolBit shapes shipped with FreeCAD (Mod/Path/Tools/Shape/<name>.fcstd) that TMM creates bits of
-BIT_SHAPES_BY_NAME = {"endmill": "endmill", "ballend": "ballend", "bullnose": "bullnose"}
+BIT_SHAPES = ("endmill", "ballend", "bullnose")
 # API names of the shapes TMM creates (lower case) -> ToolBit shape
 SHAPE_ALIASES = {"ballend": "ballend", "ball": "ballend", "endmill": "endmill", "flat": "endmill",
                  "bullnose": "bullnose", "bull": "bullnose"}
@@ -126,8 +125,8 @@ def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 
     stores FlatRadius = diameter/2 - corner radius (see the module doc), 1.1's CornerRadius."""
     from tmm_workbench.app import compat
 
-    if shape not in BIT_SHAPES_BY_NAME:
-        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPES_BY_NAME)}")
+    if shape not in BIT_SHAPES:
+        raise TmmError(f"tool shape '{shape}' is not one of {', '.join(BIT_SHAPES)}")
     for name, v in (("diameter", diameter), ("corner radius", corner_radius)):
         if not (isinstance(v, (int, float)) and math.isfinite(v)):
             raise TmmError(f"tool {name} must be a finite number of mm, got {v!r}")
@@ -143,7 +142,7 @@ def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 
     elif shape == "bullnose":
         params["FlatRadius"] = f"{diameter / 2 - corner_radius} mm"
     label = label or f"{diameter:g} mm {shape}" + (f" r{corner_radius:g}" if shape == "bullnose" else "")
-    return compat.make_toolbit(doc, BIT_SHAPES_BY_NAME[shape], params, label)
+    return compat.make_toolbit(doc, shape, params, label)
 
 
 def bit_for_cutter(doc: Any, cutter: Cutter, label: str = "") -> Any:

@@ -13,13 +13,13 @@ ends at the clearance height (5-axis: upright again, so any later op starts unti
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Callable, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.params import Spec, check
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
 
@@ -40,10 +40,9 @@ class LinkPolicy:
     lowest_below_tip: Optional[Callable[[Axis], float]] = None
 
     def validate(self) -> None:
-        for name in ("safe_height", "clearance_height", "axis_retract"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v)):
-                raise TmmError(f"{name.replace('_', ' ')} must be a finite number of mm, got {v!r}")
+        check(Spec("safe height", "mm"), self.safe_height)
+        check(Spec("clearance height", "mm"), self.clearance_height)
+        check(Spec("axis retract", "mm", low=0, kind="length"), self.axis_retract)
         if self.clearance_height < self.safe_height:
             raise TmmError(f"clearance height {self.clearance_height:g} mm is below the safe height "
                            f"{self.safe_height:g} mm")
@@ -51,8 +50,6 @@ class LinkPolicy:
             raise TmmError(f"retract must be '{VERTICAL}' or '{ALONG_AXIS}', got {self.retract!r}")
         if self.entry not in ENTRIES:
             raise TmmError(f"entry must be one of {', '.join(ENTRIES)}, got {self.entry!r}")
-        if self.axis_retract < 0:
-            raise TmmError(f"axis retract must be >= 0 mm, got {self.axis_retract:g}")
 
 
 def _plunge(tp: Toolpath, tip: np.ndarray, axis: Axis) -> None:

@@ -26,6 +26,7 @@ from typing import Optional
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.axes import slerp
 from tmm_workbench.core.machine.tarus import _LIMIT_SLACK, JointLimitError, Joints, TarusMachine
 
 TWO_PI = 2.0 * math.pi
@@ -168,18 +169,6 @@ def _check_linear(machine: TarusMachine, j: np.ndarray, index: int) -> None:
         if not (lim[0] - _LIMIT_SLACK <= value <= lim[1] + _LIMIT_SLACK):
             raise JointLimitError(f"move {index}: {TarusMachine._limit_message(joint, float(value), lim)} "
                                   f"({machine.name})", joint, float(value), lim, index)
-
-
-def slerp(a0: np.ndarray, a1: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Unit vectors (m, 3) between unit a0 and a1 at the fractions s (constant angular rate)."""
-    s = np.asarray(s, dtype=float).reshape(-1, 1)
-    dot = float(np.clip(a0 @ a1, -1.0, 1.0))
-    theta = math.acos(dot)
-    if theta < 1e-9:
-        out = (1 - s) * a0 + s * a1
-    else:
-        out = (np.sin((1 - s) * theta) * a0 + np.sin(s * theta) * a1) / math.sin(theta)
-    return out / np.linalg.norm(out, axis=1, keepdims=True)
 
 
 def deviation(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, checks: int = _CHECKS

@@ -221,11 +221,11 @@ class _Writer:
         known = ~np.isnan(tip)
         j = Joints.from_array(planned)
         prev = self.joints
-        turns = prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
+        turns = _turns(prev, j)
         if name == "G0":
             for step in self.a_steps(prev, j):  # an unwinding turn in steps of at most 90 degrees of A
                 step_tip = tip if step is j else m.forward(step.as_array())[0]
-                self.emit("G0 " + self.words(pose.tip if step is j else step_tip, step, known))
+                self.emit("G0 " + self.words(step_tip, step, known))
                 self.advance(step, step_tip, m.motion_time(self.joints, step) if self.joints is not None else 0.0)
             return
         feed = pose.feed
@@ -237,7 +237,7 @@ class _Writer:
             extra = " ".join(f"{w}{self.length(float(params[w]))}" for w in ("I", "J", "K", "R") if w in params)
             dist = self.distance(tip, known)
             seconds = max(dist / feed if math.isfinite(dist) else 0.0, m.motion_time(prev, j))
-            self.emit(f"{self.set_feed_mode('G94')}{name} {self.words(pose.tip, j, known)} {extra} "
+            self.emit(f"{self.set_feed_mode('G94')}{name} {self.words(tip, j, known)} {extra} "
                       f"F{self.linear_feed(feed)}")
             self.advance(j, tip, seconds)
             return
@@ -254,11 +254,9 @@ class _Writer:
                     start = np.array([prev.x, prev.y, prev.z, j.a, prev.c])
                     self.linear(name, Joints.from_array(start), np.array(self.tip), feed, known)
                 pieces = list(rotary.subdivide(m, start, planned, tip_tol, self.o.axis_tolerance))
-        for piece in pieces:
-            jp = Joints.from_array(piece)
-            piece_tip, _ = m.forward(piece)  # on the straight line (subdivide's targets)
-            piece_tip = tip if piece is pieces[-1] else piece_tip
-            self.linear(name, jp, piece_tip, feed, known)
+        for piece in pieces:  # the pieces' tips are on the straight line (subdivide's targets)
+            piece_tip = tip if piece is pieces[-1] else m.forward(piece)[0]
+            self.linear(name, Joints.from_array(piece), piece_tip, feed, known)
 
     def a_steps(self, prev: Optional[Joints], j: Joints) -> list[Joints]:
         """The joints j reached in equal linear joint steps of at most 90 degrees of A (a control may take a
@@ -290,10 +288,8 @@ class _Writer:
         joint_time = self.m.motion_time(prev, j) if prev is not None else 0.0
         dist = self.distance(tip, known)
         seconds = max(dist / feed if math.isfinite(dist) else 0.0, joint_time)
-        turns = prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
-        xyz = tuple(float(v) for v in tip) if self.o.tcp else (j.x, j.y, j.z)
-        words = self.words(xyz, j, known, joints_given=True)
-        if turns:
+        words = self.words(tip, j, known)
+        if _turns(prev, j):
             minutes = max(seconds, 1e-6) / 60.0
             line = f"{self.set_feed_mode('G93')}{name} {words} F{self.feed_word(1.0 / minutes)}"
         else:
@@ -302,10 +298,10 @@ class _Writer:
         self.emit(line)
         self.advance(j, tip, seconds)
 
-    def words(self, xyz: Any, j: Joints, known: np.ndarray, joints_given: bool = False) -> str:
-        if not joints_given:
-            xyz = xyz if self.o.tcp else (j.x, j.y, j.z)
-        out = [f"{w}{self.length(v)}" for w, v, k in zip("XYZ", xyz, known) if k]
+    def words(self, tip: Any, j: Joints, known: np.ndarray) -> str:
+        """X Y Z (the tip in TCP mode, else the pivot point) where known, A and C."""
+        xyz = tip if self.o.tcp else (j.x, j.y, j.z)
+        out = [f"{w}{self.length(float(v))}" for w, v, k in zip("XYZ", xyz, known) if k]
         return " ".join(out + [f"A{self.angle(j.a)}", f"C{self.angle(j.c)}"])
 
     def distance(self, tip: np.ndarray, known: np.ndarray) -> float:
@@ -324,6 +320,11 @@ class _Writer:
             return ""
         self.feed_mode = mode
         return mode + " "
+
+
+def _turns(prev: Optional[Joints], j: Joints) -> bool:
+    """The move from prev to j turns A or C."""
+    return prev is not None and (abs(j.a - prev.a) > 1e-12 or abs(j.c - prev.c) > 1e-12)
 
 
 def write_tarus(program: Program, machine: Optional[TarusMachine] = None,

@@ -188,14 +188,13 @@ def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[Mul
     method = params.method if method is None else method
     if method not in METHODS:
         raise TmmError(f"method must be 'vcrf' or 'drd', got {method!r}")
-    options = dict(
+    options = native.MultipointOptions(
         Ro=float(Ro), Ri=float(Ri), shape=params.shape, method=method, rotation=params.rotation,
         beta_max=math.radians(params.beta_max_deg), tol=float(params.tol),
         sample_spacing=float(params.sample_spacing), divisions=int(params.divisions),
         refinements=int(params.refinements), drd_divisions=int(params.drd_divisions),
         drd_refinements=int(params.drd_refinements), drd_bisections=int(params.drd_bisections),
         extend=float(params.extend), anchor=params.anchor, anchor_iterations=int(params.anchor_iterations))
-    options = native.MultipointOptions(**options)
     try:
         return native.MultipointPositioner(face.native, options)
     except ValueError as exc:
@@ -208,7 +207,12 @@ def position_points(face: BezierFace, Ro: float, Ri: float, xy: np.ndarray,
     """Multipoint positions of the torus (Ro, Ri) at the (n, 2) footprint points (method: params.method
     unless given)."""
     params = params or MultipointParams()
-    mp = make_positioner(face, Ro, Ri, params, method)
+    return _position(make_positioner(face, Ro, Ri, params, method), xy, params, progress)
+
+
+def _position(mp, xy: np.ndarray, params: MultipointParams, progress: Optional[Progress] = None
+              ) -> MultipointResults:
+    """The positioner `mp`'s positions at the (n, 2) footprint points."""
     pts = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
     if not np.isfinite(pts).all():
         raise TmmError("footprint points contain a non-finite coordinate")
@@ -232,7 +236,8 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
         raise TmmError("the footprint is empty")
     xy = np.vstack(passes)
     pass_index = np.concatenate([np.full(len(p), k) for k, p in enumerate(passes)])
-    res = position_points(surface, Ro, Ri, xy, params, None, progress)
+    positioner = make_positioner(surface, Ro, Ri, params)  # for the footprint and any positions inserted
+    res = _position(positioner, xy, params, progress)
     res.passes = pass_index
     good = res.status != STATUS_FAILED
     runs: list[list[int]] = []
@@ -249,10 +254,8 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     if params.between_tol > 0 and params.between_rounds > 0:
         from tmm_workbench.core.strategies import multipoint_refine
 
-        positioner = make_positioner(surface, Ro, Ri, params)
         diagnostics["between"] = multipoint_refine.refine(
-            surface, positioner, Ro, Ri, params, runs, res,
-            lambda pts: position_points(surface, Ro, Ri, pts, params))
+            surface, positioner, Ro, Ri, params, runs, res, lambda pts: _position(positioner, pts, params))
     diagnostics["counts"] = res.counts()
     tip, axis = res["tip"], res["axis"]
     cut = [CutSegment(tip[r], axes=axis[r], pass_index=int(res.passes[r[0]])) for r in runs]

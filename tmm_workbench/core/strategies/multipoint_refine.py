@@ -11,9 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from tmm_workbench.core.strategies.multipoint import STATUS_FAILED
 from tmm_workbench.core.verify import swept
-
-STATUS_FAILED = 2
 
 
 def refine(surface: Any, positioner: Any, Ro: float, Ri: float, params: Any, runs: list[list[int]], res: Any,
@@ -69,7 +68,7 @@ def refine(surface: Any, positioner: Any, Ro: float, Ri: float, params: Any, run
             for k in range(len(run) - 1):
                 if run[k] >= base or run[k + 1] >= base:
                     todo.append((r, k))
-    remaining = [d for (i, j), d in deepest.items()
-                 if any(a == i and b == j for run in runs for a, b in zip(run, run[1:]))]
+    moves = {(a, b) for run in runs for a, b in zip(run, run[1:])}
+    remaining = [d for pair, d in deepest.items() if pair in moves]
     return {"checked": checked, "inserted": inserted, "remaining": len(remaining),
             "deepest": max(remaining, default=0.0)}

@@ -112,19 +112,19 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     surface = surface or DropSurface(mesh)
     skip = params.off_model == OFF_MODEL_SKIP
     air_floor = float(lo[2]) - _AIR_DEPTH_MM
-    z = surface.drop(cutter.offset(s), xy, (air_floor if skip else floor_z) - s, progress) + s
-    air = z <= air_floor + 1.0 if skip else np.zeros(len(z), dtype=bool)
+
+    def drop(points: np.ndarray, report: Optional[Progress] = None) -> tuple[np.ndarray, np.ndarray]:
+        """Tip heights (on the floor at least) and air flags of the cutter dropped at `points`."""
+        zz = surface.drop(cutter.offset(s), points, (air_floor if skip else floor_z) - s, report) + s
+        aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
+        return np.maximum(zz, floor_z), aa
+
+    z, air = drop(xy, progress)
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
-    z = np.maximum(z, floor_z)
     diagnostics: dict = {"points": len(xy), "passes": len(lines)}
     if params.gouge_tol > 0:
         from tmm_workbench.core.strategies import raster_refine
-
-        def drop(more: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            zz = surface.drop(cutter.offset(s), more, (air_floor if skip else floor_z) - s) + s
-            aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
-            return np.maximum(zz, floor_z), aa
 
         runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
                                                                     chained=params.pattern == ZIGZAG)

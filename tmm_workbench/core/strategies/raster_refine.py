@@ -32,6 +32,7 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
         pts.append(np.column_stack([xy, z[k:k + len(xy)]]))
         airs.append(air[k:k + len(xy)].copy())
         k += len(xy)
+
     def nxt(r: int, i: int) -> tuple[np.ndarray, bool]:
         """The point after point i of run r (in the next run when i is the last), and its air flag."""
         if i + 1 < len(pts[r]):
@@ -48,10 +49,11 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
             break
         a = np.array([pts[r][i] for r, i in todo])
         b = np.array([nxt(r, i)[0] for r, i in todo])
-        samples = a[:, None, :] + _FRACTIONS[None, :, None] * (b - a)[:, None, :]   # (m, 4, 3)
+        samples = a[:, None, :] + _FRACTIONS[None, :, None] * (b - a)[:, None, :]   # (m, 5, 3)
         zs, air_s = drop(samples[:, :, :2].reshape(-1, 2))
-        cut = (zs.reshape(len(todo), -1) - samples[:, :, 2])
-        cut[air_s.reshape(len(todo), -1)] = -np.inf
+        zs, air_s = zs.reshape(len(todo), -1), air_s.reshape(len(todo), -1)
+        cut = zs - samples[:, :, 2]
+        cut[air_s] = -np.inf
         worst = cut.max(axis=1)
         # a jump of the drop height (an edge the tool falls off or climbs onto) can hide between the samples:
         # a steep move whose middle is far from its chord, above or below, is split until the jump is found
@@ -66,11 +68,9 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
         for n in bad:
             r, i = todo[n]
             pa, pb = a[n], b[n]
-            if np.hypot(*(pb[:2] - pa[:2])) > min_step:
-                half = (pa + pb) / 2
-                zz, aa = drop(half[None, :2])
-                new = np.array([half[0], half[1], zz[0]])
-                additions.setdefault(r, []).append((i, new, bool(aa[0])))
+            if np.hypot(*(pb[:2] - pa[:2])) > min_step:  # the halfway point, dropped with the samples
+                half = np.array([samples[n, _MID, 0], samples[n, _MID, 1], zs[n, _MID]])
+                additions.setdefault(r, []).append((i, half, bool(air_s[n, _MID])))
             else:  # a cliff: across at the upper height, then straight down (or up, then across)
                 corner = np.array([pb[0], pb[1], pa[2]]) if pa[2] > pb[2] else np.array([pa[0], pa[1], pb[2]])
                 additions.setdefault(r, []).append((i, corner, False))

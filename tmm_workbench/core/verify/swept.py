@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tmm_workbench.core.geometry.axes import slerp
 from tmm_workbench.core.geometry.face import BezierFace
 
 _CELL_MM = 4.0
@@ -62,18 +63,12 @@ def penetration(positioner, samples: FaceSamples, reach: float, tips: np.ndarray
     return out
 
 
-def slerp_rows(a0: np.ndarray, a1: np.ndarray, s: np.ndarray) -> np.ndarray:
-    from tmm_workbench.core.machine.rotary import slerp
-
-    return slerp(np.asarray(a0, float), np.asarray(a1, float), s)
-
-
 def between(positioner, samples: FaceSamples, reach: float, tip0, axis0, tip1, axis1, checks: int = 8) -> float:
     """The deepest cut (mm) at `checks` instances strictly between two positions: tip on its straight line,
     axis by slerp (the motion a control with tool-centre-point mode makes)."""
     s = np.arange(1, checks + 1) / (checks + 1)
     tips = np.asarray(tip0, float)[None, :] * (1 - s[:, None]) + np.asarray(tip1, float)[None, :] * s[:, None]
-    return float(penetration(positioner, samples, reach, tips, slerp_rows(axis0, axis1, s)).max())
+    return float(penetration(positioner, samples, reach, tips, slerp(axis0, axis1, s)).max())
 
 
 class FaceGouge:

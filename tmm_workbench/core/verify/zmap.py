@@ -54,6 +54,7 @@ from typing import TYPE_CHECKING, Optional, Sequence
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.axes import slerp
 
 if TYPE_CHECKING:
     from tmm_workbench.core.tools.cutter import Cutter
@@ -258,14 +259,7 @@ def interpolate_axis(a0: np.ndarray, a1: np.ndarray, s: np.ndarray, mode: str = 
         return v / np.linalg.norm(v, axis=1, keepdims=True)
     if mode != "slerp":
         raise TmmError(f"axis interpolation must be 'slerp' or 'nlerp', got {mode!r}")
-    c = float(np.clip(np.dot(a0, a1), -1.0, 1.0))
-    th = math.acos(c)
-    if th < 1e-9:
-        return np.repeat(a0[None, :] / np.linalg.norm(a0), len(s), axis=0)
-    w0 = np.sin((1.0 - s) * th) / math.sin(th)
-    w1 = np.sin(s * th) / math.sin(th)
-    v = w0 * a0 + w1 * a1
-    return v / np.linalg.norm(v, axis=1, keepdims=True)
+    return slerp(a0, a1, s)
 
 
 def substeps(tool: ZTool, tip0, a0, tip1, a1, max_step: float) -> int:
