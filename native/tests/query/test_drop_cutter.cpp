@@ -17,6 +17,7 @@
 #include "tmm/query/drop_contacts.hpp"
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/mesh/mesh_index.hpp"
+#include "support/test_geometry.hpp"
 #include "support/test_meshes.hpp"
 
 namespace {
@@ -52,13 +53,7 @@ Vector3d closest_on_triangle(const Vector3d& p, const Vector3d& a, const Vector3
   return a + ab * (vb * denom) + ac * (vc * denom);
 }
 
-bool inside_xy(double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  auto cross = [](double ux, double uy, double vx, double vy) { return ux * vy - uy * vx; };
-  const double w0 = cross(b.x() - x, b.y() - y, c.x() - x, c.y() - y);
-  const double w1 = cross(c.x() - x, c.y() - y, a.x() - x, a.y() - y);
-  const double w2 = cross(a.x() - x, a.y() - y, b.x() - x, b.y() - y);
-  return (w0 >= 0 && w1 >= 0 && w2 >= 0) || (w0 <= 0 && w1 <= 0 && w2 <= 0);
-}
+using tmm_test::inside_xy;
 
 double plane_z(double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
   const Vector3d n = (b - a).cross(c - a);

@@ -24,6 +24,7 @@
 #include <utility>
 #include <vector>
 
+#include "support/test_geometry.hpp"
 #include "support/test_meshes.hpp"
 #include "tmm/mesh/mesh_index.hpp"
 #include "tmm/query/drop_contacts.hpp"
@@ -76,13 +77,7 @@ double ref_edge(const Cutter& c, double x, double y, const Vector3d& p, const Ve
   return golden_max(f, t0, t1);
 }
 
-bool inside_xy(double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& c) {
-  auto cross = [](double ux, double uy, double vx, double vy) { return ux * vy - uy * vx; };
-  const double w0 = cross(b.x() - x, b.y() - y, c.x() - x, c.y() - y);
-  const double w1 = cross(c.x() - x, c.y() - y, a.x() - x, a.y() - y);
-  const double w2 = cross(a.x() - x, a.y() - y, b.x() - x, b.y() - y);
-  return (w0 >= 0 && w1 >= 0 && w2 >= 0) || (w0 <= 0 && w1 <= 0 && w2 <= 0);
-}
+using tmm_test::inside_xy;
 
 // Reference facet contact (the plane's contact if it lies in the triangle), or -inf.
 double ref_facet(const Cutter& c, double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& p) {
