@@ -256,3 +256,15 @@ def test_three_axis_machine():
         m.inverse((0, 0, 0), (0.1, 0, 1), index=7)
     assert m.motion_time(Joints(0, 0, 0, 0, 0), Joints(170, 0, 0, 0, 0)) == pytest.approx(1.0)
     assert m.solve_path(np.zeros((2, 3)), np.array([[0, 0, 1.0], [0, 0, 1.0]])).shape == (2, 5)
+
+
+def test_a_continuous_does_not_unwind_between_cuts():
+    """Without A limits each cut continues from the one before: no whole turn at the rapid between."""
+    m = TarusMachine(a_limits=None)
+    t1, a1 = spiral(300 / 360, 301)
+    tips = np.vstack([t1, [[0.0, 0.0, 80.0]], t1])
+    axes = np.vstack([a1, [[0.0, 0.0, 1.0]], a1])
+    rapid = [False] * len(t1) + [True] + [True] + [False] * (len(t1) - 1)
+    j = m.solve_path(tips, axes, rapid=rapid)
+    assert np.abs(np.diff(j[:, 3])).max() < math.radians(61)
+    assert j[-1, 3] == pytest.approx(math.radians(660))

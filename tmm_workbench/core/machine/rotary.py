@@ -115,7 +115,7 @@ def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = No
         previous = Joints.from_array(block[-1])
     options: list[list[int]] = []
     for (first, last), block in zip(spans, parts):
-        turns = _turns(machine, block[:, 3], a_prev)
+        turns = _turns(machine, block[:, 3])
         if not turns:
             lo, hi = machine.a_limits  # type: ignore[misc]
             a = block[:, 3]
@@ -151,11 +151,11 @@ def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = No
     return joints
 
 
-def _turns(machine: TarusMachine, a: np.ndarray, a_prev: float) -> list[int]:
-    """The whole turns k that keep a + 2 pi k inside the A limits (all of them: [k nearest a_prev] for a
-    continuous A)."""
+def _turns(machine: TarusMachine, a: np.ndarray) -> list[int]:
+    """The whole turns k that keep a + 2 pi k inside the A limits (all of them; [0] for a continuous A: the
+    block already continues from the one before)."""
     if machine.a_limits is None:
-        return [int(round((a_prev - a[0]) / TWO_PI))]
+        return [0]
     lo, hi = machine.a_limits
     k_lo = math.ceil((lo - _LIMIT_SLACK - float(a.min())) / TWO_PI)
     k_hi = math.floor((hi + _LIMIT_SLACK - float(a.max())) / TWO_PI)
