@@ -23,7 +23,6 @@ from PySide import QtCore, QtGui
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui_smoke.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_smoke.json")
-STL = os.environ.get("TMM_GUI_STL") or "/work/shared/benchmarks/stl/sphere_on_plate.stl"
 
 
 def pump(seconds: float) -> None:
@@ -125,9 +124,11 @@ def smoke() -> dict:
     assert registry.entry("TMM_Multipoint").command_name in commands, "the 5-axis Multipoint command is missing"
 
     from tmm_workbench.app.api import run_surface
+    from tmm_workbench.core.shared_data import benchmark_file
     from tmm_workbench.gui.op_surface_gui import ViewProvider
 
-    r = run_surface(STL, stepover=2.0, sample_step=1.0, doc_name="TmmGuiSmoke", progress=True)
+    stl = os.environ.get("TMM_GUI_STL") or str(benchmark_file("stl", "sphere_on_plate.stl"))
+    r = run_surface(stl, stepover=2.0, sample_step=1.0, doc_name="TmmGuiSmoke", progress=True)
     info["api_moves"] = len(r.toolpath)
     assert isinstance(r.op.ViewObject.Proxy, ViewProvider), "API op lacks the TMM view provider"
     assert Path(r.op.ViewObject.Proxy.getIcon()).is_file(), "the op's tree icon is not a file"

@@ -8,8 +8,9 @@ from pathlib import Path
 try:
     sys.path.insert(0, str(Path(globals().get("__file__") or sys.argv[-1]).resolve().parents[2]))
     from tmm_workbench.app.api import run_surface
+    from tmm_workbench.core.shared_data import benchmark_file
 
-    run_surface(os.environ.get("TMM_GUI_STL") or "/work/shared/benchmarks/stl/sphere_on_plate.stl",
+    run_surface(os.environ.get("TMM_GUI_STL") or str(benchmark_file("stl", "sphere_on_plate.stl")),
                 stepover=3.0, sample_step=1.5, progress=False, doc_name="TmmHeadless",
                 fcstd_path=os.environ["TMM_GUI_REOPEN"])
     code = 0

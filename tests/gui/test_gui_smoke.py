@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 
+from tests.conftest import SHARED_STL
 from tests.freecad import fc_process
 
 HERE = Path(__file__).resolve().parent
@@ -13,6 +14,7 @@ PNG = fc_process.ROOT / "out" / "gui_smoke.png"
 FREECAD = fc_process.find("freecad", "FreeCAD")
 XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 120
+STL = str(SHARED_STL / "sphere_on_plate.stl")  # where the test finds it, also inside a chroot
 
 
 def test_gui_smoke(tmp_path: Path) -> None:
@@ -23,12 +25,12 @@ def test_gui_smoke(tmp_path: Path) -> None:
     freecadcmd = fc_process.find("freecadcmd", "FreeCADCmd")
     if freecadcmd:  # a document saved without the GUI, for the GUI to reopen
         code, out = fc_process.run([freecadcmd, str(HERE / "make_headless_doc.py")], cwd=tmp_path, timeout=120,
-                                   TMM_GUI_REOPEN=str(headless_doc))
+                                   TMM_GUI_REOPEN=str(headless_doc), TMM_GUI_STL=STL)
         assert code == 0 and headless_doc.is_file(), out
     code, out = fc_process.run(
         [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", FREECAD, str(HERE / "gui_smoke.py")],
         cwd=tmp_path, timeout=TIMEOUT_S, TMM_GUI_PNG=str(PNG), TMM_GUI_RESULT=str(result),
-        TMM_GUI_REOPEN=str(headless_doc) if freecadcmd else "",
+        TMM_GUI_REOPEN=str(headless_doc) if freecadcmd else "", TMM_GUI_STL=STL,
         QTWEBENGINE_DISABLE_SANDBOX="1")  # FreeCAD's start page uses QtWebEngine, which refuses root
     info = json.loads(result.read_text()) if result.is_file() else {}
     assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
