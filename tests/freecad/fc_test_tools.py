@@ -1,5 +1,6 @@
 """FreeCAD ToolBits -> core cutters: endmill, ballend, bullnose (0.20's FlatRadius), chamfer and v-bit
-(cones), others refused."""
+(cones), TMM's tmm_apt shape (the generalized APT cutter: made, read from a .fctb, drawn to the kernel's
+profile, saved and reopened, cutting), others refused."""
 from __future__ import annotations
 
 import unittest
@@ -7,11 +8,18 @@ from pathlib import Path
 
 import Path as FCPath
 
-from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
+import FreeCAD
+import Part
+
+from fc_helpers import OUT, FreeCADTestCase, bump_stl, close_all, job_with_op, new_doc
 from tmm_workbench.app import tools
 from tmm_workbench.app import compat
 from tmm_workbench.app.tools import cutter_from_tool, shape_name
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.tools.cutter import Cutter
+
+APT_BIT_FILE = tools.APT_SHAPE_FILE.parents[1] / "Bit" / "tmm_apt_10mm_r2_taper3.fctb"
+
 
 def stock_bit(doc, file_name: str):
     """One of the ToolBits FreeCAD ships (Mod/Path/Tools/Bit/*.fctb on 0.20, Mod/CAM/... from 1.0)."""
@@ -99,6 +107,119 @@ class ToolMapping(FreeCADTestCase):
         self.assertFalse(op.isValid())
         self.assertIn("'drill'", op.getStatusString())
         self.assertEqual(len(op.Path.Commands), 0)
+
+def profile_error(shape, cutter: Cutter) -> float:
+    """Largest |z - h(rho)| between the drawn tool's lowest point at distance rho from its axis (a vertical
+    line through the solid) and the kernel's profile h, for rho across the lower profile."""
+    box = shape.BoundBox
+    x0, y0 = (box.XMin + box.XMax) / 2, (box.YMin + box.YMax) / 2
+    n, worst = cutter.native, 0.0
+    for i in range(1, 60):
+        rho = n.max_radius * i / 60
+        line = Part.LineSegment(FreeCAD.Vector(x0 + rho, y0, box.ZMin - 1), FreeCAD.Vector(x0 + rho, y0, box.ZMax + 1))
+        hits = shape.section(line.toShape()).Vertexes
+        if not hits:
+            return float("inf")
+        worst = max(worst, abs(min(v.Point.z for v in hits) - box.ZMin - float(n.height(rho))))
+    return worst
+
+
+class AptBits(FreeCADTestCase):
+    """The generalized APT cutter from TMM's own ToolBit shape, on every version."""
+
+    def test_made_bit_maps_back_and_is_drawn_to_the_kernel_profile(self) -> None:
+        doc = new_doc()
+        for cutter in (Cutter(10.0, 2.0, 5.0, 3.0, 20.0), Cutter(12.0, 3.0, 10.0, -4.0, 20.0),
+                       Cutter(10.0, 0.0, 0.0, 10.0, 15.0)):
+            bit = tools.make_apt_bit(doc, cutter)
+            self.assertEqual(shape_name(bit), "tmm_apt")
+            self.assertEqual(cutter_from_tool(bit), cutter)
+            self.assertTrue(bit.Shape.isValid() and bit.Shape.Volume > 0, cutter.describe())
+            self.assertLess(profile_error(bit.Shape, cutter), 1e-4, cutter.describe())
+        # a plain cutter through bit_for_cutter keeps FreeCAD's shapes; a cone gets TMM's
+        self.assertEqual(shape_name(tools.bit_for_cutter(doc, Cutter.ball(6.0))), "ballend")
+        self.assertEqual(shape_name(tools.bit_for_cutter(doc, Cutter.vbit(10.0, 60.0, 1.0))), "tmm_apt")
+
+    def test_shipped_shape_is_what_the_generator_makes(self) -> None:
+        import os
+        import runpy
+
+        out = OUT / "tmm_apt_regenerated.fcstd"
+        os.environ["TMM_SHAPE_OUT"] = str(out)
+        try:
+            runpy.run_path(str(tools.APT_SHAPE_FILE.parents[3] / "scripts" / "make_tool_shape.py"))
+        finally:
+            del os.environ["TMM_SHAPE_OUT"]
+
+        def summary(path: Path) -> tuple:
+            doc = FreeCAD.openDocument(str(path))
+            try:
+                bag = next(o for o in doc.Objects if o.Label == "Attributes")
+                props = sorted((p, bag.getTypeIdOfProperty(p), bag.getGroupOfProperty(p), str(bag.getPropertyByName(p)))
+                               for p in bag.PropertiesList if bag.getGroupOfProperty(p) in ("Shape", "Attributes"))
+                sketch = doc.getObject("Sketch")
+                return (doc.getObject("Body").Label, props, sorted(sketch.ExpressionEngine), len(sketch.Constraints))
+            finally:
+                FreeCAD.closeDocument(doc.Name)
+
+        self.assertEqual(summary(tools.APT_SHAPE_FILE), summary(out),
+                         "resources/tools/Shape/tmm_apt.fcstd is stale: run freecadcmd scripts/make_tool_shape.py")
+
+    def test_impossible_bit_is_refused_by_name(self) -> None:
+        doc = new_doc()
+        bit = tools.make_apt_bit(doc, Cutter(10.0, 2.0, 0.0, 3.0, 20.0), label="Taper3")
+        bit.CornerRadius = 6.0  # the arc centre would cross the axis
+        with self.assertRaises(TmmError) as ctx:
+            cutter_from_tool(bit)
+        self.assertIn("'Taper3'", str(ctx.exception))
+        self.assertIn("corner radius", str(ctx.exception))
+        with self.assertRaises(TmmError):
+            tools.make_apt_bit(doc, Cutter(10.0, 2.0, 0.0, 3.0, 20.0), length=10.0)
+
+    def test_shipped_bit_file(self) -> None:
+        doc = new_doc()
+        c = cutter_from_tool(compat.toolbit_from_file(doc, str(APT_BIT_FILE)))
+        self.assertEqual(c, Cutter(10.0, 2.0, 0.0, 3.0, 20.0))
+        self.assertEqual(c.kind, "general")
+
+    def test_saved_bit_reopens_as_the_same_cutter(self) -> None:
+        doc = new_doc("TmmApt")
+        cutter = Cutter(8.0, 1.5, 2.0, 4.0, 16.0)
+        name = tools.make_apt_bit(doc, cutter).Name
+        path = OUT / "apt_bit.FCStd"
+        doc.saveAs(str(path))
+        close_all()
+        doc = FreeCAD.openDocument(str(path))
+        bit = doc.getObject(name)
+        self.assertEqual(cutter_from_tool(bit), cutter)
+        bit.TaperAngle = 6.0  # edited after reopening: the cutter follows
+        doc.recompute()
+        self.assertEqual(cutter_from_tool(bit).taper_angle_deg, 6.0)
+        close_all()
+
+    def test_op_with_an_apt_bit_cuts(self) -> None:
+        doc = new_doc()
+        job, tc, op = job_with_op(doc, str(bump_stl()))
+        cutter = Cutter(6.0, 1.0, 5.0, 3.0, 15.0)
+        bit = tools.make_apt_bit(doc, cutter)
+        self.assertTrue(op.Proxy.isToolSupported(op, bit))
+        tc.Tool = bit
+        op.touch()
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertGreater(len(op.Path.Commands), 10)
+
+    def test_api_takes_a_core_cutter(self) -> None:
+        from tmm_workbench.app.api import run_surface
+
+        cutter = Cutter(6.0, 1.0, 5.0, 3.0, 15.0)
+        r = run_surface(str(bump_stl()), tool=cutter, stepover=2.0, sample_step=1.0, progress=False,
+                        doc_name="TmmAptApi")
+        self.assertEqual(cutter_from_tool(r.op.ToolController.Tool), cutter)
+        self.assertEqual(shape_name(r.op.ToolController.Tool), "tmm_apt")
+        self.assertGreater(sum(line.startswith("G1") for line in r.gcode.splitlines()), 10)
+        close_all()
+
 
 if __name__ == "__main__":
     unittest.main()

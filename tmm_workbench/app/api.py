@@ -30,6 +30,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
 
 TOOL_ALIASES = tools.SHAPE_ALIASES
 _LENGTH = Spec("", "mm")
@@ -52,8 +53,8 @@ class SurfaceResult:
     mesh: TriMesh        # the core mesh that was machined
 
 
-def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", diameter: float = 6.0,
-                corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
+def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter] = "ballend",
+                diameter: float = 6.0, corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
                 boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
@@ -63,7 +64,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
 
-    tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose).
+    tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose), or a
+    core.tools.Cutter (any APT cutter, e.g. Cutter(10, 2, 5, 3, 20): a ToolBit of TMM's tmm_apt shape when
+    it has a cone or taper; diameter and corner_radius are then the cutter's own).
     pattern: 'zigzag' | 'oneway'; boundary: 'model' | 'stock' XY box grown by `margin` (mm).
     off_model: 'floor' (cut along the model's lowest point where no part of it is under the tool) | 'skip'
     (lift over such places, cut only over the model).
@@ -79,7 +82,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: str = "ballend", d
              stock_to_leave=(stock_to_leave, spec_of(SurfaceParams, "stock_to_leave")), margin=(margin, _LENGTH),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
-    shape = _option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
+    shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
+                                                          sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)
     boundary_name = _option("boundary", boundary, BOUNDARY_NAMES)
     off_model_name = _option("off_model", off_model, OFF_MODEL_NAMES)
@@ -127,8 +131,8 @@ def _by_core_name(props: dict[str, str]) -> dict[str, str]:
     return {core: prop for prop, core in props.items()}
 
 
-def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: float, stepover: float,
-           sample_step: float, angle_deg: float, pattern: str, stock_to_leave: float, boundary: str,
+def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float,
+           stepover: float, sample_step: float, angle_deg: float, pattern: str, stock_to_leave: float, boundary: str,
            margin: float, off_model: str, safe_height: Optional[float], clearance_height: Optional[float],
            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str,
            gcode_path: Any, progress: Any) -> SurfaceResult:
@@ -139,7 +143,8 @@ def _build(doc: Any, model: Any, shape: str, diameter: float, corner_radius: flo
     clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
 
     job = jobs.create_job(doc, jm.job_base)
-    bit = tools.make_tool_bit(doc, shape, diameter, corner_radius)
+    bit = (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
+           else tools.make_tool_bit(doc, shape, diameter, corner_radius))
     tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
     values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
               "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
@@ -240,7 +245,6 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     from tmm_workbench.app import geometry, op_multipoint
     from tmm_workbench.app import posts as posts_mod
     from tmm_workbench.core.strategies.multipoint import MultipointParams, face_top
-    from tmm_workbench.core.tools.cutter import Cutter
 
     method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
     shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))

@@ -157,16 +157,27 @@ def toolbits_are_assets() -> bool:
 
 
 def make_toolbit(doc: Any, shape: str, parameters: dict[str, str], label: str) -> Any:
-    """A ToolBit object in `doc` of FreeCAD's shape `shape` ('ballend') with `parameters` (unit strings)."""
+    """A ToolBit object in `doc` of FreeCAD's shape `shape` ('ballend') or of the shape file `shape` (a path
+    to an .fcstd: every version takes a custom shape so), with `parameters` (unit strings)."""
     import FreeCAD
 
     FreeCAD.setActiveDocument(doc.Name)
+    custom = shape.lower().endswith(".fcstd")
     if not toolbits_are_assets():
         return import_app("tool_bit").Factory.CreateFromAttrs(
-            {"name": label, "shape": shape + ".fcstd", "parameter": parameters, "attribute": {}}, name="ToolBit")
+            {"name": label, "shape": shape if custom else shape + ".fcstd", "parameter": parameters,
+             "attribute": {}}, name="ToolBit")
     from Path.Tool.toolbit import ToolBit  # 1.1
 
-    bit = ToolBit.from_dict({"name": label, "shape": shape, "parameter": parameters, "attribute": {}})
+    attrs = {"name": label, "parameter": parameters, "attribute": {}}
+    if custom:  # 1.1 looks shapes up in its asset store by name; a file outside it is read directly
+        import pathlib
+
+        from Path.Tool.shape import ToolBitShape
+
+        bit = ToolBit.from_shape(ToolBitShape.from_file(pathlib.Path(shape)), attrs)
+    else:
+        bit = ToolBit.from_dict(dict(attrs, shape=shape))
     return bit.attach_to_doc(doc, label)
 
 
@@ -182,12 +193,26 @@ def remove_toolbit(bit: Any) -> None:
 
 
 def toolbit_from_file(doc: Any, path: str) -> Any:
-    """A ToolBit object in `doc` from a .fctb file (0.20 and 1.0: Factory.CreateFrom; 1.1: ToolBit.from_file)."""
+    """A ToolBit object in `doc` from a .fctb file (0.20 and 1.0: Factory.CreateFrom, which also finds the
+    shape in the Shape folder beside the file's Bit folder; 1.1: ToolBit.from_file, and for a shape 1.1's
+    asset store lacks but that folder holds, such as TMM's resources/tools, the shape file read directly)."""
     import FreeCAD
 
     FreeCAD.setActiveDocument(doc.Name)
     if not toolbits_are_assets():
         return import_app("tool_bit").Factory.CreateFrom(path)
-    from Path.Tool.toolbit import ToolBit  # 1.1
+    import json
+    import os
 
+    from Path.Tool.camassets import cam_assets  # 1.1
+    from Path.Tool.shape import ToolBitShape
+    from Path.Tool.toolbit import ToolBit
+
+    with open(path, encoding="utf-8") as f:
+        attrs = json.load(f)
+    shape = os.path.basename(str(attrs.get("shape", "")))
+    beside = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(path))), "Shape", shape)
+    if shape and os.path.isfile(beside) and not cam_assets.exists(
+            ToolBitShape.resolve_name(shape), store=("local", "builtin")):
+        return make_toolbit(doc, beside, attrs.get("parameter", {}), attrs.get("name") or shape)
     return ToolBit.from_file(path).attach_to_doc(doc)

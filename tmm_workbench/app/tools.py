@@ -11,17 +11,24 @@ corner radius is Diameter/2 - FlatRadius (FreeCAD issue #19050; later versions m
 `TorusRadius`) is taken at its word. The shape is the bit's shape file name (`BitShape`, 0.20 and 1.0),
 its `ShapeID` / `ShapeName` (1.1), or a legacy tool's `ToolType` (EndMill: bull-nose when CornerRadius
 > 0, BallEndMill). Which cutters a strategy takes is the strategy's data (`SUPPORTED_TOOLS`, Cutter kinds).
+
+The generalized APT cutter itself comes from TMM's own ToolBit shape `tmm_apt` (resources/tools/Shape/
+tmm_apt.fcstd, made by scripts/make_tool_shape.py; every version takes a custom shape file): Diameter (2R
+at the cutting-edge height), CornerRadius r, BottomAngle beta1, TaperAngle beta2, CuttingEdgeHeight L_C.
 """
 from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 from typing import Any, Optional
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.tools.cutter import Cutter
 
-TOOLBIT_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit")  # shapes TMM maps to a cutter
+TOOLBIT_SHAPES = ("endmill", "ballend", "bullnose", "chamfer", "v-bit", "tmm_apt")  # shapes TMM maps to a cutter
+APT_SHAPE = "tmm_apt"  # TMM's shape for the generalized APT cutter, shipped beside the add-on
+APT_SHAPE_FILE = Path(__file__).resolve().parents[2] / "resources" / "tools" / "Shape" / f"{APT_SHAPE}.fcstd"
 _LEGACY_TYPES = {"EndMill": "endmill", "BallEndMill": "ballend"}  # 0.20's deprecated Path.Tool
 # ToolBit shapes shipped with FreeCAD (Mod/Path/Tools/Shape/<name>.fcstd) that TMM creates bits of
 BIT_SHAPES = ("endmill", "ballend", "bullnose")
@@ -80,6 +87,8 @@ def cutter_from_tool(tool: Any) -> Cutter:
         return Cutter.bull(d, corner) if corner > 0 else Cutter.flat(d)
     if name == "ballend":
         return Cutter.ball(d)
+    if name == APT_SHAPE:
+        return _apt_cutter(tool, d)
     if name in ("chamfer", "v-bit"):
         angle = float(getattr(tool, "CuttingEdgeAngle", 0.0))
         tip = _mm(getattr(tool, "TipDiameter", 0.0))
@@ -87,6 +96,29 @@ def cutter_from_tool(tool: Any) -> Cutter:
             raise TmmError(f"tool '{label}': cutting edge angle {angle:g} deg must be between 0 and 180")
         return Cutter.vbit(d, angle, tip)
     return Cutter.bull(d, bull_corner_radius(tool, d))
+
+
+def _degrees(value: Any) -> float:
+    """A FreeCAD angle Quantity (its Value is in degrees), a number of degrees or a unit string in degrees."""
+    if isinstance(value, str):
+        import FreeCAD  # only for unit strings
+        return float(FreeCAD.Units.Quantity(value).getValueAs("deg"))
+    return float(getattr(value, "Value", value))
+
+
+def _apt_cutter(tool: Any, diameter: float) -> Cutter:
+    """The generalized APT cutter of a `tmm_apt` bit; TmmError naming the tool and what is impossible."""
+    label = label_of(tool)
+    values = {}
+    for prop in ("CornerRadius", "BottomAngle", "TaperAngle", "CuttingEdgeHeight"):
+        if not hasattr(tool, prop):
+            raise TmmError(f"tool '{label}' of the {APT_SHAPE} shape has no {prop}")
+        values[prop] = getattr(tool, prop)
+    try:
+        return Cutter(diameter, _mm(values["CornerRadius"]), _degrees(values["BottomAngle"]),
+                      _degrees(values["TaperAngle"]), _mm(values["CuttingEdgeHeight"]))
+    except TmmError as exc:
+        raise TmmError(f"tool '{label}': {exc}") from exc
 
 
 def bull_corner_radius(tool: Any, diameter: float) -> float:
@@ -145,9 +177,33 @@ def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 
     return compat.make_toolbit(doc, shape, params, label)
 
 
+def make_apt_bit(doc: Any, cutter: Cutter, label: str = "", length: Optional[float] = None,
+                 shank_diameter: Optional[float] = None) -> Any:
+    """A ToolBit of TMM's `tmm_apt` shape in `doc` standing for `cutter` (any APT cutter; it needs a finite
+    cutting-edge height). The drawn shank is `shank_diameter` (default: the diameter) up to `length`
+    (default: the cutting-edge height plus 2 diameters)."""
+    from tmm_workbench.app import compat
+
+    if not math.isfinite(cutter.cutting_length):
+        raise TmmError(f"the {cutter.describe()} cutter needs a finite cutting-edge height for a ToolBit")
+    length = cutter.cutting_length + 2 * cutter.diameter if length is None else length
+    shank = cutter.diameter if shank_diameter is None else shank_diameter
+    if not (math.isfinite(length) and length > cutter.cutting_length):
+        raise TmmError(f"tool length {length!r} mm must be longer than the cutting-edge height "
+                       f"{cutter.cutting_length:g} mm")
+    if not (math.isfinite(shank) and shank > 0):
+        raise TmmError(f"tool shank diameter must be a length > 0 mm, got {shank!r}")
+    params = {"Diameter": f"{cutter.diameter} mm", "CornerRadius": f"{cutter.corner_radius} mm",
+              "BottomAngle": f"{cutter.bottom_angle_deg} deg", "TaperAngle": f"{cutter.taper_angle_deg} deg",
+              "CuttingEdgeHeight": f"{cutter.cutting_length} mm", "Length": f"{length} mm",
+              "ShankDiameter": f"{shank} mm"}
+    return compat.make_toolbit(doc, str(APT_SHAPE_FILE), params, label or cutter.describe())
+
+
 def bit_for_cutter(doc: Any, cutter: Cutter, label: str = "") -> Any:
-    """The ToolBit standing for a core cutter (ball, flat or bull-nose)."""
+    """The ToolBit standing for a core cutter: FreeCAD's ballend, endmill or bullnose, TMM's tmm_apt for the
+    others (cones, tapers)."""
     shape = {"ball": "ballend", "flat": "endmill", "bull": "bullnose"}.get(cutter.kind)
     if shape is None:
-        raise TmmError(f"no FreeCAD ToolBit shape is made for the {cutter.describe()} cutter")
+        return make_apt_bit(doc, cutter, label)
     return make_tool_bit(doc, shape, cutter.diameter, cutter.corner_radius, label)
