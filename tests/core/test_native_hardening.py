@@ -64,6 +64,23 @@ def test_positioner_takes_surface_and_options_only():
         native.MultipointPositioner(s, 6.7, 6.0)  # the old positional constructor is gone
 
 
+def test_clearance_is_signed_and_refuses_bad_rows_by_name():
+    mp = native.MultipointPositioner(seed_convex(), options())
+    r = mp.position_batch(np.array([[75.0, 75.0]]), 1)
+    tip, axis = r["tip"][0], r["axis"][0]
+    c = mp.clearance(np.array([tip, tip + 0.1 * axis, tip - 0.1 * axis]), np.array([axis] * 3), 1)
+    assert abs(c[0]) < 1e-6 and c[1] == pytest.approx(0.1, abs=1e-3) and c[2] == pytest.approx(-0.1, abs=1e-3)
+    assert np.isinf(mp.clearance(np.array([[900.0, 900.0, 0.0]]), np.array([[0.0, 0.0, 1.0]]))[0])
+    with pytest.raises(ValueError, match=r"tips: row 1 is not finite"):
+        mp.clearance(np.array([tip, [np.nan, 0, 0]]), np.array([axis, axis]))
+    with pytest.raises(ValueError, match=r"axes: row 0 is not a direction"):
+        mp.clearance(np.array([tip]), np.array([[0.0, 0.0, 0.0]]))
+    with pytest.raises(ValueError, match=r"as many rows"):
+        mp.clearance(np.array([tip, tip]), np.array([axis]))
+    with pytest.raises(ValueError, match=r"tips must have shape \(n, 3\)"):
+        mp.clearance(np.array([tip[:2]]), np.array([axis]))
+
+
 def test_positions_do_not_depend_on_how_the_options_were_made():
     s = seed_convex()
     xy = np.array([[40.0, 60.0], [75.0, 75.0], [120.0, 30.0]])

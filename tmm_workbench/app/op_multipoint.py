@@ -81,8 +81,9 @@ PROPERTIES: list[Prop] = [
          "tip sideways); Tip: the tilted tool's tip lies on the footprint point (passes exactly one side step "
          "apart)", "anchor"),
     Prop("App::PropertyDistance", "GougeTolerance", "Multipoint",
-         "Deepest cut allowed on the way from one position to the next (the tool moved in a straight line, its axis "
-         "turning evenly); where a move cuts deeper, positions are inserted halfway (0: not checked)", "between_tol"),
+         "Tolerance on the way from one position to the next (the tool moved in a straight line, its axis turning "
+         "evenly): the deepest cut into the face, and the most material left beyond what the positions leave; "
+         "where a move is out of it, positions are inserted halfway (0: not checked)", "between_tol"),
     Prop("App::PropertyDistance", "AxisRetract", "Linking",
          "Entry and exit distance along the tool axis (then straight up/down to the safe height)"),
     Prop("App::PropertyString", "ContactSummary", "Multipoint",
@@ -186,6 +187,13 @@ class ObjectTmmMultipoint(op_base.TmmOp):
         if obj.ContactSummary != text:
             obj.ContactSummary = text
         FreeCAD.Console.PrintMessage(f"{obj.Label}: {text}\n")
+        between = result.diagnostics.get("between") or {}
+        if between.get("remaining"):
+            FreeCAD.Console.PrintWarning(
+                f"{obj.Label}: {between['remaining']} moves between positions are still out of the tolerance "
+                f"{params.between_tol:g} mm after {params.between_rounds} rounds of inserted positions (cutting "
+                f"up to {between['deepest']:.4f} mm in, leaving up to {between['widest_gap']:.4f} mm); use a "
+                "smaller ForwardStep\n")
         self.commandlist.extend(Path.Command(n, p) for n, p in
                                 path5.encode_toolpath(toolpath, self.horizFeed, self.vertFeed))
 

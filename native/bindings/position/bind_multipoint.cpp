@@ -260,6 +260,41 @@ void bind_multipoint(py::module_& m) {
            },
            py::arg("tip"), py::arg("axis"), py::arg("points"),
            "Signed distance (n,) of points to the tool solid at (tip, axis): negative inside.")
+      .def("clearance",
+           [](const tmm::MultipointPositioner& mp, const Arr& tips_in, const Arr& axes_in, int threads) {
+             const Arr tips = check_points(tips_in, 3, "tips");
+             const Arr axes = check_points(axes_in, 3, "axes");
+             const std::size_t n = static_cast<std::size_t>(tips.shape(0));
+             if (static_cast<std::size_t>(axes.shape(0)) != n)
+               throw std::invalid_argument("tips and axes must have as many rows");
+             py::array_t<double> out(static_cast<py::ssize_t>(n));
+             double* o = out.mutable_data();
+             const double* t = tips.data();
+             const double* a = axes.data();
+             for (std::size_t i = 0; i < n; ++i) {
+               const Eigen::Vector3d ti(t[3 * i], t[3 * i + 1], t[3 * i + 2]), ai(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+               if (!ti.allFinite()) throw std::invalid_argument("tips: row " + std::to_string(i) + " is not finite");
+               if (!(ai.allFinite() && ai.norm() > 0.0))
+                 throw std::invalid_argument("axes: row " + std::to_string(i) + " is not a direction");
+             }
+             tmm::BatchOptions options;
+             options.threads = threads;
+             {
+               py::gil_scoped_release release;
+               tmm::parallel_chunks(n, 16, options, [&](std::size_t begin, std::size_t end) {
+                 for (std::size_t i = begin; i < end; ++i) {
+                   const Eigen::Vector3d axis = Eigen::Vector3d(a[3 * i], a[3 * i + 1], a[3 * i + 2]).normalized();
+                   o[i] = mp.clearance_real(Eigen::Vector3d(t[3 * i], t[3 * i + 1], t[3 * i + 2]), axis, nullptr,
+                                            nullptr);
+                 }
+               });
+             }
+             return out;
+           },
+           py::arg("tips"), py::arg("axes"), py::arg("threads") = 0,
+           "Signed clearance (n,) of the real face from the tool at each (tip, axis): the smallest signed "
+           "distance from the face to the tool solid, negative when the face is inside the tool (a gouge), "
+           "positive the gap left (exact by Newton within Ri of the tool; +inf where the tool is off the face).")
       .def_property_readonly("sample_count", [](const tmm::MultipointPositioner& mp) { return mp.samples().points().size(); })
       .def_property_readonly("sample_spacing", [](const tmm::MultipointPositioner& mp) { return mp.samples().spacing(); });
 }

@@ -22,8 +22,8 @@ constexpr std::size_t kMaxPolished = 16;
 
 }  // namespace
 
-double penetration(const PatchSurface& s, const SurfaceSamples& samples, const TorusTool& tool,
-                   const ToolPose& pose, Vector2d* where, int* evals) {
+double clearance(const PatchSurface& s, const SurfaceSamples& samples, const TorusTool& tool,
+                 const ToolPose& pose, Vector2d* where, int* evals) {
   const Vector3d C = pose.tip + tool.Ri * pose.axis;
   // The tilted tool's torus lies within Ro + Ri of C; the margin covers the shank's foot.
   const double r = tool.radius() + 0.5 * tool.Ri;
@@ -35,9 +35,15 @@ double penetration(const PatchSurface& s, const SurfaceSamples& samples, const T
   // contact 2 mm from P has its own basin, however close (issue 11: a thinning radius of two sample
   // spacings kept only P's sample and missed a 1.8 um gouge on the edge beside it).
   std::vector<std::pair<double, std::size_t>> cand;
+  double nearest = kInf;
+  std::size_t nearest_k = 0;
   samples.within(C.x(), C.y(), r, [&](std::size_t k) {
     const double d = dist(k);
     if (evals) ++*evals;
+    if (d < nearest) {
+      nearest = d;
+      nearest_k = k;
+    }
     if (!(d <= tool.Ri)) return;
     bool grid_min = true, edge_min = samples.on_boundary(k);
     samples.grid_neighbours(k, [&](std::size_t n) { grid_min = grid_min && !(dist(n) < d); });
@@ -61,8 +67,18 @@ double penetration(const PatchSurface& s, const SurfaceSamples& samples, const T
       at = L.f <= d0 ? uv : samples.params()[k];
     }
   }
+  if (!std::isfinite(best) && std::isfinite(nearest)) {
+    best = nearest;
+    at = samples.params()[nearest_k];
+  }
   if (where) *where = at;
-  return std::isfinite(best) ? std::max(0.0, -best) : 0.0;
+  return best;
+}
+
+double penetration(const PatchSurface& s, const SurfaceSamples& samples, const TorusTool& tool,
+                   const ToolPose& pose, Vector2d* where, int* evals) {
+  const double c = clearance(s, samples, tool, pose, where, evals);
+  return std::isfinite(c) ? std::max(0.0, -c) : 0.0;
 }
 
 }  // namespace tmm

@@ -98,6 +98,11 @@ double MultipointPositioner::penetration_real(const Vector3d& tip, const Vector3
   return tmm::penetration(*real_, *real_samples_, tool_, {tip, axis}, where, evals);
 }
 
+double MultipointPositioner::clearance_real(const Vector3d& tip, const Vector3d& axis, Vector2d* where,
+                                            int* evals) const {
+  return tmm::clearance(*real_, real_samples_ ? *real_samples_ : samples_, tool_, {tip, axis}, where, evals);
+}
+
 MultipointResult MultipointPositioner::position_core(double x, double y) const {
   MultipointResult res;
   const PatchSurface& s = *surface_;

@@ -73,10 +73,11 @@ class MultipointParams(StrategyParams):
     drd_refinements: int = param(5, "DRD refinements", low=0, high=50, integer=True)  # zoom levels (seed 5)
     drd_bisections: int = param(16, "DRD bisections", low=1, high=200, integer=True)  # bisections of the tilt
     threads: int = param(0, "threads", low=0, high=1024, integer=True)                # 0: all cores
-    # no gouge between positions (multipoint_refine): the deepest cut allowed on the way from one position to
-    # the next (0: not checked), and how many times positions are inserted halfway
-    # 0.005: with the post's 0.005 mm of joint-interpolation deviation the motion stays within 0.01 mm
-    between_tol: float = param(0.005, "gouge tolerance between positions", "mm", low=0)
+    # no gouge and no chord error between positions (multipoint_refine): the deepest cut, and the largest gap
+    # beyond the positions' own, allowed on the way from one position to the next (0: not checked), and how
+    # many times positions are inserted halfway. 0.005: with the post's 0.005 mm of joint-interpolation
+    # deviation the motion stays within 0.01 mm
+    between_tol: float = param(0.005, "tolerance between positions", "mm", low=0)
     between_rounds: int = param(4, "refinement rounds", low=0, high=12, integer=True)
 
     def validate(self) -> None:
@@ -255,7 +256,7 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
         from tmm_workbench.core.strategies import multipoint_refine
 
         diagnostics["between"] = multipoint_refine.refine(
-            surface, positioner, Ro, Ri, params, runs, res, lambda pts: _position(positioner, pts, params))
+            positioner, params, runs, res, lambda pts: _position(positioner, pts, params))
     diagnostics["counts"] = res.counts()
     tip, axis = res["tip"], res["axis"]
     cut = [CutSegment(tip[r], axes=axis[r], pass_index=int(res.passes[r[0]])) for r in runs]

@@ -71,6 +71,33 @@ def between(positioner, samples: FaceSamples, reach: float, tip0, axis0, tip1, a
     return float(penetration(positioner, samples, reach, tips, slerp(axis0, axis1, s)).max())
 
 
+def signed_clearance(positioner, samples: FaceSamples, reach: float, tip, axis) -> float:
+    """The smallest signed distance (mm) from the face samples to the tool at (tip, axis): negative inside
+    (a gouge), positive the gap; +inf where no sample lies under the tool."""
+    idx = samples.near(np.asarray(tip, float)[:2], reach)
+    return float(positioner.tool_distance(tip, axis, samples.points[idx]).min()) if len(idx) else math.inf
+
+
+def worst_between(positioner, samples: FaceSamples, reach: float, segments, spacing: float = 0.5
+                  ) -> tuple[float, float]:
+    """(deepest cut, widest gap) along the moves of 5-axis cut segments (tip straight, axis by slerp), at
+    instances `spacing` apart: the gap is how much further off the face the tool stands than the ends'
+    gaps, interpolated, say (the chord error). Sampled independently of the kernel's clearance."""
+    deepest = widest = 0.0
+    for seg in segments:
+        ends = [signed_clearance(positioner, samples, reach, t, a) for t, a in zip(seg.tips, seg.axes)]
+        for k in range(len(seg.tips) - 1):
+            n = max(2, int(math.ceil(float(np.linalg.norm(seg.tips[k + 1] - seg.tips[k])) / spacing)))
+            s = np.arange(1, n) / n
+            for sk, axis in zip(s, slerp(seg.axes[k], seg.axes[k + 1], s)):
+                c = signed_clearance(positioner, samples, reach, seg.tips[k] * (1 - sk) + seg.tips[k + 1] * sk, axis)
+                expected = ends[k] * (1 - sk) + ends[k + 1] * sk
+                deepest = max(deepest, -c)
+                if math.isfinite(c) and math.isfinite(expected):
+                    widest = max(widest, c - expected)
+    return deepest, widest
+
+
 class FaceGouge:
     """Depths (mm) of tool instances in a face, exact to about 0.0013 mm for a torus of minor radius 6 mm:
     every instance on samples 0.5 mm apart, those deeper there than `screen` again on samples 0.25 mm apart

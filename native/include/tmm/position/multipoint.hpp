@@ -69,6 +69,9 @@ class MultipointPositioner {
   double penetration(const Vector3d& tip, const Vector3d& axis, Vector2d* where, int* evals) const;
   // The same against the real face (differs from penetration() only when extend > 0).
   double penetration_real(const Vector3d& tip, const Vector3d& axis, Vector2d* where, int* evals) const;
+  // Signed clearance of the real face from the tool at (tip, axis) (gouge_check.hpp): negative inside,
+  // positive the gap the tool leaves; what the moves between positions are checked by.
+  double clearance_real(const Vector3d& tip, const Vector3d& axis, Vector2d* where, int* evals) const;
 
  private:
   MultipointResult position_core(double x, double y) const;
