@@ -1,0 +1,6 @@
+// Scaffolding: filled in by the bind_sim work (see native/include/tmm/sim/).
+#include <pybind11/pybind11.h>
+
+namespace py = pybind11;
+
+void bind_sim(py::module_& m) { (void)m; }
