@@ -1,6 +1,132 @@
-// Scaffolding: filled in by the bind_sim work (see native/include/tmm/sim/).
+// Python binding of the z-map stock and the exact 3-axis cutting simulation: numpy in, and the stock's
+// heights as a writable numpy view (no copies either way).
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-namespace py = pybind11;
+#include <cstdint>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
 
-void bind_sim(py::module_& m) { (void)m; }
+#include "tmm/sim/sweep3.hpp"
+#include "tmm/sim/zmap.hpp"
+#include "util/progress.hpp"
+
+namespace py = pybind11;
+using tmm_bindings::python_progress;
+
+namespace {
+
+using Tips = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// An (n - 1,) integer array of move kinds, checked before any narrowing cast (a 256 must not become 0).
+std::vector<tmm::MoveKind> kinds_from(const py::handle& obj, std::size_t moves) {
+  const py::array a = py::array::ensure(obj);
+  if (!a) throw py::type_error("kinds must be an (n - 1,) integer array of move kinds");
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::type_error("kinds must be an integer array (0 cut, 1 rapid, 2 jump), got dtype " +
+                         std::string(py::str(a.dtype())));
+  if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != moves) {
+    std::ostringstream msg;
+    msg << "kinds must have shape (n - 1,) = (" << moves << ",), one per move, got ";
+    if (a.ndim() == 1) msg << "(" << a.shape(0) << ",)";
+    else msg << "ndim " << a.ndim();
+    throw std::invalid_argument(msg.str());
+  }
+  std::vector<tmm::MoveKind> out(moves);
+  const auto put = [&](auto typed) {
+    const auto r = typed.template unchecked<1>();
+    for (py::ssize_t k = 0; k < r.shape(0); ++k) {
+      const auto v = r(k);
+      if (v < 0 || v > 2) {
+        std::ostringstream msg;
+        msg << "kind of move " << k << " is " << v << ": not a move kind (0 cut, 1 rapid, 2 jump)";
+        throw std::invalid_argument(msg.str());
+      }
+      out[static_cast<std::size_t>(k)] = static_cast<tmm::MoveKind>(v);
+    }
+  };
+  if (kind == 'u') put(py::array_t<std::uint64_t, py::array::forcecast>(a));
+  else put(py::array_t<std::int64_t, py::array::forcecast>(a));
+  return out;
+}
+
+py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips, const py::handle& kinds,
+                   double collision_tol, int threads, const py::object& progress) {
+  if (tips.ndim() != 2 || tips.shape(1) != 3) {
+    std::ostringstream msg;
+    msg << "tips must have shape (n, 3), got ndim " << tips.ndim();
+    if (tips.ndim() == 2) msg << " and " << tips.shape(1) << " columns";
+    throw std::invalid_argument(msg.str());
+  }
+  const std::size_t n = static_cast<std::size_t>(tips.shape(0));
+  const std::vector<tmm::MoveKind> k = kinds_from(kinds, n > 0 ? n - 1 : 0);
+  tmm::Sweep3Options options;
+  options.collision_tol = collision_tol;
+  tmm::BatchOptions batch;
+  batch.threads = threads;
+  batch.progress = python_progress(progress);
+  tmm::SimReport report;
+  {
+    py::gil_scoped_release release;
+    report = tmm::cut_3axis(stock, cutter, tips.data(), k.data(), n, options, batch);
+  }
+  py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
+  auto c = collisions.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < report.collisions.size(); ++i) {
+    c(i, 0) = static_cast<double>(report.collisions[i].move);
+    c(i, 1) = report.collisions[i].depth;
+  }
+  py::dict out;
+  out["moves_cut"] = report.moves_cut;
+  out["cells_lowered"] = report.cells_lowered;
+  out["collisions"] = collisions;
+  return out;
+}
+
+}  // namespace
+
+void bind_sim(py::module_& m) {
+  py::class_<tmm::ZMap>(m, "ZMap",
+      "The stock as a height field: cell (i, j) holds the top's height on the vertical line through its "
+      "centre (x0 + (i + 0.5) cell, y0 + (j + 0.5) cell).")
+      .def(py::init<double, double, double, std::size_t, std::size_t, double, std::size_t>(), py::arg("x0"),
+           py::arg("y0"), py::arg("cell"), py::arg("nx"), py::arg("ny"), py::arg("top"),
+           py::arg("max_cells") = tmm::ZMap::kDefaultMaxCells,
+           "A grid of nx x ny cells at the height top; refuses (ValueError) more than max_cells cells "
+           "before allocating.")
+      .def_readonly_static("DEFAULT_MAX_CELLS", &tmm::ZMap::kDefaultMaxCells)
+      .def_static("bytes_for",
+                  [](std::size_t nx, std::size_t ny) {
+                    if (nx != 0 && ny > std::numeric_limits<std::size_t>::max() / sizeof(double) / nx)
+                      throw std::invalid_argument("bytes_for: nx * ny cells overflow a byte count");
+                    return tmm::ZMap::bytes_for(nx, ny);
+                  },
+                  py::arg("nx"), py::arg("ny"), "Bytes the heights of an nx x ny grid take.")
+      .def_property_readonly("x0", &tmm::ZMap::x0)
+      .def_property_readonly("y0", &tmm::ZMap::y0)
+      .def_property_readonly("cell", &tmm::ZMap::cell)
+      .def_property_readonly("nx", &tmm::ZMap::nx)
+      .def_property_readonly("ny", &tmm::ZMap::ny)
+      .def_property_readonly(
+          "heights",
+          [](py::object self) {
+            tmm::ZMap& z = self.cast<tmm::ZMap&>();
+            const auto nx = static_cast<py::ssize_t>(z.nx()), ny = static_cast<py::ssize_t>(z.ny());
+            const auto s = static_cast<py::ssize_t>(sizeof(double));
+            // The array's base is the ZMap object: the view keeps it alive.
+            return py::array_t<double>({ny, nx}, {nx * s, s}, z.heights().data(), self);
+          },
+          "Writable (ny, nx) float64 view of the heights (row j is y); keeps the ZMap alive.");
+
+  m.def("cut_3axis", &cut_3axis, py::arg("stock"), py::arg("cutter"), py::arg("tips"), py::arg("kinds"),
+        py::arg("collision_tol") = 1e-3, py::arg("threads") = 0, py::arg("progress") = py::none(),
+        "Cuts the tool path into the stock: tips (n, 3) tool tips, kinds (n - 1,) integers (0 cut, 1 rapid, "
+        "2 jump) for the moves tips[k] -> tips[k + 1]. Each cell within the tool's radius of a Cut or Rapid "
+        "move is lowered to the exact swept envelope. A rapid removing more than collision_tol mm is a "
+        "collision. progress(fraction) -> bool; False cancels (raises Cancelled, the stock partly cut). "
+        "Returns {'moves_cut', 'cells_lowered', 'collisions': (k, 2) [move index, depth]}.");
+}

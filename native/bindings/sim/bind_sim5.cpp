@@ -1,6 +1,148 @@
-// Scaffolding: filled in by the bind_sim5 work (see native/include/tmm/sim/).
+// Python binding of the 5-axis cutting simulation (tmm/sim/sweep5.hpp) on the bound ZMap stock.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
-namespace py = pybind11;
+#include <cmath>
+#include <cstdint>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
 
-void bind_sim5(py::module_& m) { (void)m; }
+#include "tmm/sim/sweep5.hpp"
+#include "util/progress.hpp"
+
+namespace py = pybind11;
+using tmm_bindings::python_progress;
+
+namespace {
+
+using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+tmm::TorusTool tool_from(double Ro, double Ri, const std::string& shape) {
+  tmm::TorusTool t;
+  t.Ro = Ro;
+  t.Ri = Ri;
+  if (shape == "round_insert") t.shape = tmm::ToolShape::RoundInsert;
+  else if (shape == "bull_nose") t.shape = tmm::ToolShape::BullNose;
+  else throw std::invalid_argument("tool_shape must be 'round_insert' or 'bull_nose', got '" + shape + "'");
+  t.validate();
+  return t;
+}
+
+void check_rows(const Rows& a, const char* what) {
+  if (a.ndim() != 2 || a.shape(1) != 3) {
+    std::ostringstream msg;
+    msg << what << " must have shape (n, 3), got ndim " << a.ndim();
+    if (a.ndim() == 2) msg << " and " << a.shape(1) << " columns";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+// (n - 1,) integer move kinds, range-checked before the narrowing cast (a 256 must not become 0).
+std::vector<tmm::MoveKind> kinds_from(const py::handle& obj, std::size_t moves) {
+  const py::array a = py::array::ensure(obj);
+  if (!a) throw py::type_error("kinds must be an (n - 1,) integer array of move kinds");
+  const char kind = a.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::type_error("kinds must be an integer array (0 cut, 1 rapid, 2 jump), got dtype " +
+                         std::string(py::str(a.dtype())));
+  if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != moves) {
+    std::ostringstream msg;
+    msg << "kinds must have shape (n - 1,) = (" << moves << ",), one per move, got ";
+    if (a.ndim() == 1) msg << "(" << a.shape(0) << ",)";
+    else msg << "ndim " << a.ndim();
+    throw std::invalid_argument(msg.str());
+  }
+  std::vector<tmm::MoveKind> out(moves);
+  const py::array_t<std::int64_t, py::array::forcecast> v(a);
+  const auto r = v.unchecked<1>();
+  for (py::ssize_t k = 0; k < r.shape(0); ++k) {
+    if (r(k) < 0 || r(k) > 2) {
+      std::ostringstream msg;
+      msg << "kinds[" << k << "] = " << r(k) << " is not a move kind (0 cut, 1 rapid, 2 jump)";
+      throw std::invalid_argument(msg.str());
+    }
+    out[static_cast<std::size_t>(k)] = static_cast<tmm::MoveKind>(r(k));
+  }
+  return out;
+}
+
+py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& shape, const Rows& tips,
+                   const Rows& axes, const py::handle& kinds, double max_step, double collision_tol, int threads,
+                   const py::object& progress) {
+  const tmm::TorusTool tool = tool_from(Ro, Ri, shape);
+  check_rows(tips, "tips");
+  check_rows(axes, "axes");
+  const std::size_t n = static_cast<std::size_t>(tips.shape(0));
+  if (static_cast<std::size_t>(axes.shape(0)) != n) {
+    std::ostringstream msg;
+    msg << "axes must have as many rows as tips (" << n << "), got " << axes.shape(0);
+    throw std::invalid_argument(msg.str());
+  }
+  const std::vector<tmm::MoveKind> k = kinds_from(kinds, n > 0 ? n - 1 : 0);
+  tmm::Sweep5Options options;
+  options.max_step = max_step;
+  options.collision_tol = collision_tol;
+  tmm::BatchOptions batch;
+  batch.threads = threads;
+  batch.progress = python_progress(progress);
+  tmm::SimReport report;
+  tmm::Sweep5Stats stats;
+  {
+    py::gil_scoped_release release;
+    report = tmm::cut_5axis(stock, tool, tips.data(), axes.data(), k.data(), n, options, batch, &stats);
+  }
+  py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
+  auto c = collisions.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < report.collisions.size(); ++i) {
+    c(i, 0) = static_cast<double>(report.collisions[i].move);
+    c(i, 1) = report.collisions[i].depth;
+  }
+  py::dict out;
+  out["moves_cut"] = report.moves_cut;
+  out["cells_lowered"] = report.cells_lowered;
+  out["collisions"] = collisions;
+  out["instances"] = stats.instances;
+  out["cells_tested"] = stats.cells_tested;
+  out["exact_solves"] = stats.exact_solves;
+  out["fallback_solves"] = stats.fallback_solves;
+  out["lowerings"] = stats.lowerings;
+  return out;
+}
+
+Eigen::Vector3d vec3(const Rows& a, const char* what) {
+  if (a.size() != 3) throw std::invalid_argument(std::string(what) + " must have 3 components");
+  const double* d = a.data();
+  return {d[0], d[1], d[2]};
+}
+
+}  // namespace
+
+void bind_sim5(py::module_& m) {
+  m.def("cut_5axis", &cut_5axis, py::arg("stock"), py::arg("tool_Ro"), py::arg("tool_Ri"), py::arg("tool_shape"),
+        py::arg("tips"), py::arg("axes"), py::arg("kinds"), py::arg("max_step") = 0.05,
+        py::arg("collision_tol") = 1e-3, py::arg("threads") = 0, py::arg("progress") = py::none(),
+        "Cuts a 5-axis tool path into the ZMap stock with the toroidal tool (Ro, Ri, 'round_insert' | "
+        "'bull_nose'): tips, axes (n, 3) (axes tip -> spindle, normalised, a_z > 0), kinds (n - 1,) integers "
+        "(0 cut, 1 rapid, 2 jump) for the moves k -> k + 1. Tip linear, axis by slerp, sub-stepped so that no "
+        "torus point moves more than max_step between instances; each cell is lowered to the tool's lowest "
+        "point on its vertical line. A rapid removing more than collision_tol mm is a collision. "
+        "progress(fraction) -> bool; False cancels (raises Cancelled, the stock partly cut). Returns "
+        "{'moves_cut', 'cells_lowered', 'collisions': (k, 2) [move index, depth], 'instances', "
+        "'cells_tested', 'exact_solves', 'fallback_solves'}.");
+  m.def("lowest_on_vertical",
+        [](double Ro, double Ri, const std::string& shape, const Rows& tip, const Rows& axis, double x, double y) {
+          const tmm::TorusTool tool = tool_from(Ro, Ri, shape);
+          Eigen::Vector3d a = vec3(axis, "axis");
+          const double len = a.norm();
+          if (!(len > 0.0 && std::isfinite(len))) throw std::invalid_argument("axis must be a finite nonzero vector");
+          a /= len;
+          if (!(a.z() > 1e-6)) throw std::invalid_argument("axis must point upwards (a_z > 0)");
+          return tmm::lowest_on_vertical(tool, vec3(tip, "tip"), a, x, y);
+        },
+        py::arg("tool_Ro"), py::arg("tool_Ri"), py::arg("tool_shape"), py::arg("tip"), py::arg("axis"),
+        py::arg("x"), py::arg("y"),
+        "Lowest z of the tool solid at (tip, axis) on the vertical line through (x, y); inf if it misses.");
+}

@@ -27,7 +27,9 @@ ZMap::ZMap(double x0, double y0, double cell, std::size_t nx, std::size_t ny, do
   if (ny == 0) refuse("ny must be at least 1", 0.0);
   if (nx > max_cells / ny) {
     std::ostringstream msg;
-    msg << "z-map of " << nx << " x " << ny << " cells (" << static_cast<double>(bytes_for(nx, ny)) / (1 << 20)
+    // In double: the byte count of a grid this large may not fit a size_t.
+    const double mib = static_cast<double>(nx) * static_cast<double>(ny) * sizeof(double) / (1 << 20);
+    msg << "z-map of " << nx << " x " << ny << " cells (" << mib
         << " MiB) is above the limit of " << max_cells << " cells: use larger cells";
     throw std::invalid_argument(msg.str());
   }
