@@ -94,11 +94,34 @@ def run_freecad(case: Case, out: Path) -> dict[str, Any]:
     dt = time.perf_counter() - t0
     row = dict(mesh=res.mesh, toolpath=res.toolpath, seconds=dt,
                files=[out / f"{case.name}.ngc", out / f"{case.name}.FCStd"])
+    row["sim"] = simulate_case(res, out / f"{case.name}_sim.png", SIM_CELL_MM)
+    row["files"].append(out / f"{case.name}_sim.png")
     try:
         FreeCAD.closeDocument(res.doc.Name)  # saved already; keep memory flat across cases
     except Exception:  # noqa: BLE001 - closing is a courtesy, never a failure
         pass
     return row
+
+
+SIM_CELL_MM = 0.1      # 3-axis simulation cells (the demo's step-overs are 0.3-1 mm)
+SIM_CELL_5AXIS_MM = 0.25
+
+
+def simulate_case(result: Any, png: Path, cell: float) -> dict[str, Any]:
+    """The Job's stock cut by its op and compared with its model (api.simulate), with the heat map."""
+    from tmm_workbench.app.api import simulate
+
+    t0 = time.perf_counter()
+    rep = simulate(result, cell=cell, tolerance=0.01, png_path=png, progress=False)
+    return dict(max_left=rep.max_left, min_dev=rep.min_deviation, p95=rep.percentiles[95], gouged=rep.gouged,
+                collisions=len(rep.collisions), cycle=rep.cycle_seconds, seconds=time.perf_counter() - t0)
+
+
+def sim_line(name: str, sim: dict[str, Any]) -> str:
+    verdict = "GOUGED" if sim["gouged"] else "no gouge"
+    return (f"{name:<16} max left {sim['max_left']:.4f} mm, min {sim['min_dev']:+.4f} mm, p95 {sim['p95']:.4f} mm, "
+            f"{verdict}, {sim['collisions']} rapid collisions, cycle {sim['cycle'] / 60:.1f} min, "
+            f"simulated in {sim['seconds']:.1f} s")
 
 
 def run_core(case: Case, out: Path) -> dict[str, Any]:
@@ -213,6 +236,8 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
         face, results, core_tp = r.op.Proxy.face, r.results, r.toolpath
         n_commands, summary = len(r.op.Path.Commands), r.op.ContactSummary
         files += [r.files["tarus"], r.files["apt_cl"], r.files["fcstd"]]
+        sim = simulate_case(r, out / f"{MP_NAME}_sim.png", SIM_CELL_5AXIS_MM)
+        files.append(out / f"{MP_NAME}_sim.png")
         try:
             FreeCAD.closeDocument(r.doc.Name)
         except Exception:  # noqa: BLE001 - closing is a courtesy
@@ -223,7 +248,7 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
             face, Cutter.torus(p["Ro"], p["Ri"]),
             MultipointParams(side_step=p["side_step"], pass_spacing=p["pass_spacing"],
                              forward_step=p["forward_step"], method=p["method"]))
-        n_commands, summary = 0, ""
+        n_commands, summary, sim = 0, "", None
     seconds = time.perf_counter() - t0
 
     import numpy as np
@@ -254,7 +279,7 @@ def run_multipoint_case(out: Path, with_freecad: bool) -> dict[str, Any]:
     tilt = np.degrees(np.arccos(np.clip(results["axis"][results.status != 2][:, 2], -1, 1)))
     return dict(name=MP_NAME, counts=counts, points=len(results), commands=n_commands, summary=summary,
                 cut_moves=sum(1 for m in core_tp if m.kind.name != "RAPID"), max_tilt=float(tilt.max()),
-                seconds=seconds, png_seconds=png_seconds, files=files, section=section_note)
+                seconds=seconds, png_seconds=png_seconds, files=files, section=section_note, sim=sim)
 
 
 def print_table5(r: dict[str, Any], total: float) -> None:
@@ -267,6 +292,8 @@ def print_table5(r: dict[str, Any], total: float) -> None:
           f"{r['commands']:>8} {r['max_tilt']:>7.1f}d {r['seconds']:>9.2f} {r['png_seconds']:>6.2f}")
     if r["section"]:
         print(r["section"])
+    if r.get("sim"):
+        print("simulated: " + sim_line(r["name"], r["sim"]))
     print("\nwritten (5-axis):")
     for f in r["files"]:
         size = f.stat().st_size if f.exists() else -1
@@ -284,6 +311,11 @@ def print_table(rows: list[dict[str, Any]], total: float) -> None:
         print(f"{r['name']:<16} {r['tool']:<20} {len(r['mesh'].triangles):>9} "
               f"{s['feed_count'] + s['plunge_count']:>9} {s['cutting_length']:>9.0f} {s['rapid_count']:>6} "
               f"{r['seconds']:>9.2f} {r['png_seconds']:>6.2f}")
+    sims = [r for r in rows if r.get("sim")]
+    if sims:
+        print("\nsimulated stock vs model (vertical deviation; api.simulate):")
+        for r in sims:
+            print("  " + sim_line(r["name"], r["sim"]))
     print("\nwritten:")
     for r in rows:
         for f in [*r["files"], r["png"]]:

@@ -58,13 +58,23 @@ def test_along_axis_retract_and_transit_height():
     assert m[0].z == m[1].z >= 15.0 and m[-1].z >= 15.0
     drop = tool.lowest_below_tip(tuple(axis))
     assert drop == pytest.approx(6.0 * (1 - math.cos(t)) + 6.7 * math.sin(t))
-    for i, mv in enumerate(m):
-        if mv.kind is MoveKind.PLUNGE:   # entered along its axis from axis_retract above
-            d = np.subtract((mv.x, mv.y, mv.z), (m[i - 1].x, m[i - 1].y, m[i - 1].z))
-            np.testing.assert_allclose(-d / np.linalg.norm(d), axis, atol=1e-12)
-            assert np.linalg.norm(d) == pytest.approx(5.0)
-            assert m[i - 2].z == pytest.approx(max(mv.z + 5 * axis[2], 10.0 + drop))
-    assert kinds(tp).count(MoveKind.PLUNGE) == 2
+    firsts = {(0.0, 0.0, 0.0), (20.0, 10.0, 0.0)}
+    entries = [i for i, mv in enumerate(m) if mv.kind is MoveKind.PLUNGE and (mv.x, mv.y, mv.z) in firsts]
+    assert len(entries) == 2
+    for i in entries:                    # entered along its axis from axis_retract above, at the feed
+        d = np.subtract((m[i].x, m[i].y, m[i].z), (m[i - 1].x, m[i - 1].y, m[i - 1].z))
+        np.testing.assert_allclose(-d / np.linalg.norm(d), axis, atol=1e-12)
+        assert np.linalg.norm(d) == pytest.approx(5.0)
+        assert m[i - 1].kind is MoveKind.PLUNGE                      # fed down from the transit height too
+        assert m[i - 2].kind is MoveKind.RAPID and m[i - 2].z == pytest.approx(max(m[i].z + 5 * axis[2], 10.0 + drop))
+    # rapids stay above the safe height (the tilted tool's lowest point at both ends), but for straight up
+    # out of the tool's own column (as the 3-axis retract: under the tool all is cut already)
+    for i in range(1, len(m)):
+        up = (m[i].x, m[i].y, m[i].axis) == (m[i - 1].x, m[i - 1].y, m[i - 1].axis) and m[i].z > m[i - 1].z
+        if m[i].kind is MoveKind.RAPID and not up:
+            for p in (m[i - 1], m[i]):
+                assert p.z - tool.lowest_below_tip(p.axis) >= 10.0 - 1e-9, (i, p)
+    assert kinds(tp).count(MoveKind.PLUNGE) == 6  # per segment: down to the entry point, the entry, the exit
 
 
 def test_along_axis_needs_the_tool_geometry():

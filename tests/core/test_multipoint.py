@@ -184,9 +184,13 @@ def test_seed_surfaces_contacts_touch_and_nothing_penetrates(seed_run):
 
 def test_toolpath_moves_carry_tip_and_axis(seed_run):
     kind, net, face, path, res = seed_run
-    good = int((res.status != STATUS_FAILED).sum())
-    cutting = [m for m in path if m.kind is not MoveKind.RAPID]
+    ok = res.status != STATUS_FAILED
+    good = int(ok.sum())
+    tips = {tuple(t) for t in res["tip"][ok]}
+    cutting = [m for m in path if m.kind is not MoveKind.RAPID and (m.x, m.y, m.z) in tips]
     assert len(cutting) == good
+    # the other fed moves are the approaches and exits along the axis (below the safe height: never rapid)
+    assert all(m.kind is MoveKind.PLUNGE for m in path if m.kind is not MoveKind.RAPID and (m.x, m.y, m.z) not in tips)
     assert path.is_five_axis()
     ax = path.axes()
     np.testing.assert_allclose(np.linalg.norm(ax, axis=1), 1.0, atol=1e-12)

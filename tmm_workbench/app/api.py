@@ -9,13 +9,14 @@ Run under FreeCAD (`freecadcmd script.py`, or the GUI's Python console), with th
 
 The call builds a Path Job (the mesh gets a stand-in box, see model_proxy), a ToolBit and tool
 controller, a 'TMM 3-axis Surface' op, recomputes, post-processes and optionally saves. Feeds are
-given in mm/min here (FreeCAD stores mm/s). Heights default to the model top + 5 mm (safe) and
-+ 10 mm (clearance). A FreeCAD object input is machined in its own document; an STL path opens a
-new document `doc_name`. On failure a TmmError with the op's message is raised (a document opened
+given in mm/min here (FreeCAD stores mm/s). Heights default to the top of the model or of the Job's
+stock, whichever is higher, + 5 mm (safe) and + 10 mm (clearance). A FreeCAD object input is machined
+in its own document; an STL path opens a new document `doc_name`. On failure a TmmError with the op's message is raised (a document opened
 by the call is closed first).
 """
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -138,11 +139,10 @@ def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, cor
            gcode_path: Any, progress: Any) -> SurfaceResult:
     jm = jobs.prepare_model(doc, model)
     doc.recompute()
-    top = jm.job_base.Shape.BoundBox.ZMax
+    job = jobs.create_job(doc, jm.job_base)
+    top = max(jm.job_base.Shape.BoundBox.ZMax, _stock_top(job))
     safe = top + 5.0 if safe_height is None else float(safe_height)
     clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
-
-    job = jobs.create_job(doc, jm.job_base)
     bit = (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
            else tools.make_tool_bit(doc, shape, diameter, corner_radius))
     tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
@@ -161,6 +161,11 @@ def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, cor
     _compute(op, progress)
     gcode = posts.export(post, [tc, op], gcode_path)
     return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
+
+
+def _stock_top(job: Any) -> float:
+    stock = getattr(job, "Stock", None)
+    return float(stock.Shape.BoundBox.ZMax) if stock is not None and not stock.Shape.isNull() else -math.inf
 
 
 def _job_posts(job: Any) -> list[str]:
@@ -237,7 +242,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     surface_extension (mm, 0: off): position against the face continued past its edges (checked against
     the real face); footprint_anchor 'axis' (seed 001: the pre-tilt axis on the footprint point) | 'tip'
     (the tilted tip on it).
-    Heights default to the face's top + 5 mm (safe, for the tool's lowest point) and + 10 mm (clearance).
+    Heights default to the face's or the Job stock's top, whichever is higher, + 5 mm (safe, for the tool's
+    lowest point) and + 10 mm (clearance).
     Feeds in mm/min. Each post's output goes to out_dir/<name><suffix> (tarus: .tarus.ngc, apt_cl: .apt,
     others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
     document opened by the call is closed first).
@@ -277,10 +283,10 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             top = face_top(geometry.bezier_face(surf))
         except TmmError:  # the op reports it (and keeps its message as its status)
             top = source_obj.Shape.BoundBox.ZMax
+        job = jobs.create_job(doc, source_obj, name="Job")
+        top = max(top, _stock_top(job))  # rapids at the safe height must clear the stock, not only the face
         safe = top + 5.0 if safe_height is None else float(safe_height)
         clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
-
-        job = jobs.create_job(doc, source_obj, name="Job")
         clone = job.Model.Group[-1]
         bit = tools.bit_for_cutter(doc, cutter)
         tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
@@ -364,3 +370,66 @@ def _surface_feature(doc: Any, source: Any) -> Any:
     obj.Shape = surf.toShape()
     obj.Label = "Bezier surface" if type(surf).__name__ == "BezierSurface" else "B-spline surface"
     return obj
+
+
+# --- stock simulation ----------------------------------------------------------------------------
+@dataclass
+class SimulationReport:
+    max_left: float            # mm, the largest deviation above the design (scallop, material left)
+    min_deviation: float       # mm, the smallest (negative: the deepest gouge)
+    percentiles: dict          # {50, 90, 95, 99: deviation mm}
+    removed_volume: float      # mm^3
+    remaining_volume: float    # mm^3 above the design
+    gouge_cells: int           # cells below the design by more than the tolerance
+    gouged: bool
+    collisions: list           # [(op label, move, depth mm)]: rapids through stock
+    cycle_seconds: float       # all ops
+    ops: list                  # app.simulation.OpSimulation per op
+    png: Optional[str]         # the heat map written, when asked
+    cell: float
+    tolerance: float
+    simulation: Any            # app.simulation.JobSimulation (grids, heights, deviation)
+
+
+def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
+             png_path: Optional[Union[str, os.PathLike]] = None, progress: Union[bool, Callable[[float], bool]] = True,
+             fail_on_gouge: bool = False) -> SimulationReport:
+    """Cuts the stock of a Job with its active ops in order (or with one op), compares it with the Job's model
+    and reports: the deviation (vertical, + material left, - gouge) extremes and percentiles, removed and
+    remaining volume, rapids through stock, cycle time. `target`: a Job, an op, or a SurfaceResult /
+    MultipointResult of this API. png_path: writes the heat map. A gouge deeper than `tolerance` is printed
+    as an error; with fail_on_gouge it raises TmmError. 5-axis moves are sub-stepped `max_step` mm apart
+    (default: the step whose cusp between tool instances is a tenth of the tolerance, core.sim.simulate.sub_step)."""
+    from tmm_workbench.app import simulation
+    from tmm_workbench.core.preview.deviation_png import render_deviation_png
+
+    target = getattr(target, "job", None) or target
+    _numbers(cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
+             tolerance=(tolerance, Spec(low=0.0, high=10.0, unit="mm", label="tolerance")),
+             max_step=(max_step, Spec(low=1e-3, high=10.0, unit="mm", label="max_step", optional=True)))
+    label = str(getattr(target, "Label", "simulation"))
+    factory = (lambda _: _CallbackProgress(progress)) if callable(progress) else None
+    with progress_mod.using(factory):
+        with progress_mod.reporter(f"{label} simulation", bool(progress)) as cb:
+            sim = simulation.simulate_job(target, cell, tolerance, max_step, cb)
+    o = sim.comparison.overall
+    png = None
+    if png_path:
+        png = render_deviation_png(sim.comparison, sim.grid, str(png_path), f"{label}: simulated stock vs design")
+    report = SimulationReport(o.max_left, o.min_deviation, dict(o.percentiles), sim.comparison.removed_volume,
+                              o.remaining_volume, o.gouge_cells, sim.comparison.gouged, sim.collisions,
+                              sim.cycle_seconds, sim.ops, png, cell, tolerance, sim)
+    problems = []
+    if report.gouged:
+        problems.append(f"the simulated stock is gouged {-o.min_deviation:.4f} mm below the design in "
+                        f"{o.gouge_cells} cells (tolerance {tolerance:g} mm)")
+    if report.collisions:
+        op_label, move, depth = report.collisions[0]
+        problems.append(f"{len(report.collisions)} rapids cut stock (the first: op '{op_label}', move {move}, "
+                        f"{depth:.3f} mm deep)")
+    if problems:
+        text = f"{label}: " + "; ".join(problems)
+        FreeCAD.Console.PrintError(text + "\n")
+        if fail_on_gouge:
+            raise TmmError(text)
+    return report

@@ -147,6 +147,23 @@ class TmmOp(PathOp.ObjectOp):
         if not self._computed:
             self.fail(obj, "FreeCAD did not compute the operation (its Job, model or stock is missing; "
                            "see the report view)")
+        self.set_cycle_time(obj)
+
+    def set_cycle_time(self, obj: Any) -> None:
+        """FreeCAD's CycleTime counts no rotary axis and no joint speed: TMM's estimate replaces it
+        (app.simulation.op_cycle_seconds), and the Job's total is summed again."""
+        from tmm_workbench.app.simulation import op_cycle_seconds
+
+        try:
+            seconds = op_cycle_seconds(obj)
+        except TmmError as exc:  # the op's own estimate stays; say why ours is missing
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: no cycle time estimate ({exc})\n")
+            return
+        s = int(round(seconds))
+        obj.CycleTime = f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"
+        job = getattr(self, "job", None)
+        if job is not None and hasattr(getattr(job, "Proxy", None), "getCycleTime"):
+            job.Proxy.getCycleTime()
 
     def input_problem(self, obj: Any) -> str:
         """What makes computing impossible, in the user's terms ('' when nothing)."""

@@ -98,11 +98,11 @@ class ObjectTmmSurface(op_base.TmmOp):
         if obj.StlFile:
             return geometry.mesh_from_stl(obj.StlFile)
         if obj.Model is not None:
-            return _mesh_of(obj.Model, deflection)
+            return mesh_of_model(obj.Model, deflection)
         models = list(self.model or [])
         if not models:
             raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
-        return geometry.combine([_mesh_of(m, deflection) for m in models])
+        return geometry.combine([mesh_of_model(m, deflection) for m in models])
 
     def boundary(self, obj: Any, mesh: TriMesh) -> tuple[float, float, float, float]:
         if obj.BoundaryShape == "Stock":
@@ -137,7 +137,7 @@ class ObjectTmmSurface(op_base.TmmOp):
         return out
 
 
-def _mesh_of(obj: Any, deflection: float) -> TriMesh:
+def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
     """The mesh to machine for a model object; TMM's stand-in boxes give what they stand for."""
     source = model_proxy.source_of(obj)
     if source is None:

@@ -3,9 +3,11 @@
 Between segments the tool either stays down (a segment `joined` to the previous one: a zig-zag link the
 strategy made of dropped, gouge-free points, then the next pass) or leaves and re-enters:
   retract VERTICAL (3-axis): straight up to the safe height, a rapid across, the entry down;
-  retract ALONG_AXIS (5-axis): back along the tool axis by `axis_retract`, straight up to the transit
-      height (the lowest point of the tilted tool at the safe height), a rapid across with the tool
-      already turned, down to `axis_retract` above the next first point on its axis, the entry along it.
+  retract ALONG_AXIS (5-axis): back along the tool axis by `axis_retract` (fed: the tilted tool moves
+      sideways too, through what may still be stock), straight up to the transit height (the lowest point
+      of the tilted tool at the safe height), a rapid across with the tool already turned, down (fed, as
+      everything below the safe height) to `axis_retract` above the next first point on its axis, the
+      entry along it.
 The entry is a PLUNGE move at the vertical feed (the only entry so far); ramps and helices are entries
 too: they get a row in ENTRIES and an `entry` name, nothing else changes.
 The path starts at the clearance height over the first entry (5-axis: upright, then turned there) and
@@ -113,7 +115,8 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
         if k == 0 or not seg.joined:
             a = seg.axis(0)
             tp.add(MoveKind.RAPID, *above(seg.tips[0], a), a)              # transit, the tool turned above the entry
-            tp.add(MoveKind.RAPID, *(seg.tips[0] + r * np.asarray(a)), a)  # down to the entry point on the axis
+            # below the safe height at the vertical feed, as the 3-axis entry: rapids stay above the stock
+            tp.add(MoveKind.PLUNGE, *(seg.tips[0] + r * np.asarray(a)), a)  # down to the entry point on the axis
             enter(tp, seg.tips[0], a)                                        # along the axis onto the face
             start = 1
         for i in range(start, len(seg)):
@@ -121,8 +124,8 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
         if k + 1 < len(segments) and segments[k + 1].joined:
             continue
         a1 = seg.axis(len(seg) - 1)
-        tp.add(MoveKind.RAPID, *(seg.tips[-1] + r * np.asarray(a1)), a1)    # back along the axis
-        tp.add(MoveKind.RAPID, *above(seg.tips[-1], a1), a1)                # straight up
+        tp.add(MoveKind.PLUNGE, *(seg.tips[-1] + r * np.asarray(a1)), a1)   # back along the axis, fed: the
+        tp.add(MoveKind.RAPID, *above(seg.tips[-1], a1), a1)                # tilted tool moves sideways; up
     last = tp.moves[-1]
     top = max(policy.clearance_height, last.z)
     tp.add(MoveKind.RAPID, last.x, last.y, top, last.axis)

@@ -1,0 +1,93 @@
+"""Stock simulation of a Job (app.simulation, api.simulate): a 3-axis TMM Surface Job on the bump and seed
+001's 5-axis Multipoint Job, each simulated in its stock and compared with its model (no gouge, scallops
+left, the heat map written), the same paths lowered by 0.05 mm reported as gouges (and raised with
+fail_on_gouge), the op's CycleTime replaced by TMM's estimate (3-axis: feeds and rapid rates; 5-axis: the
+Tarus post's joint-speed estimate), and bad input refused by name."""
+from __future__ import annotations
+
+import unittest
+
+import Path
+
+from fc_helpers import OUT, FreeCADTestCase, bump_stl, close_all, job_with_op, new_doc
+from fc_test_multipoint import FAST, seed_net
+from tmm_workbench.app import simulation
+from tmm_workbench.app.api import run_multipoint, simulate
+from tmm_workbench.core.errors import TmmError
+
+
+def hms_seconds(text: str) -> int:
+    h, m, s = (int(v) for v in text.split(":"))
+    return 3600 * h + 60 * m + s
+
+
+def lowered(op, dz: float = 0.05) -> None:
+    """The op's Path with every feed move 0.05 mm lower (rapids as they were)."""
+    out = []
+    for c in op.Path.Commands:
+        p = dict(c.Parameters)
+        if c.Name in ("G1", "G01") and "Z" in p:
+            p["Z"] -= dz
+        out.append(Path.Command(c.Name, p))
+    op.Path = Path.Path(out)
+
+
+class Simulate3Axis(FreeCADTestCase):
+    def test_surface_job(self) -> None:
+        doc = new_doc("TmmSim3")
+        job, tc, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 1.0, "SampleStep": 0.5})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        png = OUT / "sim3.png"
+        r = simulate(job, cell=0.1, tolerance=0.01, png_path=png, progress=False)
+        self.assertFalse(r.gouged, (r.min_deviation, r.gouge_cells))
+        self.assertGreater(r.min_deviation, -0.01)
+        self.assertGreater(r.max_left, 0.01)          # ball D4 at 1 mm step-over leaves cusps (0.063 mm)
+        self.assertGreater(r.removed_volume, 0)
+        self.assertEqual(r.collisions, [])
+        self.assertTrue(png.is_file() and png.stat().st_size > 20_000)
+        # the op's CycleTime is TMM's estimate, and the report's
+        self.assertAlmostEqual(hms_seconds(op.CycleTime), round(simulation.op_cycle_seconds(op)), delta=1)
+        self.assertAlmostEqual(r.cycle_seconds, simulation.op_cycle_seconds(op), places=6)
+        lowered(op)
+        bad = simulate(op, cell=0.1, progress=False)
+        self.assertTrue(bad.gouged)
+        self.assertLess(bad.min_deviation, -0.04)
+        with self.assertRaises(TmmError) as ctx:
+            simulate(op, cell=0.1, progress=False, fail_on_gouge=True)
+        self.assertIn("gouged", str(ctx.exception))
+        close_all()
+
+    def test_bad_input(self) -> None:
+        doc = new_doc("TmmSimBad")
+        job, _, op = job_with_op(doc, str(bump_stl()))
+        for kwargs, text in ((dict(cell=0.0), "cell"), (dict(cell=float("nan")), "cell"),
+                             (dict(tolerance=-1.0), "tolerance"), (dict(cell=1e-4), "simulation cells")):
+            with self.assertRaises(TmmError) as ctx:
+                simulate(job, progress=False, **kwargs)
+            self.assertIn(text, str(ctx.exception))
+        empty = doc.addObject("App::FeaturePython", "Loose")
+        with self.assertRaises(TmmError) as ctx:
+            simulate(empty, progress=False)
+        self.assertIn("not in a Job", str(ctx.exception))
+        close_all()
+
+
+class Simulate5Axis(FreeCADTestCase):
+    def test_multipoint_job(self) -> None:
+        r5 = run_multipoint(seed_net(), doc_name="TmmSim5", **FAST)
+        png = OUT / "sim5.png"
+        r = simulate(r5, cell=0.5, tolerance=0.01, png_path=png, progress=False)
+        self.assertFalse(r.gouged, (r.min_deviation, r.gouge_cells))
+        self.assertGreater(r.max_left, 0.05)           # 18 mm between passes
+        self.assertTrue(r.ops[0].five_axis)
+        self.assertTrue(png.is_file())
+        tarus = simulation._tarus_cycle_time(r5.op)
+        self.assertAlmostEqual(r.cycle_seconds, tarus, places=6)
+        self.assertAlmostEqual(hms_seconds(r5.op.CycleTime), round(tarus), delta=1)
+        lowered(r5.op)
+        self.assertTrue(simulate(r5.op, cell=0.5, progress=False).gouged)
+        close_all()
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,183 @@
+"""A Job's (or one op's) tool paths cut into its stock and compared with its model (issue 12): the App side
+of core.sim. The stock is the Job's stock solid as a height field (box, cylinder or any solid: its top on
+each cell's vertical line), the design the Job's model objects tessellated finely; each active op in order
+cuts the same z-map with its own tool (app.tools, the one ToolBit map) from its Path (G0/G1, 5-axis axes
+in U/V/W: core.path5). Cycle time: 3-axis ops from the Path's feeds and the tool controller's rapid rates,
+5-axis ops from the Tarus post's estimate (joint speeds, A and C planned)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from tmm_workbench.app import geometry, post_objects, tools
+from tmm_workbench.core import path5
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.sim import compare as compare_mod
+from tmm_workbench.core.sim.cycle_time import three_axis_time
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import SimResult, simulate
+from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
+
+DESIGN_DEFLECTION_MM = 0.001  # the model tessellated this close: well below the scallops compared
+
+
+@dataclass
+class OpSimulation:
+    label: str
+    five_axis: bool
+    moves: int
+    cycle_seconds: float
+    collisions: list            # [(move index, depth mm)]
+    seconds: float              # simulation time
+
+
+@dataclass
+class JobSimulation:
+    grid: Grid
+    result: SimResult                   # the stock after the last op (initial: before the first)
+    comparison: compare_mod.Comparison
+    ops: list = field(default_factory=list)   # OpSimulation per op, in order
+    design: Optional[np.ndarray] = None
+
+    @property
+    def cycle_seconds(self) -> float:
+        return sum(o.cycle_seconds for o in self.ops)
+
+    @property
+    def collisions(self) -> list:
+        return [(o.label, int(m), float(d)) for o in self.ops for m, d in o.collisions]
+
+
+def job_of(obj: Any) -> Any:
+    """The Job holding `obj` (or `obj` itself when it is a Job)."""
+    if hasattr(obj, "Operations") and hasattr(obj, "Stock"):
+        return obj
+    for parent in getattr(obj, "InList", []) or []:
+        found = job_of(parent)
+        if found is not None:
+            return found
+    return None
+
+
+def operations(job: Any) -> list:
+    out = []
+
+    def walk(objs: Any) -> None:
+        for o in objs:
+            if hasattr(o, "Group") and not hasattr(o, "Path"):
+                walk(o.Group)
+            elif hasattr(o, "Path") and getattr(o, "Active", True) and getattr(o, "ToolController", None):
+                out.append(o)
+    walk(job.Operations.Group)
+    return out
+
+
+def _toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
+    commands = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
+    moves = path5.decode_commands(commands)
+    tp = Toolpath()
+    feeds: list = []
+    for m in moves:
+        if m.name not in ("G0", "G1"):
+            raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): arcs are not simulated yet")
+        if any(math.isnan(c) for c in m.tip):
+            if m.is_rapid and not len(tp):
+                continue  # a Z-only rapid before the first XY: from wherever the tool is, up (never into stock)
+            raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): X, Y or Z was never given")
+        tp.add(MoveKind.RAPID if m.is_rapid else MoveKind.FEED, *m.tip, axis=m.axis)
+        feeds.append(None if m.is_rapid else (m.feed or float(op.ToolController.HorizFeed.Value)))
+    return tp, feeds
+
+
+def _five_axis_shape(op: Any) -> str:
+    params = getattr(getattr(op, "Proxy", None), "params_from", None)
+    shape = getattr(params(op), "shape", None) if callable(params) else None
+    return shape or "bull_nose"
+
+
+def _tarus_cycle_time(op: Any) -> float:
+    from tmm_workbench.core.post.tarus_writer import write_tarus
+
+    program = post_objects.program_from_objects([op.ToolController, op])
+    return float(write_tarus(program).cycle_time)
+
+
+def op_cycle_seconds(op: Any) -> float:
+    """The op's cycle time, s: 5-axis paths from the Tarus post (joint speeds, A and C planned), 3-axis from
+    the Path's feeds and the tool controller's rapid rates (core.sim.cycle_time)."""
+    tp, feeds = _toolpath_and_feeds(op)
+    if len(tp) < 2:
+        return 0.0
+    if tp.is_five_axis():
+        return _tarus_cycle_time(op)
+    tc = op.ToolController
+    return three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).seconds
+
+
+def _stock_heights(job: Any, grid: Grid) -> np.ndarray:
+    stock = getattr(job, "Stock", None)
+    if stock is None or stock.Shape.isNull():
+        raise TmmError(f"Job '{job.Label}' has no stock to simulate")
+    h = mesh_heights(geometry.mesh_from_shape(stock.Shape, 0.01, stock.Label), grid)
+    return np.where(np.isfinite(h), h, float(stock.Shape.BoundBox.ZMin))  # outside the stock: none
+
+
+def _design_heights(job: Any, ops: list, grid: Grid) -> np.ndarray:
+    """The design under each cell: the Job's models (TMM's stand-in boxes give the mesh or STL they stand for)
+    and any model an op machines instead (its StlFile or Model), highest where they overlap."""
+    from tmm_workbench.app.op_surface import mesh_of_model
+
+    meshes = [mesh_of_model(m, DESIGN_DEFLECTION_MM) for m in list(getattr(job.Model, "Group", []) or [])]
+    for op in ops:
+        if getattr(op, "StlFile", ""):
+            meshes.append(geometry.mesh_from_stl(op.StlFile))
+        elif getattr(op, "Model", None) is not None:
+            meshes.append(mesh_of_model(op.Model, DESIGN_DEFLECTION_MM))
+    if not meshes:
+        raise TmmError(f"Job '{job.Label}' has no model to compare with")
+    return mesh_heights(geometry.combine(meshes), grid)
+
+
+def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
+                 progress: Optional[Callable[[float], bool]] = None) -> JobSimulation:
+    """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
+    compares the result with the Job's model."""
+    job = job_of(target)
+    if job is None:
+        raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
+    ops = operations(job) if target is job else [target]
+    if not ops:
+        raise TmmError(f"Job '{job.Label}' has no active operation with a tool path")
+    bb = job.Stock.Shape.BoundBox
+    grid = Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, cell)
+    initial = _stock_heights(job, grid)
+    design = _design_heights(job, ops, grid)
+    heights, done = initial, []
+    result = None
+    for k, op in enumerate(ops):
+        tp, feeds = _toolpath_and_feeds(op)
+        if len(tp) < 2:
+            raise TmmError(f"op '{op.Label}' has no tool path: recompute it first")
+        cutter = tools.cutter_from_tool(op.ToolController.Tool)
+        five = tp.is_five_axis()
+
+        def part(f: float, k: int = k) -> bool:  # this op's share of the whole progress
+            return progress((k + f) / len(ops)) if progress else True
+        r = simulate(tp, cutter, grid, heights, shape=_five_axis_shape(op) if five else "bull_nose",
+                     max_step=max_step, tolerance=tolerance, progress=part if progress else None)
+        seconds = op_cycle_seconds(op)
+        done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds))
+        heights = r.heights
+        result = r if result is None else SimResult(grid, result.initial, r.heights,
+                                                    np.vstack([result.collisions, r.collisions]),
+                                                    result.moves_cut + r.moves_cut,
+                                                    result.cells_lowered + r.cells_lowered,
+                                                    result.seconds + r.seconds, result.five_axis or five)
+    # cells compared: the design under them and stock there to begin with
+    design_here = np.where(initial >= design - tolerance, design, np.nan)
+    comparison = compare_mod.compare(result, design_here, tolerance)
+    return JobSimulation(grid, result, comparison, done, design_here)

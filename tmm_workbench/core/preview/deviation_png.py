@@ -1,0 +1,46 @@
+"""The simulated stock's deviation from the design as a heat map (PNG, matplotlib Agg): red where material
+is left, blue where the design is gouged, a colour bar in mm, the numbers in the title. Cells without the
+design under them are grey. matplotlib is imported inside the function (no GUI backend on import)."""
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from tmm_workbench.core.sim.compare import Comparison
+    from tmm_workbench.core.sim.grid import Grid
+
+
+def render_deviation_png(comparison: "Comparison", grid: "Grid", path: str, title: str = "",
+                         dpi: int = 110) -> str:
+    import matplotlib
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import TwoSlopeNorm
+
+    dev = comparison.deviation
+    o = comparison.overall
+    tol = comparison.tolerance
+    low = min(-tol, o.min_deviation if o.cells else -tol)
+    high = max(tol, o.max_left if o.cells else tol)
+    cmap = plt.get_cmap("RdBu_r").copy()
+    cmap.set_bad("#d9d9d9")
+    fig, ax = plt.subplots(figsize=(7.2, 6.0), dpi=dpi)
+    x0, x1, y0, y1 = grid.extent
+    im = ax.imshow(np.ma.masked_invalid(dev), origin="lower", extent=(x0, x1, y0, y1), cmap=cmap,
+                   norm=TwoSlopeNorm(vmin=low, vcenter=0.0, vmax=high), interpolation="nearest")
+    bar = fig.colorbar(im, ax=ax, shrink=0.85)
+    bar.set_label("deviation from the design, mm (vertical; + material left, - gouge)")
+    ax.set_xlabel("x mm")
+    ax.set_ylabel("y mm")
+    ax.set_aspect("equal")
+    verdict = f"GOUGE in {o.gouge_cells} cells" if o.gouge_cells else "no gouge"
+    ax.set_title(f"{title}\nmax left {o.max_left:.4f} mm, min {o.min_deviation:.4f} mm, "
+                 f"p95 {o.percentiles.get(95, 0.0):.4f} mm; {verdict} (tolerance {tol:g} mm)\n"
+                 f"removed {comparison.removed_volume / 1000:.2f} cm3, left {o.remaining_volume / 1000:.3f} cm3, "
+                 f"cell {grid.cell:g} mm", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path

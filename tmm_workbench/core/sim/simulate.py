@@ -1,0 +1,92 @@
+"""What a tool path leaves in the stock: the kernel cuts the z-map along every move (3-axis: the APT cutter's
+swept envelope, exact per cell; 5-axis: the torus sub-stepped along the move, tip straight and axis by slerp,
+bound in the kernel's sweep5.hpp). Rapids cut too; one that removes material is a collision (a crash on the
+machine), reported with its move."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.kernel import native
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
+
+Progress = Callable[[float], bool]
+CUT, RAPID = 0, 1  # the kernel's MoveKind
+SHAPES_5AXIS = ("round_insert", "bull_nose")
+
+
+@dataclass
+class SimResult:
+    grid: Grid
+    initial: np.ndarray       # (ny, nx) stock heights before cutting
+    heights: np.ndarray       # (ny, nx) after
+    collisions: np.ndarray    # (k, 2): [move index, depth mm] of rapids that removed material
+    moves_cut: int
+    cells_lowered: int
+    seconds: float
+    five_axis: bool
+
+    @property
+    def removed_volume(self) -> float:
+        """mm^3 removed from the stock."""
+        return float(np.sum(self.initial - self.heights) * self.grid.cell_area)
+
+
+def move_kinds(toolpath: Toolpath) -> np.ndarray:
+    """(n - 1,) kernel kinds: the move into point k + 1 is a rapid when point k + 1 is reached by G0."""
+    return np.array([RAPID if m.kind is MoveKind.RAPID else CUT for m in toolpath.moves[1:]], dtype=np.uint8)
+
+
+def sub_step(tool: Cutter, tolerance: float) -> float:
+    """The 5-axis sub-step whose cusp between instances, s^2 / (8 Ri) (the kernel's sweep5.hpp bound), is a
+    tenth of `tolerance`: sqrt(0.8 Ri tol), at most 0.5 mm."""
+    _, Ri = tool.torus_radii
+    return min(0.5, math.sqrt(0.8 * Ri * tolerance))
+
+
+def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *, shape: str = "bull_nose",
+             max_step: Optional[float] = None, tolerance: float = 0.01, collision_tol: float = 1e-3, threads: int = 0,
+             progress: Optional[Progress] = None) -> SimResult:
+    """Cuts `stock` ((ny, nx) heights on `grid`, copied) along `toolpath` with `tool`. A 5-axis path (any
+    axis off vertical) needs a toroidal or ball tool (`tool.torus_radii`); `shape` is its solid
+    ('bull_nose': a solid end mill; 'round_insert': the seed's insert cutter with its hollow); its moves are
+    sub-stepped `max_step` mm apart (default: sub_step(tool, tolerance))."""
+    if len(toolpath) < 2:
+        raise TmmError("the tool path to simulate has no moves")
+    stock = np.asarray(stock, dtype=float)
+    if stock.shape != (grid.ny, grid.nx):
+        raise TmmError(f"stock heights have shape {stock.shape}, the grid {grid.ny} x {grid.nx}")
+    if not np.isfinite(stock).all():
+        raise TmmError("stock heights must be finite")
+    tips = np.ascontiguousarray(toolpath.points())
+    bad = np.flatnonzero(~np.isfinite(tips).all(axis=1))
+    if len(bad):
+        raise TmmError(f"tool path point {int(bad[0])} is not finite: {tips[bad[0]].tolist()}")
+    kinds = move_kinds(toolpath)
+    five = toolpath.is_five_axis()
+    if five and shape not in SHAPES_5AXIS:
+        raise TmmError(f"5-axis tool shape must be one of {', '.join(SHAPES_5AXIS)}, got {shape!r}")
+    zmap = native.ZMap(grid.x0, grid.y0, grid.cell, grid.nx, grid.ny, 0.0)
+    zmap.heights[:] = stock
+    t0 = time.perf_counter()
+    try:
+        if five:
+            Ro, Ri = tool.torus_radii
+            max_step = sub_step(tool, tolerance) if max_step is None else max_step
+            rep = native.cut_5axis(zmap, Ro, Ri, shape, tips, np.ascontiguousarray(toolpath.axes()), kinds,
+                                   max_step, collision_tol, threads, progress)
+        else:
+            rep = native.cut_3axis(zmap, tool.native, tips, kinds, collision_tol, threads, progress)
+    except native.Cancelled as exc:
+        raise Cancelled("simulation cancelled") from exc
+    except ValueError as exc:
+        raise TmmError(f"simulation: {exc}") from exc
+    return SimResult(grid, stock.copy(), np.array(zmap.heights), np.asarray(rep["collisions"]).reshape(-1, 2),
+                     int(rep["moves_cut"]), int(rep["cells_lowered"]), time.perf_counter() - t0, five)

@@ -1,0 +1,43 @@
+"""Stock for the simulation as heights per cell: a box top, a cylinder (cells outside the circle hold no
+stock), or the top of a mesh (a height field: the highest point of the mesh on each cell's vertical line);
+and the same vertical-line heights of a design model, to compare the simulated stock with."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.tools.cutter import Cutter
+
+NEEDLE_RADIUS = 1e-4  # mm: the "cutter" whose drop is a vertical line's hit (a flat disc this small)
+
+
+def box_heights(grid: Grid, top: float) -> np.ndarray:
+    if not math.isfinite(top):
+        raise TmmError(f"stock top must be finite, got {top!r}")
+    return np.full((grid.ny, grid.nx), float(top))
+
+
+def cylinder_heights(grid: Grid, centre: tuple[float, float], radius: float, top: float, bottom: float
+                     ) -> np.ndarray:
+    """A vertical cylinder stock: `top` inside the circle, `bottom` (no stock) outside."""
+    if not (math.isfinite(radius) and radius > 0):
+        raise TmmError(f"cylinder stock radius must be a length > 0 mm, got {radius!r}")
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    inside = (X - centre[0]) ** 2 + (Y - centre[1]) ** 2 <= radius * radius
+    return np.where(inside, float(top), float(bottom))
+
+
+def mesh_heights(mesh: TriMesh, grid: Grid, surface: DropSurface | None = None, progress=None,
+                 threads: int = 0) -> np.ndarray:
+    """(ny, nx) highest point of the mesh on each cell centre's vertical line (a disc of NEEDLE_RADIUS
+    dropped: higher by at most slope x 1e-4 mm); NaN where the line misses the mesh."""
+    floor = float(mesh.vertices[:, 2].min()) - 1.0
+    surface = surface or DropSurface(mesh)
+    z = surface.drop(Cutter.flat(2 * NEEDLE_RADIUS), grid.centres(), floor, progress, threads)
+    z = np.asarray(z).reshape(grid.ny, grid.nx)
+    return np.where(z > floor + 0.5, z, np.nan)
