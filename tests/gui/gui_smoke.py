@@ -2,12 +2,13 @@
 
 FreeCAD starts, the TMM workbench activates (TMM and Path commands registered), the API makes a Job
 with a TMM Surface op, the TMM Surface command adds a second op and opens its task panel, the main
-window (with the 3D view rendered offscreen) is grabbed into a PNG; the API's 5-axis Multipoint op opens
-its panel and the 5-axis command adds an op on the selected face; then a document saved headless
-(env TMM_GUI_REOPEN, made by make_headless_doc.py) is reopened and its op's panel opens; the GUI
-progress dialog reports a Cancel; FreeCAD quits. The outcome goes to env TMM_GUI_RESULT (a JSON file)
-and the exit code (os._exit: the GUI would otherwise swallow SystemExit). Screenshot: env
-TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
+window (with the 3D view rendered offscreen) is grabbed into a PNG; TMM Simulate on that Job shows its
+numbers and the stock coloured by deviation (grabbed into gui_simulate.png beside it) and leaves nothing
+when closed; the API's 5-axis Multipoint op opens its panel and the 5-axis command adds an op on the
+selected face; then a document saved headless (env TMM_GUI_REOPEN, made by make_headless_doc.py) is
+reopened and its op's panel opens; the GUI progress dialog reports a Cancel; FreeCAD quits. The outcome
+goes to env TMM_GUI_RESULT (a JSON file) and the exit code (os._exit: the GUI would otherwise swallow
+SystemExit). Screenshot: env TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
 """
 import json
 import os
@@ -45,6 +46,84 @@ def close_panel(op) -> None:
     op.ViewObject.Proxy.panel.reject()
     pump(0.3)
     assert not FreeCADGui.Control.activeDialog(), "the task panel stayed open"
+
+
+def screenshot(png: Path) -> None:
+    """The main window into `png`."""
+    mw = FreeCADGui.getMainWindow()
+    png.parent.mkdir(parents=True, exist_ok=True)
+    shot = mw.grab()
+    # the 3D view draws with OpenGL, which a widget grab misses under Xvfb: render it offscreen
+    # and paint it where the view is
+    area = mw.findChild(QtGui.QMdiArea)
+    view = (area.activeSubWindow() or area.currentSubWindow()).widget()  # none active after a dialog closed
+    rect = QtCore.QRect(view.mapTo(mw, QtCore.QPoint(0, 0)), view.size())
+    png3d = png.with_name(png.stem + "_3d.png")
+    FreeCADGui.activeDocument().activeView().saveImage(str(png3d), rect.width(), rect.height(), "White")
+    painter = QtGui.QPainter(shot)
+    painter.drawImage(rect, QtGui.QImage(str(png3d)))
+    painter.end()
+    assert shot.save(str(png)), f"could not write {png}"
+
+
+def click_close() -> None:
+    """The task dialog's Close button, as a user clicks it."""
+    for box in FreeCADGui.getMainWindow().findChildren(QtGui.QDialogButtonBox):
+        button = box.button(QtGui.QDialogButtonBox.Close)
+        if button is not None and button.isVisible():
+            button.click()
+            pump(0.5)
+            return
+    raise AssertionError("the task panel has no visible Close button")
+
+
+def simulate_panel(info: dict, r) -> None:
+    """TMM Simulate on the API's Job: the panel at cell 0.5 mm shows the numbers, the coloured stock is in the
+    3D view (screenshot), and Close removes it and shows the Job's objects again (nothing left in the
+    document)."""
+    from tmm_workbench.gui import simulate_cmd
+
+    before = sorted(o.Name for o in r.doc.Objects)
+    shown = sorted(o.Name for o in r.doc.Objects if o.ViewObject is not None and o.ViewObject.Visibility)
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(r.job)
+    FreeCADGui.runCommand(simulate_cmd.COMMAND_NAME)
+    pump(1.0)
+    page = find_panel(simulate_cmd.PANEL_NAME)
+    page.findChild(QtGui.QDoubleSpinBox, "cell").setValue(0.5)
+    page.findChild(QtGui.QPushButton, "simulate").click()  # returns when done (the progress dialog pumps)
+    pump(1.0)
+
+    def shown_value(name: str):
+        return page.findChild(QtGui.QLabel, name).property("value")
+    info["sim_status"] = page.findChild(QtGui.QLabel, "status").text()
+    info["sim_max_left"] = shown_value("maxLeft")
+    info["sim_min_deviation"] = shown_value("minDeviation")
+    info["sim_p95"] = shown_value("p95")
+    info["sim_removed_cm3"] = shown_value("removedVolume")
+    info["sim_cycle_s"] = shown_value("cycleTime")
+    info["sim_cell"] = shown_value("cellSize")
+    info["sim_collisions"] = page.findChild(QtGui.QLabel, "collisions").text()
+    info["sim_legend"] = [page.findChild(QtGui.QLabel, n).text() for n in ("legendMin", "legendZero", "legendMax")]
+    info["sim_gouged"] = info["sim_status"].startswith("GOUGED")
+    assert info["sim_max_left"] is not None, f"no simulation results: {info['sim_status']}"
+    scene = FreeCADGui.activeDocument().activeView().getSceneGraph()
+    info["sim_node"] = simulate_cmd.find_node(scene)
+    mw = FreeCADGui.getMainWindow()
+    for dock in mw.findChildren(QtGui.QDockWidget):
+        if dock.isVisible() and dock.isAncestorOf(page):
+            mw.resizeDocks([dock], [430], QtCore.Qt.Horizontal)  # the whole panel in the picture
+    pump(0.5)
+    png = PNG.with_name("gui_simulate.png")
+    screenshot(png)
+    info["sim_png"] = str(png)
+    click_close()
+    info["sim_panel_closed"] = not FreeCADGui.Control.activeDialog()
+    info["sim_node_removed"] = not simulate_cmd.find_node(scene)
+    info["sim_doc_unchanged"] = sorted(o.Name for o in r.doc.Objects) == before
+    info["sim_visibility_restored"] = shown == sorted(
+        o.Name for o in r.doc.Objects if o.ViewObject is not None and o.ViewObject.Visibility)
+    assert info["sim_panel_closed"], "the simulate panel stayed open"
 
 
 def multipoint_panel(info: dict) -> None:
@@ -156,20 +235,11 @@ def smoke() -> dict:
     FreeCADGui.SendMsgToActiveView("ViewFit")
     pump(1.0)
 
-    PNG.parent.mkdir(parents=True, exist_ok=True)
-    shot = mw.grab()
-    # the 3D view draws with OpenGL, which a widget grab misses under Xvfb: render it offscreen
-    # and paint it where the view is
-    view = mw.findChild(QtGui.QMdiArea).activeSubWindow().widget()
-    rect = QtCore.QRect(view.mapTo(mw, QtCore.QPoint(0, 0)), view.size())
-    png3d = PNG.with_name(PNG.stem + "_3d.png")
-    FreeCADGui.activeDocument().activeView().saveImage(str(png3d), rect.width(), rect.height(), "White")
-    painter = QtGui.QPainter(shot)
-    painter.drawImage(rect, QtGui.QImage(str(png3d)))
-    painter.end()
-    assert shot.save(str(PNG)), f"could not write {PNG}"
+    screenshot(PNG)
     info["png"] = str(PNG)
     close_panel(ops[0])  # Cancel: the new op goes again
+
+    simulate_panel(info, r)
 
     multipoint_panel(info)
 

@@ -1,5 +1,5 @@
 """GUI smoke test: FreeCAD under Xvfb runs tests/gui/gui_smoke.py (workbench, Job, op, task panel,
-screenshot) and must exit 0 within the time limit, leaving a non-blank PNG."""
+screenshot, TMM Simulate) and must exit 0 within the time limit, leaving non-blank PNGs."""
 from __future__ import annotations
 
 import json
@@ -11,6 +11,7 @@ from tests.freecad import fc_process
 
 HERE = Path(__file__).resolve().parent
 PNG = fc_process.ROOT / "out" / "gui_smoke.png"
+SIM_PNG = PNG.with_name("gui_simulate.png")  # gui_smoke.py writes it beside PNG
 FREECAD = fc_process.find("freecad", "FreeCAD")
 XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 120
@@ -22,6 +23,7 @@ def test_gui_smoke(tmp_path: Path) -> None:
     assert FREECAD is not None and XVFB_RUN is not None, "freecad and xvfb-run are needed (run scripts/setup.sh)"
     result, headless_doc = tmp_path / "gui_smoke.json", tmp_path / "headless.FCStd"
     PNG.unlink(missing_ok=True)
+    SIM_PNG.unlink(missing_ok=True)
     freecadcmd = fc_process.find("freecadcmd", "FreeCADCmd")
     if freecadcmd:  # a document saved without the GUI, for the GUI to reopen
         code, out = fc_process.run([freecadcmd, str(HERE / "make_headless_doc.py")], cwd=tmp_path, timeout=120,
@@ -40,6 +42,13 @@ def test_gui_smoke(tmp_path: Path) -> None:
     assert info.get("mp_anchor") == ["Tip", ["Axis", "Tip"]] and abs(info.get("mp_extension", 0) - 12.7) < 1e-9
     assert PNG.is_file() and PNG.stat().st_size > 10_000
     assert not _blank(PNG), "the screenshot is blank"
+    # TMM Simulate: the panel's numbers, the coloured stock shown and removed on Close, nothing left behind
+    sim = {k: v for k, v in info.items() if k.startswith("sim_")}
+    assert not info["sim_gouged"] and info["sim_max_left"] > 0, sim
+    assert info["sim_node"] and info["sim_node_removed"], sim
+    assert info["sim_doc_unchanged"] and info["sim_visibility_restored"], sim
+    assert SIM_PNG.is_file() and SIM_PNG.stat().st_size > 10_000
+    assert not _blank(SIM_PNG), "the simulation screenshot is blank"
 
 
 def _blank(png: Path) -> bool:

@@ -16,11 +16,11 @@ CAM_TOOLBAR = "New Operations"
 def tmm_commands() -> list[str]:
     """TMM's command names, registering them first (the TMM workbench does the same on Initialize)."""
     from tmm_workbench.app import registry
-    from tmm_workbench.gui import job_cmd
+    from tmm_workbench.gui import job_cmd, simulate_cmd
 
     for entry in registry.OPS:
         entry.gui()
-    return [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS]
+    return [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS] + [simulate_cmd.COMMAND_NAME]
 
 
 class CamManipulator:

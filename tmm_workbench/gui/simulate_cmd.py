@@ -1,0 +1,537 @@
+"""Command 'TMM Simulate' (issue 12): the selected Job's stock (or one op's) cut by its tool paths and
+compared with the design, in a task panel (the numbers of api.simulate, a colour legend) and in the 3D view
+(the simulated stock as a mesh coloured by its deviation, RdBu_r as the heat map PNG, grey where there is no
+design). The mesh is a Coin node of the view's scene graph, not a document object: closing the panel
+removes it and leaves the document as it was (the Job's objects hidden meanwhile are shown again)."""
+from __future__ import annotations
+
+import math
+import shutil
+import tempfile
+import time
+import traceback
+from pathlib import Path
+from typing import Any, Optional
+
+import numpy as np
+
+import FreeCAD
+import FreeCADGui
+from PySide import QtCore, QtGui
+
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.gui import resources
+
+COMMAND_NAME = "TMM_Simulate"
+NODE_NAME = "TmmSimulatedStock"    # the Coin node's name: tests and users find it in the scene graph
+PANEL_NAME = "TmmSimulatePanel"
+MAX_VERTICES_PER_SIDE = 400        # the mesh shown: a few 100k vertices draw fast, finer adds nothing visible
+CELL_3AXIS, CELL_5AXIS = 0.1, 0.25  # mm: 5-axis sweeps are sub-stepped, so a finer grid costs much more
+# grey where there is no design: darker than deviation_png's #d9d9d9, which the view's lighting makes look
+# like RdBu_r's near-white centre (0 mm) on a lit face
+NO_DESIGN_HEX = "#8c8c8c"
+NO_DESIGN_RGB = tuple(int(NO_DESIGN_HEX[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
+RED = "color: #c00000; font-weight: bold"
+
+
+# --- target ------------------------------------------------------------------------------------------
+def _is_job(obj: Any) -> bool:
+    return hasattr(obj, "Operations") and hasattr(obj, "Stock")
+
+
+def _is_op(obj: Any) -> bool:
+    return hasattr(obj, "Path") and hasattr(obj, "ToolController") and not _is_job(obj)
+
+
+def selected_target() -> Optional[Any]:
+    """The one selected Job, or the one selected Path op inside a Job; None otherwise."""
+    from tmm_workbench.app.simulation import job_of
+
+    sel = FreeCADGui.Selection.getSelection()
+    if len(sel) != 1:
+        return None
+    obj = sel[0]
+    if _is_job(obj) or (_is_op(obj) and job_of(obj) is not None):
+        return obj
+    return None
+
+
+def _is_five_axis(op: Any) -> bool:
+    """TMM writes the tool axis (U, V, W) on every motion of a 5-axis path and none on a 3-axis one."""
+    return any("W" in c.Parameters for c in op.Path.Commands)
+
+
+def default_cell(target: Any) -> float:
+    from tmm_workbench.app.simulation import job_of, operations
+
+    ops = operations(job_of(target)) if _is_job(target) else [target]
+    try:
+        return CELL_5AXIS if any(_is_five_axis(op) for op in ops) else CELL_3AXIS
+    except Exception:  # a broken op: the simulation will say what is wrong
+        return CELL_3AXIS
+
+
+# --- the mesh shown: decimation and colours (numpy only) ----------------------------------------------
+def decimate(heights: np.ndarray, deviation: np.ndarray, tolerance: float,
+             limit: int = MAX_VERTICES_PER_SIDE) -> tuple[np.ndarray, np.ndarray, int]:
+    """(heights, deviation, block) at most `limit` x `limit`: each block of block x block cells is shown by one
+    of its cells, the deepest gouge (beyond the tolerance) if any, else the largest |deviation| (so scallop
+    crests stay), else (no design under the block) the lowest height."""
+    ny, nx = heights.shape
+    b = max(1, math.ceil(max(nx, ny) / limit))
+    if b == 1:
+        return heights, deviation, 1
+    nby, nbx = math.ceil(ny / b), math.ceil(nx / b)
+    H = np.full((nby * b, nbx * b), np.inf)
+    D = np.full((nby * b, nbx * b), np.nan)
+    H[:ny, :nx], D[:ny, :nx] = heights, deviation
+
+    def blocks(a: np.ndarray) -> np.ndarray:
+        return a.reshape(nby, b, nbx, b).transpose(0, 2, 1, 3).reshape(nby, nbx, b * b)
+    Hb, Db = blocks(H), blocks(D)
+    finite = np.isfinite(Db)
+    low = np.where(finite, Db, np.inf)
+    deepest = np.argmin(low, axis=2)
+    largest = np.argmax(np.where(finite, np.abs(Db), -1.0), axis=2)
+    gouge = np.take_along_axis(low, deepest[..., None], 2)[..., 0] < -tolerance
+    pick = np.where(gouge, deepest, largest)
+    pick = np.where(finite.any(axis=2), pick, np.argmin(Hb, axis=2))
+
+    def take(a: np.ndarray) -> np.ndarray:
+        return np.take_along_axis(a, pick[..., None], 2)[..., 0]
+    return take(Hb), take(Db), b
+
+
+def block_centres(start: float, cell: float, n: int, b: int) -> np.ndarray:
+    """Centres of the blocks of `b` cells along one axis of `n` cells (the last block may be shorter)."""
+    first = np.arange(0, n, b)
+    last = np.minimum(first + b, n)
+    return start + cell * (first + last) / 2.0
+
+
+def colour_range(deviation: np.ndarray, tolerance: float) -> tuple[float, float]:
+    """The colour map's ends, mm, as deviation_png's: at least +-tolerance, 0 at the centre."""
+    d = deviation[np.isfinite(deviation)]
+    low = min(-tolerance, float(d.min())) if d.size else -tolerance
+    high = max(tolerance, float(d.max())) if d.size else tolerance
+    if not low < 0.0 < high:  # a zero tolerance and no deviation: still a centred map
+        low, high = min(low, -1e-6), max(high, 1e-6)
+    return low, high
+
+
+def _cmap() -> Any:
+    from matplotlib import colormaps
+
+    return colormaps["RdBu_r"]
+
+
+def normalised(deviation: np.ndarray, low: float, high: float) -> np.ndarray:
+    """Deviation -> [0, 1] with 0 mm at 0.5, linear on each side (matplotlib's TwoSlopeNorm)."""
+    d = np.asarray(deviation, dtype=float)
+    t = np.where(d < 0, 0.5 * (1.0 - d / low), 0.5 * (1.0 + d / high))
+    return np.clip(t, 0.0, 1.0)
+
+
+def colours(deviation: np.ndarray, low: float, high: float) -> np.ndarray:
+    """(n, 3) RGB in [0, 1] per deviation value (flattened): RdBu_r, grey where NaN."""
+    d = np.asarray(deviation, dtype=float).ravel()
+    rgb = _cmap()(normalised(np.nan_to_num(d), low, high))[:, :3]
+    rgb[~np.isfinite(d)] = NO_DESIGN_RGB
+    return rgb
+
+
+# --- Coin ---------------------------------------------------------------------------------------------
+def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float) -> tuple[Any, int]:
+    """A SoSeparator holding the simulated stock as a quad mesh with per-vertex colours, and the block size
+    of the decimation."""
+    from pivy import coin
+
+    h, d, b = decimate(np.asarray(heights, dtype=float), np.asarray(deviation, dtype=float), tolerance)
+    low, high = colour_range(np.asarray(deviation, dtype=float), tolerance)
+    X, Y = np.meshgrid(block_centres(grid.x0, grid.cell, grid.nx, b),
+                       block_centres(grid.y0, grid.cell, grid.ny, b))
+    points = np.column_stack([X.ravel(), Y.ravel(), h.ravel()])
+    root = coin.SoSeparator()
+    root.setName(NODE_NAME)
+    hints = coin.SoShapeHints()  # lit from both sides: walls seen from below are not black
+    hints.vertexOrdering = coin.SoShapeHints.COUNTERCLOCKWISE
+    hints.shapeType = coin.SoShapeHints.UNKNOWN_SHAPE_TYPE
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, len(points), points.tolist())
+    material = coin.SoMaterial()
+    material.diffuseColor.setValues(0, len(points), colours(d, low, high).tolist())
+    binding = coin.SoMaterialBinding()
+    # a quad mesh is not indexed: Coin reads PER_VERTEX_INDEXED as PER_VERTEX there, so say what it is
+    binding.value = coin.SoMaterialBinding.PER_VERTEX
+    mesh = coin.SoQuadMesh()
+    mesh.verticesPerRow = h.shape[1]
+    mesh.verticesPerColumn = h.shape[0]
+    for child in (hints, coords, material, binding, mesh):
+        root.addChild(child)
+    return root, b
+
+
+def find_node(scene: Any, name: str = NODE_NAME) -> bool:
+    """Whether a node named `name` is in the scene graph."""
+    from pivy import coin
+
+    search = coin.SoSearchAction()
+    search.setName(coin.SbName(name))
+    search.setInterest(coin.SoSearchAction.FIRST)
+    search.setSearchingAll(True)
+    search.apply(scene)
+    return search.getPath() is not None
+
+
+# --- text ---------------------------------------------------------------------------------------------
+def hms(seconds: float) -> str:
+    s = int(round(max(seconds, 0.0)))
+    return f"{s // 3600:02d}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+
+def mm(value: float) -> str:
+    return f"{value:+.4f} mm"
+
+
+def cm3(mm3: float) -> str:
+    return f"{mm3 / 1000.0:.3f} cm³"
+
+
+def collisions_text(collisions: list) -> str:
+    if not collisions:
+        return "none"
+    label, move, depth = collisions[0]
+    return f"{len(collisions)} (first: op '{label}', move {move}, {depth:.3f} mm deep)"
+
+
+def ops_text(ops: list) -> str:
+    return "\n".join(f"{o.label}: {hms(o.cycle_seconds)} ({'5' if o.five_axis else '3'}-axis, {o.moves} moves)"
+                     for o in ops)
+
+
+def _buttons(flags: Any) -> int:
+    """FreeCAD reads the standard buttons as an int (PySide6's flags are Python enums: take .value)."""
+    return int(getattr(flags, "value", flags))
+
+
+# --- the panel ----------------------------------------------------------------------------------------
+# (label names, row text): a row of several labels shows them side by side
+RESULT_ROWS = ((("maxLeft",), "Max material left"), (("minDeviation",), "Min deviation (gouge)"),
+               (("p50", "p95", "p99"), "p50 / p95 / p99"),
+               (("removedVolume",), "Removed volume"), (("remainingVolume",), "Remaining above design"),
+               (("cycleTime",), "Cycle time"), (("opTimes",), "Per op"), (("collisions",), "Rapid collisions"),
+               (("cellSize",), "Cell size"), (("simTime",), "Simulation time"), (("heatMap",), "Heat map"))
+LEGEND_SIZE = (260, 14)
+
+
+def _spin(name: str, value: float, decimals: int, low: float, high: float, step: float) -> QtGui.QDoubleSpinBox:
+    spin = QtGui.QDoubleSpinBox()
+    spin.setObjectName(name)
+    spin.setDecimals(decimals)
+    spin.setRange(low, high)
+    spin.setSingleStep(step)
+    spin.setSuffix(" mm")
+    spin.setValue(value)
+    return spin
+
+
+def _legend_image(width: int, height: int) -> QtGui.QImage:
+    """The colour bar: RdBu_r from the most negative deviation (left) through 0 (centre) to the largest."""
+    image = QtGui.QImage(width, height, QtGui.QImage.Format_RGB32)
+    gradient = QtGui.QLinearGradient(0, 0, width, 0)
+    for t in np.linspace(0.0, 1.0, 33):
+        gradient.setColorAt(float(t), QtGui.QColor.fromRgbF(*map(float, _cmap()(t)[:3])))
+    painter = QtGui.QPainter(image)
+    painter.fillRect(0, 0, width, height, QtGui.QBrush(gradient))
+    painter.end()
+    return image
+
+
+class SimulatePanel:
+    """Inputs (cell, tolerance), the Simulate button, the results and legend; the coloured stock in the view."""
+
+    def __init__(self, target: Any) -> None:
+        from tmm_workbench.app.simulation import job_of
+
+        self.target, self.job = target, job_of(target)
+        self.scene: Any = None
+        self.node: Any = None
+        self.hidden: list[Any] = []      # view objects we hid, to show again
+        self.tmp = Path(tempfile.mkdtemp(prefix="tmm_simulate_"))
+        self.runs = 0
+        self.form = self._build_form()
+        # Control.closeDialog() (another command, a closed document) skips reject(): clean up on the form's end
+        self.form.destroyed.connect(lambda *_: self.cleanup())
+        self.observer: Optional[_DocumentGone] = _DocumentGone(self.job.Document.Name)
+        FreeCAD.addDocumentObserver(self.observer)
+
+    # FreeCAD's task dialog protocol (0.20, 1.0, 1.1)
+    def getStandardButtons(self) -> int:
+        return _buttons(QtGui.QDialogButtonBox.Close)
+
+    def reject(self) -> bool:
+        self.cleanup()
+        return True
+
+    def accept(self) -> bool:
+        return self.reject()
+
+    def isAllowedAlterDocument(self) -> bool:
+        return False
+
+    # the form
+    def _build_form(self) -> QtGui.QWidget:
+        form = QtGui.QWidget()
+        form.setObjectName(PANEL_NAME)
+        form.setWindowTitle("TMM Simulate")
+        form.setWindowIcon(QtGui.QIcon(resources.icon("TMM_Simulate")))
+        layout = QtGui.QVBoxLayout(form)
+        layout.addWidget(self._inputs_box())
+        self.status = QtGui.QLabel("")
+        self.status.setObjectName("status")
+        self.status.setWordWrap(True)
+        layout.addWidget(self.status)
+        layout.addWidget(self._results_box())
+        layout.addStretch(1)
+        return form
+
+    def _inputs_box(self) -> QtGui.QGroupBox:
+        box = QtGui.QGroupBox("Simulation")
+        grid = QtGui.QFormLayout(box)
+        kind = "Job" if _is_job(self.target) else "op"
+        of_job = "" if kind == "Job" else f" of Job '{self.job.Label}'"
+        target = QtGui.QLabel(f"{kind} '{self.target.Label}'{of_job}")
+        target.setObjectName("target")
+        grid.addRow("Stock of", target)
+        self.cell = _spin("cell", default_cell(self.target), 3, 0.005, 10.0, 0.05)
+        self.cell.setToolTip("Size of the simulation grid's square cells: finer shows finer scallops, "
+                             "and takes (1 / cell)² longer")
+        self.tolerance = _spin("tolerance", 0.01, 4, 0.0, 10.0, 0.005)
+        self.tolerance.setToolTip("Cells below the design by more than this are gouges")
+        grid.addRow("Cell size", self.cell)
+        grid.addRow("Tolerance", self.tolerance)
+        self.button = QtGui.QPushButton("Simulate")
+        self.button.setObjectName("simulate")
+        self.button.clicked.connect(self.simulate)
+        grid.addRow(self.button)
+        return box
+
+    def _results_box(self) -> QtGui.QGroupBox:
+        box = QtGui.QGroupBox("Results (deviation: vertical, + material left, - gouge)")
+        box.setObjectName("results")
+        grid = QtGui.QFormLayout(box)
+        grid.addRow(self._legend())  # first: it explains the 3D view, and stays in sight
+        self.values: dict[str, QtGui.QLabel] = {}
+        for names, text in RESULT_ROWS:
+            row = QtGui.QHBoxLayout()
+            for name in names:
+                label = QtGui.QLabel("-")
+                label.setObjectName(name)
+                label.setWordWrap(len(names) == 1)
+                label.setTextInteractionFlags(QtCore.Qt.TextSelectableByMouse | QtCore.Qt.LinksAccessibleByMouse)
+                row.addWidget(label, 1)
+                self.values[name] = label
+            grid.addRow(text, row)
+        self.values["heatMap"].setOpenExternalLinks(True)
+        box.setEnabled(False)
+        self.results = box
+        return box
+
+    def _legend(self) -> QtGui.QWidget:
+        legend = QtGui.QWidget()
+        legend.setObjectName("legend")
+        v = QtGui.QVBoxLayout(legend)
+        v.setContentsMargins(0, 0, 0, 4)
+        v.addWidget(QtGui.QLabel("Colours of the stock in the 3D view: deviation, mm"))
+        bar = QtGui.QLabel()
+        bar.setObjectName("colourBar")
+        bar.setPixmap(QtGui.QPixmap.fromImage(_legend_image(*LEGEND_SIZE)))
+        v.addWidget(bar)
+        row = QtGui.QHBoxLayout()
+        self.legend_labels = []
+        for name, align in (("legendMin", QtCore.Qt.AlignLeft), ("legendZero", QtCore.Qt.AlignHCenter),
+                            ("legendMax", QtCore.Qt.AlignRight)):
+            label = QtGui.QLabel("")
+            label.setObjectName(name)
+            label.setAlignment(align)
+            row.addWidget(label, 1)
+            self.legend_labels.append(label)
+        wrap = QtGui.QWidget()
+        wrap.setFixedWidth(LEGEND_SIZE[0])
+        wrap.setLayout(row)
+        row.setContentsMargins(0, 0, 0, 0)
+        v.addWidget(wrap)
+        grey = QtGui.QLabel("grey: no design under the cell")
+        grey.setStyleSheet(f"QLabel {{ background: {NO_DESIGN_HEX}; color: white; padding: 1px 4px; }}")
+        v.addWidget(grey)
+        return legend
+
+    def _set(self, name: str, text: str, value: Optional[float] = None, style: str = "") -> None:
+        label = self.values[name]
+        label.setText(text)
+        label.setStyleSheet(style)
+        label.setProperty("value", value)  # the number itself, for macros and tests
+
+    def _say(self, text: str, error: bool = False) -> None:
+        self.status.setText(text)
+        self.status.setStyleSheet(RED if error else "")
+
+    # simulating
+    def simulate(self) -> None:
+        from tmm_workbench.app import api
+
+        self.remove_node()
+        self.clear_results()
+        self.runs += 1
+        png = self.tmp / f"deviation_{self.runs}.png"
+        self._say("simulating...")
+        self.button.setEnabled(False)
+        QtGui.QApplication.setOverrideCursor(QtCore.Qt.WaitCursor)
+        t0 = time.monotonic()
+        try:
+            report = api.simulate(self.target, cell=self.cell.value(), tolerance=self.tolerance.value(),
+                                  png_path=png, progress=True)
+        except Cancelled:
+            self._say("cancelled")
+            return
+        except TmmError as exc:
+            self._say(str(exc), error=True)
+            return
+        except Exception as exc:  # a bug: the console has the traceback, the panel a line (no dialog)
+            FreeCAD.Console.PrintError(traceback.format_exc())
+            self._say(f"simulation failed: {type(exc).__name__}: {exc}", error=True)
+            return
+        finally:
+            QtGui.QApplication.restoreOverrideCursor()
+            self.button.setEnabled(True)
+        self.show_report(report, time.monotonic() - t0)
+        try:
+            self.show_node(report)
+        except Exception as exc:  # the numbers stand; say why the view has no coloured stock
+            FreeCAD.Console.PrintError(traceback.format_exc())
+            self._say(f"{self.status.text()}; not shown in the 3D view: {exc}", error=True)
+
+    def clear_results(self) -> None:
+        """No numbers of an earlier run beside a new one's error or cancel."""
+        for name in self.values:
+            self._set(name, "-")
+        for label in self.legend_labels:
+            label.setText("")
+        self.results.setEnabled(False)
+
+    def show_report(self, r: Any, seconds: float) -> None:
+        verdict = (f"GOUGED: {r.gouge_cells} cells below the design by more than {r.tolerance:g} mm"
+                   if r.gouged else "no gouge")
+        self._say(verdict + (f"; {len(r.collisions)} rapids cut stock" if r.collisions else ""),
+                  error=bool(r.gouged or r.collisions))
+        self._set("maxLeft", mm(r.max_left), r.max_left)
+        self._set("minDeviation", mm(r.min_deviation), r.min_deviation, RED if r.gouged else "")
+        for p in (50, 95, 99):
+            v = float(r.percentiles.get(p, 0.0))
+            self._set(f"p{p}", f"{v:+.4f}", v)
+        self._set("removedVolume", cm3(r.removed_volume), r.removed_volume / 1000.0)
+        self._set("remainingVolume", cm3(r.remaining_volume), r.remaining_volume / 1000.0)
+        self._set("cycleTime", hms(r.cycle_seconds), r.cycle_seconds)
+        self._set("opTimes", ops_text(r.ops))
+        self._set("collisions", collisions_text(r.collisions), float(len(r.collisions)),
+                  RED if r.collisions else "")
+        grid = r.simulation.grid
+        self._set("cellSize", f"{r.cell:g} mm ({grid.nx} x {grid.ny} cells)", r.cell)
+        kernel = sum(o.seconds for o in r.ops)
+        self._set("simTime", f"{seconds:.2f} s (cutting {kernel:.2f} s)", seconds)
+        link = QtCore.QUrl.fromLocalFile(str(r.png)).toString() if r.png else ""
+        self._set("heatMap", f'<a href="{link}">deviation map (PNG)</a>' if link else "-")
+        low, high = colour_range(r.simulation.comparison.deviation, r.tolerance)
+        for label, text in zip(self.legend_labels, (f"{low:.4f}", "0", f"{high:+.4f} mm")):
+            label.setText(text)
+        self.results.setEnabled(True)
+
+    def show_node(self, r: Any) -> None:
+        sim = r.simulation
+        view = FreeCADGui.getDocument(self.job.Document.Name).activeView()
+        if not hasattr(view, "getSceneGraph"):
+            raise TmmError("the document's active view is not a 3D view")
+        node, block = stock_node(sim.grid, sim.result.heights, sim.comparison.deviation, r.tolerance)
+        self.scene = view.getSceneGraph()
+        self.scene.addChild(node)
+        self.node = node
+        self.hide_job()
+        if block > 1:
+            self._set("cellSize", self.values["cellSize"].text() + f"; shown every {block} cells", r.cell)
+        view.fitAll()
+
+    # the view as it was
+    def hide_job(self) -> None:
+        """The Job's model, stock and paths would hide the coloured stock or fight with it (the design is
+        where the stock is, within the scallops): hidden while it shows."""
+        objs = list(getattr(self.job.Model, "Group", []) or []) + [self.job.Stock]
+        objs += self.job.Operations.OutListRecursive if self.job.Operations else []
+        for obj in objs:
+            vo = getattr(obj, "ViewObject", None)
+            if vo is not None and vo.Visibility:
+                vo.Visibility = False
+                self.hidden.append(vo)
+
+    def show_job(self) -> None:
+        for vo in self.hidden:
+            try:
+                vo.Visibility = True
+            except Exception:  # the object went meanwhile
+                pass
+        self.hidden = []
+
+    def remove_node(self) -> None:
+        if self.node is not None and self.scene is not None:
+            try:
+                index = self.scene.findChild(self.node)
+                if index >= 0:
+                    self.scene.removeChild(index)
+            except Exception:  # the view (its document) was closed: the node went with it
+                pass
+        self.node = self.scene = None
+        self.show_job()
+
+    def cleanup(self) -> None:
+        self.remove_node()
+        shutil.rmtree(self.tmp, ignore_errors=True)
+        if self.observer is not None:
+            FreeCAD.removeDocumentObserver(self.observer)
+            self.observer = None
+
+
+class _DocumentGone:
+    """Closes the panel when its Job's document closes (0.20's Python task dialogs stay open otherwise)."""
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+
+    def slotDeletedDocument(self, doc: Any) -> None:
+        if doc.Name == self.name:  # after the deletion, not inside it
+            QtCore.QTimer.singleShot(0, FreeCADGui.Control.closeDialog)
+
+
+# --- the command --------------------------------------------------------------------------------------
+class CommandSimulate:
+    def GetResources(self) -> dict[str, str]:
+        return {"Pixmap": resources.icon("TMM_Simulate"),
+                "MenuText": QtCore.QT_TRANSLATE_NOOP("TMM_Simulate", "TMM Simulate"),
+                "ToolTip": QtCore.QT_TRANSLATE_NOOP(
+                    "TMM_Simulate", "Cuts the selected Job's stock with its active operations (or with the "
+                    "selected operation) and compares it with the model: material left, gouges, volumes, "
+                    "cycle time, rapids through stock; the simulated stock coloured by its deviation")}
+
+    def IsActive(self) -> bool:
+        return FreeCAD.ActiveDocument is not None and selected_target() is not None
+
+    def Activated(self) -> None:
+        target = selected_target()
+        if target is None:
+            return
+        if FreeCADGui.Control.activeDialog():
+            QtGui.QMessageBox.information(FreeCADGui.getMainWindow(), "TMM",
+                                          "Close the open task panel first, then simulate.")
+            return
+        FreeCADGui.Control.showDialog(SimulatePanel(target))
+
+
+FreeCADGui.addCommand(COMMAND_NAME, CommandSimulate())
