@@ -27,6 +27,7 @@ from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute_sur
 from tmm_workbench.core.tools.cutter import Cutter
 
 SLOPE_BANDS = ((0.0, 20.0), (20.0, 40.0), (40.0, 60.0), (60.0, 90.0))  # degrees from the horizontal
+TIE_MM = 1e-4
 
 
 @dataclass
@@ -48,7 +49,8 @@ class CutterScore:
 class CutterComparison:
     scores: list                # CutterScore, ranked best first
     reasons: list               # one sentence per rank
-    best_cell: np.ndarray       # (ny, nx) index into `labels` of the cutter leaving the least; -1: no design
+    best_cell: np.ndarray       # (ny, nx) index into `labels` of the cutter leaving the least (the first of
+    #                             those tied); -1: no design
     labels: list                # candidate labels in the order given
     grid: Grid
 
@@ -98,11 +100,15 @@ def compare_cutters(mesh: TriMesh, candidates: Sequence[tuple[str, Cutter]], *, 
     labels = [label for label, _ in candidates]
     ranked = sorted(scores, key=lambda s: (s.gouge > tolerance, s.remaining_volume, s.cycle_seconds))
     reasons = []
+    least = stack.min(axis=0)
+    on_design = np.isfinite(design)
     for k, s in enumerate(ranked):
-        share = float(np.mean(best_cell[best_cell >= 0] == labels.index(s.label))) * 100
+        # ties are common (every cutter leaves 0 on a flat): "the least" is within TIE_MM of the best
+        mine = stack[labels.index(s.label)]
+        share = float(np.mean((mine <= least + TIE_MM)[on_design])) * 100
         text = (f"{k + 1}. {s.label}: {s.remaining_volume / 1000:.3f} cm3 left above the design, max scallop "
                 f"{s.max_left:.4f} mm (mean {s.mean_left:.4f}), {s.cycle_seconds / 60:.1f} min; leaves the least "
-                f"in {share:.0f} % of the surface")
+                f"(within {TIE_MM * 1000:g} um) in {share:.0f} % of the surface")
         if s.gouge > tolerance:
             text += f"; GOUGES {s.gouge:.4f} mm (ranked last)"
         reasons.append(text)
