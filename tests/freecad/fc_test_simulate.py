@@ -72,6 +72,23 @@ class Simulate3Axis(FreeCADTestCase):
         close_all()
 
 
+class OptimalCutter(FreeCADTestCase):
+    def test_compare_cutters_from_tool_bits(self) -> None:
+        from tmm_workbench.app import tools
+        from tmm_workbench.app.api import compare_cutters
+
+        doc = new_doc("TmmOptimal")
+        ball = tools.make_tool_bit(doc, "ballend", 4.0)
+        bull = tools.make_tool_bit(doc, "bullnose", 4.0, 1.0)
+        out = compare_cutters(str(bump_stl()), [ball, bull], stepover=1.0, sample_step=0.5, cell=0.1)
+        self.assertEqual({s.label for s in out.scores}, {ball.Label, bull.Label})
+        self.assertEqual(len(out.reasons), 2)
+        self.assertTrue(all(s.gouge <= 0.01 for s in out.scores))
+        with self.assertRaises(TmmError):
+            compare_cutters(str(bump_stl()), [ball], stepover=0.0, sample_step=0.5)
+        close_all()
+
+
 class Simulate5Axis(FreeCADTestCase):
     def test_multipoint_job(self) -> None:
         r5 = run_multipoint(seed_net(), doc_name="TmmSim5", **FAST)

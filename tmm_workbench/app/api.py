@@ -433,3 +433,37 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
         if fail_on_gouge:
             raise TmmError(text)
     return report
+
+
+def compare_cutters(model: Any, candidates: Sequence[Any], *, stepover: float, sample_step: float,
+                    cell: float = 0.1, tolerance: float = 0.01, angle_deg: float = 0.0, margin: float = 0.0,
+                    horiz_feed: float = 1000.0, vert_feed: float = 300.0) -> Any:
+    """Seed 003's optimal cutter (core.sim.optimal_cutter): the same 3-axis raster with each candidate, each
+    simulated and compared with the model, ranked with the reason. `model`: an STL path, a Mesh/Part object
+    or a Job (its model); `candidates`: ToolBits, tool controllers (their tool) or core Cutters. Feeds in
+    mm/min, the same for all (the cycle times compare the paths)."""
+    from tmm_workbench.app import geometry, simulation
+    from tmm_workbench.app.op_surface import mesh_of_model
+    from tmm_workbench.core.sim.optimal_cutter import compare_cutters as core_compare
+    from tmm_workbench.core.strategies.raster_drop import SurfaceParams
+
+    _numbers(stepover=(stepover, spec_of(SurfaceParams, "stepover")),
+             sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
+             cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
+             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED))
+    if isinstance(model, (str, os.PathLike)):
+        mesh = geometry.mesh_from_stl(model)
+    elif simulation.job_of(model) is model:
+        mesh = geometry.combine([mesh_of_model(m, 0.001) for m in model.Model.Group])
+    else:
+        mesh = mesh_of_model(model, 0.001)
+    cutters = []
+    for c in candidates:
+        if isinstance(c, Cutter):
+            cutters.append((c.describe(), c))
+        else:
+            bit = getattr(c, "Tool", c)  # a tool controller carries its ToolBit
+            cutters.append((tools.label_of(bit), tools.cutter_from_tool(bit)))
+    return core_compare(mesh, cutters, stepover=stepover, sample_step=sample_step, cell=cell, tolerance=tolerance,
+                        angle_deg=angle_deg, margin=margin, horiz_feed=horiz_feed / 60.0,
+                        vert_feed=vert_feed / 60.0)
