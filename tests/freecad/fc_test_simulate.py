@@ -72,6 +72,46 @@ class Simulate3Axis(FreeCADTestCase):
         close_all()
 
 
+class FreeCADArcs(FreeCADTestCase):
+    def test_a_path_with_arcs_is_simulated_as_chords(self) -> None:
+        """A Path object in the Job with a G2 full circle (as FreeCAD's Profile writes): read as chords within
+        1 um, and the flat end mill's groove in the stock is the circle's (depth and radius)."""
+        import numpy as np
+
+        doc = new_doc("TmmArcs")
+        job, tc, op = job_with_op(doc, str(bump_stl()), shape="endmill", diameter=2.0)
+        arc = doc.addObject("Path::Feature", "Circle")
+        arc.addProperty("App::PropertyLink", "ToolController", "Path")
+        arc.ToolController = tc
+        top = job.Stock.Shape.BoundBox.ZMax
+        arc.Path = Path.Path([Path.Command("G0", {"X": 15.0, "Y": 10.0, "Z": top + 5}),
+                              Path.Command("G1", {"X": 15.0, "Y": 10.0, "Z": top - 0.5, "F": 5.0}),
+                              Path.Command("G2", {"X": 15.0, "Y": 10.0, "Z": top - 0.5, "I": -5.0, "J": 0.0}),
+                              Path.Command("G0", {"X": 15.0, "Y": 10.0, "Z": top + 5})])
+        job.Operations.addObject(arc)
+        tp, feeds = simulation._toolpath_and_feeds(arc)
+        pts = tp.points()[2:-1]
+        self.assertGreater(len(pts), 100)
+        np.testing.assert_allclose(np.hypot(pts[:, 0] - 10.0, pts[:, 1] - 10.0), 5.0, atol=1e-9)
+        r = simulate(arc, cell=0.1, progress=False)
+        sim = r.simulation
+        h, xs, ys = sim.result.heights, sim.grid.xs(), sim.grid.ys()
+        X, Y = np.meshgrid(xs, ys)
+        rho = np.hypot(X - 10.0, Y - 10.0)
+        self.assertTrue(np.allclose(h[np.abs(rho - 5.0) < 0.9], top - 0.5))      # under the 2 mm tool
+        self.assertTrue(np.allclose(h[(rho < 3.9) | (rho > 6.1)], top))          # beside it: untouched
+        # fed down 5.5 mm and round the circle at 5 mm/s, rapid up 5.5 mm
+        self.assertAlmostEqual(r.ops[0].cycle_seconds, (5.5 + 2 * np.pi * 5.0) / 5.0 + 5.5 / simulation_rapid(tc),
+                               delta=1e-3)
+        close_all()
+
+
+def simulation_rapid(tc) -> float:
+    from tmm_workbench.core.sim.cycle_time import DEFAULT_RAPID_MM_S
+
+    return tc.VertRapid.Value or DEFAULT_RAPID_MM_S
+
+
 class OptimalCutter(FreeCADTestCase):
     def test_compare_cutters_from_tool_bits(self) -> None:
         from tmm_workbench.app import tools

@@ -2,7 +2,7 @@
 of core.sim. The stock is the Job's stock solid as a height field (box, cylinder or any solid: its top on
 each cell's vertical line), the design the Job's model objects tessellated finely; each active op in order
 cuts the same z-map with its own tool (app.tools, the one ToolBit map) from its Path (G0/G1, 5-axis axes
-in U/V/W: core.path5). Cycle time: 3-axis ops from the Path's feeds and the tool controller's rapid rates,
+in U/V/W: core.path5; the XY arcs of FreeCAD's own ops as chords within 1 um: core.arcs). Cycle time: 3-axis ops from the Path's feeds and the tool controller's rapid rates,
 5-axis ops from the Tarus post's estimate (joint speeds, A and C planned)."""
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import numpy as np
 
 from tmm_workbench.app import geometry, post_objects, tools
 from tmm_workbench.core import path5
+from tmm_workbench.core.arcs import arc_points
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.sim import compare as compare_mod
 from tmm_workbench.core.sim.cycle_time import three_axis_time
@@ -23,6 +24,7 @@ from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 DESIGN_DEFLECTION_MM = 0.001  # the model tessellated this close: well below the scallops compared
+ARC_TOLERANCE_MM = 0.001      # chords of G2/G3 arcs (FreeCAD's ops) within this of the arc
 
 
 @dataclass
@@ -82,14 +84,26 @@ def _toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
     tp = Toolpath()
     feeds: list = []
     for m in moves:
-        if m.name not in ("G0", "G1"):
-            raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): arcs are not simulated yet")
         if any(math.isnan(c) for c in m.tip):
             if m.is_rapid and not len(tp):
                 continue  # a Z-only rapid before the first XY: from wherever the tool is, up (never into stock)
             raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): X, Y or Z was never given")
+        feed = None if m.is_rapid else (m.feed or float(op.ToolController.HorizFeed.Value))
+        if m.name in ("G2", "G3"):  # FreeCAD's own ops: chords within 1 um, at the arc's feed
+            if not len(tp):
+                raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): an arc before any position")
+            last = tp.moves[-1]
+            try:
+                pts = arc_points((last.x, last.y, last.z), m.tip, float(m.params.get("I", 0.0)),
+                                 float(m.params.get("J", 0.0)), m.name == "G2", ARC_TOLERANCE_MM)
+            except TmmError as exc:
+                raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): {exc}") from None
+            for p in pts:
+                tp.add(MoveKind.FEED, *p, axis=m.axis)
+                feeds.append(feed)
+            continue
         tp.add(MoveKind.RAPID if m.is_rapid else MoveKind.FEED, *m.tip, axis=m.axis)
-        feeds.append(None if m.is_rapid else (m.feed or float(op.ToolController.HorizFeed.Value)))
+        feeds.append(feed)
     return tp, feeds
 
 

@@ -1,0 +1,37 @@
+"""Arcs (G2/G3 in the XY plane, FreeCAD's I/J: the centre relative to the start; Z helical, linear in the
+angle) as chords no further than `tolerance` from the arc: what the simulator and the checks read of paths
+made by FreeCAD's own ops (TMM's ops write lines only)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+
+
+def arc_points(start, end, i: float, j: float, clockwise: bool, tolerance: float = 1e-3) -> np.ndarray:
+    """(k, 3) points after `start` along the arc to `end` (the last row is `end`). A full circle when start
+    and end coincide in XY. TmmError when the centre is not equidistant (by more than 1e-4 relative)."""
+    p0, p1 = np.asarray(start, float), np.asarray(end, float)
+    c = p0[:2] + (i, j)
+    r0, r1 = float(np.hypot(*(p0[:2] - c))), float(np.hypot(*(p1[:2] - c)))
+    if not (r0 > 0 and math.isfinite(r0)):
+        raise TmmError(f"arc from {p0.tolist()} with centre offset ({i:g}, {j:g}): zero radius")
+    if abs(r0 - r1) > 1e-4 * max(r0, 1.0) + 1e-6:
+        raise TmmError(f"arc from {p0.tolist()} to {p1.tolist()}: the centre is {r0:.6g} mm from the start and "
+                       f"{r1:.6g} mm from the end")
+    a0 = math.atan2(p0[1] - c[1], p0[0] - c[0])
+    a1 = math.atan2(p1[1] - c[1], p1[0] - c[0])
+    sweep = (a0 - a1) if clockwise else (a1 - a0)
+    sweep %= 2 * math.pi
+    if sweep < 1e-12:
+        sweep = 2 * math.pi  # the same point: a full circle
+    step = 2 * math.acos(max(-1.0, 1 - tolerance / r0)) if tolerance < r0 else math.pi / 2
+    n = max(1, math.ceil(sweep / step))
+    t = np.arange(1, n + 1) / n
+    ang = a0 + (-sweep if clockwise else sweep) * t
+    r = r0 + (r1 - r0) * t
+    pts = np.column_stack([c[0] + r * np.cos(ang), c[1] + r * np.sin(ang), p0[2] + (p1[2] - p0[2]) * t])
+    pts[-1] = p1
+    return pts
