@@ -95,7 +95,7 @@ def test_rapid_collisions_and_refusals():
     bad[2, 1] = np.nan
     with pytest.raises(ValueError, match="tips row 2"):
         nat.cut_5axis(stock, RO, RI, "round_insert", bad, axes, np.zeros(3, np.uint8))
-    with pytest.raises(ValueError, match="kinds"):
+    with pytest.raises(ValueError, match="kind of move 1 is 3"):
         nat.cut_5axis(stock, RO, RI, "round_insert", tips, axes, np.array([0, 3, 0], np.uint8))
     with pytest.raises(ValueError, match="max_step"):
         nat.cut_5axis(stock, RO, RI, "round_insert", tips, axes, np.zeros(3, np.uint8), max_step=0.0)

@@ -12,6 +12,7 @@
 
 #include "tmm/sim/sweep3.hpp"
 #include "tmm/sim/zmap.hpp"
+#include "sim/sim_arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -19,49 +20,14 @@ using tmm_bindings::python_progress;
 
 namespace {
 
-using Tips = py::array_t<double, py::array::c_style | py::array::forcecast>;
-
-// An (n - 1,) integer array of move kinds, checked before any narrowing cast (a 256 must not become 0).
-std::vector<tmm::MoveKind> kinds_from(const py::handle& obj, std::size_t moves) {
-  const py::array a = py::array::ensure(obj);
-  if (!a) throw py::type_error("kinds must be an (n - 1,) integer array of move kinds");
-  const char kind = a.dtype().kind();
-  if (kind != 'i' && kind != 'u')
-    throw py::type_error("kinds must be an integer array (0 cut, 1 rapid, 2 jump), got dtype " +
-                         std::string(py::str(a.dtype())));
-  if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != moves) {
-    std::ostringstream msg;
-    msg << "kinds must have shape (n - 1,) = (" << moves << ",), one per move, got ";
-    if (a.ndim() == 1) msg << "(" << a.shape(0) << ",)";
-    else msg << "ndim " << a.ndim();
-    throw std::invalid_argument(msg.str());
-  }
-  std::vector<tmm::MoveKind> out(moves);
-  const auto put = [&](auto typed) {
-    const auto r = typed.template unchecked<1>();
-    for (py::ssize_t k = 0; k < r.shape(0); ++k) {
-      const auto v = r(k);
-      if (v < 0 || v > 2) {
-        std::ostringstream msg;
-        msg << "kind of move " << k << " is " << v << ": not a move kind (0 cut, 1 rapid, 2 jump)";
-        throw std::invalid_argument(msg.str());
-      }
-      out[static_cast<std::size_t>(k)] = static_cast<tmm::MoveKind>(v);
-    }
-  };
-  if (kind == 'u') put(py::array_t<std::uint64_t, py::array::forcecast>(a));
-  else put(py::array_t<std::int64_t, py::array::forcecast>(a));
-  return out;
-}
+using tmm_bindings::check_rows;
+using tmm_bindings::kinds_from;
+using tmm_bindings::report_dict;
+using Tips = tmm_bindings::Rows;
 
 py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips, const py::handle& kinds,
                    double collision_tol, int threads, const py::object& progress) {
-  if (tips.ndim() != 2 || tips.shape(1) != 3) {
-    std::ostringstream msg;
-    msg << "tips must have shape (n, 3), got ndim " << tips.ndim();
-    if (tips.ndim() == 2) msg << " and " << tips.shape(1) << " columns";
-    throw std::invalid_argument(msg.str());
-  }
+  check_rows(tips, "tips");
   const std::size_t n = static_cast<std::size_t>(tips.shape(0));
   const std::vector<tmm::MoveKind> k = kinds_from(kinds, n > 0 ? n - 1 : 0);
   tmm::Sweep3Options options;
@@ -74,17 +40,7 @@ py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips
     py::gil_scoped_release release;
     report = tmm::cut_3axis(stock, cutter, tips.data(), k.data(), n, options, batch);
   }
-  py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
-  auto c = collisions.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < report.collisions.size(); ++i) {
-    c(i, 0) = static_cast<double>(report.collisions[i].move);
-    c(i, 1) = report.collisions[i].depth;
-  }
-  py::dict out;
-  out["moves_cut"] = report.moves_cut;
-  out["cells_lowered"] = report.cells_lowered;
-  out["collisions"] = collisions;
-  return out;
+  return report_dict(report);
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "tmm/sim/sweep5.hpp"
+#include "sim/sim_arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -18,7 +19,10 @@ using tmm_bindings::python_progress;
 
 namespace {
 
-using Rows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+using tmm_bindings::check_rows;
+using tmm_bindings::kinds_from;
+using tmm_bindings::report_dict;
+using tmm_bindings::Rows;
 
 tmm::TorusTool tool_from(double Ro, double Ri, const std::string& shape) {
   tmm::TorusTool t;
@@ -29,44 +33,6 @@ tmm::TorusTool tool_from(double Ro, double Ri, const std::string& shape) {
   else throw std::invalid_argument("tool_shape must be 'round_insert' or 'bull_nose', got '" + shape + "'");
   t.validate();
   return t;
-}
-
-void check_rows(const Rows& a, const char* what) {
-  if (a.ndim() != 2 || a.shape(1) != 3) {
-    std::ostringstream msg;
-    msg << what << " must have shape (n, 3), got ndim " << a.ndim();
-    if (a.ndim() == 2) msg << " and " << a.shape(1) << " columns";
-    throw std::invalid_argument(msg.str());
-  }
-}
-
-// (n - 1,) integer move kinds, range-checked before the narrowing cast (a 256 must not become 0).
-std::vector<tmm::MoveKind> kinds_from(const py::handle& obj, std::size_t moves) {
-  const py::array a = py::array::ensure(obj);
-  if (!a) throw py::type_error("kinds must be an (n - 1,) integer array of move kinds");
-  const char kind = a.dtype().kind();
-  if (kind != 'i' && kind != 'u')
-    throw py::type_error("kinds must be an integer array (0 cut, 1 rapid, 2 jump), got dtype " +
-                         std::string(py::str(a.dtype())));
-  if (a.ndim() != 1 || static_cast<std::size_t>(a.shape(0)) != moves) {
-    std::ostringstream msg;
-    msg << "kinds must have shape (n - 1,) = (" << moves << ",), one per move, got ";
-    if (a.ndim() == 1) msg << "(" << a.shape(0) << ",)";
-    else msg << "ndim " << a.ndim();
-    throw std::invalid_argument(msg.str());
-  }
-  std::vector<tmm::MoveKind> out(moves);
-  const py::array_t<std::int64_t, py::array::forcecast> v(a);
-  const auto r = v.unchecked<1>();
-  for (py::ssize_t k = 0; k < r.shape(0); ++k) {
-    if (r(k) < 0 || r(k) > 2) {
-      std::ostringstream msg;
-      msg << "kinds[" << k << "] = " << r(k) << " is not a move kind (0 cut, 1 rapid, 2 jump)";
-      throw std::invalid_argument(msg.str());
-    }
-    out[static_cast<std::size_t>(k)] = static_cast<tmm::MoveKind>(r(k));
-  }
-  return out;
 }
 
 py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& shape, const Rows& tips,
@@ -94,16 +60,7 @@ py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& sh
     py::gil_scoped_release release;
     report = tmm::cut_5axis(stock, tool, tips.data(), axes.data(), k.data(), n, options, batch, &stats);
   }
-  py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
-  auto c = collisions.mutable_unchecked<2>();
-  for (std::size_t i = 0; i < report.collisions.size(); ++i) {
-    c(i, 0) = static_cast<double>(report.collisions[i].move);
-    c(i, 1) = report.collisions[i].depth;
-  }
-  py::dict out;
-  out["moves_cut"] = report.moves_cut;
-  out["cells_lowered"] = report.cells_lowered;
-  out["collisions"] = collisions;
+  py::dict out = report_dict(report);
   out["instances"] = stats.instances;
   out["cells_tested"] = stats.cells_tested;
   out["exact_solves"] = stats.exact_solves;
