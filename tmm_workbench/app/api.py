@@ -384,6 +384,7 @@ class SimulationReport:
     gouged: bool
     collisions: list           # [(op label, move, depth mm)]: rapids through stock
     cycle_seconds: float       # all ops
+    regions: dict              # "slope 0-20 deg", ...: the same numbers per slope band of the design
     ops: list                  # app.simulation.OpSimulation per op
     png: Optional[str]         # the heat map written, when asked
     cell: float
@@ -418,7 +419,9 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
         png = render_deviation_png(sim.comparison, sim.grid, str(png_path), f"{label}: simulated stock vs design")
     report = SimulationReport(o.max_left, o.min_deviation, dict(o.percentiles), sim.comparison.removed_volume,
                               o.remaining_volume, o.gouge_cells, sim.comparison.gouged, sim.collisions,
-                              sim.cycle_seconds, sim.ops, png, cell, tolerance, sim)
+                              sim.cycle_seconds,
+                              {k: v.as_dict() for k, v in sim.comparison.regions.items()}, sim.ops, png, cell,
+                              tolerance, sim)
     problems = []
     if report.gouged:
         problems.append(f"the simulated stock is gouged {-o.min_deviation:.4f} mm below the design in "

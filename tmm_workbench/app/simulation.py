@@ -156,6 +156,17 @@ def _design_heights(job: Any, ops: list, grid: Grid) -> np.ndarray:
     return mesh_heights(geometry.combine(meshes), grid)
 
 
+def slope_regions(design: np.ndarray, cell: float) -> dict:
+    """Masks of the design's cells by slope band (core.sim.optimal_cutter.SLOPE_BANDS): where seed 003
+    found the cutters differ."""
+    from tmm_workbench.core.sim.optimal_cutter import SLOPE_BANDS
+
+    filled = np.where(np.isfinite(design), design, np.nanmin(design) if np.isfinite(design).any() else 0.0)
+    gy, gx = np.gradient(filled, cell)
+    slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    return {f"slope {lo:g}-{hi:g} deg": np.isfinite(design) & (slope >= lo) & (slope < hi) for lo, hi in SLOPE_BANDS}
+
+
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
                  progress: Optional[Callable[[float], bool]] = None) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
@@ -193,5 +204,5 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
                                                     result.seconds + r.seconds, result.five_axis or five)
     # cells compared: the design under them and stock there to begin with
     design_here = np.where(initial >= design - tolerance, design, np.nan)
-    comparison = compare_mod.compare(result, design_here, tolerance)
+    comparison = compare_mod.compare(result, design_here, tolerance, slope_regions(design_here, grid.cell))
     return JobSimulation(grid, result, comparison, done, design_here)
