@@ -76,8 +76,12 @@ class MultipointOp(FreeCADTestCase):
         # the cut moves are the strategy's cut segments, tip and axis, within 1e-6 (linked once)
         cut_tips = np.vstack([s.tips for s in r.segments])
         cut_axes = np.vstack([s.axes for s in r.segments])
-        cut_path = [m for m in decoded if m.name == "G1"]
+        # G1: the cut moves, and the approaches and exits along the axis below the safe height (fed)
+        on_face = {tuple(np.round(t, 6)) for t in cut_tips}
+        cut_path = [m for m in decoded if m.name == "G1" and tuple(np.round(m.tip, 6)) in on_face]
         self.assertEqual(len(cut_path), len(cut_tips))
+        approach = [m for m in decoded if m.name == "G1" and tuple(np.round(m.tip, 6)) not in on_face]
+        self.assertEqual(len(approach), 2 * len(r.segments) - 2 * sum(bool(s.joined) for s in r.segments))
         np.testing.assert_allclose([m.tip for m in cut_path], cut_tips, atol=1e-6)
         np.testing.assert_allclose([m.axis for m in cut_path], cut_axes, atol=1e-9)
         # tilted where the core reports two contacts
@@ -91,12 +95,18 @@ class MultipointOp(FreeCADTestCase):
         # feeds: plunge at the vertical, cutting at the horizontal feed (mm/s); rapids carry no F
         self.assertEqual({round(m.params["F"] * 60, 6) for m in cut_path if "F" in m.params}, {1000.0, 300.0})
         self.assertTrue(all("F" not in p for n, p in motion if n == "G0"))
-        # retract along the tool axis: each G0 right after a cut leaves along the last axis
+        # in and out along the tool axis, fed (G1) below the safe height: each exit leaves a cut along its
+        # last axis, each entry reaches the face along its first, AxisRetract long; rapids only above
+        def faced(m) -> bool:
+            return m.name == "G1" and tuple(np.round(m.tip, 6)) in on_face
+        exits = 0
         for a, b in zip(decoded, decoded[1:]):
-            if a.name == "G1" and b.name == "G0":
-                d = np.subtract(b.tip, a.tip)
-                np.testing.assert_allclose(d / np.linalg.norm(d), a.axis, atol=1e-9)
+            if faced(a) != faced(b) and a.name == b.name == "G1":
+                d = np.subtract(b.tip, a.tip) * (1 if faced(a) else -1)
+                np.testing.assert_allclose(d / np.linalg.norm(d), (a if faced(a) else b).axis, atol=1e-9)
                 self.assertAlmostEqual(float(np.linalg.norm(d)), op.AxisRetract.Value, places=9)
+                exits += faced(a)
+        self.assertGreater(exits, 0)
 
         # posts (through compat.load_post): tarus -> A and C words, apt_cl -> GOTO/x,y,z,i,j,k
         tarus = r.gcode["tarus"]

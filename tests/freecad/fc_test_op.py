@@ -188,6 +188,26 @@ class OpInJob(FreeCADTestCase):
 
 
 class SaveAndReopen(FreeCADTestCase):
+    def test_a_document_from_before_the_chord_tolerance_keeps_every_point(self) -> None:
+        doc = new_doc("TmmOld")
+        _, _, op = job_with_op(doc, str(bump_stl()))
+        self.assertAlmostEqual(op.ChordTolerance.Value, 0.001)   # a new op: longer moves where they fit
+        lean = len(op.Path.Commands)
+        op.removeProperty("ChordTolerance")                      # as saved by an older TMM
+        path = OUT / "old_chord.FCStd"
+        doc.saveAs(str(path))
+        name = op.Name
+        close_all()
+        doc = FreeCAD.openDocument(str(path))
+        op = doc.getObject(name)
+        self.assertEqual(op.ChordTolerance.Value, 0.0)           # what it was computed with
+        op.Proxy.progress_enabled = False
+        op.touch()
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertGreater(len(op.Path.Commands), lean)
+        close_all()
+
     def test_save_reopen_keeps_op_properties_and_path(self) -> None:
         doc = new_doc("TmmSave")
         values = {"StepOver": 2.5, "SampleStep": 0.8, "Pattern": "OneWay", "RasterAngle": 30.0,

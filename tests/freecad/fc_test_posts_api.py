@@ -127,7 +127,9 @@ class Api(FreeCADTestCase):
         self.assertEqual(gcode_path.read_text(), r.gcode)
         self.assertEqual(r.job.PostProcessor, "linuxcnc")
         self.assertEqual(len(r.mesh), 7570)
-        top = float(r.mesh.bounds[1][2])
+        # heights from the higher of the model's and the Job stock's top (the stock is 1 mm above the model)
+        top = max(float(r.mesh.bounds[1][2]), r.job.Stock.Shape.BoundBox.ZMax)
+        self.assertGreater(top, float(r.mesh.bounds[1][2]))
         self.assertAlmostEqual(r.op.SafeHeight.Value, top + 5, places=6)
         self.assertAlmostEqual(r.op.ClearanceHeight.Value, top + 10, places=6)
         lo, hi = r.mesh.bounds
@@ -171,7 +173,7 @@ class Api(FreeCADTestCase):
         cut = r.toolpath.cutting_points()
         self.assertAlmostEqual(cut[:, 2].max(), 10.0, places=6)  # the flat top, with the placement
         self.assertAlmostEqual(cut[:, 0].min(), 5.0, places=6)
-        self.assertAlmostEqual(r.op.SafeHeight.Value, 15.0)
+        self.assertAlmostEqual(r.op.SafeHeight.Value, r.job.Stock.Shape.BoundBox.ZMax + 5.0)  # above the stock
 
     def test_progress_callback_and_cancel(self) -> None:
         seen = []

@@ -58,6 +58,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 diameter: float = 6.0, corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
                 boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
+                chord_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
@@ -71,6 +72,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     pattern: 'zigzag' | 'oneway'; boundary: 'model' | 'stock' XY box grown by `margin` (mm).
     off_model: 'floor' (cut along the model's lowest point where no part of it is under the tool) | 'skip'
     (lift over such places, cut only over the model).
+    chord_tolerance: how far above the CL points a longer straight move may pass where it replaces them
+    (mm; default the op's, 0.001; 0 keeps every point off a straight line).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -81,8 +84,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
              sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
              angle_deg=(angle_deg, spec_of(SurfaceParams, "angle_deg")),
              stock_to_leave=(stock_to_leave, spec_of(SurfaceParams, "stock_to_leave")), margin=(margin, _LENGTH),
+             chord_tolerance=(chord_tolerance, spec_of(SurfaceParams, "chord_tol")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
+    extra = {} if chord_tolerance is None else {"ChordTolerance": chord_tolerance}
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)
@@ -96,7 +101,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     try:
         result = _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
                         pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height,
-                        clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress)
+                        clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress, extra)
     except BaseException:
         if own_doc:
             FreeCAD.closeDocument(doc.Name)
@@ -136,7 +141,7 @@ def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, cor
            stepover: float, sample_step: float, angle_deg: float, pattern: str, stock_to_leave: float, boundary: str,
            margin: float, off_model: str, safe_height: Optional[float], clearance_height: Optional[float],
            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str,
-           gcode_path: Any, progress: Any) -> SurfaceResult:
+           gcode_path: Any, progress: Any, extra: dict) -> SurfaceResult:
     jm = jobs.prepare_model(doc, model)
     doc.recompute()
     job = jobs.create_job(doc, jm.job_base)
@@ -149,6 +154,7 @@ def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, cor
     values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
               "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
               "BoundaryMargin": margin, "OffModel": off_model, "SafeHeight": safe, "ClearanceHeight": clearance}
+    values.update(extra)
     if jm.stl_file:
         values["StlFile"] = jm.stl_file
     else:

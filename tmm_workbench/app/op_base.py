@@ -55,14 +55,16 @@ def _plain(value: Any) -> Any:
 class TmmOp(PathOp.ObjectOp):
     """Base of the TMM op proxies. Subclasses set PARAMS (the strategy's params dataclass), PROPERTIES
     (Prop rows), CHOICES (enumeration property -> {property value: core value}), DEFAULTS (values of
-    properties that name no params field), READ_ONLY, and implement `compute(obj)` (opExecute runs it
-    through `guarded`)."""
+    properties that name no params field), READ_ONLY, RESTORED_DEFAULTS (what a property added later gets
+    in a document saved before it: the behaviour the document was computed with), and implement
+    `compute(obj)` (opExecute runs it through `guarded`)."""
 
     PARAMS: Optional[type] = None
     PROPERTIES: list[Prop] = []
     CHOICES: dict[str, dict[str, Any]] = {}
     DEFAULTS: dict[str, Any] = {}
     READ_ONLY: tuple[str, ...] = ()
+    RESTORED_DEFAULTS: dict[str, Any] = {}
     progress_enabled: bool = True
 
     def __init__(self, obj: Any, name: str, parentJob: Any = None,
@@ -113,8 +115,8 @@ class TmmOp(PathOp.ObjectOp):
                 obj.addProperty(row.type, row.name, row.group, row.tooltip)
                 if row.name in self.CHOICES:
                     setattr(obj, row.name, list(self.CHOICES[row.name]))
-                if restoring and row.name in defaults:
-                    setattr(obj, row.name, defaults[row.name])
+                if restoring and row.name in defaults:  # an older document: what it computed then
+                    setattr(obj, row.name, self.RESTORED_DEFAULTS.get(row.name, defaults[row.name]))
         for name in self.READ_ONLY:
             obj.setEditorMode(name, 1)
 

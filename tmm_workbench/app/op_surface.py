@@ -47,6 +47,9 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "Pattern", "Surface",
          "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes", "pattern"),
     Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
+    Prop("App::PropertyDistance", "ChordTolerance", "Surface",
+         "How far above the CL points a longer straight move may pass where it replaces them (never below one; "
+         "0: keep every point off a straight line)", "chord_tol"),
     Prop("App::PropertyAngle", "PlungeAngle", "Feeds",
          "Cutting moves going down more steeply than this (below the horizontal) run at the vertical feed"),
     Prop("App::PropertyEnumeration", "OffModel", "Surface",
@@ -65,6 +68,7 @@ class ObjectTmmSurface(op_base.TmmOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
+    RESTORED_DEFAULTS = {"ChordTolerance": 0.0}  # documents from before it kept every point
     toolpath: Optional[Toolpath] = None
     mesh: Optional[TriMesh] = None
 

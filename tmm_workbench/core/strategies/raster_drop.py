@@ -55,6 +55,9 @@ class SurfaceParams(StrategyParams):
     # the deepest a straight move may pass below the exact drop height between its CL points (raster_refine;
     # 0: not checked)
     gouge_tol: float = param(0.005, "gouge tolerance between CL points", "mm", low=0)
+    # how far above the CL points a longer straight move may pass where it replaces them (flats and even
+    # slopes become a few long moves; never below a CL point: 0 keeps every point off a straight line)
+    chord_tol: float = param(0.001, "chord tolerance", "mm", low=0, high=1.0)
 
     def validate(self) -> None:
         super().validate()
@@ -129,7 +132,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
                                                                     chained=params.pattern == ZIGZAG)
     diagnostics["top"] = float(z[~air].max())
-    segments = _segments(runs, z, air, params.pattern)
+    segments = _segments(runs, z, air, params.pattern, params.chord_tol)
     return StrategyResult(segments, diagnostics)
 
 
@@ -147,7 +150,7 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
 
 
 def _segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray,
-              pattern: str) -> list[CutSegment]:
+              pattern: str, chord_tol: float = 0.0) -> list[CutSegment]:
     """Segments in cutting order. A pass is split where it crosses air; a zig-zag link that crosses air is
     left out. A segment is `joined` when the tool reaches it without a retract."""
     out: list[CutSegment] = []
@@ -170,7 +173,7 @@ def _segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarra
         # consecutive on-model points: [start, end) index pairs
         edges = np.flatnonzero(np.diff(np.concatenate([[True], gap, [True]]).astype(np.int8)))
         for start, end in zip(edges[::2], edges[1::2]):
-            out.append(CutSegment(_drop_collinear(pts[start:end]), joined=not (detach or start > 0),
+            out.append(CutSegment(reduce_chords(pts[start:end], chord_tol), joined=not (detach or start > 0),
                                   pass_index=index))
             detach = False
         if len(gap) and gap[-1]:
@@ -178,14 +181,44 @@ def _segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarra
     return out
 
 
-def _drop_collinear(pts: np.ndarray) -> np.ndarray:
-    """Remove interior points lying on the chord of their neighbours (flat stretches)."""
-    if len(pts) < 3:
+def reduce_chords(pts: np.ndarray, tol: float) -> np.ndarray:
+    """The points of one straight pass (XY on one line, in order) thinned so that each straight move that
+    replaces some passes no more than `tol` above any of them and never below one (by more than
+    _COLLINEAR_MM): the exact CL path is the sampled one, and a chord above all its vertices is above the
+    sampled polyline everywhere (both linear in between), so nothing gouges that did not before. Greedy
+    from each kept point: the feasible slopes of the chord form an interval that every skipped point
+    narrows (a sleeve), O(n)."""
+    n = len(pts)
+    if n < 3:
         return pts
-    a, p, c = pts[:-2], pts[1:-1], pts[2:]
-    ac = c - a
-    ap = p - a
-    cross = np.linalg.norm(np.cross(ac, ap), axis=1)
-    dist = cross / np.maximum(np.linalg.norm(ac, axis=1), 1e-300)
-    keep = np.concatenate([[True], dist > _COLLINEAR_MM, [True]])
-    return pts[keep]
+    xy = pts[:, :2]
+    d = xy[-1] - xy[0]
+    length = float(np.hypot(*d))
+    if length <= 0:
+        return pts[[0, -1]] if np.ptp(pts[:, 2]) <= _COLLINEAR_MM else pts
+    u = d / length
+    s = (xy - xy[0]) @ u                                   # distance along the pass
+    off = np.abs((xy - xy[0]) @ np.array([-u[1], u[0]]))  # off the pass line (none, for a raster pass)
+    if off.max() > _COLLINEAR_MM or np.any(np.diff(s) < 0):
+        return pts  # not one straight, ordered pass: keep it as it is
+    steps = np.flatnonzero(np.diff(s) <= _COLLINEAR_MM)  # vertical moves (raster_refine's cliff corners)
+    if len(steps):  # each side reduced on its own, the vertical moves kept
+        cuts = np.concatenate([[0], steps + 1, [n]])
+        return np.vstack([reduce_chords(pts[a:b], tol) for a, b in zip(cuts[:-1], cuts[1:])])
+    z = pts[:, 2]
+    keep = [0]
+    a = 0
+    lo, hi = -math.inf, math.inf
+    for j in range(1, n):
+        ds = s[j] - s[a]
+        m = (z[j] - z[a]) / ds
+        if j > a + 1 and not (lo <= m <= hi):
+            keep.append(j - 1)                               # the chord a -> j - 1 was the last that held
+            a = j - 1
+            ds = s[j] - s[a]
+            lo, hi = -math.inf, math.inf
+        # j becomes a point a later chord from a must pass: on or above it, within tol
+        lo = max(lo, (z[j] - _COLLINEAR_MM - z[a]) / ds)
+        hi = min(hi, (z[j] + tol - z[a]) / ds)
+    keep.append(n - 1)
+    return pts[np.unique(keep)]
