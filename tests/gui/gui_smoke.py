@@ -81,7 +81,7 @@ def simulate_panel(info: dict, r) -> None:
     """TMM Simulate on the API's Job: the panel at cell 0.5 mm shows the numbers, the coloured stock is in the
     3D view (screenshot), and Close removes it and shows the Job's objects again (nothing left in the
     document)."""
-    from tmm_workbench.gui import simulate_cmd
+    from tmm_workbench.gui import simulate_cmd, stock_view
 
     before = sorted(o.Name for o in r.doc.Objects)
     shown = sorted(o.Name for o in r.doc.Objects if o.ViewObject is not None and o.ViewObject.Visibility)
@@ -108,7 +108,7 @@ def simulate_panel(info: dict, r) -> None:
     info["sim_gouged"] = info["sim_status"].startswith("GOUGED")
     assert info["sim_max_left"] is not None, f"no simulation results: {info['sim_status']}"
     scene = FreeCADGui.activeDocument().activeView().getSceneGraph()
-    info["sim_node"] = simulate_cmd.find_node(scene)
+    info["sim_node"] = stock_view.find_node(scene)
     mw = FreeCADGui.getMainWindow()
     for dock in mw.findChildren(QtGui.QDockWidget):
         if dock.isVisible() and dock.isAncestorOf(page):
@@ -119,7 +119,7 @@ def simulate_panel(info: dict, r) -> None:
     info["sim_png"] = str(png)
     click_close()
     info["sim_panel_closed"] = not FreeCADGui.Control.activeDialog()
-    info["sim_node_removed"] = not simulate_cmd.find_node(scene)
+    info["sim_node_removed"] = not stock_view.find_node(scene)
     info["sim_doc_unchanged"] = sorted(o.Name for o in r.doc.Objects) == before
     info["sim_visibility_restored"] = shown == sorted(
         o.Name for o in r.doc.Objects if o.ViewObject is not None and o.ViewObject.Visibility)

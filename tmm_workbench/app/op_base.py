@@ -155,14 +155,14 @@ class TmmOp(PathOp.ObjectOp):
         """FreeCAD's CycleTime counts no rotary axis and no joint speed: TMM's estimate replaces it
         (app.simulation.op_cycle_seconds), and the Job's total is summed again."""
         from tmm_workbench.app.simulation import op_cycle_seconds
+        from tmm_workbench.core.sim.cycle_time import hms
 
         try:
             seconds = op_cycle_seconds(obj)
         except TmmError as exc:  # the op's own estimate stays; say why ours is missing
             FreeCAD.Console.PrintWarning(f"{obj.Label}: no cycle time estimate ({exc})\n")
             return
-        s = int(round(seconds))
-        obj.CycleTime = f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"
+        obj.CycleTime = hms(seconds)
         job = getattr(self, "job", None)
         if job is not None and hasattr(getattr(job, "Proxy", None), "getCycleTime"):
             job.Proxy.getCycleTime()

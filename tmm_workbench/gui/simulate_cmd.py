@@ -5,7 +5,6 @@ design). The mesh is a Coin node of the view's scene graph, not a document objec
 removes it and leaves the document as it was (the Job's objects hidden meanwhile are shown again)."""
 from __future__ import annotations
 
-import math
 import shutil
 import tempfile
 import time
@@ -20,17 +19,14 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.preview.deviation_colours import NO_DESIGN_HEX, cmap as _cmap, colour_range
+from tmm_workbench.core.sim.cycle_time import hms
 from tmm_workbench.gui import resources
+from tmm_workbench.gui.stock_view import stock_node
 
 COMMAND_NAME = "TMM_Simulate"
-NODE_NAME = "TmmSimulatedStock"    # the Coin node's name: tests and users find it in the scene graph
 PANEL_NAME = "TmmSimulatePanel"
-MAX_VERTICES_PER_SIDE = 400        # the mesh shown: a few 100k vertices draw fast, finer adds nothing visible
 CELL_3AXIS, CELL_5AXIS = 0.1, 0.25  # mm: 5-axis sweeps are sub-stepped, so a finer grid costs much more
-# grey where there is no design: darker than deviation_png's #d9d9d9, which the view's lighting makes look
-# like RdBu_r's near-white centre (0 mm) on a lit face
-NO_DESIGN_HEX = "#8c8c8c"
-NO_DESIGN_RGB = tuple(int(NO_DESIGN_HEX[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
 RED = "color: #c00000; font-weight: bold"
 
 
@@ -71,124 +67,7 @@ def default_cell(target: Any) -> float:
         return CELL_3AXIS
 
 
-# --- the mesh shown: decimation and colours (numpy only) ----------------------------------------------
-def decimate(heights: np.ndarray, deviation: np.ndarray, tolerance: float,
-             limit: int = MAX_VERTICES_PER_SIDE) -> tuple[np.ndarray, np.ndarray, int]:
-    """(heights, deviation, block) at most `limit` x `limit`: each block of block x block cells is shown by one
-    of its cells, the deepest gouge (beyond the tolerance) if any, else the largest |deviation| (so scallop
-    crests stay), else (no design under the block) the lowest height."""
-    ny, nx = heights.shape
-    b = max(1, math.ceil(max(nx, ny) / limit))
-    if b == 1:
-        return heights, deviation, 1
-    nby, nbx = math.ceil(ny / b), math.ceil(nx / b)
-    H = np.full((nby * b, nbx * b), np.inf)
-    D = np.full((nby * b, nbx * b), np.nan)
-    H[:ny, :nx], D[:ny, :nx] = heights, deviation
-
-    def blocks(a: np.ndarray) -> np.ndarray:
-        return a.reshape(nby, b, nbx, b).transpose(0, 2, 1, 3).reshape(nby, nbx, b * b)
-    Hb, Db = blocks(H), blocks(D)
-    finite = np.isfinite(Db)
-    low = np.where(finite, Db, np.inf)
-    deepest = np.argmin(low, axis=2)
-    largest = np.argmax(np.where(finite, np.abs(Db), -1.0), axis=2)
-    gouge = np.take_along_axis(low, deepest[..., None], 2)[..., 0] < -tolerance
-    pick = np.where(gouge, deepest, largest)
-    pick = np.where(finite.any(axis=2), pick, np.argmin(Hb, axis=2))
-
-    def take(a: np.ndarray) -> np.ndarray:
-        return np.take_along_axis(a, pick[..., None], 2)[..., 0]
-    return take(Hb), take(Db), b
-
-
-def block_centres(start: float, cell: float, n: int, b: int) -> np.ndarray:
-    """Centres of the blocks of `b` cells along one axis of `n` cells (the last block may be shorter)."""
-    first = np.arange(0, n, b)
-    last = np.minimum(first + b, n)
-    return start + cell * (first + last) / 2.0
-
-
-def colour_range(deviation: np.ndarray, tolerance: float) -> tuple[float, float]:
-    """The colour map's ends, mm, as deviation_png's: at least +-tolerance, 0 at the centre."""
-    d = deviation[np.isfinite(deviation)]
-    low = min(-tolerance, float(d.min())) if d.size else -tolerance
-    high = max(tolerance, float(d.max())) if d.size else tolerance
-    if not low < 0.0 < high:  # a zero tolerance and no deviation: still a centred map
-        low, high = min(low, -1e-6), max(high, 1e-6)
-    return low, high
-
-
-def _cmap() -> Any:
-    from matplotlib import colormaps
-
-    return colormaps["RdBu_r"]
-
-
-def normalised(deviation: np.ndarray, low: float, high: float) -> np.ndarray:
-    """Deviation -> [0, 1] with 0 mm at 0.5, linear on each side (matplotlib's TwoSlopeNorm)."""
-    d = np.asarray(deviation, dtype=float)
-    t = np.where(d < 0, 0.5 * (1.0 - d / low), 0.5 * (1.0 + d / high))
-    return np.clip(t, 0.0, 1.0)
-
-
-def colours(deviation: np.ndarray, low: float, high: float) -> np.ndarray:
-    """(n, 3) RGB in [0, 1] per deviation value (flattened): RdBu_r, grey where NaN."""
-    d = np.asarray(deviation, dtype=float).ravel()
-    rgb = _cmap()(normalised(np.nan_to_num(d), low, high))[:, :3]
-    rgb[~np.isfinite(d)] = NO_DESIGN_RGB
-    return rgb
-
-
-# --- Coin ---------------------------------------------------------------------------------------------
-def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float) -> tuple[Any, int]:
-    """A SoSeparator holding the simulated stock as a quad mesh with per-vertex colours, and the block size
-    of the decimation."""
-    from pivy import coin
-
-    h, d, b = decimate(np.asarray(heights, dtype=float), np.asarray(deviation, dtype=float), tolerance)
-    low, high = colour_range(np.asarray(deviation, dtype=float), tolerance)
-    X, Y = np.meshgrid(block_centres(grid.x0, grid.cell, grid.nx, b),
-                       block_centres(grid.y0, grid.cell, grid.ny, b))
-    points = np.column_stack([X.ravel(), Y.ravel(), h.ravel()])
-    root = coin.SoSeparator()
-    root.setName(NODE_NAME)
-    hints = coin.SoShapeHints()  # lit from both sides: walls seen from below are not black
-    hints.vertexOrdering = coin.SoShapeHints.COUNTERCLOCKWISE
-    hints.shapeType = coin.SoShapeHints.UNKNOWN_SHAPE_TYPE
-    coords = coin.SoCoordinate3()
-    coords.point.setValues(0, len(points), points.tolist())
-    material = coin.SoMaterial()
-    material.diffuseColor.setValues(0, len(points), colours(d, low, high).tolist())
-    binding = coin.SoMaterialBinding()
-    # a quad mesh is not indexed: Coin reads PER_VERTEX_INDEXED as PER_VERTEX there, so say what it is
-    binding.value = coin.SoMaterialBinding.PER_VERTEX
-    mesh = coin.SoQuadMesh()
-    mesh.verticesPerRow = h.shape[1]
-    mesh.verticesPerColumn = h.shape[0]
-    for child in (hints, coords, material, binding, mesh):
-        root.addChild(child)
-    return root, b
-
-
-def find_node(scene: Any, name: str = NODE_NAME) -> bool:
-    """Whether a node named `name` is in the scene graph."""
-    from pivy import coin
-
-    search = coin.SoSearchAction()
-    search.setName(coin.SbName(name))
-    search.setInterest(coin.SoSearchAction.FIRST)
-    search.setSearchingAll(True)
-    search.apply(scene)
-    return search.getPath() is not None
-
-
 # --- text ---------------------------------------------------------------------------------------------
-def hms(seconds: float) -> str:
-    s = int(round(max(seconds, 0.0)))
-    return f"{s // 3600:02d}:{s % 3600 // 60:02d}:{s % 60:02d}"
-
-
 def mm(value: float) -> str:
     return f"{value:+.4f} mm"
 

@@ -1,6 +1,7 @@
 """The simulated stock's deviation from the design as a heat map (PNG, matplotlib Agg): red where material
 is left, blue where the design is gouged, a colour bar in mm, the numbers in the title. Cells without the
-design under them are grey. matplotlib is imported inside the function (no GUI backend on import)."""
+design under them are grey (the colours are core.preview.deviation_colours', as the GUI's). matplotlib is
+imported inside the function (no GUI backend on import)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -19,13 +20,14 @@ def render_deviation_png(comparison: "Comparison", grid: "Grid", path: str, titl
     import matplotlib.pyplot as plt
     from matplotlib.colors import TwoSlopeNorm
 
+    from tmm_workbench.core.preview.deviation_colours import NO_DESIGN_HEX, cmap as rdbu, colour_range
+
     dev = comparison.deviation
     o = comparison.overall
     tol = comparison.tolerance
-    low = min(-tol, o.min_deviation if o.cells else -tol)
-    high = max(tol, o.max_left if o.cells else tol)
-    cmap = plt.get_cmap("RdBu_r").copy()
-    cmap.set_bad("#d9d9d9")
+    low, high = colour_range(dev, tol)
+    cmap = rdbu().copy()
+    cmap.set_bad(NO_DESIGN_HEX)
     fig, ax = plt.subplots(figsize=(7.2, 6.0), dpi=dpi)
     x0, x1, y0, y1 = grid.extent
     im = ax.imshow(np.ma.masked_invalid(dev), origin="lower", extent=(x0, x1, y0, y1), cmap=cmap,

@@ -25,8 +25,13 @@ class CycleTime:
     rapid_length: float
 
     def hms(self) -> str:
-        s = int(round(self.seconds))
-        return f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"
+        return hms(self.seconds)
+
+
+def hms(seconds: float) -> str:
+    """HH:MM:SS, as FreeCAD's CycleTime shows it."""
+    s = int(round(max(seconds, 0.0)))
+    return f"{s // 3600:02d}:{s // 60 % 60:02d}:{s % 60:02d}"
 
 
 def three_axis_time(tips: np.ndarray, feeds: Sequence[Optional[float]], horiz_rapid: Optional[float] = None,

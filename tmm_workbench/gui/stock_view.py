@@ -1,0 +1,54 @@
+"""The simulated stock in the 3D view: a Coin quad mesh coloured by deviation (core.preview
+.deviation_colours), a node of the view's scene graph (never a document object), named so tests and users
+find it."""
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from tmm_workbench.core.preview.deviation_colours import block_centres, colour_range, colours, decimate
+
+NODE_NAME = "TmmSimulatedStock"
+
+
+def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float) -> tuple[Any, int]:
+    """A SoSeparator holding the simulated stock as a quad mesh with per-vertex colours, and the block size
+    of the decimation."""
+    from pivy import coin
+
+    h, d, b = decimate(np.asarray(heights, dtype=float), np.asarray(deviation, dtype=float), tolerance)
+    low, high = colour_range(np.asarray(deviation, dtype=float), tolerance)
+    X, Y = np.meshgrid(block_centres(grid.x0, grid.cell, grid.nx, b),
+                       block_centres(grid.y0, grid.cell, grid.ny, b))
+    points = np.column_stack([X.ravel(), Y.ravel(), h.ravel()])
+    root = coin.SoSeparator()
+    root.setName(NODE_NAME)
+    hints = coin.SoShapeHints()  # lit from both sides: walls seen from below are not black
+    hints.vertexOrdering = coin.SoShapeHints.COUNTERCLOCKWISE
+    hints.shapeType = coin.SoShapeHints.UNKNOWN_SHAPE_TYPE
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, len(points), points.tolist())
+    material = coin.SoMaterial()
+    material.diffuseColor.setValues(0, len(points), colours(d, low, high).tolist())
+    binding = coin.SoMaterialBinding()
+    # a quad mesh is not indexed: Coin reads PER_VERTEX_INDEXED as PER_VERTEX there, so say what it is
+    binding.value = coin.SoMaterialBinding.PER_VERTEX
+    mesh = coin.SoQuadMesh()
+    mesh.verticesPerRow = h.shape[1]
+    mesh.verticesPerColumn = h.shape[0]
+    for child in (hints, coords, material, binding, mesh):
+        root.addChild(child)
+    return root, b
+
+
+def find_node(scene: Any, name: str = NODE_NAME) -> bool:
+    """Whether a node named `name` is in the scene graph."""
+    from pivy import coin
+
+    search = coin.SoSearchAction()
+    search.setName(coin.SbName(name))
+    search.setInterest(coin.SoSearchAction.FIRST)
+    search.setSearchingAll(True)
+    search.apply(scene)
+    return search.getPath() is not None
