@@ -47,7 +47,7 @@ def three_axis_time(tips: np.ndarray, feeds: Sequence[Optional[float]], horiz_ra
     f = np.array([math.inf if v is None else float(v) for v in list(feeds)[1:]])
     bad = np.flatnonzero(~(f > 0))
     if len(bad):
-        raise TmmError(f"move {int(bad[0]) + 1} has the feed {f[bad[0]]!r} mm/s: a feed must be > 0 for a cycle time")
+        raise TmmError(f"move {int(bad[0]) + 1} has the feed {float(f[bad[0]])!r} mm/s: a feed must be > 0 for a cycle time")
     hr = horiz_rapid if horiz_rapid and horiz_rapid > 0 else DEFAULT_RAPID_MM_S
     vr = vert_rapid if vert_rapid and vert_rapid > 0 else DEFAULT_RAPID_MM_S
     d = np.abs(np.diff(p, axis=0))

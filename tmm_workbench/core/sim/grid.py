@@ -29,10 +29,11 @@ class Grid:
         """The grid of `cell` mm cells covering the box; TmmError naming the cell size when it is not a
         length > 0 or the grid is more than the machine can hold."""
         if not (isinstance(cell, (int, float)) and math.isfinite(cell) and cell > 0):
-            raise TmmError(f"simulation cell size must be a length > 0 mm, got {cell!r}")
+            shown = float(cell) if isinstance(cell, (int, float)) else cell  # numpy 2 repr: np.float64(...)
+            raise TmmError(f"simulation cell size must be a length > 0 mm, got {shown!r}")
         for name, v in (("xmin", xmin), ("ymin", ymin), ("xmax", xmax), ("ymax", ymax)):
-            if not math.isfinite(v):
-                raise TmmError(f"simulation box {name} must be finite, got {v!r}")
+            if not math.isfinite(float(v)):
+                raise TmmError(f"simulation box {name} must be finite, got {float(v)!r}")
         if not (xmax > xmin and ymax > ymin):
             raise TmmError(f"simulation box is empty: x {xmin:g}..{xmax:g}, y {ymin:g}..{ymax:g} mm")
         nx = max(1, math.ceil((xmax - xmin) / cell - 1e-9))

@@ -18,7 +18,7 @@ NEEDLE_RADIUS = 1e-4  # mm: the "cutter" whose drop is a vertical line's hit (a 
 
 def box_heights(grid: Grid, top: float) -> np.ndarray:
     if not math.isfinite(top):
-        raise TmmError(f"stock top must be finite, got {top!r}")
+        raise TmmError(f"stock top must be finite, got {float(top)!r}")
     return np.full((grid.ny, grid.nx), float(top))
 
 
@@ -26,7 +26,7 @@ def cylinder_heights(grid: Grid, centre: tuple[float, float], radius: float, top
                      ) -> np.ndarray:
     """A vertical cylinder stock: `top` inside the circle, `bottom` (no stock) outside."""
     if not (math.isfinite(radius) and radius > 0):
-        raise TmmError(f"cylinder stock radius must be a length > 0 mm, got {radius!r}")
+        raise TmmError(f"cylinder stock radius must be a length > 0 mm, got {float(radius)!r}")
     X, Y = np.meshgrid(grid.xs(), grid.ys())
     inside = (X - centre[0]) ** 2 + (Y - centre[1]) ** 2 <= radius * radius
     return np.where(inside, float(top), float(bottom))
