@@ -173,13 +173,9 @@ double isolated_lowest(const Quartic& k, const Line& l, double Ro, double Ri) {
   return best;
 }
 
-// Lowest t of the solid torus on the line; +inf if missed. fallback counts the re-solved lines.
-double torus_lowest(const Line& l, double Ro, double Ri, std::size_t* fallback) {
-  if (Ro == 0.0) return l.qq <= Ri * Ri ? -std::sqrt(Ri * Ri - l.qq) : kInf;  // a ball
-  const double R2 = Ro * Ro;
-  const double K = l.qq + R2 - Ri * Ri;
-  const Quartic k{2.0 * K - 4.0 * R2 * (1.0 - l.az * l.az), 8.0 * R2 * l.qa * l.az,
-                  K * K - 4.0 * R2 * (l.qq - l.qa * l.qa)};
+// Lowest t of the solid torus on the line by Ferrari (the general path); +inf if missed. fallback counts the
+// lines re-solved by root isolation.
+double ferrari_lowest(const Quartic& k, const Line& l, double Ro, double Ri, std::size_t* fallback) {
   double roots[4];
   ferrari(k, roots);
   std::sort(roots, roots + 4);
@@ -203,6 +199,94 @@ double torus_lowest(const Line& l, double Ro, double Ri, std::size_t* fallback) 
   if (!doubt) return best;
   if (fallback) ++*fallback;
   return isolated_lowest(k, l, Ro, Ri);
+}
+
+// f is convex on (-inf, t]: f'' = 12 t^2 + 2 P >= 0 there (P >= 0: everywhere; else left of -sqrt(-P / 6)).
+bool convex_left_of(const Quartic& k, double t) { return k.P >= 0.0 || (t <= 0.0 && 6.0 * t * t >= -k.P); }
+
+// The lowest real root of k by Newton from t, when it can be certified: f convex on (-inf, t], f(t) > 0 and
+// f'(t) < 0 mean f > 0 left of t (convex and decreasing there), so no root and no local minimum (no
+// near-tangent touch) lies below t. Newton then climbs monotonically to the lowest root: each tangent lies
+// below the convex f, so every iterate stays left of the root, and each is certified again the same way.
+// Returns false when a check fails (the start is not below the root, f turns or leaves its convex part
+// before reaching zero: a near-tangent line or a root beyond the inflection) - the caller then uses Ferrari.
+bool newton_lowest(const Quartic& k, double t, double& root) {
+  constexpr int kMaxIter = 40;
+  for (int it = 0; it < kMaxIter; ++it) {
+    if (!convex_left_of(k, t)) return false;
+    const double f = k.f(t), d = k.df(t);
+    if (f <= 0.0) {  // rounding put the iterate on (or a hair past) the root it approached from the left
+      if (it == 0) return false;  // the start itself is not certified below the root
+      root = t;
+      return true;
+    }
+    if (!(d < 0.0)) return false;
+    const double step = -f / d, t1 = t + step;
+    if (!convex_left_of(k, t1)) return false;  // past the inflection: the tangent no longer certifies t1
+    // Stop when the next step, f(t1) / |f'(t1)|, is below 1e-13 mm: with M the largest f'' on [t, t1] (at an
+    // end: f'' is a parabola), f(t1) <= M step^2 / 2 and |f'(t1)| >= |f'(t)| - M step.
+    const double M = std::max(6.0 * t * t, 6.0 * t1 * t1) * 2.0 + 2.0 * k.P;
+    const double slope = -d - M * step;
+    t = t1;
+    // slope > 1e-3 M: f' is not near zero, so the root is within twice that next step, and it is well
+    // conditioned (no second root within ~1e-3 mm). Near-double roots (lines grazing the tube) are left to
+    // Ferrari and its near-tangent rules, so that both paths agree to rounding.
+    if (slope > 1e-3 * M && 0.5 * M * step * step <= 1e-13 * slope) {
+      root = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+// Whether the torus meets the line below the cell top (t < t_top), from the quartic alone. Yes: the top is
+// inside the tube (f < 0 there: a root lies below; the usual case, the top being the previous instance's
+// lowest point). No: f >= 0 at the top, convex and not increasing left of it, so f > 0 all the way down (no
+// root and no near-tangent minimum: a line that misses below the top or meets the torus only above it).
+enum class Verdict { Yes, No, Unknown };
+Verdict torus_below(const Quartic& k, double t_top) {
+  if (k.f(t_top) < 0.0) return Verdict::Yes;
+  if (k.df(t_top) <= 0.0 && convex_left_of(k, t_top)) return Verdict::No;
+  return Verdict::Unknown;
+}
+
+// The torus quartic of the line (see the header): negative inside the tube, its lowest root the entry.
+Quartic torus_quartic(const Line& l, double Ro, double Ri) {
+  const double R2 = Ro * Ro;
+  const double K = l.qq + R2 - Ri * Ri;
+  return {2.0 * K - 4.0 * R2 * (1.0 - l.az * l.az), 8.0 * R2 * l.qa * l.az, K * K - 4.0 * R2 * (l.qq - l.qa * l.qa)};
+}
+
+// Lowest t of the solid torus (Ro > 0, k its quartic) on the line; +inf if missed. fallback counts the lines
+// re-solved by root isolation. t_hint: the cell top, usually inside the tube (k < 0 there: the previous
+// instance's root, a few micrometres above this one's); +inf when there is none. Newton starts from the
+// hint's tangent, else 0.1 mm below the hint, else at the torus' own lower bound on the line; Ferrari solves
+// what Newton cannot certify (the same root: the lowest real one).
+double torus_lowest(const Quartic& k, const Line& l, double Ro, double Ri, std::size_t* fallback, double t_hint) {
+  // Every torus point has h >= -Ri and |x - C| <= Ro + Ri: no root below t_lb.
+  const double Rt = Ro + Ri;
+  const double t_lb = std::max((-Ri - l.qa) / l.az, -std::sqrt(std::max(Rt * Rt - l.qq, 0.0))) - 1e-9;
+  double root;
+  if (t_hint < kInf) {
+    // From the hint inside the tube (f < 0), its tangent's zero: left of the root where f is convex (the
+    // tangent lies below f), typically a few micrometres from it, so Newton needs a step or two more.
+    const double f = k.f(t_hint), d = k.df(t_hint);
+    const double t_tangent = f < 0.0 && d < 0.0 ? t_hint - f / d : kInf;
+    if (t_tangent > t_lb && t_tangent < kInf && newton_lowest(k, t_tangent, root)) return root;
+    constexpr double kHintDrop = 0.1;  // mm below the hint: more than a cell usually falls between instances
+    const double t_near = t_hint - kHintDrop;
+    if (t_near > t_lb && newton_lowest(k, t_near, root)) return root;
+  }
+  if (newton_lowest(k, t_lb, root)) return root;
+  return ferrari_lowest(k, l, Ro, Ri, fallback);
+}
+
+// The same without a hint (lowest_on_vertical, a ball in the sweep): Ferrari, as zmap.py solves it, so that
+// lowest_on_vertical stays its exact port (on a steep entry where Ferrari's root is off by up to the 1e-7 mm
+// touching tolerance, Newton's exact root would differ from zmap.py's by that much).
+double torus_lowest(const Line& l, double Ro, double Ri, std::size_t* fallback) {
+  if (Ro == 0.0) return l.qq <= Ri * Ri ? -std::sqrt(Ri * Ri - l.qq) : kInf;  // a ball
+  return ferrari_lowest(torus_quartic(l, Ro, Ri), l, Ro, Ri, fallback);
 }
 
 // Lowest t of the whole solid (torus, bull-nose core, shank) on the line.
@@ -371,6 +455,7 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
   const double Ro = tool.Ro, Ri = tool.Ri, Rt = tool.radius();
   const double reach = std::hypot(Rt, 2.0 * Ri);
   const bool core = tool.shape == ToolShape::BullNose && Ro > 0.0;
+  const bool ball = Ro == 0.0;
   // Squared radii and margins of the pruning tests: a line within the tangent tolerance counts as touching.
   const double Rt2_hit = (Rt + kTangentTol + kPruneMargin) * (Rt + kTangentTol + kPruneMargin);
   const double Ro2_hit = (Ro + kPruneMargin) * (Ro + kPruneMargin);
@@ -473,8 +558,12 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
               // The shank {rho <= Rt, h >= 0} and the flat core {rho <= Ro, h >= -Ri}: exact tests.
               const bool shank = hp >= 0.0 && rho2_min(0.0, hp / az) <= Rt2_hit;
               const bool flat = core && rho2_min(0.0, (hp + Ri) / az) <= Ro2_hit;
-              bool torus = false;
-              if (qq <= Rt2_hit) {
+              // The quartic decides most lines at the price of one evaluation; the bounds decide the rest.
+              const Line l{qa, qq, az};
+              const Quartic quartic = ball ? Quartic{} : torus_quartic(l, Ro, Ri);
+              const Verdict verdict = ball ? Verdict::Unknown : torus_below(quartic, dz);
+              bool torus = verdict == Verdict::Yes;
+              if (verdict == Verdict::Unknown && qq <= Rt2_hit) {
                 const double w = std::sqrt(Rt2_hit - qq);
                 const double lo = std::max({0.0, (hp - Ri) / az, dz - w}), hi = std::min((hp + Ri) / az, dz + w);
                 // Inside the torus: |x - C|^2 + Ro^2 - Ri^2 <= 2 Ro rho, and rho lies under its chord on each
@@ -493,11 +582,11 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
                 }
               }
               if (!(torus || shank || flat)) continue;
-              const Line l{qa, qq, az};
               double t = kInf;
               if (torus) {
                 ++out.stats.exact_solves;
-                t = torus_lowest(l, Ro, Ri, &out.stats.fallback_solves);
+                std::size_t* fallback = &out.stats.fallback_solves;
+                t = ball ? torus_lowest(l, Ro, Ri, fallback) : torus_lowest(quartic, l, Ro, Ri, fallback, dz);
               }
               if (shank) t = std::min(t, half_cylinder_lowest(l, Rt, 0.0));
               if (flat) t = std::min(t, half_cylinder_lowest(l, Ro, -Ri));

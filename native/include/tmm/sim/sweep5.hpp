@@ -16,7 +16,10 @@
 // touching: the tool grown by at most 1e-7 mm). Lines with a candidate within 0.05 mm of the tube but not on
 // it (near-tangent lines, rounding in the closed form) are solved again by isolating the real roots between
 // the critical points of the quartic (closed-form cubic, safeguarded Newton); zmap.py uses the companion
-// matrix' eigenvalues there. The ball is closed form, the half-cylinders a quadratic clipped by a plane.
+// matrix' eigenvalues there. In the sweep, where it can be certified, the same lowest root is found faster by
+// Newton from the left (the quartic convex and decreasing below the start, so no root or near-tangent minimum
+// lies below; started from the tangent at the cell's current height), Ferrari being the general path and
+// lowest_on_vertical's. The ball is closed form, the half-cylinders a quadratic clipped by a plane.
 //
 // Motion (zmap.py's default): between points k and k + 1 the tip moves linearly and the axis by slerp
 // (constant angular rate about a_k x a_k+1). A move is cut into n = max(1, ceil((|tip_k+1 - tip_k| + theta
