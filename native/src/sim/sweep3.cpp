@@ -12,6 +12,14 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+// The block tests and the closed-form block evaluation also in AVX2 (four lanes per instruction), chosen at
+// run time: the same IEEE operations in the same order per lane (no FMA), so heights are bit-identical to
+// the SSE2 path.
+#if defined(__SSE2__) && defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#include <immintrin.h>
+#define TMM_SWEEP3_AVX2 1
+#define TMM_AVX2 __attribute__((target("avx2")))
+#endif
 
 namespace tmm {
 
@@ -20,7 +28,7 @@ namespace {
 // Cells per row block. Each block keeps an upper bound of its heights: a move skips the block when even
 // its lowest point over the block (the move's lowest tip plus h at the block's nearest distance) is not
 // below it, which in a raster is most of the tool's disc (cut already by the previous moves).
-constexpr std::size_t kBlock = 8;
+constexpr std::size_t kBlock = 8;  // at most 8: a block's lowered cells are the bits of a byte
 constexpr double kArcCertificate = 1e-10;  // mm: the arc solve stops when its excess is below this
 
 // One linear move, with what does not depend on the cell.
@@ -142,15 +150,18 @@ class PieceSolver {
       const double dP = 2.0 * (t * (rho * rho - cq) + t * t * rho - sr * rho);
       double tn = t - P / dP;
       if (!(tn > lo && tn < hi)) tn = 0.5 * (lo + hi);
-      if (std::fabs(tn - t) <= 1e-9 * r_ || hi - lo <= 1e-15 * r_) {
+      const double step = tn - t;
+      t = tn;
+      // Certify the new iterate once the steps are small (Newton's error is then about the step squared).
+      if (std::fabs(step) <= 1e-6 * r_ || hi - lo <= 1e-15 * r_) {
         // Both v and the minimiser lie in [v_lo, v_hi]: that width bounds their distance.
-        const double v = std::sqrt(maxd(rho * rho - q2, 0.0));
-        const double gp = t / std::sqrt(maxd(r_ * r_ - t * t, 0.0)) * (rho > 0 ? v / rho : 0.0) - sn_ / cs_;
+        const double rn = t + e_;
+        const double v = std::sqrt(maxd(rn * rn - q2, 0.0));
+        const double gp = t / std::sqrt(maxd(r_ * r_ - t * t, 0.0)) * (rn > 0 ? v / rn : 0.0) - sn_ / cs_;
         if (std::fabs(gp) * (v_hi - v_lo) <= kArcCertificate || hi - lo <= 1e-15 * r_) {
           return std::clamp(v, v_lo, v_hi);
         }
       }
-      t = tn;
     }
     return std::clamp(std::sqrt(maxd((t + e_) * (t + e_) - q2, 0.0)), v_lo, v_hi);
   }
@@ -183,6 +194,21 @@ struct BallProfile {  // h = r - sqrt(r^2 - rho^2): reach and minimiser without 
     return _mm_add_pd(zt, _mm_sub_pd(_mm_set1_pd(r), _mm_sqrt_pd(d)));
   }
 #endif
+#if defined(TMM_SWEEP3_AVX2)
+  TMM_AVX2 __m256d reach2_avx(__m256d lift) const {
+    const __m256d vr = _mm256_set1_pd(r), in = _mm256_cmp_pd(lift, vr, _CMP_LT_OQ);
+    const __m256d q = _mm256_mul_pd(lift, _mm256_sub_pd(_mm256_add_pd(vr, vr), lift));
+    return _mm256_blendv_pd(_mm256_set1_pd(INFINITY), q, in);
+  }
+  TMM_AVX2 __m256d v_abs_avx(const Move& m, __m256d q2) const {
+    const __m256d d = _mm256_max_pd(_mm256_sub_pd(_mm256_set1_pd(r2), q2), _mm256_setzero_pd());
+    return _mm256_mul_pd(_mm256_set1_pd(m.sn), _mm256_sqrt_pd(d));
+  }
+  TMM_AVX2 __m256d value_avx(__m256d zt, __m256d rho2) const {
+    const __m256d d = _mm256_max_pd(_mm256_sub_pd(_mm256_set1_pd(r2), rho2), _mm256_setzero_pd());
+    return _mm256_add_pd(zt, _mm256_sub_pd(_mm256_set1_pd(r), _mm256_sqrt_pd(d)));
+  }
+#endif
 };
 
 struct FlatProfile {  // h = 0: the lowest tip still within reach
@@ -203,6 +229,17 @@ struct FlatProfile {  // h = 0: the lowest tip still within reach
     return _mm_sqrt_pd(_mm_max_pd(_mm_sub_pd(_mm_set1_pd(R2), q2), _mm_setzero_pd()));
   }
   __m128d value_sse(__m128d zt, __m128d) const { return zt; }
+#endif
+#if defined(TMM_SWEEP3_AVX2)
+  TMM_AVX2 __m256d reach2_avx(__m256d lift) const {
+    const __m256d up = _mm256_cmp_pd(lift, _mm256_setzero_pd(), _CMP_GT_OQ);
+    return _mm256_blendv_pd(_mm256_set1_pd(-1.0), _mm256_set1_pd(INFINITY), up);
+  }
+  TMM_AVX2 __m256d v_abs_avx(const Move& m, __m256d q2) const {
+    if (!(m.sn > 0.0)) return _mm256_setzero_pd();
+    return _mm256_sqrt_pd(_mm256_max_pd(_mm256_sub_pd(_mm256_set1_pd(R2), q2), _mm256_setzero_pd()));
+  }
+  TMM_AVX2 __m256d value_avx(__m256d zt, __m256d) const { return zt; }
 #endif
 };
 
@@ -240,6 +277,24 @@ struct BullProfile : GeneralProfile {
     const __m128d t = _mm_max_pd(_mm_sub_pd(_mm_sqrt_pd(rho2), _mm_set1_pd(e)), zero);
     const __m128d d = _mm_max_pd(_mm_sub_pd(_mm_mul_pd(vr, vr), _mm_mul_pd(t, t)), zero);
     return _mm_add_pd(zt, _mm_sub_pd(vr, _mm_sqrt_pd(d)));
+  }
+#endif
+#if defined(TMM_SWEEP3_AVX2)
+  TMM_AVX2 __m256d reach2_avx(__m256d lift) const {
+    const __m256d zero = _mm256_setzero_pd(), vr = _mm256_set1_pd(r);
+    const __m256d a = _mm256_sub_pd(vr, lift);
+    const __m256d rho = _mm256_add_pd(
+        _mm256_set1_pd(e), _mm256_sqrt_pd(_mm256_max_pd(_mm256_sub_pd(_mm256_mul_pd(vr, vr), _mm256_mul_pd(a, a)), zero)));
+    const __m256d arc = _mm256_mul_pd(rho, rho), up = _mm256_cmp_pd(lift, zero, _CMP_GT_OQ);
+    const __m256d over = _mm256_cmp_pd(lift, vr, _CMP_GE_OQ);
+    return _mm256_blendv_pd(_mm256_set1_pd(-1.0), _mm256_blendv_pd(arc, _mm256_set1_pd(INFINITY), over), up);
+  }
+  TMM_AVX2 __m256d v_abs_avx(const Move&, __m256d) const { return _mm256_setzero_pd(); }  // not used
+  TMM_AVX2 __m256d value_avx(__m256d zt, __m256d rho2) const {
+    const __m256d zero = _mm256_setzero_pd(), vr = _mm256_set1_pd(r);
+    const __m256d t = _mm256_max_pd(_mm256_sub_pd(_mm256_sqrt_pd(rho2), _mm256_set1_pd(e)), zero);
+    const __m256d d = _mm256_max_pd(_mm256_sub_pd(_mm256_mul_pd(vr, vr), _mm256_mul_pd(t, t)), zero);
+    return _mm256_add_pd(zt, _mm256_sub_pd(vr, _mm256_sqrt_pd(d)));
   }
 #endif
 };
@@ -299,7 +354,8 @@ class BandCutter {
   BandCutter(ZMap& stock, std::size_t j0, std::size_t j1)
       : z_(stock), j0_(j0), j1_(j1), nx_(stock.nx()), nblk_((stock.nx() + kBlock - 1) / kBlock),
         bx_lo_(nblk_), bx_hi_(nblk_), bmax_((j1 - j0 + 1) * nblk_, -INFINITY),
-        lowered_((j1 - j0 + 1) * stock.nx(), 0) {
+        lowered_((j1 - j0 + 1) * nblk_, 0), cx_(nx_) {
+    for (std::size_t i = 0; i < nx_; ++i) cx_[i] = stock.cx(i);
     for (std::size_t b = 0; b < nblk_; ++b) {
       bx_lo_[b] = stock.cx(b * kBlock);
       bx_hi_[b] = stock.cx(std::min(nx_, (b + 1) * kBlock) - 1);
@@ -335,7 +391,7 @@ class BandCutter {
       double va_row = -1.0;  // solved at the row's first block that may be lowered
       double* row = &z_.at(0, j);
       double* bmax = &bmax_[(j - j0_) * nblk_];
-      std::uint8_t* low = &lowered_[(j - j0_) * nx_];
+      std::uint8_t* low = &lowered_[(j - j0_) * nblk_];
       // Blocks the move may lower, 64 at a time as a bit mask (the tests are branch-free), then those.
       for (std::size_t bb = ia / kBlock, blast = ib / kBlock; bb <= blast; bb += 64) {
        std::uint64_t mask = block_mask(prof, m, ddy, xs, bmax, bb, std::min(blast, bb + 63));
@@ -346,7 +402,13 @@ class BandCutter {
 #if defined(__SSE2__)
         if constexpr (Profile::kSseValue) {
           if (cb - ca == kBlock && (q_const || Profile::kSseSolve)) {
-            block_sse(prof, m, ddy, q_const, va_row, row, low, ca, R2, removed, bmax[b]);
+#if defined(TMM_SWEEP3_AVX2)
+            if (avx2_) {
+              block_avx(prof, m, ddy, q_const, va_row, row, low[b], ca, R2, removed, bmax[b]);
+              continue;
+            }
+#endif
+            block_sse(prof, m, ddy, q_const, va_row, row, low[b], ca, R2, removed, bmax[b]);
             continue;
           }
         }
@@ -364,7 +426,7 @@ class BandCutter {
           const double val = zt + prof.h(mind(v * v + q * q, R2));
           if (val < zc) {
             row[i] = val;
-            low[i] = 1;
+            low[b] |= static_cast<std::uint8_t>(1u << (i - ca));
             removed = maxd(removed, zc - val);
           }
         }
@@ -383,6 +445,11 @@ class BandCutter {
                            std::size_t bb, std::size_t be) const {
     std::uint64_t mask = 0;
     std::size_t b = bb;
+#if defined(TMM_SWEEP3_AVX2)
+    if constexpr (Profile::kSseValue) {
+      if (avx2_) b = block_mask_avx(prof, m, ddy, xs, bmax, bb, be, mask);
+    }
+#endif
 #if defined(__SSE2__)
     if constexpr (Profile::kSseValue) {
       const __m128d zero = _mm_setzero_pd(), vL = _mm_set1_pd(m.L), vxs = _mm_set1_pd(xs);
@@ -415,17 +482,17 @@ class BandCutter {
   // square roots of neighbouring cells overlap). The same arithmetic as the scalar path.
   template <class Profile>
   void block_sse(const Profile& prof, const Move& m, double ddy, bool q_const, double va_row, double* row,
-                 std::uint8_t* low, std::size_t i0, double R2, double& removed, double& block_max) const {
+                 std::uint8_t& low, std::size_t i0, double R2, double& removed, double& block_max) const {
     const __m128d zero = _mm_setzero_pd(), vR2 = _mm_set1_pd(R2), vL = _mm_set1_pd(m.L);
     const __m128d vdx = _mm_set1_pd(m.dirx), vdy = _mm_set1_pd(m.diry), vddy = _mm_set1_pd(ddy);
     const __m128d vsign = _mm_set1_pd(m.sign), vzb = _mm_set1_pd(m.zbase), vkz = _mm_set1_pd(m.kz);
-    const __m128d vg0 = _mm_set1_pd(z_.x0()), vcell = _mm_set1_pd(z_.cell()), vx0 = _mm_set1_pd(m.x0);
+    const __m128d vx0 = _mm_set1_pd(m.x0);
     const __m128d ddy_dx = _mm_mul_pd(vddy, vdx), ddy_dy = _mm_mul_pd(vddy, vdy);
     __m128d vrem = _mm_set1_pd(removed), vmax = _mm_set1_pd(-INFINITY);
+    int taken = 0;
     for (std::size_t p = 0; p < kBlock; p += 2) {
       const std::size_t i = i0 + p;
-      const __m128d ix = _mm_set_pd(static_cast<double>(i + 1) + 0.5, static_cast<double>(i) + 0.5);
-      const __m128d ddx = _mm_sub_pd(_mm_add_pd(vg0, _mm_mul_pd(ix, vcell)), vx0);
+      const __m128d ddx = _mm_sub_pd(_mm_loadu_pd(&cx_[i]), vx0);
       const __m128d u = _mm_add_pd(_mm_mul_pd(ddx, vdx), ddy_dy);
       const __m128d q = _mm_sub_pd(ddy_dx, _mm_mul_pd(ddx, vdy));
       const __m128d du = _mm_add_pd(_mm_min_pd(u, zero), _mm_max_pd(_mm_sub_pd(u, vL), zero));
@@ -443,12 +510,79 @@ class BandCutter {
       _mm_storeu_pd(row + i, nz);
       vrem = _mm_max_pd(vrem, _mm_sub_pd(zc, nz));
       vmax = _mm_max_pd(vmax, nz);
-      const int mask = _mm_movemask_pd(take);
-      low[i] |= static_cast<std::uint8_t>(mask & 1);
-      low[i + 1] |= static_cast<std::uint8_t>(mask >> 1);
+      taken |= _mm_movemask_pd(take) << p;
     }
+    low |= static_cast<std::uint8_t>(taken);
     removed = maxd(_mm_cvtsd_f64(vrem), _mm_cvtsd_f64(_mm_unpackhi_pd(vrem, vrem)));
     block_max = maxd(_mm_cvtsd_f64(vmax), _mm_cvtsd_f64(_mm_unpackhi_pd(vmax, vmax)));
+  }
+#endif
+
+#if defined(TMM_SWEEP3_AVX2)
+  // block_mask's test four blocks at a time from bb on, while at least four are left: sets their bits in
+  // mask and returns the first block not tested.
+  template <class Profile>
+  TMM_AVX2 std::size_t block_mask_avx(const Profile& prof, const Move& m, double ddy, double xs,
+                                      const double* bmax, std::size_t bb, std::size_t be,
+                                      std::uint64_t& mask) const {
+    const __m256d zero = _mm256_setzero_pd(), vL = _mm256_set1_pd(m.L), vxs = _mm256_set1_pd(xs);
+    const __m256d vx0 = _mm256_set1_pd(m.x0), vdx = _mm256_set1_pd(m.dirx), vdy = _mm256_set1_pd(m.diry);
+    const __m256d ddy_dx = _mm256_set1_pd(ddy * m.dirx), ddy_dy = _mm256_set1_pd(ddy * m.diry);
+    const __m256d vzmin = _mm256_set1_pd(m.zmin);
+    std::size_t b = bb;
+    for (; b + 3 <= be; b += 4) {
+      const __m256d xn = _mm256_min_pd(_mm256_max_pd(_mm256_loadu_pd(&bx_lo_[b]), vxs), _mm256_loadu_pd(&bx_hi_[b]));
+      const __m256d ddx = _mm256_sub_pd(xn, vx0);
+      const __m256d u = _mm256_add_pd(_mm256_mul_pd(ddx, vdx), ddy_dy);
+      const __m256d q = _mm256_sub_pd(ddy_dx, _mm256_mul_pd(ddx, vdy));
+      const __m256d du = _mm256_add_pd(_mm256_min_pd(u, zero), _mm256_max_pd(_mm256_sub_pd(u, vL), zero));
+      const __m256d d2 = _mm256_add_pd(_mm256_mul_pd(q, q), _mm256_mul_pd(du, du));
+      const __m256d reach = prof.reach2_avx(_mm256_sub_pd(_mm256_loadu_pd(bmax + b), vzmin));
+      mask |= static_cast<std::uint64_t>(_mm256_movemask_pd(_mm256_cmp_pd(d2, reach, _CMP_LT_OQ))) << (b - bb);
+    }
+    return b;
+  }
+
+  // block_sse four cells at a time.
+  template <class Profile>
+  TMM_AVX2 void block_avx(const Profile& prof, const Move& m, double ddy, bool q_const, double va_row,
+                          double* row, std::uint8_t& low, std::size_t i0, double R2, double& removed,
+                          double& block_max) const {
+    const __m256d zero = _mm256_setzero_pd(), vR2 = _mm256_set1_pd(R2), vL = _mm256_set1_pd(m.L);
+    const __m256d vdx = _mm256_set1_pd(m.dirx), vdy = _mm256_set1_pd(m.diry), vddy = _mm256_set1_pd(ddy);
+    const __m256d vsign = _mm256_set1_pd(m.sign), vzb = _mm256_set1_pd(m.zbase), vkz = _mm256_set1_pd(m.kz);
+    const __m256d vx0 = _mm256_set1_pd(m.x0);
+    const __m256d ddy_dx = _mm256_mul_pd(vddy, vdx), ddy_dy = _mm256_mul_pd(vddy, vdy);
+    __m256d vrem = _mm256_set1_pd(removed), vmax = _mm256_set1_pd(-INFINITY);
+    int taken = 0;
+    for (std::size_t p = 0; p < kBlock; p += 4) {
+      const std::size_t i = i0 + p;
+      const __m256d ddx = _mm256_sub_pd(_mm256_loadu_pd(&cx_[i]), vx0);
+      const __m256d u = _mm256_add_pd(_mm256_mul_pd(ddx, vdx), ddy_dy);
+      const __m256d q = _mm256_sub_pd(ddy_dx, _mm256_mul_pd(ddx, vdy));
+      const __m256d du = _mm256_add_pd(_mm256_min_pd(u, zero), _mm256_max_pd(_mm256_sub_pd(u, vL), zero));
+      const __m256d q2 = _mm256_mul_pd(q, q);
+      const __m256d d2 = _mm256_add_pd(q2, _mm256_mul_pd(du, du));
+      const __m256d va = q_const ? _mm256_set1_pd(va_row) : prof.v_abs_avx(m, q2);
+      const __m256d v = _mm256_min_pd(_mm256_max_pd(_mm256_mul_pd(vsign, va), _mm256_sub_pd(zero, u)),
+                                      _mm256_sub_pd(vL, u));
+      const __m256d s = _mm256_min_pd(_mm256_max_pd(_mm256_add_pd(u, v), zero), vL);
+      const __m256d zt = _mm256_add_pd(vzb, _mm256_mul_pd(vkz, s));
+      const __m256d rho2 = _mm256_min_pd(_mm256_add_pd(_mm256_mul_pd(v, v), q2), vR2);
+      const __m256d val = prof.value_avx(zt, rho2);
+      const __m256d zc = _mm256_loadu_pd(row + i);
+      const __m256d take = _mm256_and_pd(_mm256_cmp_pd(d2, vR2, _CMP_LE_OQ), _mm256_cmp_pd(val, zc, _CMP_LT_OQ));
+      const __m256d nz = _mm256_blendv_pd(zc, val, take);
+      _mm256_storeu_pd(row + i, nz);
+      vrem = _mm256_max_pd(vrem, _mm256_sub_pd(zc, nz));
+      vmax = _mm256_max_pd(vmax, nz);
+      taken |= _mm256_movemask_pd(take) << p;
+    }
+    low |= static_cast<std::uint8_t>(taken);
+    const __m128d rem2 = _mm_max_pd(_mm256_castpd256_pd128(vrem), _mm256_extractf128_pd(vrem, 1));
+    const __m128d max2 = _mm_max_pd(_mm256_castpd256_pd128(vmax), _mm256_extractf128_pd(vmax, 1));
+    removed = maxd(_mm_cvtsd_f64(rem2), _mm_cvtsd_f64(_mm_unpackhi_pd(rem2, rem2)));
+    block_max = maxd(_mm_cvtsd_f64(max2), _mm_cvtsd_f64(_mm_unpackhi_pd(max2, max2)));
   }
 #endif
 
@@ -456,7 +590,7 @@ class BandCutter {
 
   std::size_t lowered() const {
     std::size_t n = 0;
-    for (const std::uint8_t f : lowered_) n += f;
+    for (const std::uint8_t f : lowered_) n += static_cast<std::size_t>(__builtin_popcount(f));
     return n;
   }
 
@@ -472,7 +606,11 @@ class BandCutter {
   std::size_t j0_, j1_, nx_, nblk_;
   std::vector<double> bx_lo_, bx_hi_;   // per block: x of its first and last cell centres
   std::vector<double> bmax_;            // per row block: the largest height in it
-  std::vector<std::uint8_t> lowered_;   // per cell: lowered by some move
+  std::vector<std::uint8_t> lowered_;   // per row block: bit i - (first cell) set when cell i was lowered
+  std::vector<double> cx_;              // per column: x of the cell centres
+#if defined(TMM_SWEEP3_AVX2)
+  bool avx2_ = __builtin_cpu_supports("avx2");
+#endif
   std::size_t current_move_ = 0;
 };
 
