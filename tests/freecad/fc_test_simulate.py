@@ -44,9 +44,14 @@ class Simulate3Axis(FreeCADTestCase):
         self.assertGreater(r.max_left, 0.01)          # ball D4 at 1 mm step-over leaves cusps (0.063 mm)
         self.assertGreater(r.removed_volume, 0)
         self.assertEqual(r.collisions, [])
-        # per slope band: the bands cover the compared cells, and each band's extremes lie within the whole's
-        self.assertEqual(sum(v["cells"] for v in r.regions.values()), r.simulation.comparison.overall.cells)
+        # per slope band and per XY bucket: each set covers the compared cells once, and each region's
+        # extremes lie within the whole's
+        for prefix in ("slope", "bucket"):
+            part = {k: v for k, v in r.regions.items() if k.startswith(prefix)}
+            self.assertGreater(len(part), 1, prefix)
+            self.assertEqual(sum(v["cells"] for v in part.values()), r.simulation.comparison.overall.cells)
         self.assertTrue(all(v["max_left"] <= r.max_left + 1e-12 for v in r.regions.values()))
+        self.assertAlmostEqual(max(v["max_left"] for v in r.regions.values()), r.max_left, places=12)
         self.assertTrue(png.is_file() and png.stat().st_size > 20_000)
         # the op's CycleTime is TMM's estimate, and the report's
         self.assertAlmostEqual(hms_seconds(op.CycleTime), round(simulation.op_cycle_seconds(op)), delta=1)

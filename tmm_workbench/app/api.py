@@ -390,7 +390,7 @@ class SimulationReport:
     gouged: bool
     collisions: list           # [(op label, move, depth mm)]: rapids through stock
     cycle_seconds: float       # all ops
-    regions: dict              # "slope 0-20 deg", ...: the same numbers per slope band of the design
+    regions: dict              # the same numbers per slope band ("slope 0-20 deg") and per XY bucket (25 mm, or a quarter of the stock)
     ops: list                  # app.simulation.OpSimulation per op
     png: Optional[str]         # the heat map written, when asked
     cell: float

@@ -167,6 +167,26 @@ def slope_regions(design: np.ndarray, cell: float) -> dict:
     return {f"slope {lo:g}-{hi:g} deg": np.isfinite(design) & (slope >= lo) & (slope < hi) for lo, hi in SLOPE_BANDS}
 
 
+BUCKET_MM = 25.0  # seed 003's buckets: square XY regions of the grid, reported one by one
+
+
+def bucket_regions(grid: Grid, design: np.ndarray, size: float = BUCKET_MM) -> dict:
+    """Masks of the design's cells by square XY bucket of `size` mm (seed 003, section 4.1: the regions whose
+    scallop is compared), at most a quarter of the grid's longer side, named by their XY box."""
+    size = min(size, max(grid.nx, grid.ny) * grid.cell / 4)
+    nb = max(1, int(round(size / grid.cell)))
+    out = {}
+    for j0 in range(0, grid.ny, nb):
+        for i0 in range(0, grid.nx, nb):
+            mask = np.zeros(design.shape, dtype=bool)
+            mask[j0:j0 + nb, i0:i0 + nb] = True
+            mask &= np.isfinite(design)
+            if mask.any():
+                x0, y0 = grid.x0 + i0 * grid.cell, grid.y0 + j0 * grid.cell
+                out[f"bucket x {x0:g}..{x0 + nb * grid.cell:g} y {y0:g}..{y0 + nb * grid.cell:g}"] = mask
+    return out
+
+
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
                  progress: Optional[Callable[[float], bool]] = None) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
@@ -204,5 +224,6 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
                                                     result.seconds + r.seconds, result.five_axis or five)
     # cells compared: the design under them and stock there to begin with
     design_here = np.where(initial >= design - tolerance, design, np.nan)
-    comparison = compare_mod.compare(result, design_here, tolerance, slope_regions(design_here, grid.cell))
+    regions = {**slope_regions(design_here, grid.cell), **bucket_regions(grid, design_here)}
+    comparison = compare_mod.compare(result, design_here, tolerance, regions)
     return JobSimulation(grid, result, comparison, done, design_here)
