@@ -23,12 +23,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
+from tmm_workbench.core.geometry import bezier  # noqa: E402
 from tmm_workbench.core.strategies.multipoint import (BezierFace, MultipointParams, make_positioner,  # noqa: E402
                                            STATUS_NAMES)
 
 Z = {"convex": [80, 90, 90, 80, 90, 105, 105, 90, 90, 105, 105, 90, 80, 90, 90, 80],
      "concave": [80, 70, 70, 80, 70, 55, 55, 70, 70, 55, 55, 70, 80, 70, 70, 80],
-     "saddle": [80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85]}  # seed table 1
+     "saddle": list(bezier.SEED_001_SADDLE_Z)}  # seed table 1
 RO, RI = 6.7, 6.0
 
 

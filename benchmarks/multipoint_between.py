@@ -12,8 +12,6 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
@@ -25,14 +23,11 @@ from tmm_workbench.core.strategies.multipoint import MultipointParams, make_posi
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 from tmm_workbench.core.verify import swept  # noqa: E402
 
-SADDLE_Z = [80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85.0]  # seed 001 table 1
 RO, RI = 6.7, 6.0
 
 
 def patch(name: str) -> BezierFace:
-    net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex" if name == "saddle" else name)
-    if name == "saddle":
-        net[..., 2] = np.array(SADDLE_Z).reshape(4, 4)
+    net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), name)
     return BezierFace.from_net(net)
 
 

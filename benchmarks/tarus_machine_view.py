@@ -36,17 +36,11 @@ TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")
 
 
-SADDLE_Z = [80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85.0]  # seed 001 table 1
 
 
 def seed_net(which: str):
-    """Seed 001's convex and concave nets; the saddle: the convex net's x, y with table 1's heights."""
-    import numpy as np
-
-    net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex" if which == "saddle" else which)
-    if which == "saddle":
-        net[..., 2] = np.array(SADDLE_Z).reshape(4, 4)
-    return net
+    """Seed 001's convex, concave and saddle (table 1) nets."""
+    return bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), which)
 
 
 def post_modules(tree: Path | None):

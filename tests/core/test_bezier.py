@@ -157,8 +157,11 @@ def test_seed_patches_follow_the_table(seed_json: Path) -> None:
     centre = bezier.evaluate(convex, np.array([0.5]), np.array([0.5]))[0]
     np.testing.assert_allclose(centre, [75, 75, w @ convex[:, :, 2] @ w], atol=1e-12)
     assert centre[2] > 80 > bezier.evaluate(concave, np.array([0.5]), np.array([0.5]))[0, 2]
-    with pytest.raises(TmmError):
-        bezier.load_seed_patch(seed_json, "saddle")
+    saddle = bezier.load_seed_patch(seed_json, "saddle")  # seed 001 table 1: P01 65, P11 85, P33 85
+    np.testing.assert_array_equal(saddle[:, :, :2], convex[:, :, :2])
+    assert (saddle[0, 1, 2], saddle[1, 1, 2], saddle[3, 3, 2]) == (65, 85, 85)
+    with pytest.raises(TmmError, match="'convex', 'concave' or 'saddle', got 'flat'"):
+        bezier.load_seed_patch(seed_json, "flat")
 
 
 def test_tessellation_counts_bounds_and_orientation(seed_json: Path) -> None:

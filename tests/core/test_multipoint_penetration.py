@@ -22,17 +22,8 @@ from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, STATUS_TWO,
 RO, RI = 6.7, 6.0
 TOL = MultipointParams().tol
 SPAN = 150.0  # the seed patches: x = 150 u, y = 150 v
-# Seed 001 Table 1's saddle (seed_surfaces.json holds the convex and concave patches only).
-SADDLE_Z = [80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85]
-
-
 def seed_net(kind: str) -> np.ndarray:
-    if kind != "saddle" and SEED_JSON.exists():
-        return bezier.load_seed_patch(SEED_JSON, kind)
-    z = {"convex": [80, 90, 90, 80, 90, 105, 105, 90, 90, 105, 105, 90, 80, 90, 90, 80],
-         "concave": [80, 70, 70, 80, 70, 55, 55, 70, 70, 55, 55, 70, 80, 70, 70, 80], "saddle": SADDLE_Z}[kind]
-    i, j = np.meshgrid(np.arange(4), np.arange(4), indexing="ij")
-    return np.stack([50.0 * i, 50.0 * j, np.asarray(z, dtype=float).reshape(4, 4)], axis=-1)
+    return bezier.load_seed_patch(SEED_JSON, kind)
 
 
 def torus_distance(tip, axis, pts):

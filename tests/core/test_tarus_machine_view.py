@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 from tests.conftest import SEED_JSON
@@ -24,16 +23,13 @@ from tmm_workbench.core.strategies.multipoint import (MultipointParams, compute_
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.verify import machine_view, swept
 
-SADDLE_Z = [80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85.0]  # seed 001 table 1
 TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter=25.4, corner_radius=6.0,
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")
 
 
 @pytest.fixture(scope="module", params=["convex", "concave", "saddle"])
 def program(request):
-    net = bezier.load_seed_patch(SEED_JSON, "convex" if request.param == "saddle" else request.param)
-    if request.param == "saddle":
-        net[..., 2] = np.array(SADDLE_Z).reshape(4, 4)
+    net = bezier.load_seed_patch(SEED_JSON, request.param)
     face = BezierFace.from_net(net)
     tool = Cutter.torus(6.7, 6.0)
     safe = face_top(face) + 5.0

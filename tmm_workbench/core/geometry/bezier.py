@@ -177,12 +177,25 @@ def tessellate_to_tolerance(patch: np.ndarray, tol_mm: float, name: str = "bezie
     return tessellate(patch, nu, nv, name=name)
 
 
+# Seed 001 Table 1's saddle heights, P00 P01 .. P33 (benchmarks/seed_surfaces.json holds the convex and
+# concave patches only).
+SEED_001_SADDLE_Z = (80, 65, 90, 85, 80, 85, 90, 95, 100, 105, 95, 100, 90, 100, 100, 85)
+
+
+def _seed_net(z: np.ndarray) -> np.ndarray:
+    i, j = np.meshgrid(np.arange(4), np.arange(4), indexing="ij")  # row order P00 P01 .. P33
+    return np.stack([50.0 * i, 50.0 * j, np.asarray(z, dtype=np.float64).reshape(4, 4)], axis=-1)
+
+
 def load_seed_patch(json_path: str | Path, which: str = "convex") -> np.ndarray:
-    """Control net (4, 4, 3) in mm of the convex or concave bicubic patch of seed 001
-    (section `singh2020_bezier` of benchmarks/seed_surfaces.json): P[i][j] = (50 i, 50 j, z_ij)."""
+    """Control net (4, 4, 3) in mm of seed 001's convex, concave (section `singh2020_bezier` of
+    benchmarks/seed_surfaces.json) or saddle (Table 1, SEED_001_SADDLE_Z) bicubic patch:
+    P[i][j] = (50 i, 50 j, z_ij)."""
     p = Path(json_path)
+    if which == "saddle":
+        return _seed_net(np.array(SEED_001_SADDLE_Z))
     if which not in ("convex", "concave"):
-        raise TmmError(f"seed patch must be 'convex' or 'concave', got {which!r}")
+        raise TmmError(f"seed patch must be 'convex', 'concave' or 'saddle', got {which!r}")
     try:
         section = json.loads(p.read_text())["singh2020_bezier"]
         z = np.asarray(section["z"][which], dtype=np.float64)
@@ -192,5 +205,4 @@ def load_seed_patch(json_path: str | Path, which: str = "convex") -> np.ndarray:
         raise TmmError(f"{p}: singh2020_bezier units are {section.get('units')!r}, expected 'mm'")
     if z.shape != (16,):
         raise TmmError(f"{p}: singh2020_bezier/z/{which} must hold 16 heights, got {z.size}")
-    i, j = np.meshgrid(np.arange(4), np.arange(4), indexing="ij")  # row order P00 P01 .. P33
-    return np.stack([50.0 * i, 50.0 * j, z.reshape(4, 4)], axis=-1)
+    return _seed_net(z)
