@@ -120,10 +120,11 @@ def _tarus_cycle_time(op: Any) -> float:
     return float(write_tarus(program).cycle_time)
 
 
-def op_cycle_seconds(op: Any) -> float:
+def op_cycle_seconds(op: Any, decoded: Optional[tuple[Toolpath, list]] = None) -> float:
     """The op's cycle time, s: 5-axis paths from the Tarus post (joint speeds, A and C planned), 3-axis from
-    the Path's feeds and the tool controller's rapid rates (core.sim.cycle_time)."""
-    tp, feeds = _toolpath_and_feeds(op)
+    the Path's feeds and the tool controller's rapid rates (core.sim.cycle_time). `decoded`: the op's
+    (toolpath, feeds) when the caller has read its Path already."""
+    tp, feeds = decoded or _toolpath_and_feeds(op)
     if len(tp) < 2:
         return 0.0
     if tp.is_five_axis():
@@ -161,9 +162,7 @@ def slope_regions(design: np.ndarray, cell: float) -> dict:
     found the cutters differ."""
     from tmm_workbench.core.sim.optimal_cutter import SLOPE_BANDS
 
-    filled = np.where(np.isfinite(design), design, np.nanmin(design) if np.isfinite(design).any() else 0.0)
-    gy, gx = np.gradient(filled, cell)
-    slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    slope = compare_mod.slope_deg(design, cell)
     return {f"slope {lo:g}-{hi:g} deg": np.isfinite(design) & (slope >= lo) & (slope < hi) for lo, hi in SLOPE_BANDS}
 
 
@@ -214,7 +213,7 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
             return progress((k + f) / len(ops)) if progress else True
         r = simulate(tp, cutter, grid, heights, shape=_five_axis_shape(op) if five else "bull_nose",
                      max_step=max_step, tolerance=tolerance, progress=part if progress else None)
-        seconds = op_cycle_seconds(op)
+        seconds = op_cycle_seconds(op, (tp, feeds))
         done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds))
         heights = r.heights
         result = r if result is None else SimResult(grid, result.initial, r.heights,

@@ -2,7 +2,7 @@
 design's on the same vertical line; positive = material left, negative = gouge), its extremes and
 percentiles, removed and remaining volume, overall and per region (boolean masks over the grid: selected
 faces, seed 003's buckets). Deviations are measured vertically: on a wall of slope a the distance along the
-surface normal is the vertical one times cos a (`normal_deviation`)."""
+surface normal is the vertical one times cos a (`slope_deg`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -70,8 +70,11 @@ def compare(result: SimResult, design: np.ndarray, tolerance: float = 0.01,
     return out
 
 
-def normal_deviation(deviation: np.ndarray, design: np.ndarray, cell: float) -> np.ndarray:
-    """The vertical deviation turned towards the design surface's normal (times cos of its slope, from
-    the design heights' central differences): what a scallop is across the surface on walls."""
-    gy, gx = np.gradient(design, cell)
-    return deviation / np.sqrt(1.0 + gx * gx + gy * gy)
+def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
+    """(ny, nx) slope of the design from the horizontal, degrees, by central differences of its heights
+    (cells without design take its lowest height: a wall where the design ends). A vertical deviation is
+    the distance along the design's normal divided by cos of this slope."""
+    finite = np.isfinite(design)
+    filled = np.where(finite, design, design[finite].min() if finite.any() else 0.0)
+    gy, gx = np.gradient(filled, cell)
+    return np.degrees(np.arctan(np.hypot(gx, gy)))

@@ -18,7 +18,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.sim.compare import compare
+from tmm_workbench.core.sim.compare import compare, slope_deg
 from tmm_workbench.core.sim.cycle_time import three_axis_time, toolpath_feeds
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
@@ -55,11 +55,6 @@ class CutterComparison:
     grid: Grid
 
 
-def _slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
-    gy, gx = np.gradient(design, cell)
-    return np.degrees(np.arctan(np.hypot(gx, gy)))
-
-
 def compare_cutters(mesh: TriMesh, candidates: Sequence[tuple[str, Cutter]], *, stepover: float,
                     sample_step: float, cell: float = 0.1, tolerance: float = 0.01, angle_deg: float = 0.0,
                     boundary: Optional[tuple[float, float, float, float]] = None, horiz_feed: float = 1000 / 60,
@@ -74,7 +69,7 @@ def compare_cutters(mesh: TriMesh, candidates: Sequence[tuple[str, Cutter]], *, 
     grid = Grid.covering(x0, y0, x1, y1, cell)
     surface = DropSurface(mesh)
     design = mesh_heights(mesh, grid, surface)
-    slope = _slope_deg(np.where(np.isfinite(design), design, np.nanmin(design)), cell)
+    slope = slope_deg(design, cell)
     stock = box_heights(grid, float(hi[2]) + 1.0)
     policy = LinkPolicy(float(hi[2]) + 5.0, float(hi[2]) + 10.0)
     params = SurfaceParams(boundary=(x0, y0, x1, y1), stepover=stepover, sample_step=sample_step,
