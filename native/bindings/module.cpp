@@ -8,6 +8,7 @@ void bind_drop(py::module_& m);   // bind_drop.cpp: cutters, spatial index, batc
 void bind_direction(py::module_& m);  // bind_direction.cpp: drop along any direction, any axis
 void bind_surface(py::module_& m);    // bind_surface.cpp: Bezier/B-spline faces
 void bind_multipoint(py::module_& m);  // bind_multipoint.cpp: multipoint positioning of a torus
+void bind_waterline(py::module_& m);  // query/bind_waterline.cpp: exact waterline loops
 void bind_sim(py::module_& m);    // sim/bind_sim.cpp: the z-map stock and 3-axis cutting simulation
 void bind_sim5(py::module_& m);   // sim/bind_sim5.cpp: 5-axis cutting simulation (moving tool axis)
 
@@ -16,6 +17,7 @@ PYBIND11_MODULE(_native, m) {
   bind_mesh(m);
   bind_drop(m);
   bind_direction(m);
+  bind_waterline(m);
   bind_surface(m);
   bind_multipoint(m);
   bind_sim(m);

@@ -1,0 +1,334 @@
+#include "tmm/query/waterline.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <unordered_map>
+
+#include "tmm/query/drop_cutter.hpp"
+#include "tmm/util/bracket_1d.hpp"
+
+namespace tmm {
+
+double WaterlineLoop::area() const {
+  const std::size_t n = size();
+  double a = 0;
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) a += xy[2 * j] * xy[2 * i + 1] - xy[2 * i] * xy[2 * j + 1];
+  return 0.5 * a;
+}
+
+namespace {
+
+constexpr int kIllinoisSteps = 12;  // then bisection: h can jump (a flat end mill at a vertical wall)
+
+void check_options(const WaterlineOptions& o) {
+  auto fail = [](const char* what, double v, const char* allowed) {
+    std::ostringstream msg;
+    msg << "waterline " << what << " must be " << allowed << ", got " << v;
+    throw std::invalid_argument(msg.str());
+  };
+  for (double v : {o.xmin, o.ymin, o.xmax, o.ymax})
+    if (!std::isfinite(v)) fail("bounds", v, "finite");
+  if (!(o.xmax > o.xmin)) fail("bounds xmax", o.xmax, "> xmin");
+  if (!(o.ymax > o.ymin)) fail("bounds ymax", o.ymax, "> ymin");
+  if (!(o.sample_step > 0 && std::isfinite(o.sample_step))) fail("sample step", o.sample_step, "> 0 (mm)");
+  if (!(o.chord_tol > 0 && std::isfinite(o.chord_tol))) fail("chord tolerance", o.chord_tol, "> 0 (mm)");
+  if (!(o.bracket > 0 && o.bracket < 0.5 * o.chord_tol)) fail("bracket", o.bracket, "in (0, chord tolerance / 2)");
+  if (!(o.min_segment > 0 && std::isfinite(o.min_segment))) fail("minimum segment", o.min_segment, "> 0 (mm)");
+  if (o.max_depth < 0 || o.max_depth > 64) fail("maximum depth", o.max_depth, "in [0, 64]");
+}
+
+std::size_t nodes_along(double width, double step) {
+  const double cells = std::ceil(width / step - 1e-9);
+  if (!(cells < 1e9)) return std::numeric_limits<std::size_t>::max();
+  return std::max<std::size_t>(2, static_cast<std::size_t>(cells) + 1);
+}
+
+struct Point {
+  double x, y;
+  bool contact;
+};
+
+// The shared grid of drop heights, padded by one ring of free nodes (height -inf).
+struct Grid {
+  std::size_t NX = 0, NY = 0;  // padded node counts
+  double x0 = 0, y0 = 0;       // position of padded node (1, 1), the bounds' corner
+  double dx = 0, dy = 0;
+  std::vector<double> h;       // NX * NY heights
+  std::vector<double> row_lo, row_hi;  // per cell row J: lowest and highest height of rows J and J + 1
+
+  double x(std::size_t I) const { return x0 + (static_cast<double>(I) - 1.0) * dx; }
+  double y(std::size_t J) const { return y0 + (static_cast<double>(J) - 1.0) * dy; }
+  bool ring(std::size_t I, std::size_t J) const { return I == 0 || J == 0 || I + 1 == NX || J + 1 == NY; }
+};
+
+// One level: marching squares, exact crossings, loops, refinement. Drops from one thread, with hints.
+class Level {
+ public:
+  Level(const MeshIndex& index, const Cutter& cutter, const Grid& grid, const WaterlineOptions& o, double z)
+      : index_(index), cutter_(cutter), g_(grid), o_(o), z_(z),
+        eval_floor_(z - 2.0 * std::max({cutter.max_radius(), grid.dx, grid.dy})) {}
+
+  std::vector<WaterlineLoop> loops();
+  std::size_t drops() const { return drops_; }
+
+ private:
+  bool blocked(double x, double y) {
+    ++drops_;
+    return drop_point(index_, cutter_, x, y, z_, nullptr, &hint_) > z_;
+  }
+  // z - h, h clamped to a floor below z (Illinois needs finite values where nothing is under the tool).
+  double clearance(double x, double y) {
+    ++drops_;
+    return z_ - drop_point(index_, cutter_, x, y, eval_floor_, nullptr, &hint_);
+  }
+  // The boundary on the segment from a free point f (clearance cf >= 0) to a blocked point b (cb < 0): the
+  // free end of a bracket narrower than o_.bracket.
+  Point crossing(Point f, Point b, double cf, double cb);
+  Point edge_crossing(uint64_t edge);
+  void refine(const Point& p, const Point& q, int depth, std::vector<Point>& out);
+
+  const MeshIndex& index_;
+  const Cutter& cutter_;
+  const Grid& g_;
+  const WaterlineOptions& o_;
+  const double z_, eval_floor_;
+  int32_t hint_ = -1;
+  std::size_t drops_ = 0;
+};
+
+Point Level::crossing(Point f, Point b, double cf, double cb) {
+  const double length = std::hypot(b.x - f.x, b.y - f.y);
+  const double width = o_.bracket / length;
+  auto at = [&](double t) { return Point{f.x + t * (b.x - f.x), f.y + t * (b.y - f.y), true}; };
+  Bracket br = illinois(0.0, 1.0, std::min(cf, z_ - eval_floor_), cb, kIllinoisSteps, width, [&](double t) {
+    const Point p = at(t);
+    return clearance(p.x, p.y);
+  });
+  if (br.bad - br.good > width) {
+    const int steps = static_cast<int>(std::ceil(std::log2((br.bad - br.good) / width)));
+    br = bisect(br.good, br.bad, steps, [&](double t) {
+      const Point p = at(t);
+      return !blocked(p.x, p.y);
+    });
+  }
+  return at(br.good);
+}
+
+// Edge ids: 2 (J NX + I) for the edge (I, J)-(I + 1, J), + 1 for (I, J)-(I, J + 1).
+Point Level::edge_crossing(uint64_t edge) {
+  const std::size_t node = static_cast<std::size_t>(edge >> 1);
+  const std::size_t I = node % g_.NX, J = node / g_.NX;
+  const bool vertical = edge & 1u;
+  const std::size_t I2 = vertical ? I : I + 1, J2 = vertical ? J + 1 : J;
+  const double ha = g_.h[J * g_.NX + I], hb = g_.h[J2 * g_.NX + I2];
+  Point a{g_.x(I), g_.y(J), true}, b{g_.x(I2), g_.y(J2), true};
+  // A ring node stands for "outside the bounds": the crossing is the bound itself, not a contact.
+  if (g_.ring(I, J)) return Point{b.x, b.y, false};
+  if (g_.ring(I2, J2)) return Point{a.x, a.y, false};
+  if (ha > z_) return crossing(b, a, z_ - hb, z_ - ha);
+  return crossing(a, b, z_ - ha, z_ - hb);
+}
+
+void Level::refine(const Point& p, const Point& q, int depth, std::vector<Point>& out) {
+  const double dx = q.x - p.x, dy = q.y - p.y, length = std::hypot(dx, dy);
+  if (depth >= o_.max_depth || length < o_.min_segment) return;
+  const double nx = -dy / length, ny = dx / length;  // left normal: the blocked side
+  const Point m{0.5 * (p.x + q.x), 0.5 * (p.y + q.y), true};
+  const bool m_blocked = blocked(m.x, m.y);
+  // The boundary lies towards the free side of m (right if m is blocked, left if free): within chord_tol
+  // when the state changes there already.
+  const double sign = m_blocked ? -1.0 : 1.0;
+  const double tol = o_.chord_tol;
+  auto along = [&](double s) { return Point{m.x + sign * s * nx, m.y + sign * s * ny, true}; };
+  double s_in = 0.0, s_out = tol;
+  Point out_pt = along(s_out);
+  while (blocked(out_pt.x, out_pt.y) == m_blocked) {
+    s_in = s_out;
+    s_out *= 2.0;
+    if (s_out > length) return;  // no boundary within a chord length: leave the chord
+    out_pt = along(s_out);
+  }
+  if (s_in == 0.0) return;  // the exact loop is within chord_tol of the chord
+  const Point in_pt = along(s_in);
+  const Point& f = m_blocked ? out_pt : in_pt;
+  const Point& b = m_blocked ? in_pt : out_pt;
+  const double cf = clearance(f.x, f.y), cb = clearance(b.x, b.y);
+  const Point c = cb < 0.0 ? crossing(f, b, cf, cb) : f;  // (cb >= 0 cannot be: b is blocked)
+  const double slack = 1e-9;
+  if (c.x < o_.xmin - slack || c.x > o_.xmax + slack || c.y < o_.ymin - slack || c.y > o_.ymax + slack) return;
+  refine(p, c, depth + 1, out);
+  out.push_back(c);
+  refine(c, q, depth + 1, out);
+}
+
+std::vector<WaterlineLoop> Level::loops() {
+  const std::size_t NX = g_.NX, NY = g_.NY;
+  auto s = [&](std::size_t I, std::size_t J) { return g_.h[J * NX + I] > z_; };
+  auto H = [&](std::size_t I, std::size_t J) { return static_cast<uint64_t>(2 * (J * NX + I)); };
+  auto V = [&](std::size_t I, std::size_t J) { return static_cast<uint64_t>(2 * (J * NX + I) + 1); };
+  // Segments of the marching squares, blocked on the left: start edge -> end edge.
+  std::unordered_map<uint64_t, uint64_t> next;
+  std::vector<uint64_t> starts;  // in scan order (the loops' order)
+  for (std::size_t J = 0; J + 1 < NY; ++J) {
+    if (z_ >= g_.row_hi[J] || z_ < g_.row_lo[J]) continue;  // the row is all free or all blocked
+    for (std::size_t I = 0; I + 1 < NX; ++I) {
+      const bool c[4] = {s(I, J), s(I + 1, J), s(I + 1, J + 1), s(I, J + 1)};
+      const int k = c[0] + c[1] + c[2] + c[3];
+      if (k == 0 || k == 4) continue;
+      // edge e between corners e and e + 1 (counter-clockwise): bottom, right, top, left
+      const uint64_t e[4] = {H(I, J), V(I + 1, J), H(I, J + 1), V(I, J)};
+      auto add = [&](int from, int to) {
+        next.emplace(e[from], e[to]);
+        starts.push_back(e[from]);
+      };
+      if (k == 2 && c[0] == c[2]) {  // a saddle: the centre decides whether the blocked corners join
+        const bool centre = blocked(0.5 * (g_.x(I) + g_.x(I + 1)), 0.5 * (g_.y(J) + g_.y(J + 1)));
+        const int first = c[0] ? 0 : 1;  // the blocked -> free edges are first and first + 2
+        for (int f : {first, first + 2}) add(f, centre ? (f + 1) % 4 : (f + 3) % 4);
+        continue;
+      }
+      int from = -1, to = -1;
+      for (int q = 0; q < 4; ++q) {
+        if (c[q] && !c[(q + 1) % 4]) from = q;
+        if (!c[q] && c[(q + 1) % 4]) to = q;
+      }
+      add(from, to);
+    }
+  }
+  std::vector<WaterlineLoop> result;
+  std::unordered_map<uint64_t, bool> done;
+  done.reserve(starts.size());
+  for (uint64_t first : starts) {
+    if (done.count(first)) continue;
+    std::vector<Point> pts;
+    for (uint64_t e = first;;) {
+      done.emplace(e, true);
+      const Point p = edge_crossing(e);
+      if (pts.empty() || p.x != pts.back().x || p.y != pts.back().y) pts.push_back(p);
+      else pts.back().contact = pts.back().contact && p.contact;
+      e = next.at(e);
+      if (e == first) break;
+    }
+    while (pts.size() > 1 && pts.front().x == pts.back().x && pts.front().y == pts.back().y) {
+      pts.front().contact = pts.front().contact && pts.back().contact;
+      pts.pop_back();
+    }
+    if (pts.size() < 3) continue;  // a degenerate loop (a blocked node touching the bounds' corner only)
+    WaterlineLoop loop;
+    loop.z = z_;
+    const std::size_t n = pts.size();
+    std::vector<Point> fine;
+    fine.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point& p = pts[i];
+      const Point& q = pts[(i + 1) % n];
+      fine.push_back(p);
+      if (p.contact && q.contact) refine(p, q, 0, fine);
+    }
+    loop.xy.reserve(2 * fine.size());
+    loop.contact.reserve(fine.size());
+    for (const Point& p : fine) {
+      loop.xy.push_back(p.x);
+      loop.xy.push_back(p.y);
+      loop.contact.push_back(p.contact ? 1 : 0);
+    }
+    result.push_back(std::move(loop));
+  }
+  return result;
+}
+
+}  // namespace
+
+void waterline_grid_size(const WaterlineOptions& options, std::size_t& nx, std::size_t& ny) {
+  check_options(options);
+  nx = nodes_along(options.xmax - options.xmin, options.sample_step);
+  ny = nodes_along(options.ymax - options.ymin, options.sample_step);
+  const double padded = (static_cast<double>(nx) + 2.0) * (static_cast<double>(ny) + 2.0);
+  if (padded > static_cast<double>(kMaxWaterlineGridNodes)) {
+    std::ostringstream msg;
+    msg << "waterline sample step " << options.sample_step << " mm over " << options.xmax - options.xmin << " x "
+        << options.ymax - options.ymin << " mm gives a drop grid of " << padded << " nodes, more than the "
+        << "kernel's limit of " << kMaxWaterlineGridNodes << "; use a larger sample step or smaller bounds";
+    throw std::invalid_argument(msg.str());
+  }
+}
+
+std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const Cutter& cutter,
+                                                  const std::vector<double>& zs, const WaterlineOptions& o,
+                                                  const BatchOptions& batch, WaterlineStats* stats) {
+  std::size_t nx = 0, ny = 0;
+  waterline_grid_size(o, nx, ny);
+  double zlow = kInf;
+  for (double z : zs) {
+    if (!std::isfinite(z)) {
+      std::ostringstream msg;
+      msg << "waterline level z must be finite, got " << z;
+      throw std::invalid_argument(msg.str());
+    }
+    zlow = std::min(zlow, z);
+  }
+  std::vector<std::vector<WaterlineLoop>> result(zs.size());
+  if (zs.empty()) return result;
+
+  Grid g;
+  g.NX = nx + 2;
+  g.NY = ny + 2;
+  g.x0 = o.xmin;
+  g.y0 = o.ymin;
+  g.dx = (o.xmax - o.xmin) / static_cast<double>(nx - 1);
+  g.dy = (o.ymax - o.ymin) / static_cast<double>(ny - 1);
+  // Progress: the grid's share of the work by a rough count of drops (a level costs some 30 drops per
+  // crossing, a few crossings per grid line).
+  const double grid_work = static_cast<double>(nx * ny);
+  const double level_work = static_cast<double>(zs.size()) * 60.0 * static_cast<double>(nx + ny);
+  const double grid_share = grid_work / (grid_work + level_work);
+  BatchOptions grid_batch{batch.threads, {}};
+  if (batch.progress)
+    grid_batch.progress = [&](double f) { return batch.progress(f * grid_share); };
+  {
+    std::vector<double> xy(2 * nx * ny), z(nx * ny);
+    for (std::size_t j = 0; j < ny; ++j)
+      for (std::size_t i = 0; i < nx; ++i) {
+        xy[2 * (j * nx + i)] = g.x(i + 1);
+        xy[2 * (j * nx + i) + 1] = g.y(j + 1);
+      }
+    // Any floor below the lowest level: a height at the floor is free at every level.
+    drop_batch(index, cutter, xy.data(), nx * ny, zlow - 1.0, z.data(), grid_batch);
+    g.h.assign(g.NX * g.NY, -kInf);
+    for (std::size_t j = 0; j < ny; ++j)
+      std::copy(z.begin() + j * nx, z.begin() + (j + 1) * nx, g.h.begin() + (j + 1) * g.NX + 1);
+  }
+  g.row_lo.assign(g.NY - 1, kInf);
+  g.row_hi.assign(g.NY - 1, -kInf);
+  for (std::size_t J = 0; J + 1 < g.NY; ++J) {
+    for (std::size_t I = 0; I < g.NX; ++I) {
+      for (std::size_t r : {J, J + 1}) {
+        g.row_lo[J] = std::min(g.row_lo[J], g.h[r * g.NX + I]);
+        g.row_hi[J] = std::max(g.row_hi[J], g.h[r * g.NX + I]);
+      }
+    }
+  }
+
+  std::atomic<std::size_t> drops{0};
+  BatchOptions level_batch{batch.threads, {}};
+  if (batch.progress)
+    level_batch.progress = [&](double f) { return batch.progress(grid_share + f * (1.0 - grid_share)); };
+  parallel_chunks(zs.size(), 1, level_batch, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      Level level(index, cutter, g, o, zs[k]);
+      result[k] = level.loops();
+      drops += level.drops();
+    }
+  });
+  if (stats) {
+    stats->grid_nodes = nx * ny;
+    stats->drops = drops.load();
+  }
+  return result;
+}
+
+}  // namespace tmm
