@@ -85,9 +85,9 @@ def test_along_axis_needs_the_tool_geometry():
 def test_policy_is_checked():
     with pytest.raises(TmmError, match="clearance height 5 mm is below the safe height 10 mm"):
         link([seg([(0, 0, 0)])], LinkPolicy(10.0, 5.0))
-    with pytest.raises(TmmError, match="entry must be one of plunge"):
-        link([seg([(0, 0, 0)])], LinkPolicy(10.0, 15.0, entry="helix"))
-    assert set(ENTRIES) == {"plunge"}
+    with pytest.raises(TmmError, match="entry must be one of plunge, helix, ramp"):
+        link([seg([(0, 0, 0)])], LinkPolicy(10.0, 15.0, entry="spiral"))
+    assert set(ENTRIES) == {"plunge", "helix", "ramp"}
 
 
 def test_no_segments_no_path():

@@ -6,6 +6,11 @@ A segment is a run of CL points cut in one go: tool tips (n, 3) and, for 5-axis 
   LINK  a gouge-free connector the strategy computed between two passes (dropped points), cut at feed.
 `joined` says the segment continues the previous one with the tool down (no retract): a zig-zag pass
 after its link, a link after its pass. Anything else is entered from above by the linker's policy.
+Optional entry facts a strategy may give (core.linking's HELIX and RAMP use them; PLUNGE ignores them):
+`entry` (this segment's entry instead of the policy's), `entry_z` (where the material starts above the first
+tip: the helix or ramp begins there, the tool fed down to it through air; None: at the safe height),
+`helix_centre` and `helix_ccw` (the helix circle through the first tip and its sense), `closed` (the tips
+are a loop: a ramp follows it backwards from the first tip, around it as often as needed).
 """
 from __future__ import annotations
 
@@ -28,6 +33,11 @@ class CutSegment:
     axes: Optional[np.ndarray] = None     # (n, 3) unit tool axes; None: (0, 0, 1)
     joined: bool = False                  # continues the previous segment with the tool down
     pass_index: int = 0
+    entry: Optional[str] = None           # a key of core.linking.ENTRIES; None: the policy's
+    entry_z: Optional[float] = None       # where the material starts above the first tip, mm
+    helix_centre: Optional[tuple[float, float]] = None
+    helix_ccw: bool = True
+    closed: bool = False                  # the tips are a closed loop
 
     def __post_init__(self) -> None:
         self.tips = np.asarray(self.tips, dtype=float).reshape(-1, 3)

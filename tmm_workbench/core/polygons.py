@@ -1,0 +1,215 @@
+"""The one polygon module: offsets and booleans of XY polygons by Clipper 6 (Debian's python3-pyclipper).
+
+Polygons are (n, 2) float arrays in mm, closed implicitly; a *shape* is a list of them read with the
+non-zero fill rule (outer boundaries counter-clockwise, holes clockwise, as Clipper returns them). Clipper
+works on integers: coordinates are scaled by SCALE (1 unit = 1 nm) here and nowhere else.
+
+Round joins everywhere (an offset of a polygon by a disc is what a cutter of that radius sweeps); arcs are
+split into chords within `arc_tol` mm (ARC_TOL by default) of the true circle, the chords lying inside it
+(Clipper's round joins), so an inward offset is never wider than the exact one by more than `arc_tol`.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+import pyclipper
+
+SCALE = 1e6          # Clipper integer units per mm
+ARC_TOL = 0.005      # mm: chord deviation of round joins unless given
+Shape = list[np.ndarray]
+
+
+def _to_int(paths: Iterable[np.ndarray]) -> list[list[tuple[int, int]]]:
+    out = []
+    for p in paths:
+        a = np.asarray(p, dtype=float).reshape(-1, 2)
+        if len(a) >= 2:
+            out.append([(int(x), int(y)) for x, y in np.rint(a * SCALE)])
+    return out
+
+
+def _from_int(paths: Iterable[Sequence[Sequence[int]]]) -> Shape:
+    return [np.asarray(p, dtype=float).reshape(-1, 2) / SCALE for p in paths if len(p) >= 3]
+
+
+def signed_area(poly: np.ndarray) -> float:
+    """Shoelace area, mm^2: positive counter-clockwise."""
+    p = np.asarray(poly, dtype=float).reshape(-1, 2)
+    if len(p) < 3:
+        return 0.0
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def area(shape: Shape) -> float:
+    """Area of a shape (outer boundaries minus holes, as oriented by Clipper), mm^2."""
+    return float(sum(signed_area(p) for p in shape))
+
+
+def is_ccw(poly: np.ndarray) -> bool:
+    return bool(pyclipper.Orientation(_to_int([poly])[0]))
+
+
+def oriented(poly: np.ndarray, ccw: bool) -> np.ndarray:
+    """`poly` counter-clockwise (ccw True) or clockwise."""
+    return poly if (signed_area(poly) > 0) == ccw else poly[::-1].copy()
+
+
+def _offsetter(arc_tol: float) -> pyclipper.PyclipperOffset:
+    return pyclipper.PyclipperOffset(2.0, arc_tol * SCALE)
+
+
+def offset(shape: Shape, delta: float, arc_tol: float = ARC_TOL) -> Shape:
+    """The shape grown by `delta` mm (negative: shrunk; an erosion by a disc), round joins."""
+    paths = _to_int(shape)
+    if not paths:
+        return []
+    if delta == 0:
+        return union(shape)
+    o = _offsetter(arc_tol)
+    o.AddPaths(paths, pyclipper.JT_ROUND, pyclipper.ET_CLOSEDPOLYGON)
+    return _from_int(o.Execute(delta * SCALE))
+
+
+def offset_open(paths: Sequence[np.ndarray], delta: float, arc_tol: float = ARC_TOL,
+                closed: bool = False) -> Shape:
+    """What a disc of radius `delta` sweeps along open polylines (round ends), or along closed loops
+    (closed=True: the band either side of each loop)."""
+    ints = _to_int(paths)
+    if not ints or delta <= 0:
+        return []
+    o = _offsetter(arc_tol)
+    o.AddPaths(ints, pyclipper.JT_ROUND, pyclipper.ET_CLOSEDLINE if closed else pyclipper.ET_OPENROUND)
+    return _from_int(o.Execute(delta * SCALE))
+
+
+def _boolean(subject: Shape, clip: Shape, op: int) -> Shape:
+    s, c = _to_int(subject), _to_int(clip)
+    if not s and op != pyclipper.CT_UNION:
+        return []
+    pc = pyclipper.Pyclipper()
+    if s:
+        pc.AddPaths(s, pyclipper.PT_SUBJECT, True)
+    if c:
+        pc.AddPaths(c, pyclipper.PT_CLIP, True)
+    if not s and not c:
+        return []
+    return _from_int(pc.Execute(op, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO))
+
+
+def union(a: Shape, b: Shape = ()) -> Shape:  # type: ignore[assignment]
+    """Union (also: one shape cleaned into non-overlapping, oriented boundaries)."""
+    return _boolean(list(a) + list(b), [], pyclipper.CT_UNION)
+
+
+def difference(a: Shape, b: Shape) -> Shape:
+    return _boolean(a, b, pyclipper.CT_DIFFERENCE) if b else union(a)
+
+
+def intersection(a: Shape, b: Shape) -> Shape:
+    return _boolean(a, b, pyclipper.CT_INTERSECTION)
+
+
+def clip_open(paths: Sequence[np.ndarray], shape: Shape) -> list[np.ndarray]:
+    """The pieces of open polylines that lie inside `shape` ((n, 2) each, in their own direction or
+    reversed: Clipper does not keep the direction of open paths)."""
+    ints, c = _to_int(paths), _to_int(shape)
+    if not ints or not c:
+        return []
+    pc = pyclipper.Pyclipper()
+    for p in ints:
+        pc.AddPath(p, pyclipper.PT_SUBJECT, False)
+    pc.AddPaths(c, pyclipper.PT_CLIP, True)
+    tree = pc.Execute2(pyclipper.CT_INTERSECTION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
+    return [np.asarray(p, dtype=float).reshape(-1, 2) / SCALE for p in pyclipper.OpenPathsFromPolyTree(tree)
+            if len(p) >= 2]
+
+
+def segment_inside(a: np.ndarray, b: np.ndarray, shape: Shape, tol: float = 1e-6) -> bool:
+    """The straight segment a -> b lies in `shape` (within `tol` mm of its length)."""
+    length = float(np.hypot(*(np.asarray(b, float) - np.asarray(a, float))))
+    if length <= tol:
+        return contains_point(shape, a)
+    inside = clip_open([np.array([a, b], dtype=float)], shape)
+    return sum(float(np.hypot(*np.diff(p, axis=0).T).sum()) for p in inside) >= length - tol
+
+
+def contains_point(shape: Shape, point: Sequence[float]) -> bool:
+    """`point` inside the shape or on its boundary (non-zero rule over all its polygons)."""
+    q = (int(round(point[0] * SCALE)), int(round(point[1] * SCALE)))
+    winding = 0
+    for p in _to_int(shape):
+        r = pyclipper.PointInPolygon(q, p)
+        if r == -1:
+            return True
+        if r == 1:
+            winding += 1 if pyclipper.Orientation(p) else -1
+    return winding != 0
+
+
+def covers(outer: Shape, inner: Shape, tol_area: float = 1e-6) -> bool:
+    """`inner` lies in `outer` (what sticks out is below `tol_area` mm^2)."""
+    return area(difference(inner, outer)) <= tol_area
+
+
+def rectangle(xmin: float, ymin: float, xmax: float, ymax: float) -> np.ndarray:
+    return np.array([[xmin, ymin], [xmax, ymin], [xmax, ymax], [xmin, ymax]], dtype=float)
+
+
+def circle(centre: Sequence[float], radius: float, chord_tol: float = ARC_TOL) -> np.ndarray:
+    """A counter-clockwise polygon inscribed in the circle with sagitta at most `chord_tol`."""
+    n = max(8, math.ceil(math.pi / math.acos(max(-1.0, 1.0 - chord_tol / radius)))) if radius > chord_tol else 8
+    t = np.linspace(0.0, 2 * math.pi, n, endpoint=False)
+    return np.column_stack([centre[0] + radius * np.cos(t), centre[1] + radius * np.sin(t)])
+
+
+@dataclass
+class Region:
+    """One connected piece of a shape: its outer boundary (counter-clockwise) and holes (clockwise)."""
+    outer: np.ndarray
+    holes: list[np.ndarray] = field(default_factory=list)
+
+    @property
+    def shape(self) -> Shape:
+        return [self.outer, *self.holes]
+
+    @property
+    def area(self) -> float:
+        return area(self.shape)
+
+
+def regions(shape: Shape) -> list[Region]:
+    """The connected pieces of a shape (Clipper's PolyTree: each outer boundary with its own holes; an
+    island inside a hole is a piece of its own)."""
+    ints = _to_int(shape)
+    if not ints:
+        return []
+    pc = pyclipper.Pyclipper()
+    pc.AddPaths(ints, pyclipper.PT_SUBJECT, True)
+    tree = pc.Execute2(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
+    out: list[Region] = []
+
+    def walk(node) -> None:
+        for child in node.Childs:
+            if not child.IsHole:
+                holes = [np.asarray(h.Contour, float).reshape(-1, 2) / SCALE for h in child.Childs
+                         if len(h.Contour) >= 3]
+                if len(child.Contour) >= 3:
+                    out.append(Region(np.asarray(child.Contour, float).reshape(-1, 2) / SCALE, holes))
+                for h in child.Childs:
+                    walk(h)
+
+    walk(tree)
+    return out
+
+
+def bounds(shape: Shape) -> tuple[float, float, float, float]:
+    pts = np.vstack(shape)
+    return float(pts[:, 0].min()), float(pts[:, 1].min()), float(pts[:, 0].max()), float(pts[:, 1].max())
+
+
+def point_count(shape: Shape) -> int:
+    return int(sum(len(p) for p in shape))
