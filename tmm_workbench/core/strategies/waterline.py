@@ -1,0 +1,168 @@
+"""Waterline finishing: the exact waterline loops (core.query.waterline) at levels step-down apart, each loop
+one closed pass at its height; the linker (core.linking, VERTICAL) makes the tool path.
+
+    result = compute(mesh, Cutter.ball(6), WaterlineParams(boundary=(0, 0, 100, 80), step_down=0.5))
+    path = link(result.segments, LinkPolicy(safe_height=40, clearance_height=45))
+
+Levels run top-down from `top_z` - `step_down` (default top: the model's highest point) to `bottom_z` (the
+last level exactly there; default: the model's lowest point). Within a level the loops are cut nearest-first,
+each closed loop starting at its point nearest to where the tool is. Where the blocked region runs past the
+boundary, the loop's points on the boundary split it: those pieces are not cut, the rest are open passes.
+
+Direction, for a right-hand (M3, clockwise seen from above) spindle: the kernel's loops keep the material on
+the tool's left, which is conventional milling (the tooth at the contact moves with the tool's travel);
+climb milling keeps the material on the tool's right. So with "climb" an island loop (around material) runs
+clockwise and a pocket loop counter-clockwise; with "conventional" the other way round.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+from typing import Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.raster import Rect
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.params import StrategyParams, check_finite, param
+from tmm_workbench.core.query import waterline as wl
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
+from tmm_workbench.core.tools.cutter import Cutter
+
+SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
+CLIMB, CONVENTIONAL = "climb", "conventional"
+_LEVEL_EPS_MM = 1e-9  # a level this close above the bottom is the bottom
+_HAS_CLOSED = "closed" in {f.name for f in fields(CutSegment)}  # the linker's ramp entry walks closed loops
+
+
+@dataclass
+class WaterlineParams(StrategyParams):
+    boundary: Rect = (0.0, 0.0, 0.0, 0.0)        # xmin, ymin, xmax, ymax of the tip positions (mm)
+    step_down: float = param(1.0, "step-down", "mm", low=0, low_open=True, kind="length")
+    top_z: Optional[float] = param(None, "top", "mm", optional=True)        # default: the model's top
+    bottom_z: Optional[float] = param(None, "bottom", "mm", optional=True)  # default: the model's lowest point
+    stock_to_leave: float = param(0.0, "stock to leave", "mm", low=0)
+    sample_step: Optional[float] = param(None, "sample step", "mm", optional=True, low=0, low_open=True)
+    chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
+    direction: str = param(CLIMB, "direction", choices=(CLIMB, CONVENTIONAL))
+
+    def validate(self) -> None:
+        super().validate()
+        if len(self.boundary) != 4:
+            raise TmmError(f"boundary must be four finite numbers xmin, ymin, xmax, ymax, got {self.boundary!r}")
+        check_finite("boundary (xmin, ymin, xmax, ymax)", self.boundary)
+        b = self.boundary
+        if not (b[2] > b[0] and b[3] > b[1]):
+            raise TmmError(f"boundary is empty: x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g}")
+        if self.top_z is not None and self.bottom_z is not None and not self.top_z > self.bottom_z:
+            raise TmmError(f"top {self.top_z:g} mm must be above bottom {self.bottom_z:g} mm")
+
+
+def levels(top: float, bottom: float, step_down: float) -> list[float]:
+    """Tip heights top - step_down, top - 2 step_down, ... above bottom, then bottom itself."""
+    if not top > bottom:
+        raise TmmError(f"top {top:g} mm must be above bottom {bottom:g} mm")
+    count = math.ceil((top - bottom) / step_down - _LEVEL_EPS_MM)
+    zs = [top - k * step_down for k in range(1, count)]
+    return [z for z in zs if z > bottom + _LEVEL_EPS_MM] + [bottom]
+
+
+def _range(mesh: TriMesh, params: WaterlineParams) -> tuple[float, float]:
+    lo, hi = mesh.bounds
+    top = float(hi[2]) if params.top_z is None else float(params.top_z)
+    bottom = float(lo[2]) if params.bottom_z is None else float(params.bottom_z)
+    return top, bottom
+
+
+def estimate_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: float) -> float:
+    """Drops of the shared grid and loop points of all levels (an estimate), refused above core.limits
+    before anything is allocated."""
+    params.validate()
+    b = params.boundary
+    step = wl.default_sample_step(cutter, b) if params.sample_step is None else params.sample_step
+    return wl.estimate_work(b, len(levels(top, bottom, params.step_down)), step)
+
+
+def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Optional[Progress] = None,
+            surface: Optional[DropSurface] = None) -> StrategyResult:
+    """Gouge-free waterline finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments, levels
+    top-down. diagnostics: "levels" (count), "loops", "points", "top" (highest tip)."""
+    params.validate()
+    if cutter.kind not in SUPPORTED_TOOLS:
+        raise TmmError(f"the {cutter.describe()} cutter is not supported by waterline finishing")
+    lo, hi = mesh.bounds
+    b = params.boundary
+    if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
+        raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
+                       f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
+    top, bottom = _range(mesh, params)
+    estimate_work(params, cutter, top, bottom)
+    zs = levels(top, bottom, params.step_down)
+    s = params.stock_to_leave
+    surface = surface or DropSurface(mesh)
+    # Stock to leave: the cutter grown by s at tip heights z - s is exactly this cutter at z on the mesh
+    # offset by s (Cutter.offset).
+    found = wl.waterline_loops(surface, cutter.offset(s), [z - s for z in zs], b, sample_step=params.sample_step,
+                               chord_tol=params.chord_tol, progress=progress)
+    segments: list[CutSegment] = []
+    where: Optional[np.ndarray] = None
+    loops = points = 0
+    for k, (z, level) in enumerate(zip(zs, found)):
+        pieces = [p for loop in level for p in _pieces(loop, params.direction == CLIMB)]
+        loops += len(level)
+        while pieces:
+            j, start = _nearest(pieces, where)
+            xy, closed = pieces.pop(j)
+            if closed:
+                xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
+            tips = np.column_stack([xy, np.full(len(xy), z)])
+            # The linker enters each segment from above onto its first tip: gouge-free, since every loop
+            # point is free (its drop height is at most z).
+            extra = {"closed": closed} if _HAS_CLOSED else {}
+            segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
+            points += len(tips)
+            where = xy[-1]
+    if not segments:
+        raise TmmError(f"no waterline loop within the boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} "
+                       f"between {bottom:g} and {top:g} mm: the model lies outside it or below the levels")
+    diagnostics = {"levels": len(zs), "loops": loops, "points": points,
+                   "top": max(float(seg.tips[0, 2]) for seg in segments)}
+    return StrategyResult(segments, diagnostics)
+
+
+def _pieces(loop: wl.WaterlineLoop, climb: bool) -> list[tuple[np.ndarray, bool]]:
+    """The loop's parts to cut, (xy, closed), in the cutting direction: the whole loop if every point is a
+    contact, else the runs of contacts between points on the boundary (two points at least)."""
+    xy, contact = loop.xy, loop.contact
+    if climb:  # the kernel's loops keep the material on the left (conventional)
+        xy, contact = xy[::-1], contact[::-1]
+    if contact.all():
+        return [(xy, True)]
+    n = len(xy)
+    first = int(np.flatnonzero(~contact)[0])
+    order = (np.arange(n) + first) % n        # starting at a boundary point: runs do not wrap
+    runs, run = [], []
+    for i in order:
+        if contact[i]:
+            run.append(i)
+        elif run:
+            runs.append(run)
+            run = []
+    if run:
+        runs.append(run)
+    return [(xy[r], False) for r in runs if len(r) >= 2]
+
+
+def _nearest(pieces: list[tuple[np.ndarray, bool]], where: Optional[np.ndarray]) -> tuple[int, int]:
+    """(piece, start point) nearest to `where`: any point of a closed loop, the first of an open piece."""
+    if where is None:
+        return 0, 0
+    best = (math.inf, 0, 0)
+    for j, (xy, closed) in enumerate(pieces):
+        d = np.hypot(*(xy - where).T) if closed else np.array([math.hypot(*(xy[0] - where))])
+        i = int(np.argmin(d))
+        if d[i] < best[0]:
+            best = (float(d[i]), j, i)
+    return best[1], best[2]
