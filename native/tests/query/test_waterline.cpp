@@ -1,0 +1,289 @@
+// Exact waterline against closed forms and against the drop-cutter itself:
+//  - a ball over a sphere mesh: a circle of radius sqrt((Rs + R)^2 - (z + R - zc)^2), within the mesh's
+//    faceting error (the mesh is inscribed: loops lie inside the exact circle, never outside);
+//  - a flat end mill on a box: the box's rectangle offset by R with round corners (distance R from it);
+//  - every loop point is free (drop height <= z) and blocked material lies within 1e-6 mm on its left, or
+//    its drop height is z within 1e-6;
+//  - loops closed without self-intersections, islands counter-clockwise, pockets clockwise;
+//  - identical loops for any thread count, cancel, bad input.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "tmm/mesh/mesh_index.hpp"
+#include "tmm/query/drop_cutter.hpp"
+#include "tmm/query/waterline.hpp"
+
+namespace {
+
+using tmm::Cutter;
+using tmm::MeshIndex;
+using tmm::WaterlineLoop;
+using tmm::WaterlineOptions;
+
+constexpr double kPi = 3.14159265358979323846;
+
+// A UV sphere with its vertices on the sphere (inscribed): `n` bands from pole to pole, 2n sectors.
+MeshIndex sphere(double Rs, double zc, int n) {
+  const int m = 2 * n;
+  tmm::Vertices V((n - 1) * m + 2, 3);
+  V.row(0) << 0, 0, zc + Rs;
+  for (int i = 1; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double th = kPi * i / n, ph = 2 * kPi * j / m;
+      V.row(1 + (i - 1) * m + j) << Rs * std::sin(th) * std::cos(ph), Rs * std::sin(th) * std::sin(ph),
+          zc + Rs * std::cos(th);
+    }
+  const int last = static_cast<int>(V.rows()) - 1;
+  V.row(last) << 0, 0, zc - Rs;
+  auto id = [&](int i, int j) { return 1 + (i - 1) * m + (j % m); };
+  std::vector<std::array<int, 3>> F;
+  for (int j = 0; j < m; ++j) F.push_back({0, id(1, j), id(1, j + 1)});
+  for (int i = 1; i < n - 1; ++i)
+    for (int j = 0; j < m; ++j) {
+      F.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      F.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  for (int j = 0; j < m; ++j) F.push_back({id(n - 1, j), last, id(n - 1, j + 1)});
+  tmm::Triangles T(static_cast<Eigen::Index>(F.size()), 3);
+  for (std::size_t t = 0; t < F.size(); ++t) T.row(static_cast<Eigen::Index>(t)) << F[t][0], F[t][1], F[t][2];
+  return MeshIndex(V, T);
+}
+
+// Triangles of quads (corners counter-clockwise seen from above), each split along its first diagonal.
+MeshIndex quads(const std::vector<std::array<Eigen::Vector3d, 4>>& q) {
+  tmm::Vertices V(4 * q.size(), 3);
+  tmm::Triangles T(2 * q.size(), 3);
+  for (std::size_t k = 0; k < q.size(); ++k) {
+    for (int c = 0; c < 4; ++c) V.row(static_cast<Eigen::Index>(4 * k + c)) = q[k][c].transpose();
+    const int b = static_cast<int>(4 * k);
+    T.row(static_cast<Eigen::Index>(2 * k)) << b, b + 1, b + 2;
+    T.row(static_cast<Eigen::Index>(2 * k + 1)) << b, b + 2, b + 3;
+  }
+  return MeshIndex(V, T);
+}
+
+// A closed box [x0, x1] x [y0, y1] x [0, top].
+MeshIndex box(double x0, double y0, double x1, double y1, double top) {
+  using P = Eigen::Vector3d;
+  return quads({{P(x0, y0, top), P(x1, y0, top), P(x1, y1, top), P(x0, y1, top)},
+                {P(x0, y0, 0), P(x0, y1, 0), P(x1, y1, 0), P(x1, y0, 0)},
+                {P(x0, y0, 0), P(x1, y0, 0), P(x1, y0, top), P(x0, y0, top)},
+                {P(x1, y0, 0), P(x1, y1, 0), P(x1, y1, top), P(x1, y0, top)},
+                {P(x1, y1, 0), P(x0, y1, 0), P(x0, y1, top), P(x1, y1, top)},
+                {P(x0, y1, 0), P(x0, y0, 0), P(x0, y0, top), P(x0, y1, top)}});
+}
+
+// The top of a 40 x 40 frame around a 20 x 20 hole, at height 5 (no walls: the drop sees the top's edges).
+MeshIndex frame() {
+  using P = Eigen::Vector3d;
+  const P o[4] = {P(0, 0, 5), P(40, 0, 5), P(40, 40, 5), P(0, 40, 5)};
+  const P i[4] = {P(10, 10, 5), P(30, 10, 5), P(30, 30, 5), P(10, 30, 5)};
+  std::vector<std::array<P, 4>> q;
+  for (int k = 0; k < 4; ++k) q.push_back({o[k], o[(k + 1) % 4], i[(k + 1) % 4], i[k]});
+  return quads(q);
+}
+
+WaterlineOptions options(double x0, double y0, double x1, double y1, double step, double tol) {
+  WaterlineOptions o;
+  o.xmin = x0;
+  o.ymin = y0;
+  o.xmax = x1;
+  o.ymax = y1;
+  o.sample_step = step;
+  o.chord_tol = tol;
+  return o;
+}
+
+bool blocked(const MeshIndex& index, const Cutter& c, double x, double y, double z) {
+  return tmm::drop_point(index, c, x, y, z) > z;
+}
+
+// Every point free; blocked material within 1e-6 mm on the left of the loop there (or h = z within 1e-6).
+void expect_contacts(const MeshIndex& index, const Cutter& c, const WaterlineLoop& loop) {
+  const std::size_t n = loop.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!loop.contact[i]) continue;
+    const double x = loop.xy[2 * i], y = loop.xy[2 * i + 1];
+    const double h = tmm::drop_point(index, c, x, y, loop.z - 100.0);
+    ASSERT_LE(h, loop.z) << "point " << i << " (" << x << ", " << y << ") gouges";
+    if (std::abs(h - loop.z) <= 1e-6) continue;
+    const std::size_t a = (i + n - 1) % n, b = (i + 1) % n;
+    const double dx = loop.xy[2 * b] - loop.xy[2 * a], dy = loop.xy[2 * b + 1] - loop.xy[2 * a + 1];
+    const double len = std::hypot(dx, dy);
+    EXPECT_TRUE(blocked(index, c, x - 1e-6 * dy / len, y + 1e-6 * dx / len, loop.z))
+        << "point " << i << " (" << x << ", " << y << "): h - z = " << h - loop.z << " and nothing blocked beside it";
+  }
+}
+
+bool segments_cross(const double* p, const double* q, const double* r, const double* s) {
+  auto orient = [](const double* a, const double* b, const double* c) {
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+  };
+  const double d1 = orient(r, s, p), d2 = orient(r, s, q), d3 = orient(p, q, r), d4 = orient(p, q, s);
+  return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+// No two edges of the level's loops cross (neighbouring edges share a point and never count).
+void expect_simple(const std::vector<WaterlineLoop>& level) {
+  struct Edge {
+    const double* p;
+    const double* q;
+  };
+  std::vector<Edge> edges;
+  for (const auto& loop : level)
+    for (std::size_t i = 0, n = loop.size(); i < n; ++i) edges.push_back({&loop.xy[2 * i], &loop.xy[2 * ((i + 1) % n)]});
+  for (std::size_t a = 0; a < edges.size(); ++a)
+    for (std::size_t b = a + 1; b < edges.size(); ++b)
+      ASSERT_FALSE(segments_cross(edges[a].p, edges[a].q, edges[b].p, edges[b].q))
+          << "edges " << a << " and " << b << " cross";
+}
+
+TEST(Waterline, BallOverSphereIsTheCircleOfTheOffsetSphere) {
+  const double Rs = 10, zc = 2, R = 3;
+  const int n = 96;
+  const MeshIndex index = sphere(Rs, zc, n);
+  const Cutter ball(R, R);
+  const std::vector<double> zs = {zc - 2.0, zc, zc + 4.0, zc + 9.0};
+  const auto levels = tmm::waterline(index, ball, zs, options(-20, -20, 20, 20, 0.75, 1e-3), {});
+  ASSERT_EQ(levels.size(), zs.size());
+  // Facets lie inside the sphere by at most Rs (1 - cos(a)), a the angular radius of a facet (< pi / n from
+  // a corner); the offset surface (the ball centre) by the same, and the circle's radius r by that times
+  // (Rs + R) / r.
+  const double facet = Rs * (1.0 - std::cos(kPi / n));
+  for (std::size_t k = 0; k < zs.size(); ++k) {
+    ASSERT_EQ(levels[k].size(), 1u) << "z " << zs[k];
+    const WaterlineLoop& loop = levels[k][0];
+    const double dz = zs[k] + R - zc;
+    const double r = std::sqrt((Rs + R) * (Rs + R) - dz * dz);
+    const double below = facet * (Rs + R) / r + 1e-6;
+    EXPECT_GT(loop.area(), 0.0);
+    EXPECT_NEAR(loop.area(), kPi * r * r, 2 * kPi * r * (below + 1e-3));
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      ASSERT_TRUE(loop.contact[i]);
+      const double rho = std::hypot(loop.xy[2 * i], loop.xy[2 * i + 1]);
+      ASSERT_LE(rho, r + 1e-6) << "z " << zs[k] << " point " << i;
+      ASSERT_GE(rho, r - below) << "z " << zs[k] << " point " << i;
+    }
+    expect_contacts(index, ball, loop);
+    expect_simple(levels[k]);
+  }
+}
+
+TEST(Waterline, FlatOnABoxIsTheBoxOffsetWithRoundCorners) {
+  const double R = 3, x0 = 0, y0 = 0, x1 = 20, y1 = 10;
+  const MeshIndex index = box(x0, y0, x1, y1, 5);
+  for (const Cutter& c : {Cutter(R, 0), Cutter(R, 1), Cutter(R, R)}) {
+    const double z = 2.0;  // below the corner arcs of all three: the tool's side touches the walls
+    const auto levels = tmm::waterline(index, c, {z}, options(-10, -10, 30, 20, 0.6, 1e-4), {});
+    ASSERT_EQ(levels[0].size(), 1u);
+    const WaterlineLoop& loop = levels[0][0];
+    for (std::size_t i = 0; i < loop.size(); ++i) {
+      const double x = loop.xy[2 * i], y = loop.xy[2 * i + 1];
+      const double dx = std::max({x0 - x, x - x1, 0.0}), dy = std::max({y0 - y, y - y1, 0.0});
+      ASSERT_NEAR(std::hypot(dx, dy), R, 1e-6) << "point " << i << " (" << x << ", " << y << ")";
+    }
+    const double area = (x1 - x0) * (y1 - y0) + 2 * R * ((x1 - x0) + (y1 - y0)) + kPi * R * R;
+    // inscribed polygon: below the exact area by at most the chord tolerance along the round corners
+    EXPECT_LE(loop.area(), area + 1e-4);
+    EXPECT_GE(loop.area(), area - 2 * kPi * R * 1e-4 - 1e-4);
+    expect_contacts(index, c, loop);
+  }
+}
+
+TEST(Waterline, PocketRunsClockwiseAndTheIslandCounterClockwise) {
+  const MeshIndex index = frame();
+  const Cutter flat(3, 0);
+  const auto levels = tmm::waterline(index, flat, {2.5}, options(-10, -10, 50, 50, 0.7, 1e-3), {});
+  ASSERT_EQ(levels[0].size(), 2u);
+  int islands = 0, pockets = 0;
+  for (const WaterlineLoop& loop : levels[0]) {
+    expect_contacts(index, flat, loop);
+    if (loop.area() > 0) {
+      ++islands;
+      EXPECT_NEAR(loop.area(), 1600 + 4 * 40 * 3 + kPi * 9, 0.1);
+    } else {
+      ++pockets;
+      // the hole shrunk by R: a 14 x 14 square with sharp corners (the tool's edge on two sides at once)
+      EXPECT_NEAR(-loop.area(), 14.0 * 14.0, 1e-4);
+    }
+  }
+  EXPECT_EQ(islands, 1);
+  EXPECT_EQ(pockets, 1);
+  expect_simple(levels[0]);
+}
+
+TEST(Waterline, BlockedPastTheBoundsIsFlaggedAndTheLoopStillCloses) {
+  const MeshIndex index = box(0, 0, 20, 10, 5);
+  const Cutter ball(3, 3);
+  // bounds cut through the box: the loop runs along the bounds where the box goes on past them
+  const auto levels = tmm::waterline(index, ball, {2.0}, options(10, -10, 30, 20, 0.5, 1e-3), {});
+  ASSERT_EQ(levels[0].size(), 1u);
+  const WaterlineLoop& loop = levels[0][0];
+  std::size_t off = 0;
+  for (std::size_t i = 0; i < loop.size(); ++i) {
+    if (loop.contact[i]) continue;
+    ++off;
+    EXPECT_NEAR(loop.xy[2 * i], 10.0, 1e-12);  // on the bound x = 10
+  }
+  EXPECT_GT(off, 10u);
+  EXPECT_GT(loop.area(), 0.0);
+  expect_contacts(index, ball, loop);
+  expect_simple(levels[0]);
+}
+
+TEST(Waterline, ThreadsGiveIdenticalLoops) {
+  const MeshIndex index = sphere(10, 0, 48);
+  const Cutter bull(3, 1);
+  std::vector<double> zs;
+  for (int k = 0; k < 12; ++k) zs.push_back(-2.0 + k);
+  tmm::BatchOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const auto a = tmm::waterline(index, bull, zs, options(-15, -15, 15, 15, 0.5, 1e-3), one);
+  const auto b = tmm::waterline(index, bull, zs, options(-15, -15, 15, 15, 0.5, 1e-3), two);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    ASSERT_EQ(a[k].size(), b[k].size());
+    for (std::size_t l = 0; l < a[k].size(); ++l) {
+      EXPECT_EQ(a[k][l].xy, b[k][l].xy);
+      EXPECT_EQ(a[k][l].contact, b[k][l].contact);
+    }
+  }
+}
+
+TEST(Waterline, ProgressFalseCancels) {
+  const MeshIndex index = sphere(10, 0, 48);
+  const Cutter ball(3, 3);
+  std::atomic<int> calls{0};
+  tmm::BatchOptions batch;
+  batch.progress = [&](double) { return ++calls < 1; };
+  EXPECT_THROW(tmm::waterline(index, ball, {0.0, 1.0, 2.0}, options(-15, -15, 15, 15, 0.05, 1e-3), batch),
+               tmm::Cancelled);
+  EXPECT_GE(calls.load(), 1);
+}
+
+TEST(Waterline, BadInputIsRefusedByName) {
+  const MeshIndex index = sphere(10, 0, 16);
+  const Cutter ball(3, 3);
+  auto message = [&](const WaterlineOptions& o, std::vector<double> zs) {
+    try {
+      tmm::waterline(index, ball, zs, o, {});
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(options(0, 0, 0, 10, 1, 0.01), {0}).find("xmax"), std::string::npos);
+  EXPECT_NE(message(options(0, 0, 10, 10, 0, 0.01), {0}).find("sample step"), std::string::npos);
+  EXPECT_NE(message(options(0, 0, 10, 10, 1, 0), {0}).find("chord tolerance"), std::string::npos);
+  EXPECT_NE(message(options(0, 0, 10, 10, 1, 0.01), {std::nan("")}).find("level z"), std::string::npos);
+  const std::string big = message(options(0, 0, 1000, 1000, 0.01, 0.01), {0});
+  EXPECT_NE(big.find("sample step 0.01 mm"), std::string::npos) << big;
+  EXPECT_NE(big.find("limit"), std::string::npos) << big;
+}
+
+}  // namespace
