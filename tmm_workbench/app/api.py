@@ -25,7 +25,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 import FreeCAD
 
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import posts, registry, tools
+from tmm_workbench.app import geometry, posts, registry, tools
 from tmm_workbench.app import progress as progress_mod
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
@@ -48,7 +48,7 @@ OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 class SurfaceResult:
     doc: Any             # App.Document holding everything
     job: Any             # the Path Job
-    op: Any              # the TMM_Surface operation
+    op: Any              # the TMM op (Surface; also what run_roughing and run_waterline return)
     gcode: str           # post-processed G-code
     toolpath: Toolpath   # the core tool path the op's Path was made from
     mesh: TriMesh        # the core mesh that was machined
@@ -145,21 +145,39 @@ def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, cor
     jm = jobs.prepare_model(doc, model)
     doc.recompute()
     job = jobs.create_job(doc, jm.job_base)
-    top = max(jm.job_base.Shape.BoundBox.ZMax, _stock_top(job))
+    values = _heights(job, jm.job_base.Shape.BoundBox.ZMax, safe_height, clearance_height)
+    bit = _bit(doc, shape, diameter, corner_radius)
+    tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
+    values.update({"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
+                   "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
+                   "BoundaryMargin": margin, "OffModel": off_model})
+    values.update(extra)
+    values.update(_model_values(jm))
+    op = registry.create("TMM_Surface", job, values)
+    return _post_op(doc, job, tc, op, post, gcode_path, progress)
+
+
+def _heights(job: Any, model_top: float, safe_height: Optional[float], clearance_height: Optional[float]) -> dict:
+    """SafeHeight and ClearanceHeight: given, or the top of the model or of the Job's stock, whichever is
+    higher, + 5 mm and + 10 mm."""
+    top = max(model_top, _stock_top(job))
     safe = top + 5.0 if safe_height is None else float(safe_height)
     clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
-    bit = (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
-           else tools.make_tool_bit(doc, shape, diameter, corner_radius))
-    tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
-    values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
-              "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
-              "BoundaryMargin": margin, "OffModel": off_model, "SafeHeight": safe, "ClearanceHeight": clearance}
-    values.update(extra)
-    if jm.stl_file:
-        values["StlFile"] = jm.stl_file
-    else:
-        values["Model"] = jm.link
-    op = registry.create("TMM_Surface", job, values)
+    return {"SafeHeight": safe, "ClearanceHeight": clearance}
+
+
+def _bit(doc: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float) -> Any:
+    return (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
+            else tools.make_tool_bit(doc, shape, diameter, corner_radius))
+
+
+def _model_values(jm: jobs.JobModel) -> dict:
+    """The op's model properties for a prepared model: its STL file or its object."""
+    return {"StlFile": jm.stl_file} if jm.stl_file else {"Model": jm.link}
+
+
+def _post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, progress: Any) -> SurfaceResult:
+    """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller)."""
     if post in _job_posts(job):
         job.PostProcessor = post
         job.PostProcessorArgs = posts.DEFAULT_ARGS.get(post, "")
@@ -201,6 +219,227 @@ class _CallbackProgress(progress_mod.ProgressReporter):
 
     def __call__(self, fraction: float) -> bool:
         return bool(self.callback(fraction))
+
+
+# --- z-level roughing and waterline ----------------------------------------------------------------
+StockBox = tuple[float, float, float, float, float, float]
+
+
+def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[str, Cutter] = "endmill",
+                 diameter: float = 6.0, corner_radius: float = 0.0, step_down: float = 2.0,
+                 stepover_percent: float = 40.0, stock_to_leave: float = 0.5,
+                 stock_to_leave_axial: Optional[float] = None, layer_mode: str = "fixed",
+                 remaining_height: Optional[float] = None, flat_layers: bool = True, pattern: str = "offset",
+                 direction: str = "climb", entry: str = "helix", ramp_angle_deg: Optional[float] = None,
+                 helix_diameter_percent: Optional[float] = None, keep_tool_down: bool = True,
+                 final_z: Optional[float] = None, chord_tolerance: Optional[float] = None,
+                 stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
+                 job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
+                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
+                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
+                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+    """Z-level roughing of a block down to `model` (STL path, Mesh::Feature or Part::Feature) + stock to leave,
+    to G-code (a 'TMM Roughing' op in a new Job, or in `job`).
+
+    tool: 'endmill' | 'bullnose' | 'ballend' (corner_radius for bullnose) or a core Cutter (as run_surface).
+    The stock: the model's box grown by `stock_margin` on the sides and `stock_above` on top (mm; the Job's
+    box stock, 1 mm below), or `stock` = (xmin, ymin, zmin, xmax, ymax, zmax) given; with `job` (a Job or a
+    result of this API), the op is added to it with its own tool controller and cuts that Job's stock
+    (`model`: None for the Job's model). layer_mode 'fixed' | 'tolerance' (remaining_height: seed 000
+    eq. 3.11); pattern 'offset' | 'zigzag'; direction 'climb' | 'conventional'; entry 'helix' | 'ramp' |
+    'plunge'. stock_to_leave_axial: None follows stock_to_leave. final_z: None roughs down to the model's
+    lowest point. None for the other optional numbers keeps the op's defaults. Heights, feeds (mm/min), post,
+    files and progress as run_surface; the result is a SurfaceResult (op: the roughing op).
+    """
+    from tmm_workbench.app import op_roughing
+    from tmm_workbench.core.strategies.zlevel_rough import RoughingParams
+
+    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+             **_specs(RoughingParams, step_down=step_down, stepover_percent=stepover_percent,
+                      stock_to_leave=stock_to_leave, stock_to_leave_axial=stock_to_leave_axial,
+                      remaining_height=remaining_height, ramp_angle_deg=ramp_angle_deg,
+                      helix_diameter_percent=helix_diameter_percent),
+             chord_tolerance=(chord_tolerance, spec_of(RoughingParams, "chord_tol")),
+             final_z=(final_z, _LENGTH), stock_margin=(stock_margin, _LENGTH), stock_above=(stock_above, _LENGTH),
+             **_common_numbers(safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed))
+    if stock is not None:
+        _stock_box_checked(stock)
+    values: dict[str, Any] = {
+        "StepDown": step_down, "StepOver": stepover_percent, "StockToLeave": stock_to_leave,
+        "LayerMode": _option("layer_mode", layer_mode, _by_core_name(op_roughing.LAYER_MODES)),
+        "FlatLayers": bool(flat_layers), "KeepToolDown": bool(keep_tool_down),
+        "Pattern": _option("pattern", pattern, _by_core_name(op_roughing.PATTERNS)),
+        "Direction": _option("direction", direction, _by_core_name(op_roughing.DIRECTIONS)),
+        "Entry": _option("entry", entry, _by_core_name(op_roughing.ENTRIES))}
+    for prop, value in (("AxialStockToLeave", stock_to_leave_axial), ("RemainingHeight", remaining_height),
+                        ("RampAngle", ramp_angle_deg), ("HelixDiameter", helix_diameter_percent),
+                        ("ChordTolerance", chord_tolerance)):
+        if value is not None:
+            values[prop] = value
+    if final_z is not None:
+        values.update(UseFinalZ=True, FinalZ=final_z)
+    stock_ext = (stock, stock_margin, stock_above)
+    return _run_op(op_roughing.OP_NAME, model, job, values, stock_ext, _tool_shape(tool), diameter, corner_radius,
+                   safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path,
+                   fcstd_path, doc_name, progress)
+
+
+def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[str, Cutter] = "ballend",
+                  diameter: float = 6.0, corner_radius: float = 0.0, step_down: float = 1.0,
+                  stock_to_leave: float = 0.0, sample_step: Optional[float] = None,
+                  chord_tolerance: Optional[float] = None, direction: str = "climb", boundary: str = "model",
+                  margin: float = 0.0, top_z: Optional[float] = None, bottom_z: Optional[float] = None,
+                  stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
+                  job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
+                  horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                  post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
+                  fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
+                  progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+    """Waterline finishing of `model` (STL path, Mesh::Feature or Part::Feature): closed loops at constant
+    heights `step_down` apart (a 'TMM Waterline' op in a new Job, or in `job`: e.g. after run_roughing, with
+    its own tool controller; `model` None for the Job's model).
+
+    boundary: 'model' (its XY box grown by the tool radius) | 'stock', grown by `margin`. top_z, bottom_z:
+    the highest and lowest level (both or neither; default the model's top and lowest point). sample_step:
+    None automatic. direction 'climb' | 'conventional'. The stock of a new Job as run_roughing's. Heights,
+    feeds (mm/min), post, files and progress as run_surface; the result is a SurfaceResult (op: the waterline op).
+    """
+    from tmm_workbench.app import op_waterline
+    from tmm_workbench.core.strategies.waterline import WaterlineParams
+
+    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+             **_specs(WaterlineParams, step_down=step_down, stock_to_leave=stock_to_leave, sample_step=sample_step),
+             chord_tolerance=(chord_tolerance, spec_of(WaterlineParams, "chord_tol")), margin=(margin, _LENGTH),
+             top_z=(top_z, _LENGTH), bottom_z=(bottom_z, _LENGTH), stock_margin=(stock_margin, _LENGTH),
+             stock_above=(stock_above, _LENGTH),
+             **_common_numbers(safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed))
+    if (top_z is None) != (bottom_z is None):
+        raise TmmError(f"top_z and bottom_z are given together or not at all, got top_z={top_z!r}, "
+                       f"bottom_z={bottom_z!r}")
+    if stock is not None:
+        _stock_box_checked(stock)
+    values: dict[str, Any] = {
+        "StepDown": step_down, "StockToLeave": stock_to_leave, "BoundaryMargin": margin,
+        "BoundaryShape": _option("boundary", boundary, BOUNDARY_NAMES),
+        "Direction": _option("direction", direction, _by_core_name(op_waterline.DIRECTIONS))}
+    if sample_step is not None:
+        values["SampleStep"] = sample_step
+    if chord_tolerance is not None:
+        values["ChordTolerance"] = chord_tolerance
+    if top_z is not None:
+        values.update(UseZRange=True, TopZ=top_z, BottomZ=bottom_z)
+    return _run_op(op_waterline.OP_NAME, model, job, values, (stock, stock_margin, stock_above), _tool_shape(tool),
+                   diameter, corner_radius, safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed,
+                   post, gcode_path, fcstd_path, doc_name, progress)
+
+
+def _specs(params_class: type, **values: Any) -> dict[str, tuple[Any, Spec]]:
+    """API arguments named as the params fields, each with its field's spec."""
+    return {name: (value, spec_of(params_class, name)) for name, value in values.items()}
+
+
+def _common_numbers(safe_height: Any, clearance_height: Any, horiz_feed: Any, vert_feed: Any,
+                    spindle_speed: Any) -> dict[str, tuple[Any, Spec]]:
+    return dict(safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
+                horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
+
+
+def _tool_shape(tool: Union[str, Cutter]) -> Union[str, Cutter]:
+    return tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
+
+
+def _stock_box_checked(stock: Any) -> StockBox:
+    from tmm_workbench.core.params import check_finite
+
+    try:
+        box = tuple(float(v) for v in stock)
+    except (TypeError, ValueError):
+        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}") from None
+    if len(box) != 6:
+        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}")
+    check_finite("stock", box)
+    if not (box[3] > box[0] and box[4] > box[1] and box[5] > box[2]):
+        raise TmmError(f"stock box is empty: x {box[0]:g}..{box[3]:g}, y {box[1]:g}..{box[4]:g}, "
+                       f"z {box[2]:g}..{box[5]:g} mm")
+    return box  # type: ignore[return-value]
+
+
+def _set_stock(job: Any, stock: Optional[StockBox], margin: float, above: float) -> None:
+    """The Job's box stock (FreeCAD's stock from the base, its extents set): `stock` exactly, or the model's box
+    grown by `margin` on the sides and `above` on top."""
+    s = job.Stock
+    bb = s.Base.Shape.BoundBox if getattr(s, "Base", None) is not None else None
+    if bb is None or not hasattr(s, "ExtXneg"):
+        raise TmmError(f"Job '{job.Label}': its stock is not FreeCAD's stock from the base; set it in the Job")
+    if stock is None:
+        ext = (margin, margin, 1.0, margin, margin, above)
+    else:
+        ext = (bb.XMin - stock[0], bb.YMin - stock[1], bb.ZMin - stock[2],
+               stock[3] - bb.XMax, stock[4] - bb.YMax, stock[5] - bb.ZMax)
+    for name, v in zip(("ExtXneg", "ExtYneg", "ExtZneg", "ExtXpos", "ExtYpos", "ExtZpos"), ext):
+        setattr(s, name, v)
+    job.Document.recompute()
+
+
+def _add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, spindle_speed: float) -> Any:
+    """A further tool controller in `job` for `bit` (the next tool number)."""
+    from tmm_workbench.app.compat import PathToolController
+
+    FreeCAD.setActiveDocument(job.Document.Name)
+    number = max([int(t.ToolNumber) for t in job.Tools.Group] + [0]) + 1
+    tc = PathToolController.Create(f"TC: {bit.Label}", bit, number)
+    job.Proxy.addToolController(tc)
+    tc.HorizFeed = horiz_feed_mm_s
+    tc.VertFeed = vert_feed_mm_s
+    tc.SpindleSpeed = float(spindle_speed)
+    return tc
+
+
+def _run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
+            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
+            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str, gcode_path: Any, fcstd_path: Any,
+            doc_name: str, progress: Any) -> SurfaceResult:
+    """A roughing or waterline op (property `values`) in a new Job for `model` with a box stock, or in `job`
+    with a further tool controller; computed, posted, saved. A document opened here is closed on failure."""
+    job = getattr(job, "job", None) or job
+    if job is None and model is None:
+        raise TmmError("model: give an STL path, a Mesh or a Part object (or a job to add the op to)")
+    own_doc = job is None and isinstance(model, (str, os.PathLike))
+    if own_doc and not Path(model).expanduser().is_file():
+        raise TmmError(f"STL file not found: {model}")
+    doc = FreeCAD.newDocument(doc_name) if own_doc else (job.Document if job is not None else model.Document)
+    try:
+        values = dict(values)
+        if job is None:
+            jm = jobs.prepare_model(doc, model)
+            doc.recompute()
+            job = jobs.create_job(doc, jm.job_base)
+            _set_stock(job, *stock_ext)
+            values.update(_model_values(jm))
+            tc = jobs.set_tool(job, _bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0,
+                               vert_feed / 60.0, spindle_speed)
+        else:  # the Job's stock and model stay; the op machines `model` when one is given
+            if isinstance(model, (str, os.PathLike)):
+                geometry.mesh_from_stl(model)  # a clear error for a missing or bad file
+                values["StlFile"] = str(Path(model).expanduser().resolve())
+            elif model is not None:
+                values["Model"] = model
+            tc = _add_tool(job, _bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0, vert_feed / 60.0,
+                           spindle_speed)
+        top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
+        values.update(_heights(job, top, safe_height, clearance_height))
+        values["ToolController"] = tc
+        op = registry.create(op_name, job, values)
+        result = _post_op(doc, job, tc, op, post, gcode_path, progress)
+    except BaseException:
+        if own_doc:
+            FreeCAD.closeDocument(doc.Name)
+        raise
+    if fcstd_path:
+        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
+        doc.saveAs(str(fcstd_path))
+    return result
 
 
 # --- 5-axis multipoint ---------------------------------------------------------------------------
