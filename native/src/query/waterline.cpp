@@ -89,6 +89,9 @@ class Level {
   // free end of a bracket narrower than o_.bracket.
   Point crossing(Point f, Point b, double cf, double cb);
   Point edge_crossing(uint64_t edge);
+  // Whether the exact loop crosses the perpendicular through p + t (q - p) farther than chord_tol from the
+  // chord (inside the bounds); c: that crossing.
+  bool off_chord(const Point& p, const Point& q, double t, Point& c);
   void refine(const Point& p, const Point& q, int depth, std::vector<Point>& out);
 
   const MeshIndex& index_;
@@ -133,36 +136,45 @@ Point Level::edge_crossing(uint64_t edge) {
   return crossing(a, b, z_ - ha, z_ - hb);
 }
 
-void Level::refine(const Point& p, const Point& q, int depth, std::vector<Point>& out) {
+bool Level::off_chord(const Point& p, const Point& q, double t, Point& c) {
   const double dx = q.x - p.x, dy = q.y - p.y, length = std::hypot(dx, dy);
-  if (depth >= o_.max_depth || length < o_.min_segment) return;
   const double nx = -dy / length, ny = dx / length;  // left normal: the blocked side
-  const Point m{0.5 * (p.x + q.x), 0.5 * (p.y + q.y), true};
+  const Point m{p.x + t * dx, p.y + t * dy, true};
   const bool m_blocked = blocked(m.x, m.y);
   // The boundary lies towards the free side of m (right if m is blocked, left if free): within chord_tol
   // when the state changes there already.
   const double sign = m_blocked ? -1.0 : 1.0;
-  const double tol = o_.chord_tol;
   auto along = [&](double s) { return Point{m.x + sign * s * nx, m.y + sign * s * ny, true}; };
-  double s_in = 0.0, s_out = tol;
+  double s_in = 0.0, s_out = o_.chord_tol;
   Point out_pt = along(s_out);
   while (blocked(out_pt.x, out_pt.y) == m_blocked) {
     s_in = s_out;
     s_out *= 2.0;
-    if (s_out > length) return;  // no boundary within a chord length: leave the chord
+    if (s_out > length) return false;  // no boundary within a chord length: leave the chord
     out_pt = along(s_out);
   }
-  if (s_in == 0.0) return;  // the exact loop is within chord_tol of the chord
+  if (s_in == 0.0) return false;  // the exact loop is within chord_tol of the chord here
   const Point in_pt = along(s_in);
   const Point& f = m_blocked ? out_pt : in_pt;
   const Point& b = m_blocked ? in_pt : out_pt;
   const double cf = clearance(f.x, f.y), cb = clearance(b.x, b.y);
-  const Point c = cb < 0.0 ? crossing(f, b, cf, cb) : f;  // (cb >= 0 cannot be: b is blocked)
+  c = cb < 0.0 ? crossing(f, b, cf, cb) : f;  // (cb >= 0 cannot be: b is blocked)
   const double slack = 1e-9;
-  if (c.x < o_.xmin - slack || c.x > o_.xmax + slack || c.y < o_.ymin - slack || c.y > o_.ymax + slack) return;
-  refine(p, c, depth + 1, out);
-  out.push_back(c);
-  refine(c, q, depth + 1, out);
+  return c.x >= o_.xmin - slack && c.x <= o_.xmax + slack && c.y >= o_.ymin - slack && c.y <= o_.ymax + slack;
+}
+
+void Level::refine(const Point& p, const Point& q, int depth, std::vector<Point>& out) {
+  if (depth >= o_.max_depth || std::hypot(q.x - p.x, q.y - p.y) < o_.min_segment) return;
+  // The midpoint, then the quarters: on a faceted mesh the loop's curvature changes along a chord, so its
+  // farthest point need not lie at the middle.
+  Point c;
+  for (double t : {0.5, 0.25, 0.75}) {
+    if (!off_chord(p, q, t, c)) continue;
+    refine(p, c, depth + 1, out);
+    out.push_back(c);
+    refine(c, q, depth + 1, out);
+    return;
+  }
 }
 
 std::vector<WaterlineLoop> Level::loops() {
