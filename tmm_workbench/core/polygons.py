@@ -62,15 +62,17 @@ def _offsetter(arc_tol: float) -> pyclipper.PyclipperOffset:
     return pyclipper.PyclipperOffset(2.0, arc_tol * SCALE)
 
 
-def offset(shape: Shape, delta: float, arc_tol: float = ARC_TOL) -> Shape:
-    """The shape grown by `delta` mm (negative: shrunk; an erosion by a disc), round joins."""
+def offset(shape: Shape, delta: float, arc_tol: float = ARC_TOL, miter: bool = False) -> Shape:
+    """The shape grown by `delta` mm (negative: shrunk; an erosion by a disc), round joins; miter=True:
+    mitred joins (limit 2: corners sharper than 60 degrees squared off), which contain the round ones and
+    add no points (for small safety growths)."""
     paths = _to_int(shape)
     if not paths:
         return []
     if delta == 0:
         return union(shape)
     o = _offsetter(arc_tol)
-    o.AddPaths(paths, pyclipper.JT_ROUND, pyclipper.ET_CLOSEDPOLYGON)
+    o.AddPaths(paths, pyclipper.JT_MITER if miter else pyclipper.JT_ROUND, pyclipper.ET_CLOSEDPOLYGON)
     return _from_int(o.Execute(delta * SCALE))
 
 
