@@ -1,0 +1,488 @@
+"""Z-level roughing (seed 000 section 3.4): the stock cut down to the model plus stock to leave in 2.5-axis
+layers; the linker (core.linking) makes the tool path.
+
+    result = compute(mesh, Cutter.flat(6), RoughingParams(stock_box=(0, 0, 0, 100, 100, 30)))
+    path = compute_roughing_toolpath(mesh, cutter, params, LinkPolicy(safe_height=35, clearance_height=40))
+
+Per layer (tip height z, descending; zlevel_layers):
+  blocked   where the tool would cut the model offset by the stock to leave: the exact waterline
+            (core.query.waterline) of the cutter grown by the radial stock to leave, `Cutter.offset(s)`,
+            at z - axial stock to leave. The seed offsets the mesh along vertex normals instead (3.4.3): that
+            is not an exact offset (it shrinks concave corners and opens gaps at sharp edges), the grown
+            cutter's drop is (Cutter.offset). Radial and axial differ: the grown cutter keeps s on walls,
+            the level z - s_a keeps s_a on flats (on slopes a mix of the two);
+  region    the tool-centre positions that touch material: the stock's XY grown by the tool radius (less a
+            step-over, so the first loop around the stock takes no more than a step-over), minus blocked.
+            Every position in it is gouge-free at z and above (the blocked region only shrinks upwards);
+  clearing  contour-parallel offsets (or zig-zag lines) of each region at the step-over (zlevel_clearing),
+            climb or conventional;
+  entries   a region open to the air outside the stock is entered from there: down through air beside the
+            stock, then fed in at depth, and cut from the outside in; a closed one from its middle outwards,
+            by a helix whose circle lies in the region, else a ramp along the first loop (at least a tool
+            diameter long), else a TmmError naming the region. The helix or ramp starts just above the
+            material: the top of what earlier layers left over the entry's footprint (their swept areas are
+            kept as polygons, so no air is cut over and over);
+  links     tool down from one pass to the next inside a region when the straight link lies in the region
+            (every point of it a gouge-free tool-centre position: no check against the model needed) and is
+            no longer than the tool diameter (a longer one would slot through uncut material); else a
+            retract to the safe height and a new entry.
+Where the material is not a box (`stock_heights`: a cast or what an earlier op left), a layer cuts only where
+the stock is above it.
+
+Work (layers x loops x points) is estimated from the parameters and refused above core.limits before any
+waterline is computed.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.core import polygons as P
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.linking import HELIX, PLUNGE, RAMP, LinkPolicy, link
+from tmm_workbench.core.params import StrategyParams, check_finite, param
+from tmm_workbench.core.query import waterline as wl
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
+from tmm_workbench.core.strategies import zlevel_clearing as clearing
+from tmm_workbench.core.strategies import zlevel_layers as layers_mod
+from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
+
+SUPPORTED_TOOLS = ("flat", "bull", "ball")
+_AIR_MARGIN = 1.0           # mm: the tool-centre box reaches this far past the tool touching the stock
+_ENTRY_CLEARANCE = 0.5      # mm: helices and ramps start this far above the material
+_MIN_REGION_AREA = 1e-6     # mm^2: tool-centre regions smaller than this are rounding, not room
+_SLIVER = 0.02              # mm: unreachable material thinner than this is the offsets' rounding
+_BYTES_PER_POINT = 160      # a loop point: polygons (float and Clipper's integers), segments, moves
+
+
+@dataclass
+class RoughingParams(StrategyParams):
+    stock_box: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # xmin, ymin, zmin, xmax, ymax, zmax of the stock (mm)
+    step_down: float = param(2.0, "step-down", "mm", low=0, low_open=True, kind="length")
+    layer_mode: str = param("fixed", "layers", choices=("fixed", "tolerance"))   # tolerance: seed eq. 3.11
+    remaining_height: float = param(0.1, "remaining material", "mm", low=0, low_open=True)  # delta of eq. 3.10
+    flat_layers: bool = param(True, "extra layers on flat areas", choices=(True, False))
+    stepover_percent: float = param(40.0, "step-over", "%", low=0, high=100, low_open=True, high_open=True)
+    stock_to_leave: float = param(0.5, "stock to leave", "mm", low=0)                 # radial
+    stock_to_leave_axial: Optional[float] = param(None, "axial stock to leave", "mm", optional=True, low=0)
+    pattern: str = param("offset", "pattern", choices=("offset", "zigzag"))
+    direction: str = param("climb", "direction", choices=("climb", "conventional"))
+    entry: str = param("helix", "entry", choices=("helix", "ramp", "plunge"))       # plunge: the tool can
+    ramp_angle_deg: float = param(3.0, "ramp angle", "deg", low=0, high=90, low_open=True)
+    helix_diameter_percent: float = param(50.0, "helix diameter", "%", low=0, high=100, low_open=True)
+    final_z: Optional[float] = param(None, "final depth", "mm", optional=True)  # default: model's lowest + axial stock
+    chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
+    keep_tool_down: bool = param(True, "keep tool down", choices=(True, False))
+    stock_heights: Optional[Any] = None   # optional (Grid, heights) of a stock that is not a box, or of what an
+                                          # earlier op left (rest roughing): only where material lies is cut
+
+    @property
+    def axial(self) -> float:
+        return self.stock_to_leave if self.stock_to_leave_axial is None else self.stock_to_leave_axial
+
+    def validate(self) -> None:
+        super().validate()
+        if len(self.stock_box) != 6:
+            raise TmmError(f"stock box must be six finite numbers xmin, ymin, zmin, xmax, ymax, zmax, "
+                           f"got {self.stock_box!r}")
+        check_finite("stock box (xmin, ymin, zmin, xmax, ymax, zmax)", self.stock_box)
+        b = self.stock_box
+        if not (b[3] > b[0] and b[4] > b[1] and b[5] > b[2]):
+            raise TmmError(f"stock box is empty: x {b[0]:g}..{b[3]:g}, y {b[1]:g}..{b[4]:g}, "
+                           f"z {b[2]:g}..{b[5]:g} mm")
+        if self.stock_heights is not None:
+            try:
+                grid, heights = self.stock_heights
+                heights = np.asarray(heights, dtype=float)
+                shape_ok = heights.shape == (grid.ny, grid.nx)
+            except (TypeError, ValueError, AttributeError):
+                raise TmmError("stock heights must be a (Grid, heights) pair with heights of shape (ny, nx)")
+            if not shape_ok:
+                raise TmmError(f"stock heights have shape {heights.shape}, the grid {grid.ny} x {grid.nx}")
+            if not np.isfinite(heights).all():
+                raise TmmError("stock heights must be finite numbers of mm")
+
+    def stepover(self, cutter: Cutter) -> float:
+        return self.stepover_percent / 100.0 * cutter.diameter
+
+
+def _check(mesh: TriMesh, cutter: Cutter, params: RoughingParams) -> tuple[float, float]:
+    """(stock top, final layer height) after the checks that need the model and the tool."""
+    if cutter.kind not in SUPPORTED_TOOLS:
+        raise TmmError(f"the {cutter.describe()} cutter is not supported by z-level roughing "
+                       f"(supported: {', '.join(SUPPORTED_TOOLS)})")
+    for label, s in (("stock to leave", params.stock_to_leave), ("axial stock to leave", params.axial)):
+        if s > cutter.diameter:
+            raise TmmError(f"{label} {s:g} mm is larger than the tool (diameter {cutter.diameter:g} mm; "
+                           f"allowed: 0 to {cutter.diameter:g} mm)")
+    if math.isfinite(cutter.cutting_length) and params.step_down > cutter.cutting_length:
+        raise TmmError(f"step-down {params.step_down:g} mm is larger than the cutting length "
+                       f"{cutter.cutting_length:g} mm of the {cutter.describe()} cutter")
+    b = params.stock_box
+    lo, hi = mesh.bounds
+    eps = 1e-6
+    if lo[0] < b[0] - eps or lo[1] < b[1] - eps or hi[0] > b[3] + eps or hi[1] > b[4] + eps or lo[2] < b[2] - eps:
+        raise TmmError(f"the model (x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g}, z {lo[2]:g}..{hi[2]:g} mm) "
+                       f"lies outside the stock (x {b[0]:g}..{b[3]:g}, y {b[1]:g}..{b[4]:g}, z {b[2]:g}..{b[5]:g})")
+    if hi[2] > b[5] + eps:
+        raise TmmError(f"the stock is not above the model: its top {b[5]:g} mm is below the model's top "
+                       f"{hi[2]:g} mm")
+    final = float(lo[2]) + params.axial + layers_mod.PLATEAU_LIFT if params.final_z is None else float(params.final_z)
+    if final < b[2] - eps:
+        raise TmmError(f"final depth {final:g} mm is below the stock's bottom {b[2]:g} mm")
+    top = float(b[5])
+    if params.stock_heights is not None:
+        top = min(top, float(np.max(params.stock_heights[1])))
+    if not top > final:
+        raise TmmError(f"the stock is not above the model: its top {top:g} mm is not above the final depth "
+                       f"{final:g} mm (the model's lowest point plus the axial stock to leave)")
+    return top, final
+
+
+def layer_heights(mesh: TriMesh, cutter: Cutter, params: RoughingParams, top: float, final: float) -> np.ndarray:
+    """The layers' tip heights, descending (zlevel_layers)."""
+    if params.layer_mode == "fixed":
+        zs = layers_mod.fixed_layers(top, final, params.step_down)
+    else:
+        zs = layers_mod.tolerance_layers(mesh, cutter, top, final, params.step_down, params.remaining_height,
+                                         params.axial)
+    if params.flat_layers:
+        zs = layers_mod.with_plateaus(zs, layers_mod.plateau_heights(mesh), top, final, params.axial,
+                                      params.remaining_height)
+    return zs
+
+
+def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] = None) -> float:
+    """Loop points over all layers (layers x loops x points, an upper bound: every loop as long as the
+    stock's outline, at the waterline's sample spacing), refused above the limits before any is made.
+    `layers` when known; else from the step-down (tolerance mode: the shallowest layer eq. 3.11 allows)."""
+    b = params.stock_box
+    w, h = b[3] - b[0], b[4] - b[1]
+    if layers is None:
+        depth = params.step_down
+        if params.layer_mode == "tolerance":
+            depth = min(depth, layers_mod.tolerance_depth(cutter, params.remaining_height, 0.0))
+        layers = max(1, math.ceil((b[5] - b[2]) / depth))
+    s = params.stepover(cutter)
+    loops = math.ceil(min(w, h) / (2 * s)) + 2
+    spacing = wl.default_sample_step(cutter, (0, 0, w + 2 * cutter.diameter, h + 2 * cutter.diameter))
+    points = 2 * (w + h + 4 * cutter.diameter) / spacing * wl._REFINE_FACTOR
+    count = float(layers) * loops * points
+    check_work("roughing loop points", count, _BYTES_PER_POINT,
+               f"{layers} layers (step-down {params.step_down:g} mm), step-over {params.stepover_percent:g} % "
+               f"of D{cutter.diameter:g} over a {w:.6g} x {h:.6g} mm stock")
+    return count
+
+
+def wall_margin(params: RoughingParams) -> float:
+    """mm (horizontal) the blocked region is grown by before it is taken from the tool-centre box: the
+    waterline's chords lie within chord_tol of the exact loop, on either side (this growth is mitred: it
+    reaches at least as far as the round one), and Clipper's round joins of the erosions within half of it, so no pass comes nearer the
+    model than the stock to leave. Walls keep up to this much more. (Growing the cutter instead would not
+    do: on a slope a cutter grown by m moves its waterline by less than m.)"""
+    return 2.0 * params.chord_tol + 1e-4
+
+
+def _profile_height(cutter: Cutter, rho: float) -> float:
+    """Height of the cutter's lower surface above its tip at radius rho (ball, flat, bull-nose)."""
+    R, r = cutter.radius, cutter.corner_radius
+    rho = min(max(rho, 0.0), R)
+    flat = R - r
+    if rho <= flat:
+        return 0.0
+    return r - math.sqrt(max(0.0, r * r - (rho - flat) ** 2))
+
+
+class _Steps:
+    """Progress over the phases (waterlines, then layers) with cancel."""
+
+    def __init__(self, progress: Optional[Progress]) -> None:
+        self.progress = progress
+
+    def part(self, lo: float, hi: float) -> Optional[Progress]:
+        if self.progress is None:
+            return None
+        return lambda f: self.progress(lo + (hi - lo) * min(max(f, 0.0), 1.0))
+
+    def at(self, f: float) -> None:
+        if self.progress is not None and self.progress(f) is False:
+            raise Cancelled("roughing cancelled")
+
+    def cancelled(self) -> bool:
+        """For the long loops inside a layer: the progress callback answered False."""
+        return self.progress is not None and self.progress(self.last) is False
+
+    last = 0.0
+
+
+@dataclass
+class _Layer:
+    z: float
+    tool_centres: P.Shape    # where the tool centre may go (gouge-free)
+    material: P.Shape        # XY where the stock reaches above z
+    cut: P.Shape             # the regions cleared at this layer
+
+
+class _Context:
+    """What the layers share: the tool, the stock, the swept areas of the layers above (for entry heights)."""
+
+    def __init__(self, cutter: Cutter, params: RoughingParams, top: float, outer: np.ndarray) -> None:
+        self.cutter = cutter
+        self.params = params
+        self.top = top
+        self.outer = outer
+        self.R = cutter.radius
+        self.D = cutter.diameter
+        self.s = params.stepover(cutter)
+        self.arc_tol = max(1e-4, params.chord_tol / 2)
+        self.climb = params.direction == "climb"
+        # after a layer, its regions swept by this much are down to the layer plus `floor_cusp`
+        self.reach = min(self.s, self.R)
+        self.floor_cusp = _profile_height(cutter, self.reach)
+        self.swept: list[tuple[float, P.Shape]] = []
+        self.helix_r = params.helix_diameter_percent / 100.0 * cutter.diameter / 2.0
+
+    def material_xy(self, z: float) -> P.Shape:
+        b = self.params.stock_box
+        if self.params.stock_heights is None:
+            return [P.rectangle(b[0], b[1], b[3], b[4])]
+        grid, heights = self.params.stock_heights
+        heights = np.asarray(heights, dtype=float)
+        rects = []
+        xs0 = grid.x0 + np.arange(grid.nx) * grid.cell
+        for j in range(grid.ny):
+            above = np.concatenate([[False], heights[j] > z, [False]]).astype(np.int8)
+            edges = np.flatnonzero(np.diff(above))
+            y0 = grid.y0 + j * grid.cell
+            for a, e in zip(edges[::2], edges[1::2]):
+                rects.append(P.rectangle(xs0[a], y0, xs0[e - 1] + grid.cell, y0 + grid.cell))
+        return P.intersection(P.union(rects), [P.rectangle(b[0], b[1], b[3], b[4])]) if rects else []
+
+    def material_top(self, footprint: P.Shape) -> float:
+        """The highest the material can be over `footprint` now: the lowest earlier layer whose swept area
+        covers it (plus the floor cusp), else the stock's top there."""
+        top = self.top
+        if self.params.stock_heights is not None:
+            grid, heights = self.params.stock_heights
+            x0, y0, x1, y1 = P.bounds(footprint)
+            i0, i1 = int((x0 - grid.x0) // grid.cell) - 1, int((x1 - grid.x0) // grid.cell) + 2
+            j0, j1 = int((y0 - grid.y0) // grid.cell) - 1, int((y1 - grid.y0) // grid.cell) + 2
+            sub = np.asarray(heights)[max(0, j0):max(0, j1), max(0, i0):max(0, i1)]
+            if sub.size:
+                top = min(top, float(sub.max()))
+        for z, swept in reversed(self.swept):   # the lowest layer first
+            if P.covers(swept, footprint):
+                return min(top, z + self.floor_cusp)
+        return top
+
+
+def _region_label(z: float, region: P.Region) -> str:
+    x0, y0, x1, y1 = P.bounds([region.outer])
+    return (f"the region at z {z:.4g} mm, x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm "
+            f"({region.area:.3g} mm^2 of tool-centre positions)")
+
+
+def _helix_centre(ctx: _Context, region: P.Region, pas: clearing.Pass
+                  ) -> Optional[tuple[np.ndarray, np.ndarray, clearing.Pass]]:
+    """(centre, helix end, the pass rotated to start at its vertex next to the end) with the helix disc in
+    the region and the straight move from the helix end to the pass inside it; None if there is no room."""
+    rh = ctx.helix_r
+    room = P.offset(region.shape, -(rh + 1e-3), ctx.arc_tol)
+    if not room:
+        return None
+    cands = np.vstack(room)
+    mid = pas.xy.mean(axis=0)
+    order = np.argsort(np.sum((cands - mid) ** 2, axis=1))[:24]
+    for c in cands[order]:
+        k = int(np.argmin(np.sum((pas.xy - c) ** 2, axis=1))) if pas.closed else 0
+        q = pas.xy[k]
+        d = q - c
+        n = float(np.hypot(*d))
+        end = c + (rh * d / n if n > 1e-9 else np.array([rh, 0.0]))
+        if P.segment_inside(end, q, region.shape):
+            xy = np.roll(pas.xy, -k, axis=0)
+            return c, end, clearing.Pass(xy, pas.closed, pas.level, pas.outer)
+    return None
+
+
+def _tips(xy: np.ndarray, z: float, closed: bool) -> np.ndarray:
+    pts = np.vstack([xy, xy[:1]]) if closed else xy
+    return np.column_stack([pts, np.full(len(pts), z)])
+
+
+def _enter(ctx: _Context, z: float, region: P.Region, pas: clearing.Pass, joined: bool) -> CutSegment:
+    """The segment of `pas` with its entry (or joined to the previous one)."""
+    p = ctx.params
+    if joined:
+        return CutSegment(_tips(pas.xy, z, pas.closed), joined=True, closed=pas.closed)
+    if p.entry == PLUNGE:
+        return CutSegment(_tips(pas.xy, z, pas.closed), entry=PLUNGE, closed=pas.closed)
+    if p.entry == HELIX:
+        found = _helix_centre(ctx, region, pas)
+        if found is not None:
+            c, end, pas = found
+            tips = np.vstack([[[end[0], end[1], z]], _tips(pas.xy, z, pas.closed)])
+            footprint = [P.circle(c, ctx.helix_r + ctx.R + ctx.arc_tol)]
+            top = ctx.material_top(footprint) + _ENTRY_CLEARANCE
+            return CutSegment(tips, entry=HELIX, entry_z=top, helix_centre=(float(c[0]), float(c[1])),
+                              helix_ccw=ctx.climb, closed=False)
+    length = float(np.hypot(*np.diff(np.vstack([pas.xy, pas.xy[:1]]) if pas.closed else pas.xy, axis=0).T).sum())
+    if length >= ctx.D:
+        footprint = P.offset_open([pas.xy], ctx.R + ctx.arc_tol, ctx.arc_tol, closed=pas.closed)
+        top = ctx.material_top(footprint) + _ENTRY_CLEARANCE
+        return CutSegment(_tips(pas.xy, z, pas.closed), entry=RAMP, entry_z=top, closed=pas.closed)
+    what = f"no room for a helix of diameter {2 * ctx.helix_r:g} mm and " if p.entry == HELIX else ""
+    raise TmmError(f"cannot enter {_region_label(z, region)}: {what}its first pass is {length:.3g} mm long, "
+                   f"shorter than the tool diameter {ctx.D:g} mm needed for a ramp; use a smaller helix diameter, "
+                   f"a smaller tool, or entry 'plunge' if the tool can cut straight down")
+
+
+def _air_approach(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, air_free: P.Shape
+                  ) -> Optional[tuple[np.ndarray, int]]:
+    """(a point beside the stock where the tool stands in air, the index of the outer loop's vertex it is
+    fed to) if the region is open to the outside; the straight move between them lies in the tool-centre
+    region, so it is gouge-free, and the tool there touches no material at any height."""
+    outer = region.outer
+    n = len(outer)
+    step = max(1, n // 48)
+    d = ctx.s + _AIR_MARGIN
+    for k in range(0, n, step):
+        a, b = outer[k - 1], outer[(k + 1) % n]
+        t = b - a
+        tl = float(np.hypot(*t))
+        if tl <= 0:
+            continue
+        normal = np.array([t[1], -t[0]]) / tl   # outward of a counter-clockwise loop
+        p = outer[k] + d * normal
+        if not P.contains_point(air_free, p) and P.segment_inside(p, outer[k], tool_centres):
+            return p, k
+    return None
+
+
+def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, air_free: P.Shape,
+                  steps: _Steps) -> list[CutSegment]:
+    p = ctx.params
+    approach = _air_approach(ctx, z, region, tool_centres, air_free)
+    open_region = approach is not None
+    if p.pattern == "offset":
+        passes = clearing.offset_passes(region, ctx.s, climb=ctx.climb, outside_in=open_region,
+                                        arc_tol=ctx.arc_tol, cancelled=steps.cancelled)
+    else:
+        passes = clearing.zigzag_passes(region, ctx.s, climb=ctx.climb, arc_tol=ctx.arc_tol)
+    passes += clearing.fill_gaps(region, passes, ctx.R, ctx.arc_tol)
+    start = None
+    if open_region:
+        air, k = approach
+        start = region.outer[k]
+        # the outer boundary goes first, from the vertex the air approach reaches
+        first = next(i for i, q in enumerate(passes) if q.outer)
+        passes.insert(0, passes.pop(first))
+    passes = clearing.order_from(passes, start)
+    out: list[CutSegment] = []
+    prev_end: Optional[np.ndarray] = None
+    for i, pas in enumerate(passes):
+        joined = False
+        if i > 0 and p.keep_tool_down and prev_end is not None:
+            q = pas.xy[0]
+            joined = float(np.hypot(*(q - prev_end))) <= ctx.D and P.segment_inside(prev_end, q, region.shape)
+        if i == 0 and open_region:
+            tips = np.vstack([[[air[0], air[1], z]], _tips(pas.xy, z, pas.closed)])
+            seg = CutSegment(tips, entry=PLUNGE, closed=False)   # down through air beside the stock
+        else:
+            seg = _enter(ctx, z, region, pas, joined)
+        seg.kind = SegmentKind.PASS
+        out.append(seg)
+        prev_end = seg.tips[-1, :2]
+    return out
+
+
+def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Optional[Progress] = None,
+            surface: Optional[DropSurface] = None) -> StrategyResult:
+    """Z-level roughing of the stock down to `mesh` plus stock to leave with `cutter`, as cut segments with
+    their entries. diagnostics: "layers" (count), "layer_z" (their heights), "regions", "points" (tips),
+    "unreachable" (mm^2 summed over layers: stock the tool cannot reach above the model plus stock to leave,
+    narrower than the tool), "top" (highest tip), "entries" (count per kind)."""
+    params.validate()
+    top, final = _check(mesh, cutter, params)
+    estimate_work(params, cutter)
+    zs = layer_heights(mesh, cutter, params, top, final)
+    estimate_work(params, cutter, len(zs))
+    steps = _Steps(progress)
+    steps.at(0.0)
+    b = params.stock_box
+    s_r, s_a = params.stock_to_leave, params.axial
+    grow = cutter.radius + s_r + _AIR_MARGIN + params.stepover(cutter)
+    outer = P.rectangle(b[0] - grow, b[1] - grow, b[3] + grow, b[4] + grow)
+    bounds = (b[0] - grow, b[1] - grow, b[3] + grow, b[4] + grow)
+    surface = surface or DropSurface(mesh)
+    grown = cutter.offset(s_r)
+    sample = wl.default_sample_step(cutter, bounds)
+    levels = [float(z) - s_a for z in zs]
+    loops = wl.waterline_loops(surface, grown, levels, bounds, sample_step=sample, chord_tol=params.chord_tol,
+                               progress=steps.part(0.0, 0.45))
+    # the model plus stock to leave sliced at each layer (a ball of radius s dropped, raised by s, is the top
+    # of the model offset by s; a needle for s = 0): what is left outside the tool's reach and is not model
+    needle = Cutter.flat(2e-3).offset(s_r)
+    slices = wl.waterline_loops(surface, needle, levels, bounds, sample_step=sample, chord_tol=params.chord_tol,
+                                progress=steps.part(0.45, 0.6))
+    ctx = _Context(cutter, params, top, outer)
+    air_free = P.offset(ctx.material_xy(final), ctx.R + 1e-3, ctx.arc_tol)
+    segments: list[CutSegment] = []
+    unreachable = 0.0
+    region_count = 0
+    for k, z in enumerate(zs):
+        steps.last = 0.6 + 0.4 * k / len(zs)
+        steps.at(steps.last)
+        blocked = P.offset(P.union([lp.xy for lp in loops[k]]), wall_margin(params), ctx.arc_tol, miter=True)
+        tool_centres = P.difference([outer], blocked)
+        material = ctx.material_xy(float(z))
+        if not material or not tool_centres:
+            continue
+        touching = P.offset(material, ctx.R - ctx.s, ctx.arc_tol)
+        cut_shape = P.intersection(tool_centres, touching)
+        regions = [r for r in P.regions(cut_shape) if r.area > _MIN_REGION_AREA]
+        for region in regions:
+            segments += _clear_region(ctx, float(z), region, tool_centres, air_free, steps)
+        region_count += len(regions)
+        swept = P.offset(cut_shape, ctx.reach, ctx.arc_tol) if cut_shape else []
+        ctx.swept.append((float(z), swept))
+        model = P.union([lp.xy for lp in slices[k]])
+        reach = P.offset(cut_shape, ctx.R, ctx.arc_tol) if cut_shape else []
+        left = P.difference(P.difference(material, reach), model)
+        opened = P.offset(P.offset(left, -_SLIVER, ctx.arc_tol), _SLIVER, ctx.arc_tol)
+        unreachable += P.area(opened)
+    steps.at(1.0)
+    kinds: dict[str, int] = {}
+    for seg in segments:
+        if not seg.joined:
+            kinds[seg.entry or PLUNGE] = kinds.get(seg.entry or PLUNGE, 0) + 1
+    pts = sum(len(sg) for sg in segments)
+    diagnostics = {"layers": len(zs), "layer_z": [float(z) for z in zs], "regions": region_count, "points": pts,
+                   "unreachable": unreachable, "top": float(max(zs)) if len(zs) else top, "entries": kinds,
+                   "stock_top": top}
+    return StrategyResult(segments, diagnostics)
+
+
+def compute_roughing_toolpath(mesh: TriMesh, cutter: Cutter, params: RoughingParams, policy: LinkPolicy,
+                              progress: Optional[Progress] = None,
+                              surface: Optional[DropSurface] = None) -> Toolpath:
+    """The strategy and the linker (vertical retracts; the entries the segments carry, at the params'
+    ramp angle) in one call."""
+    policy = dataclasses.replace(policy, entry=params.entry, ramp_angle_deg=params.ramp_angle_deg,
+                                 arc_tol=params.chord_tol)
+    policy.validate()
+    params.validate()
+    top = float(params.stock_box[5])
+    if policy.safe_height <= top:
+        raise TmmError(f"safe height {policy.safe_height:g} mm is not above the stock top {top:g} mm")
+    result = compute(mesh, cutter, params, progress, surface)
+    return link(result.segments, policy)
+
