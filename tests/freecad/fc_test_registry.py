@@ -14,7 +14,9 @@ from tmm_workbench.core.params import StrategyParams
 
 class Registry(FreeCADTestCase):
     def test_every_entry_is_a_complete_room(self) -> None:
-        self.assertEqual([e.name for e in registry.OPS], ["TMM_Surface", "TMM_Multipoint"])
+        self.assertEqual([e.name for e in registry.OPS],
+                         ["TMM_Surface", "TMM_Multipoint", "TMM_Roughing", "TMM_Waterline"])
+        self.assertEqual(len({e.view_kind for e in registry.OPS}), len(registry.OPS))  # one view hook each
         for entry in registry.OPS:
             with self.subTest(op=entry.name):
                 app, core = entry.app(), entry.core()
@@ -48,6 +50,25 @@ class Registry(FreeCADTestCase):
                                                             "BoundaryShape": "Model"})
         params = op.Proxy.params_from(op, boundary=(0.0, 0.0, 1.0, 1.0))
         self.assertEqual((params.stepover, params.pattern, params.sample_step), (1.5, "oneway", 1.0))
+
+    def test_roughing_and_waterline_properties_map_to_params(self) -> None:
+        doc = new_doc("TmmRegistryZ")
+        _, _, surface = job_with_op(doc, str(bump_stl()))
+        job = surface.Proxy.job
+        rough = registry.create("TMM_Roughing", job, {"StlFile": str(bump_stl()), "StepOver": 55.0,
+                                                      "Entry": "Ramp", "LayerMode": "Tolerance",
+                                                      "Direction": "Conventional", "StockToLeave": 0.25})
+        rough.Proxy.progress_enabled = False
+        doc.recompute()  # evaluates the axial stock's expression
+        params = rough.Proxy.params_from(rough)
+        self.assertEqual((params.stepover_percent, params.entry, params.layer_mode, params.direction),
+                         (55.0, "ramp", "tolerance", "conventional"))
+        self.assertEqual((params.stock_to_leave, params.stock_to_leave_axial), (0.25, 0.25))  # axial follows
+        water = registry.create("TMM_Waterline", job, {"StlFile": str(bump_stl()), "StepDown": 0.75,
+                                                       "Direction": "Conventional"})
+        water.Proxy.progress_enabled = False
+        params = water.Proxy.params_from(water, boundary=(0.0, 0.0, 1.0, 1.0))
+        self.assertEqual((params.step_down, params.direction), (0.75, "conventional"))
 
 
 if __name__ == "__main__":

@@ -5,7 +5,8 @@ with a TMM Surface op, the TMM Surface command adds a second op and opens its ta
 window (with the 3D view rendered offscreen) is grabbed into a PNG; TMM Simulate on that Job shows its
 numbers and the stock coloured by deviation (grabbed into gui_simulate.png beside it) and leaves nothing
 when closed; the API's 5-axis Multipoint op opens its panel and the 5-axis command adds an op on the
-selected face; then a document saved headless (env TMM_GUI_REOPEN, made by make_headless_doc.py) is
+selected face; TMM Roughing and TMM Waterline are made by their commands, their panels open and OK gives
+their paths; then a document saved headless (env TMM_GUI_REOPEN, made by make_headless_doc.py) is
 reopened and its op's panel opens; the GUI progress dialog reports a Cancel; FreeCAD quits. The outcome
 goes to env TMM_GUI_RESULT (a JSON file) and the exit code (os._exit: the GUI would otherwise swallow
 SystemExit). Screenshot: env TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
@@ -174,6 +175,54 @@ def multipoint_panel(info: dict) -> None:
     pump(0.3)
 
 
+def zlevel_panels(info: dict) -> None:
+    """TMM Roughing and TMM Waterline, each made by its command in a Job on a Part block with a pocket: its
+    panel opens (step-over in % of the diameter, the page fits a 1000 px screen without scrolling), OK
+    recomputes it and the Job holds its path."""
+    import Part
+    from tmm_workbench.app import job as jobs
+    from tmm_workbench.app import registry, tools
+
+    doc = FreeCAD.newDocument("TmmGuiZlevel")
+    block = doc.addObject("Part::Feature", "PocketBlock")
+    block.Shape = Part.makeBox(40, 30, 10).cut(Part.makeBox(20, 12, 10, FreeCAD.Vector(10, 9, 5)))
+    doc.recompute()
+    job = jobs.create_job(doc, block)
+    jobs.set_tool(job, tools.make_tool_bit(doc, "endmill", 6.0), 20.0, 5.0, 10000)
+    doc.recompute()
+    for name, page_name in (("TMM_Roughing", "TmmRoughingOpPage"), ("TMM_Waterline", "TmmWaterlineOpPage")):
+        before = list(job.Operations.Group)
+        FreeCADGui.Selection.clearSelection()
+        FreeCADGui.runCommand(registry.entry(name).command_name)
+        pump(1.5)
+        ops = [o for o in job.Operations.Group if o not in before]
+        assert ops, f"the {name} command made no op"
+        op = ops[0]
+        page = find_panel(page_name)
+        key = name.split("_")[1].lower()
+        info[f"{key}_page_height"] = page.sizeHint().height()
+        assert info[f"{key}_page_height"] < 760, f"the {name} page needs {info[f'{key}_page_height']} px"
+        if name == "TMM_Roughing":
+            step_over = page.findChild(QtGui.QDoubleSpinBox, "stepOver")
+            info["roughing_step_over"] = [step_over.value(), step_over.suffix().strip()]
+            assert info["roughing_step_over"] == [op.StepOver, "%"], info["roughing_step_over"]
+        info[f"{key}_step_down"] = page.findChild(QtGui.QWidget, "stepDown").property("rawValue")
+        assert abs(info[f"{key}_step_down"] - op.StepDown.Value) < 1e-9, info[f"{key}_step_down"]
+        FreeCADGui.activeDocument().activeView().viewIsometric()
+        FreeCADGui.SendMsgToActiveView("ViewFit")
+        pump(0.3)
+        screenshot(PNG.with_name(f"gui_{key}.png"))
+        op.ViewObject.Proxy.panel.accept()  # OK: the op is kept and recomputed
+        pump(1.0)
+        assert not FreeCADGui.Control.activeDialog(), f"the {name} panel stayed open"
+        info[f"{key}_valid"] = op.isValid()
+        info[f"{key}_commands"] = len(op.Path.Commands)
+        assert op.isValid() and len(op.Path.Commands) > 10, (name, op.getStatusString())
+        assert op in job.Operations.Group
+    FreeCAD.closeDocument(doc.Name)
+    pump(0.3)
+
+
 def smoke() -> dict:
     info: dict = {}
     if str(ROOT) not in sys.path:
@@ -187,7 +236,7 @@ def smoke() -> dict:
                 if b.objectName() == "New Operations"]
         texts = {a.text() for b in bars for a in b.actions()}
         info["cam_toolbar"] = sorted(t for t in texts if "TMM" in t)
-        for text in ("TMM 3-axis Surface", "TMM 5-axis Multipoint"):
+        for text in ("TMM 3-axis Surface", "TMM 5-axis Multipoint", "TMM Roughing", "TMM Waterline"):
             assert text in texts, f"'{text}' is not in the CAM workbench's New Operations toolbar: {sorted(texts)}"
     FreeCADGui.activateWorkbench("TMMWorkbench")
     pump(0.5)
@@ -242,6 +291,8 @@ def smoke() -> dict:
     simulate_panel(info, r)
 
     multipoint_panel(info)
+
+    zlevel_panels(info)
 
     reopen = os.environ.get("TMM_GUI_REOPEN")
     if reopen:  # a document saved headless: op and Job get their view providers, the panel opens

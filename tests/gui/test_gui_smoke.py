@@ -39,6 +39,7 @@ def test_gui_smoke(tmp_path: Path) -> None:
     assert info["workbench"] == "TMMWorkbench" and info["panel_open"] and info["cancel_seen"]
     assert info["multipoint_command_panel"] and "two" in info["multipoint_contacts"]
     assert info.get("reopened_panel") or not freecadcmd
+    assert info.get("roughing_valid") and info.get("waterline_valid"), info  # made by their commands, OK: a path
     assert info.get("mp_anchor") == ["Tip", ["Axis", "Tip"]] and abs(info.get("mp_extension", 0) - 12.7) < 1e-9
     assert PNG.is_file() and PNG.stat().st_size > 10_000
     assert not _blank(PNG), "the screenshot is blank"

@@ -50,6 +50,16 @@ OPS: tuple[OpEntry, ...] = (
             "(select the face first)", "TMM_Multipoint",
             "tmm_workbench.app.op_multipoint", "tmm_workbench.gui.op_multipoint_gui", "multipoint_op",
             "tmm_workbench.core.strategies.multipoint"),
+    OpEntry("TMM_Roughing", "TMM Roughing",
+            "Z-level roughing of the Job's stock down to a mesh or Part model plus stock to leave (offset or "
+            "zig-zag clearing, helix or ramp entries)", "TMM_Roughing",
+            "tmm_workbench.app.op_roughing", "tmm_workbench.gui.op_roughing_gui", "roughing_op",
+            "tmm_workbench.core.strategies.zlevel_rough"),
+    OpEntry("TMM_Waterline", "TMM Waterline",
+            "Waterline finishing of a mesh or Part model: closed loops at constant heights for steep walls",
+            "TMM_Waterline",
+            "tmm_workbench.app.op_waterline", "tmm_workbench.gui.op_waterline_gui", "waterline_op",
+            "tmm_workbench.core.strategies.waterline"),
 )
 
 

@@ -1,0 +1,139 @@
+"""'TMM Waterline': a Path operation that finishes the steep walls of a model with closed loops at constant
+heights (core.strategies.waterline: per level the loops where the cutter touches the model, linked by the
+one linker with vertical retracts).
+
+What is machined: as the Surface op (op_surface: `StlFile`, then `Model`, then the Job's model; STL files,
+Mesh and Part objects). Boundary (the tool tip's XY box): the model's box grown by the tool radius (so the
+tool reaches round the model's outside walls) and `BoundaryMargin`, or the Job stock's box and the margin.
+Levels: a step-down below the model's top, then `StepDown` apart down to its lowest point (the last
+level exactly there), or the same from TopZ down to BottomZ (UseZRange). Heights: FreeCAD's SafeHeight and ClearanceHeight (their SetupSheet defaults put them above the
+stock top). The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight. Feeds from the
+tool controller as the Surface op's (op_surface.commands). Errors never leave a partial path.
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+from tmm_workbench.app import geometry, hooks, op_base, progress
+from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
+from tmm_workbench.app.op_base import Prop
+from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
+from tmm_workbench.app.op_surface import ObjectTmmSurface
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import VERTICAL, LinkPolicy, link
+from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.strategies.waterline import WaterlineParams
+from tmm_workbench.core.toolpath import Toolpath
+
+OP_NAME = "TMM_Waterline"
+DIRECTIONS = {"Climb": "climb", "Conventional": "conventional"}
+BOUNDARIES = ("Model", "Stock")
+
+PROPERTIES: list[Prop] = [
+    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
+    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
+    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+    Prop("App::PropertyEnumeration", "BoundaryShape", "Boundary",
+         "Area the tool tip may reach: the Model's XY box grown by the tool radius, or the Stock's XY box"),
+    Prop("App::PropertyDistance", "BoundaryMargin", "Boundary",
+         "Grows (positive) or shrinks (negative) the boundary on every side"),
+    Prop("App::PropertyDistance", "StepDown", "Waterline", "Height between levels (at most the tool's cutting "
+         "edge height)", "step_down"),
+    Prop("App::PropertyDistance", "StockToLeave", "Waterline", "Material left on the model", "stock_to_leave"),
+    Prop("App::PropertyDistance", "SampleStep", "Waterline",
+         "Spacing of the points the loops are found from (0: automatic, from the tool and the chord tolerance)"),
+    Prop("App::PropertyDistance", "ChordTolerance", "Waterline", "Largest deviation of the loops' chords",
+         "chord_tol"),
+    Prop("App::PropertyEnumeration", "Direction", "Waterline", "Climb or conventional milling", "direction"),
+    Prop("App::PropertyBool", "UseZRange", "Levels", "Levels between TopZ and BottomZ instead of the model's "
+         "top and lowest point"),
+    Prop("App::PropertyDistance", "TopZ", "Levels", "Top of the levels when UseZRange is set: the first level is a "
+         "step-down below it"),
+    Prop("App::PropertyDistance", "BottomZ", "Levels", "Lowest level when UseZRange is set"),
+]
+CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Direction": DIRECTIONS}
+DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Model",
+                            "BoundaryMargin": 0.0, "SampleStep": 0.0, "UseZRange": False, "TopZ": 0.0,
+                            "BottomZ": 0.0}
+
+
+class ObjectTmmWaterline(op_base.TmmOp):
+    """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
+    (the strategy's, as computed), `diagnostics` (the strategy's: levels, loops, points, top)."""
+
+    PARAMS = WaterlineParams
+    PROPERTIES = PROPERTIES
+    CHOICES = CHOICES
+    DEFAULTS = DEFAULTS
+    toolpath: Optional[Toolpath] = None
+    mesh: Optional[TriMesh] = None
+    params: Optional[WaterlineParams] = None
+    diagnostics: Optional[dict] = None
+
+    def opFeatures(self, obj: Any) -> int:
+        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
+
+    def opOnDocumentRestored(self, obj: Any) -> None:
+        self.ensure_properties(obj, restoring=True)
+        hooks.attach_view("waterline_op", obj)  # a document saved headless has no view providers
+        job = PathUtils.findParentJob(obj)
+        if job is not None:
+            hooks.attach_view("job", job)
+
+    # --- computation -------------------------------------------------------------------------
+    def clear_results(self) -> None:
+        self.mesh = self.toolpath = self.params = self.diagnostics = None
+
+    def compute(self, obj: Any) -> None:
+        mesh = ObjectTmmSurface.model_mesh(self, obj)  # the Surface op's model rules, one place
+        cutter = self.cutter()
+        check_step_down(self.tool, obj.StepDown.Value)
+        sample = obj.SampleStep.Value
+        extra: dict[str, Any] = {"boundary": self.boundary(obj, mesh, cutter.radius),
+                                 "sample_step": None if sample == 0 else sample}
+        if obj.UseZRange:
+            extra.update(top_z=obj.TopZ.Value, bottom_z=obj.BottomZ.Value)
+        params = self.params_from(obj, **extra)
+        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
+        policy.validate()
+        with progress.reporter(obj.Label, self.progress_enabled) as cb:
+            result = waterline.compute(mesh, cutter, params, cb)
+        top = result.diagnostics.get("top")
+        if top is not None and policy.safe_height <= top:
+            raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
+                           f"{top:.4g} mm")
+        # each loop is entered from above onto one of its points: a loop point is free (the tool's drop
+        # height there is its level), so the plunge down to it cuts nothing of the model
+        toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
+        self.mesh, self.toolpath, self.params = mesh, toolpath, params
+        self.diagnostics = dict(result.diagnostics)
+        self.commandlist.extend(ObjectTmmSurface.commands(self, toolpath, STEEP_DESCENT_DEG,
+                                                          obj.ClearanceHeight.Value))
+
+    def boundary(self, obj: Any, mesh: TriMesh, radius: float) -> tuple[float, float, float, float]:
+        if obj.BoundaryShape == "Stock":
+            if self.stock is None or self.stock.Shape.isNull():
+                raise TmmError("boundary 'Stock': the Job has no stock")
+            bb = self.stock.Shape.BoundBox
+            x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
+        else:  # the tool reaches round the model's outside walls
+            lo, hi = mesh.bounds
+            x0, y0 = float(lo[0]) - radius, float(lo[1]) - radius
+            x1, y1 = float(hi[0]) + radius, float(hi[1]) + radius
+        m = obj.BoundaryMargin.Value
+        return (x0 - m, y0 - m, x1 + m, y1 + m)
+
+
+def SetupProperties() -> list[str]:
+    """Properties the Job's SetupSheet may hold defaults for."""
+    return op_base.setup_properties(ObjectTmmWaterline, exclude=("StlFile", "Model"))
+
+
+def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
+           values: Optional[dict[str, Any]] = None) -> Any:
+    """A new op in `parentJob` (or the only Job of the active document), with property `values`."""
+    return op_base.create(ObjectTmmWaterline, "waterline_op", name, obj, parentJob, values)
+
+
+PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)
