@@ -202,6 +202,14 @@ def test_tolerance_layers_on_the_sphere():
     check_roughing(mesh, cutter, tol, cell=0.25, safe=hi[2] + 10, clear=hi[2] + 15)
 
 
+def test_the_seeds_step_over_of_0_95_d(pocket):
+    """Seed 000 section 3.4.5: step-over c D, c = 0.95: past the radius the offsets alone would leave islands
+    between loops and the stock's corners; the gaps are cleared (zlevel_clearing.fill_gaps)."""
+    out = check_roughing(pocket, Cutter.flat(6), RoughingParams(stock_box=BOX, step_down=4.0, stepover_percent=95.0),
+                         cell=0.2)
+    assert out["sim"].heights.max() < BOX[5]                          # the stock's corners too
+
+
 def test_zigzag_conventional_and_senses(pocket):
     flat = Cutter.flat(6)
     check_roughing(pocket, flat, RoughingParams(stock_box=BOX, step_down=4.0, pattern="zigzag",

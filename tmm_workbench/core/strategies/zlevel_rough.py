@@ -11,8 +11,9 @@ Per layer (tip height z, descending; zlevel_layers):
             is not an exact offset (it shrinks concave corners and opens gaps at sharp edges), the grown
             cutter's drop is (Cutter.offset). Radial and axial differ: the grown cutter keeps s on walls,
             the level z - s_a keeps s_a on flats (on slopes a mix of the two);
-  region    the tool-centre positions that touch material: the stock's XY grown by the tool radius (less a
-            step-over, so the first loop around the stock takes no more than a step-over), minus blocked.
+  region    the tool-centre positions that touch material: the stock's XY grown by the tool radius less a
+            step-over (so the first loop around the stock takes no more than a step-over; not grown at all
+            for step-overs past the radius), minus blocked.
             Every position in it is gouge-free at z and above (the blocked region only shrinks upwards);
   clearing  contour-parallel offsets (or zig-zag lines) of each region at the step-over (zlevel_clearing),
             climb or conventional;
@@ -446,7 +447,9 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
         material = ctx.material_xy(float(z))
         if not material or not tool_centres:
             continue
-        touching = P.offset(material, ctx.R - ctx.s, ctx.arc_tol)
+        # the first loop round the material takes a step-over of it (or the tool's radius, for step-overs
+        # past half the diameter: an erosion by s - R would cut the stock's corners off)
+        touching = P.offset(material, max(ctx.R - ctx.s, 0.0), ctx.arc_tol)
         cut_shape = P.intersection(tool_centres, touching)
         regions = [r for r in P.regions(cut_shape) if r.area > _MIN_REGION_AREA]
         for region in regions:
