@@ -10,8 +10,9 @@ pieces (`fill_gaps`).
 Order and direction. Climb milling (spindle clockwise) keeps the material on the right of the travel:
   inside-out (a closed pocket entered in its middle): the material is outside the level being cut, so
   loops run with the region on their left (outer boundaries counter-clockwise, holes clockwise);
-  outside-in (a region open to the air, entered from outside the stock): the material is inside, so the
-  loops run the other way. Conventional milling reverses both.
+  outside-in (a region open to the air, entered from outside the stock): the outer boundaries' offsets
+  have the material inside, so they run the other way; the loops round islands come last, from the
+  farthest in towards the island, with the material outside them again. Conventional milling reverses all.
 Zig-zag lines alternate direction (climb and conventional by turns); the region's boundary loops follow
 them as a contour pass in the chosen direction.
 """
@@ -65,33 +66,53 @@ def _levels(region: P.Region, stepover: float, arc_tol: float, cancelled=None) -
     return root
 
 
-def _loops_of(node: _Node, material_inside: bool, climb: bool) -> list[Pass]:
+def _loops_of(node: _Node, material_inside: bool, climb: bool, holes: bool = True) -> list[Pass]:
     # region on the left (Clipper's orientation) is climb when the material lies outside the level
     keep = climb != material_inside
     out = []
-    for i, poly in enumerate(node.region.shape):
+    for i, poly in enumerate(node.region.shape if holes else node.region.shape[:1]):
         xy = poly if keep else poly[::-1].copy()
         if len(xy) >= 3:
             out.append(Pass(np.asarray(xy, float), True, node.level, node.level == 0 and i == 0))
     return out
 
 
+def _hole_loops(node: _Node, climb: bool) -> list[Pass]:
+    """The loops round the region's islands, from the farthest level in to the island: each takes the
+    step-over between it and the one before (the material lies towards the island: outside the level)."""
+    found: list[Pass] = []
+
+    def visit(n: _Node) -> None:
+        for poly in n.region.holes:
+            if len(poly) >= 3:
+                found.append(Pass(np.asarray(poly if climb else poly[::-1].copy(), float), True, n.level))
+        for child in n.children:
+            visit(child)
+
+    visit(node)
+    return sorted(found, key=lambda p: -p.level)
+
+
 def offset_passes(region: P.Region, stepover: float, *, climb: bool = True, outside_in: bool = False,
                   arc_tol: float = P.ARC_TOL, cancelled=None) -> list[Pass]:
     """Contour-parallel loops of `region` in cutting order: inside-out (children before their parent
-    level) or outside-in (parents first)."""
+    level), or outside-in (a region open to the air: the outer boundaries' offsets from the outside in,
+    parents first, then the loops round the islands from the farthest in to the island, so none slots
+    through full material)."""
     root = _levels(region, stepover, arc_tol, cancelled)
     out: list[Pass] = []
 
     def visit(node: _Node) -> None:
         if outside_in:
-            out.extend(_loops_of(node, True, climb))
+            out.extend(_loops_of(node, True, climb, holes=False))
         for child in node.children:
             visit(child)
         if not outside_in:
             out.extend(_loops_of(node, False, climb))
 
     visit(root)
+    if outside_in:
+        out.extend(_hole_loops(root, climb))
     return out
 
 
