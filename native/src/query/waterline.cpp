@@ -22,7 +22,7 @@ double WaterlineLoop::area() const {
 
 namespace {
 
-constexpr int kIllinoisSteps = 12;  // then bisection: h can jump (a flat end mill at a vertical wall)
+constexpr int kIllinoisSteps = 16;  // then bisection: h can jump (a flat end mill at a vertical wall)
 
 void check_options(const WaterlineOptions& o) {
   auto fail = [](const char* what, double v, const char* allowed) {
@@ -105,20 +105,57 @@ class Level {
 
 Point Level::crossing(Point f, Point b, double cf, double cb) {
   const double length = std::hypot(b.x - f.x, b.y - f.y);
-  const double width = o_.bracket / length;
+  const double width = o_.bracket / length;  // in t
   auto at = [&](double t) { return Point{f.x + t * (b.x - f.x), f.y + t * (b.y - f.y), true}; };
-  Bracket br = illinois(0.0, 1.0, std::min(cf, z_ - eval_floor_), cb, kIllinoisSteps, width, [&](double t) {
+  auto good = [&](double t) {
     const Point p = at(t);
-    return clearance(p.x, p.y);
-  });
-  if (br.bad - br.good > width) {
-    const int steps = static_cast<int>(std::ceil(std::log2((br.bad - br.good) / width)));
-    br = bisect(br.good, br.bad, steps, [&](double t) {
-      const Point p = at(t);
-      return !blocked(p.x, p.y);
-    });
+    return !blocked(p.x, p.y);
+  };
+  // Illinois regula falsi on z - h over [a, c] (a free, c blocked). Once the secant puts the root within the
+  // bracket width of a new point, one predicate drop on the other side closes the bracket (h is smooth
+  // almost everywhere: the usual case ends in a few drops). Steps that do not halve the bracket are
+  // followed by a bisection: h can jump (a flat end mill reaching a vertical wall).
+  double a = 0.0, c = 1.0, fa = std::min(cf, z_ - eval_floor_), fc = cb;
+  int side = 0;
+  for (int k = 0; k < kIllinoisSteps && c - a > width; ++k) {
+    const double before = c - a;
+    double m = (a * fc - c * fa) / (fc - fa);
+    if (!(m > a && m < c)) m = 0.5 * (a + c);
+    const Point p = at(m);
+    const double fm = clearance(p.x, p.y);
+    const double slope = (fc - fa) / (c - a);  // < 0
+    if (fm >= 0.0) {
+      a = m;
+      fa = fm;
+      if (side == -1) fc *= 0.5;
+      side = -1;
+      if (fm < -slope * width && m + width < c && !good(m + width)) c = m + width;
+    } else {
+      c = m;
+      fc = fm;
+      if (side == 1) fa *= 0.5;
+      side = 1;
+      if (-fm < -slope * width && m - width > a && good(m - width)) a = m - width;
+    }
+    if (c - a > 0.5 * before && c - a > width) {
+      const double mid = 0.5 * (a + c);
+      const Point q = at(mid);
+      const double fq = clearance(q.x, q.y);
+      if (fq >= 0.0) {
+        a = mid;
+        fa = fq;
+      } else {
+        c = mid;
+        fc = fq;
+      }
+      side = 0;
+    }
   }
-  return at(br.good);
+  if (c - a > width) {
+    const int steps = static_cast<int>(std::ceil(std::log2((c - a) / width)));
+    a = bisect(a, c, steps, good).good;
+  }
+  return at(a);
 }
 
 // Edge ids: 2 (J NX + I) for the edge (I, J)-(I + 1, J), + 1 for (I, J)-(I, J + 1).
