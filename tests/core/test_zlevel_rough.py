@@ -257,14 +257,21 @@ def test_entries_helix_ramp_and_from_the_air():
     assert len(simulate(vertical_as_rapid(tp), flat, grid, box_heights(grid, 22.0)).collisions) > 0
 
 
-def test_no_room_for_any_entry_is_a_clear_error():
-    # a hole 7 x 6.5 mm in a block: a D6 tool centre has a region of about 1 x 0.5 mm there, no room for a
-    # helix of 3 mm and a first loop of about 3 mm, too short to ramp along
+def test_spots_too_small_to_enter_are_left_and_named():
+    # a hole 6.3 mm square in a block: a D6 tool centre fits in a spot of about 0.26 mm there, its outline
+    # shorter than the quarter diameter a ramp needs and no room for a helix: left uncut, named
     H = np.full((3, 3), 20.0)
     H[1, 1] = 5.0
-    slot = blocks_mesh([0, 26.5, 33.5, 60], [0, 21.75, 28.25, 50], H, "short hole")
-    with pytest.raises(TmmError, match=r"cannot enter the region at z .* use a smaller helix diameter"):
-        compute(slot, Cutter.flat(6), RoughingParams(stock_box=BOX, step_down=4.0, stock_to_leave=0.0))
+    hole = blocks_mesh([0, 26.85, 33.15, 60], [0, 21.85, 28.15, 50], H, "small hole")
+    result = compute(hole, Cutter.flat(6), RoughingParams(stock_box=BOX, step_down=4.0, stock_to_leave=0.0))
+    spots = result.diagnostics["not_entered"]
+    assert spots and all(s.startswith("the region at z") and "x 29.8" in s for s in spots)
+    assert all(abs(sg.tips[:, 0] - 30).min() > 0.5 or sg.tips[:, 2].min() >= 20 - 1e-9 for sg in result.segments)
+    # with entry 'plunge' (a tool that can) the spot is cut
+    plunged = compute(hole, Cutter.flat(6), RoughingParams(stock_box=BOX, step_down=4.0, stock_to_leave=0.0,
+                                                           entry=PLUNGE))
+    assert not plunged.diagnostics["not_entered"]
+    assert min(sg.tips[:, 2].min() for sg in plunged.segments) < 10
 
 
 def test_stock_that_is_not_a_box():

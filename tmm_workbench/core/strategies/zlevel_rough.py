@@ -19,8 +19,11 @@ Per layer (tip height z, descending; zlevel_layers):
             climb or conventional;
   entries   a region open to the air outside the stock is entered from there: down through air beside the
             stock, then fed in at depth, and cut from the outside in; a closed one from its middle outwards,
-            by a helix whose circle lies in the region, else a ramp along the first loop (at least a tool
-            diameter long), else a TmmError naming the region. The helix or ramp starts just above the
+            by a helix whose circle lies in the region, else a ramp along the first loop (at least a quarter
+            of the tool diameter long), else, for a region whose outline is longer than that, a TmmError
+            naming it; a spot where the tool centre just fits (a valley's bottom in the last layer that
+            reaches it) is left uncut and named in the diagnostics ("not_entered"): on real models such
+            spots come by chance, and refusing the whole roughing for one would leave none. The helix or ramp starts just above the
             material: the top of what earlier layers left over the entry's footprint (their swept areas are
             kept as polygons, so no air is cut over and over);
   links     tool down from one pass to the next inside a region when the straight link lies in the region
@@ -61,6 +64,8 @@ _AIR_MARGIN = 1.0           # mm: the tool-centre box reaches this far past the 
 _ENTRY_CLEARANCE = 0.5      # mm: helices and ramps start this far above the material
 _MIN_REGION_AREA = 1e-6     # mm^2: tool-centre regions smaller than this are rounding, not room
 _SLIVER = 0.02              # mm: unreachable material thinner than this is the offsets' rounding
+_MIN_RAMP = 0.25            # a ramp follows a pass at least this many tool diameters long; a region whose
+                            # whole outline is shorter (its tool centre fits in a spot) is not entered
 _BYTES_PER_POINT = 160      # a loop point: polygons (float and Clipper's integers), segments, moves
 
 
@@ -250,6 +255,7 @@ class _Context:
         self.floor_cusp = _profile_height(cutter, self.reach)
         self.swept: list[tuple[float, P.Shape]] = []
         self.helix_r = params.helix_diameter_percent / 100.0 * cutter.diameter / 2.0
+        self.not_entered: list[str] = []    # regions and passes too small to enter (see _MIN_RAMP)
 
     def material_xy(self, z: float) -> P.Shape:
         b = self.params.stock_box
@@ -335,15 +341,24 @@ def _enter(ctx: _Context, z: float, region: P.Region, pas: clearing.Pass, joined
             top = ctx.material_top(footprint) + _ENTRY_CLEARANCE
             return CutSegment(tips, entry=HELIX, entry_z=top, helix_centre=(float(c[0]), float(c[1])),
                               helix_ccw=ctx.climb, closed=False)
-    length = float(np.hypot(*np.diff(np.vstack([pas.xy, pas.xy[:1]]) if pas.closed else pas.xy, axis=0).T).sum())
-    if length >= ctx.D:
+    length = _length(pas)
+    if length >= _MIN_RAMP * ctx.D:
         footprint = P.offset_open([pas.xy], ctx.R + ctx.arc_tol, ctx.arc_tol, closed=pas.closed)
         top = ctx.material_top(footprint) + _ENTRY_CLEARANCE
         return CutSegment(_tips(pas.xy, z, pas.closed), entry=RAMP, entry_z=top, closed=pas.closed)
     what = f"no room for a helix of diameter {2 * ctx.helix_r:g} mm and " if p.entry == HELIX else ""
-    raise TmmError(f"cannot enter {_region_label(z, region)}: {what}its first pass is {length:.3g} mm long, "
-                   f"shorter than the tool diameter {ctx.D:g} mm needed for a ramp; use a smaller helix diameter, "
-                   f"a smaller tool, or entry 'plunge' if the tool can cut straight down")
+    raise _NoEntry(f"cannot enter {_region_label(z, region)}: {what}its pass is {length:.3g} mm long, shorter "
+                   f"than the {_MIN_RAMP * ctx.D:g} mm ({_MIN_RAMP:g} tool diameter) a ramp needs; use a smaller "
+                   f"helix diameter, a smaller tool, or entry 'plunge' if the tool can cut straight down")
+
+
+class _NoEntry(TmmError):
+    """No helix fits and the pass is too short to ramp along."""
+
+
+def _length(pas: clearing.Pass) -> float:
+    xy = np.vstack([pas.xy, pas.xy[:1]]) if pas.closed else pas.xy
+    return float(np.hypot(*np.diff(xy, axis=0).T).sum())
 
 
 def _air_approach(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, air_free: P.Shape
@@ -398,7 +413,18 @@ def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Sha
             tips = np.vstack([[[air[0], air[1], z]], _tips(pas.xy, z, pas.closed)])
             seg = CutSegment(tips, entry=PLUNGE, closed=False)   # down through air beside the stock
         else:
-            seg = _enter(ctx, z, region, pas, joined)
+            try:
+                seg = _enter(ctx, z, region, pas, joined)
+            except _NoEntry as exc:
+                # a spot where the tool centre just fits (a valley's bottom, a fill of a gap): left, and
+                # reported; anything larger has room for a ramp along its outline, so this is an error
+                if i == 0 and _length(clearing.Pass(region.outer, True)) >= _MIN_RAMP * ctx.D:
+                    raise TmmError(str(exc)) from None
+                ctx.not_entered.append(str(exc).split(": ")[0].replace("cannot enter ", ""))
+                if i == 0:
+                    return []
+                prev_end = None
+                continue
         seg.kind = SegmentKind.PASS
         out.append(seg)
         prev_end = seg.tips[-1, :2]
@@ -410,7 +436,8 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     """Z-level roughing of the stock down to `mesh` plus stock to leave with `cutter`, as cut segments with
     their entries. diagnostics: "layers" (count), "layer_z" (their heights), "regions", "points" (tips),
     "unreachable" (mm^2 summed over layers: stock the tool cannot reach above the model plus stock to leave,
-    narrower than the tool), "top" (highest tip), "entries" (count per kind)."""
+    narrower than the tool), "top" (highest tip), "entries" (count per kind), "not_entered" (the regions and
+    passes too small for any entry (a spot the tool centre just fits), left uncut)."""
     params.validate()
     top, final = _check(mesh, cutter, params)
     estimate_work(params, cutter)
@@ -470,7 +497,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     pts = sum(len(sg) for sg in segments)
     diagnostics = {"layers": len(zs), "layer_z": [float(z) for z in zs], "regions": region_count, "points": pts,
                    "unreachable": unreachable, "top": float(max(zs)) if len(zs) else top, "entries": kinds,
-                   "stock_top": top}
+                   "stock_top": top, "not_entered": list(ctx.not_entered)}
     return StrategyResult(segments, diagnostics)
 
 
