@@ -10,7 +10,8 @@ Per case: layers, regions, moves, seconds for the whole roughing (compute + link
 roughing, so its Waterline at the same levels and sampling (the part of roughing it can do) stands beside
 ours, timed on a few of the layers and scaled to all (column `ocl wl s`), with the ratio to our waterline
 part. Then the simulated stock (0.25 mm cells) against the model plus stock to leave: the deepest cell below
-it (a gouge if below -0.001 mm), the rapids that removed material, and the material left (median, 99 %).
+it (a gouge if below -0.001 mm), the rapids that removed material, and the material left (median, 99 %)
+over the cells with model under them.
 """
 from __future__ import annotations
 
@@ -34,7 +35,7 @@ from tmm_workbench.core.query import waterline as wl  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
 from tmm_workbench.core.sim.grid import Grid  # noqa: E402
 from tmm_workbench.core.sim.simulate import simulate  # noqa: E402
-from tmm_workbench.core.sim.stock import box_heights  # noqa: E402
+from tmm_workbench.core.sim.stock import box_heights, mesh_heights  # noqa: E402
 from tmm_workbench.core.strategies import zlevel_rough as zr  # noqa: E402
 from tmm_workbench.core.toolpath import MoveKind  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
@@ -95,11 +96,13 @@ def run(name: str, mesh: TriMesh, cutter: Cutter, params: zr.RoughingParams, sur
     s = params.stock_to_leave
     design = (surface.drop(Cutter.ball(2 * s), grid.centres(), float(mesh.bounds[0][2]) - 1.0) + s
               ).reshape(grid.ny, grid.nx)
+    design[np.isnan(mesh_heights(mesh, grid, surface))] = np.nan     # no model under the cell: not compared
     dev = sim.heights - design
     feeds = sum(1 for m in path.moves if m.kind is not MoveKind.RAPID)
     return dict(case=name, tool=cutter.describe(), layers=d["layers"], regions=d["regions"], moves=len(path),
-                feeds=feeds, total=total, wl=t_wl, ocl=t_ocl, ratio=t_ocl / t_wl, gouge=float(dev.min()),
-                rapids=len(sim.collisions), p50=float(np.percentile(dev, 50)), p99=float(np.percentile(dev, 99)),
+                feeds=feeds, total=total, wl=t_wl, ocl=t_ocl, ratio=t_ocl / t_wl, gouge=float(np.nanmin(dev)),
+                rapids=len(sim.collisions), p50=float(np.nanpercentile(dev, 50)),
+                p99=float(np.nanpercentile(dev, 99)),
                 entries=d["entries"], sim_s=sim.seconds)
 
 
