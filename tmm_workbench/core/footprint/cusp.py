@@ -36,7 +36,8 @@ def _profile(cutter: Cutter) -> tuple[np.ndarray, np.ndarray]:
     return u, np.asarray(cutter.native.height(np.abs(u)))
 
 
-def _height(cutter: Cutter, u: np.ndarray) -> np.ndarray:
+def profile_height(cutter: Cutter, u: np.ndarray) -> np.ndarray:
+    """h(|u|) of the cutter, inf beyond its widest radius (its side wall)."""
     r_max = cutter.native.max_radius
     out = np.full(u.shape, np.inf)
     inside = np.abs(u) <= r_max
@@ -70,7 +71,7 @@ def plane_cusp(cutter: Cutter, stepover: float, slope_deg: float = 0.0) -> float
     u, h = _profile(cutter)
     rel = h - u * t
     j = int(np.argmin(rel))
-    base = _golden_min(lambda v: float(_height(cutter, np.array([v]))[0] - v * t),
+    base = _golden_min(lambda v: float(profile_height(cutter, np.array([v]))[0] - v * t),
                        u[max(j - 1, 0)], u[min(j + 1, len(u) - 1)], float(rel[j]))
 
     def left(y: np.ndarray, without: int | None = None) -> np.ndarray:
@@ -79,7 +80,7 @@ def plane_cusp(cutter: Cutter, stepover: float, slope_deg: float = 0.0) -> float
         if without is not None:
             k = k[k != without]
         du = y[:, None] - k[None, :] * stepover
-        return (_height(cutter, du) - du * t - base).min(axis=1)
+        return (profile_height(cutter, du) - du * t - base).min(axis=1)
 
     y = np.linspace(0.0, stepover, _SAMPLES + 1)
     values = left(y)

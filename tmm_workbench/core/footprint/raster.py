@@ -48,7 +48,7 @@ def raster_lines(boundary: Rect, stepover: float, angle_deg: float = 0.0, spacin
         offsets = np.concatenate([start + math.copysign(1.0, end - start) * inside, [end]])
     lines = []
     for c in offsets:
-        seg = _clip_line_to_rect(c * n, d, boundary)
+        seg = clip_line_to_rect(c * n, d, boundary)
         if seg is not None:
             lines.append(seg)
     return lines
@@ -59,7 +59,7 @@ def pass_count(width: float, stepover: float) -> int:
     return max(1, math.ceil(width / stepover - 1e-9)) + 1
 
 
-def _clip_line_to_rect(p: np.ndarray, d: np.ndarray, r: Rect) -> np.ndarray | None:
+def clip_line_to_rect(p: np.ndarray, d: np.ndarray, r: Rect) -> np.ndarray | None:
     """The part of the line p + t d inside the rectangle (Liang-Barsky), or None."""
     t0, t1 = -math.inf, math.inf
     for k, (lo, hi) in enumerate(((r[0], r[2]), (r[1], r[3]))):
