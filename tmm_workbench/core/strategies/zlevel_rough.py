@@ -212,6 +212,7 @@ class _Steps:
 
     def __init__(self, progress: Optional[Progress]) -> None:
         self.progress = progress
+        self.last = 0.0          # the fraction reached (the layers' loop sets it)
 
     def part(self, lo: float, hi: float) -> Optional[Progress]:
         if self.progress is None:
@@ -226,25 +227,14 @@ class _Steps:
         """For the long loops inside a layer: the progress callback answered False."""
         return self.progress is not None and self.progress(self.last) is False
 
-    last = 0.0
-
-
-@dataclass
-class _Layer:
-    z: float
-    tool_centres: P.Shape    # where the tool centre may go (gouge-free)
-    material: P.Shape        # XY where the stock reaches above z
-    cut: P.Shape             # the regions cleared at this layer
-
 
 class _Context:
     """What the layers share: the tool, the stock, the swept areas of the layers above (for entry heights)."""
 
-    def __init__(self, cutter: Cutter, params: RoughingParams, top: float, outer: np.ndarray) -> None:
+    def __init__(self, cutter: Cutter, params: RoughingParams, top: float) -> None:
         self.cutter = cutter
         self.params = params
         self.top = top
-        self.outer = outer
         self.R = cutter.radius
         self.D = cutter.diameter
         self.s = params.stepover(cutter)
@@ -461,7 +451,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     needle = Cutter.flat(2e-3).offset(s_r)
     slices = wl.waterline_loops(surface, needle, levels, bounds, sample_step=sample, chord_tol=params.chord_tol,
                                 progress=steps.part(0.45, 0.6))
-    ctx = _Context(cutter, params, top, outer)
+    ctx = _Context(cutter, params, top)
     air_free = P.offset(ctx.material_xy(final), ctx.R + 1e-3, ctx.arc_tol)
     segments: list[CutSegment] = []
     unreachable = 0.0
