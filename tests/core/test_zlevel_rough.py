@@ -300,14 +300,15 @@ def test_progress_and_cancel(pocket):
 
 
 @pytest.mark.parametrize("change, message", [
-    ({"stock_box": (0, 0, 0, 60, 50, 15)}, "the stock is not above the model: its top 15 mm is below the model's top 20"),
+    ({"stock_box": (0, 0, 0, 60, 50, 15)},
+     "the stock is not above the model: its top 15 mm is below the model's top 20"),
     ({"final_z": 25.0}, "is not above the final depth 25 mm"),
     ({"step_down": 0.0}, "step-down must be a positive length, got 0"),
     ({"step_down": -1.0}, "step-down must be a positive length, got -1"),
     ({"step_down": math.nan}, "step-down must be a positive length, got nan"),
     ({"stepover_percent": 100.0}, r"step-over must be in \(0, 100\) %, got 100"),
     ({"stepover_percent": 0.0}, r"step-over must be in \(0, 100\) %, got 0"),
-    ({"stock_to_leave": -0.1}, "stock to leave must be a length >= 0, got -0.1|stock to leave must be >= 0 mm, got -0.1"),
+    ({"stock_to_leave": -0.1}, "stock to leave must be >= 0 mm, got -0.1"),
     ({"stock_to_leave": 7.0}, r"stock to leave 7 mm is larger than the tool \(diameter 6 mm"),
     ({"stock_to_leave_axial": 6.5}, r"axial stock to leave 6.5 mm is larger than the tool"),
     ({"ramp_angle_deg": 0.0}, r"ramp angle must be in \(0, 90\] deg, got 0"),
