@@ -12,13 +12,15 @@ passes (the tool stays down). Work is estimated from the parameters before anyth
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.raster import Rect, pass_count, raster_lines, sample_segment
+from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
+from tmm_workbench.core.footprint.cusp import steepest_crossing_deg, stepover_for_cusp
+from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, pass_count, raster_lines, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
@@ -33,6 +35,7 @@ ONEWAY = "oneway"
 # Where no triangle lies under the cutter ("air": beside an open surface or a relief without a base, in a
 # hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
 # is split, the tool lifts to the safe height and plunges again where the model resumes.
+STEPOVER, CUSP, ADAPTIVE = "stepover", "cusp", "adaptive"
 OFF_MODEL_FLOOR = "floor"
 OFF_MODEL_SKIP = "skip"
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
@@ -58,6 +61,13 @@ class SurfaceParams(StrategyParams):
     # how far above the CL points a longer straight move may pass where it replaces them (flats and even
     # slopes become a few long moves; never below a CL point: 0 keeps every point off a straight line)
     chord_tol: float = param(0.001, "chord tolerance", "mm", low=0, high=1.0)
+    # how the passes are spaced: STEPOVER (the step-over above), CUSP (constant: the step-over that keeps the
+    # cusp height on the region's steepest crossing, up to max_slope_deg; planar, core.footprint.cusp) or
+    # ADAPTIVE (each pass placed from the previous one's CL points so the cusp between them is the cusp height;
+    # core.footprint.adaptive_raster)
+    stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE))
+    cusp: float = param(0.01, "cusp height", "mm", low=0, low_open=True, kind="length")
+    max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
 
     def validate(self) -> None:
         super().validate()
@@ -87,7 +97,8 @@ def estimate_work(params: SurfaceParams) -> float:
 def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Optional[Progress] = None,
             surface: Optional[DropSurface] = None) -> StrategyResult:
     """Gouge-free raster finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments.
-    diagnostics: "points" (CL points dropped), "passes", "top" (highest tip on the model)."""
+    diagnostics: "points" (CL points dropped), "passes", "top" (highest tip on the model), and the spacing's
+    (see _pass_lines)."""
     params.validate()
     if cutter.kind not in SUPPORTED_TOOLS:
         raise TmmError(f"the {cutter.describe()} cutter is not supported by 3-axis raster finishing")
@@ -96,10 +107,9 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
         raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
-    estimate_work(params)
     floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
-
-    lines = raster_lines(b, params.stepover, params.angle_deg)
+    diagnostics: dict = {}
+    lines = _pass_lines(mesh, cutter, params, floor_z, diagnostics, progress)
     if params.pattern == ZIGZAG:
         lines = [ln if i % 2 == 0 else ln[::-1] for i, ln in enumerate(lines)]
     # Runs of XY points: passes, and for zig-zag the links between them, dropped in one batch.
@@ -122,10 +132,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
         return np.maximum(zz, floor_z), aa
 
+    if progress is not None and params.stepover_mode == ADAPTIVE:  # the placement reported the first half
+        report = progress
+        progress = lambda f: report(0.5 + 0.5 * f)  # noqa: E731
     z, air = drop(xy, progress)
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
-    diagnostics: dict = {"points": len(xy), "passes": len(lines)}
+    diagnostics.update(points=len(xy), passes=len(lines))
     if params.gouge_tol > 0:
         from tmm_workbench.core.strategies import raster_refine
 
@@ -134,6 +147,37 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     diagnostics["top"] = float(z[~air].max())
     segments = _segments(runs, z, air, params.pattern, params.chord_tol)
     return StrategyResult(segments, diagnostics)
+
+
+def _pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: float, diagnostics: dict,
+                progress: Optional[Progress]) -> list[np.ndarray]:
+    """The raster's passes ((2, 2) start and end each, across the boundary in order) by the step-over mode;
+    the work is estimated before any pass is dropped. diagnostics: "stepover" (the largest gap, mm) and, by
+    cusp, "cusp_slope_deg" (constant) or "cusps" / "cusp_limited" / "cusp_unreachable" (adaptive)."""
+    b = params.boundary
+    mode = params.stepover_mode
+    if mode != STEPOVER and params.cusp > cutter.radius:
+        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
+    if mode == STEPOVER:
+        stepover = params.stepover
+    elif mode == CUSP:
+        slope = steepest_crossing_deg(mesh, b, params.angle_deg, params.max_slope_deg)
+        stepover = stepover_for_cusp(cutter, params.cusp, slope)
+        diagnostics["cusp_slope_deg"] = slope
+    else:
+        # the adaptive placement drops its passes on the way (its own work estimate, then pass by pass)
+        estimate_work(replace(params, stepover=stepover_for_cusp(cutter, params.cusp, params.max_slope_deg)))
+        placed = adaptive_pass_offsets(mesh, cutter, b, params.angle_deg, params.cusp, params.sample_step,
+                                       floor_z, params.stock_to_leave, params.max_slope_deg,
+                                       None if progress is None else lambda f: progress(0.5 * f))
+        diagnostics.update(cusps=placed.cusps, cusp_limited=placed.limited, cusp_unreachable=placed.unreachable,
+                           stepover=float(np.diff(placed.offsets).max()))
+        a = math.radians(params.angle_deg)
+        d, n = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
+        return [seg for seg in (clip_line_to_rect(c * n, d, b) for c in placed.offsets) if seg is not None]
+    estimate_work(replace(params, stepover=stepover))
+    diagnostics["stepover"] = stepover
+    return raster_lines(b, stepover, params.angle_deg)
 
 
 def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, policy: LinkPolicy,
