@@ -187,6 +187,51 @@ class OpInJob(FreeCADTestCase):
         self.assertEqual(len([1 for n_, _ in moves(op) if n_ == "G1"]), n)
 
 
+class CuspSpacing(FreeCADTestCase):
+    def test_spacing_by_a_cusp_height_saves_and_reopens(self) -> None:
+        doc = new_doc("TmmCusp")
+        _, _, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.5})
+        self.assertEqual(op.StepOverMode, "StepOver")                  # a new op: the step-over, as before
+        self.assertEqual(op.getEnumerationsOfProperty("StepOverMode"), ["StepOver", "Cusp", "Adaptive"])
+        ys = lambda: sorted({round(p["Y"], 6) for n, p in moves(op) if n == "G1"})  # noqa: E731
+        fixed = ys()
+        for mode in ("Cusp", "Adaptive"):
+            op.StepOverMode, op.CuspHeight = mode, 0.02
+            doc.recompute()
+            self.assertTrue(op.isValid(), op.getStatusString())
+            self.assertNotEqual(ys(), fixed)
+        adaptive = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
+        path = OUT / "cusp.FCStd"
+        doc.saveAs(str(path))
+        name = op.Name
+        close_all()
+        doc = FreeCAD.openDocument(str(path))
+        op = doc.getObject(name)
+        self.assertEqual((op.StepOverMode, round(op.CuspHeight.Value, 9)), ("Adaptive", 0.02))
+        self.assertEqual(len(op.Path.Commands), len(adaptive))
+        op.CuspHeight = 50.0                                           # above the tool radius
+        doc.recompute()
+        self.assertFalse(op.isValid())
+        self.assertIn("cusp height must be in (0, 2] mm (the tool radius), got 50", op.getStatusString())
+        self.assertEqual(len(op.Path.Commands), 0)
+        close_all()
+
+    def test_a_document_from_before_the_cusp_spacing_keeps_the_step_over(self) -> None:
+        doc = new_doc("TmmOldCusp")
+        _, _, op = job_with_op(doc, str(bump_stl()))
+        for prop in ("StepOverMode", "CuspHeight", "CuspSlopeLimit"):
+            op.removeProperty(prop)                                    # as saved by an older TMM
+        path = OUT / "old_cusp.FCStd"
+        doc.saveAs(str(path))
+        name = op.Name
+        close_all()
+        doc = FreeCAD.openDocument(str(path))
+        op = doc.getObject(name)
+        self.assertEqual(op.StepOverMode, "StepOver")
+        self.assertAlmostEqual(op.CuspHeight.Value, 0.01)
+        close_all()
+
+
 class SaveAndReopen(FreeCADTestCase):
     def test_a_document_from_before_the_chord_tolerance_keeps_every_point(self) -> None:
         doc = new_doc("TmmOld")

@@ -25,7 +25,8 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import raster_drop
-from tmm_workbench.core.strategies.raster_drop import OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY, ZIGZAG, SurfaceParams
+from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
+                                                       STEPOVER, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
@@ -42,6 +43,14 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyDistance", "BoundaryMargin", "Boundary",
          "Grows (positive) or shrinks (negative) the boundary on every side"),
     Prop("App::PropertyDistance", "StepOver", "Surface", "Distance between raster passes", "stepover"),
+    Prop("App::PropertyEnumeration", "StepOverMode", "Surface",
+         "StepOver: passes StepOver apart; Cusp: the step-over that keeps CuspHeight on the steepest crossing of "
+         "the boundary (up to CuspSlopeLimit); Adaptive: each pass placed from the previous one's tool positions "
+         "so that the cusp between them is CuspHeight", "stepover_mode"),
+    Prop("App::PropertyDistance", "CuspHeight", "Surface",
+         "Largest scallop left between passes (Cusp and Adaptive spacing), along the surface normal", "cusp"),
+    Prop("App::PropertyAngle", "CuspSlopeLimit", "Surface",
+         "Steeper places are not held to CuspHeight (walls are waterline's)", "max_slope_deg"),
     Prop("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass", "sample_step"),
     Prop("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X", "angle_deg"),
     Prop("App::PropertyEnumeration", "Pattern", "Surface",
@@ -56,7 +65,9 @@ PROPERTIES: list[Prop] = [
          "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
          "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model"),
 ]
-CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL}
+SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE}
+CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
+           "StepOverMode": SPACINGS}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
                             "BoundaryMargin": 0.0, "PlungeAngle": 45.0}
 

@@ -16,8 +16,10 @@ JOB_MODEL = "(Job model)"
 # widget name -> property
 SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampleStep": "SampleStep",
               "rasterAngle": "RasterAngle", "stockToLeave": "StockToLeave",
-              "linearDeflection": "LinearDeflection"}
-COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel"}
+              "linearDeflection": "LinearDeflection", "cuspHeight": "CuspHeight",
+              "cuspSlopeLimit": "CuspSlopeLimit"}
+COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
+          "stepOverMode": "StepOverMode"}
 
 
 class TaskPanelOpPage(op_page.OpPage):
