@@ -188,6 +188,14 @@ class Api(FreeCADTestCase):
         self.assertIn("cancelled", str(ctx.exception))
         self.assertEqual(set(FreeCAD.listDocuments()), docs)  # the call's own document is closed again
 
+    def test_cusp_spacing(self) -> None:
+        r = run_surface(bump_stl(), stepover=2.0, sample_step=1.0, stepover_mode="adaptive", cusp=0.02,
+                        progress=False, doc_name="TmmApiCusp")
+        self.assertEqual((r.op.StepOverMode, round(r.op.CuspHeight.Value, 9)), ("Adaptive", 0.02))
+        ys = sorted({round(float(y), 6) for y in r.toolpath.cutting_points()[:, 1]})
+        self.assertGreater(len(ys), 10)
+        FreeCAD.closeDocument(r.doc.Name)
+
     def test_bad_arguments(self) -> None:
         with self.assertRaises(TmmError) as ctx:
             run_surface(OUT / "nowhere.stl")
@@ -195,7 +203,9 @@ class Api(FreeCADTestCase):
         for kwargs, text in (({"tool": "chamfer"}, "tool must be one of"), ({"pattern": "spiral"}, "pattern"),
                              ({"boundary": "custom"}, "boundary"),
                              ({"tool": "bullnose", "corner_radius": 4.0}, "larger than the tool radius"),
-                             ({"stepover": 0.0}, "must be a positive length")):
+                             ({"stepover": 0.0}, "must be a positive length"),
+                             ({"stepover_mode": "scallop"}, "stepover_mode must be one of stepover, cusp, adaptive, got 'scallop'"),
+                             ({"cusp": -1.0}, "cusp must be a positive length, got -1")):
             with self.subTest(**kwargs):
                 with self.assertRaises(TmmError) as ctx:
                     run_surface(bump_stl(), progress=False, **kwargs)

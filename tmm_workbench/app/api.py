@@ -42,6 +42,7 @@ _SPEED = Spec("", "rpm", low=0)
 PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
+STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
 
 
 @dataclass
@@ -58,7 +59,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 diameter: float = 6.0, corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
                 boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
-                chord_tolerance: Optional[float] = None,
+                chord_tolerance: Optional[float] = None, stepover_mode: str = "stepover",
+                cusp: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
@@ -74,6 +76,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     (lift over such places, cut only over the model).
     chord_tolerance: how far above the CL points a longer straight move may pass where it replaces them
     (mm; default the op's, 0.001; 0 keeps every point off a straight line).
+    stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
+    `cusp` on the boundary's steepest crossing) | 'adaptive' (each pass placed from the previous one's tool
+    positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -85,9 +90,14 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
              angle_deg=(angle_deg, spec_of(SurfaceParams, "angle_deg")),
              stock_to_leave=(stock_to_leave, spec_of(SurfaceParams, "stock_to_leave")), margin=(margin, _LENGTH),
              chord_tolerance=(chord_tolerance, spec_of(SurfaceParams, "chord_tol")),
+             cusp=(cusp, spec_of(SurfaceParams, "cusp")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
-    extra = {} if chord_tolerance is None else {"ChordTolerance": chord_tolerance}
+    extra: dict[str, Any] = {"StepOverMode": _option("stepover_mode", stepover_mode, STEPOVER_MODE_NAMES)}
+    if chord_tolerance is not None:
+        extra["ChordTolerance"] = chord_tolerance
+    if cusp is not None:
+        extra["CuspHeight"] = cusp
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)
