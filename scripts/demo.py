@@ -1,5 +1,6 @@
-"""TMM's main job, headless: three models finished with a 3-axis surface raster, then seed 001's convex
-Bézier patch finished 5-axis by multipoint positioning (tarus G-code, APT CL, document, pictures).
+"""TMM's main job, headless: three models finished with a 3-axis surface raster, a block roughed down to
+sphere_on_plate and its walls finished by waterline (one Job), then seed 001's convex Bézier patch finished
+5-axis by multipoint positioning (tarus G-code, APT CL, document, pictures).
 
     freecadcmd scripts/demo.py            # G-code (.ngc), FreeCAD document (.FCStd) and picture (.png)
     /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
@@ -193,10 +194,99 @@ def main() -> None:
 
     print_table(rows, time.perf_counter() - t_all)
 
+    # stock to part: a block roughed down to sphere_on_plate, its walls finished by waterline, one Job
+    t_r = time.perf_counter()
+    print_rough_finish(run_rough_finish_case(out, with_freecad), time.perf_counter() - t_r)
+
     # 5-axis part: seed 001's convex patch, multipoint positioning (the 3-axis part above is unchanged)
     t5 = time.perf_counter()
     row5 = run_multipoint_case(out, with_freecad)
     print_table5(row5, time.perf_counter() - t5)
+
+
+# --- stock to part ----------------------------------------------------------------------------------
+RF_NAME = "rough_finish"
+# A block 1 mm beyond the model on the sides and on top; bull-nose D10 r1 roughing 3 mm layers at 45 %
+# step-over leaving 0.5 mm, then a ball D6 waterline every 0.5 mm over the walls (stock to leave 0).
+RF_ROUGH = dict(tool="bullnose", diameter=10.0, corner_radius=1.0, step_down=3.0, stepover_percent=45.0,
+                stock_to_leave=0.5, entry="helix")
+RF_WATER = dict(tool="ballend", diameter=6.0, step_down=0.5)
+
+
+def run_rough_finish_case(out: Path, with_freecad: bool) -> dict[str, Any]:
+    """Z-level roughing then waterline finishing of sphere_on_plate.stl in one Job (run_roughing, then
+    run_waterline with job=), both posted; the Job simulated (heat map) and both paths drawn. Without FreeCAD
+    the core strategies give the pictures of the paths."""
+    from tmm_workbench.core.preview.toolpath_png import render_toolpath_png
+
+    model = str(bench() / "stl" / "sphere_on_plate.stl")
+    print(f"--- {RF_NAME}: sphere_on_plate.stl from a block: roughing {describe_tool(RF_ROUGH)}, step-down "
+          f"{RF_ROUGH['step_down']:g} mm, step-over {RF_ROUGH['stepover_percent']:g} %, stock to leave "
+          f"{RF_ROUGH['stock_to_leave']:g} mm; waterline {describe_tool(RF_WATER)}, step-down "
+          f"{RF_WATER['step_down']:g} mm", flush=True)
+    files: list[Path] = []
+    t0 = time.perf_counter()
+    if with_freecad:
+        import FreeCAD
+        from tmm_workbench.app.api import run_roughing, run_waterline
+
+        rough = run_roughing(model, gcode_path=str(out / f"{RF_NAME}_roughing.ngc"), doc_name=RF_NAME,
+                             progress=False, **RF_ROUGH)
+        t1 = time.perf_counter()
+        water = run_waterline(None, job=rough, gcode_path=str(out / f"{RF_NAME}_waterline.ngc"),
+                              fcstd_path=str(out / f"{RF_NAME}.FCStd"), progress=False, **RF_WATER)
+        t2 = time.perf_counter()
+        files += [out / f"{RF_NAME}_roughing.ngc", out / f"{RF_NAME}_waterline.ngc", out / f"{RF_NAME}.FCStd"]
+        mesh, paths = rough.mesh, (rough.toolpath, water.toolpath)
+        sim = simulate_case(water, out / f"{RF_NAME}_sim.png", 0.2)
+        files.append(out / f"{RF_NAME}_sim.png")
+        seconds = (t1 - t0, t2 - t1)
+        try:
+            FreeCAD.closeDocument(rough.doc.Name)
+        except Exception:  # noqa: BLE001 - closing is a courtesy
+            pass
+    else:
+        from tmm_workbench.core.geometry.mesh import load_stl
+        from tmm_workbench.core.linking import LinkPolicy, link
+        from tmm_workbench.core.strategies import waterline, zlevel_rough
+        from tmm_workbench.core.tools.cutter import Cutter
+
+        mesh = load_stl(model)
+        lo, hi = mesh.bounds
+        top = float(hi[2]) + 1.0
+        policy = LinkPolicy(top + 5.0, top + 10.0)
+        rough_params = zlevel_rough.RoughingParams(
+            stock_box=(lo[0] - 1, lo[1] - 1, lo[2] - 1, hi[0] + 1, hi[1] + 1, top),
+            step_down=RF_ROUGH["step_down"], stepover_percent=RF_ROUGH["stepover_percent"],
+            stock_to_leave=RF_ROUGH["stock_to_leave"])
+        rough_tp = zlevel_rough.compute_roughing_toolpath(mesh, Cutter.bull(10.0, 1.0), rough_params, policy)
+        t1 = time.perf_counter()
+        ball = Cutter.ball(RF_WATER["diameter"])
+        r = ball.radius
+        water_params = waterline.WaterlineParams(boundary=(lo[0] - r, lo[1] - r, hi[0] + r, hi[1] + r),
+                                                 step_down=RF_WATER["step_down"])
+        water_tp = link(waterline.compute(mesh, ball, water_params).segments, policy)
+        paths, sim, seconds = (rough_tp, water_tp), None, (t1 - t0, time.perf_counter() - t1)
+    for kind, tp, what in (("roughing", paths[0], f"z-level roughing, {describe_tool(RF_ROUGH)}"),
+                           ("waterline", paths[1], f"waterline finishing, {describe_tool(RF_WATER)}")):
+        png = out / f"{RF_NAME}_{kind}.png"
+        render_toolpath_png(mesh, tp, str(png), title=f"TMM {what}: sphere_on_plate.stl from a block")
+        files.append(png)
+    return dict(name=RF_NAME, moves=(len(paths[0]), len(paths[1])), seconds=seconds, sim=sim, files=files)
+
+
+def print_rough_finish(r: dict[str, Any], total: float) -> None:
+    print(f"\n{'case (stock to part)':<22} {'roughing moves':>14} {'roughing s':>10} {'waterline moves':>15} "
+          f"{'waterline s':>11}")
+    print(f"{r['name']:<22} {r['moves'][0]:>14} {r['seconds'][0]:>10.2f} {r['moves'][1]:>15} {r['seconds'][1]:>11.2f}")
+    if r.get("sim"):
+        print("simulated (roughing + waterline; shallow areas keep the roughing's 0.5 mm): "
+              + sim_line(r["name"], r["sim"]))
+    print("written (stock to part):")
+    for f in r["files"]:
+        size = f.stat().st_size if f.exists() else -1
+        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print(f"stock to part {total:.1f} s", flush=True)
 
 
 # --- 5-axis part -------------------------------------------------------------------------------------
