@@ -117,6 +117,16 @@ class BadInput(FreeCADTestCase):
         self.tc.Tool.Diameter = 0.0
         self.assertFails("diameter must be a length > 0 mm, got 0")
 
+    def test_zero_feeds(self) -> None:
+        """Tool controllers from FreeCAD's tool library have feed 0: G1 F0 must not reach a post."""
+        self.tc.HorizFeed = 0.0
+        self.assertFails("HorizFeed must be a feed > 0 mm/min, got 0 mm/min", "set the cutting feeds")
+        self.tc.HorizFeed = 10.0
+        self.tc.VertFeed = 0.0
+        self.assertFails("VertFeed must be a feed > 0 mm/min, got 0 mm/min")
+        self.tc.VertFeed = 4.0
+        self.recovers()
+
     def test_tool_controller_removed(self) -> None:
         self.op.ToolController = None
         self.assertFails("no tool controller")

@@ -186,9 +186,11 @@ class TmmOp(PathOp.ObjectOp):
         if not (math.isfinite(d) and d > 0):
             return f"tool '{label_of(tool)}': diameter must be a length > 0 mm, got {d:g} mm"
         for name in ("HorizFeed", "VertFeed"):
-            v = float(_plain(getattr(tc, name, 0.0)))
-            if not math.isfinite(v) or v < 0:
-                return f"tool controller '{tc.Label}': {name} must be a feed >= 0, got {v:g}"
+            v = float(_plain(getattr(tc, name, 0.0)))  # mm/s
+            if not (math.isfinite(v) and v > 0):
+                # tool controllers from FreeCAD's tool library start with no feeds: G1 F0 would stall the machine
+                return (f"tool controller '{tc.Label}': {name} must be a feed > 0 mm/min, got {v * 60:g} mm/min "
+                        "(set the cutting feeds in the tool controller)")
         try:
             kernel.require()
         except kernel.KernelMissing as exc:
