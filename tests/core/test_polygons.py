@@ -78,3 +78,25 @@ def test_circle_within_its_chord_tolerance():
     assert np.allclose(r, 5.0)
     half = math.pi / len(c)
     assert 5.0 * (1 - math.cos(half)) <= 0.001 and P.is_ccw(c)
+
+
+def test_without_pyclipper_everything_loads_and_roughing_says_what_is_missing():
+    """pyclipper is imported on first use: the workbench's op modules load (and documents restore) on a
+    FreeCAD without it; clipping then fails with the package to install."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    code = (
+        "import sys; sys.modules['pyclipper'] = None\n"
+        "import tmm_workbench.core.strategies.zlevel_rough, tmm_workbench.core.polygons as P\n"
+        "import numpy as np\n"
+        "from tmm_workbench.core.errors import TmmError\n"
+        "try:\n"
+        "    P.union([np.array([[0, 0], [1, 0], [1, 1.0]])])\n"
+        "except TmmError as e:\n"
+        "    print('REFUSED', e)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=Path(__file__).resolve().parents[2], timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "REFUSED polygon clipping needs pyclipper" in out.stdout and "python3-pyclipper" in out.stdout

@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 from typing import Iterable, Sequence
 
 import numpy as np
-import pyclipper
+
+from tmm_workbench.core.errors import TmmError
 
 SCALE = 1e6          # Clipper integer units per mm
 ARC_TOL = 0.005      # mm: chord deviation of round joins unless given
@@ -50,7 +51,7 @@ def area(shape: Shape) -> float:
 
 
 def is_ccw(poly: np.ndarray) -> bool:
-    return bool(pyclipper.Orientation(_to_int([poly])[0]))
+    return bool(_clipper().Orientation(_to_int([poly])[0]))
 
 
 def oriented(poly: np.ndarray, ccw: bool) -> np.ndarray:
@@ -58,8 +59,19 @@ def oriented(poly: np.ndarray, ccw: bool) -> np.ndarray:
     return poly if (signed_area(poly) > 0) == ccw else poly[::-1].copy()
 
 
-def _offsetter(arc_tol: float) -> pyclipper.PyclipperOffset:
-    return pyclipper.PyclipperOffset(2.0, arc_tol * SCALE)
+def _clipper():
+    """pyclipper, imported on first use: a FreeCAD without it still loads the workbench and every document,
+    and only roughing says what is missing."""
+    try:
+        import pyclipper
+    except ImportError as exc:
+        raise TmmError("polygon clipping needs pyclipper (Clipper 6): install Debian's python3-pyclipper, or "
+                       "`python3 -m pip install pyclipper` for the Python FreeCAD runs") from exc
+    return pyclipper
+
+
+def _offsetter(arc_tol: float):
+    return _clipper().PyclipperOffset(2.0, arc_tol * SCALE)
 
 
 def offset(shape: Shape, delta: float, arc_tol: float = ARC_TOL, miter: bool = False) -> Shape:
@@ -72,7 +84,7 @@ def offset(shape: Shape, delta: float, arc_tol: float = ARC_TOL, miter: bool = F
     if delta == 0:
         return union(shape)
     o = _offsetter(arc_tol)
-    o.AddPaths(paths, pyclipper.JT_MITER if miter else pyclipper.JT_ROUND, pyclipper.ET_CLOSEDPOLYGON)
+    o.AddPaths(paths, _clipper().JT_MITER if miter else _clipper().JT_ROUND, _clipper().ET_CLOSEDPOLYGON)
     return _from_int(o.Execute(delta * SCALE))
 
 
@@ -84,35 +96,35 @@ def offset_open(paths: Sequence[np.ndarray], delta: float, arc_tol: float = ARC_
     if not ints or delta <= 0:
         return []
     o = _offsetter(arc_tol)
-    o.AddPaths(ints, pyclipper.JT_ROUND, pyclipper.ET_CLOSEDLINE if closed else pyclipper.ET_OPENROUND)
+    o.AddPaths(ints, _clipper().JT_ROUND, _clipper().ET_CLOSEDLINE if closed else _clipper().ET_OPENROUND)
     return _from_int(o.Execute(delta * SCALE))
 
 
 def _boolean(subject: Shape, clip: Shape, op: int) -> Shape:
     s, c = _to_int(subject), _to_int(clip)
-    if not s and op != pyclipper.CT_UNION:
+    if not s and op != _clipper().CT_UNION:
         return []
-    pc = pyclipper.Pyclipper()
+    pc = _clipper().Pyclipper()
     if s:
-        pc.AddPaths(s, pyclipper.PT_SUBJECT, True)
+        pc.AddPaths(s, _clipper().PT_SUBJECT, True)
     if c:
-        pc.AddPaths(c, pyclipper.PT_CLIP, True)
+        pc.AddPaths(c, _clipper().PT_CLIP, True)
     if not s and not c:
         return []
-    return _from_int(pc.Execute(op, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO))
+    return _from_int(pc.Execute(op, _clipper().PFT_NONZERO, _clipper().PFT_NONZERO))
 
 
 def union(a: Shape, b: Shape = ()) -> Shape:  # type: ignore[assignment]
     """Union (also: one shape cleaned into non-overlapping, oriented boundaries)."""
-    return _boolean(list(a) + list(b), [], pyclipper.CT_UNION)
+    return _boolean(list(a) + list(b), [], _clipper().CT_UNION)
 
 
 def difference(a: Shape, b: Shape) -> Shape:
-    return _boolean(a, b, pyclipper.CT_DIFFERENCE) if b else union(a)
+    return _boolean(a, b, _clipper().CT_DIFFERENCE) if b else union(a)
 
 
 def intersection(a: Shape, b: Shape) -> Shape:
-    return _boolean(a, b, pyclipper.CT_INTERSECTION)
+    return _boolean(a, b, _clipper().CT_INTERSECTION)
 
 
 def clip_open(paths: Sequence[np.ndarray], shape: Shape) -> list[np.ndarray]:
@@ -121,12 +133,12 @@ def clip_open(paths: Sequence[np.ndarray], shape: Shape) -> list[np.ndarray]:
     ints, c = _to_int(paths), _to_int(shape)
     if not ints or not c:
         return []
-    pc = pyclipper.Pyclipper()
+    pc = _clipper().Pyclipper()
     for p in ints:
-        pc.AddPath(p, pyclipper.PT_SUBJECT, False)
-    pc.AddPaths(c, pyclipper.PT_CLIP, True)
-    tree = pc.Execute2(pyclipper.CT_INTERSECTION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
-    return [np.asarray(p, dtype=float).reshape(-1, 2) / SCALE for p in pyclipper.OpenPathsFromPolyTree(tree)
+        pc.AddPath(p, _clipper().PT_SUBJECT, False)
+    pc.AddPaths(c, _clipper().PT_CLIP, True)
+    tree = pc.Execute2(_clipper().CT_INTERSECTION, _clipper().PFT_NONZERO, _clipper().PFT_NONZERO)
+    return [np.asarray(p, dtype=float).reshape(-1, 2) / SCALE for p in _clipper().OpenPathsFromPolyTree(tree)
             if len(p) >= 2]
 
 
@@ -144,11 +156,11 @@ def contains_point(shape: Shape, point: Sequence[float]) -> bool:
     q = (int(round(point[0] * SCALE)), int(round(point[1] * SCALE)))
     winding = 0
     for p in _to_int(shape):
-        r = pyclipper.PointInPolygon(q, p)
+        r = _clipper().PointInPolygon(q, p)
         if r == -1:
             return True
         if r == 1:
-            winding += 1 if pyclipper.Orientation(p) else -1
+            winding += 1 if _clipper().Orientation(p) else -1
     return winding != 0
 
 
@@ -189,9 +201,9 @@ def regions(shape: Shape) -> list[Region]:
     ints = _to_int(shape)
     if not ints:
         return []
-    pc = pyclipper.Pyclipper()
-    pc.AddPaths(ints, pyclipper.PT_SUBJECT, True)
-    tree = pc.Execute2(pyclipper.CT_UNION, pyclipper.PFT_NONZERO, pyclipper.PFT_NONZERO)
+    pc = _clipper().Pyclipper()
+    pc.AddPaths(ints, _clipper().PT_SUBJECT, True)
+    tree = pc.Execute2(_clipper().CT_UNION, _clipper().PFT_NONZERO, _clipper().PFT_NONZERO)
     out: list[Region] = []
 
     def walk(node) -> None:
