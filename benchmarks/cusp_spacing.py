@@ -1,0 +1,124 @@
+"""Passes and cycle time at equal maximum cusp (issue 14): the 3-axis Surface raster spaced adaptively (each pass
+from the previous one's CL points) against a constant step-over chosen so that its simulated maximum cusp is
+the same, and against the constant cusp mode (the planar step-over at the steepest crossing).
+
+The maximum cusp of every raster is measured the same way, independently of how it was placed: the raster and a
+dense raster (0.1 mm apart) are cut into the stock simulation (core.sim, 0.1 mm cells), and the cusp is the
+largest difference along the normal where the slope is at most the cusp slope limit and the dense raster comes
+within the tolerance of the model (elsewhere the tool cannot reach: not a cusp).
+
+    .venv/bin/python benchmarks/cusp_spacing.py            # sphere_on_plate and mount_rush, ball D6, 0.01 mm
+    .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
+from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
+from tmm_workbench.core.sim.compare import slope_deg  # noqa: E402
+from tmm_workbench.core.sim.cycle_time import three_axis_time, toolpath_feeds  # noqa: E402
+from tmm_workbench.core.sim.grid import Grid  # noqa: E402
+from tmm_workbench.core.sim.simulate import simulate  # noqa: E402
+from tmm_workbench.core.sim.stock import box_heights, mesh_heights  # noqa: E402
+from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
+from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
+
+CELL = 0.1
+SLOPE_LIMIT = 75.0
+FEED, PLUNGE = 1000.0 / 60, 300.0 / 60  # mm/s
+
+
+def measure(mesh, cutter, path, envelope, design, grid, tol):
+    """The largest cusp of `path` (see the module) and the share of cells measured."""
+    cut = simulate(path, cutter, grid, box_heights(grid, float(mesh.bounds[1][2]) + 5)).heights
+    slope = slope_deg(envelope, grid.cell)
+    cos = np.cos(np.radians(slope))
+    ok = np.isfinite(design) & (slope <= SLOPE_LIMIT) & ((envelope - design) * cos <= tol)
+    return float(((cut - envelope) * cos)[ok].max()), float(ok.mean())
+
+
+def raster(mesh, cutter, boundary, **kw):
+    """The linked raster, the seconds it took (strategy and linker: what a user waits for before the post) and
+    its pass count."""
+    t0 = time.perf_counter()
+    result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, **kw))
+    top = float(mesh.bounds[1][2])
+    path = link(result.segments, LinkPolicy(top + 5, top + 10))
+    return path, time.perf_counter() - t0, result.diagnostics["passes"]
+
+
+def cycle(path) -> float:
+    tips = np.array([[m.x, m.y, m.z] for m in path.moves])
+    return three_axis_time(tips, toolpath_feeds(path, FEED, PLUNGE)).seconds
+
+
+def run(name: str, stl: Path, cutter: Cutter, tol: float) -> list[str]:
+    mesh = load_stl(stl)
+    lo, hi = mesh.bounds
+    boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    # measured inside, clear of the boundary's edges by the tool radius (the passes' ends)
+    r = cutter.radius
+    grid = Grid.covering(boundary[0] + r, boundary[1] + r, boundary[2] - r, boundary[3] - r, CELL)
+    design = mesh_heights(mesh, grid)
+    dense, _, _ = raster(mesh, cutter, (boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=0.1)
+    envelope = simulate(dense, cutter, grid, box_heights(grid, float(hi[2]) + 5)).heights
+
+    rows = []
+    path, secs, n_adaptive = raster(mesh, cutter, boundary, stepover_mode="adaptive", cusp=tol,
+                                    max_slope_deg=SLOPE_LIMIT)
+    cusp, share = measure(mesh, cutter, path, envelope, design, grid, tol)
+    rows.append(("adaptive", n_adaptive, cusp, cycle(path), secs, len(path)))
+
+    path, secs, n = raster(mesh, cutter, boundary, stepover_mode="cusp", cusp=tol, max_slope_deg=SLOPE_LIMIT)
+    c, _ = measure(mesh, cutter, path, envelope, design, grid, tol)
+    rows.append(("constant cusp mode", n, c, cycle(path), secs, len(path)))
+
+    # the constant step-over whose simulated maximum cusp is the adaptive raster's (bisection on the step)
+    lo_s, hi_s = 0.02, 2 * math.sqrt(2 * r * tol)
+    best = None
+    for _ in range(7):
+        s = 0.5 * (lo_s + hi_s)
+        path, secs, n = raster(mesh, cutter, boundary, stepover=s)
+        c, _ = measure(mesh, cutter, path, envelope, design, grid, tol)
+        if c <= cusp:
+            lo_s, best = s, (f"constant step-over {s:.3f} mm", n, c, cycle(path), secs, len(path))
+        else:
+            hi_s = s
+    if best is not None:
+        rows.append(best)
+
+    out = [f"\n{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm (slopes up to "
+           f"{SLOPE_LIMIT:g} deg; {share:.0%} of the cells measured)",
+           "| spacing | passes | simulated max cusp mm | cycle min | compute s | moves |", "|---|---|---|---|---|---|"]
+    for label, n, c, t, secs, moves in rows:
+        out.append(f"| {label} | {n} | {c:.4f} | {t / 60:.1f} | {secs:.1f} | {moves} |")
+    if best is not None:
+        out.append(f"passes: constant step-over at the same max cusp / adaptive = {best[1] / n_adaptive:.2f}")
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
+    args = ap.parse_args()
+    stl = shared_dir() / "benchmarks" / "stl"
+    cases = [("sphere_on_plate", stl / "sphere_on_plate.stl")]
+    if not args.quick:
+        cases.append(("mount_rush", stl / "mount_rush.stl"))
+    for name, path in cases:
+        print("\n".join(run(name, path, Cutter.ball(6.0), 0.01)), flush=True)
+
+
+if __name__ == "__main__":
+    main()
