@@ -161,3 +161,23 @@ def test_simulated_waterline_does_not_gouge(cutter, stock):
     assert sim.removed_volume > 0
     # the passes reach the offset model somewhere: cells beside a contact line
     assert normal.min() < 0.05
+
+
+@pytest.mark.parametrize("cutter", [Cutter.ball(6), Cutter.bull(8, 1.5)], ids=lambda c: c.kind)
+def test_default_chord_tolerance_does_not_gouge_steep_walls(cutter):
+    """At the default chord tolerance (0.01 mm) the chords between exact loop points would cut into a convex wall
+    (0.047 mm vertically on sphere_on_plate's steep sides before the loops were grown): nothing in the simulated
+    stock lies below the model by more than 1e-3 mm vertically, on any slope, and the walls are left within
+    the tolerance along the normal."""
+    mesh = load_stl(SHARED_STL / "sphere_on_plate.stl")
+    lo, hi = mesh.bounds
+    p = WaterlineParams(boundary=(lo[0], lo[1], hi[0], hi[1]), step_down=0.5, bottom_z=2.0)
+    assert p.chord_tol == 0.01
+    path = link(compute(mesh, cutter, p).segments, LinkPolicy(safe_height=hi[2] + 5, clearance_height=hi[2] + 10))
+    grid = Grid.covering(20, 20, 56, 56, 0.1)                     # the sphere, its steep sides included
+    design = mesh_heights(mesh, grid)
+    dev = compare(simulate(path, cutter, grid, box_heights(grid, hi[2] + 1.0)), design, tolerance=1e-3).deviation
+    slope = slope_deg(design, grid.cell)
+    ok = np.isfinite(dev)
+    assert dev[ok].min() >= -1e-3
+    assert (slope[ok] > 80).any()                                  # steep walls were there to gouge

@@ -22,6 +22,7 @@ from typing import Optional
 
 import numpy as np
 
+from tmm_workbench.core import polygons as P
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
@@ -34,6 +35,10 @@ from tmm_workbench.core.tools.cutter import Cutter
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 CLIMB, CONVENTIONAL = "climb", "conventional"
 _LEVEL_EPS_MM = 1e-9  # a level this close above the bottom is the bottom
+# The chord tolerance is shared: the kernel's loops within 0.4 of it of the exact loop (inside it, on convex
+# stretches), then grown by 0.5 of it (core.polygons, mitred): no move inside the exact loop, none more than 0.9
+# of the tolerance outside it (a sharp convex corner's mitre a little more).
+_LOOP_CHORD, _GROWTH = 0.4, 0.5
 _HAS_CLOSED = "closed" in {f.name for f in fields(CutSegment)}  # the linker's ramp entry walks closed loops
 
 
@@ -105,7 +110,8 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     # Stock to leave: the cutter grown by s at tip heights z - s is exactly this cutter at z on the mesh
     # offset by s (Cutter.offset).
     found = wl.waterline_loops(surface, cutter.offset(s), [z - s for z in zs], b, sample_step=params.sample_step,
-                               chord_tol=params.chord_tol, progress=progress)
+                               chord_tol=_LOOP_CHORD * params.chord_tol, progress=progress)
+    found = [_clear_of_chords(level, b, _GROWTH * params.chord_tol) for level in found]
     segments: list[CutSegment] = []
     where: Optional[np.ndarray] = None
     loops = points = 0
@@ -130,6 +136,25 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     diagnostics = {"levels": len(zs), "loops": loops, "points": points,
                    "top": max(float(seg.tips[0, 2]) for seg in segments)}
     return StrategyResult(segments, diagnostics)
+
+
+def _clear_of_chords(level: list[wl.WaterlineLoop], bounds: Rect, grow: float) -> list[wl.WaterlineLoop]:
+    """The level's loops grown away from the material by `grow` mm (the blocked region they bound, offset by
+    Clipper with mitred joins): the kernel's loop points are exact contacts, but on a convex stretch the chords
+    between them cut into the material by up to the loop's chord error (vertically many times that on a steep
+    wall). Grown by more than that error, every move is clear of the exact loop, and at most
+    `_LOOP_CHORD + _GROWTH` chord tolerances outside it. Points the growth carries onto or past the bounds'
+    edges are no contacts (the pieces there are not cut, as the kernel's closing points)."""
+    if not level:
+        return level
+    z = level[0].z
+    grown = P.offset([lp.xy for lp in level], grow, miter=True)
+    xmin, ymin, xmax, ymax = bounds
+    out = []
+    for xy in grown:
+        contact = (xy[:, 0] > xmin) & (xy[:, 0] < xmax) & (xy[:, 1] > ymin) & (xy[:, 1] < ymax)
+        out.append(wl.WaterlineLoop(xy, z, contact))
+    return out
 
 
 def _pieces(loop: wl.WaterlineLoop, climb: bool) -> list[tuple[np.ndarray, bool]]:
