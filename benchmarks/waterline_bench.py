@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/waterline_bench.py            # 3 levels per case, 3 cutters (about 25 minutes)
     .venv/bin/python benchmarks/waterline_bench.py --quick    # 1 level, the ball only (under 3 minutes)
+    .venv/bin/python benchmarks/waterline_bench.py --quick --chord-tol 0.003 --step 0.25   # at matched accuracy
 
 Cases: the shared STLs sphere_on_plate.stl and mount_rush.stl and the 80k-triangle height field of
 drop_cutter_bench.py; ball D6, flat D6, bull D10 r2. Per case and level all three compute the loops at the
@@ -62,14 +63,14 @@ def distance_to_polylines(pts: np.ndarray, a: np.ndarray, b: np.ndarray) -> floa
     return worst
 
 
-def run_ocl(kind, surf, make_cutter, z: float, threads: int) -> tuple[float, list[np.ndarray]]:
+def run_ocl(kind, surf, make_cutter, z: float, threads: int, step: float = STEP) -> tuple[float, list[np.ndarray]]:
     w = kind()
     w.setSTL(surf)
     w.setCutter(make_cutter())
     w.setZ(z)
-    w.setSampling(STEP)
+    w.setSampling(step)
     if kind is ocl.AdaptiveWaterline:
-        w.setMinSampling(STEP / 10)
+        w.setMinSampling(step / 10)
     w.setThreads(threads)
     t = time.perf_counter()
     w.run()
@@ -77,7 +78,8 @@ def run_ocl(kind, surf, make_cutter, z: float, threads: int) -> tuple[float, lis
     return seconds, [np.array([[p.x, p.y] for p in loop]) for loop in w.getLoops() if len(loop)]
 
 
-def case(name, mesh, threads: int, fractions, cutters) -> list[dict]:
+def case(name, mesh, threads: int, fractions, cutters, step: float = STEP, chord_tol: float = CHORD_TOL,
+         ocl_step: float = STEP) -> list[dict]:
     lo, hi = mesh.bounds
     surface = DropSurface(mesh)
     surf = ocl_surface(mesh)
@@ -87,10 +89,10 @@ def case(name, mesh, threads: int, fractions, cutters) -> list[dict]:
         g = cutter.radius + 1.0
         bounds = (lo[0] - g, lo[1] - g, hi[0] + g, hi[1] + g)
         t = time.perf_counter()
-        ours = waterline_loops(surface, cutter, zs, bounds, sample_step=STEP, chord_tol=CHORD_TOL, threads=threads)
+        ours = waterline_loops(surface, cutter, zs, bounds, sample_step=step, chord_tol=chord_tol, threads=threads)
         batch = (time.perf_counter() - t) / len(zs)
         t = time.perf_counter()
-        waterline_loops(surface, cutter, zs[:1], bounds, sample_step=STEP, chord_tol=CHORD_TOL, threads=threads)
+        waterline_loops(surface, cutter, zs[:1], bounds, sample_step=step, chord_tol=chord_tol, threads=threads)
         single = time.perf_counter() - t
         row = {"model": name, "tool": cname, "levels": len(zs), "tmm": batch, "tmm1": single,
                "wl": 0.0, "awl": 0.0, "n": [0, 0, 0], "ours_err": 0.0, "wl_err": 0.0, "awl_err": 0.0,
@@ -99,7 +101,7 @@ def case(name, mesh, threads: int, fractions, cutters) -> list[dict]:
             mine = [lp.xy for lp in level]
             row["n"][0] += len(mine)
             for key, kind, k in (("wl", ocl.Waterline, 1), ("awl", ocl.AdaptiveWaterline, 2)):
-                seconds, theirs = run_ocl(kind, surf, make, z, threads)
+                seconds, theirs = run_ocl(kind, surf, make, z, threads, ocl_step)
                 row[key] += seconds / len(zs)
                 row["n"][k] += len(theirs)
                 if not mine or not theirs:
@@ -122,10 +124,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="one level per case, the ball cutter only")
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--step", type=float, default=STEP, help="our grid step, mm")
+    ap.add_argument("--chord-tol", type=float, default=CHORD_TOL, help="our chord tolerance, mm")
+    ap.add_argument("--ocl-step", type=float, default=STEP,
+                    help="OpenCAMLib's fibre spacing, mm (AdaptiveWaterline's minimum: a tenth of it)")
     args = ap.parse_args()
     fractions = LEVEL_FRACTIONS[:1] if args.quick else LEVEL_FRACTIONS
     print(f"# waterline, TMM vs OpenCAMLib {ocl.version()} Waterline / AdaptiveWaterline, {args.threads} threads, "
-          f"sampling {STEP} mm (AdaptiveWaterline min {STEP / 10:g} mm), our chord tolerance {CHORD_TOL} mm")
+          f"sampling {args.ocl_step:g} mm (AdaptiveWaterline min {args.ocl_step / 10:g} mm), our grid {args.step:g} mm "
+          f"and chord tolerance {args.chord_tol:g} mm")
     print("| model | tool | levels | TMM ms/level (batch) | TMM ms (1 level) | WL ms/level | AWL ms/level | "
           "WL/TMM | AWL/TMM | AWL/TMM (1 level) | loops TMM / WL / AWL | our chord err vs AWL / WL pts (mm) | "
           "WL chord err (mm) | AWL chord err (mm) |")
@@ -134,7 +141,8 @@ def main() -> None:
               ("mount_rush.stl", load_stl(STL_DIR / "mount_rush.stl")),
               ("height field 80k", height_field(200, False))]
     for name, mesh in models:
-        case(name, mesh, args.threads, fractions, CUTTERS[:1] if args.quick else CUTTERS)
+        case(name, mesh, args.threads, fractions, CUTTERS[:1] if args.quick else CUTTERS, args.step,
+             args.chord_tol, args.ocl_step)
 
 
 if __name__ == "__main__":

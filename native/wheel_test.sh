@@ -14,4 +14,8 @@ TAG="$("$VENV/bin/python" -c 'import sys; print(f"cp{sys.version_info.major}{sys
 cd "$TMP"
 "$VENV/bin/python" -c "from tmm_workbench.core.kernel import native; f = native.load().__file__; \
 assert '/site-packages/tmm_kernel/' in f, f; print('[wheel_test] kernel from the wheel:', f)"
-"$VENV/bin/python" -m pytest -q -p no:cacheprovider "${TESTS[@]/#/tests/core/}"
+# The OpenCAMLib comparison needs the peer, which only .venv has on the host: it runs there (the in-place
+# module and the UBSan one); here it is left out by name rather than skipped.
+DESELECT=()
+"$VENV/bin/python" -c "import opencamlib" 2>/dev/null || DESELECT=(--deselect tests/core/test_waterline.py::test_opencamlib_waterline_agrees_on_a_real_stl)
+"$VENV/bin/python" -m pytest -q -p no:cacheprovider "${DESELECT[@]}" "${TESTS[@]/#/tests/core/}"
