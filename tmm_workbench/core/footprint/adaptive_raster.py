@@ -24,7 +24,7 @@ as `limited`. Passes run along `angle_deg` from +X; the work is done in a frame 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 import numpy as np
@@ -51,7 +51,6 @@ class AdaptivePasses:
     limited: int = 0                     # gaps at the smallest allowed step whose cusp still exceeds it
     unreachable: int = 0                 # gaps with places the tool cannot bring within the cusp (not measured)
     evaluations: int = 0                 # candidate passes dropped and simulated
-    notes: list[str] = field(default_factory=list)
 
 
 class _Frame:
