@@ -9,6 +9,8 @@ within the tolerance of the model (elsewhere the tool cannot reach: not a cusp).
 
     .venv/bin/python benchmarks/cusp_spacing.py            # sphere_on_plate and mount_rush, ball D6, 0.01 mm
     .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
+    .venv/bin/python benchmarks/cusp_spacing.py --seed000  # seed 000's convex and concave surfaces (ball D 0.5 in,
+                                                           # cusp 0.002 in; benchmarks/seed000_surfaces.py)
 """
 from __future__ import annotations
 
@@ -48,11 +50,11 @@ def measure(mesh, cutter, path, envelope, design, grid, tol):
     return float(((cut - envelope) * cos)[ok].max()), float(ok.mean())
 
 
-def raster(mesh, cutter, boundary, **kw):
+def raster(mesh, cutter, boundary, sample_step=0.25, **kw):
     """The linked raster, the seconds it took (strategy and linker: what a user waits for before the post) and
     its pass count."""
     t0 = time.perf_counter()
-    result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, **kw))
+    result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=sample_step, **kw))
     top = float(mesh.bounds[1][2])
     path = link(result.segments, LinkPolicy(top + 5, top + 10))
     return path, time.perf_counter() - t0, result.diagnostics["passes"]
@@ -63,15 +65,17 @@ def cycle(path) -> float:
     return three_axis_time(tips, toolpath_feeds(path, FEED, PLUNGE)).seconds
 
 
-def run(name: str, stl: Path, cutter: Cutter, tol: float) -> list[str]:
-    mesh = load_stl(stl)
+def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundary=None) -> list[str]:
+    """The table for one model; `cell` is the simulation's cell and the dense raster's step-over (its own cusp
+    is negligible against `tol`); `boundary` (x0, y0, x1, y1) the region, by default the model's box."""
     lo, hi = mesh.bounds
-    boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    if boundary is None:
+        boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     # measured inside, clear of the boundary's edges by the tool radius (the passes' ends)
     r = cutter.radius
-    grid = Grid.covering(boundary[0] + r, boundary[1] + r, boundary[2] - r, boundary[3] - r, CELL)
+    grid = Grid.covering(boundary[0] + r, boundary[1] + r, boundary[2] - r, boundary[3] - r, cell)
     design = mesh_heights(mesh, grid)
-    dense, _, _ = raster(mesh, cutter, (boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=0.1)
+    dense, _, _ = raster(mesh, cutter, (boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=cell)
     envelope = simulate(dense, cutter, grid, box_heights(grid, float(hi[2]) + 5)).heights
 
     rows = []
@@ -111,13 +115,29 @@ def run(name: str, stl: Path, cutter: Cutter, tol: float) -> list[str]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
+    ap.add_argument("--seed000", action="store_true", help="seed 000's convex and concave surfaces only")
+    ap.add_argument("--window", type=float, default=100.0,
+                    help="with --seed000: the side in mm of the square region centred on the surface (0: all of "
+                         "its 254 x 270 mm, which takes hours in the Python adaptive raster)")
     args = ap.parse_args()
+    if args.seed000:
+        from seed000_surfaces import INCH, seed000_mesh
+        for name in ("convex", "concave"):
+            mesh, deviation = seed000_mesh(name)
+            lo, hi = mesh.bounds
+            c, h = 0.5 * (lo + hi), 0.5 * args.window
+            region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if args.window else None
+            print(f"\nseed 000 {name}: ruled through its two cubic B-spline sections, mesh within {deviation:.4f} mm; "
+                  f"region {region or 'the whole surface'}")
+            print("\n".join(run(f"seed 000 {name}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, cell=0.2,
+                                 boundary=region)), flush=True)
+        return
     stl = shared_dir() / "benchmarks" / "stl"
     cases = [("sphere_on_plate", stl / "sphere_on_plate.stl")]
     if not args.quick:
         cases.append(("mount_rush", stl / "mount_rush.stl"))
     for name, path in cases:
-        print("\n".join(run(name, path, Cutter.ball(6.0), 0.01)), flush=True)
+        print("\n".join(run(name, load_stl(path), Cutter.ball(6.0), 0.01)), flush=True)
 
 
 if __name__ == "__main__":

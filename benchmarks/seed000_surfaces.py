@@ -1,0 +1,90 @@
+"""Seed 000's convex and concave benchmark surfaces (Appendix A; `shared/benchmarks/seed_surfaces.json`,
+`lu2007_bspline_sections`) as triangle meshes in mm, for the cusp-spacing benchmark.
+
+How they are built (the seed gives only the poles, in inches, of two section curves in the planes X = 0 and
+X = 10; the JSON's reconstruction note is followed): each section is a cubic, clamped, uniformly knotted
+B-spline curve through its poles (all weights 1); the surface is the ruled surface between the two sections
+at equal curve parameter, S(t, s) = (1 - s) C0(t) + s C1(t) (what a "through-curve" surface of two sections
+is, and what OCC's ruled surface does with two curves of one parameter range). The concave surface's sections
+have 11 and 9 poles: equal parameter, not equal pole index, pairs them. Units are converted to mm (x 25.4).
+The mesh is a regular (t, s) grid split into triangles, fine enough that its largest deviation from the
+surface (measured at every triangle's centroid, printed by `python benchmarks/seed000_surfaces.py`) is far
+below the seed's tessellation tolerance of 0.002 in.
+"""
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from tmm_workbench.core.geometry.mesh import TriMesh  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
+
+INCH = 25.4
+DEGREE = 3
+
+
+def clamped_uniform_knots(n_poles: int, degree: int = DEGREE) -> np.ndarray:
+    inner = np.linspace(0.0, 1.0, n_poles - degree + 1)
+    return np.concatenate([np.zeros(degree), inner, np.ones(degree)])
+
+
+def bspline_curve(poles: np.ndarray, t: np.ndarray, degree: int = DEGREE) -> np.ndarray:
+    """Points (len(t), dim) of the clamped uniform B-spline curve with these poles (Cox-de Boor basis)."""
+    knots = clamped_uniform_knots(len(poles), degree)
+    t = np.clip(np.asarray(t, dtype=float), 0.0, 1.0)
+    # degree-0 basis; t = 1 belongs to the last non-empty span
+    span = np.clip(np.searchsorted(knots, t, side="right") - 1, degree, len(poles) - 1)
+    basis = np.zeros((len(t), len(knots) - 1))
+    basis[np.arange(len(t)), span] = 1.0
+    for p in range(1, degree + 1):
+        nxt = np.zeros((len(t), len(knots) - 1 - p))
+        for i in range(len(knots) - 1 - p):
+            d0 = knots[i + p] - knots[i]
+            d1 = knots[i + p + 1] - knots[i + 1]
+            if d0 > 0:
+                nxt[:, i] += (t - knots[i]) / d0 * basis[:, i]
+            if d1 > 0:
+                nxt[:, i] += (knots[i + p + 1] - t) / d1 * basis[:, i + 1]
+        basis = nxt
+    return basis @ poles
+
+
+def ruled_points(sections: list[np.ndarray], t: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Points (n, 3) of the ruled surface between two section curves at the parameter pairs (t[k], s[k])."""
+    c0, c1 = (bspline_curve(np.asarray(p, dtype=float), t) for p in sections)
+    return (1.0 - s)[:, None] * c0 + s[:, None] * c1
+
+
+def _grid_triangles(nt: int, ns: int) -> np.ndarray:
+    i, j = np.meshgrid(np.arange(nt - 1), np.arange(ns - 1), indexing="ij")
+    a = (i * ns + j).ravel()
+    b, c, d = a + ns, a + 1, a + ns + 1
+    return np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
+
+
+def seed000_mesh(name: str, nt: int = 401, ns: int = 41) -> tuple[TriMesh, float]:
+    """The surface `name` ("convex" or "concave") in mm and the mesh's largest deviation from it (mm)."""
+    data = json.loads((shared_dir() / "benchmarks" / "seed_surfaces.json").read_text())
+    sections = [np.asarray(p) * INCH for p in data["lu2007_bspline_sections"]["surfaces"][name]]
+    tt, ss = (g.ravel() for g in np.meshgrid(np.linspace(0, 1, nt), np.linspace(0, 1, ns), indexing="ij"))
+    pts = ruled_points(sections, tt, ss)
+    tri = _grid_triangles(nt, ns)
+    # the deviation at each triangle's centroid: the surface at the centroid's parameters against the plane
+    uv = np.stack([tt, ss], 1)[tri].mean(axis=1)
+    deviation = float(np.linalg.norm(ruled_points(sections, uv[:, 0], uv[:, 1]) - pts[tri].mean(axis=1),
+                                     axis=1).max())
+    return TriMesh(pts, tri, f"seed000_{name}"), deviation
+
+
+if __name__ == "__main__":
+    for n in ("convex", "concave"):
+        mesh, dev = seed000_mesh(n)
+        lo, hi = mesh.bounds
+        print(f"{n}: {len(mesh.triangles)} triangles, box {np.round(lo, 2)} .. {np.round(hi, 2)} mm, "
+              f"largest deviation from the surface {dev:.5f} mm (seed tolerance {0.002 * INCH:.4f} mm)")
