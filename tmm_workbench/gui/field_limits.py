@@ -52,6 +52,7 @@ class FieldGuard:
     def __init__(self, page: Any, obj: Any) -> None:
         self.page, self.obj = page, obj
         self.refused: dict[str, str] = {}
+        self.typed_refusals: dict[str, str] = {}  # typed out of range: the field went back to its value
         self.estimate_text = ""
         self.widgets = {prop: getattr(page.form, w) for w, prop in page.SPIN_BOXES.items()}
         for prop, widget in self.widgets.items():
@@ -74,7 +75,27 @@ class FieldGuard:
         widget.setToolTip(f"{spec.label if spec else prop}: {span}; a bare number is in {unit}")
         line = widget.findChild(QtGui.QLineEdit)
         if line is not None:
-            line.textEdited.connect(lambda text, line=line, unit=unit: _with_unit(line, unit, text))
+            line.textEdited.connect(lambda text, prop=prop, line=line, unit=unit: self.typed(prop, line, unit, text))
+
+    def typed(self, prop: str, line: QtGui.QLineEdit, unit: str, text: str) -> None:
+        """Each key: the default unit added to a bare number, and a value out of range marked at once (the
+        spin box itself would silently go back to its last value when the field is left)."""
+        _with_unit(line, unit, text)
+        value = entered_value(self.widgets[prop])
+        self.typed_refusals.pop(prop, None)
+        spec = work_estimate.spec_for(self.obj.Proxy, prop)
+        if value is not None:
+            try:
+                work_estimate.check_value(self.obj.Proxy, prop, value)
+            except TmmError as exc:
+                self.typed_refusals[prop] = str(exc)
+        elif text.strip().startswith("-") and spec is not None and spec.low is not None and spec.low >= 0:
+            # the spin box takes no digit after a minus below its minimum: say why
+            self.typed_refusals[prop] = f"{spec.label} must be {spec.range_text()}, got a negative value"
+        self.refused = {p: m for p, m in self.refused.items() if p != prop}
+        self.refused.update({p: m for p, m in self.typed_refusals.items() if p == prop})
+        self.mark()
+        self.page.showStatus(self.obj)
 
     def held(self, obj: Any) -> set[str]:
         """Checks the values entered but not yet written (range, then the work estimate with all of them);
@@ -113,6 +134,8 @@ class FieldGuard:
                 self.estimate_text = f"will fail: {exc}"
         except Exception as exc:  # noqa: BLE001 - an estimate that cannot run must not break the panel
             self.estimate_text = f"no estimate ({exc})"
+        for prop, message in self.typed_refusals.items():
+            refused.setdefault(prop, message)
         self.refused = refused
         self.mark()
         return set(refused)
