@@ -202,6 +202,10 @@ class TmmOp(PathOp.ObjectOp):
         from tmm_workbench.app import work_estimate
 
         try:
+            work_estimate.check_ranges(obj)
+        except TmmError as exc:
+            self.fail(obj, str(exc))
+        try:
             work_estimate.estimate(obj, load_stl=False)
         except WorkLimitError as exc:
             self.fail(obj, str(exc))

@@ -57,6 +57,15 @@ def check_value(proxy: Any, prop: str, value: float) -> None:
     check(spec, value)
 
 
+def check_ranges(obj: Any, overrides: Optional[Mapping[str, float]] = None) -> None:
+    """The op's properties that name no params field inside EXTRA_SPECS (a tessellation tolerance of 1e-6 mm
+    would tessellate a Part model into more triangles than memory holds)."""
+    ov = dict(overrides or {})
+    for prop in EXTRA_SPECS:
+        if prop not in ov and hasattr(obj, prop):
+            check_value(obj.Proxy, prop, _value(obj, prop, ov))
+
+
 def _value(obj: Any, prop: str, overrides: Mapping[str, float]) -> Any:
     if prop in overrides:
         return overrides[prop]
@@ -209,9 +218,7 @@ def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl
     ov = dict(overrides or {})
     for prop, value in ov.items():
         check_value(proxy, prop, value)
-    for prop in EXTRA_SPECS:
-        if prop not in ov and hasattr(obj, prop):
-            check_value(proxy, prop, _value(obj, prop, ov))
+    check_ranges(obj, ov)
     run = _BY_CLASS.get(type(proxy).__name__)
     if run is None:
         return None
