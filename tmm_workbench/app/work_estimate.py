@@ -87,12 +87,7 @@ def model_bounds(proxy: Any, obj: Any, load_stl: bool) -> Optional[tuple[float, 
     """(xmin, ymin, zmin, xmax, ymax, zmax) of what the op machines, from bounding boxes (TMM's stand-in
     boxes have the mesh's); an STL file is read only with `load_stl` (else None)."""
     if getattr(obj, "StlFile", ""):
-        if not load_stl:
-            return None
-        from tmm_workbench.app import geometry
-
-        lo, hi = geometry.mesh_from_stl(obj.StlFile).bounds
-        return (*map(float, lo), *map(float, hi))
+        return _stl_bounds(obj.StlFile) if load_stl else None
     models = [obj.Model] if getattr(obj, "Model", None) is not None else list(getattr(proxy, "model", None) or [])
     if not models:
         from tmm_workbench.app.compat import PathUtils
@@ -104,6 +99,27 @@ def model_bounds(proxy: Any, obj: Any, load_stl: bool) -> Optional[tuple[float, 
     boxes = [_box(m) for m in models]
     return (min(b.XMin for b in boxes), min(b.YMin for b in boxes), min(b.ZMin for b in boxes),
             max(b.XMax for b in boxes), max(b.YMax for b in boxes), max(b.ZMax for b in boxes))
+
+
+_stl_cache: dict[tuple[str, float, int], tuple[float, ...]] = {}
+
+
+def _stl_bounds(path: str) -> tuple[float, ...]:
+    """An STL file's bounds, read once per file version (the panel asks on every value entered)."""
+    import os
+
+    from tmm_workbench.app import geometry
+
+    try:
+        st = os.stat(path)
+        key = (path, st.st_mtime, st.st_size)
+    except OSError:
+        key = (path, 0.0, -1)
+    if key not in _stl_cache:
+        lo, hi = geometry.mesh_from_stl(path).bounds  # a missing or bad file: its TmmError
+        _stl_cache.clear()
+        _stl_cache[key] = (*map(float, lo), *map(float, hi))
+    return _stl_cache[key]
 
 
 def _stock(obj: Any) -> Any:
