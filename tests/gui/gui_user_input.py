@@ -9,8 +9,8 @@ are found among the top-level widgets and closed, as a user does:
   4. a sane value again: the status line shows the estimate; Apply computes, the status line shows the result;
   5. step-over 0 typed, OK: a message box, nothing computed;
   6. a missing STL typed, Apply: the op fails, a message box, one line in the report view and no traceback;
-  7. a tool controller with horizontal feed 0: the reopened panel says so before computing, Apply fails the op
-     with a message box.
+  7. a tool controller with horizontal feed 0 and spindle speed 0 (the Job's post linuxcnc writes S): the
+     reopened panel says both before computing; Apply fails the op with a message box.
 A screenshot per step goes to env TMM_GUI_SHOTS (a folder; docs/gui by default); the outcome to env
 TMM_GUI_RESULT (JSON) and the exit code.
 """
@@ -120,7 +120,13 @@ def shot(info: dict, name: str) -> None:
         if label is not None and area.isAncestorOf(label):
             area.ensureWidgetVisible(label)  # the status line in the picture
     pump(0.2)
-    image = FreeCADGui.getMainWindow().grab().scaledToWidth(800, QtCore.Qt.SmoothTransformation)
+    mw = FreeCADGui.getMainWindow()
+    full = mw.grab()
+    painter = QtGui.QPainter(full)
+    for box in message_boxes():  # a window of its own: painted where it stands over the main window
+        painter.drawPixmap(box.frameGeometry().topLeft() - mw.frameGeometry().topLeft(), box.grab())
+    painter.end()
+    image = full.scaledToWidth(800, QtCore.Qt.SmoothTransformation)
     assert image.save(str(png)), f"could not write {png}"
     info.setdefault("shots", []).append(str(png))
 
@@ -260,9 +266,12 @@ def session(info: dict) -> dict:
     # 7. a tool controller with no horizontal feed: the panel says so before computing; Apply fails the op
     tc = op.ToolController
     tc.HorizFeed = 0.0
+    tc.SpindleSpeed = 0.0  # and no spindle speed, with a post that writes S
+    r.job.PostProcessor = "linuxcnc"
     open_panel(op)
     info["status_zero_feed"] = status()
     assert "HorizFeed must be a feed > 0" in info["status_zero_feed"][0], info["status_zero_feed"]
+    assert "SpindleSpeed is 0 rpm" in info["status_zero_feed"][0], info["status_zero_feed"]
     shot(info, "07_zero_feed_panel")
     type_into("stepOver", "2.5")
     button(QtGui.QDialogButtonBox.Apply).click()

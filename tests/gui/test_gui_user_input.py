@@ -37,6 +37,7 @@ def test_gui_user_input(tmp_path: Path) -> None:
     assert "moves" in info["status_apply"][0], info["status_apply"]
     assert "file not found" in info["box_missing_stl"] and "Traceback" not in info["report_missing_stl"], info
     assert "HorizFeed must be a feed > 0" in info["status_zero_feed"][0], info["status_zero_feed"]
+    assert "SpindleSpeed is 0 rpm" in info["status_zero_feed"][0], info["status_zero_feed"]
     for name in STEPS:
         png = SHOTS / f"{name}.png"
         assert png.is_file() and png.stat().st_size > 5_000, png
