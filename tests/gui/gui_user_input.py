@@ -10,7 +10,9 @@ are found among the top-level widgets and closed, as a user does:
   5. step-over 0 typed, OK: a message box, nothing computed;
   6. a missing STL typed, Apply: the op fails, a message box, one line in the report view and no traceback;
   7. a tool controller with horizontal feed 0 and spindle speed 0 (the Job's post linuxcnc writes S): the
-     reopened panel says both before computing; Apply fails the op with a message box.
+     reopened panel says both before computing; Apply fails the op with a message box;
+  8. a TMM Waterline page: its ranges from the waterline's params, a sampling step above its work limit
+     refused before any compute.
 A screenshot per step goes to env TMM_GUI_SHOTS (a folder; docs/gui by default); the outcome to env
 TMM_GUI_RESULT (JSON) and the exit code.
 """
@@ -162,6 +164,8 @@ def session(info: dict) -> dict:
     doc.recompute()
     commands_before = len(op.Path.Commands)
     open_panel(op)
+    info["status_open"] = status()  # the estimate of the op's values, before anything is typed
+    assert "about" in info["status_open"][0] and "CL points" in info["status_open"][0], info["status_open"]
 
     # 1. the µm trap: a bare number is mm
     sample = field("sampleStep")
@@ -283,7 +287,46 @@ def session(info: dict) -> dict:
     pump(0.5)
     FreeCAD.closeDocument(doc.Name)
     pump(0.3)
+    waterline_panel(info)
     return info
+
+
+def waterline_panel(info: dict) -> None:
+    """8. Another op's page: the TMM Waterline fields take their ranges from the waterline's params, and a
+    sampling step of 0.00001 mm is refused by the waterline's own estimate before any compute."""
+    import Part
+    from tmm_workbench.app import job as jobs
+    from tmm_workbench.app import registry, tools
+
+    global PAGE
+    doc = FreeCAD.newDocument("TmmGuiUserWaterline")
+    block = doc.addObject("Part::Feature", "PocketBlock")
+    block.Shape = Part.makeBox(40, 30, 10).cut(Part.makeBox(20, 12, 10, FreeCAD.Vector(10, 9, 5)))
+    doc.recompute()
+    job = jobs.create_job(doc, block)
+    jobs.set_tool(job, tools.make_tool_bit(doc, "endmill", 6.0), 20.0, 5.0, 10000)
+    op = registry.create("TMM_Waterline", job)
+    op.Proxy.progress_enabled = False
+    doc.recompute()
+    assert op.isValid(), op.getStatusString()
+    PAGE = "TmmWaterlineOpPage"
+    open_panel(op)
+    info["wl_ranges"] = {name: [field(name).property("minimum"), field(name).property("maximum")]
+                         for name in ("stepDown", "sampleStep", "chordTolerance", "topZ")}
+    assert info["wl_ranges"]["chordTolerance"] == [0.0, 1.0], info["wl_ranges"]  # the params' (0, 1] mm
+    assert info["wl_ranges"]["stepDown"][0] == 0.0 and info["wl_ranges"]["topZ"] == [-10000.0, 10000.0], info
+    commands = len(op.Path.Commands)
+    type_into("sampleStep", "0.00001")
+    info["wl_refused"] = field("sampleStep").property("tmmRefused")
+    assert "waterline drops and points" in (info["wl_refused"] or ""), info["wl_refused"]
+    shot(info, "08_waterline_limit_refused")
+    button(QtGui.QDialogButtonBox.Apply).click()
+    text = take_box(info, "box_wl_limit")
+    assert "Not computed" in text and len(op.Path.Commands) == commands and op.isValid(), text
+    op.ViewObject.Proxy.panel.reject()
+    pump(0.5)
+    FreeCAD.closeDocument(doc.Name)
+    pump(0.3)
 
 
 def main() -> None:

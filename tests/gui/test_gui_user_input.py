@@ -17,7 +17,7 @@ XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 150
 STL = str(SHARED_STL / "sphere_on_plate.stl")
 STEPS = ("01_bare_number_is_mm", "02_negative_refused", "03_work_limit_refused", "04_status_after_apply",
-         "05_stepover_zero_box", "06_missing_stl_box", "07_zero_feed_panel")
+         "05_stepover_zero_box", "06_missing_stl_box", "07_zero_feed_panel", "08_waterline_limit_refused")
 
 
 def test_gui_user_input(tmp_path: Path) -> None:
@@ -38,6 +38,7 @@ def test_gui_user_input(tmp_path: Path) -> None:
     assert "file not found" in info["box_missing_stl"] and "Traceback" not in info["report_missing_stl"], info
     assert "HorizFeed must be a feed > 0" in info["status_zero_feed"][0], info["status_zero_feed"]
     assert "SpindleSpeed is 0 rpm" in info["status_zero_feed"][0], info["status_zero_feed"]
+    assert "waterline drops and points" in info["wl_refused"] and "Not computed" in info["box_wl_limit"], info
     for name in STEPS:
         png = SHOTS / f"{name}.png"
         assert png.is_file() and png.stat().st_size > 5_000, png

@@ -24,6 +24,7 @@ EXTRA_SPECS: dict[str, Spec] = {
     "TopZ": Spec("top", "mm", low=-10_000.0, high=10_000.0),
     "BottomZ": Spec("bottom", "mm", low=-10_000.0, high=10_000.0),
     "PlungeAngle": Spec("plunge angle", "deg", low=0.0, high=90.0),
+    "SampleStep": Spec("sample step", "mm", low=0.0, high=1000.0, optional=True),  # waterline: 0 derives it
 }
 # a side of a range the params leave open, for the panel's minimum / maximum
 OPEN_HIGH = {"mm": 10_000.0, "deg": 360.0, "%": 100.0}
@@ -40,12 +41,16 @@ class Estimate:
         return f"about {self.count:.3g} {self.what}{passes}"
 
 
-def spec_for(proxy: Any, prop: str) -> Optional[Spec]:
-    """The allowed range of the op's property `prop`: its params field's Spec, else EXTRA_SPECS."""
+def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
     for row in getattr(proxy, "PROPERTIES", ()):
         if row.name == prop and row.field and proxy.PARAMS is not None:
             return spec_of(proxy.PARAMS, row.field)
-    return EXTRA_SPECS.get(prop)
+    return None
+
+
+def spec_for(proxy: Any, prop: str) -> Optional[Spec]:
+    """The allowed range of the op's property `prop`: its params field's Spec, else EXTRA_SPECS."""
+    return _field_spec(proxy, prop) or EXTRA_SPECS.get(prop)
 
 
 def check_value(proxy: Any, prop: str, value: float) -> None:
@@ -62,7 +67,7 @@ def check_ranges(obj: Any, overrides: Optional[Mapping[str, float]] = None) -> N
     would tessellate a Part model into more triangles than memory holds)."""
     ov = dict(overrides or {})
     for prop in EXTRA_SPECS:
-        if prop not in ov and hasattr(obj, prop):
+        if prop not in ov and hasattr(obj, prop) and _field_spec(obj.Proxy, prop) is None:
             check_value(obj.Proxy, prop, _value(obj, prop, ov))
 
 

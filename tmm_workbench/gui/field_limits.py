@@ -61,6 +61,18 @@ class FieldGuard:
             spec = work_estimate.spec_for(obj.Proxy, prop)
             if spec is not None and spec.low is not None:
                 getattr(page.form, w).setRange(spec.low, spec.high if spec.high is not None else 100.0)
+        self.estimate_text = self.estimate(obj, {})
+
+    @staticmethod
+    def estimate(obj: Any, entered: dict[str, float]) -> str:
+        """The status line's estimate of the op's values ('' when it cannot be told); raises nothing."""
+        try:
+            est = work_estimate.estimate(obj, entered)
+            return est.text() if est is not None else ""
+        except TmmError as exc:
+            return f"will fail: {exc}"
+        except Exception as exc:  # noqa: BLE001 - an estimate that cannot run must not break the panel
+            return f"no estimate ({exc})"
 
     def bind(self, widget: Any, prop: str) -> None:
         unit = default_unit(self.obj, prop)
@@ -122,18 +134,14 @@ class FieldGuard:
             value = float(getattr(self.page.form, w).value())
             if abs(value - float(getattr(obj, prop))) > 1e-9:
                 entered[prop] = value
-        self.estimate_text = ""
-        try:
-            est = work_estimate.estimate(obj, entered)
-            self.estimate_text = est.text() if est is not None else ""
-        except TmmError as exc:
-            for prop in entered:
-                if prop in self.widgets:
-                    refused[prop] = str(exc)
-            if not entered:  # the op's own values are out: shown, nothing to hold back
-                self.estimate_text = f"will fail: {exc}"
-        except Exception as exc:  # noqa: BLE001 - an estimate that cannot run must not break the panel
-            self.estimate_text = f"no estimate ({exc})"
+        self.estimate_text = self.estimate(obj, entered)
+        failing = self.estimate_text.startswith("will fail: ")
+        if failing and entered and self.estimate(obj, {}) != self.estimate_text:  # caused by what was entered
+            hit = [prop for prop in entered if prop in self.widgets]
+            for prop in hit:
+                refused[prop] = self.estimate_text[len("will fail: "):]
+            if hit:
+                self.estimate_text = ""
         for prop, message in self.typed_refusals.items():
             refused.setdefault(prop, message)
         self.refused = refused

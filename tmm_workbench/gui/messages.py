@@ -4,6 +4,7 @@ result. Installed as app.hooks' failure hook by gui.startup (headless nothing of
 from __future__ import annotations
 
 import sys
+import time
 import traceback
 from typing import Any, Callable, Optional
 
@@ -29,11 +30,21 @@ def quiet_traceback() -> None:
     QtCore.QTimer.singleShot(0, _restore_tracebacks)
 
 
+_last_shown: dict[str, float] = {}
+REPEAT_S = 5.0  # Cancel after a failed Apply recomputes the op: the same failure again is not a new box
+
+
 def show_box(text: str, parent: Optional[QtGui.QWidget] = None) -> None:
-    """A non-modal warning box (a recompute is never blocked); the same text twice shows one box."""
+    """A non-modal warning box (a recompute is never blocked); the same text again within REPEAT_S seconds,
+    or while its box is open, shows no second box (the status line and report view still say it)."""
     for w in QtGui.QApplication.topLevelWidgets():
         if isinstance(w, QtGui.QMessageBox) and w.objectName() == BOX_NAME and w.isVisible() and w.text() == text:
             return
+    now = time.monotonic()
+    if now - _last_shown.get(text, -REPEAT_S) < REPEAT_S:
+        return
+    _last_shown.clear()
+    _last_shown[text] = now
     box = QtGui.QMessageBox(QtGui.QMessageBox.Warning, TITLE, text, QtGui.QMessageBox.Ok,
                             parent or FreeCADGui.getMainWindow())
     box.setObjectName(BOX_NAME)
