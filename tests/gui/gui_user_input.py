@@ -12,7 +12,8 @@ are found among the top-level widgets and closed, as a user does:
   7. a tool controller with horizontal feed 0 and spindle speed 0 (the Job's post linuxcnc writes S): the
      reopened panel says both before computing; Apply fails the op with a message box;
   8. a TMM Waterline page: its ranges from the waterline's params, a sampling step above its work limit
-     refused before any compute.
+     refused before any compute;
+  9. a post that fails shows a message box (and still raises to its caller).
 A screenshot per step goes to env TMM_GUI_SHOTS (a folder; docs/gui by default); the outcome to env
 TMM_GUI_RESULT (JSON) and the exit code.
 """
@@ -325,6 +326,17 @@ def waterline_panel(info: dict) -> None:
     assert "Not computed" in text and len(op.Path.Commands) == commands and op.isValid(), text
     op.ViewObject.Proxy.panel.reject()
     pump(0.5)
+    # 9. a post that fails (FreeCAD's Post command calls the same export): a box, the error still raised
+    from tmm_workbench.app import posts
+    from tmm_workbench.core.errors import TmmError
+
+    try:
+        posts.export("tarus", [op.ToolController, op], args="--a-min 0")
+        raise AssertionError("the tarus post took --a-min without --a-max")
+    except TmmError as exc:
+        info["post_error"] = str(exc)
+    text = take_box(info, "box_post")
+    assert text.startswith("post 'tarus': ") and "--a-min" in text, text
     FreeCAD.closeDocument(doc.Name)
     pump(0.3)
 

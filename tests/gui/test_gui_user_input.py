@@ -39,6 +39,7 @@ def test_gui_user_input(tmp_path: Path) -> None:
     assert "HorizFeed must be a feed > 0" in info["status_zero_feed"][0], info["status_zero_feed"]
     assert "SpindleSpeed is 0 rpm" in info["status_zero_feed"][0], info["status_zero_feed"]
     assert "waterline drops and points" in info["wl_refused"] and "Not computed" in info["box_wl_limit"], info
+    assert info["box_post"].startswith("post 'tarus': "), info["box_post"]
     for name in STEPS:
         png = SHOTS / f"{name}.png"
         assert png.is_file() and png.stat().st_size > 5_000, png
