@@ -17,7 +17,7 @@ from tmm_workbench.app import hooks
 from tmm_workbench.app.compat import PathOp
 from tmm_workbench.app.tools import TOOLBIT_SHAPES, cutter_from_tool, label_of, shape_name
 from tmm_workbench.core import kernel, limits
-from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.errors import Cancelled, TmmError, WorkLimitError
 from tmm_workbench.core.tools.cutter import Cutter
 
 
@@ -144,6 +144,7 @@ class TmmOp(PathOp.ObjectOp):
         problem = self.input_problem(obj)
         if problem:
             self.fail(obj, problem)
+        self.check_work(obj)
         self._computed = False
         super().execute(obj)
         if not self._computed:
@@ -185,17 +186,34 @@ class TmmOp(PathOp.ObjectOp):
             return f"tool '{label_of(tool)}' has no diameter"
         if not (math.isfinite(d) and d > 0):
             return f"tool '{label_of(tool)}': diameter must be a length > 0 mm, got {d:g} mm"
-        for name in ("HorizFeed", "VertFeed"):
-            v = float(_plain(getattr(tc, name, 0.0)))  # mm/s
-            if not (math.isfinite(v) and v > 0):
-                # tool controllers from FreeCAD's tool library start with no feeds: G1 F0 would stall the machine
-                return (f"tool controller '{tc.Label}': {name} must be a feed > 0 mm/min, got {v * 60:g} mm/min "
-                        "(set the cutting feeds in the tool controller)")
+        problem = feed_problem(tc)
+        if problem:
+            return problem
         try:
             kernel.require()
         except kernel.KernelMissing as exc:
             return str(exc)
         return ""
+
+    def check_work(self, obj: Any) -> None:
+        """The work estimated from the properties and bounding boxes before anything is loaded, tessellated
+        or allocated (app.work_estimate; an STL file is estimated right after reading, in the strategy);
+        the chosen post's need of a spindle speed reported."""
+        from tmm_workbench.app import work_estimate
+
+        try:
+            work_estimate.check_ranges(obj)
+        except TmmError as exc:
+            self.fail(obj, str(exc))
+        try:
+            work_estimate.estimate(obj, load_stl=False)
+        except WorkLimitError as exc:
+            self.fail(obj, str(exc))
+        except TmmError:  # other bad input: the computation names it with what it reads
+            pass
+        spindle = spindle_problem(obj)
+        if spindle:
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: {spindle}\n")
 
     def opExecute(self, obj: Any) -> None:
         self._computed = True
@@ -233,10 +251,43 @@ class TmmOp(PathOp.ObjectOp):
         obj.Path = Path.Path()
         self.on_fail(obj)
         FreeCAD.Console.PrintError(f"{obj.Label}: {message}\n")
+        hooks.report_failure(obj, message)  # the GUI's message box; headless nothing
         raise TmmError(message) from None
 
     def on_fail(self, obj: Any) -> None:
         """Clears what a subclass shows of its last result."""
+
+
+def feed_problem(tc: Any) -> str:
+    """Why the tool controller's cutting feeds cannot run ('' when they can)."""
+    for name in ("HorizFeed", "VertFeed"):
+        v = float(_plain(getattr(tc, name, 0.0)))  # mm/s
+        if not (math.isfinite(v) and v > 0):
+            # tool controllers from FreeCAD's tool library start with no feeds: G1 F0 would stall the machine
+            return (f"tool controller '{tc.Label}': {name} must be a feed > 0 mm/min, got {v * 60:g} mm/min "
+                    "(set the cutting feeds in the tool controller)")
+    return ""
+
+
+# posts that write no spindle words (cutter location data): a spindle speed of 0 is no problem for them
+NO_SPINDLE_POSTS = ("apt_cl",)
+
+
+def spindle_problem(obj: Any) -> str:
+    """'' unless the op's tool controller turns the spindle at 0 rpm and its Job's post writes spindle words
+    (the program would cut with the spindle stopped)."""
+    from tmm_workbench.app.compat import PathUtils
+
+    tc = getattr(obj, "ToolController", None)
+    job = PathUtils.findParentJob(obj)
+    if tc is None or job is None or getattr(tc, "SpindleDir", "Forward") == "None":
+        return ""
+    post = str(getattr(job, "PostProcessor", "") or "")
+    speed = float(_plain(getattr(tc, "SpindleSpeed", 0.0)))
+    if post and post not in NO_SPINDLE_POSTS and not (math.isfinite(speed) and speed > 0):
+        return (f"tool controller '{tc.Label}': SpindleSpeed is {speed:g} rpm with the spindle on, and the Job's "
+                f"post '{post}' writes it (S0): set the spindle speed in the tool controller")
+    return ""
 
 
 def create(proxy_class: type, view_kind: str, name: str, obj: Any = None, parentJob: Any = None,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, replace
 
-from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.errors import WorkLimitError
 
 
 def _env(name: str, default: float) -> float:
@@ -60,7 +60,7 @@ def check_work(what: str, count: float, bytes_each: float, cause: str, limit: st
     most = getattr(limits, limit)
     memory = count * bytes_each
     if count > most or memory > limits.max_memory_bytes:
-        raise TmmError(
+        raise WorkLimitError(
             f"{cause} gives about {count:.3g} {what} ({memory / 1e9:.3g} GB): more than this machine's limit of "
             f"{most:.3g} {what} and {limits.max_memory_bytes / 1e9:.3g} GB; use coarser values or a smaller "
             f"boundary (limits: TMM_{limit.upper()} / TMM_MAX_MEMORY_GB, or core.limits.set_limits)")

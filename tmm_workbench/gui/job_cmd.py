@@ -12,7 +12,6 @@ from PySide import QtCore, QtGui
 
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app.compat import import_gui
-from tmm_workbench.core.errors import TmmError
 from tmm_workbench.gui import resources
 
 COMMAND_NAME = "TMM_JobFromModel"
@@ -43,11 +42,12 @@ class CommandJobFromModel:
                                                         "STL (*.stl *.STL);;All files (*)")
             if not name:
                 return
-            model = import_stl(name)
         try:
-            create_job_gui(model)
-        except TmmError as exc:
-            QtGui.QMessageBox.warning(FreeCADGui.getMainWindow(), "TMM", str(exc))
+            create_job_gui(import_stl(name) if model is None else model)
+        except Exception as exc:  # noqa: BLE001 - a box, one report line, the traceback in the log
+            from tmm_workbench.gui import messages
+
+            messages.report("TMM Job from model", exc)
 
 
 def import_stl(path: str) -> Any:

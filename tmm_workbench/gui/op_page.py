@@ -11,10 +11,10 @@ from typing import Any, Callable
 
 import FreeCAD
 import FreeCADGui
-from PySide import QtGui
+from PySide import QtCore, QtGui
 
 from tmm_workbench.app.compat import PathOp, PathUtils, command_prefix, import_gui
-from tmm_workbench.gui import resources
+from tmm_workbench.gui import field_limits, messages, resources
 
 PathOpGui = import_gui("op_gui")
 PathGui = import_gui("path_gui")
@@ -46,6 +46,7 @@ class OpPage(PathOpGui.TaskPanelPage):
     def initPage(self, obj: Any) -> None:
         self.spins = {prop: PathGui.QuantitySpinBox(getattr(self.form, widget), obj, prop)
                       for widget, prop in self.SPIN_BOXES.items()}
+        self.init_limits(obj)
         for widget, prop in self.COMBOS.items():
             combo = getattr(self.form, widget)
             combo.clear()
@@ -53,8 +54,10 @@ class OpPage(PathOpGui.TaskPanelPage):
         self.init_extra(obj)
 
     def getFields(self, obj: Any) -> None:
-        for spin in self.spins.values():
-            spin.updateProperty()
+        held = self.guard.held(obj) if getattr(self, "guard", None) else set()
+        for prop, spin in self.spins.items():
+            if prop not in held:  # a refused value never reaches the op
+                spin.updateProperty()
         for widget, prop in self.COMBOS.items():
             value = getattr(self.form, widget).currentText()
             if value and getattr(obj, prop) != value:
@@ -66,6 +69,7 @@ class OpPage(PathOpGui.TaskPanelPage):
         self.get_extra(obj)
         self.updateToolController(obj, self.form.toolController)
         self.updateCoolant(obj, self.form.coolantController)
+        self.showStatus(obj)
 
     def setFields(self, obj: Any) -> None:
         for spin in self.spins.values():
@@ -86,13 +90,7 @@ class OpPage(PathOpGui.TaskPanelPage):
             pass
 
     def show_status(self, obj: Any) -> None:
-        if obj.isValid():
-            moves = len(obj.Path.Commands)
-            self.form.status.setStyleSheet("")
-            self.form.status.setText(f"{moves} path commands" if moves else "")
-        else:
-            self.form.status.setStyleSheet("color: #c00000")
-            self.form.status.setText(obj.getStatusString())
+        self.show_result(obj)
 
     def getSignalsForUpdate(self, obj: Any) -> list[Any]:
         signals = [getattr(self.form, w).editingFinished for w in self.SPIN_BOXES]
@@ -121,6 +119,45 @@ class OpPage(PathOpGui.TaskPanelPage):
     def extra_signals(self) -> list[Any]:
         return []
 
+    # Field limits, work estimate and the status line (gui.field_limits, gui.messages).
+    def init_limits(self, obj: Any) -> None:
+        self.guard = field_limits.FieldGuard(self, obj)
+        self.form.status.setWordWrap(True)
+
+    def show_result(self, obj: Any) -> None:
+        """The status line now, and again once the recompute is over (an op that fails empties its Path
+        before FreeCAD marks it invalid)."""
+        self.fill_status(obj)
+        if not getattr(self, "_status_pending", False):
+            self._status_pending = True
+            QtCore.QTimer.singleShot(0, lambda: self._status_later(obj))
+
+    def _status_later(self, obj: Any) -> None:
+        self._status_pending = False
+        try:
+            self.fill_status(obj)
+        except (RuntimeError, ReferenceError):  # the panel or the op went in the meantime
+            pass
+
+    def fill_status(self, obj: Any) -> None:
+        """The status line: refused values, else the op's error, the tool controller's missing feeds, the
+        last result (moves, cuts, cycle time) and the work estimate, and a spindle speed the post needs."""
+        from tmm_workbench.app.op_base import feed_problem, spindle_problem
+
+        guard = getattr(self, "guard", None)
+        tc = getattr(obj, "ToolController", None)
+        errors = guard.problems() if guard else []
+        if not errors and not obj.isValid():
+            errors = [obj.getStatusString()]
+        if not errors and tc is not None and feed_problem(tc):
+            errors = [feed_problem(tc)]
+        lines = errors or [t for t in (messages.result_text(obj), guard.estimate_text if guard else "") if t]
+        spindle = spindle_problem(obj)
+        if spindle:
+            lines.append(spindle)
+        self.form.status.setStyleSheet("color: #c00000" if errors else ("color: #a05000" if spindle else ""))
+        self.form.status.setText("\n".join(lines))
+
 
 class OpViewProvider(PathOpGui.ViewProvider):
     """PathOpGui's view provider with the op icon read from the add-on's file (class attribute ICON), and
@@ -130,6 +167,10 @@ class OpViewProvider(PathOpGui.ViewProvider):
 
     def getSelectionFactory(self) -> Any:
         return lambda: None
+
+    def setupTaskPanel(self, panel: Any) -> None:
+        field_limits.guard_panel(panel)  # OK / Apply compute nothing while a value is refused
+        super().setupTaskPanel(panel)
 
     def getIcon(self) -> str:
         if self.Object is not None and not self.Object.Active:

@@ -410,7 +410,12 @@ class CommandSimulate:
             QtGui.QMessageBox.information(FreeCADGui.getMainWindow(), "TMM",
                                           "Close the open task panel first, then simulate.")
             return
-        FreeCADGui.Control.showDialog(SimulatePanel(target))
+        try:
+            FreeCADGui.Control.showDialog(SimulatePanel(target))
+        except Exception as exc:  # noqa: BLE001 - a box, one report line, the traceback in the log
+            from tmm_workbench.gui import messages
+
+            messages.report("TMM Simulate", exc)
 
 
 FreeCADGui.addCommand(COMMAND_NAME, CommandSimulate())

@@ -27,6 +27,12 @@ def _dialog_progress(label: str) -> Any:
     return progress_dialog.factory(label)
 
 
+def _failure_box(obj: Any, message: str) -> None:
+    from tmm_workbench.gui import messages
+
+    messages.on_failure(obj, message)
+
+
 def install_hooks() -> None:
     from tmm_workbench.app import hooks, progress, registry
 
@@ -34,6 +40,8 @@ def install_hooks() -> None:
         hooks.view_hooks.setdefault(entry.view_kind, _op_view(entry))
     hooks.view_hooks.setdefault("job", _job_view)
     progress.progress_factory = _dialog_progress
+    if _failure_box not in hooks.failure_hooks:
+        hooks.failure_hooks.append(_failure_box)
     from tmm_workbench.app.compat import freecad_version
 
     if freecad_version() >= (1, 0):

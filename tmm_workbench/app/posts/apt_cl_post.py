@@ -4,6 +4,7 @@ representation (X Y Z tip, U V W tool axis; docs/path5.md); plain 3-axis paths p
 All logic lives in tmm_workbench.core.post.apt_writer; this module keeps no state between exports.
 """
 from tmm_workbench.core.post import apt_writer as _writer
+from tmm_workbench.app import hooks as _hooks
 from tmm_workbench.app import post_objects as _objects
 
 TOOLTIP = """TMM APT CL post: GOTO/x,y,z,i,j,k (tool tip and tool axis), CUTTER, LOADTL, FEDRAT, SPINDL."""
@@ -21,3 +22,6 @@ def export(objectslist, filename, argstring):
         with open(filename, "w") as f:
             f.write(text)
     return text
+
+
+export = _hooks.reported("post 'apt_cl'", export)  # a failure shows a message box in the GUI

@@ -6,6 +6,7 @@ by --inches). Reads TMM's 5-axis Path representation (X Y Z tip, U V W tool axis
 All logic lives in tmm_workbench.core.post.tarus_writer; this module only adapts FreeCAD's post interface
 and keeps no state between exports (FreeCAD reloads posts, module globals would leak otherwise).
 """
+from tmm_workbench.app import hooks as _hooks
 from tmm_workbench.app import post_objects as _objects
 from tmm_workbench.core.post import tarus_writer as _writer
 
@@ -29,3 +30,6 @@ def export(objectslist, filename, argstring):
             f.write(result.text)
     LAST_RESULT = result
     return result.text
+
+
+export = _hooks.reported("post 'tarus'", export)  # a failure shows a message box in the GUI

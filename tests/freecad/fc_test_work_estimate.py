@@ -1,0 +1,92 @@
+"""The work estimate of an op from its properties (app.work_estimate): an upper bound of what the strategy
+really computes, refused above the limits before the op loads or tessellates its model; the ranges of the
+properties that name no params field; the spindle speed a post needs; no message box hook headless."""
+from __future__ import annotations
+
+import time
+
+import FreeCAD
+import Part
+
+from fc_helpers import FreeCADTestCase, bump_stl, job_with_op, new_doc
+from tmm_workbench.app import hooks, work_estimate
+from tmm_workbench.app.op_base import spindle_problem
+from tmm_workbench.app.tools import cutter_from_tool
+from tmm_workbench.core.errors import TmmError, WorkLimitError
+from tmm_workbench.core.strategies import raster_drop
+
+
+class WorkEstimate(FreeCADTestCase):
+    def test_estimate_bounds_the_strategy_points(self) -> None:
+        """The panel's number is an upper bound of the CL points the strategy drops, and not far above it."""
+        doc = new_doc("TmmEstimate")
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"BoundaryShape": "Model", "StepOver": 1.5,
+                                                              "SampleStep": 0.4})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        mesh = op.Proxy.mesh
+        params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
+        points = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params).diagnostics["points"]
+        self.assertEqual(est.what, "CL points")
+        self.assertGreaterEqual(est.count, points)
+        self.assertLess(est.count, 3.0 * points, (est.count, points))
+        # an override is what the panel asks before writing the value: the op is not changed
+        finer = work_estimate.estimate(op, {"SampleStep": 0.2})
+        self.assertGreater(finer.count, 1.8 * est.count)
+        self.assertAlmostEqual(op.SampleStep.Value, 0.4)
+        with self.assertRaises(WorkLimitError) as ctx:
+            work_estimate.estimate(op, {"SampleStep": 1e-5})
+        self.assertIn("sample step 1e-05 mm", str(ctx.exception))
+        with self.assertRaises(TmmError) as ctx:
+            work_estimate.estimate(op, {"StepOver": -1.0})
+        self.assertIn("step-over must be a positive length, got -1", str(ctx.exception))
+
+    def test_part_model_refused_before_tessellation(self) -> None:
+        """A Part model with a tessellation tolerance below the range, or a raster above the limit: the op fails
+        at once, from the bounding boxes, without tessellating the sphere."""
+        doc = new_doc("TmmEstimatePart")
+        ball = doc.addObject("Part::Feature", "Ball")
+        ball.Shape = Part.makeSphere(200.0)
+        doc.recompute()
+        job, _, op = job_with_op(doc, ball, values={"StepOver": 5.0, "SampleStep": 5.0, "BoundaryShape": "Model"})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        for prop, value, fragment in (("LinearDeflection", 1e-6, "tessellation tolerance must be in [0.001, 10] mm"),
+                                      ("SampleStep", 1e-4, "CL points")):
+            old = getattr(op, prop).Value
+            setattr(op, prop, value)
+            t0 = time.perf_counter()
+            op.touch()
+            doc.recompute()
+            self.assertLess(time.perf_counter() - t0, 2.0)
+            self.assertFalse(op.isValid())
+            self.assertIn(fragment, op.getStatusString())
+            self.assertEqual(len(op.Path.Commands), 0)
+            setattr(op, prop, old)
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+
+    def test_spindle_speed_needed_by_the_post(self) -> None:
+        doc = new_doc("TmmSpindle")
+        job, tc, op = job_with_op(doc, str(bump_stl()))
+        job.PostProcessor = "linuxcnc"
+        self.assertEqual(spindle_problem(op), "")
+        tc.SpindleSpeed = 0.0
+        self.assertIn("SpindleSpeed is 0 rpm", spindle_problem(op))
+        self.assertIn("'linuxcnc'", spindle_problem(op))
+        job.PostProcessor = "apt_cl"  # cutter location data: no spindle words
+        self.assertEqual(spindle_problem(op), "")
+        job.PostProcessor = "linuxcnc"
+        tc.SpindleDir = "None"
+        self.assertEqual(spindle_problem(op), "")
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())  # reported, not refused
+
+    def test_no_failure_box_headless(self) -> None:
+        seen = []
+        hooks.failure_hooks.append(lambda obj, message: seen.append(message))
+        try:
+            hooks.report_failure(None, "x")
+        finally:
+            hooks.failure_hooks.pop()
+        self.assertFalse(FreeCAD.GuiUp)
+        self.assertEqual(seen, [])

@@ -1,0 +1,247 @@
+"""The work of a TMM op estimated from its properties alone (bounding boxes, never a mesh or a tool path), by
+the strategies' own `estimate_work` through core.limits: the panel runs it when a value is entered (with the
+value not yet written, `overrides`), and `TmmOp.execute` runs it before the op loads or tessellates anything.
+A value above the work limits raises the strategies' TmmError (what, how many, which parameters).
+
+Also the ranges of the op's length and angle properties that name no params field (`EXTRA_SPECS`): the
+panel's minimum and maximum for them, checked here like the params' own.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any, Mapping, Optional
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.params import Spec, check, spec_of
+
+# properties that name no params field: their allowed range (a length beyond 10 m is a typing slip)
+EXTRA_SPECS: dict[str, Spec] = {
+    "LinearDeflection": Spec("tessellation tolerance", "mm", low=0.001, high=10.0),
+    "BoundaryMargin": Spec("boundary margin", "mm", low=-100_000.0, high=100_000.0),
+    "AxisRetract": Spec("axis retract", "mm", low=0.0, high=1000.0),
+    "FinalZ": Spec("final depth", "mm", low=-10_000.0, high=10_000.0),
+    "TopZ": Spec("top", "mm", low=-10_000.0, high=10_000.0),
+    "BottomZ": Spec("bottom", "mm", low=-10_000.0, high=10_000.0),
+    "PlungeAngle": Spec("plunge angle", "deg", low=0.0, high=90.0),
+    "SampleStep": Spec("sample step", "mm", low=0.0, high=1000.0, optional=True),  # waterline: 0 derives it
+}
+# a side of a range the params leave open, for the panel's minimum / maximum
+OPEN_HIGH = {"mm": 10_000.0, "deg": 360.0, "%": 100.0}
+
+
+@dataclass(frozen=True)
+class Estimate:
+    count: float   # what the strategy estimates: CL points, tool positions, loop points...
+    what: str
+    passes: Optional[int] = None
+
+    def text(self) -> str:
+        passes = f", {self.passes} passes" if self.passes else ""
+        return f"about {self.count:.3g} {self.what}{passes}"
+
+
+def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
+    for row in getattr(proxy, "PROPERTIES", ()):
+        if row.name == prop and row.field and proxy.PARAMS is not None:
+            return spec_of(proxy.PARAMS, row.field)
+    return None
+
+
+def spec_for(proxy: Any, prop: str) -> Optional[Spec]:
+    """The allowed range of the op's property `prop`: its params field's Spec, else EXTRA_SPECS."""
+    return _field_spec(proxy, prop) or EXTRA_SPECS.get(prop)
+
+
+def check_value(proxy: Any, prop: str, value: float) -> None:
+    """TmmError naming the parameter, its value and its range when `value` does not fit (0 on an optional
+    field means 'derive it', as the ops read it)."""
+    spec = spec_for(proxy, prop)
+    if spec is None or (spec.optional and value == 0):
+        return
+    check(spec, value)
+
+
+def check_ranges(obj: Any, overrides: Optional[Mapping[str, float]] = None) -> None:
+    """The op's properties that name no params field inside EXTRA_SPECS (a tessellation tolerance of 1e-6 mm
+    would tessellate a Part model into more triangles than memory holds)."""
+    ov = dict(overrides or {})
+    for prop in EXTRA_SPECS:
+        if prop not in ov and hasattr(obj, prop) and _field_spec(obj.Proxy, prop) is None:
+            check_value(obj.Proxy, prop, _value(obj, prop, ov))
+
+
+def _value(obj: Any, prop: str, overrides: Mapping[str, float]) -> Any:
+    if prop in overrides:
+        return overrides[prop]
+    v = getattr(obj, prop)
+    return float(v.Value) if hasattr(v, "Value") else v
+
+
+def _params(proxy: Any, obj: Any, overrides: Mapping[str, float], **extra: Any) -> Any:
+    fields = {row.field: overrides[row.name] for row in proxy.PROPERTIES if row.field and row.name in overrides}
+    return proxy.params_from(obj, **{**fields, **extra})
+
+
+def _box(o: Any) -> Any:
+    mesh = getattr(o, "Mesh", None)
+    return mesh.BoundBox if mesh is not None and not hasattr(o, "Shape") else o.Shape.BoundBox
+
+
+def model_bounds(proxy: Any, obj: Any, load_stl: bool) -> Optional[tuple[float, ...]]:
+    """(xmin, ymin, zmin, xmax, ymax, zmax) of what the op machines, from bounding boxes (TMM's stand-in
+    boxes have the mesh's); an STL file is read only with `load_stl` (else None)."""
+    if getattr(obj, "StlFile", ""):
+        return _stl_bounds(obj.StlFile) if load_stl else None
+    models = [obj.Model] if getattr(obj, "Model", None) is not None else list(getattr(proxy, "model", None) or [])
+    if not models:
+        from tmm_workbench.app.compat import PathUtils
+
+        job = PathUtils.findParentJob(obj)
+        models = list(job.Model.Group) if job is not None else []
+    if not models:
+        raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
+    boxes = [_box(m) for m in models]
+    return (min(b.XMin for b in boxes), min(b.YMin for b in boxes), min(b.ZMin for b in boxes),
+            max(b.XMax for b in boxes), max(b.YMax for b in boxes), max(b.ZMax for b in boxes))
+
+
+_stl_cache: dict[tuple[str, float, int], tuple[float, ...]] = {}
+
+
+def _stl_bounds(path: str) -> tuple[float, ...]:
+    """An STL file's bounds, read once per file version (the panel asks on every value entered)."""
+    import os
+
+    from tmm_workbench.app import geometry
+
+    try:
+        st = os.stat(path)
+        key = (path, st.st_mtime, st.st_size)
+    except OSError:
+        key = (path, 0.0, -1)
+    if key not in _stl_cache:
+        lo, hi = geometry.mesh_from_stl(path).bounds  # a missing or bad file: its TmmError
+        _stl_cache.clear()
+        _stl_cache[key] = (*map(float, lo), *map(float, hi))
+    return _stl_cache[key]
+
+
+def _stock(obj: Any) -> Any:
+    from tmm_workbench.app.compat import PathUtils
+
+    job = PathUtils.findParentJob(obj)
+    stock = getattr(job, "Stock", None) if job is not None else None
+    if stock is None or stock.Shape.isNull():
+        raise TmmError("boundary 'Stock': the Job has no stock")
+    return stock.Shape.BoundBox
+
+
+def _cutter(obj: Any) -> Any:
+    from tmm_workbench.app.tools import cutter_from_tool
+
+    return cutter_from_tool(obj.ToolController.Tool)
+
+
+def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+    from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+    from tmm_workbench.core.footprint.raster import pass_count
+    from tmm_workbench.core.strategies import raster_drop
+
+    if obj.BoundaryShape == "Stock":
+        bb = _stock(obj)
+        x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
+    else:
+        b = model_bounds(proxy, obj, load_stl)
+        if b is None:
+            return None
+        x0, y0, x1, y1 = b[0], b[1], b[3], b[4]
+    m = _value(obj, "BoundaryMargin", ov)
+    params = _params(proxy, obj, ov, boundary=(x0 - m, y0 - m, x1 + m, y1 + m))
+    params.validate()
+    stepover = params.stepover
+    if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
+        stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
+    count = raster_drop.estimate_work(replace(params, stepover=stepover))
+    w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
+    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover))
+
+
+def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+    from tmm_workbench.core.strategies import waterline
+
+    cutter = _cutter(obj)
+    b = model_bounds(proxy, obj, load_stl)
+    if b is None:
+        return None
+    if obj.BoundaryShape == "Stock":
+        bb = _stock(obj)
+        box = (bb.XMin, bb.YMin, bb.XMax, bb.YMax)
+    else:
+        r = cutter.radius
+        box = (b[0] - r, b[1] - r, b[3] + r, b[4] + r)
+    m = _value(obj, "BoundaryMargin", ov)
+    sample = _value(obj, "SampleStep", ov)
+    extra: dict[str, Any] = {"boundary": (box[0] - m, box[1] - m, box[2] + m, box[3] + m),
+                             "sample_step": None if sample == 0 else sample}
+    top, bottom = b[5], b[2]
+    if obj.UseZRange:
+        top, bottom = _value(obj, "TopZ", ov), _value(obj, "BottomZ", ov)
+        extra.update(top_z=top, bottom_z=bottom)
+    params = _params(proxy, obj, ov, **extra)
+    count = waterline.estimate_work(params, cutter, top, bottom)
+    return Estimate(count, "waterline drops and points", len(waterline.levels(top, bottom, params.step_down)))
+
+
+def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+    from tmm_workbench.app.op_roughing import stock_box_of
+    from tmm_workbench.app.compat import PathUtils
+    from tmm_workbench.core.strategies import zlevel_rough
+
+    job = PathUtils.findParentJob(obj)
+    stock = getattr(job, "Stock", None) if job is not None else None
+    if stock is None or stock.Shape.isNull() or not stock.Shape.Solids:
+        raise TmmError("the Job has no stock solid to rough from")
+    final_z = _value(obj, "FinalZ", ov) if obj.UseFinalZ else None
+    params = _params(proxy, obj, ov, final_z=final_z, stock_box=stock_box_of(stock))
+    params.validate()
+    return Estimate(zlevel_rough.estimate_work(params, _cutter(obj)), "roughing loop points")
+
+
+def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+    from tmm_workbench.core.footprint.raster import pass_count
+    from tmm_workbench.core.strategies import multipoint
+
+    if not obj.Base or not obj.Base[0][1]:
+        return None  # the op says what is missing when it computes
+    base, subs = obj.Base[0]
+    bb = base.Shape.getElement(subs[0]).BoundBox
+    params = _params(proxy, obj, ov)
+    params.validate()
+    m = float(params.margin)
+    rect = (bb.XMin - m, bb.YMin - m, bb.XMax + m, bb.YMax + m)
+    count = multipoint.estimate_work(rect, params)
+    return Estimate(count, "tool positions",
+                    pass_count(math.hypot(rect[2] - rect[0], rect[3] - rect[1]), params.side_step))
+
+
+_BY_CLASS = {"ObjectTmmSurface": _surface, "ObjectTmmWaterline": _waterline, "ObjectTmmRoughing": _roughing,
+             "ObjectTmmMultipoint": _multipoint}
+
+
+def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl: bool = True) -> Optional[Estimate]:
+    """The op's work with its properties (and `overrides`: property -> value in mm / deg / %), refused by a
+    TmmError above the work limits (the user's preferences) or for a value out of its range; None when it
+    cannot be told without reading the model (an STL file and not `load_stl`, no face yet)."""
+    from tmm_workbench.app.op_base import apply_work_limits
+
+    proxy = obj.Proxy
+    ov = dict(overrides or {})
+    for prop, value in ov.items():
+        check_value(proxy, prop, value)
+    check_ranges(obj, ov)
+    run = _BY_CLASS.get(type(proxy).__name__)
+    if run is None:
+        return None
+    apply_work_limits()
+    return run(proxy, obj, ov, load_stl)
