@@ -277,6 +277,14 @@ def smoke() -> dict:
     off = page.findChild(QtGui.QComboBox, "offModel")
     info["panel_off_model"] = [off.currentText(), [off.itemText(i) for i in range(off.count())]]
     assert info["panel_off_model"] == [ops[0].OffModel, ["Floor", "Skip"]], info["panel_off_model"]
+    # the region group box (issue 14 item 3): its choices and the op's values
+    reg = page.findChild(QtGui.QComboBox, "region")
+    info["panel_region"] = [reg.currentText(), [reg.itemText(i) for i in range(reg.count())]]
+    assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch"]], info["panel_region"]
+    pattern = page.findChild(QtGui.QComboBox, "pattern")
+    assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
+    info["panel_slope_max"] = page.findChild(QtGui.QWidget, "slopeMax").property("rawValue")
+    assert info["panel_slope_max"] == 90.0, info["panel_slope_max"]
     mw = FreeCADGui.getMainWindow()
     for dock in mw.findChildren(QtGui.QDockWidget):
         if dock.isVisible() and dock.isAncestorOf(page):
