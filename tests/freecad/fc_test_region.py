@@ -108,6 +108,10 @@ class RegionFromFaces(FreeCADTestCase):
         self.assertGreaterEqual(min(dist(p) for p in pts), RADIUS - 0.011)
         with self.assertRaisesRegex(Exception, r"slope_max must be .*got 120"):
             run_surface(model, diameter=4, region=ring, slope_range=(0, 120), progress=False)
+        with self.assertRaisesRegex(Exception, r"region_tolerance must be .*got 0"):
+            run_surface(model, diameter=4, region=ring, region_tolerance=0.0, progress=False)
+        with self.assertRaisesRegex(Exception, r"region must be None \(the box\), a sketch, face names"):
+            run_surface(model, diameter=4, region=[3.5], progress=False)
 
 
 class RegionFromSketch(FreeCADTestCase):
@@ -161,6 +165,11 @@ class RegionFromSketch(FreeCADTestCase):
         self.assertIn("no reachable point", op.getStatusString())
         self.assertEqual(len(op.Path.Commands), 0)
         op.Region = "Sketch"
+        op.RegionTolerance = 0.0
+        op.SlopeMin = 0.0
+        doc.recompute()
+        self.assertIn("RegionTolerance must be in [0.001, 10] mm, got 0 mm", op.getStatusString())
+        op.RegionTolerance = 0.01
         op.RegionSketch = None
         op.SlopeMin = 0.0
         op.SlopeMax = 90.0

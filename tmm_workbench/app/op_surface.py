@@ -71,7 +71,7 @@ PROPERTIES: list[Prop] = [
          "Where the tool centre may go: Box (BoundaryShape with BoundaryMargin), Faces (RegionFaces seen from "
          "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes)"),
     Prop("App::PropertyLinkSubListGlobal", "RegionFaces", "Region", "Faces of the model bounding the region"),
-    Prop("App::PropertyLinkGlobal", "RegionSketch", "Region", "Sketch (or closed edges) bounding the region"),
+    Prop("App::PropertyLink", "RegionSketch", "Region", "Sketch (or closed edges) bounding the region"),
     Prop("App::PropertyDistance", "RegionTolerance", "Region",
          "How far the region's polygon may depart from the faces' or the sketch's exact outline"),
     Prop("App::PropertyEnumeration", "SpiralDirection", "Surface",
@@ -185,7 +185,7 @@ def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
 
 def SetupProperties() -> list[str]:
     """Properties the Job's SetupSheet may hold defaults for."""
-    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model"))
+    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model", "RegionFaces", "RegionSketch"))
 
 
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,

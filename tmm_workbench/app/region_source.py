@@ -20,6 +20,8 @@ from tmm_workbench.core.polygons import Shape
 
 BOX, FACES, SKETCH = "Box", "Faces", "Sketch"
 REGIONS = (BOX, FACES, SKETCH)
+TOLERANCE_RANGE = (0.001, 10.0)  # mm
+MAX_TRIANGLES = 2_000_000        # of the selected faces' tessellation: refused above, before the union
 
 
 def _label(obj: Any) -> str:
@@ -68,6 +70,10 @@ def faces_region(links: list[tuple[Any, tuple[str, ...]]], models: list[Any], to
                 continue
             p = np.array([(v.x, v.y) for v in points], dtype=float)
             tris.append(p[np.array(triangles, dtype=np.int64)])
+            count = sum(len(t) for t in tris)
+            if count > MAX_TRIANGLES:
+                raise TmmError(f"Region 'Faces': the selected faces give {count} triangles at RegionTolerance "
+                               f"{tolerance:g} mm, more than {MAX_TRIANGLES}: make the tolerance larger")
         if not subs:
             raise TmmError(f"Region 'Faces': no face of {_label(obj)} named (select faces, not the object)")
     if not tris:
@@ -103,8 +109,9 @@ def region_of(op: Any, job: Any) -> Optional[Shape]:
     if kind == BOX:
         return None
     tolerance = float(op.RegionTolerance.Value)
-    if not tolerance > 0:
-        raise TmmError(f"RegionTolerance must be a length > 0 mm, got {tolerance:g} mm")
+    if not TOLERANCE_RANGE[0] <= tolerance <= TOLERANCE_RANGE[1]:  # finer would tessellate without bound
+        raise TmmError(f"RegionTolerance must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] mm, got "
+                       f"{tolerance:g} mm")
     if kind == FACES:
         return faces_region(list(op.RegionFaces or []), model_objects(op, job), tolerance)
     return sketch_region(op.RegionSketch, tolerance)
@@ -116,13 +123,13 @@ def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
     region None (the box), an object with closed edges (a sketch), or faces: names of the model's faces
     ("Face3", ["Face3", "Face5"]) or (object, names) pairs; slope_range (min, max) deg or None."""
     from tmm_workbench.app.api import _numbers, _option
-    from tmm_workbench.core.params import spec_of
+    from tmm_workbench.core.params import Spec, spec_of
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
     values: dict[str, Any] = {"SpiralDirection": _option("spiral_direction", spiral_direction,
                                                          {"outward": "Outward", "inward": "Inward"})}
     if tolerance is not None:
-        _numbers(region_tolerance=(tolerance, spec_of(SurfaceParams, "stepover")))
+        _numbers(region_tolerance=(tolerance, Spec("", "mm", low=TOLERANCE_RANGE[0], high=TOLERANCE_RANGE[1])))
         values["RegionTolerance"] = tolerance
     if slope_range is not None:
         try:

@@ -85,9 +85,11 @@ def zigzag_chains(pieces: Sequence[Sequence[np.ndarray]], shape: Shape, max_link
     edges = edges_of(shape)
     left = [list(range(len(p))) for p in pieces]
     chains: list[Chain] = []
+    first = 0  # the first pass with a piece left: a chain takes pieces only after it, so it only grows
     while True:
-        first = next((i for i, rest in enumerate(left) if rest), None)
-        if first is None:
+        while first < len(left) and not left[first]:
+            first += 1
+        if first == len(left):
             return chains
         j = left[first].pop(0)
         piece = pieces[first][j]
