@@ -212,6 +212,29 @@ def test_bad_region_input_is_refused_by_name():
         region.loops_region([np.array([[0, 0], [1, 1], [2, 2]])], "sketch 'S'")
 
 
+def test_spiral_work_is_estimated_before_it_is_made():
+    from tmm_workbench.core import limits
+
+    shape = ring_with_notch()
+    old = limits.set_limits(max_points=20000)
+    try:
+        # the spiral out to the farthest vertex (r 20): 20^2 pi / 0.1 / 0.1 = 1.3e5 points
+        with pytest.raises(TmmError, match=r"gives about 1\.3\d*e\+05 CL points .* more than this machine's limit"):
+            compute(WAVY, Cutter.ball(4), SurfaceParams(boundary=polygons.bounds(shape), stepover=0.1,
+                                                        sample_step=0.1, region=shape, pattern="spiral"))
+    finally:
+        limits.set_limits(max_points=old.max_points)
+
+
+def test_cusp_and_adaptive_spacing_work_in_a_region():
+    shape = ring_with_notch()
+    for mode in ("cusp", "adaptive"):
+        params = SurfaceParams(boundary=polygons.bounds(shape), stepover=1.0, sample_step=0.5, region=shape,
+                               stepover_mode=mode, cusp=0.03)
+        result = compute(WAVY, Cutter.ball(6), params)
+        assert result.diagnostics["stepover"] < 1.0 and result.diagnostics["passes"] > 40
+
+
 def test_loops_nest_into_holes_and_islands():
     outer = polygons.rectangle(0, 0, 10, 10)
     hole = polygons.rectangle(2, 2, 8, 8)

@@ -100,7 +100,7 @@ def clip_curve(curve: np.ndarray, shape: Shape) -> list[np.ndarray]:
 def spiral_pieces(shape: Shape, stepover: float, sample_step: float, inward: bool = False) -> list[np.ndarray]:
     """The spiral footprint of the region: its pieces inside the region in cutting order."""
     centre = centre_of(shape)
-    r_max = float(np.hypot(*(np.vstack(shape) - centre).T).max()) + 1e-6
+    r_max = float(np.hypot(*(np.vstack(shape) - centre).T).max()) + 1e-6  # raster_region.spiral_radius
     pieces = clip_curve(spiral_points(centre, r_max, stepover, sample_step), shape)
     if inward:
         pieces = [p[::-1] for p in pieces[::-1]]

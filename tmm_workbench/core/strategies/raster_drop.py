@@ -101,10 +101,11 @@ def estimate_work(params: SurfaceParams) -> float:
     count = passes * (diagonal / params.sample_step + 2)
     if params.pattern == ZIGZAG:
         count += passes * (params.stepover / params.sample_step + 2)
-    if params.pattern == SPIRAL:  # the spiral over the circle round the boundary (core.footprint.spiral)
+    if params.pattern == SPIRAL:  # the spiral out to the region's farthest point (core.footprint.spiral)
         from tmm_workbench.core.footprint.spiral import spiral_length
+        from tmm_workbench.core.strategies.raster_region import spiral_radius
 
-        count = spiral_length(diagonal / 2, params.stepover) / params.sample_step + 8 * passes
+        count = spiral_length(spiral_radius(params), params.stepover) / params.sample_step + 8 * passes
     check_work("CL points", count, _BYTES_PER_POINT,
                f"sample step {params.sample_step:g} mm and step-over {params.stepover:g} mm over a "
                f"{w:.6g} x {h:.6g} mm boundary")

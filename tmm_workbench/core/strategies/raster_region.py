@@ -52,6 +52,12 @@ def shape_of(params: Any) -> Shape:
     return params.region if params.region is not None else region_mod.box_region(params.boundary)
 
 
+def spiral_radius(params: Any) -> float:
+    """How far the spiral goes from its centre: to the region's farthest vertex (for the work estimate)."""
+    shape = shape_of(params)
+    return float(np.hypot(*(np.vstack(shape) - spiral.centre_of(shape)).T).max())
+
+
 def max_link(stepover: float, cutter: Cutter) -> float:
     """The longest straight link cut with the tool down between two pieces (inside the region): three
     step-overs or the tool's diameter; longer gaps are jumps."""
