@@ -8,7 +8,6 @@ from typing import Any
 import FreeCADGui
 
 from tmm_workbench.app import region_source
-from tmm_workbench.app.compat import PathUtils
 
 SPIN_BOXES = {"regionTolerance": "RegionTolerance", "slopeMin": "SlopeMin", "slopeMax": "SlopeMax"}
 COMBOS = {"region": "Region", "spiralDirection": "SpiralDirection"}
@@ -17,14 +16,10 @@ NO_SKETCH = "(none)"
 
 def sketch_candidates(obj: Any) -> list[Any]:
     """Objects whose edges can bound a region: sketches and other 2D objects, and edge-only shapes whose
-    wires are all closed; the Job's own objects left out."""
-    job = PathUtils.findParentJob(obj)
-    own = set()
-    if job is not None:
-        own = {o.Name for o in job.Model.Group} | {job.Stock.Name if job.Stock else ""}
+    wires are all closed (the Job's model clones and stock are solids: never among them)."""
     out = []
     for o in obj.Document.Objects:
-        if o.Name in own or not hasattr(o, "Shape") or hasattr(o, "PathResource"):
+        if not hasattr(o, "Shape") or hasattr(o, "PathResource"):
             continue
         shape = o.Shape
         if shape.isNull() or not shape.Edges:
