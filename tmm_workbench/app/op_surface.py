@@ -56,7 +56,8 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass", "sample_step"),
     Prop("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X", "angle_deg"),
     Prop("App::PropertyEnumeration", "Pattern", "Surface",
-         "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes", "pattern"),
+         "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes; "
+         "Spiral: from the region's centre (SpiralDirection)", "pattern"),
     Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
     Prop("App::PropertyDistance", "ChordTolerance", "Surface",
          "How far above the CL points a longer straight move may pass where it replaces them (never below one; "
