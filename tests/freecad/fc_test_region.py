@@ -80,6 +80,14 @@ class RegionFromFaces(FreeCADTestCase):
         self.assertAlmostEqual(min(xs), 0.0, places=3)
         self.assertAlmostEqual(max(ys), 40.0, places=3)
         self.assertGreater(sum(1 for n, _ in moves(op) if n == "G0"), 4)  # jumps over the post
+        # in the GUI one selects the faces of the Job's model clone: the same region
+        clone = job.Model.Group[0]
+        self.assertIsNot(clone, model)
+        count = len(op.Path.Commands)
+        op.RegionFaces = [(clone, (ring,))]
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertEqual(len(op.Path.Commands), count)
 
     def test_faces_of_another_object_are_refused(self) -> None:
         doc = new_doc("TmmRegionOther")
