@@ -68,6 +68,14 @@ class RegionFromFaces(FreeCADTestCase):
         self.assertGreater(len(pts), 30)   # flat: each pass a few long moves (ChordTolerance)
         self.assertLessEqual(max(dist(p) for p in pts), RADIUS + 0.011)    # within the disc (+ tolerance)
         self.assertGreater(max(dist(p) for p in pts), RADIUS - 1.0)        # out to its edge
+        op.BoundaryMargin = -2.0                                           # shrunk as the box would be
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertLessEqual(max(dist(p) for p in cut_xy(op)), RADIUS - 2.0 + 0.011)
+        op.BoundaryMargin = -9.0
+        doc.recompute()
+        self.assertIn("Region 'Faces' shrunk by BoundaryMargin -9 mm leaves nothing", op.getStatusString())
+        op.BoundaryMargin = 0.0
         # the block's top face: the rectangle with the post's hole; the tool centre never in the hole
         ring = face_at(model, 10.0)
         op.RegionFaces = [(model, (ring,))]

@@ -7,6 +7,8 @@
   Sketch  `RegionSketch`: a sketch or any object whose edges form closed loops (a Draft wire, a Part
           circle...), discretised within `RegionTolerance` (global coordinates, its placement applied),
           projected along Z; inner loops are holes.
+Faces and Sketch regions are grown or shrunk by `BoundaryMargin` as the box is (minus the tool radius keeps
+the whole tool inside).
 """
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import region
 from tmm_workbench.core.polygons import Shape
@@ -113,8 +116,15 @@ def region_of(op: Any, job: Any) -> Optional[Shape]:
         raise TmmError(f"RegionTolerance must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] mm, got "
                        f"{tolerance:g} mm")
     if kind == FACES:
-        return faces_region(list(op.RegionFaces or []), model_objects(op, job), tolerance)
-    return sketch_region(op.RegionSketch, tolerance)
+        shape = faces_region(list(op.RegionFaces or []), model_objects(op, job), tolerance)
+    else:
+        shape = sketch_region(op.RegionSketch, tolerance)
+    margin = float(op.BoundaryMargin.Value)
+    if margin:  # as for the box: grown or shrunk on every side (-tool radius: the whole tool inside)
+        shape = polygons.offset(shape, margin, arc_tol=min(tolerance, polygons.ARC_TOL))
+        if not shape:
+            raise TmmError(f"Region '{kind}' shrunk by BoundaryMargin {margin:g} mm leaves nothing")
+    return shape
 
 
 def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
