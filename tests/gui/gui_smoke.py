@@ -294,7 +294,19 @@ def smoke() -> dict:
 
     screenshot(PNG)
     info["png"] = str(PNG)
+    # after the picture: a face selected in the 3D view becomes the region (Use selected faces)
+    region_box = r.doc.addObject("Part::Box", "RegionBox")
+    r.doc.recompute()
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(region_box, "Face6")
+    page.findChild(QtGui.QPushButton, "regionFacesButton").click()
+    info["panel_region_faces"] = [ops[0].Region, [[o.Name, list(subs)] for o, subs in ops[0].RegionFaces]]
+    assert info["panel_region_faces"] == ["Faces", [["RegionBox", ["Face6"]]]], info["panel_region_faces"]
+    assert "RegionBox.Face6" in page.findChild(QtGui.QLabel, "regionFacesInfo").text()
+    FreeCADGui.Selection.clearSelection()
     close_panel(ops[0])  # Cancel: the new op goes again
+    if r.doc.getObject("RegionBox") is not None:  # Cancel undoes what the panel did, the box too
+        r.doc.removeObject("RegionBox")
 
     simulate_panel(info, r)
 
