@@ -2,8 +2,8 @@
 1 mm, sample step 0.5 mm): the box raster (today) against a region with a hole (the box minus a disc of radius
 20 mm about its centre) by zig-zag, one-way and spiral, a disc (radius 35 mm) by zig-zag and spiral, and the box
 with the slope range (shallow: 0..30 deg; steep: 30..75 deg). Per row: pieces, jumps (lifts between chains), CL
-points, cutting and rapid length,
-TMM's cycle time estimate (1000 / 300 mm/min feeds, the default rapids) and the time to compute.
+points, cutting and rapid length, TMM's cycle time estimate (1000 / 300 mm/min feeds, the default rapids) and
+the time to compute.
 
     .venv/bin/python benchmarks/region_bench.py            # all rows
     .venv/bin/python benchmarks/region_bench.py --quick    # box and region zig-zag, region spiral

@@ -151,6 +151,12 @@ def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
         values.update(SlopeMin=low, SlopeMax=high)
     if region is None:
         return values
+    doc = getattr(model, "Document", None)  # an STL path gets a new document: no object of the caller's is in it
+    for obj in ([region] if hasattr(region, "TypeId") else
+                [i[0] for i in (region if isinstance(region, list) else [region]) if isinstance(i, tuple) and i]):
+        if getattr(obj, "Document", None) is not doc:
+            raise TmmError(f"region {_label(obj)} must be in the model's document (an STL path makes a new "
+                           f"one: pass a Mesh or Part object of the region's document as the model)")
     if hasattr(region, "TypeId"):
         values.update(Region=SKETCH, RegionSketch=region)
         return values
