@@ -24,7 +24,7 @@ from tmm_workbench.core.polygons import Shape
 BOX, FACES, SKETCH = "Box", "Faces", "Sketch"
 REGIONS = (BOX, FACES, SKETCH)
 TOLERANCE_RANGE = (0.001, 10.0)  # mm
-MAX_TRIANGLES = 2_000_000        # of the selected faces' tessellation: refused above, before the union
+MAX_TRIANGLES = 500_000          # of the selected faces' tessellation: refused above, before the union (~20 s)
 
 
 def _label(obj: Any) -> str:

@@ -28,6 +28,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.polygons import Shape
 
 _MIN_PIECE_MM = 1e-6   # clipped pieces shorter than this are a touch of the boundary, not a pass
+_UNION_CHUNK = 2000   # triangles per first union (triangles_region)
 _LOOP_CLOSE_MM = 1e-6  # a loop whose last point repeats its first (within this) is closed by it
 
 
@@ -70,10 +71,27 @@ def triangles_region(triangles: np.ndarray, name: str = "faces") -> Shape:
     cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     keep = np.abs(cross) > 1e-12
     t = np.where((cross < 0)[:, None, None], t[:, ::-1], t)[keep]  # all counter-clockwise
-    shape = polygons.union(list(t)) if len(t) else []
+    # in chunks of neighbours (Morton order of the centroids), then the chunks' outlines pairwise: one union
+    # of many triangles costs more than linearly, compact patches have short outlines
+    t = t[_morton_order(t.mean(axis=1))]
+    parts = [polygons.union(list(t[k:k + _UNION_CHUNK])) for k in range(0, len(t), _UNION_CHUNK)]
+    while len(parts) > 1:
+        parts = [polygons.union(a, b) for a, b in zip(parts[::2], parts[1::2] + [[]] * (len(parts) % 2))]
+    shape = parts[0] if parts else []
     if not shape or polygons.area(shape) <= 1e-12:
         raise TmmError(f"{name}: seen from above the selected faces cover no area (vertical faces only?)")
     return shape
+
+
+def _morton_order(points: np.ndarray) -> np.ndarray:
+    """Indices sorting XY points along a Z-order curve (neighbours stay close in the order)."""
+    lo, span = points.min(axis=0), np.ptp(points, axis=0)
+    q = ((points - lo) / np.where(span > 0, span, 1.0) * 65535).astype(np.uint64)
+    code = np.zeros(len(points), dtype=np.uint64)
+    for bit in range(16):
+        for axis in (0, 1):
+            code |= ((q[:, axis] >> np.uint64(bit)) & np.uint64(1)) << np.uint64(2 * bit + axis)
+    return np.argsort(code, kind="stable")
 
 
 def check_overlap(shape: Shape, lo: Sequence[float], hi: Sequence[float]) -> None:
