@@ -104,7 +104,7 @@ def test_stock_to_leave_on_a_slope_is_a_normal_offset():
     (dict(boundary=(100, 100, 120, 120)), "lies outside the model"),
     (dict(safe_height=1.0, clearance_height=15.0), "safe height 1 mm is not above the highest tool position"),
     (dict(clearance_height=5.0), "clearance height 5 mm is below the safe height 10 mm"),
-    (dict(pattern="spiral"), "pattern must be"),
+    (dict(pattern="helix"), "pattern must be"),  # spiral is a pattern since issue 14 item 3
 ])
 def test_bad_parameters_raise_clear_errors(wavy_mesh, change, message):
     with pytest.raises(TmmError, match=message):

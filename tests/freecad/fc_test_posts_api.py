@@ -200,7 +200,7 @@ class Api(FreeCADTestCase):
         with self.assertRaises(TmmError) as ctx:
             run_surface(OUT / "nowhere.stl")
         self.assertIn("file not found", str(ctx.exception))
-        for kwargs, text in (({"tool": "chamfer"}, "tool must be one of"), ({"pattern": "spiral"}, "pattern"),
+        for kwargs, text in (({"tool": "chamfer"}, "tool must be one of"), ({"pattern": "helix"}, "pattern"),
                              ({"boundary": "custom"}, "boundary"),
                              ({"tool": "bullnose", "corner_radius": 4.0}, "larger than the tool radius"),
                              ({"stepover": 0.0}, "must be a positive length"),

@@ -277,6 +277,14 @@ def smoke() -> dict:
     off = page.findChild(QtGui.QComboBox, "offModel")
     info["panel_off_model"] = [off.currentText(), [off.itemText(i) for i in range(off.count())]]
     assert info["panel_off_model"] == [ops[0].OffModel, ["Floor", "Skip"]], info["panel_off_model"]
+    # the region group box (issue 14 item 3): its choices and the op's values
+    reg = page.findChild(QtGui.QComboBox, "region")
+    info["panel_region"] = [reg.currentText(), [reg.itemText(i) for i in range(reg.count())]]
+    assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch"]], info["panel_region"]
+    pattern = page.findChild(QtGui.QComboBox, "pattern")
+    assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
+    info["panel_slope_max"] = page.findChild(QtGui.QWidget, "slopeMax").property("rawValue")
+    assert info["panel_slope_max"] == 90.0, info["panel_slope_max"]
     mw = FreeCADGui.getMainWindow()
     for dock in mw.findChildren(QtGui.QDockWidget):
         if dock.isVisible() and dock.isAncestorOf(page):
@@ -286,7 +294,19 @@ def smoke() -> dict:
 
     screenshot(PNG)
     info["png"] = str(PNG)
+    # after the picture: a face selected in the 3D view becomes the region (Use selected faces)
+    region_box = r.doc.addObject("Part::Box", "RegionBox")
+    r.doc.recompute()
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(region_box, "Face6")
+    page.findChild(QtGui.QPushButton, "regionFacesButton").click()
+    info["panel_region_faces"] = [ops[0].Region, [[o.Name, list(subs)] for o, subs in ops[0].RegionFaces]]
+    assert info["panel_region_faces"] == ["Faces", [["RegionBox", ["Face6"]]]], info["panel_region_faces"]
+    assert "RegionBox.Face6" in page.findChild(QtGui.QLabel, "regionFacesInfo").text()
+    FreeCADGui.Selection.clearSelection()
     close_panel(ops[0])  # Cancel: the new op goes again
+    if r.doc.getObject("RegionBox") is not None:  # Cancel undoes what the panel did, the box too
+        r.doc.removeObject("RegionBox")
 
     simulate_panel(info, r)
 

@@ -39,7 +39,7 @@ _POSITIVE = Spec("", "mm", low=0, low_open=True, kind="length")
 _NON_NEGATIVE = Spec("", "mm", low=0, kind="length")
 _FEED = Spec("", "mm/min", low=0, low_open=True)
 _SPEED = Spec("", "rpm", low=0)
-PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay"}
+PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
@@ -61,6 +61,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
                 chord_tolerance: Optional[float] = None, stepover_mode: str = "stepover",
                 cusp: Optional[float] = None,
+                region: Any = None, slope_range: Optional[tuple[float, float]] = None,
+                spiral_direction: str = "outward", region_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
@@ -79,6 +81,11 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
     `cusp` on the boundary's steepest crossing) | 'adaptive' (each pass placed from the previous one's tool
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
+    region (where the tool centre may go; app.region_source): None (the boundary box), a sketch or any
+    object with closed edges (inner loops are holes), or faces of the model seen from above: face names
+    ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.
+    pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
+    max) deg, cut only where the surface slope lies in it (default all).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -98,6 +105,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
         extra["ChordTolerance"] = chord_tolerance
     if cusp is not None:
         extra["CuspHeight"] = cusp
+    from tmm_workbench.app import region_source
+
+    extra.update(region_source.api_values(region, model, spiral_direction, slope_range, region_tolerance))
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)

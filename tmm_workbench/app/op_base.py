@@ -117,6 +117,13 @@ class TmmOp(PathOp.ObjectOp):
                     setattr(obj, row.name, list(self.CHOICES[row.name]))
                 if restoring and row.name in defaults:  # an older document: what it computed then
                     setattr(obj, row.name, self.RESTORED_DEFAULTS.get(row.name, defaults[row.name]))
+            elif restoring and row.name in self.CHOICES:  # choices added since it was saved: offered, value kept
+                known = obj.getEnumerationsOfProperty(row.name) or []
+                if set(self.CHOICES[row.name]) - set(known):
+                    value = getattr(obj, row.name)
+                    setattr(obj, row.name, list(self.CHOICES[row.name]))
+                    if value in self.CHOICES[row.name]:
+                        setattr(obj, row.name, value)
         for name in self.READ_ONLY:
             obj.setEditorMode(name, 1)
 

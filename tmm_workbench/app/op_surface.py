@@ -18,19 +18,21 @@ from typing import Any, Optional
 
 import Path
 
-from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
+from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
                                                        STEPOVER, ZIGZAG, SurfaceParams)
+from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
-PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY}
+PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL}
 OFF_MODEL = {"Floor": OFF_MODEL_FLOOR, "Skip": OFF_MODEL_SKIP}
 BOUNDARIES = ("Stock", "Model")
 
@@ -54,7 +56,8 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyDistance", "SampleStep", "Surface", "Sampling step along a pass", "sample_step"),
     Prop("App::PropertyAngle", "RasterAngle", "Surface", "Direction of the passes, from +X", "angle_deg"),
     Prop("App::PropertyEnumeration", "Pattern", "Surface",
-         "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes", "pattern"),
+         "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes; "
+         "Spiral: from the region's centre (SpiralDirection)", "pattern"),
     Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
     Prop("App::PropertyDistance", "ChordTolerance", "Surface",
          "How far above the CL points a longer straight move may pass where it replaces them (never below one; "
@@ -64,12 +67,29 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "OffModel", "Surface",
          "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
          "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model"),
+    # --- machining region, spiral, slope range (issue 14 item 3; app.region_source) ---
+    Prop("App::PropertyEnumeration", "Region", "Region",
+         "Where the tool centre may go: Box (BoundaryShape with BoundaryMargin), Faces (RegionFaces seen from "
+         "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes)"),
+    Prop("App::PropertyLinkSubListGlobal", "RegionFaces", "Region", "Faces of the model bounding the region"),
+    Prop("App::PropertyLink", "RegionSketch", "Region", "Sketch (or closed edges) bounding the region"),
+    Prop("App::PropertyDistance", "RegionTolerance", "Region",
+         "How far the region's polygon may depart from the faces' or the sketch's exact outline"),
+    Prop("App::PropertyEnumeration", "SpiralDirection", "Surface",
+         "Spiral pattern: from the region's centre Outward, or Inward to it", "spiral_direction"),
+    Prop("App::PropertyAngle", "SlopeMin", "Surface",
+         "Cut only where the surface slope is at least this (shallower areas left to another op)", "slope_min_deg"),
+    Prop("App::PropertyAngle", "SlopeMax", "Surface",
+         "Cut only where the surface slope is at most this (steeper walls left to waterline)", "slope_max_deg"),
 ]
 SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE}
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
            "StepOverMode": SPACINGS}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
                             "BoundaryMargin": 0.0, "PlungeAngle": 45.0}
+CHOICES.update({"Region": {r: r for r in region_source.REGIONS},
+                "SpiralDirection": {"Outward": OUTWARD, "Inward": INWARD}})
+DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -101,7 +121,9 @@ class ObjectTmmSurface(op_base.TmmOp):
     def compute(self, obj: Any) -> None:
         mesh = self.model_mesh(obj)
         cutter = self.cutter()
-        params = self.params_from(obj, boundary=self.boundary(obj, mesh))
+        region = region_source.region_of(obj, PathUtils.findParentJob(obj))  # None: the box
+        boundary = self.boundary(obj, mesh) if region is None else polygons.bounds(region)
+        params = self.params_from(obj, boundary=boundary, region=region)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
@@ -164,7 +186,7 @@ def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
 
 def SetupProperties() -> list[str]:
     """Properties the Job's SetupSheet may hold defaults for."""
-    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model"))
+    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model", "RegionFaces", "RegionSketch"))
 
 
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,

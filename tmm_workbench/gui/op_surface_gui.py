@@ -8,7 +8,7 @@ from PySide import QtGui
 
 from tmm_workbench.app import model_proxy, registry
 from tmm_workbench.app.compat import PathUtils
-from tmm_workbench.gui import op_page, resources
+from tmm_workbench.gui import op_page, region_panel, resources
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
@@ -20,6 +20,8 @@ SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampl
               "cuspSlopeLimit": "CuspSlopeLimit"}
 COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
           "stepOverMode": "StepOverMode"}
+SPIN_BOXES.update(region_panel.SPIN_BOXES)  # the region group box (issue 14 item 3)
+COMBOS.update(region_panel.COMBOS)
 
 
 class TaskPanelOpPage(op_page.OpPage):
@@ -32,6 +34,7 @@ class TaskPanelOpPage(op_page.OpPage):
 
     def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)
+        region_panel.init_fields(self, obj)
 
     def model_candidates(self, obj: Any) -> list[Any]:
         """Meshes and top-level Part objects of the document, without the Job's own objects
@@ -67,6 +70,7 @@ class TaskPanelOpPage(op_page.OpPage):
         target = obj.Document.getObject(model) if model else None
         if obj.Model != target:
             obj.Model = target
+        region_panel.get_fields(self, obj)
 
     def set_extra(self, obj: Any) -> None:
         self.form.stlFile.setText(obj.StlFile)
@@ -79,9 +83,10 @@ class TaskPanelOpPage(op_page.OpPage):
         index = combo.findData(obj.Model.Name) if obj.Model is not None else 0
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
+        region_panel.set_fields(self, obj)
 
     def extra_signals(self) -> list[Any]:
-        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged]
+        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + region_panel.signals(self)
 
 
 class ViewProvider(op_page.OpViewProvider):

@@ -32,6 +32,8 @@ from tmm_workbench.core.tools.cutter import Cutter
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
+SPIRAL = "spiral"  # an Archimedean spiral from the region's centre (core.footprint.spiral)
+OUTWARD, INWARD = "outward", "inward"
 # Where no triangle lies under the cutter ("air": beside an open surface or a relief without a base, in a
 # hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
 # is split, the tool lifts to the safe height and plunges again where the model resumes.
@@ -51,7 +53,7 @@ class SurfaceParams(StrategyParams):
     stepover: float = param(1.0, "step-over", "mm", low=0, low_open=True, kind="length")
     sample_step: float = param(0.5, "sample step", "mm", low=0, low_open=True, kind="length")
     angle_deg: float = param(0.0, "raster angle", "deg")                # from +X
-    pattern: str = param(ZIGZAG, "pattern", choices=(ZIGZAG, ONEWAY))
+    pattern: str = param(ZIGZAG, "pattern", choices=(ZIGZAG, ONEWAY, SPIRAL))
     stock_to_leave: float = param(0.0, "stock to leave", "mm")        # material left on the surface
     floor_z: Optional[float] = param(None, "floor", "mm", optional=True)  # default: the model's lowest point
     off_model: str = param(OFF_MODEL_FLOOR, "off-model", choices=(OFF_MODEL_FLOOR, OFF_MODEL_SKIP))
@@ -68,12 +70,23 @@ class SurfaceParams(StrategyParams):
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE))
     cusp: float = param(0.01, "cusp height", "mm", low=0, low_open=True, kind="length")
     max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
+    # --- machining region, spiral and slope range (issue 14 item 3: core.strategies.raster_region) ---
+    # polygons with holes (core.polygons Shape) where the tool centre may go; None: the boundary rectangle.
+    # `boundary` is then the region's box.
+    region: Optional[list] = None
+    spiral_direction: str = param(OUTWARD, "spiral direction", choices=(OUTWARD, INWARD))
+    # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
+    slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
+    slope_max_deg: float = param(90.0, "slope maximum", "deg", low=0, high=90)
 
     def validate(self) -> None:
         super().validate()
         if len(self.boundary) != 4:
             raise TmmError(f"boundary must be four finite numbers xmin, ymin, xmax, ymax, got {self.boundary!r}")
         check_finite("boundary (xmin, ymin, xmax, ymax)", self.boundary)
+        from tmm_workbench.core.strategies import raster_region
+
+        raster_region.validate(self)
 
 
 def estimate_work(params: SurfaceParams) -> float:
@@ -88,6 +101,11 @@ def estimate_work(params: SurfaceParams) -> float:
     count = passes * (diagonal / params.sample_step + 2)
     if params.pattern == ZIGZAG:
         count += passes * (params.stepover / params.sample_step + 2)
+    if params.pattern == SPIRAL:  # the spiral out to the region's farthest point (core.footprint.spiral)
+        from tmm_workbench.core.footprint.spiral import spiral_length
+        from tmm_workbench.core.strategies.raster_region import spiral_radius
+
+        count = spiral_length(spiral_radius(params), params.stepover) / params.sample_step + 8 * passes
     check_work("CL points", count, _BYTES_PER_POINT,
                f"sample step {params.sample_step:g} mm and step-over {params.stepover:g} mm over a "
                f"{w:.6g} x {h:.6g} mm boundary")
@@ -104,6 +122,10 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         raise TmmError(f"the {cutter.describe()} cutter is not supported by 3-axis raster finishing")
     lo, hi = mesh.bounds
     b = params.boundary
+    if params.region is not None:  # said in the region's terms before the box's
+        from tmm_workbench.core.footprint.region import check_overlap
+
+        check_overlap(params.region, lo, hi)
     if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
         raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
@@ -114,7 +136,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         lines = [ln if i % 2 == 0 else ln[::-1] for i, ln in enumerate(lines)]
     # Runs of XY points: passes, and for zig-zag the links between them, dropped in one batch.
     runs: list[tuple[bool, np.ndarray]] = []  # (is_link, xy)
-    for i, ln in enumerate(lines):
+    chains = None  # a region or the spiral: runs in chains cut with the tool down, jumps between them
+    if params.region is not None or params.pattern == SPIRAL:
+        from tmm_workbench.core.strategies import raster_region
+
+        chains = raster_region.chains(lines, cutter, params, diagnostics)
+        runs = raster_region.flatten(chains)
+    for i, ln in enumerate(lines if chains is None else ()):
         if i > 0 and params.pattern == ZIGZAG:
             link_xy = sample_segment(lines[i - 1][1], ln[0], params.sample_step)[1:-1]
             runs.append((True, link_xy))
@@ -138,14 +166,21 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     z, air = drop(xy, progress)
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
-    diagnostics.update(points=len(xy), passes=len(lines))
+    diagnostics.update(points=len(xy), passes=len(lines) if chains is None else diagnostics["passes"])
     if params.gouge_tol > 0:
         from tmm_workbench.core.strategies import raster_refine
 
         runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
-                                                                    chained=params.pattern == ZIGZAG)
+                                                                    chained=params.pattern in (ZIGZAG, SPIRAL))
+    if params.slope_min_deg > 0 or params.slope_max_deg < 90:
+        from tmm_workbench.core.strategies import raster_region
+
+        air = raster_region.slope_flags(runs, z, air, drop, cutter, params, diagnostics)
     diagnostics["top"] = float(z[~air].max())
-    segments = _segments(runs, z, air, params.pattern, params.chord_tol)
+    if chains is None:
+        segments = _segments(runs, z, air, params.pattern, params.chord_tol)
+    else:
+        segments = raster_region.segments(runs, z, air, params, chains, _segments)
     return StrategyResult(segments, diagnostics)
 
 
