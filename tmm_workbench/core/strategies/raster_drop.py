@@ -38,6 +38,9 @@ ONEWAY = "oneway"
 STEPOVER, CUSP, ADAPTIVE = "stepover", "cusp", "adaptive"
 OFF_MODEL_FLOOR = "floor"
 OFF_MODEL_SKIP = "skip"
+# The forward step along a pass: SAMPLED keeps the samples (reduce_chords thins them, above only); TOLERANCE
+# replaces them by the fewest moves within +-chord_tol of the exact CL path (core.strategies.raster_lean).
+SAMPLED, TOLERANCE = "sample", "tolerance"
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 _AIR_DEPTH_MM = 1e6  # SKIP drops onto a floor this far below the model: only air points end there
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
@@ -68,6 +71,9 @@ class SurfaceParams(StrategyParams):
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE))
     cusp: float = param(0.01, "cusp height", "mm", low=0, low_open=True, kind="length")
     max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
+    # lean passes (issue 14 item 2, core.strategies.raster_lean): the forward step by the chord tolerance
+    forward_step: str = param(SAMPLED, "forward step", choices=(SAMPLED, TOLERANCE))
+    arcs: bool = param(False, "arc fitting", choices=(True, False))  # G2/G3 in XZ/YZ (TOLERANCE only)
 
     def validate(self) -> None:
         super().validate()
@@ -145,7 +151,14 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
                                                                     chained=params.pattern == ZIGZAG)
     diagnostics["top"] = float(z[~air].max())
-    segments = _segments(runs, z, air, params.pattern, params.chord_tol)
+    lean = params.forward_step == TOLERANCE and params.chord_tol > 0
+    segments = _segments(runs, z, air, params.pattern, 0.0 if lean else params.chord_tol)
+    if lean:
+        from tmm_workbench.core.strategies import raster_lean
+
+        segments, diagnostics["arcs"], stats = raster_lean.lean_segments(
+            segments, lambda p: drop(p), params.chord_tol, params.arcs, min(params.sample_step / 4, 0.05))
+        diagnostics["lean"] = stats.as_dict()
     return StrategyResult(segments, diagnostics)
 
 
@@ -190,6 +203,11 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
+    arcs = result.diagnostics.pop("arcs", None)
+    if arcs:
+        from tmm_workbench.core.strategies.raster_lean import attach_arcs
+
+        return attach_arcs(link(result.segments, policy), arcs)
     return link(result.segments, policy)
 
 
