@@ -43,6 +43,7 @@ PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
+FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes (issue 14 item 2)
 
 
 @dataclass
@@ -63,6 +64,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 cusp: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                forward_step: str = "tolerance", arcs: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
@@ -79,6 +81,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
     `cusp` on the boundary's steepest crossing) | 'adaptive' (each pass placed from the previous one's tool
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
+    forward_step: 'tolerance' (the fewest moves within +-chord_tolerance of the exact tool path: lean passes)
+    | 'sample' (a point every sample_step, thinned above only); arcs: G2/G3 in the pass's plane (XZ/YZ, rasters
+    at 0/90 deg) with 'tolerance', where the post writes K (not linuxcnc: lines there, with a warning).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -98,6 +103,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
         extra["ChordTolerance"] = chord_tolerance
     if cusp is not None:
         extra["CuspHeight"] = cusp
+    extra["ForwardStep"] = _option("forward_step", forward_step, FORWARD_STEP_NAMES)
+    if not isinstance(arcs, bool):
+        raise TmmError(f"arcs must be True or False, got {arcs!r}")
+    extra["ArcFitting"] = arcs
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)
