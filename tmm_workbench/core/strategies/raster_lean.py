@@ -32,8 +32,10 @@ from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy (n, 2) -> (z (n,), air (n,) bool)
 _FLAT = 1e-7              # mm: collinearity, a vertical move's horizontal length
+_MIN_RADIUS_MM = 0.5      # tighter arcs are a valley's kink rounded, not the path
 _MAX_RADIUS_MM = 1000.0   # flatter arcs are lines to a controller (and to the post's rounding)
 _BAND_USED = 0.8          # of the tolerance, by the fit and at the check points (the rest: between them)
+_ARC_MAX_SLOPE = 1.0      # arcs only where their chord rises no more than 45 deg
 _AXIS_TOL = 1e-9          # a pass direction this close to X or Y lies in a principal plane
 
 
@@ -88,7 +90,7 @@ def _circle(p: tuple[float, float], q: tuple[float, float], t: tuple[float, floa
     cx = (a1 * (y2 - y3) + a2 * (y3 - y1) + a3 * (y1 - y2)) / d
     cy = (a1 * (x3 - x2) + a2 * (x1 - x3) + a3 * (x2 - x1)) / d
     r = math.hypot(x1 - cx, y1 - cy)
-    if r > _MAX_RADIUS_MM:
+    if not (_MIN_RADIUS_MM <= r <= _MAX_RADIUS_MM):
         return None
     side = 1.0 if y1 > cy else -1.0
     if not (side * (y1 - cy) > 0 and side * (y2 - cy) > 0 and side * (y3 - cy) > 0):
@@ -180,6 +182,8 @@ def _arc_reach(s, e, lo, hi, limit: int, a: int, za: float) -> Optional[_Piece]:
         return None
 
     def fits(j: int) -> Optional[_Piece]:
+        if abs(e[j] - za) > _ARC_MAX_SLOPE * (s[j] - s[a]):
+            return None  # steep: lines (a vertical band there is a thin one along the normal)
         q = (a + j) // 2
         c = _circle((s[a], za), (s[q], e[q]), (s[j], e[j]))
         if c is None:
