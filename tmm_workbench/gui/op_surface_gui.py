@@ -20,6 +20,10 @@ SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampl
               "cuspSlopeLimit": "CuspSlopeLimit"}
 COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
           "stepOverMode": "StepOverMode"}
+# lean passes (issue 14 item 2)
+SPIN_BOXES["chordTolerance"] = "ChordTolerance"
+COMBOS["forwardStep"] = "ForwardStep"
+CHECKS = {"arcFitting": "ArcFitting"}
 
 
 class TaskPanelOpPage(op_page.OpPage):
@@ -29,6 +33,7 @@ class TaskPanelOpPage(op_page.OpPage):
     ICON = ICON
     SPIN_BOXES = SPIN_BOXES
     COMBOS = COMBOS
+    CHECKS = CHECKS
 
     def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)
