@@ -126,7 +126,7 @@ def fit_profile(s: np.ndarray, e: np.ndarray, tol: float, fixed: np.ndarray, arc
         if fixed[j] or j == n - 1:
             m = 0.5 * (mlo + mhi)
         else:
-            d1 = (e[j] - e[j - 1]) / (s[j] - s[j - 1])
+            d1 = (e[j] - e[j - 1]) / max(s[j] - s[j - 1], _FLAT)
             d2 = (e[j + 1] - e[j]) / max(s[j + 1] - s[j], _FLAT)
             m = mhi if d2 < d1 - 1e-9 else mlo if d2 > d1 + 1e-9 else 0.5 * (mlo + mhi)
         zj = min(max(za + m * (s[j] - s[a]), float(lo[j])), float(hi[j]))
