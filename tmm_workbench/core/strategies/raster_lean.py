@@ -350,11 +350,24 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
             # samples are added and fixed only inside failing pieces: the pieces before the one ahead of the
             # first (whose reach an added sample may shorten) stay as checked
             r.keep = max(0, int(who[bad].min()) - 1)
-            if round_ >= insert_rounds:  # not converging: the failing pieces' moves as sampled
-                for piece in np.unique(who[bad]):
+            if round_ >= insert_rounds:
+                # not converging: the failing pieces become the polyline through every exact point known there
+                # (their samples and all their check points, fixed), which no later round checks
+                pieces = np.unique(who[bad])
+                w = np.flatnonzero(np.isin(who, pieces) & ~ai)
+                w = w[np.argsort(cs[w], kind="stable")]
+                i = np.clip(np.searchsorted(r.s, cs[w]), 1, len(r.s) - 1)
+                w = w[np.minimum(np.abs(r.s[i] - cs[w]), np.abs(r.s[i - 1] - cs[w])) > 1e-6]
+                for piece in pieces:
                     q = r.pieces[piece]
                     r.fixed[q.a:q.b + 1] = True
                     stats.sampled_pieces += 1
+                if len(w):
+                    at = np.searchsorted(r.s, cs[w])
+                    r.s = np.insert(r.s, at, cs[w])
+                    r.e = np.insert(r.e, at, ex[w])
+                    r.fixed = np.insert(r.fixed, at, True)
+                    stats.inserted += len(w)
                 continue
             # every check point outside the band becomes a sample (the profile curves more between the
             # samples there than the tolerance allows); air between two samples keeps that move as sampled
