@@ -224,6 +224,7 @@ class _Run:
     s: np.ndarray
     e: np.ndarray
     fixed: np.ndarray
+    settled: np.ndarray       # per sample: the move to the next one is final (vertical, beside air, or given up)
     pieces: list = None
     done: bool = False
     keep: int = 0             # pieces before this one passed their checks and stay
@@ -247,7 +248,7 @@ def _straight_parts(pts: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[_Run]:
-    if len(pts) < 3 or seg.axes is not None:
+    if len(pts) < 2 or seg.axes is not None:
         return None
     xy = pts[:, :2]
     d = xy[-1] - xy[0]
@@ -264,7 +265,9 @@ def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[_Run]:
     fixed[[0, -1]] = True
     vertical = np.flatnonzero(ds <= _FLAT)
     fixed[vertical] = fixed[vertical + 1] = True
-    return _Run(seg, xy[0].copy(), u, s.copy(), pts[:, 2].copy(), fixed)
+    settled = np.zeros(len(s), dtype=bool)
+    settled[vertical] = True
+    return _Run(seg, xy[0].copy(), u, s.copy(), pts[:, 2].copy(), fixed, settled)
 
 
 def _plane(u: np.ndarray) -> Optional[str]:
@@ -285,7 +288,7 @@ def _check_points(run: _Run, step: float, first: int = 0) -> tuple[np.ndarray, n
     zb = np.array([p.zb for p in run.pieces])
     arc = np.array([p.circle is not None for p in run.pieces])
     sa, sb = s[a], s[b]
-    as_sampled = (b == a + 1) & ~arc & (za == e[a]) & (zb == e[b])
+    as_sampled = (b == a + 1) & run.settled[a]
     use = np.flatnonzero((sb - sa > _FLAT) & ~as_sampled & (np.arange(len(a)) >= first))
     if not len(use):
         return np.zeros(0), np.zeros(0), np.zeros(0, dtype=int)
@@ -322,7 +325,7 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
     # bull-nose (convex stretches of a CL path curve no tighter than the cutter's corner)
     margin = tol * (1 - _BAND_USED)
     tol = tol * _BAND_USED
-    parts = {i: _straight_parts(seg.tips) if len(seg) >= 3 and seg.axes is None else [] for i, seg in enumerate(segments)}
+    parts = {i: _straight_parts(seg.tips) if len(seg) >= 2 and seg.axes is None else [] for i, seg in enumerate(segments)}
     runs = {(i, k): _as_run(segments[i], segments[i].tips[a:b + 1]) for i in parts for k, (a, b) in enumerate(parts[i])}
     runs = {key: r for key, r in runs.items() if r is not None}
     stats.points_in = sum(len(seg) for seg in segments)
@@ -354,6 +357,7 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
                 # not converging: the failing pieces become the polyline through every exact point known there
                 # (their samples and all their check points, fixed), which no later round checks
                 pieces = np.unique(who[bad])
+                spans = [(r.s[r.pieces[k].a], r.s[r.pieces[k].b]) for k in pieces]
                 w = np.flatnonzero(np.isin(who, pieces) & ~ai)
                 w = w[np.argsort(cs[w], kind="stable")]
                 i = np.clip(np.searchsorted(r.s, cs[w]), 1, len(r.s) - 1)
@@ -367,7 +371,10 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
                     r.s = np.insert(r.s, at, cs[w])
                     r.e = np.insert(r.e, at, ex[w])
                     r.fixed = np.insert(r.fixed, at, True)
+                    r.settled = np.insert(r.settled, at, True)
                     stats.inserted += len(w)
+                for sa, sb in spans:
+                    r.settled[(r.s >= sa) & (r.s < sb)] = True
                 continue
             # every check point outside the band becomes a sample (the profile curves more between the
             # samples there than the tolerance allows); air between two samples keeps that move as sampled
@@ -377,11 +384,13 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
             i = np.searchsorted(r.s, cs[bad & ai])
             fix_pairs = list(np.concatenate([i - 1, i]))
             r.fixed[fix_pairs] = True
+            r.settled[i - 1] = True  # the sampled move across air stays
             if adds_s:
                 at = np.searchsorted(r.s, adds_s)
                 r.s = np.insert(r.s, at, adds_s)
                 r.e = np.insert(r.e, at, adds_e)
                 r.fixed = np.insert(r.fixed, at, False)
+                r.settled = np.insert(r.settled, at, False)
                 stats.inserted += len(adds_s)
     out = list(segments)
     arc_map: dict = {}
