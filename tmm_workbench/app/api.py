@@ -43,6 +43,7 @@ PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
+FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes (issue 14 item 2)
 
 
 @dataclass
@@ -65,6 +66,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 spiral_direction: str = "outward", region_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+                forward_step: str = "sample", arcs: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
@@ -86,6 +88,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.
     pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
     max) deg, cut only where the surface slope lies in it (default all).
+    forward_step: 'sample' (default: a point every sample_step, thinned above only) | 'tolerance' (the fewest
+    moves within +-chord_tolerance of the exact tool path: lean passes; more compute, in Python for now); arcs:
+    G2/G3 in the pass's plane (XZ/YZ, rasters at 0/90 deg) with 'tolerance', where the post writes K (not
+    linuxcnc: lines there, with a warning).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     """
@@ -108,6 +114,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     from tmm_workbench.app import region_source
 
     extra.update(region_source.api_values(region, model, spiral_direction, slope_range, region_tolerance))
+    extra["ForwardStep"] = _option("forward_step", forward_step, FORWARD_STEP_NAMES)
+    if not isinstance(arcs, bool):
+        raise TmmError(f"arcs must be True or False, got {arcs!r}")
+    extra["ArcFitting"] = arcs
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)

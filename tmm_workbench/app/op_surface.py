@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+import FreeCAD
 import Path
 
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
@@ -29,6 +30,8 @@ from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
                                                        STEPOVER, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
+from tmm_workbench.core.strategies.raster_drop import SAMPLED, TOLERANCE
+from tmm_workbench.core.strategies.raster_lean import arc_offsets
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
@@ -60,8 +63,17 @@ PROPERTIES: list[Prop] = [
          "Spiral: from the region's centre (SpiralDirection)", "pattern"),
     Prop("App::PropertyDistance", "StockToLeave", "Surface", "Material left on the surface", "stock_to_leave"),
     Prop("App::PropertyDistance", "ChordTolerance", "Surface",
-         "How far above the CL points a longer straight move may pass where it replaces them (never below one; "
-         "0: keep every point off a straight line)", "chord_tol"),
+         "The tolerance of the moves: with ForwardStep Tolerance, how far above or below the exact tool path a "
+         "move may pass; with SampleStep, how far above the CL points a longer straight move may pass where it "
+         "replaces them (never below one; 0: keep every point off a straight line)", "chord_tol"),
+    # lean passes (issue 14 item 2): the forward step by ChordTolerance, arcs in the pass's plane
+    Prop("App::PropertyEnumeration", "ForwardStep", "Surface",
+         "Tolerance: the fewest moves within ChordTolerance of the exact tool path, above or below it (points "
+         "added where a move would leave it, removed where a longer move stays in it); SampleStep: a point "
+         "every SampleStep, moves above them only"),
+    Prop("App::PropertyBool", "ArcFitting", "Surface",
+         "With ForwardStep Tolerance, passes at 0 or 90 deg get arcs (G2/G3 in G18 XZ / G19 YZ) where they fit "
+         "within ChordTolerance; lines where the Job's post drops K (linuxcnc, mach3_mach4, ...)", "arcs"),
     Prop("App::PropertyAngle", "PlungeAngle", "Feeds",
          "Cutting moves going down more steeply than this (below the horizontal) run at the vertical feed"),
     Prop("App::PropertyEnumeration", "OffModel", "Surface",
@@ -83,13 +95,18 @@ PROPERTIES: list[Prop] = [
          "Cut only where the surface slope is at most this (steeper walls left to waterline)", "slope_max_deg"),
 ]
 SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE}
+FORWARD_STEPS = {"Tolerance": TOLERANCE, "SampleStep": SAMPLED}
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
-           "StepOverMode": SPACINGS}
+           "StepOverMode": SPACINGS, "ForwardStep": FORWARD_STEPS}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
-                            "BoundaryMargin": 0.0, "PlungeAngle": 45.0}
+                            "BoundaryMargin": 0.0, "PlungeAngle": 45.0, "ForwardStep": "SampleStep"}
 CHOICES.update({"Region": {r: r for r in region_source.REGIONS},
                 "SpiralDirection": {"Outward": OUTWARD, "Inward": INWARD}})
 DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
+# FreeCAD posts whose parameter list has no K: an arc in XZ or YZ would lose its centre's Z (0.20-1.1)
+POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
+                   "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
+_PLANE_CODES = {"XZ": "G18", "YZ": "G19"}
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -99,7 +116,8 @@ class ObjectTmmSurface(op_base.TmmOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
-    RESTORED_DEFAULTS = {"ChordTolerance": 0.0}  # documents from before it kept every point
+    # documents from before them kept every point, on the samples
+    RESTORED_DEFAULTS = {"ChordTolerance": 0.0, "ForwardStep": "SampleStep"}
     toolpath: Optional[Toolpath] = None
     mesh: Optional[TriMesh] = None
 
@@ -123,12 +141,24 @@ class ObjectTmmSurface(op_base.TmmOp):
         cutter = self.cutter()
         region = region_source.region_of(obj, PathUtils.findParentJob(obj))  # None: the box
         boundary = self.boundary(obj, mesh) if region is None else polygons.bounds(region)
-        params = self.params_from(obj, boundary=boundary, region=region)
+        params = self.params_from(obj, boundary=boundary, region=region,
+                                  forward_step=FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""), SAMPLED))
+        if params.arcs and self.post_without_k(obj):
+            params.arcs = False
+            FreeCAD.Console.PrintWarning(
+                f"{obj.Label}: ArcFitting off: the Job's post '{self.post_without_k(obj)}' writes no K, so arcs in "
+                "XZ/YZ would be wrong; lines within ChordTolerance instead\n")
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
+
+    def post_without_k(self, obj: Any) -> str:
+        """The Job's post processor when it drops the K word of arcs, else ''."""
+        job = PathUtils.findParentJob(obj)
+        name = str(getattr(job, "PostProcessor", "") or "")
+        return name if name in POSTS_WITHOUT_K else ""
 
     def model_mesh(self, obj: Any) -> TriMesh:
         deflection = obj.LinearDeflection.Value
@@ -165,12 +195,25 @@ class ObjectTmmSurface(op_base.TmmOp):
         out = []
         if clearance is not None and len(toolpath):
             out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
-        for m, down in zip(toolpath, steep):
+        plane = "XY"
+        for i, (m, down) in enumerate(zip(toolpath, steep)):
+            arc = toolpath.arcs.get(i)
+            if arc is not None:  # lean passes: G2/G3 in the pass's vertical plane, the plane selected first
+                if arc.plane != plane:
+                    out.append(Path.Command(_PLANE_CODES[arc.plane], {}))
+                    plane = arc.plane
+                prev = toolpath.moves[i - 1]
+                words = {"X": m.x, "Y": m.y, "Z": m.z, "F": self.horizFeed}
+                words.update(arc_offsets((prev.x, prev.y, prev.z), arc))
+                out.append(Path.Command("G2" if arc.clockwise else "G3", words))
+                continue
             if m.kind is MoveKind.RAPID:
                 out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
             else:
                 feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
                 out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
+        if plane != "XY":
+            out.append(Path.Command("G17", {}))
         return out
 
 

@@ -24,7 +24,8 @@ from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 DESIGN_DEFLECTION_MM = 0.001  # the model tessellated this close: well below the scallops compared
-ARC_TOLERANCE_MM = 0.001      # chords of G2/G3 arcs (FreeCAD's ops) within this of the arc
+ARC_TOLERANCE_MM = 1e-4       # chords of G2/G3 arcs within this of the arc (lean passes: 0.1 of their band)
+_PLANES = {"G17": "XY", "G18": "XZ", "G19": "YZ"}
 
 
 @dataclass
@@ -81,6 +82,11 @@ def operations(job: Any) -> list:
 def _toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
     commands = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
     moves = path5.decode_commands(commands)
+    # the arc plane in force at each command (G17 XY, G18 XZ, G19 YZ: TMM's lean passes write G18/G19 arcs)
+    planes, plane = [], "XY"
+    for name, _ in commands:
+        plane = _PLANES.get(name.upper(), plane)
+        planes.append(plane)
     tp = Toolpath()
     feeds: list = []
     for m in moves:
@@ -95,7 +101,8 @@ def _toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
             last = tp.moves[-1]
             try:
                 pts = arc_points((last.x, last.y, last.z), m.tip, float(m.params.get("I", 0.0)),
-                                 float(m.params.get("J", 0.0)), m.name == "G2", ARC_TOLERANCE_MM)
+                                 float(m.params.get("J", 0.0)), m.name == "G2", ARC_TOLERANCE_MM,
+                                 plane=planes[m.index], k=float(m.params.get("K", 0.0)))
             except TmmError as exc:
                 raise TmmError(f"op '{op.Label}', command {m.index} ({m.name}): {exc}") from None
             for p in pts:

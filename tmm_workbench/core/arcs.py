@@ -1,6 +1,7 @@
-"""Arcs (G2/G3 in the XY plane, FreeCAD's I/J: the centre relative to the start; Z helical, linear in the
-angle) as chords no further than `tolerance` from the arc: what the simulator and the checks read of paths
-made by FreeCAD's own ops (TMM's ops write lines only)."""
+"""Arcs (G2/G3; FreeCAD's I/J/K: the centre relative to the start) as chords no further than `tolerance`
+from the arc: what the simulator and the checks read of paths made by FreeCAD's own ops (XY, G17: Z
+helical, linear in the angle) and of TMM's lean passes (XZ, G18, and YZ, G19: arcs in a pass's vertical
+plane). As RS274/NGC: G2 is clockwise viewed from the positive end of the plane's normal axis (Z, Y, X)."""
 from __future__ import annotations
 
 import math
@@ -10,10 +11,26 @@ import numpy as np
 from tmm_workbench.core.errors import TmmError
 
 
-def arc_points(start, end, i: float, j: float, clockwise: bool, tolerance: float = 1e-3) -> np.ndarray:
-    """(k, 3) points after `start` along the arc to `end` (the last row is `end`). A full circle when start
-    and end coincide in XY. TmmError when the centre is not equidistant (by more than 1e-4 relative)."""
-    p0, p1 = np.asarray(start, float), np.asarray(end, float)
+# the plane's two axes in the order that makes a counter-clockwise turn positive about its normal, then the normal
+_AXES = {"XY": (0, 1, 2), "XZ": (2, 0, 1), "YZ": (1, 2, 0)}
+
+
+def arc_points(start, end, i: float, j: float, clockwise: bool, tolerance: float = 1e-3, plane: str = "XY",
+               k: float = 0.0) -> np.ndarray:
+    """(k, 3) points after `start` along the arc to `end` (the last row is `end`) in `plane` ("XY", "XZ",
+    "YZ"; i, j, k: the centre's X, Y, Z offsets from the start, the plane's two used). A full circle when start
+    and end coincide in the plane. TmmError when the centre is not equidistant (by more than 1e-4 relative)."""
+    if plane not in _AXES:
+        raise TmmError(f"arc plane must be one of {', '.join(_AXES)}, got {plane!r}")
+    order = list(_AXES[plane])
+    back = np.argsort(order)
+    offsets = np.array([i, j, k], dtype=float)[order]
+    pts = _arc_xy(np.asarray(start, float)[order], np.asarray(end, float)[order], offsets[0], offsets[1],
+                  clockwise, tolerance)
+    return pts[:, back]
+
+
+def _arc_xy(p0: np.ndarray, p1: np.ndarray, i: float, j: float, clockwise: bool, tolerance: float) -> np.ndarray:
     c = p0[:2] + (i, j)
     r0, r1 = float(np.hypot(*(p0[:2] - c))), float(np.hypot(*(p1[:2] - c)))
     if not (r0 > 0 and math.isfinite(r0)):

@@ -33,6 +33,9 @@ class Move:
 @dataclass
 class Toolpath:
     moves: list[Move] = field(default_factory=list)
+    # move index -> core.strategies.raster_lean.Arc: that FEED move is an arc to its point (G2/G3 in a
+    # vertical plane; lean passes with arcs only). Readers that take moves as lines: raster_lean.chorded.
+    arcs: dict = field(default_factory=dict)
 
     def __iter__(self) -> Iterator[Move]:
         return iter(self.moves)

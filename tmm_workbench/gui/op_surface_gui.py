@@ -22,6 +22,10 @@ COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "O
           "stepOverMode": "StepOverMode"}
 SPIN_BOXES.update(region_panel.SPIN_BOXES)  # the region group box (issue 14 item 3)
 COMBOS.update(region_panel.COMBOS)
+# lean passes (issue 14 item 2)
+SPIN_BOXES["chordTolerance"] = "ChordTolerance"
+COMBOS["forwardStep"] = "ForwardStep"
+CHECKS = {"arcFitting": "ArcFitting"}
 
 
 class TaskPanelOpPage(op_page.OpPage):
@@ -31,6 +35,7 @@ class TaskPanelOpPage(op_page.OpPage):
     ICON = ICON
     SPIN_BOXES = SPIN_BOXES
     COMBOS = COMBOS
+    CHECKS = CHECKS
 
     def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)

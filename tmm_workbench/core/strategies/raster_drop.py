@@ -40,6 +40,9 @@ OUTWARD, INWARD = "outward", "inward"
 STEPOVER, CUSP, ADAPTIVE = "stepover", "cusp", "adaptive"
 OFF_MODEL_FLOOR = "floor"
 OFF_MODEL_SKIP = "skip"
+# The forward step along a pass: SAMPLED keeps the samples (reduce_chords thins them, above only); TOLERANCE
+# replaces them by the fewest moves within +-chord_tol of the exact CL path (core.strategies.raster_lean).
+SAMPLED, TOLERANCE = "sample", "tolerance"
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 _AIR_DEPTH_MM = 1e6  # SKIP drops onto a floor this far below the model: only air points end there
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
@@ -78,6 +81,9 @@ class SurfaceParams(StrategyParams):
     # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
     slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
     slope_max_deg: float = param(90.0, "slope maximum", "deg", low=0, high=90)
+    # lean passes (issue 14 item 2, core.strategies.raster_lean): the forward step by the chord tolerance
+    forward_step: str = param(SAMPLED, "forward step", choices=(SAMPLED, TOLERANCE))
+    arcs: bool = param(False, "arc fitting", choices=(True, False))  # G2/G3 in XZ/YZ (TOLERANCE only)
 
     def validate(self) -> None:
         super().validate()
@@ -177,10 +183,18 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
 
         air = raster_region.slope_flags(runs, z, air, drop, cutter, params, diagnostics)
     diagnostics["top"] = float(z[~air].max())
+    lean = params.forward_step == TOLERANCE and params.chord_tol > 0
     if chains is None:
-        segments = _segments(runs, z, air, params.pattern, params.chord_tol)
-    else:
-        segments = raster_region.segments(runs, z, air, params, chains, _segments)
+        segments = _segments(runs, z, air, params.pattern, 0.0 if lean else params.chord_tol)
+    else:  # lean passes start from the unthinned points
+        segments = raster_region.segments(runs, z, air, replace(params, chord_tol=0.0) if lean else params, chains,
+                                          _segments)
+    if lean:
+        from tmm_workbench.core.strategies import raster_lean
+
+        segments, diagnostics["arcs"], stats = raster_lean.lean_segments(
+            segments, lambda p: drop(p), params.chord_tol, params.arcs, min(params.sample_step / 4, 0.05))
+        diagnostics["lean"] = stats.as_dict()
     return StrategyResult(segments, diagnostics)
 
 
@@ -225,6 +239,11 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
+    arcs = result.diagnostics.pop("arcs", None)
+    if arcs:
+        from tmm_workbench.core.strategies.raster_lean import attach_arcs
+
+        return attach_arcs(link(result.segments, policy), arcs)
     return link(result.segments, policy)
 
 
