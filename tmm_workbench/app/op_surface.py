@@ -19,12 +19,13 @@ from typing import Any, Optional
 import Path
 
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress
+from tmm_workbench.app import surface_passes
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
-from tmm_workbench.core.strategies import raster_drop
+from tmm_workbench.core.strategies import finish_passes
 from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
                                                        STEPOVER, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
@@ -70,6 +71,10 @@ CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "Of
            "StepOverMode": SPACINGS}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
                             "BoundaryMargin": 0.0, "PlungeAngle": 45.0}
+# % step-over, Depths (final depth, finishing passes) and start point (issue 15 item 6): app.surface_passes
+PROPERTIES += surface_passes.PROPERTIES
+CHOICES.update(surface_passes.CHOICES)
+DEFAULTS.update(surface_passes.DEFAULTS)
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -101,10 +106,11 @@ class ObjectTmmSurface(op_base.TmmOp):
     def compute(self, obj: Any) -> None:
         mesh = self.model_mesh(obj)
         cutter = self.cutter()
-        params = self.params_from(obj, boundary=self.boundary(obj, mesh))
+        params = self.params_from(obj, boundary=self.boundary(obj, mesh), **surface_passes.params_extra(obj, cutter))
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
+            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, surface_passes.finish_params(obj),
+                                                             policy, cb)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 

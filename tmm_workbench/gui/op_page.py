@@ -136,6 +136,12 @@ class OpViewProvider(PathOpGui.ViewProvider):
             return f":/icons/{command_prefix()}OpActive.svg"
         return self.ICON
 
+    def setupTaskPanel(self, panel: Any) -> None:
+        from tmm_workbench.gui import panel_state
+
+        panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
+        super().setupTaskPanel(panel)
+
 
 def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:
     """Gives an op created from Python (macro, API) the same view provider as the command's."""

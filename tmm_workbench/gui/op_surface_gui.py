@@ -8,7 +8,7 @@ from PySide import QtGui
 
 from tmm_workbench.app import model_proxy, registry
 from tmm_workbench.app.compat import PathUtils
-from tmm_workbench.gui import op_page, resources
+from tmm_workbench.gui import op_page, resources, surface_depths_gui
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
@@ -20,15 +20,21 @@ SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampl
               "cuspSlopeLimit": "CuspSlopeLimit"}
 COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
           "stepOverMode": "StepOverMode"}
+CHECKS: dict[str, str] = {}
+# the group 'Depths, passes and start point' (issue 15 item 6)
+SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
+COMBOS.update(surface_depths_gui.COMBOS)
+CHECKS.update(surface_depths_gui.CHECKS)
 
 
-class TaskPanelOpPage(op_page.OpPage):
+class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
     """Tool controller, coolant, model, boundary and raster parameters of the op."""
 
     PANEL = "surface_op"
     ICON = ICON
     SPIN_BOXES = SPIN_BOXES
     COMBOS = COMBOS
+    CHECKS = CHECKS
 
     def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)
@@ -67,6 +73,7 @@ class TaskPanelOpPage(op_page.OpPage):
         target = obj.Document.getObject(model) if model else None
         if obj.Model != target:
             obj.Model = target
+        self.get_depths(obj)
 
     def set_extra(self, obj: Any) -> None:
         self.form.stlFile.setText(obj.StlFile)
@@ -79,9 +86,15 @@ class TaskPanelOpPage(op_page.OpPage):
         index = combo.findData(obj.Model.Name) if obj.Model is not None else 0
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
+        self.set_depths(obj)
 
     def extra_signals(self) -> list[Any]:
-        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged]
+        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + self.depth_signals()
+
+    def updateData(self, obj: Any, prop: str) -> None:
+        super().updateData(obj, prop)
+        if prop in surface_depths_gui.ENABLING:
+            self.enable_depths(obj)
 
 
 class ViewProvider(op_page.OpViewProvider):
