@@ -1,7 +1,7 @@
 """What FreeCAD's 3D Surface users expect of the 3-axis raster, around raster_drop's strategy: the step-over
 in % of the tool diameter, a final depth (no tip below it), several finishing passes over a semi-finish stock
 to leave (pass k of n leaves stock_to_leave + (n - 1 - k) * step_down, the last one the finish) and a start
-point (each pass set begins at the end of the raster nearest to it).
+point (each pass set begins at the corner of the raster nearest to it).
 
     fp = FinishParams(passes=3, step_down=0.5, start_xy=(0, 0))
     path = compute_finish_toolpath(mesh, cutter, surface_params, fp, policy)
@@ -59,18 +59,29 @@ def stepover_of_percent(percent: float, cutter: Cutter) -> float:
 
 
 def start_order(segments: list[CutSegment], start_xy: Optional[tuple[float, float]]) -> list[CutSegment]:
-    """The segments of one pass set in the order whose first point is nearest `start_xy`: as they are or
-    reversed as a whole (every path runs backwards too: links and joins stay), and when no segment is joined to
-    the one before (one-way passes, lifts between them) also each run the other way or the set in reverse
-    order. Ties keep the earlier candidate (as they are first)."""
+    """The segments of one pass set in the order that begins with the pass nearest `start_xy`, at its end
+    nearest it: as they are or reversed as a whole (every path runs backwards too: links and joins stay), and
+    when no segment is joined to the one before (one-way passes, lifts between them) also each run the other
+    way or the set in reverse order. Ties keep the earlier candidate (as they are first)."""
     if start_xy is None or not segments:
         return segments
     candidates = [segments, reverse_path(segments)]
     if not any(s.joined for s in segments):
         candidates += [list(reversed(segments)), [_flipped(s, s.joined) for s in segments]]
+    keys = [start_key(c[0].tips, start_xy) for c in candidates]
+    return candidates[min(range(len(keys)), key=keys.__getitem__)]
+
+
+def start_key(tips: np.ndarray, start_xy: tuple[float, float]) -> tuple[float, float]:
+    """(distance of the start point from the line of the first pass, from its first point), mm: the nearest
+    pass first, then its nearer end. Rounded to 1e-6 mm so that the two ends of one pass tie on the first."""
     target = np.asarray(start_xy, dtype=float)
-    dist = [float(np.hypot(*(c[0].tips[0, :2] - target))) for c in candidates]
-    return candidates[int(np.argmin(dist))]
+    a, b = tips[0, :2], tips[-1, :2]
+    point = float(np.hypot(*(a - target)))
+    length = float(np.hypot(*(b - a)))
+    d, t = b - a, target - a
+    line = abs(float(d[0] * t[1] - d[1] * t[0])) / length if length > 1e-9 else point
+    return round(line, 6), round(point, 6)
 
 
 def reverse_path(segments: list[CutSegment]) -> list[CutSegment]:
@@ -116,9 +127,9 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
         report = None
         if progress is not None:
             report = lambda f, i=i: progress((i + f) / len(levels))  # noqa: E731
-        result = raster_drop.compute(mesh, cutter, replace(params, stock_to_leave=stock), report, surface)
-        top = max(top, result.diagnostics["top"])
-        pass_set = start_order(result.segments, finish.start_xy)
+        top_i, pass_set = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy, report,
+                                    surface)
+        top = max(top, top_i)
         if pass_set:
             pass_set[0] = replace(pass_set[0], joined=False)  # a retract between the sets
         segments += pass_set
@@ -126,3 +137,26 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
     return link(segments, policy)
+
+
+def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Optional[tuple[float, float]],
+              progress: Optional[Progress], surface: DropSurface) -> tuple[float, list[CutSegment]]:
+    """(highest tip, segments) of one pass set, begun nearest the start point. A zig-zag can only be run
+    forwards or backwards; the raster turned by 180 degrees (the same passes in the other order, each run the
+    other way) starts at the mirror image of these ends through the boundary's centre, and is computed when that
+    would start nearer (an even pass count: the other two corners)."""
+    result = raster_drop.compute(mesh, cutter, params, progress, surface)
+    segments = start_order(result.segments, start_xy)
+    if start_xy is None or not segments:
+        return result.diagnostics["top"], segments
+    b = params.boundary
+    centre = np.array([(b[0] + b[2]) / 2.0, (b[1] + b[3]) / 2.0, 0.0])
+    best = start_key(segments[0].tips, start_xy)
+    mirrored = [2.0 * centre - seg.tips for seg in (result.segments[0], reverse_path(result.segments)[0])]
+    if min(start_key(m, start_xy) for m in mirrored) < best:
+        other = raster_drop.compute(mesh, cutter, replace(params, angle_deg=params.angle_deg + 180.0), progress,
+                                    surface)
+        other_segments = start_order(other.segments, start_xy)
+        if other_segments and start_key(other_segments[0].tips, start_xy) < best:
+            return other.diagnostics["top"], other_segments
+    return result.diagnostics["top"], segments
