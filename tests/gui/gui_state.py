@@ -217,6 +217,7 @@ def cancel_keeps_path(info: dict, doc, op) -> None:
     info["failed_apply_valid"] = op.isValid()
     info["failed_apply_status"] = op.getStatusString()
     info["failed_apply_commands"] = len(op.Path.Commands)
+    info["failed_apply_status_line"] = visible(QtGui.QLabel, "status").text()
     info["png_failed_apply"] = screenshot("state_4_failed_apply")
     click(QtGui.QDialogButtonBox.Cancel)
     wait_closed()
@@ -286,7 +287,25 @@ def reopen(info: dict, doc, job) -> None:
     FreeCAD.closeDocument(doc.Name)
 
 
+def watch_message_boxes(info: dict) -> QtCore.QTimer:
+    """A modal message box (an error shown to the user) is read into info["message_boxes"] and closed with its
+    default button, as a user would, so that the session goes on."""
+    seen = info.setdefault("message_boxes", [])
+
+    def close_boxes() -> None:
+        box = QtGui.QApplication.activeModalWidget()
+        if isinstance(box, QtGui.QMessageBox):
+            seen.append(box.text())
+            (box.defaultButton() or box.buttons()[0]).click()
+
+    timer = QtCore.QTimer()
+    timer.timeout.connect(close_boxes)
+    timer.start(200)
+    return timer
+
+
 def session(info: dict) -> dict:
+    info["_timer"] = watch_message_boxes(info)
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
     FreeCADGui.activateWorkbench("TMMWorkbench")
@@ -316,6 +335,7 @@ def main() -> None:
     code, info = 1, {}
     try:
         session(info)
+        info.pop("_timer").stop()
         code = 0
     except BaseException:  # noqa: B902 - every failure must reach the exit code
         info["error"] = traceback.format_exc()

@@ -58,7 +58,8 @@ def test_gui_state(tmp_path: Path) -> None:
     assert info["cycle_time"] and info["cycle_time"] != "00:00:00", info["cycle_time"]
     x, y = info["first_cut_xy"]
     sx, sy = info["start_point"]
-    assert abs(y - sy) < 1.0, (x, y, sx, sy)  # the pass nearest the start point first (zig-zag: its y side)
+    assert abs(y - sy) < 1e-3, (x, y, sx, sy)  # the pass nearest the start point first
+    assert abs(x - sx) < 1e-3, (x, y, sx, sy)  # at its end nearest it (here: reachable by the zig-zag)
     # Cancel: after a change, after a failed Apply (its message shown as the status), after a good Apply
     assert info["path_kept_after_cancel"] and info["cancel_percent"] == 50.0, info
     assert not info["failed_apply_valid"] and info["failed_apply_commands"] == 0

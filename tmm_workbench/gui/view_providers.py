@@ -37,13 +37,14 @@ class BoundsViewProvider:
 
 def attach_bounds(obj: Any) -> None:
     """The stand-in box gets its view provider and is hidden, with the Job's clones of it (a clone saved without
-    the GUI has no view provider proxy either: it gets this one)."""
-    clones = [o for o in obj.InList if obj in (getattr(o, "Objects", None) or [])]
-    for o in [obj] + clones:
-        vo = getattr(o, "ViewObject", None)
+    the GUI has no view provider proxy either: it gets the one the Job gives its model clones in the GUI)."""
+    if not isinstance(getattr(obj.ViewObject, "Proxy", None), BoundsViewProvider):
+        BoundsViewProvider(obj.ViewObject)
+    obj.ViewObject.Visibility = False
+    for clone in (o for o in obj.InList if obj in (getattr(o, "Objects", None) or [])):
+        vo = getattr(clone, "ViewObject", None)
         if vo is None:
             continue
-        if o is obj and not isinstance(getattr(vo, "Proxy", None), BoundsViewProvider) or \
-                getattr(vo, "Proxy", None) is None:
-            BoundsViewProvider(vo)
+        if getattr(vo, "Proxy", None) is None:
+            import_gui("icon_view_provider").Attach(vo, "BaseGeometry")
         vo.Visibility = False
