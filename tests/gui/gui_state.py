@@ -99,6 +99,18 @@ def widen_panel(widget) -> None:
             mw.resizeDocks([dock], [440], QtCore.Qt.Horizontal)  # the whole panel in the picture
 
 
+def show_page_of(widget) -> None:
+    """Opens the panel's page (a QToolBox page) that holds `widget`, as a click on its title does."""
+    box = widget.parentWidget()
+    while box is not None and not isinstance(box, QtGui.QToolBox):
+        box = box.parentWidget()
+    if box is not None:
+        for i in range(box.count()):
+            if box.widget(i).isAncestorOf(widget):
+                box.setCurrentIndex(i)
+    pump(0.5)
+
+
 def path_key(op) -> list:
     return [(c.Name, sorted((k, round(v, 6)) for k, v in c.Parameters.items())) for c in op.Path.Commands]
 
@@ -160,8 +172,9 @@ def new_op(info: dict, doc, job):
     page = visible(QtGui.QWidget, "TmmSurfaceOpPage")
     widen_panel(page)
     FreeCADGui.SendMsgToActiveView("ViewFit")
-    pump(0.5)
+    show_page_of(safe)  # the user opens the Heights page
     info["png_heights"] = screenshot("state_2_new_op_heights")
+    show_page_of(page)
     # the user's values: % step-over, two finishing passes 0.5 mm apart, a start point at the far corner
     unit = visible(QtGui.QComboBox, "stepOverUnit")
     unit.setCurrentIndex(unit.findText("%"))
