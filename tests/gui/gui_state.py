@@ -111,6 +111,17 @@ def show_page_of(widget) -> None:
     pump(0.5)
 
 
+def scroll_to(widget) -> None:
+    """Scrolls the panel so that `widget` is in view (a smaller panel, FreeCAD 1.x)."""
+    area = widget.parentWidget()
+    while area is not None and not isinstance(area, QtGui.QScrollArea):
+        area = area.parentWidget()
+    if area is not None:
+        area.ensureWidgetVisible(widget)
+        area.horizontalScrollBar().setValue(0)  # the labels stay in view
+    pump(0.3)
+
+
 def path_key(op) -> list:
     return [(c.Name, sorted((k, round(v, 6)) for k, v in c.Parameters.items())) for c in op.Path.Commands]
 
@@ -190,6 +201,7 @@ def new_op(info: dict, doc, job):
     type_into(visible(QtGui.QDoubleSpinBox, "startY"), f"{bb.YMax:.3f}")
     info["percent_enabled"] = visible(QtGui.QDoubleSpinBox, "stepOverPercent").isEnabled()
     info["mm_step_over_enabled"] = visible(QtGui.QWidget, "stepOver").isEnabled()
+    scroll_to(visible(QtGui.QGroupBox, "depthsGroup"))
     info["png_fields"] = screenshot("state_3_depths_fields")
     click(QtGui.QDialogButtonBox.Ok)
     wait_closed()
