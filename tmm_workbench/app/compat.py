@@ -34,6 +34,7 @@ _GUI_MODULES: dict[str, tuple[str, ...]] = {
     "commands": ("PathCommands", "PathCommands"),
     "path_gui": ("PathScripts.PathGui", "Path.Base.Gui.Util"),
     "job_gui": ("PathScripts.PathJobGui", "Path.Main.Gui.Job"),
+    "icon_view_provider": ("PathScripts.PathIconViewProvider", "Path.Base.Gui.IconViewProvider"),
 }
 
 

@@ -48,7 +48,58 @@ def create_job(doc: Any, base: Any, name: str = "Job") -> Any:
     FreeCAD.setActiveDocument(doc.Name)
     job = PathJob.Create(name, [base])
     hooks.attach_view("job", job)
+    set_default_post(job)
     return job
+
+
+# --- the Job's post: a working one, not FreeCAD's first in the list -------------------------------------
+DEFAULT_POST = "linuxcnc"
+FIVE_AXIS_POSTS = ("tarus", "apt_cl")  # the first is the default for a Job whose first op is 5-axis
+FIVE_AXIS_OPS = ("TMM_Multipoint",)
+
+
+def user_default_post() -> str:
+    """The post chosen in FreeCAD's preferences (Path/CAM Job: default post processor), '' when none."""
+    from tmm_workbench.app.compat import PathPreferences
+
+    return PathPreferences.defaultPostProcessor() or ""
+
+
+def choose_post(job: Any, post: str) -> bool:
+    """Sets the Job's post (with TMM's default arguments) when the Job offers it."""
+    from tmm_workbench.app import posts
+
+    try:
+        offered = list(job.getEnumerationsOfProperty("PostProcessor") or [])
+    except Exception:  # an old Job without the enumeration
+        offered = []
+    if post not in offered:
+        return False
+    job.PostProcessor = post
+    job.PostProcessorArgs = posts.DEFAULT_ARGS.get(post, "--no-show-editor")
+    return True
+
+
+def set_default_post(job: Any) -> None:
+    """A new Job gets linuxcnc unless the user chose a default post: FreeCAD otherwise keeps the first post in
+    its list (KineticNCBeamicon2), which fails on our paths."""
+    if not user_default_post():
+        choose_post(job, DEFAULT_POST)
+
+
+def post_for_first_op(job: Any, op: Any, op_type: str) -> None:
+    """When a 5-axis op is the Job's first op the Job posts with tarus (a 3-axis post cannot write its tool
+    axes); a 3-axis op keeps the Job's post, made linuxcnc if it is still FreeCAD's first in the list. A default
+    post chosen in the preferences is kept."""
+    if any(o.Name != op.Name for o in job.Operations.Group) or user_default_post():
+        return
+    if op_type in FIVE_AXIS_OPS:
+        if job.PostProcessor not in FIVE_AXIS_POSTS:
+            choose_post(job, FIVE_AXIS_POSTS[0])
+        return
+    offered = list(job.getEnumerationsOfProperty("PostProcessor") or [])
+    if offered and job.PostProcessor == offered[0] and offered[0] != DEFAULT_POST:
+        choose_post(job, DEFAULT_POST)
 
 
 def set_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float,

@@ -16,7 +16,7 @@ import FreeCAD
 import Part
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.app import geometry
+from tmm_workbench.app import geometry, hooks
 
 MIN_THICKNESS_MM = 0.01  # a flat mesh still needs a solid box (grown downwards, the top stays)
 TYPE_TAG = "TmmModelBounds"
@@ -47,6 +47,10 @@ class ModelBounds:
         base = FreeCAD.Vector(lo[0], lo[1], hi[2] - size[2])
         obj.Shape = Part.makeBox(size[0], size[1], size[2], base)
 
+    def onDocumentRestored(self, obj: Any) -> None:
+        # a document saved without the GUI (or before the box had its view provider) would show the box
+        hooks.attach_view("bounds", obj)
+
     def __getstate__(self) -> None:
         return None
 
@@ -69,9 +73,10 @@ def create(doc: Any, source: Any = None, stl_file: Optional[str] = None, name: s
         doc.removeObject(obj.Name)
         raise TmmError(f"no stand-in box for the model: {message}")
     vo = obj.ViewObject
-    if vo is not None:  # GUI: a see-through box, so the mesh itself stays in view
+    if vo is not None:  # GUI: a see-through box, so the mesh itself stays in view when the user shows it
         vo.Transparency = 85
         vo.ShapeColor = (0.6, 0.7, 0.9)
+    hooks.attach_view("bounds", obj)  # hidden, and it stays hidden when the document is reopened
     return obj
 
 

@@ -134,6 +134,22 @@ class TmmOp(PathOp.ObjectOp):
             obj.setExpression(name, None)  # a given value replaces the SetupSheet's expression
             setattr(obj, name, value)
         self._initial_values = {}
+        self.new_op_state(obj, job)
+
+    # --- a new op tells the truth before its first compute (issue 15 item 5) ----------------------
+    def new_op_state(self, obj: Any, job: Any) -> None:
+        """The heights' expressions (OpStockZMax + the SetupSheet's offsets) are evaluated when ObjectOp
+        creates the op, before a compute sets OpStockZMax: a new op showed 3 / 5 mm. The stock's top goes in
+        first. The Job's post follows its first op (jobs.post_for_first_op)."""
+        from tmm_workbench.app import job as jobs
+        from tmm_workbench.app import registry
+
+        stock = getattr(job, "Stock", None)
+        if stock is not None and not stock.Shape.isNull() and hasattr(obj, "OpStockZMax"):
+            bb = stock.Shape.BoundBox
+            obj.OpStockZMin, obj.OpStockZMax = bb.ZMin, bb.ZMax
+        op_type = next((e.name for e in registry.OPS if e.app_module == type(self).__module__), "")
+        jobs.post_for_first_op(job, obj, op_type)
 
     def isToolSupported(self, obj: Any, tool: Any) -> bool:
         # every shape TMM maps is offered; the strategy refuses the cutters it cannot use with its reason

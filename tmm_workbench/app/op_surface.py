@@ -20,13 +20,14 @@ import FreeCAD
 import Path
 
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
+from tmm_workbench.app import surface_passes
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
-from tmm_workbench.core.strategies import raster_drop
+from tmm_workbench.core.strategies import finish_passes
 from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
                                                        STEPOVER, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
@@ -107,6 +108,10 @@ DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
 POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
                    "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
 _PLANE_CODES = {"XZ": "G18", "YZ": "G19"}
+# % step-over, Depths (final depth, finishing passes) and start point (issue 15 item 6): app.surface_passes
+PROPERTIES += surface_passes.PROPERTIES
+CHOICES.update(surface_passes.CHOICES)
+DEFAULTS.update(surface_passes.DEFAULTS)
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -142,7 +147,8 @@ class ObjectTmmSurface(op_base.TmmOp):
         region = region_source.region_of(obj, PathUtils.findParentJob(obj))  # None: the box
         boundary = self.boundary(obj, mesh) if region is None else polygons.bounds(region)
         params = self.params_from(obj, boundary=boundary, region=region,
-                                  forward_step=FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""), SAMPLED))
+                                  forward_step=FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""), SAMPLED),
+                                  **surface_passes.params_extra(obj, cutter))
         if params.arcs and self.post_without_k(obj):
             params.arcs = False
             FreeCAD.Console.PrintWarning(
@@ -150,7 +156,8 @@ class ObjectTmmSurface(op_base.TmmOp):
                 "XZ/YZ would be wrong; lines within ChordTolerance instead\n")
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            toolpath = raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, cb)
+            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, surface_passes.finish_params(obj),
+                                                             policy, cb)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 

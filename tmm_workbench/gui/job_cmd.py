@@ -66,6 +66,7 @@ def create_job_gui(model: Any) -> Any:
     doc.recompute()
     FreeCAD.setActiveDocument(doc.Name)
     job = import_gui("job_gui").Create([jm.job_base], None, openTaskPanel=False)
+    jobs.set_default_post(job)  # not FreeCAD's first post in the list
     doc.recompute()
     return job
 

@@ -168,14 +168,17 @@ class OpViewProvider(PathOpGui.ViewProvider):
     def getSelectionFactory(self) -> Any:
         return lambda: None
 
-    def setupTaskPanel(self, panel: Any) -> None:
-        field_limits.guard_panel(panel)  # OK / Apply compute nothing while a value is refused
-        super().setupTaskPanel(panel)
-
     def getIcon(self) -> str:
         if self.Object is not None and not self.Object.Active:
             return f":/icons/{command_prefix()}OpActive.svg"
         return self.ICON
+
+    def setupTaskPanel(self, panel: Any) -> None:
+        from tmm_workbench.gui import panel_state
+
+        panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
+        field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
+        super().setupTaskPanel(panel)
 
 
 def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:

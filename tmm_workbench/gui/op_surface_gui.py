@@ -8,7 +8,7 @@ from PySide import QtGui
 
 from tmm_workbench.app import model_proxy, registry
 from tmm_workbench.app.compat import PathUtils
-from tmm_workbench.gui import op_page, region_panel, resources
+from tmm_workbench.gui import op_page, region_panel, resources, surface_depths_gui
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
@@ -26,9 +26,13 @@ COMBOS.update(region_panel.COMBOS)
 SPIN_BOXES["chordTolerance"] = "ChordTolerance"
 COMBOS["forwardStep"] = "ForwardStep"
 CHECKS = {"arcFitting": "ArcFitting"}
+# the group 'Depths, passes and start point' (issue 15 item 6)
+SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
+COMBOS.update(surface_depths_gui.COMBOS)
+CHECKS.update(surface_depths_gui.CHECKS)
 
 
-class TaskPanelOpPage(op_page.OpPage):
+class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
     """Tool controller, coolant, model, boundary and raster parameters of the op."""
 
     PANEL = "surface_op"
@@ -76,6 +80,7 @@ class TaskPanelOpPage(op_page.OpPage):
         if obj.Model != target:
             obj.Model = target
         region_panel.get_fields(self, obj)
+        self.get_depths(obj)
 
     def set_extra(self, obj: Any) -> None:
         self.form.stlFile.setText(obj.StlFile)
@@ -89,9 +94,16 @@ class TaskPanelOpPage(op_page.OpPage):
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
         region_panel.set_fields(self, obj)
+        self.set_depths(obj)
 
     def extra_signals(self) -> list[Any]:
-        return [self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + region_panel.signals(self)
+        return ([self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + region_panel.signals(self)
+                + self.depth_signals())
+
+    def updateData(self, obj: Any, prop: str) -> None:
+        super().updateData(obj, prop)
+        if prop in surface_depths_gui.ENABLING:
+            self.enable_depths(obj)
 
 
 class ViewProvider(op_page.OpViewProvider):

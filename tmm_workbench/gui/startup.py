@@ -15,6 +15,12 @@ def _job_view(obj: Any) -> None:
     view_providers.attach_job(obj)
 
 
+def _bounds_view(obj: Any) -> None:
+    from tmm_workbench.gui import view_providers
+
+    view_providers.attach_bounds(obj)
+
+
 def _op_view(entry: Any) -> Callable[[Any], None]:
     def attach(obj: Any) -> None:
         entry.gui().attach_view_provider(obj)  # Path's Gui modules load here, not at start-up
@@ -39,6 +45,7 @@ def install_hooks() -> None:
     for entry in registry.OPS:
         hooks.view_hooks.setdefault(entry.view_kind, _op_view(entry))
     hooks.view_hooks.setdefault("job", _job_view)
+    hooks.view_hooks.setdefault("bounds", _bounds_view)
     progress.progress_factory = _dialog_progress
     if _failure_box not in hooks.failure_hooks:
         hooks.failure_hooks.append(_failure_box)

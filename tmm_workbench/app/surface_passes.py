@@ -1,0 +1,60 @@
+"""The 3-axis Surface op's properties for what FreeCAD's 3D Surface users expect (issue 15 item 6): the
+step-over in % of the tool diameter, a Depths group (final depth, finishing passes over a semi-finish stock
+to leave, their step-down) and a start point; the core is core.strategies.finish_passes.
+
+Their defaults (mm step-over, no final depth, one pass, no start point) give the op's tool path from before
+they existed, so documents saved before them restore and compute unchanged (op_base.ensure_properties).
+"""
+from __future__ import annotations
+
+from typing import Any
+
+import FreeCAD
+
+from tmm_workbench.app.op_base import Prop
+from tmm_workbench.core.strategies.finish_passes import FinishParams, stepover_of_percent
+from tmm_workbench.core.strategies.raster_drop import STEPOVER
+from tmm_workbench.core.tools.cutter import Cutter
+
+MM, PERCENT = "mm", "%"
+
+PROPERTIES: list[Prop] = [
+    Prop("App::PropertyEnumeration", "StepOverUnit", "Surface",
+         "mm: passes StepOver apart; %: StepOverPercent of the tool diameter apart (StepOver spacing)"),
+    Prop("App::PropertyFloat", "StepOverPercent", "Surface",
+         "Distance between raster passes in % of the tool diameter, when StepOverUnit is %"),
+    Prop("App::PropertyBool", "UseFinalDepth", "Depths", "No tool tip below FinalDepth (off: the model's lowest point)"),
+    Prop("App::PropertyDistance", "FinalDepth", "Depths", "Lowest tool tip height, when UseFinalDepth is set"),
+    Prop("App::PropertyInteger", "FinishPasses", "Depths",
+         "Passes over the surface: the first ones leave StockToLeave + k x StepDown (semi-finish), the last "
+         "StockToLeave"),
+    Prop("App::PropertyDistance", "StepDown", "Depths",
+         "Stock each finishing pass removes over the next one (FinishPasses > 1)"),
+    Prop("App::PropertyBool", "UseStartPoint", "Start Point",
+         "Each pass set begins at the end of the raster nearest StartPoint (X, Y)"),
+    Prop("App::PropertyVectorDistance", "StartPoint", "Start Point", "Where the cutting starts (X and Y are used)"),
+]
+CHOICES: dict[str, dict[str, Any]] = {"StepOverUnit": {MM: MM, PERCENT: PERCENT}}
+DEFAULTS: dict[str, Any] = {"StepOverUnit": MM, "StepOverPercent": 10.0, "UseFinalDepth": False, "FinalDepth": 0.0,
+                            "FinishPasses": 1, "StepDown": 0.5, "UseStartPoint": False,
+                            "StartPoint": FreeCAD.Vector(0, 0, 0)}
+
+
+def params_extra(obj: Any, cutter: Cutter) -> dict[str, Any]:
+    """Params fields these properties set: the step-over in mm from its % of the tool diameter."""
+    if obj.StepOverUnit == PERCENT and obj.StepOverMode == _spacing_name(STEPOVER):
+        return {"stepover": stepover_of_percent(float(obj.StepOverPercent), cutter)}
+    return {}
+
+
+def finish_params(obj: Any) -> FinishParams:
+    start = obj.StartPoint
+    return FinishParams(passes=int(obj.FinishPasses), step_down=float(obj.StepDown.Value),
+                        final_depth=float(obj.FinalDepth.Value) if obj.UseFinalDepth else None,
+                        start_xy=(float(start.x), float(start.y)) if obj.UseStartPoint else None)
+
+
+def _spacing_name(core: str) -> str:
+    from tmm_workbench.app.op_surface import SPACINGS
+
+    return {c: p for p, c in SPACINGS.items()}[core]
