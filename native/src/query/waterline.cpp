@@ -39,6 +39,9 @@ void check_options(const WaterlineOptions& o) {
   if (!(o.bracket > 0 && o.bracket < 0.5 * o.chord_tol)) fail("bracket", o.bracket, "in (0, chord tolerance / 2)");
   if (!(o.min_segment > 0 && std::isfinite(o.min_segment))) fail("minimum segment", o.min_segment, "> 0 (mm)");
   if (o.max_depth < 0 || o.max_depth > 64) fail("maximum depth", o.max_depth, "in [0, 64]");
+  if (!(o.min_step >= 0 && std::isfinite(o.min_step))) fail("minimum step", o.min_step, ">= 0 (mm; 0: no refinement)");
+  if (o.min_step > 0 && !(o.min_step >= o.sample_step / 256.0))
+    fail("minimum step", o.min_step, ">= sample step / 256 (mm)");
 }
 
 std::size_t nodes_along(double width, double step) {
@@ -59,6 +62,10 @@ struct Grid {
   double dx = 0, dy = 0;
   std::vector<double> h;       // NX * NY heights
   std::vector<double> row_lo, row_hi;  // per cell row J: lowest and highest height of rows J and J + 1
+  // Adaptive grid: cells refined are sampled on a lattice k times finer (k = 1: no refinement). Fine node
+  // (X, Y) lies at coarse (X / k, Y / k); band: the cutter's lift over a cell, h(cell diagonal / sqrt 2).
+  std::size_t k = 1;
+  double band = 0;
 
   double x(std::size_t I) const { return x0 + (static_cast<double>(I) - 1.0) * dx; }
   double y(std::size_t J) const { return y0 + (static_cast<double>(J) - 1.0) * dy; }
@@ -74,6 +81,7 @@ class Level {
 
   std::vector<WaterlineLoop> loops();
   std::size_t drops() const { return drops_; }
+  std::size_t refined_cells() const { return refined_count_; }
 
  private:
   bool blocked(double x, double y) {
@@ -89,6 +97,34 @@ class Level {
   // free end of a bracket narrower than o_.bracket.
   Point crossing(Point f, Point b, double cf, double cb);
   Point edge_crossing(uint64_t edge);
+
+  // The fine lattice (g_.k per coarse cell; with k = 1 it is the coarse grid). Edge keys: the edge from
+  // node (X, Y) along X (vertical = 0) or Y, one fine step long or (coarse) one coarse cell long.
+  uint64_t NXf() const { return static_cast<uint64_t>((g_.NX - 1) * g_.k + 1); }
+  uint64_t key(std::size_t X, std::size_t Y, bool vertical, bool coarse) const {
+    return ((static_cast<uint64_t>(Y) * NXf() + X) * 2 + (vertical ? 1 : 0)) * 2 + (coarse ? 1 : 0);
+  }
+  double fx(std::size_t X) const { return g_.x0 + (static_cast<double>(X) / static_cast<double>(g_.k) - 1.0) * g_.dx; }
+  double fy(std::size_t Y) const { return g_.y0 + (static_cast<double>(Y) / static_cast<double>(g_.k) - 1.0) * g_.dy; }
+  bool fine_ring(std::size_t X, std::size_t Y) const {
+    const std::size_t k = g_.k;
+    return X < k || Y < k || X > (g_.NX - 2) * k || Y > (g_.NY - 2) * k;
+  }
+  bool coarse_node(std::size_t X, std::size_t Y) const { return X % g_.k == 0 && Y % g_.k == 0; }
+  bool state(std::size_t X, std::size_t Y);  // blocked (h > z) at a lattice node; ring nodes are free
+  double node_clearance(std::size_t X, std::size_t Y);  // z - h at a lattice node
+  bool cell_refined(std::size_t I, std::size_t J) const {
+    return !refined_.empty() && refined_[J * (g_.NX - 1) + I] != 0;
+  }
+  // Whether a triangle can hold the tool above z somewhere over the rectangle (the drop's own pruning).
+  bool may_block(double x0, double y0, double x1, double y1) const;
+  void refine_cells();
+  // The key of coarse cell (I, J)'s edge from its corner (X, Y) = (I k, J k) (vertical or not) as both of
+  // its cells see it: the fine step that holds its one crossing when a refined cell shares it.
+  uint64_t shared_edge(std::size_t X, std::size_t Y, bool vertical, bool fine);
+  // Marching squares on one cell: corner states c (counter-clockwise from the lower left), edge keys e
+  // (bottom, right, top, left), the centre for a saddle.
+  void march(const bool c[4], const uint64_t e[4], double cx, double cy);
   // Whether the exact loop crosses the perpendicular through p + t (q - p) farther than chord_tol from the
   // chord (inside the bounds); c: that crossing.
   bool off_chord(const Point& p, const Point& q, double t, Point& c);
@@ -101,6 +137,12 @@ class Level {
   const double z_, eval_floor_;
   int32_t hint_ = -1;
   std::size_t drops_ = 0;
+  std::unordered_map<uint64_t, uint8_t> fine_;  // states of fine nodes sampled (not coarse ones)
+  std::vector<uint8_t> refined_;                 // per coarse cell (adaptive grid only)
+  std::vector<std::size_t> row_refined_;         // refined cells per cell row
+  std::size_t refined_count_ = 0;
+  std::unordered_map<uint64_t, uint64_t> next_;  // marching segments, blocked on the left: edge -> edge
+  std::vector<uint64_t> starts_;                 // their start edges in scan order (the loops' order)
 };
 
 Point Level::crossing(Point f, Point b, double cf, double cb) {
@@ -158,19 +200,151 @@ Point Level::crossing(Point f, Point b, double cf, double cb) {
   return at(a);
 }
 
-// Edge ids: 2 (J NX + I) for the edge (I, J)-(I + 1, J), + 1 for (I, J)-(I, J + 1).
+bool Level::state(std::size_t X, std::size_t Y) {
+  if (coarse_node(X, Y)) return g_.h[(Y / g_.k) * g_.NX + X / g_.k] > z_;
+  if (fine_ring(X, Y)) return false;
+  const uint64_t id = static_cast<uint64_t>(Y) * NXf() + X;
+  const auto it = fine_.find(id);
+  if (it != fine_.end()) return it->second != 0;
+  const bool b = blocked(fx(X), fy(Y));
+  fine_.emplace(id, b ? 1 : 0);
+  return b;
+}
+
+double Level::node_clearance(std::size_t X, std::size_t Y) {
+  if (coarse_node(X, Y)) return z_ - g_.h[(Y / g_.k) * g_.NX + X / g_.k];
+  return clearance(fx(X), fy(Y));
+}
+
 Point Level::edge_crossing(uint64_t edge) {
-  const std::size_t node = static_cast<std::size_t>(edge >> 1);
-  const std::size_t I = node % g_.NX, J = node / g_.NX;
-  const bool vertical = edge & 1u;
-  const std::size_t I2 = vertical ? I : I + 1, J2 = vertical ? J + 1 : J;
-  const double ha = g_.h[J * g_.NX + I], hb = g_.h[J2 * g_.NX + I2];
-  Point a{g_.x(I), g_.y(J), true}, b{g_.x(I2), g_.y(J2), true};
+  const bool coarse = edge & 1u, vertical = (edge >> 1) & 1u;
+  const uint64_t node = edge >> 2;
+  const std::size_t X = static_cast<std::size_t>(node % NXf()), Y = static_cast<std::size_t>(node / NXf());
+  const std::size_t L = coarse ? g_.k : 1;
+  const std::size_t X2 = vertical ? X : X + L, Y2 = vertical ? Y + L : Y;
+  const Point a{fx(X), fy(Y), true}, b{fx(X2), fy(Y2), true};
   // A ring node stands for "outside the bounds": the crossing is the bound itself, not a contact.
-  if (g_.ring(I, J)) return Point{b.x, b.y, false};
-  if (g_.ring(I2, J2)) return Point{a.x, a.y, false};
-  if (ha > z_) return crossing(b, a, z_ - hb, z_ - ha);
-  return crossing(a, b, z_ - ha, z_ - hb);
+  if (fine_ring(X, Y)) return Point{b.x, b.y, false};
+  if (fine_ring(X2, Y2)) return Point{a.x, a.y, false};
+  // The states decided the marching; the clearances only start the search (kept on their sides).
+  double ca = node_clearance(X, Y), cb = node_clearance(X2, Y2);
+  if (state(X, Y)) {
+    ca = std::min(ca, -1e-300);
+    cb = std::max(cb, 0.0);
+    return crossing(b, a, cb, ca);
+  }
+  ca = std::max(ca, 0.0);
+  cb = std::min(cb, -1e-300);
+  return crossing(a, b, ca, cb);
+}
+
+bool Level::may_block(double x0, double y0, double x1, double y1) const {
+  bool any = false;
+  index_.near_rect(x0, y0, x1, y1, cutter_.max_radius(), z_, [&](const IndexedTriangle& t, int32_t) {
+    if (any) return;
+    const double dx = std::max({t.xmin - x1, x0 - t.xmax, 0.0});
+    const double dy = std::max({t.ymin - y1, y0 - t.ymax, 0.0});
+    any = dx * dx + dy * dy < cutter_.reach2(t.zmax - z_);
+  });
+  return any;
+}
+
+void Level::refine_cells() {
+  const std::size_t NX = g_.NX, NY = g_.NY, CX = NX - 1, CY = NY - 1, k = g_.k;
+  refined_.assign(CX * CY, 0);
+  row_refined_.assign(CY, 0);
+  std::vector<std::size_t> work;
+  auto add = [&](std::size_t I, std::size_t J) {
+    uint8_t& r = refined_[J * CX + I];
+    if (r) return;
+    r = 1;
+    ++row_refined_[J];
+    ++refined_count_;
+    work.push_back(J * CX + I);
+    if (static_cast<double>(refined_count_) * static_cast<double>((k + 1) * (k + 1)) >
+        static_cast<double>(kMaxWaterlineFineNodes)) {
+      std::ostringstream msg;
+      msg << "waterline minimum step refines more than " << refined_count_ << " cells of " << k << " x " << k
+          << " at level z " << z_ << ", over the kernel's limit of " << kMaxWaterlineFineNodes
+          << " fine nodes a level; use a larger minimum step or sample step";
+      throw std::invalid_argument(msg.str());
+    }
+  };
+  const double band = g_.band;
+  for (std::size_t J = 0; J < CY; ++J) {
+    if (z_ - band >= g_.row_hi[J] || z_ < g_.row_lo[J] - band) continue;
+    for (std::size_t I = 0; I < CX; ++I) {
+      const double h[4] = {g_.h[J * NX + I], g_.h[J * NX + I + 1], g_.h[(J + 1) * NX + I + 1],
+                           g_.h[(J + 1) * NX + I]};
+      int blocked_corners = 0;
+      bool near = false;  // a node within the band of z (ring nodes are -inf: never)
+      for (double v : h) {
+        blocked_corners += v > z_;
+        near = near || std::abs(v - z_) < band;
+      }
+      if (blocked_corners == 4) continue;
+      if (blocked_corners == 2 && (h[0] > z_) == (h[2] > z_)) {  // a saddle
+        add(I, J);
+        continue;
+      }
+      if (!near) continue;
+      // All free: a blocked piece between the nodes needs triangles that lift the tool above z over it.
+      if (blocked_corners == 0 && !may_block(g_.x(I), g_.y(J), g_.x(I + 1), g_.y(J + 1))) continue;
+      add(I, J);
+    }
+  }
+  // Closure: an unrefined neighbour must see at most one crossing on the edge it shares with a refined cell.
+  while (!work.empty()) {
+    const std::size_t cell = work.back();
+    work.pop_back();
+    const std::size_t I = cell % CX, J = cell / CX, X = I * k, Y = J * k;
+    for (std::size_t b = 0; b <= k; ++b)
+      for (std::size_t a = 0; a <= k; ++a) state(X + a, Y + b);
+    auto changes = [&](std::size_t X0, std::size_t Y0, bool vertical) {
+      int n = 0;
+      for (std::size_t t = 0; t < k; ++t) {
+        const bool s0 = vertical ? state(X0, Y0 + t) : state(X0 + t, Y0);
+        const bool s1 = vertical ? state(X0, Y0 + t + 1) : state(X0 + t + 1, Y0);
+        n += s0 != s1;
+      }
+      return n;
+    };
+    if (J > 0 && !cell_refined(I, J - 1) && changes(X, Y, false) > 1) add(I, J - 1);
+    if (J + 1 < CY && !cell_refined(I, J + 1) && changes(X, Y + k, false) > 1) add(I, J + 1);
+    if (I > 0 && !cell_refined(I - 1, J) && changes(X, Y, true) > 1) add(I - 1, J);
+    if (I + 1 < CX && !cell_refined(I + 1, J) && changes(X + k, Y, true) > 1) add(I + 1, J);
+  }
+}
+
+uint64_t Level::shared_edge(std::size_t X, std::size_t Y, bool vertical, bool fine) {
+  if (!fine) return key(X, Y, vertical, true);
+  for (std::size_t t = 0; t < g_.k; ++t) {
+    const std::size_t Xa = vertical ? X : X + t, Ya = vertical ? Y + t : Y;
+    const std::size_t Xb = vertical ? X : X + t + 1, Yb = vertical ? Y + t + 1 : Y;
+    if (state(Xa, Ya) != state(Xb, Yb)) return key(Xa, Ya, vertical, false);
+  }
+  return key(X, Y, vertical, true);  // no crossing (not asked for)
+}
+
+void Level::march(const bool c[4], const uint64_t e[4], double cx, double cy) {
+  const int k = c[0] + c[1] + c[2] + c[3];
+  if (k == 0 || k == 4) return;
+  auto add = [&](int from, int to) {
+    next_.emplace(e[from], e[to]);
+    starts_.push_back(e[from]);
+  };
+  if (k == 2 && c[0] == c[2]) {  // a saddle: the centre decides whether the blocked corners join
+    const bool centre = blocked(cx, cy);
+    const int first = c[0] ? 0 : 1;  // the blocked -> free edges are first and first + 2
+    for (int f : {first, first + 2}) add(f, centre ? (f + 1) % 4 : (f + 3) % 4);
+    return;
+  }
+  int from = -1, to = -1;
+  for (int q = 0; q < 4; ++q) {
+    if (c[q] && !c[(q + 1) % 4]) from = q;
+    if (!c[q] && c[(q + 1) % 4]) to = q;
+  }
+  add(from, to);
 }
 
 bool Level::off_chord(const Point& p, const Point& q, double t, Point& c) {
@@ -215,39 +389,39 @@ void Level::refine(const Point& p, const Point& q, int depth, std::vector<Point>
 }
 
 std::vector<WaterlineLoop> Level::loops() {
-  const std::size_t NX = g_.NX, NY = g_.NY;
+  const std::size_t NX = g_.NX, NY = g_.NY, k = g_.k;
+  if (k > 1) refine_cells();
   auto s = [&](std::size_t I, std::size_t J) { return g_.h[J * NX + I] > z_; };
-  auto H = [&](std::size_t I, std::size_t J) { return static_cast<uint64_t>(2 * (J * NX + I)); };
-  auto V = [&](std::size_t I, std::size_t J) { return static_cast<uint64_t>(2 * (J * NX + I) + 1); };
-  // Segments of the marching squares, blocked on the left: start edge -> end edge.
-  std::unordered_map<uint64_t, uint64_t> next;
-  std::vector<uint64_t> starts;  // in scan order (the loops' order)
   for (std::size_t J = 0; J + 1 < NY; ++J) {
-    if (z_ >= g_.row_hi[J] || z_ < g_.row_lo[J]) continue;  // the row is all free or all blocked
+    const bool row_refined = !row_refined_.empty() && row_refined_[J] > 0;
+    if (!row_refined && (z_ >= g_.row_hi[J] || z_ < g_.row_lo[J])) continue;  // all free or all blocked
     for (std::size_t I = 0; I + 1 < NX; ++I) {
-      const bool c[4] = {s(I, J), s(I + 1, J), s(I + 1, J + 1), s(I, J + 1)};
-      const int k = c[0] + c[1] + c[2] + c[3];
-      if (k == 0 || k == 4) continue;
-      // edge e between corners e and e + 1 (counter-clockwise): bottom, right, top, left
-      const uint64_t e[4] = {H(I, J), V(I + 1, J), H(I, J + 1), V(I, J)};
-      auto add = [&](int from, int to) {
-        next.emplace(e[from], e[to]);
-        starts.push_back(e[from]);
-      };
-      if (k == 2 && c[0] == c[2]) {  // a saddle: the centre decides whether the blocked corners join
-        const bool centre = blocked(0.5 * (g_.x(I) + g_.x(I + 1)), 0.5 * (g_.y(J) + g_.y(J + 1)));
-        const int first = c[0] ? 0 : 1;  // the blocked -> free edges are first and first + 2
-        for (int f : {first, first + 2}) add(f, centre ? (f + 1) % 4 : (f + 3) % 4);
+      const std::size_t X = I * k, Y = J * k;
+      if (cell_refined(I, J)) {
+        for (std::size_t b = 0; b < k; ++b)
+          for (std::size_t a = 0; a < k; ++a) {
+            const std::size_t x = X + a, y = Y + b;
+            const bool c[4] = {state(x, y), state(x + 1, y), state(x + 1, y + 1), state(x, y + 1)};
+            const uint64_t e[4] = {key(x, y, false, false), key(x + 1, y, true, false), key(x, y + 1, false, false),
+                                   key(x, y, true, false)};
+            march(c, e, 0.5 * (fx(x) + fx(x + 1)), 0.5 * (fy(y) + fy(y + 1)));
+          }
         continue;
       }
-      int from = -1, to = -1;
-      for (int q = 0; q < 4; ++q) {
-        if (c[q] && !c[(q + 1) % 4]) from = q;
-        if (!c[q] && c[(q + 1) % 4]) to = q;
-      }
-      add(from, to);
+      const bool c[4] = {s(I, J), s(I + 1, J), s(I + 1, J + 1), s(I, J + 1)};
+      const int n = c[0] + c[1] + c[2] + c[3];
+      if (n == 0 || n == 4) continue;
+      // edge e between corners e and e + 1 (counter-clockwise): bottom, right, top, left
+      const uint64_t e[4] = {
+          c[0] != c[1] ? shared_edge(X, Y, false, J > 0 && cell_refined(I, J - 1)) : 0,
+          c[1] != c[2] ? shared_edge(X + k, Y, true, I + 2 < NX && cell_refined(I + 1, J)) : 0,
+          c[3] != c[2] ? shared_edge(X, Y + k, false, J + 2 < NY && cell_refined(I, J + 1)) : 0,
+          c[0] != c[3] ? shared_edge(X, Y, true, I > 0 && cell_refined(I - 1, J)) : 0};
+      march(c, e, 0.5 * (g_.x(I) + g_.x(I + 1)), 0.5 * (g_.y(J) + g_.y(J + 1)));
     }
   }
+  const auto& next = next_;
+  const auto& starts = starts_;
   std::vector<WaterlineLoop> result;
   std::unordered_map<uint64_t, bool> done;
   done.reserve(starts.size());
@@ -330,6 +504,11 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
   g.y0 = o.ymin;
   g.dx = (o.xmax - o.xmin) / static_cast<double>(nx - 1);
   g.dy = (o.ymax - o.ymin) / static_cast<double>(ny - 1);
+  if (o.min_step > 0) {
+    const double cell = std::max(g.dx, g.dy);
+    while (cell / static_cast<double>(g.k) > o.min_step && g.k < 256) g.k *= 2;
+    g.band = cutter.height(std::min(cell, cutter.max_radius()));
+  }
   // Progress: the grid's share of the work by a rough count of drops (a level costs some 30 drops per
   // crossing, a few crossings per grid line).
   const double grid_work = static_cast<double>(nx * ny);
@@ -362,7 +541,7 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
     }
   }
 
-  std::atomic<std::size_t> drops{0};
+  std::atomic<std::size_t> drops{0}, refined{0};
   BatchOptions level_batch{batch.threads, {}};
   if (batch.progress)
     level_batch.progress = [&](double f) { return batch.progress(grid_share + f * (1.0 - grid_share)); };
@@ -371,11 +550,13 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
       Level level(index, cutter, g, o, zs[k]);
       result[k] = level.loops();
       drops += level.drops();
+      refined += level.refined_cells();
     }
   });
   if (stats) {
     stats->grid_nodes = nx * ny;
     stats->drops = drops.load();
+    stats->refined_cells = refined.load();
   }
   return result;
 }
