@@ -427,7 +427,32 @@ TEST(WaterlineAdaptive, ThreadsGiveIdenticalLoops) {
   for (std::size_t k = 0; k < zs.size(); ++k) {
     ASSERT_EQ(a[k].size(), b[k].size());
     for (std::size_t l = 0; l < a[k].size(); ++l) EXPECT_EQ(a[k][l].xy, b[k][l].xy);
+    // One level alone (its crossings and chords on both threads) gives the points it gives on one thread.
+    // (Not bit-identical to the level in the batch: the grid's floor is below the lowest level.)
+    const auto c1 = tmm::waterline(index, ball, {zs[k]}, o, one);
+    const auto c2 = tmm::waterline(index, ball, {zs[k]}, o, two);
+    ASSERT_EQ(c1[0].size(), c2[0].size());
+    for (std::size_t l = 0; l < c1[0].size(); ++l) EXPECT_EQ(c1[0][l].xy, c2[0][l].xy);
   }
+}
+
+TEST(WaterlineAdaptive, ProgressFalseCancelsWithinALevel) {
+  const MeshIndex index = sphere(10, 0, 48);
+  const Cutter ball(3, 3);
+  tmm::BatchOptions batch;
+  batch.threads = 2;
+  // The grid is 0.72 of the estimated work (301 x 301 nodes against 60 drops per grid line), the level's
+  // crossings the next half of the rest: their end reports 0.86, and the cancel there stops the level.
+  double last = 0;
+  std::string seen;
+  batch.progress = [&](double f) {
+    last = f;
+    seen += std::to_string(f) + " ";
+    return f < 0.75;
+  };
+  EXPECT_THROW(tmm::waterline(index, ball, {1.0}, options(-15, -15, 15, 15, 0.1, 1e-6), batch), tmm::Cancelled);
+  EXPECT_GE(last, 0.75);
+  EXPECT_LT(last, 1.0) << seen;
 }
 
 TEST(WaterlineAdaptive, BadMinimumStepIsRefusedByName) {
