@@ -300,13 +300,18 @@ bool Level::split_wanted(const Square& q) {
   // over the square above z, which hold the nearest corner above z minus that lift.
   const double side = static_cast<double>(q.L) / static_cast<double>(g_.k) * std::max(g_.dx, g_.dy);
   const double band = cutter_.height(std::min(side, cutter_.max_radius()));
+  // Pockets have no such bound: the band above z is the lift of a ball of the cutter's radius over twice the
+  // side (a flat's own lift is 0), a heuristic for dips between the corners (mount_rush.stl's 0.7 x 1.1 mm
+  // pocket between 0.5 mm nodes needs the factor 2).
+  const double r = std::min(2.0 * side, cutter_.max_radius()), R = cutter_.max_radius();
+  const double pocket_band = std::max(band, R - std::sqrt(std::max(R * R - r * r, 0.0)));
   bool near = false;
-  for (double v : h) near = near || std::abs(v - z_) < band;
+  for (double v : h) near = near || (v <= z_ ? z_ - v < band : v - z_ < pocket_band);
   if (!near && q.L == g_.k) {
     // The drop height bending between the grid nodes: its range inside the cell by the cubic through the
     // 4 x 4 nodes around it (no drops), for the smooth dips and crests the corners do not show.
     double lo = kInf, hi = -kInf;
-    if (cubic_range(q.X / g_.k, q.Y / g_.k, lo, hi)) near = lo < z_ + band && hi > z_ - band;
+    if (cubic_range(q.X / g_.k, q.Y / g_.k, lo, hi)) near = lo < z_ + pocket_band && hi > z_ - band;
   }
   if (!near) return false;
   const double x0 = fx(q.X), y0 = fy(q.Y), x1 = fx(q.X + q.L), y1 = fy(q.Y + q.L);
