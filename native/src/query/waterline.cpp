@@ -65,10 +65,8 @@ struct Grid {
   double dx = 0, dy = 0;
   std::vector<double> h;       // NX * NY heights
   std::vector<double> row_lo, row_hi;  // per cell row J: lowest and highest height of rows J and J + 1
-  // Adaptive grid: cells refined are sampled on a lattice k times finer (k = 1: no refinement). Fine node
-  // (X, Y) lies at coarse (X / k, Y / k); band: the cutter's lift over a cell, h(cell diagonal / sqrt 2).
+  // Adaptive grid: cells refined are split down to a lattice k times finer (k = 1: no refinement).
   std::size_t k = 1;
-  double band = 0;
 
   double x(std::size_t I) const { return x0 + (static_cast<double>(I) - 1.0) * dx; }
   double y(std::size_t J) const { return y0 + (static_cast<double>(J) - 1.0) * dy; }
@@ -709,7 +707,6 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
   if (o.min_step > 0) {
     const double cell = std::max(g.dx, g.dy);
     while (cell / static_cast<double>(g.k) > o.min_step && g.k < 256) g.k *= 2;
-    g.band = cutter.height(std::min(cell, cutter.max_radius()));
   }
   // Progress: the grid's share of the work by a rough count of drops (a level costs some 30 drops per
   // crossing, a few crossings per grid line).

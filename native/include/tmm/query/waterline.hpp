@@ -12,13 +12,15 @@
 // through the chord's midpoint). The blocked region lies on the left of every loop: islands (loops around
 // material) run counter-clockwise, pockets clockwise.
 //
-// Adaptive grid (min_step > 0): per level, coarse cells where a feature could hide between the nodes are
-// sampled again on a fine lattice of step sample_step / k (k a power of two, the step <= min_step): saddle
-// cells, and cells with a free corner whose node heights lie within the cutter's lift over a cell
-// (h(sample_step), h the cutter's profile) of z, where triangles can hold the tool above z (a blocked
-// piece that reaches no node comes from mesh points at most that lift above z, next to such a node).
-// Neighbours whose shared edge then shows more than one crossing are refined as well, so that the loops of
-// coarse and fine cells meet on the same fine edge (docs/waterline.md, "Adaptive grid").
+// Adaptive grid (min_step > 0): per level, grid cells where a feature could hide between their corners are
+// split into quarters, recursively, down to sample_step / k (k a power of two, that step <= min_step):
+// saddles; squares with a corner within the cutter's lift over the square (h(side), h the profile) of z,
+// all-free ones only where triangles can hold the tool above z (a blocked piece that reaches no corner
+// comes from mesh points less than that lift above z, next to such a corner); all-blocked ones within a
+// ball's lift over twice the side above z (pockets: a heuristic), or, for grid cells, when the cubic
+// through the 4 x 4 nodes around dips that close to z. Then squares whose boundary (with smaller
+// neighbours' nodes) changes state more than twice are split until none does, so that neighbouring loop
+// pieces meet on the same boundary segment (docs/waterline.md, "Adaptive grid").
 #pragma once
 
 #include <cstddef>
