@@ -32,7 +32,7 @@ py::list loops_to_python(const std::vector<tmm::WaterlineLoop>& loops) {
 void bind_waterline(py::module_& m) {
   py::class_<tmm::WaterlineOptions>(m, "WaterlineOptions",
       "Options of the exact waterline: bounds of the tip (mm), grid sample step, chord tolerance, the bracket of "
-      "each exact crossing, the shortest chord split and the split depth.")
+      "each exact crossing, the shortest chord split, the split depth and the adaptive grid's finest cell (min_step; 0: a uniform grid).")
       .def(py::init<>())
       .def_readwrite("xmin", &tmm::WaterlineOptions::xmin)
       .def_readwrite("ymin", &tmm::WaterlineOptions::ymin)
@@ -42,7 +42,8 @@ void bind_waterline(py::module_& m) {
       .def_readwrite("chord_tol", &tmm::WaterlineOptions::chord_tol)
       .def_readwrite("bracket", &tmm::WaterlineOptions::bracket)
       .def_readwrite("min_segment", &tmm::WaterlineOptions::min_segment)
-      .def_readwrite("max_depth", &tmm::WaterlineOptions::max_depth);
+      .def_readwrite("max_depth", &tmm::WaterlineOptions::max_depth)
+      .def_readwrite("min_step", &tmm::WaterlineOptions::min_step);
 
   m.attr("WATERLINE_MAX_GRID_NODES") = tmm::kMaxWaterlineGridNodes;
 
@@ -71,6 +72,7 @@ void bind_waterline(py::module_& m) {
           py::dict info;
           info["grid_nodes"] = stats.grid_nodes;
           info["drops"] = stats.drops;
+          info["refined_cells"] = stats.refined_cells;
           return py::make_tuple(out, info);
         },
         py::arg("index"), py::arg("cutter"), py::arg("zs"), py::arg("options"), py::kw_only(),

@@ -5,9 +5,13 @@
 //  - every loop point is free (drop height <= z) and blocked material lies within 1e-6 mm on its left, or
 //    its drop height is z within 1e-6;
 //  - loops closed without self-intersections, islands counter-clockwise, pockets clockwise;
-//  - identical loops for any thread count, cancel, bad input.
+//  - identical loops for any thread count, cancel, bad input;
+//  - the adaptive grid (min_step): a bump and a thin ridge between the coarse nodes, which the coarse grid
+//    alone misses, are found exactly; loops the same in count, orientation and area as a uniform grid at
+//    the fine step on the cases above.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <string>
@@ -284,6 +288,184 @@ TEST(Waterline, BadInputIsRefusedByName) {
   const std::string big = message(options(0, 0, 1000, 1000, 0.01, 0.01), {0});
   EXPECT_NE(big.find("sample step 0.01 mm"), std::string::npos) << big;
   EXPECT_NE(big.find("limit"), std::string::npos) << big;
+}
+
+// ---- adaptive grid (min_step) ----
+
+WaterlineOptions adaptive(WaterlineOptions o, double min_step) {
+  o.min_step = min_step;
+  return o;
+}
+
+double max_x(const WaterlineLoop& loop) {
+  double m = -1e300;
+  for (std::size_t i = 0; i < loop.size(); ++i) m = std::max(m, loop.xy[2 * i]);
+  return m;
+}
+
+// A 20 x 20 plane at z 0 and a thin pyramid on it: apex (ax, ay, top), base half-width w.
+MeshIndex plane_with_spike(double ax, double ay, double top, double w) {
+  tmm::Vertices V(9, 3);
+  V << -10, -10, 0, 10, -10, 0, 10, 10, 0, -10, 10, 0,                               // plane
+      ax - w, ay - w, 0, ax + w, ay - w, 0, ax + w, ay + w, 0, ax - w, ay + w, 0,  // base
+      ax, ay, top;                                                                  // apex
+  tmm::Triangles T(6, 3);
+  T << 0, 1, 2, 0, 2, 3, 4, 5, 8, 5, 6, 8, 6, 7, 8, 7, 4, 8;
+  return MeshIndex(V, T);
+}
+
+TEST(WaterlineAdaptive, FindsABumpBetweenTheCoarseNodes) {
+  const Cutter ball(3, 3);
+  const double ax = 0.5, ay = 0.5;  // the centre of a 1 mm cell: 0.71 mm from its corners
+  const MeshIndex index = plane_with_spike(ax, ay, 1.0, 0.05);
+  const double rho = 0.3;           // the loop: the ball touching the apex at rho from its axis
+  const double z = 1.0 - ball.height(rho);
+  const WaterlineOptions coarse = options(-5, -5, 5, 5, 1.0, 1e-4);
+  // The corners see the apex 0.71 mm away, below z: the uniform 1 mm grid finds nothing.
+  EXPECT_EQ(tmm::waterline(index, ball, {z}, coarse, {})[0].size(), 0u);
+  tmm::WaterlineStats stats;
+  const auto levels = tmm::waterline(index, ball, {z}, adaptive(coarse, 0.05), {}, &stats);
+  EXPECT_GT(stats.refined_cells, 0u);
+  ASSERT_EQ(levels[0].size(), 1u);
+  const WaterlineLoop& loop = levels[0][0];
+  EXPECT_GT(loop.area(), 0.0);  // an island
+  EXPECT_NEAR(loop.area(), kPi * rho * rho, 2 * kPi * rho * 1e-4);
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    ASSERT_NEAR(std::hypot(loop.xy[2 * i] - ax, loop.xy[2 * i + 1] - ay), rho, 1e-6) << "point " << i;
+  expect_contacts(index, ball, loop);
+  expect_simple(levels[0]);
+  // A uniform grid at the fine step sees the same loop.
+  const auto fine = tmm::waterline(index, ball, {z}, options(-5, -5, 5, 5, 0.0625, 1e-4), {});
+  ASSERT_EQ(fine[0].size(), 1u);
+  EXPECT_NEAR(fine[0][0].area(), loop.area(), 2 * kPi * rho * 1e-4);
+}
+
+// A box [0, 10] x [-5, 5] x [0, 5] and a thin ridge of height 1 along y = 0.5 from x = 10 to x = 16.
+MeshIndex box_with_ridge() {
+  using P = Eigen::Vector3d;
+  const double y = 0.5, w = 0.02, x0 = 10, x1 = 16;
+  std::vector<std::array<P, 4>> q = {{P(0, -5, 5), P(10, -5, 5), P(10, 5, 5), P(0, 5, 5)},
+                                     {P(0, -5, 0), P(10, -5, 0), P(10, -5, 5), P(0, -5, 5)},
+                                     {P(10, -5, 0), P(10, 5, 0), P(10, 5, 5), P(10, -5, 5)},
+                                     {P(10, 5, 0), P(0, 5, 0), P(0, 5, 5), P(10, 5, 5)},
+                                     {P(0, 5, 0), P(0, -5, 0), P(0, -5, 5), P(0, 5, 5)},
+                                     {P(x0, y - w, 0), P(x1, y - w, 0), P(x1, y, 1), P(x0, y, 1)},
+                                     {P(x1, y + w, 0), P(x0, y + w, 0), P(x0, y, 1), P(x1, y, 1)}};
+  return quads(q);
+}
+
+TEST(WaterlineAdaptive, FindsAThinRidgeBetweenTwoGridLines) {
+  const Cutter ball(3, 3);
+  const MeshIndex index = box_with_ridge();
+  const double z = 0.99;
+  const double rho = std::sqrt(6.0 * 0.01 - 0.01 * 0.01);  // the ball on the ridge's crest at z: h(rho) = 0.01
+  // The ridge runs between the grid lines y = 0 and y = 1; its 0.49 mm wide strip of blocked positions
+  // sticks out 3.2 mm past the box's loop (x = 13).
+  const WaterlineOptions coarse = options(-10, -10, 20, 10, 1.0, 1e-4);
+  const auto plain = tmm::waterline(index, ball, {z}, coarse, {});
+  ASSERT_EQ(plain[0].size(), 1u);
+  EXPECT_LT(max_x(plain[0][0]), 13.0 + 1e-6);  // the coarse grid cuts the spike off
+  const auto levels = tmm::waterline(index, ball, {z}, adaptive(coarse, 0.05), {});
+  ASSERT_EQ(levels[0].size(), 1u);
+  const WaterlineLoop& loop = levels[0][0];
+  EXPECT_GT(loop.area(), 0.0);
+  EXPECT_NEAR(max_x(loop), 16.0 + rho, 1e-4);
+  expect_contacts(index, ball, loop);
+  expect_simple(levels[0]);
+  const auto fine = tmm::waterline(index, ball, {z}, options(-10, -10, 20, 10, 0.0625, 1e-4), {});
+  ASSERT_EQ(fine[0].size(), 1u);
+  EXPECT_NEAR(max_x(fine[0][0]), max_x(loop), 1e-4);
+  EXPECT_NEAR(fine[0][0].area(), loop.area(), 1e-3 * loop.area());
+}
+
+// Count, orientation and area of each loop (sorted by area) equal to a uniform grid's at the fine step.
+void expect_same_loops(const std::vector<WaterlineLoop>& a, const std::vector<WaterlineLoop>& b, double tol) {
+  ASSERT_EQ(a.size(), b.size());
+  std::vector<double> aa, bb;
+  for (const auto& l : a) aa.push_back(l.area());
+  for (const auto& l : b) bb.push_back(l.area());
+  std::sort(aa.begin(), aa.end());
+  std::sort(bb.begin(), bb.end());
+  for (std::size_t i = 0; i < aa.size(); ++i) EXPECT_NEAR(aa[i], bb[i], tol * std::max(1.0, std::abs(bb[i])));
+}
+
+TEST(WaterlineAdaptive, LoopsAsAUniformFineGridsOnTheExistingCases) {
+  const MeshIndex ball_sphere = sphere(10, 2, 48), b = box(0, 0, 20, 10, 5), f = frame();
+  std::vector<double> zs;
+  for (int k = 0; k < 6; ++k) zs.push_back(-1.5 + 2.1 * k);
+  for (const Cutter& c : {Cutter(3, 0), Cutter(3, 1), Cutter(3, 3)}) {
+    const struct {
+      const MeshIndex* index;
+      WaterlineOptions o;
+    } cases[] = {{&ball_sphere, options(-16, -16, 16, 16, 1.0, 1e-3)},
+                 {&b, options(-10, -10, 30, 20, 1.0, 1e-3)},
+                 {&f, options(-10, -10, 50, 50, 1.0, 1e-3)}};
+    for (const auto& cs : cases) {
+      const auto a = tmm::waterline(*cs.index, c, zs, adaptive(cs.o, 0.125), {});
+      WaterlineOptions u = cs.o;
+      u.sample_step = 0.125;
+      const auto ref = tmm::waterline(*cs.index, c, zs, u, {});
+      for (std::size_t k = 0; k < zs.size(); ++k) {
+        expect_same_loops(a[k], ref[k], 1e-3);
+        for (const auto& loop : a[k]) expect_contacts(*cs.index, c, loop);
+        expect_simple(a[k]);
+      }
+    }
+  }
+}
+
+TEST(WaterlineAdaptive, ThreadsGiveIdenticalLoops) {
+  const MeshIndex index = box_with_ridge();
+  const Cutter ball(3, 3);
+  const std::vector<double> zs = {0.2, 0.5, 0.9, 0.99, 0.999, 2.0};
+  tmm::BatchOptions one, two;
+  one.threads = 1;
+  two.threads = 2;
+  const WaterlineOptions o = adaptive(options(-10, -10, 20, 10, 1.0, 1e-3), 0.05);
+  const auto a = tmm::waterline(index, ball, zs, o, one);
+  const auto b = tmm::waterline(index, ball, zs, o, two);
+  for (std::size_t k = 0; k < zs.size(); ++k) {
+    ASSERT_EQ(a[k].size(), b[k].size());
+    for (std::size_t l = 0; l < a[k].size(); ++l) EXPECT_EQ(a[k][l].xy, b[k][l].xy);
+    // One level alone (its crossings and chords on both threads) gives the points it gives on one thread.
+    // (Not bit-identical to the level in the batch: the grid's floor is below the lowest level.)
+    const auto c1 = tmm::waterline(index, ball, {zs[k]}, o, one);
+    const auto c2 = tmm::waterline(index, ball, {zs[k]}, o, two);
+    ASSERT_EQ(c1[0].size(), c2[0].size());
+    for (std::size_t l = 0; l < c1[0].size(); ++l) EXPECT_EQ(c1[0][l].xy, c2[0][l].xy);
+  }
+}
+
+TEST(WaterlineAdaptive, ProgressFalseCancelsWithinALevel) {
+  const MeshIndex index = sphere(10, 0, 48);
+  const Cutter ball(3, 3);
+  tmm::BatchOptions batch;
+  batch.threads = 2;
+  // The grid is 0.72 of the estimated work (301 x 301 nodes against 60 drops per grid line), the level's
+  // crossings the next half of the rest: their end reports 0.86, and the cancel there stops the level.
+  double last = 0;
+  std::string seen;
+  batch.progress = [&](double f) {
+    last = f;
+    seen += std::to_string(f) + " ";
+    return f < 0.75;
+  };
+  EXPECT_THROW(tmm::waterline(index, ball, {1.0}, options(-15, -15, 15, 15, 0.1, 1e-6), batch), tmm::Cancelled);
+  EXPECT_GE(last, 0.75);
+  EXPECT_LT(last, 1.0) << seen;
+}
+
+TEST(WaterlineAdaptive, BadMinimumStepIsRefusedByName) {
+  const MeshIndex index = sphere(10, 0, 16);
+  const Cutter ball(3, 3);
+  for (double bad : {-0.1, 1e-4, std::nan("")}) {
+    try {
+      tmm::waterline(index, ball, {0.0}, adaptive(options(0, 0, 10, 10, 1, 0.01), bad), {});
+      ADD_FAILURE() << "min_step " << bad << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("minimum step"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

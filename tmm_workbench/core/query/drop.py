@@ -23,6 +23,11 @@ class DropSurface:
         except ValueError as exc:
             raise TmmError(f"{mesh.name}: {exc}") from exc
 
+    @property
+    def index(self) -> "native.MeshIndex":
+        """The kernel's spatial index of the mesh, for other kernel queries over the same mesh (waterline)."""
+        return self._index
+
     def drop(self, cutter: Cutter, xy: np.ndarray, floor_z: float,
              progress: Optional[Progress] = None, threads: int = 0) -> np.ndarray:
         """Tip heights (n,) of `cutter` dropped at the (n, 2) points `xy`: the lowest tip position on or

@@ -6,7 +6,8 @@ without gouging (the boundary of the region where the drop-cutter height exceeds
         for loop in level:         # loop.xy (n, 2), loop.contact (n,), loop.island, loop.area
 
 Method and limits: docs/waterline.md (a feature narrower than the sample step can be missed between grid
-lines, as with any sampled method).
+lines, as with any sampled method; `min_step` samples again, down to that step, the cells where a feature
+could hide between the nodes: the adaptive grid).
 """
 from __future__ import annotations
 
@@ -81,8 +82,8 @@ def _finite(name: str, value: object) -> float:
 
 def waterline_loops(surface: DropSurface, cutter: Cutter, zs: Sequence[float],
                     bounds: tuple[float, float, float, float], *, sample_step: float | None = None,
-                    chord_tol: float = 0.01, threads: int = 0,
-                    progress: Progress | None = None) -> list[list[WaterlineLoop]]:
+                    chord_tol: float = 0.01, threads: int = 0, progress: Progress | None = None,
+                    min_step: float | None = None) -> list[list[WaterlineLoop]]:
     """For each z in zs (any order; returned in the same order), the closed loops of tip positions at height z
     where `cutter` touches the mesh of `surface` without gouging, within bounds (xmin, ymin, xmax, ymax) of the
     tip. Cancels with core.errors.Cancelled; bad input TmmError by name.
@@ -92,7 +93,12 @@ def waterline_loops(surface: DropSurface, cutter: Cutter, zs: Sequence[float],
     within 1e-7 mm of a point that is blocked; chords between neighbours stay within `chord_tol` of the exact
     loop. Points where the blocked region runs past the bounds lie on the bounds and have contact False.
     Stock to leave s: pass `cutter.offset(s)` and the levels z - s, then add s to the loops' z (exact: the grown
-    cutter's surface lies s below this one's, Cutter.offset)."""
+    cutter's surface lies s below this one's, Cutter.offset).
+
+    min_step (mm, None: off): the adaptive grid. Per level, cells of the sample_step grid where a feature could
+    hide between the nodes (saddles; a free corner whose drop height is within the cutter's lift over a cell
+    of z, where triangles can hold the tool above z) are sampled again at sample_step / 2^m <= min_step, so a
+    coarse sample_step finds loops and spikes down to about min_step (docs/waterline.md, "Adaptive grid")."""
     if len(bounds) != 4:
         raise TmmError(f"waterline bounds must be four numbers xmin, ymin, xmax, ymax, got {bounds!r}")
     b = tuple(_finite(f"waterline bounds {k}", v) for k, v in zip(("xmin", "ymin", "xmax", "ymax"), bounds))
@@ -107,6 +113,12 @@ def waterline_loops(surface: DropSurface, cutter: Cutter, zs: Sequence[float],
         raise TmmError(f"chord tolerance must be in (0, 1] mm, got {tol:g}")
     if not isinstance(threads, int) or isinstance(threads, bool) or threads < 0:
         raise TmmError(f"threads must be a whole number >= 0 (0: all cores), got {threads!r}")
+    fine = 0.0
+    if min_step is not None:
+        fine = _finite("minimum step", min_step)
+        if not step / 256.0 <= fine <= step:
+            raise TmmError(f"minimum step must be in [sample step / 256, sample step] = [{step / 256.0:g}, {step:g}] "
+                           f"mm, got {fine:g} mm")
     if not levels:
         return []
     estimate_work(b, len(levels), step)
@@ -116,9 +128,9 @@ def waterline_loops(surface: DropSurface, cutter: Cutter, zs: Sequence[float],
     o.sample_step = step
     o.chord_tol = tol
     o.bracket = min(1e-7, tol / 4)
+    o.min_step = fine
     try:
-        # DropSurface keeps the kernel's index private to core.query; this is core.query too.
-        out, _ = native.waterline(surface._index, cutter.native, levels, o, threads=threads, progress=progress)
+        out, _ = native.waterline(surface.index, cutter.native, levels, o, threads=threads, progress=progress)
     except native.Cancelled as exc:
         raise Cancelled("waterline computation cancelled") from exc
     except ValueError as exc:

@@ -11,6 +11,16 @@
 // between two loop points lies farther than `chord_tol` from the exact loop (measured on the perpendicular
 // through the chord's midpoint). The blocked region lies on the left of every loop: islands (loops around
 // material) run counter-clockwise, pockets clockwise.
+//
+// Adaptive grid (min_step > 0): per level, grid cells where a feature could hide between their corners are
+// split into quarters, recursively, down to sample_step / k (k a power of two, that step <= min_step):
+// saddles; squares with a corner within the cutter's lift over the square (h(side), h the profile) of z,
+// all-free ones only where triangles can hold the tool above z (a blocked piece that reaches no corner
+// comes from mesh points less than that lift above z, next to such a corner); all-blocked ones within a
+// ball's lift over twice the side above z (pockets: a heuristic), or, for grid cells, when the cubic
+// through the 4 x 4 nodes around dips that close to z. Then squares whose boundary (with smaller
+// neighbours' nodes) changes state more than twice are split until none does, so that neighbouring loop
+// pieces meet on the same boundary segment (docs/waterline.md, "Adaptive grid").
 #pragma once
 
 #include <cstddef>
@@ -30,10 +40,13 @@ struct WaterlineOptions {
   double bracket = 1e-7;        // width of the bracket of every exact crossing (mm)
   double min_segment = 1e-4;    // chords shorter than this are not split further (sharp corners)
   int max_depth = 16;           // splits of one grid chord at most
+  double min_step = 0;          // adaptive grid: the finest cell (mm); 0: one uniform grid (no refinement)
 };
 
 // The largest drop grid the kernel accepts (nodes, padding included): about 1.6 GB of heights.
 constexpr std::size_t kMaxWaterlineGridNodes = 200'000'000;
+// The most fine nodes one level's refinement may sample (about 100 MB of states); more throws.
+constexpr std::size_t kMaxWaterlineFineNodes = 4'000'000;
 
 struct WaterlineLoop {
   double z = 0;
@@ -46,6 +59,7 @@ struct WaterlineLoop {
 struct WaterlineStats {
   std::size_t grid_nodes = 0;   // drops of the shared grid
   std::size_t drops = 0;        // drops of the levels (crossings, saddles, refinement)
+  std::size_t refined_cells = 0;  // coarse cells sampled again on the fine lattice, over all levels
 };
 
 // The grid's node counts along X and Y (bounds included, padding excluded) for these options; throws
