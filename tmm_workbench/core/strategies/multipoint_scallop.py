@@ -1,0 +1,366 @@
+"""Side step from a scallop height for multipoint 5-axis finishing (issue 14 item 5).
+
+Passes are placed one after the other across the boundary: the first on the start edge, each next one at the
+largest side step for which the scallop left between it and the passes before it, measured on the real tool
+positions, is at most `MultipointParams.scallop`; the last on the far edge. The scallop of a trial pass is
+read by cutting the swept tool (the kernel's 5-axis z-map cut: tip linear, axis by slerp, sub-stepped) into
+rows of vertical needles laid across the strip between the previous pass's tips and the trial pass's tips, one
+row every `scallop_row_spacing` along the passes: the largest height above the design surface on those
+needles. Needles are `NEEDLE_SPACING` apart, then `FINE_SPACING` around the highest peaks (the cusp is a
+sharp ridge). The design height is the face itself (its XY parametrisation inverted by Newton).
+
+The search per pass brackets the step (the scallop grows about with the square of the step, so the next trial
+interpolates in sqrt(scallop)), keeps the largest step found within the tolerance and stops when the scallop is
+within SCALLOP_REL of it or the bracket is narrower than STEP_TOL. Rows where one of the two passes has no
+good position near them (failed positions, the ends of the passes) are not measured and are counted.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
+from tmm_workbench.core.geometry.face import BezierFace
+from tmm_workbench.core.kernel import native
+from tmm_workbench.core.limits import check_work
+
+NEEDLE_SPACING = 0.05   # mm, needles across a strip (first reading)
+FINE_SPACING = 0.002    # mm, needles around the highest peaks (second reading)
+FINE_ROWS = 4           # rows whose peak is read finely
+SCALLOP_REL = 0.02      # a pass is accepted once its scallop is within 2 % below the tolerance
+STEP_TOL = 0.005        # mm: or once the bracket on the step is this narrow
+MAX_TRIALS = 14         # trial passes per placed pass
+_STOCK_ABOVE = 50.0     # mm: needles start this far above the face's top (an uncut needle reads huge)
+_BYTES_PER_NEEDLE = 64
+
+
+@dataclass
+class Frame:
+    """Across (c) and along (f) unit vectors of the passes, a proper rotation (c, f) of the XY plane, and the
+    boundary's extent in it: passes at across a in [a0, a1], advancing in +c from the start edge a0."""
+    c: np.ndarray
+    f: np.ndarray
+    a0: float
+    a1: float
+
+    @classmethod
+    def of(cls, rect: Rect, feed_angle_deg: float) -> "Frame":
+        a = math.radians(feed_angle_deg)
+        d = np.array([math.cos(a), math.sin(a)])
+        n = np.array([-math.sin(a), math.cos(a)])
+        corners = np.array([[rect[0], rect[1]], [rect[2], rect[1]], [rect[2], rect[3]], [rect[0], rect[3]]])
+        across = corners @ n
+        # start on the side nearest the (xmin, ymin) corner, as raster_lines' FIXED spacing does
+        if abs(corners[0] @ n - across.max()) < abs(corners[0] @ n - across.min()):
+            n = -n
+        f = d if n[0] * d[1] - n[1] * d[0] > 0 else -d
+        across = corners @ n
+        return cls(n, f, float(across.min()), float(across.max()))
+
+    def to_frame(self, p: np.ndarray) -> np.ndarray:
+        """(k, 2|3) world points -> frame (across, along[, z])."""
+        out = np.array(p, dtype=float, copy=True)
+        out[:, 0], out[:, 1] = p[:, :2] @ self.c, p[:, :2] @ self.f
+        return out
+
+    def to_world(self, q: np.ndarray) -> np.ndarray:
+        out = np.array(q, dtype=float, copy=True)
+        out[:, 0] = q[:, 0] * self.c[0] + q[:, 1] * self.f[0]
+        out[:, 1] = q[:, 0] * self.c[1] + q[:, 1] * self.f[1]
+        return out
+
+
+class DesignHeights:
+    """z of the face above world (x, y) points (NaN off the face): the face's XY map inverted by Newton from
+    the nearest of a grid of samples."""
+
+    def __init__(self, face: BezierFace, samples: int = 32) -> None:
+        self.face = face
+        u0, u1, v0, v1 = face.domain
+        U, V = np.meshgrid(np.linspace(u0, u1, samples + 1), np.linspace(v0, v1, samples + 1), indexing="ij")
+        self.uv = np.column_stack([U.ravel(), V.ravel()])
+        self.xy = face.evaluate(self.uv)["S"][:, :2]
+        self.domain = (u0, u1, v0, v1)
+
+    def __call__(self, xy: np.ndarray, iterations: int = 12, tol: float = 1e-7) -> np.ndarray:
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        uv = np.empty_like(xy)
+        for k in range(0, len(xy), 2048):  # nearest sample, in chunks
+            d = ((xy[k:k + 2048, None, :] - self.xy[None, :, :]) ** 2).sum(-1)
+            uv[k:k + 2048] = self.uv[np.argmin(d, axis=1)]
+        u0, u1, v0, v1 = self.domain
+        for _ in range(iterations):
+            ev = self.face.evaluate(uv)
+            r = ev["S"][:, :2] - xy
+            a, b, c, d = ev["Su"][:, 0], ev["Sv"][:, 0], ev["Su"][:, 1], ev["Sv"][:, 1]
+            det = a * d - b * c
+            det = np.where(np.abs(det) < 1e-300, 1e-300, det)
+            uv[:, 0] -= (d * r[:, 0] - b * r[:, 1]) / det
+            uv[:, 1] -= (-c * r[:, 0] + a * r[:, 1]) / det
+            uv[:, 0] = np.clip(uv[:, 0], u0, u1)
+            uv[:, 1] = np.clip(uv[:, 1], v0, v1)
+        ev = self.face.evaluate(uv)
+        z = ev["S"][:, 2].copy()
+        z[np.linalg.norm(ev["S"][:, :2] - xy, axis=1) > tol] = np.nan  # off the face (clamped at its edge)
+        return z
+
+
+@dataclass
+class PassPositions:
+    """One pass positioned: footprint across offset `a`, its footprint points (k, 2) in feed order from the
+    pass's start, and the kernel's results for them (a MultipointResults)."""
+    a: float
+    xy: np.ndarray
+    res: Any
+
+    def good(self, failed: int) -> np.ndarray:
+        return self.res["status"] != failed
+
+
+@dataclass
+class ScallopPlacement:
+    """What the placement did: per placed pass its across offset and the scallop measured against the pass
+    before it (0 for the first); trial passes positioned; rows not measured."""
+    offsets: list = field(default_factory=list)
+    scallops: list = field(default_factory=list)
+    trials: int = 0
+    rows_skipped: int = 0
+    unreached: list = field(default_factory=list)  # (from, to, scallop): strips no step keeps in tolerance
+
+    @property
+    def steps(self) -> list:
+        return [b - a for a, b in zip(self.offsets, self.offsets[1:])]
+
+    @property
+    def max_scallop(self) -> float:
+        return max(self.scallops, default=0.0)
+
+
+def _runs(res: Any, failed: int) -> list[np.ndarray]:
+    """Row indices of the runs of consecutive good positions."""
+    good = res["status"] != failed
+    out, run = [], []
+    for i, g in enumerate(good):
+        if g:
+            run.append(i)
+        elif run:
+            out.append(np.array(run))
+            run = []
+    if run:
+        out.append(np.array(run))
+    return out
+
+
+def estimate_passes(width: float, Ri: float, scallop: float) -> int:
+    """An upper bound of the passes over `width`: the step of a ball of half the corner radius leaving the
+    scallop on a plane (a tilted torus on a surface it fits leaves less for the same step)."""
+    r = 0.5 * Ri
+    h = min(scallop, r)
+    step = 2.0 * math.sqrt(max(2.0 * r * h - h * h, 1e-12))
+    return int(math.ceil(width / step)) + 1
+
+
+def estimate_work(rect: Rect, params: Any, Ri: float) -> float:
+    """Tool positions the placement may compute (every trial of every pass), refused above the limits."""
+    frame = Frame.of(rect, params.feed_angle_deg)
+    width = frame.a1 - frame.a0
+    length = math.hypot(rect[2] - rect[0], rect[3] - rect[1])
+    passes = estimate_passes(width, Ri, params.scallop)
+    count = passes * MAX_TRIALS * (length / params.forward_step + 2)
+    check_work("tool positions", count, 1200,
+               f"scallop {params.scallop:g} mm (corner radius {Ri:g} mm: up to {passes} passes, {MAX_TRIALS} "
+               f"trials each) and forward step {params.forward_step:g} mm over a {width:.6g} mm wide boundary",
+               "max_positions")
+    return count
+
+
+class ScallopMeter:
+    """Reads the scallop between passes: rows of needles across the strip, cut by the kernel's z-map."""
+
+    def __init__(self, face: BezierFace, Ro: float, Ri: float, shape: str, frame: Frame, row_spacing: float,
+                 max_step: float, failed: int, threads: int = 0) -> None:
+        self.face, self.Ro, self.Ri, self.shape, self.frame = face, Ro, Ri, shape, frame
+        self.row_spacing, self.max_step, self.failed, self.threads = row_spacing, max_step, failed, threads
+        self.design = DesignHeights(face)
+        (_, _, _), (_, _, ztop) = face.bounds
+        self.top = float(ztop) + _STOCK_ABOVE
+        self.rows_skipped = 0
+
+    def _paths(self, passes: list[PassPositions], t_row: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """The good runs of `passes` near the row (frame coordinates), as (tips, axes)."""
+        reach = self.Ro + self.Ri + 1e-6
+        out = []
+        for p in passes:
+            tips = self.frame.to_frame(p.res["tip"])
+            axes = self.frame.to_frame(p.res["axis"])
+            for run in _runs(p.res, self.failed):
+                near = run[np.abs(tips[run, 1] - t_row) <= reach + self.row_spacing]
+                if len(near) == 0:
+                    continue
+                lo, hi = max(near[0] - 1, run[0]), min(near[-1] + 1, run[-1])  # the moves into the row too
+                idx = np.arange(lo, hi + 1)
+                out.append((tips[idx], axes[idx]))
+        return out
+
+    def _cut_row(self, paths, t_row: float, x0: float, n: int, cell: float) -> np.ndarray:
+        zmap = native.ZMap(x0, t_row - 0.5 * cell, cell, n, 1, self.top)
+        for tips, axes in paths:
+            kinds = np.zeros(max(len(tips) - 1, 0), dtype=np.uint8)
+            native.cut_5axis(zmap, self.Ro, self.Ri, self.shape, np.ascontiguousarray(tips),
+                             np.ascontiguousarray(axes), kinds, self.max_step, 1e9, self.threads)
+        return np.array(zmap.heights).reshape(-1)
+
+    def _deviation(self, paths, t_row: float, x0: float, n: int, cell: float) -> tuple[np.ndarray, np.ndarray]:
+        xs = x0 + (np.arange(n) + 0.5) * cell
+        z = self._cut_row(paths, t_row, x0, n, cell)
+        world = self.frame.to_world(np.column_stack([xs, np.full(n, t_row)]))
+        return xs, z - self.design(world)
+
+    def scallop(self, before: list[PassPositions], prev: PassPositions, new: PassPositions) -> float:
+        """The largest height above the face left between `prev`'s tips and `new`'s tips, the passes in
+        `before` cut too (inf where a needle between them is not cut at all)."""
+        tp = self.frame.to_frame(prev.res["tip"])
+        tn = self.frame.to_frame(new.res["tip"])
+        gp, gn = prev.good(self.failed), new.good(self.failed)
+        if not gp.any() or not gn.any():
+            return math.inf
+        t_lo = max(tp[gp, 1].min(), tn[gn, 1].min())
+        t_hi = min(tp[gp, 1].max(), tn[gn, 1].max())
+        if t_hi <= t_lo:
+            return math.inf
+        k = max(1, int(math.ceil((t_hi - t_lo) / self.row_spacing)))
+        rows = t_lo + (np.arange(k) + 0.5) * (t_hi - t_lo) / k
+        passes = before + [prev, new]
+        gap = 2.0 * self.row_spacing + 1e-9  # a row farther than this from a good position is not measured
+        coarse = []
+        for t_row in rows:
+            near_p = gp & (np.abs(tp[:, 1] - t_row) <= gap)
+            near_n = gn & (np.abs(tn[:, 1] - t_row) <= gap)
+            if not near_p.any() or not near_n.any():
+                self.rows_skipped += 1
+                continue
+            # the strip: from the previous pass's tips to the new pass's tips at this row
+            a_lo = float(np.interp(t_row, *_sorted(tp[gp, 1], tp[gp, 0])))
+            a_hi = float(np.interp(t_row, *_sorted(tn[gn, 1], tn[gn, 0])))
+            if a_hi <= a_lo:
+                continue
+            n = max(2, int(math.ceil((a_hi - a_lo) / NEEDLE_SPACING)))
+            cell = (a_hi - a_lo) / n
+            paths = self._paths(passes, t_row)
+            xs, dev = self._deviation(paths, t_row, a_lo, n, cell)
+            ok = np.isfinite(dev)
+            if not ok.any():
+                continue
+            i = int(np.flatnonzero(ok)[np.argmax(dev[ok])])
+            coarse.append((float(dev[i]), float(t_row), float(xs[i]), paths))
+        if not coarse:
+            return 0.0
+        coarse.sort(key=lambda r: -r[0])
+        best = coarse[0][0]
+        for dev0, t_row, x_peak, paths in coarse[:FINE_ROWS]:
+            if not math.isfinite(dev0):
+                return math.inf
+            n = int(round(2 * NEEDLE_SPACING / FINE_SPACING))
+            _, dev = self._deviation(paths, t_row, x_peak - NEEDLE_SPACING, n, FINE_SPACING)
+            dev = dev[np.isfinite(dev)]
+            if len(dev):
+                best = max(best, float(dev.max()))
+        return best
+
+
+def _sorted(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    order = np.argsort(t)
+    return t[order], a[order]
+
+
+def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position: Callable[[np.ndarray], Any],
+                 meter: ScallopMeter, failed: int, progress: Optional[Callable[[float], bool]] = None
+                 ) -> tuple[list[PassPositions], ScallopPlacement]:
+    """Passes across `rect`, each at the largest side step whose scallop with the passes before it is at most
+    params.scallop. `position(xy)` positions footprint points (MultipointResults). Every pass runs the same
+    way (+f); the caller alternates them for zigzag."""
+    frame = meter.frame
+    h = float(params.scallop)
+    limit = estimate_passes(frame.a1 - frame.a0, Ri, h)
+    report = ScallopPlacement()
+
+    def make(a: float) -> Optional[PassPositions]:
+        seg = clip_line_to_rect(a * frame.c, frame.f, rect)
+        if seg is None:
+            return None
+        if (seg[1] - seg[0]) @ frame.f < 0:
+            seg = seg[::-1]
+        xy = sample_segment(seg[0], seg[1], params.forward_step)
+        report.trials += 1
+        return PassPositions(a, xy, position(xy))
+
+    first = make(frame.a0 + 1e-9 * max(1.0, abs(frame.a0)))
+    if first is None:
+        raise TmmError("the footprint is empty")
+    placed = [first]
+    report.offsets.append(first.a)
+    report.scallops.append(0.0)
+    step = min(float(params.side_step), frame.a1 - frame.a0)
+    while placed[-1].a < frame.a1 - 1e-9:
+        if len(placed) >= limit:
+            raise TmmError(f"scallop {h:g} mm needs more than {limit} passes over this boundary (the estimate "
+                           "the work was checked against); use a larger scallop")
+        prev, before = placed[-1], placed[-3:-1]
+        room = frame.a1 - prev.a
+        best: Optional[tuple[float, float, PassPositions]] = None  # step, scallop, pass within tolerance
+        over: Optional[tuple[float, float]] = None                  # smallest step found above it
+        s = min(step, room)
+        for _ in range(MAX_TRIALS):
+            a = frame.a1 if s >= room - 1e-9 else prev.a + s
+            trial = make(a)
+            value = meter.scallop(before, prev, trial) if trial is not None else math.inf
+            if value <= h:
+                if best is None or s > best[0]:
+                    best = (s, value, trial)
+                if s >= room - 1e-9 or h - value <= SCALLOP_REL * h:
+                    break
+            elif over is None or s < over[0]:
+                over = (s, value)
+            if over is not None and best is not None and over[0] - best[0] < STEP_TOL:
+                break
+            s = _next_step(s, value, h, best, over, room)
+        if best is None:
+            # no step keeps the strip within the tolerance (the material left is not a scallop between the
+            # passes: the tool cannot reach the face there, e.g. riding a concave face's rim): the pass goes at
+            # the last good step and the strip is reported, never silently accepted
+            s = min(step, room)
+            a = frame.a1 if s >= room - 1e-9 else prev.a + s
+            trial = make(a)
+            if trial is None:
+                raise TmmError(f"no pass at {a - frame.a0:.4g} mm from the start edge of the footprint")
+            best = (s, meter.scallop(before, prev, trial), trial)
+            report.unreached.append((prev.a - frame.a0, trial.a - frame.a0, best[1]))
+        s_ok, value, trial = best
+        placed.append(trial)
+        report.offsets.append(trial.a)
+        report.scallops.append(value)
+        step = s_ok
+        if progress is not None and progress((trial.a - frame.a0) / max(frame.a1 - frame.a0, 1e-12)) is False:
+            raise Cancelled("multipoint tool path computation cancelled")
+    report.rows_skipped = meter.rows_skipped
+    return placed, report
+
+
+def _next_step(s: float, value: float, h: float, best, over, room: float) -> float:
+    """The next trial step: scallop ~ step^2, so interpolate sqrt(scallop) linearly in the step inside the
+    bracket, kept a tenth of the bracket away from its ends; outside a bracket, grow or shrink by the ratio."""
+    if best is not None and over is not None:
+        (s0, v0, _), (s1, v1) = best, over
+        r0, r1 = math.sqrt(max(v0, 0.0)), math.sqrt(v1) if math.isfinite(v1) else math.inf
+        t = (math.sqrt(h) - r0) / (r1 - r0) if math.isfinite(r1) and r1 > r0 else 0.5
+        t = min(0.9, max(0.1, t))
+        return s0 + t * (s1 - s0)
+    if over is None:  # all within the tolerance: grow
+        ratio = math.sqrt(h / value) if value > 0 else 2.0
+        return min(room, s * min(2.0, max(1.05, ratio)))
+    ratio = math.sqrt(h / value) if math.isfinite(value) and value > 0 else 0.5  # all above: shrink
+    return s * min(0.95, max(0.3, ratio))
