@@ -2,7 +2,7 @@
 fixed 18 mm footprint: passes, the largest deviation at the section y = 27 mm (the z-map of
 benchmarks.seed.experiment, refined at the peaks) and the deepest gouge, DRD and VCRF.
 
-    .venv/bin/python benchmarks/seed/scallop_experiment.py [--scallop 0.5] [--options extend] [--surfaces ...]
+    .venv/bin/python benchmarks/seed/scallop_experiment.py [--scallop auto|0.5] [--options extend] [--surfaces ...]
 
 Targets (issue 14 item 5): the section's max scallop no larger than the seed's simulated VCRF values (convex
 0.53, concave 0.60, saddle 0.62 mm), no more passes than the seed's footprint (10), nothing below -0.01 mm.
@@ -45,7 +45,8 @@ def scallop_case(which: str, method: str, scallop: float, options: dict):
 
 def main() -> int:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--scallop", type=float, default=0.5, help="scallop height, mm")
+    ap.add_argument("--scallop", default="auto",
+                    help="scallop height, mm; auto: the surface's target (seed VCRF simulated max) less 0.02 mm")
     ap.add_argument("--options", default="extend", help=f"kernel option set, one of {', '.join(CONFIGS)}")
     ap.add_argument("--surfaces", default="convex,concave,saddle")
     ap.add_argument("--methods", default="drd,vcrf")
@@ -59,8 +60,9 @@ def main() -> int:
             if not args.no_fixed:
                 sec = run_experiment(which, method, params=MultipointParams(**options))
                 rows.append((which, method, "fixed 18 mm", SEED_PASSES, sec, sec.time_s, None))
-            sec, rep, t = scallop_case(which, method, args.scallop, options)
-            rows.append((which, method, f"scallop {args.scallop:g} mm", len(rep.offsets), sec, t, rep))
+            h = SEED_SIMULATED_MAX[(which, "vcrf")] - 0.02 if args.scallop == "auto" else float(args.scallop)
+            sec, rep, t = scallop_case(which, method, h, options)
+            rows.append((which, method, f"scallop {h:g} mm", len(rep.offsets), sec, t, rep))
             print(f"  {which} {method}: {len(rep.offsets)} passes at "
                   f"{', '.join(f'{a:.2f}' for a in rep.offsets)}; scallop per strip "
                   f"{', '.join(f'{v:.3f}' for v in rep.scallops[1:])}; {rep.trials} trial passes, "

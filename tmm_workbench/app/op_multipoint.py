@@ -148,9 +148,9 @@ def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> l
     if placement is not None:
         out.append(f"{len(placement.offsets)} passes, largest scallop {placement.max_scallop:.4g} mm "
                    f"(tolerance {params.scallop:g} mm)")
-        for a, b, h in placement.unreached:
-            out.append(f"the strip {a:.4g}..{b:.4g} mm from the start edge keeps {h:.4g} mm above the face at "
-                       "any side step (the tool cannot reach it)")
+        for a, rows, h, (x, y) in placement.unreached:
+            out.append(f"{rows} rows of the strip from {a:.4g} mm keep up to {h:.4g} mm above the face at any side "
+                       f"step (at x {x:.4g}, y {y:.4g} mm: the tool cannot reach it there; left out of the rule)")
     return out
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Callable, Optional
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -129,7 +129,9 @@ class ScallopPlacement:
     scallops: list = field(default_factory=list)
     trials: int = 0
     rows_skipped: int = 0
-    unreached: list = field(default_factory=list)  # (from, to, scallop): strips no step keeps in tolerance
+    # (strip start from the start edge, rows left out, their highest value, (x, y) of it): rows no side step
+    # keeps within the tolerance, left out of the strip's measure
+    unreached: list = field(default_factory=list)
 
     @property
     def steps(self) -> list:
@@ -220,9 +222,13 @@ class ScallopMeter:
         world = self.frame.to_world(np.column_stack([xs, np.full(n, t_row)]))
         return xs, z - self.design(world)
 
-    def scallop(self, before: list[PassPositions], prev: PassPositions, new: PassPositions) -> float:
+    def scallop(self, before: list[PassPositions], prev: PassPositions, new: PassPositions,
+                exclude: Sequence[tuple[float, float]] = ()) -> float:
         """The largest height above the face left between `prev`'s tips and `new`'s tips, the passes in
-        `before` cut too (inf where a needle between them is not cut at all)."""
+        `before` cut too (inf where a needle between them is not cut at all), on the rows outside the
+        `exclude` intervals of the along coordinate. `self.rows` keeps each row's value, `self.peak` where
+        the highest is."""
+        self.rows = {}
         tp = self.frame.to_frame(prev.res["tip"])
         tn = self.frame.to_frame(new.res["tip"])
         gp, gn = prev.good(self.failed), new.good(self.failed)
@@ -238,6 +244,8 @@ class ScallopMeter:
         gap = 2.0 * self.row_spacing + 1e-9  # a row farther than this from a good position is not measured
         coarse = []
         for t_row in rows:
+            if any(lo <= t_row <= hi for lo, hi in exclude):
+                continue
             near_p = gp & (np.abs(tp[:, 1] - t_row) <= gap)
             near_n = gn & (np.abs(tn[:, 1] - t_row) <= gap)
             if not near_p.any() or not near_n.any():
@@ -257,19 +265,27 @@ class ScallopMeter:
                 continue
             i = int(np.flatnonzero(ok)[np.argmax(dev[ok])])
             coarse.append((float(dev[i]), float(t_row), float(xs[i]), paths))
+            self.rows[float(t_row)] = float(dev[i])
         if not coarse:
             return 0.0
         coarse.sort(key=lambda r: -r[0])
         best = coarse[0][0]
+        self.peak = (coarse[0][2], coarse[0][1])
         for dev0, t_row, x_peak, paths in coarse[:FINE_ROWS]:
             if not math.isfinite(dev0):
                 return math.inf
             n = int(round(2 * NEEDLE_SPACING / FINE_SPACING))
-            _, dev = self._deviation(paths, t_row, x_peak - NEEDLE_SPACING, n, FINE_SPACING)
-            dev = dev[np.isfinite(dev)]
-            if len(dev):
-                best = max(best, float(dev.max()))
+            xs, dev = self._deviation(paths, t_row, x_peak - NEEDLE_SPACING, n, FINE_SPACING)
+            ok = np.isfinite(dev)
+            if ok.any():
+                self.rows[t_row] = max(self.rows[t_row], float(dev[ok].max()))
+            if ok.any() and float(dev[ok].max()) > best:
+                best = float(dev[ok].max())
+                self.peak = (float(xs[ok][np.argmax(dev[ok])]), t_row)
         return best
+
+    peak: tuple = (math.nan, math.nan)  # (across, along) in the frame of the last scallop's highest needle
+    rows: dict = {}
 
 
 def _sorted(t: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -311,34 +327,27 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
                            "the work was checked against); use a larger scallop")
         prev, before = placed[-1], placed[-3:-1]
         room = frame.a1 - prev.a
-        best: Optional[tuple[float, float, PassPositions]] = None  # step, scallop, pass within tolerance
-        over: Optional[tuple[float, float]] = None                  # smallest step found above it
-        s = min(step, room)
-        for _ in range(MAX_TRIALS):
-            a = frame.a1 if s >= room - 1e-9 else prev.a + s
-            trial = make(a)
-            value = meter.scallop(before, prev, trial) if trial is not None else math.inf
-            if value <= h:
-                if best is None or s > best[0]:
-                    best = (s, value, trial)
-                if s >= room - 1e-9 or h - value <= SCALLOP_REL * h:
-                    break
-            elif over is None or s < over[0]:
-                over = (s, value)
-            if over is not None and best is not None and over[0] - best[0] < STEP_TOL:
+        excluded: list[tuple[float, float]] = []
+        for _attempt in range(3):
+            best, over, smallest = _search(make, meter, before, prev, frame, h, min(step, room), room, excluded)
+            if best is not None:
                 break
-            s = _next_step(s, value, h, best, over, room)
+            # no step keeps these rows within the tolerance (material one pass leaves by itself, e.g. at the
+            # ends of the passes or on a rim: not a scallop between passes): the rows still above it at the
+            # smallest step tried are left out of this strip's measure and reported, never silently accepted
+            bad = [t for t, v in (smallest or {}).items() if v > h]
+            if not bad:
+                break
+            half = 0.5 * meter.row_spacing
+            excluded += [(t - half, t + half) for t in bad]
+            worst = max(bad, key=lambda t: smallest[t])
+            at = frame.to_world(np.array([[prev.a, worst]]))[0]
+            report.unreached.append((prev.a - frame.a0, len(bad), smallest[worst], (float(at[0]), float(at[1]))))
         if best is None:
-            # no step keeps the strip within the tolerance (the material left is not a scallop between the
-            # passes: the tool cannot reach the face there, e.g. riding a concave face's rim): the pass goes at
-            # the last good step and the strip is reported, never silently accepted
-            s = min(step, room)
-            a = frame.a1 if s >= room - 1e-9 else prev.a + s
-            trial = make(a)
-            if trial is None:
-                raise TmmError(f"no pass at {a - frame.a0:.4g} mm from the start edge of the footprint")
-            best = (s, meter.scallop(before, prev, trial), trial)
-            report.unreached.append((prev.a - frame.a0, trial.a - frame.a0, best[1]))
+            raise TmmError(f"no side step leaves a scallop within {h:g} mm after the pass at "
+                           f"{prev.a - frame.a0:.4g} mm from the start edge (the smallest tried, "
+                           f"{over[0] if over else 0:.4g} mm, leaves {over[1] if over else math.inf:.4g} mm): "
+                           "the tool does not reach the face there; use a larger scallop or check the boundary")
         s_ok, value, trial = best
         placed.append(trial)
         report.offsets.append(trial.a)
@@ -348,6 +357,31 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
             raise Cancelled("multipoint tool path computation cancelled")
     report.rows_skipped = meter.rows_skipped
     return placed, report
+
+
+def _search(make, meter: ScallopMeter, before, prev: PassPositions, frame: Frame, h: float, s: float,
+            room: float, excluded: list) -> tuple[Optional[tuple], Optional[tuple], Optional[dict]]:
+    """The largest step (<= room) found whose scallop is within h: (step, scallop, pass) or None; the
+    smallest step found above it (step, scallop) or None; the row values of the smallest step tried above."""
+    best: Optional[tuple[float, float, PassPositions]] = None
+    over: Optional[tuple[float, float]] = None
+    smallest: Optional[dict] = None
+    for _ in range(MAX_TRIALS):
+        a = frame.a1 if s >= room - 1e-9 else prev.a + s
+        trial = make(a)
+        value = meter.scallop(before, prev, trial, excluded) if trial is not None else math.inf
+        if value <= h:
+            if best is None or s > best[0]:
+                best = (s, value, trial)
+            if s >= room - 1e-9 or h - value <= SCALLOP_REL * h:
+                break
+        elif over is None or s < over[0]:
+            over = (s, value)
+            smallest = dict(meter.rows)
+        if over is not None and best is not None and over[0] - best[0] < STEP_TOL:
+            break
+        s = _next_step(s, value, h, best, over, room)
+    return best, over, smallest
 
 
 def _next_step(s: float, value: float, h: float, best, over, room: float) -> float:
