@@ -27,11 +27,14 @@ def convex_net() -> np.ndarray:
     return bezier.load_seed_patch(SEED_JSON, "convex")
 
 
-@pytest.fixture(scope="module")
-def placed(convex_net):
+@pytest.fixture(scope="module", params=["round_insert", "bull_nose"])
+def placed(convex_net, request):
+    """The seed's round insert (two contacts) at 0.3 mm, and a solid bull-nose (its flat bottom: one contact,
+    away from the tip) at 0.05 mm."""
     face = BezierFace.from_net(convex_net)
-    params = MultipointParams(pass_spacing="scallop", scallop=0.3, side_step=10.0, forward_step=2.0,
-                              boundary=BOX, between_tol=0.0)
+    h, box = (0.3, BOX) if request.param == "round_insert" else (0.05, (30.0, 40.0, 50.0, 70.0))
+    params = MultipointParams(pass_spacing="scallop", scallop=h, side_step=10.0, forward_step=2.0,
+                              boundary=box, between_tol=0.0, shape=request.param)
     return multipoint.compute(face, TORUS, params), params
 
 
@@ -66,21 +69,26 @@ def test_placed_passes_leave_the_scallop_by_an_independent_simulation(placed, co
     result, params = placed
     rep, res = result.diagnostics["scallop"], result.diagnostics["results"]
     h = params.scallop
-    assert rep.offsets[0] == pytest.approx(BOX[0]) and rep.offsets[-1] == pytest.approx(BOX[2])
+    box = params.boundary
+    assert rep.offsets[0] == pytest.approx(box[0]) and rep.offsets[-1] == pytest.approx(box[2])
     assert len(rep.offsets) == res.passes.max() + 1 >= 3
     assert all(0 < v <= h for v in rep.scallops[1:]), rep.scallops
     assert not rep.unreached
     # the independent z-map: every pass's positions, needle lines across the box at y the placement's rows
     # (every 4 mm from the passes' ends) do not use
+    # (between the outer passes' contacts: what lies beyond them is the boundary's, not the side step's)
     tool = ZTool(6.7, 6.0, params.shape)
-    paths = []
+    paths, bands = [], []
     for k in range(int(res.passes.max()) + 1):
         idx = np.flatnonzero((res.passes == k) & (res.status != STATUS_FAILED))
         paths.append((res["tip"][idx], res["axis"][idx]))
-    tips_x = [p[0][:, 0] for p in paths]
-    lo, hi = min(t.min() for t in tips_x[:1]), max(t.max() for t in tips_x[-1:])
+        P, Q = res["P"][idx], res["Q"][idx]
+        qx = np.where(np.isfinite(Q[:, 0]), Q[:, 0], P[:, 0])
+        order = np.argsort(res["tip"][idx, 1])
+        bands.append((res["tip"][idx, 1][order], np.minimum(P[:, 0], qx)[order], np.maximum(P[:, 0], qx)[order]))
     worst, lowest = 0.0, math.inf
     for y in (47.3, 62.9):
+        lo, hi = np.interp(y, bands[0][0], bands[0][1]), np.interp(y, bands[-1][0], bands[-1][2])
         xs = np.arange(lo, hi, 0.02)
         needles = np.column_stack([xs, np.full_like(xs, y)])
         sim = simulate(tool, needles, 200.0, paths, 0.25, "slerp", 2e-3)
@@ -96,10 +104,10 @@ def test_placed_passes_leave_the_scallop_by_an_independent_simulation(placed, co
 def test_fewer_passes_than_the_fixed_step_of_the_same_largest_scallop(placed):
     """The fixed step that keeps every strip within the tolerance is the placement's smallest step: a fixed
     footprint at it needs at least as many passes."""
-    result, _ = placed
+    result, params = placed
     rep = result.diagnostics["scallop"]
     steps = rep.steps[:-1] or rep.steps  # the last strip is what remains to the far edge
-    fixed_passes = math.ceil((BOX[2] - BOX[0]) / min(steps) - 1e-9) + 1
+    fixed_passes = math.ceil((params.boundary[2] - params.boundary[0]) / min(steps) - 1e-9) + 1
     assert len(rep.offsets) <= fixed_passes
     assert max(steps) > min(steps)  # the step follows the surface, not a constant
 

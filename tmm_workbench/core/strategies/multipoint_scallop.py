@@ -4,8 +4,9 @@ Passes are placed one after the other across the boundary: the first on the star
 largest side step for which the scallop left between it and the passes before it, measured on the real tool
 positions, is at most `MultipointParams.scallop`; the last on the far edge. The scallop of a trial pass is
 read by cutting the swept tool (the kernel's 5-axis z-map cut: tip linear, axis by slerp, sub-stepped) into
-rows of vertical needles laid across the strip between the previous pass's tips and the trial pass's tips, one
-row every `scallop_row_spacing` along the passes: the largest height above the design surface on those
+rows of vertical needles laid across the strip from the previous pass's first contact (P or Q, whichever is
+nearer the start edge) to the trial pass's last contact, both passes' contact bands included, one row every
+`scallop_row_spacing` along the passes: the largest height above the design surface on those
 needles. Needles are `NEEDLE_SPACING` apart, then `FINE_SPACING` around the highest peaks (the cusp is a
 sharp ridge). The design height is the face itself (its XY parametrisation inverted by Newton).
 
@@ -34,6 +35,7 @@ FINE_ROWS = 4           # rows whose peak is read finely
 SCALLOP_REL = 0.02      # a pass is accepted once its scallop is within 2 % below the tolerance
 STEP_TOL = 0.005        # mm: or once the bracket on the step is this narrow
 MAX_TRIALS = 14         # trial passes per placed pass
+MAX_LEFT_OUT = 0.2      # at most this share of a strip's rows may be left out as not reachable
 _STOCK_ABOVE = 50.0     # mm: needles start this far above the face's top (an uncut needle reads huge)
 _BYTES_PER_NEEDLE = 64
 
@@ -191,6 +193,31 @@ class ScallopMeter:
         (_, _, _), (_, _, ztop) = face.bounds
         self.top = float(ztop) + _STOCK_ABOVE
         self.rows_skipped = 0
+        self._design_rows: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        reach = Ro + Ri
+        self.lattice = np.arange(frame.a0 - reach, frame.a1 + reach + NEEDLE_SPACING, NEEDLE_SPACING)
+
+    def row_positions(self, t_lo: float, t_hi: float) -> np.ndarray:
+        """The rows read between t_lo and t_hi: on a fixed lattice (multiples of the row spacing, so the
+        design along each is computed once), at least the corner radius Ri inside the passes' ends (what a pass
+        leaves at its end is made by the boundary, not by the side step)."""
+        lo, hi = t_lo + self.Ri, t_hi - self.Ri
+        if hi < lo:
+            lo = hi = 0.5 * (t_lo + t_hi)
+        k0, k1 = math.ceil(lo / self.row_spacing - 1e-9), math.floor(hi / self.row_spacing + 1e-9)
+        rows = np.arange(k0, k1 + 1) * self.row_spacing
+        return rows if len(rows) else np.array([0.5 * (lo + hi)])
+
+    def design_row(self, t_row: float, xs: np.ndarray) -> np.ndarray:
+        """The design height at (across xs, along t_row): the face inverted once per row on needles
+        NEEDLE_SPACING apart, interpolated linearly between them (the error, curvature x spacing^2 / 8, is
+        2e-6 mm for a 150 mm radius)."""
+        key = round(float(t_row), 9)
+        if key not in self._design_rows:
+            world = self.frame.to_world(np.column_stack([self.lattice, np.full(len(self.lattice), t_row)]))
+            self._design_rows[key] = (self.lattice, self.design(world))
+        lat, z = self._design_rows[key]
+        return np.interp(xs, lat, z, left=np.nan, right=np.nan)
 
     def _paths(self, passes: list[PassPositions], t_row: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """The good runs of `passes` near the row (frame coordinates), as (tips, axes)."""
@@ -219,8 +246,17 @@ class ScallopMeter:
     def _deviation(self, paths, t_row: float, x0: float, n: int, cell: float) -> tuple[np.ndarray, np.ndarray]:
         xs = x0 + (np.arange(n) + 0.5) * cell
         z = self._cut_row(paths, t_row, x0, n, cell)
-        world = self.frame.to_world(np.column_stack([xs, np.full(n, t_row)]))
-        return xs, z - self.design(world)
+        return xs, z - self.design_row(t_row, xs)
+
+    def _contact_band(self, p: PassPositions) -> np.ndarray:
+        """(k, 3) per position: its first contact's across coordinate, the along coordinate of its tip, its
+        last contact's across coordinate (P and Q; P alone with one contact): what the pass cuts lies
+        between them, the scallop between the bands of two passes."""
+        P = self.frame.to_frame(p.res["P"])
+        Q = self.frame.to_frame(p.res["Q"])
+        qa = np.where(np.isfinite(Q[:, 0]), Q[:, 0], P[:, 0])
+        tips = self.frame.to_frame(p.res["tip"])
+        return np.column_stack([np.minimum(P[:, 0], qa), tips[:, 1], np.maximum(P[:, 0], qa)])
 
     def scallop(self, before: list[PassPositions], prev: PassPositions, new: PassPositions,
                 exclude: Sequence[tuple[float, float]] = ()) -> float:
@@ -229,17 +265,17 @@ class ScallopMeter:
         `exclude` intervals of the along coordinate. `self.rows` keeps each row's value, `self.peak` where
         the highest is."""
         self.rows = {}
-        tp = self.frame.to_frame(prev.res["tip"])
-        tn = self.frame.to_frame(new.res["tip"])
+        tp, tn = self._contact_band(prev), self._contact_band(new)
         gp, gn = prev.good(self.failed), new.good(self.failed)
+        gp &= np.isfinite(tp[:, 0])
+        gn &= np.isfinite(tn[:, 0])
         if not gp.any() or not gn.any():
             return math.inf
         t_lo = max(tp[gp, 1].min(), tn[gn, 1].min())
         t_hi = min(tp[gp, 1].max(), tn[gn, 1].max())
         if t_hi <= t_lo:
             return math.inf
-        k = max(1, int(math.ceil((t_hi - t_lo) / self.row_spacing)))
-        rows = t_lo + (np.arange(k) + 0.5) * (t_hi - t_lo) / k
+        rows = self.row_positions(t_lo, t_hi)
         passes = before + [prev, new]
         gap = 2.0 * self.row_spacing + 1e-9  # a row farther than this from a good position is not measured
         coarse = []
@@ -251,9 +287,9 @@ class ScallopMeter:
             if not near_p.any() or not near_n.any():
                 self.rows_skipped += 1
                 continue
-            # the strip: from the previous pass's tips to the new pass's tips at this row
+            # the strip: from the previous pass's first contact to the new pass's last, at this row
             a_lo = float(np.interp(t_row, *_sorted(tp[gp, 1], tp[gp, 0])))
-            a_hi = float(np.interp(t_row, *_sorted(tn[gn, 1], tn[gn, 0])))
+            a_hi = float(np.interp(t_row, *_sorted(tn[gn, 1], tn[gn, 2])))
             if a_hi <= a_lo:
                 continue
             n = max(2, int(math.ceil((a_hi - a_lo) / NEEDLE_SPACING)))
@@ -336,8 +372,8 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
             # ends of the passes or on a rim: not a scallop between passes): the rows still above it at the
             # smallest step tried are left out of this strip's measure and reported, never silently accepted
             bad = [t for t, v in (smallest or {}).items() if v > h]
-            if not bad:
-                break
+            if not bad or len(bad) > max(2, MAX_LEFT_OUT * len(smallest)):
+                break  # not a few rows: the step cannot be chosen by this tolerance (refused below)
             half = 0.5 * meter.row_spacing
             excluded += [(t - half, t + half) for t in bad]
             worst = max(bad, key=lambda t: smallest[t])
