@@ -144,3 +144,19 @@ def test_tiny_scallop_is_refused_before_any_position(convex_net):
             multipoint.compute(face, TORUS, MultipointParams(pass_spacing="scallop", scallop=1e-6))
     finally:
         limits.set_limits(max_positions=old.max_positions)
+
+
+def test_cancel_stops_the_placement(convex_net):
+    from tmm_workbench.core.errors import Cancelled
+
+    face = BezierFace.from_net(convex_net)
+    calls = []
+
+    def progress(fraction: float) -> bool:
+        calls.append(fraction)
+        return len(calls) < 2  # cancel at the second placed pass
+
+    with pytest.raises(Cancelled):
+        multipoint.compute(face, TORUS, MultipointParams(pass_spacing="scallop", scallop=0.3, boundary=BOX,
+                                                         forward_step=4.0), progress)
+    assert len(calls) == 2 and 0 < calls[0] < calls[1] < 1
