@@ -4,7 +4,8 @@
 The API makes a 5-axis op with the side step from a scallop on seed 001's convex patch; its view shows the
 tool axes (every n-th position, coloured by contact status: the colours counted against the op's results),
 hidden and shown again by the view property, every position with AxisEvery 1, tilt colours; the task panel
-opens with the Scallop field (mm) and the Scallop spacing, and fits a 1000 px screen; a screenshot with the
+opens with the Scallop field (mm) and the Scallop spacing, warns as a fixed side step wider than the tool
+cuts is typed (and not with the scallop rule), and fits a 1000 px screen; a screenshot with the
 axes goes to env TMM_GUI_PNG (default docs/gui/multipoint_axes.png); TMM Simulate on the Job simulates the
 5-axis path and shows its numbers. The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
 """
@@ -92,6 +93,25 @@ def run() -> dict:
     scallop = page.findChild(QtGui.QWidget, "scallop")
     info["scallop_field"] = [scallop.property("rawValue"), scallop.property("unit")]
     assert abs(info["scallop_field"][0] - 0.5) < 1e-9, info["scallop_field"]
+    # a fixed side step wider than the tool cuts is warned as it is typed, before any compute
+    warning = page.findChild(QtGui.QLabel, "sideStepWarning")
+    info["warning_scallop"] = warning.isVisible()
+    spacing.setCurrentIndex(spacing.findText("Fixed"))
+    side = page.findChild(QtGui.QWidget, "sideStep")
+    side.setProperty("rawValue", 30.0)
+    pump(0.3)
+    info["warning_fixed_30"] = [warning.isVisible(), warning.text()]
+    side.setProperty("rawValue", 20.0)
+    pump(0.3)
+    info["warning_fixed_20"] = warning.isVisible()
+    assert not info["warning_scallop"] and not info["warning_fixed_20"], info
+    assert info["warning_fixed_30"][0] and "uncut strips" in info["warning_fixed_30"][1], info
+    spacing.setCurrentIndex(spacing.findText("Scallop"))
+    side.setProperty("rawValue", 30.0)
+    pump(0.3)
+    info["warning_scallop_30"] = warning.isVisible()
+    assert not info["warning_scallop_30"], info
+    side.setProperty("rawValue", 18.0)
     info["page_height"] = page.sizeHint().height()
     assert info["page_height"] < 760, f"the 5-axis page needs {info['page_height']} px"
     task_view = next(w for w in FreeCADGui.getMainWindow().findChildren(QtGui.QScrollArea)

@@ -29,6 +29,7 @@ def test_gui_multipoint(tmp_path: Path) -> None:
     assert info["axes_shown"] > 0 and info["axes_hidden"] == 0 and info["axes_every_1"] == info["positions"]
     assert info["contact_colours_match"] and info["tilt_colours_distinct"] > 10
     assert info["pass_spacing"][0] == "Scallop" and abs(info["scallop_field"][0] - 0.5) < 1e-9
+    assert info["warning_fixed_30"][0] and not info["warning_fixed_20"] and not info["warning_scallop_30"]
     assert info["page_height"] < 760 and info["task_panel_height"] <= 1000, info
     assert info["sim_max_left"] is not None, info["sim_status"]
     for png in (PNG, SIM_PNG):

@@ -136,15 +136,24 @@ def tool_shape(prop_value: str, tool: Any) -> str:
     return "bull_nose" if shape == "from_tool_bit" else shape
 
 
+def uncut_strip_warning(pass_spacing: str, side_step: float, cutter: Any) -> str:
+    """The warning for a fixed side step at least the tool's cutting width 2 (Ro + Ri) on a plane (strips
+    between the passes the tool never touches), "" otherwise (and for the scallop rule)."""
+    Ro, Ri = cutter.torus_radii
+    if pass_spacing == "scallop" or side_step < 2.0 * (Ro + Ri):
+        return ""
+    return (f"side step {side_step:g} mm leaves uncut strips for this tool (cutting width {2.0 * (Ro + Ri):g} "
+            "mm); use PassSpacing Scallop or a side step below it")
+
+
 def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> list[str]:
     """What the user should know about the side step: a fixed step leaving strips the tool never touches
     (wider than its cutting width 2 (Ro + Ri) on a plane), strips the scallop rule could not keep within the
     tolerance."""
     out = []
-    Ro, Ri = cutter.torus_radii
-    if params.pass_spacing != "scallop" and params.side_step >= 2.0 * (Ro + Ri):
-        out.append(f"side step {params.side_step:g} mm leaves uncut strips for this tool (cutting width "
-                   f"{2.0 * (Ro + Ri):g} mm); use PassSpacing Scallop or a side step below it")
+    strips = uncut_strip_warning(params.pass_spacing, params.side_step, cutter)
+    if strips:
+        out.append(strips)
     if placement is not None:
         out.append(f"{len(placement.offsets)} passes, largest scallop {placement.max_scallop:.4g} mm "
                    f"(tolerance {params.scallop:g} mm)")

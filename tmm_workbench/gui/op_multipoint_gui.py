@@ -45,6 +45,32 @@ class TaskPanelOpPage(op_page.OpPage):
         self.form.contacts.setText(obj.ContactSummary)
         super().show_status(obj)
 
+    # the side step warned about as it is typed, before any compute (issue 15 item 4)
+    def init_extra(self, obj: Any) -> None:
+        self.obj = obj
+        self.form.passSpacing.currentIndexChanged.connect(self.warn_side_step)
+        self.form.sideStep.valueChanged.connect(self.warn_side_step)
+        self.form.toolController.currentIndexChanged.connect(self.warn_side_step)
+
+    def set_extra(self, obj: Any) -> None:
+        self.warn_side_step()
+
+    def warn_side_step(self, *_: Any) -> None:
+        """Shows under the side step whether the typed value leaves uncut strips for the op's tool."""
+        from tmm_workbench.app import op_multipoint, tools
+
+        text = ""
+        try:
+            spacing = op_multipoint.PASS_SPACINGS.get(self.form.passSpacing.currentText(), "")
+            step = float(self.form.sideStep.property("rawValue"))
+            tc = getattr(self.obj, "ToolController", None)
+            if tc is not None:
+                text = op_multipoint.uncut_strip_warning(spacing, step, tools.cutter_from_tool(tc.Tool))
+        except Exception:  # noqa: BLE001 - no tool or a tool the op refuses: the compute names it
+            text = ""
+        self.form.sideStepWarning.setText(text)
+        self.form.sideStepWarning.setVisible(bool(text))
+
 
 # view-provider properties of the tool axes: (type, name, tooltip, default)
 AXIS_PROPERTIES = (
