@@ -56,7 +56,8 @@ def test_design_heights_invert_the_face(convex_net):
 def test_frame_is_a_rotation_starting_at_the_corner(angle):
     rect = (10.0, 20.0, 60.0, 45.0)
     fr = Frame.of(rect, angle)
-    assert abs(fr.c[0] * fr.f[1] - fr.c[1] * fr.f[0] - 1.0) < 1e-12  # proper: the tool turns with it
+    assert abs(fr.c @ fr.f) < 1e-12 and np.allclose([fr.c @ fr.c, fr.f @ fr.f], 1.0)
+    assert np.allclose(fr.f, (np.cos(np.radians(angle)), np.sin(np.radians(angle))))  # along the feed
     p = np.array([[1.0, 2.0, 3.0], [-4.0, 5.0, -6.0]])
     assert np.allclose(fr.to_world(fr.to_frame(p)), p)
     corner = np.array([rect[0], rect[1]]) @ fr.c
@@ -160,3 +161,21 @@ def test_cancel_stops_the_placement(convex_net):
         multipoint.compute(face, TORUS, MultipointParams(pass_spacing="scallop", scallop=0.3, boundary=BOX,
                                                          forward_step=4.0), progress)
     assert len(calls) == 2 and 0 < calls[0] < calls[1] < 1
+
+
+def test_passes_along_x_mirror_the_passes_along_y(convex_net):
+    """The seed's convex net is symmetric in x and y: feeding along X over the mirrored box places the passes
+    where feeding along Y does (the frame turns, or mirrors, the tool with the passes)."""
+    box = (30.0, 40.0, 60.0, 70.0)
+    face = BezierFace.from_net(convex_net)
+    along_y = MultipointParams(pass_spacing="scallop", scallop=0.3, side_step=10.0, forward_step=2.0, boundary=box,
+                               between_tol=0.0)
+    result = multipoint.compute(face, TORUS, along_y)
+    mirrored = MultipointParams(pass_spacing="scallop", scallop=0.3, side_step=10.0, forward_step=2.0,
+                                boundary=(box[1], box[0], box[3], box[2]), between_tol=0.0, feed_angle_deg=0.0)
+    other = multipoint.compute(face, TORUS, mirrored)
+    a, b = result.diagnostics["scallop"], other.diagnostics["scallop"]
+    np.testing.assert_allclose(b.offsets, a.offsets, atol=0.05)
+    res = other.diagnostics["results"]
+    first = res.xy[res.passes == 0]
+    assert np.allclose(first[:, 1], box[0]) and first[-1, 0] > first[0, 0]  # along X at y = box's xmin

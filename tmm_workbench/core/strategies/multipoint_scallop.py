@@ -42,8 +42,8 @@ _BYTES_PER_NEEDLE = 64
 
 @dataclass
 class Frame:
-    """Across (c) and along (f) unit vectors of the passes, a proper rotation (c, f) of the XY plane, and the
-    boundary's extent in it: passes at across a in [a0, a1], advancing in +c from the start edge a0."""
+    """Across (c) and along (f, the feed direction) unit vectors of the passes, orthonormal, and the boundary's
+    extent in them: passes at across a in [a0, a1], advancing in +c from the start edge a0."""
     c: np.ndarray
     f: np.ndarray
     a0: float
@@ -59,9 +59,8 @@ class Frame:
         # start on the side nearest the (xmin, ymin) corner, as raster_lines' FIXED spacing does
         if abs(corners[0] @ n - across.max()) < abs(corners[0] @ n - across.min()):
             n = -n
-        f = d if n[0] * d[1] - n[1] * d[0] > 0 else -d
-        across = corners @ n
-        return cls(n, f, float(across.min()), float(across.max()))
+        across = corners @ n  # (n, d) may be a reflection: the tool, a solid of revolution, is symmetric
+        return cls(n, d, float(across.min()), float(across.max()))
 
     def to_frame(self, p: np.ndarray) -> np.ndarray:
         """(k, 2|3) world points -> frame (across, along[, z])."""
@@ -350,7 +349,7 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
         report.trials += 1
         return PassPositions(a, xy, position(xy))
 
-    first = make(frame.a0 + 1e-9 * max(1.0, abs(frame.a0)))
+    first = make(frame.a0)
     if first is None:
         raise TmmError("the footprint is empty")
     placed = [first]
