@@ -19,6 +19,7 @@ import numpy as np
 from tmm_workbench.app import registry
 from tmm_workbench.core import path5
 from tmm_workbench.core.preview.tool_axes import COLOURINGS, axis_lines
+from tmm_workbench.core.strategies.multipoint import STATUS_FAILED
 from tmm_workbench.gui import op_page, resources
 
 ENTRY = registry.entry("TMM_Multipoint")
@@ -97,7 +98,7 @@ def axis_source(obj: Any) -> Optional[tuple[np.ndarray, np.ndarray, Optional[np.
     res = getattr(proxy, "results", None)
     limit = float(getattr(getattr(obj, "TiltLimit", None), "Value", 45.0))
     if res is not None and len(res):
-        good = res["status"] != 2
+        good = res["status"] != STATUS_FAILED
         return res["tip"][good], res["axis"][good], res["status"][good], limit
     moves = [m for m in path5.decode_commands((c.Name, c.Parameters) for c in obj.Path.Commands)
              if m.name == "G1" and not np.isnan(m.tip).any()]

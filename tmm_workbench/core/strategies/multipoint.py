@@ -1,7 +1,8 @@
 """Multipoint 5-axis positioning of a toroidal cutter on a Bézier/B-spline face (seed 001, Singh 2020).
 
 The face is taken exactly (Bézier patches, B-splines split by knot insertion); the footprint is XY parallel
-passes (side step across, forward step along, any feed direction); at each footprint point the kernel
+passes (side step across, forward step along, any feed direction; the side step even, fixed, or from a
+scallop height on the simulated positions: pass_spacing "scallop", multipoint_scallop); at each footprint point the kernel
 drops the tool vertically to a first contact P, then tilts it about the pseudo-insert's axis until it
 touches a second point Q (methods "vcrf" and "drd" of the seed). Every position is checked for gouging.
 
