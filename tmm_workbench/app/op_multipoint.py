@@ -195,9 +195,11 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     def opFeatures(self, obj: Any) -> int:
         return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant | PathOp.FeatureBaseFaces
 
+    NEW_OP_DEFAULTS = NEW_OP_DEFAULTS  # declared exceptions to "defaults from the params dataclass"
+
     @classmethod
     def defaults(cls) -> dict[str, Any]:
-        return {**super().defaults(), **NEW_OP_DEFAULTS}
+        return {**super().defaults(), **cls.NEW_OP_DEFAULTS}
 
     def opOnDocumentRestored(self, obj: Any) -> None:
         # enumerations saved before a choice was added get it, keeping their value (an old document keeps
