@@ -57,7 +57,7 @@ class MultipointParams(StrategyParams):
     pass_spacing: str = param(EVEN, "pass spacing", choices=(EVEN, FIXED, SCALLOP))
     scallop: float = param(0.01, "scallop height", "mm", low=0, low_open=True, kind="length")
     scallop_row_spacing: float = param(0.0, "scallop row spacing", "mm", low=0)  # rows of needles read along
-    #                                                  the passes (0: twice the forward step, at least 1 mm)
+    #                                    the passes (0: twice the forward step, at least 1 mm and at most 4 mm)
     forward_step: float = param(2.0, "forward step", "mm", low=0, low_open=True, kind="length")
     feed_angle_deg: float = param(90.0, "feed angle", "deg")  # from +X (seed: along Y, side step along X)
     margin: float = param(0.0, "boundary margin", "mm")       # the face's XY extent grown by this (< 0 shrinks)
@@ -302,7 +302,7 @@ def _scallop_passes(surface: BezierFace, tool: Cutter, params: MultipointParams,
     estimate_work(rect, params)
     ms.estimate_work(rect, params, Ri)
     frame = ms.Frame.of(rect, params.feed_angle_deg)
-    rows = params.scallop_row_spacing or max(1.0, 2.0 * params.forward_step)
+    rows = params.scallop_row_spacing or min(4.0, max(1.0, 2.0 * params.forward_step))
     max_step = min(0.5, math.sqrt(0.08 * Ri * params.scallop))  # the cusp between instances: a tenth of it
     meter = ms.ScallopMeter(surface, Ro, Ri, params.shape, frame, rows, max_step, STATUS_FAILED,
                             int(params.threads))
