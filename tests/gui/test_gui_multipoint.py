@@ -32,6 +32,8 @@ def test_gui_multipoint(tmp_path: Path) -> None:
     assert info["warning_fixed_30"][0] and not info["warning_fixed_20"] and not info["warning_scallop_30"]
     assert info["page_height"] < 760 and info["task_panel_height"] <= 1000, info
     assert info["sim_max_left"] is not None, info["sim_status"]
+    # the app's own simulator (1 mm cells) reads the scallop the op was asked for (0.5 mm), and no gouge
+    assert info["sim_max_left"] <= 0.5 * 1.02 and info["sim_min_deviation"] >= -0.01, info
     for png in (PNG, SIM_PNG):
         assert png.is_file() and png.stat().st_size > 10_000, png
         assert not _blank(png), f"{png} is blank"
