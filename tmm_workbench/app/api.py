@@ -471,7 +471,8 @@ class MultipointResult:
 
 def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
                    side_step: float = 18.0, pass_spacing: Optional[str] = None, forward_step: float = 2.0,
-                   scallop: Optional[float] = None, feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True,
+                   feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True,
+                   scallop: Optional[float] = None,
                    tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
                    surface_extension: float = 0.0, footprint_anchor: str = "axis",
