@@ -9,10 +9,8 @@ cuts is typed (and not with the scallop rule), and fits a 1000 px screen; a scre
 axes goes to env TMM_GUI_PNG (default docs/gui/multipoint_axes.png); TMM Simulate on the Job simulates the
 5-axis path and shows its numbers. The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
 """
-import json
 import os
 import sys
-import traceback
 from pathlib import Path
 
 import FreeCAD
@@ -24,6 +22,7 @@ sys.path.insert(0, str(ROOT / "tests" / "gui"))
 _single_shot = QtCore.QTimer.singleShot
 QtCore.QTimer.singleShot = staticmethod(lambda *args: None)  # the smoke script's helpers, not its run
 try:
+    import gui_smoke  # noqa: E402
     from gui_smoke import close_panel, find_panel, pump, screenshot  # noqa: E402
 finally:
     QtCore.QTimer.singleShot = _single_shot
@@ -144,19 +143,9 @@ def run() -> dict:
 
 
 def main() -> None:
-    code, info = 1, {}
-    try:
-        info = run()
-        code = 0
-    except BaseException:  # noqa: B902 - every failure must reach the exit code
-        info["error"] = traceback.format_exc()
-        sys.stderr.write(info["error"])
-    info["ok"] = code == 0
-    RESULT.parent.mkdir(parents=True, exist_ok=True)
-    RESULT.write_text(json.dumps(info, indent=1, default=str))
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
+    """gui_smoke's runner (the JSON outcome, the exit code) around this test's steps."""
+    gui_smoke.smoke, gui_smoke.RESULT = run, RESULT
+    gui_smoke.main()
 
 
 QtCore.QTimer.singleShot(500, main)
