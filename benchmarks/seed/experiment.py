@@ -40,12 +40,12 @@ FORWARD_STEP = 2.0
 Y_RANGE = (0.0, 150.0)
 
 # The seed's Tables 2-3 (simulated / machined, mm), at the section y = 27.
-SEED_SIMULATED_MAX = {("convex", "drd"): 0.54, ("concave", "drd"): 0.92,
-                      ("convex", "vcrf"): 0.53, ("concave", "vcrf"): 0.60}
-SEED_SIMULATED_MIN = {("convex", "drd"): 2.9e-5, ("concave", "drd"): 1.4e-3,
-                      ("convex", "vcrf"): 1.1e-6, ("concave", "vcrf"): 1.3e-6}
-SEED_MACHINED_MAX = {("convex", "drd"): 0.57, ("concave", "drd"): 1.00,
-                     ("convex", "vcrf"): 0.51, ("concave", "vcrf"): 0.70}
+SEED_SIMULATED_MAX = {("convex", "drd"): 0.54, ("concave", "drd"): 0.92, ("saddle", "drd"): 0.79,
+                      ("convex", "vcrf"): 0.53, ("concave", "vcrf"): 0.60, ("saddle", "vcrf"): 0.62}
+SEED_SIMULATED_MIN = {("convex", "drd"): 2.9e-5, ("concave", "drd"): 1.4e-3, ("saddle", "drd"): 2.4e-5,
+                      ("convex", "vcrf"): 1.1e-6, ("concave", "vcrf"): 1.3e-6, ("saddle", "vcrf"): 9.0e-7}
+SEED_MACHINED_MAX = {("convex", "drd"): 0.57, ("concave", "drd"): 1.00, ("saddle", "drd"): 0.86,
+                     ("convex", "vcrf"): 0.51, ("concave", "vcrf"): 0.70, ("saddle", "vcrf"): 0.72}
 GOUGE_LIMIT = -0.01
 
 # Kernel option sets measured by benchmarks/seed/run_experiment.py (MultipointParams fields; everything else
@@ -153,21 +153,27 @@ def run_experiment(which: str = "convex", method: str = "vcrf", section_y: float
                    verify_tol: float = 1e-3, peak_spacing: float = 0.001, refine_minima: int = 6,
                    peak_floor: float = 0.05,
                    interp: str = "slerp",
-                   x_range: Optional[tuple[float, float]] = None, json_path: Optional[Path] = None) -> SectionResult:
+                   x_range: Optional[tuple[float, float]] = None, json_path: Optional[Path] = None,
+                   positions: Optional[tuple[MultipointResults, list]] = None) -> SectionResult:
     """Position the tool at the seed's footprint, simulate, and measure the section y = section_y over
-    x_range (default: the patch, 0..150)."""
-    if which not in ("convex", "concave"):
-        raise TmmError(f"surface must be 'convex' or 'concave', got {which!r}")
+    x_range (default: the patch, 0..150). `positions`: (results, passes) computed elsewhere (the scallop
+    placement: `passes_x` are then its pass offsets), simulated instead of positioning at the footprint."""
+    if which not in ("convex", "concave", "saddle"):
+        raise TmmError(f"surface must be 'convex', 'concave' or 'saddle', got {which!r}")
     if method not in ("vcrf", "drd"):
         raise TmmError(f"method must be 'vcrf' or 'drd', got {method!r}")
     net = load_seed_patch(json_path or seed_json_path(), which)
     face = BezierFace.from_net(net, name=f"seed {which}")
     params = params or MultipointParams()
-    passes = seed_footprint(passes_x, y_range, forward_step)
-    xy = np.vstack(passes)
-    t0 = time.perf_counter()
-    res = position_points(face, RO, RI, xy, params, method)
-    t_pos = time.perf_counter() - t0
+    if positions is None:
+        passes = seed_footprint(passes_x, y_range, forward_step)
+        xy = np.vstack(passes)
+        t0 = time.perf_counter()
+        res = position_points(face, RO, RI, xy, params, method)
+        t_pos = time.perf_counter() - t0
+    else:
+        res, passes = positions
+        xy, t_pos = res.xy, float("nan")
     counts = res.counts()
 
     tool = ZTool(RO, RI, params.shape)

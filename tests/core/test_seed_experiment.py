@@ -95,6 +95,6 @@ contacts and keep their nearest iterate, a few um off.)"""
 
 def test_run_experiment_rejects_bad_names():
     with pytest.raises(TmmError):
-        run_experiment("saddle", "vcrf")
+        run_experiment("hyperbolic", "vcrf")  # convex, concave, saddle only
     with pytest.raises(TmmError):
         run_experiment("convex", "newton")

@@ -149,7 +149,7 @@ class MultipointOp(FreeCADTestCase):
                            progress=False)
         self.assertTrue(r.op.isValid(), r.op.getStatusString())
         self.assertEqual(r.op.PassSpacing, "Fixed")
-        self.assertEqual(r.op.getEnumerationsOfProperty("PassSpacing"), ["Even", "Fixed"])
+        self.assertEqual(r.op.getEnumerationsOfProperty("PassSpacing"), ["Even", "Fixed", "Scallop"])
         seed = np.vstack(seed_footprint())
         n = len(seed)  # the footprint's positions come first, those inserted between them after
         np.testing.assert_allclose(r.results.xy[:n], seed, atol=1e-6)

@@ -158,7 +158,7 @@ def multipoint_panel(info: dict) -> None:
     assert info["mp_anchor"] == ["Tip", ["Axis", "Tip"]], info["mp_anchor"]
     spacing = page.findChild(QtGui.QComboBox, "passSpacing")
     info["mp_pass_spacing"] = [spacing.currentText(), [spacing.itemText(i) for i in range(spacing.count())]]
-    assert info["mp_pass_spacing"] == ["Fixed", ["Even", "Fixed"]], info["mp_pass_spacing"]
+    assert info["mp_pass_spacing"] == ["Fixed", ["Even", "Fixed", "Scallop"]], info["mp_pass_spacing"]
     close_panel(r.op)
     obj, face = r.face
     FreeCADGui.Selection.clearSelection()

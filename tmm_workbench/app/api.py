@@ -490,8 +490,9 @@ class MultipointResult:
 
 
 def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
-                   side_step: float = 18.0, pass_spacing: str = "even", forward_step: float = 2.0,
+                   side_step: float = 18.0, pass_spacing: Optional[str] = None, forward_step: float = 2.0,
                    feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True,
+                   scallop: Optional[float] = None,
                    tilt_limit_deg: Optional[float] = None,
                    tolerance: Optional[float] = None, tool_shape: str = "round_insert", axis_retract: float = 5.0,
                    surface_extension: float = 0.0, footprint_anchor: str = "axis",
@@ -510,7 +511,9 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     D = 2 (Ro + Ri), corner Ri). method 'vcrf' | 'drd'; tool_shape 'round_insert' (the seed's
     torus, hollow centre) | 'bull_nose' (plus its flat bottom).
     pass_spacing 'even' (passes spread evenly, at most side_step apart) | 'fixed' (side_step apart from the
-    start edge, a last pass on the far edge: the seed's footprint).
+    start edge, a last pass on the far edge: the seed's footprint) | 'scallop' (each pass at the largest side
+    step whose simulated scallop with the pass before is at most `scallop` mm; side_step is the first guess).
+    None: 'scallop' when `scallop` is given, else 'even' (what the API did before the scallop rule).
     tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm). gouge_tolerance: the deepest
     cut allowed between consecutive positions, positions inserted where a move cuts deeper (None: 0.005 mm;
     0: not checked).
@@ -530,10 +533,13 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
     shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))
     anchor_name = _option("footprint_anchor", footprint_anchor, _by_core_name(op_multipoint.ANCHORS))
+    if pass_spacing is None:  # the scallop rule when a scallop is asked for
+        pass_spacing = "even" if scallop is None else "scallop"
     spacing_name = _option("pass_spacing", pass_spacing, _by_core_name(op_multipoint.PASS_SPACINGS))
     _numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
              side_step=(side_step, spec_of(MultipointParams, "side_step")),
              forward_step=(forward_step, spec_of(MultipointParams, "forward_step")),
+             scallop=(scallop, spec_of(MultipointParams, "scallop")),
              feed_angle_deg=(feed_angle_deg, spec_of(MultipointParams, "feed_angle_deg")), margin=(margin, _LENGTH),
              tilt_limit_deg=(tilt_limit_deg, spec_of(MultipointParams, "beta_max_deg")),
              tolerance=(tolerance, spec_of(MultipointParams, "tol")),
@@ -576,6 +582,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             values["Tolerance"] = tolerance
         if gouge_tolerance is not None:
             values["GougeTolerance"] = gouge_tolerance
+        if scallop is not None:
+            values["Scallop"] = scallop
         op = registry.create(op_multipoint.OP_NAME, job, values)
         if posts and posts[0] in _job_posts(job):
             job.PostProcessor = posts[0]

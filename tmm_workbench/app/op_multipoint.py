@@ -46,9 +46,12 @@ from tmm_workbench.core.toolpath import Toolpath
 
 OP_NAME = "TMM_Multipoint"
 METHODS = {"VCRF": "vcrf", "DRD": "drd"}
-TOOL_SHAPES = {"RoundInsert": "round_insert", "BullNose": "bull_nose"}
+TOOL_SHAPES = {"RoundInsert": "round_insert", "BullNose": "bull_nose", "FromToolBit": "from_tool_bit"}
 ANCHORS = {"Axis": "axis", "Tip": "tip"}
-PASS_SPACINGS = {"Even": "even", "Fixed": "fixed"}
+PASS_SPACINGS = {"Even": "even", "Fixed": "fixed", "Scallop": "scallop"}  # Scallop last: old enum indices stay
+# what new ops get (the core's own defaults stay as they were for scripts): the side step from the scallop,
+# the tool's solid from its ToolBit
+NEW_OP_DEFAULTS: dict[str, Any] = {"PassSpacing": "Scallop", "ToolShape": "FromToolBit"}
 
 PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "Method", "Multipoint",
@@ -57,12 +60,18 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "ToolShape", "Multipoint",
          "RoundInsert: the seed's torus (round-insert cutter, hollow centre); BullNose: the torus plus its flat "
          "bottom disc (a solid bull-nose end mill; on convex faces its bottom keeps most positions at one "
-         "contact)", "shape"),
-    Prop("App::PropertyDistance", "SideStep", "Footprint", "Distance between passes (see PassSpacing)", "side_step"),
+         "contact); FromToolBit: from the tool controller's ToolBit (FreeCAD's bullnose, ballend and endmill bits "
+         "are solid end mills: BullNose)", "shape"),
+    Prop("App::PropertyDistance", "SideStep", "Footprint",
+         "Distance between passes (see PassSpacing; with Scallop the first guess of the search)", "side_step"),
     Prop("App::PropertyEnumeration", "PassSpacing", "Footprint",
-         "Even: passes spread evenly over the boundary, at most SideStep apart; Fixed: passes exactly SideStep "
-         "apart from the start edge and a last one on the far edge (seed 001's footprint: x = 0, 18, ..., 144, "
-         "150)", "pass_spacing"),
+         "Scallop: each pass at the largest side step whose simulated scallop with the pass before is at most "
+         "Scallop; Even: passes spread evenly over the boundary, at most SideStep apart; Fixed: passes exactly "
+         "SideStep apart from the start edge and a last one on the far edge (seed 001's footprint: x = 0, 18, "
+         "..., 144, 150)", "pass_spacing"),
+    Prop("App::PropertyDistance", "Scallop", "Footprint",
+         "Scallop height left between passes (PassSpacing Scallop), measured on the simulated tool positions",
+         "scallop"),
     Prop("App::PropertyDistance", "ForwardStep", "Footprint",
          "Distance between tool positions along a pass (at most)", "forward_step"),
     Prop("App::PropertyAngle", "FeedAngle", "Footprint", "Direction of the passes in XY, from +X", "feed_angle_deg"),
@@ -120,6 +129,40 @@ def face_surface(obj: Any, sub: str) -> Any:
     return surf
 
 
+def tool_shape(prop_value: str, tool: Any) -> str:
+    """The core's tool solid for the ToolShape property: FromToolBit -> bull_nose for the ToolBits TMM maps
+    (FreeCAD's bullnose, ballend, endmill: solid end mills; none models a round insert)."""
+    shape = TOOL_SHAPES[prop_value]
+    return "bull_nose" if shape == "from_tool_bit" else shape
+
+
+def uncut_strip_warning(pass_spacing: str, side_step: float, cutter: Any) -> str:
+    """The warning for a fixed side step at least the tool's cutting width 2 (Ro + Ri) on a plane (strips
+    between the passes the tool never touches), "" otherwise (and for the scallop rule)."""
+    Ro, Ri = cutter.torus_radii
+    if pass_spacing == "scallop" or side_step < 2.0 * (Ro + Ri):
+        return ""
+    return (f"side step {side_step:g} mm leaves uncut strips for this tool (cutting width {2.0 * (Ro + Ri):g} "
+            "mm); use PassSpacing Scallop or a side step below it")
+
+
+def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> list[str]:
+    """What the user should know about the side step: a fixed step leaving strips the tool never touches
+    (wider than its cutting width 2 (Ro + Ri) on a plane), strips the scallop rule could not keep within the
+    tolerance."""
+    out = []
+    strips = uncut_strip_warning(params.pass_spacing, params.side_step, cutter)
+    if strips:
+        out.append(strips)
+    if placement is not None:
+        out.append(f"{len(placement.offsets)} passes, largest scallop {placement.max_scallop:.4g} mm "
+                   f"(tolerance {params.scallop:g} mm)")
+        for a, rows, h, (x, y) in placement.unreached:
+            out.append(f"{rows} rows of the strip from {a:.4g} mm keep up to {h:.4g} mm above the face at any side "
+                       f"step (at x {x:.4g}, y {y:.4g} mm: the tool cannot reach it there; left out of the rule)")
+    return out
+
+
 def summary(res: MultipointResults) -> str:
     counts = res.counts()
     text = (f"{len(res)} footprint points: {counts['two']} two-contact, {counts['one']} one-contact, "
@@ -152,7 +195,20 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     def opFeatures(self, obj: Any) -> int:
         return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant | PathOp.FeatureBaseFaces
 
+    NEW_OP_DEFAULTS = NEW_OP_DEFAULTS  # declared exceptions to "defaults from the params dataclass"
+
+    @classmethod
+    def defaults(cls) -> dict[str, Any]:
+        return {**super().defaults(), **cls.NEW_OP_DEFAULTS}
+
     def opOnDocumentRestored(self, obj: Any) -> None:
+        # enumerations saved before a choice was added get it, keeping their value (an old document keeps
+        # its Even/Fixed side step and its tool shape: the path it was computed with)
+        for name in ("PassSpacing", "ToolShape"):
+            if hasattr(obj, name) and list(obj.getEnumerationsOfProperty(name)) != list(CHOICES[name]):
+                value = getattr(obj, name)
+                setattr(obj, name, list(CHOICES[name]))
+                setattr(obj, name, value)
         self.ensure_properties(obj, restoring=True)
         hooks.attach_view("multipoint_op", obj)
 
@@ -168,7 +224,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
         surf = face_surface(base, sub)
         face = geometry.bezier_face(surf, name=f"{base.Label}.{sub}")
         cutter = self.cutter()
-        params = self.params_from(obj)
+        params = self.params_from(obj, shape=tool_shape(obj.ToolShape, self.tool))
         safe, clearance = obj.SafeHeight.Value, obj.ClearanceHeight.Value
         top = face_top(face)
         if safe <= top:
@@ -184,6 +240,10 @@ class ObjectTmmMultipoint(op_base.TmmOp):
         self.face, self.radii, self.results = face, cutter.torus_radii, res
         self.segments, self.toolpath = result.segments, toolpath
         text = summary(res)
+        warnings = spacing_warnings(params, cutter, result.diagnostics.get("scallop"))
+        for w in warnings:
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: {w}\n")
+        text = "; ".join([text] + warnings)
         if obj.ContactSummary != text:
             obj.ContactSummary = text
         FreeCAD.Console.PrintMessage(f"{obj.Label}: {text}\n")

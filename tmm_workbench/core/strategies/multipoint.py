@@ -1,7 +1,8 @@
 """Multipoint 5-axis positioning of a toroidal cutter on a Bézier/B-spline face (seed 001, Singh 2020).
 
 The face is taken exactly (Bézier patches, B-splines split by knot insertion); the footprint is XY parallel
-passes (side step across, forward step along, any feed direction); at each footprint point the kernel
+passes (side step across, forward step along, any feed direction; the side step even, fixed, or from a
+scallop height on the simulated positions: pass_spacing "scallop", multipoint_scallop); at each footprint point the kernel
 drops the tool vertically to a first contact P, then tilts it about the pseudo-insert's axis until it
 touches a second point Q (methods "vcrf" and "drd" of the seed). Every position is checked for gouging.
 
@@ -43,6 +44,7 @@ SHAPES = ("round_insert", "bull_nose")
 ROTATIONS = ("pseudo_insert", "global_x")
 ANCHORS = ("axis", "tip")
 SUPPORTED_TOOLS = ("ball", "bull")  # Cutter.kind values: the toroidal view needs a corner radius > 0
+SCALLOP = "scallop"
 _BYTES_PER_POSITION = 1200  # kernel results (about 40 doubles) and their numpy copies, per footprint point
 
 
@@ -50,8 +52,12 @@ _BYTES_PER_POSITION = 1200  # kernel results (about 40 doubles) and their numpy 
 class MultipointParams(StrategyParams):
     side_step: float = param(18.0, "side step", "mm", low=0, low_open=True, kind="length")
     # EVEN: spread evenly, at most side_step apart; FIXED: side_step apart from the start edge, the last
-    # pass on the far edge (the seed's footprint)
-    pass_spacing: str = param(EVEN, "pass spacing", choices=(EVEN, FIXED))
+    # pass on the far edge (the seed's footprint); SCALLOP: each pass at the largest step whose simulated
+    # scallop with the pass before is at most `scallop` (multipoint_scallop; side_step is the first guess)
+    pass_spacing: str = param(EVEN, "pass spacing", choices=(EVEN, FIXED, SCALLOP))
+    scallop: float = param(0.01, "scallop height", "mm", low=0, low_open=True, kind="length")
+    scallop_row_spacing: float = param(0.0, "scallop row spacing", "mm", low=0)  # rows of needles read along
+    #                                    the passes (0: twice the forward step, at least 1 mm and at most 4 mm)
     forward_step: float = param(2.0, "forward step", "mm", low=0, low_open=True, kind="length")
     feed_angle_deg: float = param(90.0, "feed angle", "deg")  # from +X (seed: along Y, side step along X)
     margin: float = param(0.0, "boundary margin", "mm")       # the face's XY extent grown by this (< 0 shrinks)
@@ -84,6 +90,14 @@ class MultipointParams(StrategyParams):
         super().validate()
         if self.boundary is not None:
             check_finite("boundary", self.boundary)
+        if self.pass_spacing == SCALLOP:
+            check_scallop(self.scallop, None)
+
+
+def check_scallop(scallop: float, Ri: Optional[float]) -> None:
+    """The scallop height must be > 0 and below the tool's corner radius (a larger one is never a scallop)."""
+    if Ri is not None and not scallop < Ri:
+        raise TmmError(f"scallop height must be > 0 and < the corner radius {Ri:g} mm, got {scallop:g} mm")
 
 
 @dataclass
@@ -135,12 +149,9 @@ def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.
     `forward_step` apart; zigzag optional. One (k, 2) array per pass, the first nearest the boundary's
     (xmin, ymin) corner. The work is estimated first and refused above the limits (core.limits)."""
     params.validate()
-    if params.boundary is not None:
-        rect = tuple(map(float, params.boundary))
-    else:
-        x0, y0, x1, y1 = face.xy_extent()
-        m = float(params.margin)
-        rect = (x0 - m, y0 - m, x1 + m, y1 + m)
+    if params.pass_spacing == SCALLOP:
+        raise TmmError("pass spacing 'scallop' places passes from the tool positions: use compute()")
+    rect = footprint_rect(face, params)
     estimate_work(rect, params)
     lines = raster_lines(rect, params.side_step, params.feed_angle_deg, params.pass_spacing)
     # Start with the pass nearest the boundary's (xmin, ymin) corner.
@@ -154,6 +165,15 @@ def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.
             pts = pts[::-1]
         passes.append(pts)
     return passes
+
+
+def footprint_rect(face: BezierFace, params: MultipointParams) -> Rect:
+    """The boundary: `params.boundary`, or the face's XY extent grown by `params.margin`."""
+    if params.boundary is not None:
+        return tuple(map(float, params.boundary))
+    x0, y0, x1, y1 = face.xy_extent()
+    m = float(params.margin)
+    return (x0 - m, y0 - m, x1 + m, y1 + m)
 
 
 def estimate_work(rect: Rect, params: MultipointParams) -> float:
@@ -232,14 +252,20 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     if not isinstance(surface, BezierFace):
         raise TmmError(f"surface must be a BezierFace, got {type(surface).__name__}")
     Ro, Ri = _torus(tool)
-    passes = multipoint_footprint(surface, params)
-    if not passes:
-        raise TmmError("the footprint is empty")
-    xy = np.vstack(passes)
-    pass_index = np.concatenate([np.full(len(p), k) for k, p in enumerate(passes)])
-    positioner = make_positioner(surface, Ro, Ri, params)  # for the footprint and any positions inserted
-    res = _position(positioner, xy, params, progress)
-    res.passes = pass_index
+    diagnostics: dict = {}
+    if params.pass_spacing == SCALLOP:
+        positioner = make_positioner(surface, Ro, Ri, params)
+        res, diagnostics["scallop"] = _scallop_passes(surface, tool, params, positioner, progress)
+        pass_index, xy = res.passes, res.xy
+    else:
+        passes = multipoint_footprint(surface, params)
+        if not passes:
+            raise TmmError("the footprint is empty")
+        xy = np.vstack(passes)
+        pass_index = np.concatenate([np.full(len(p), k) for k, p in enumerate(passes)])
+        positioner = make_positioner(surface, Ro, Ri, params)  # for the footprint and any positions inserted
+        res = _position(positioner, xy, params, progress)
+        res.passes = pass_index
     good = res.status != STATUS_FAILED
     runs: list[list[int]] = []
     run: list[int] = []  # a segment ends at a new pass or a failed position
@@ -251,7 +277,7 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
             run.append(i)
     if run:
         runs.append(run)
-    diagnostics: dict = {"results": res}
+    diagnostics["results"] = res
     if params.between_tol > 0 and params.between_rounds > 0:
         from tmm_workbench.core.strategies import multipoint_refine
 
@@ -261,6 +287,41 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     tip, axis = res["tip"], res["axis"]
     cut = [CutSegment(tip[r], axes=axis[r], pass_index=int(res.passes[r[0]])) for r in runs]
     return StrategyResult(cut, diagnostics)
+
+
+def _scallop_passes(surface: BezierFace, tool: Cutter, params: MultipointParams, positioner,
+                    progress: Optional[Progress]) -> tuple[MultipointResults, object]:
+    """Passes placed by the scallop rule (multipoint_scallop), as one MultipointResults in cutting order
+    (odd passes reversed for zigzag), and the placement's report."""
+    from tmm_workbench.core.strategies import multipoint_scallop as ms
+
+    params.validate()
+    Ro, Ri = tool.torus_radii
+    check_scallop(params.scallop, Ri)
+    rect = footprint_rect(surface, params)
+    estimate_work(rect, params)
+    ms.estimate_work(rect, params, Ri)
+    frame = ms.Frame.of(rect, params.feed_angle_deg)
+    rows = params.scallop_row_spacing or min(4.0, max(1.0, 2.0 * params.forward_step))
+    max_step = min(0.5, math.sqrt(0.08 * Ri * params.scallop))  # the cusp between instances: a tenth of it
+    meter = ms.ScallopMeter(surface, Ro, Ri, params.shape, frame, rows, max_step, STATUS_FAILED,
+                            int(params.threads))
+    placed, report = ms.place_passes(surface, rect, params, Ri, lambda xy: _position(positioner, xy, params),
+                                     meter, STATUS_FAILED, progress)
+    order, xy, passes = [], [], []
+    base = 0
+    for k, p in enumerate(placed):
+        idx = np.arange(len(p.xy))
+        if params.zigzag and k % 2 == 1:
+            idx = idx[::-1]
+        order.append(base + idx)
+        base += len(p.xy)
+        xy.append(p.xy[idx])
+        passes.append(np.full(len(idx), k))
+    data = {key: np.concatenate([p.res.data[key] for p in placed])[np.concatenate(order)]
+            for key in placed[0].res.data}
+    res = MultipointResults(np.vstack(xy), np.concatenate(passes), data, placed[0].res.reasons)
+    return res, report
 
 
 def link_policy(tool: Cutter, safe_height: float, clearance_height: float,
