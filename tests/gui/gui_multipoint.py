@@ -27,7 +27,7 @@ try:
 finally:
     QtCore.QTimer.singleShot = _single_shot
 
-PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "docs" / "gui" / "multipoint_axes.png")
+PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui" / "multipoint_axes.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_multipoint.json")
 
 

@@ -29,7 +29,7 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
-SHOTS = Path(os.environ.get("TMM_GUI_SHOTS") or ROOT / "docs" / "gui")
+SHOTS = Path(os.environ.get("TMM_GUI_SHOTS") or ROOT / "out" / "gui")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_user_input.json")
 PAGE = "TmmSurfaceOpPage"
 TYPED: dict = {}

@@ -10,7 +10,7 @@ from tests.freecad import fc_process
 from tests.gui.test_gui_smoke import FREECAD, XVFB_RUN, _blank
 
 HERE = Path(__file__).resolve().parent
-PNG = fc_process.ROOT / "docs" / "gui" / "multipoint_axes.png"
+PNG = fc_process.ROOT / "out" / "gui" / "multipoint_axes.png"  # docs/gui keeps a copy
 SIM_PNG = PNG.with_name("multipoint_simulate.png")
 TIMEOUT_S = 240
 
@@ -18,6 +18,7 @@ TIMEOUT_S = 240
 def test_gui_multipoint(tmp_path: Path) -> None:
     assert FREECAD is not None and XVFB_RUN is not None, "freecad and xvfb-run are needed (run scripts/setup.sh)"
     result = tmp_path / "gui_multipoint.json"
+    PNG.parent.mkdir(parents=True, exist_ok=True)
     PNG.unlink(missing_ok=True)
     SIM_PNG.unlink(missing_ok=True)
     code, out = fc_process.run(

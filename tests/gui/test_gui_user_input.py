@@ -11,7 +11,7 @@ from tests.freecad import fc_process
 from tests.gui.test_gui_smoke import _blank
 
 HERE = Path(__file__).resolve().parent
-SHOTS = fc_process.ROOT / "docs" / "gui"
+SHOTS = fc_process.ROOT / "out" / "gui"  # docs/gui keeps a copy of each
 FREECAD = fc_process.find("freecad", "FreeCAD")
 XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 150
