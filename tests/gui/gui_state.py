@@ -223,15 +223,36 @@ def edit(op) -> None:
     pump(1.0)
 
 
+def tx(doc) -> dict:
+    return {"pending": doc.HasPendingTransaction, "mode": doc.UndoMode, "undo": list(doc.UndoNames),
+            "redo": list(doc.RedoNames), "active": str(getattr(FreeCAD, "getActiveTransaction", lambda: "n/a")())}
+
+
+def keep_focus(widget) -> None:
+    """The field keeps the keyboard focus up to Cancel (as after Escape): it emits editingFinished once more as
+    the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure."""
+    mw = FreeCADGui.getMainWindow()
+    mw.activateWindow()
+    QtGui.QApplication.setActiveWindow(mw)
+    widget.setFocus()
+    pump(0.3)
+
+
 def cancel_keeps_path(info: dict, doc, op) -> None:
     """Step 4: Cancel after a change keeps the path; a failed Apply then Cancel brings the good path back; a good
     Apply then a further change and Cancel keep the applied path (Apply commits a good result)."""
     before = path_key(op)
     info["path_before"] = len(before)
+    info["tx0"] = tx(doc)
     edit(op)
-    type_into(visible(QtGui.QDoubleSpinBox, "stepOverPercent"), "30")
+    info["tx1_edit"] = tx(doc)
+    spin = visible(QtGui.QDoubleSpinBox, "stepOverPercent")
+    type_into(spin, "30")
+    info["tx2_typed"] = [tx(doc), op.StepOverPercent]
+    keep_focus(spin)
     click(QtGui.QDialogButtonBox.Cancel)
     wait_closed()
+    info["tx3_cancel"] = tx(doc)
     info["cancel_percent"] = op.StepOverPercent
     info["path_kept_after_cancel"] = path_key(op) == before
 
@@ -244,6 +265,7 @@ def cancel_keeps_path(info: dict, doc, op) -> None:
     info["failed_apply_commands"] = len(op.Path.Commands)
     info["failed_apply_status_line"] = visible(QtGui.QLabel, "status").text()
     info["png_failed_apply"] = screenshot("state_4_failed_apply")
+    keep_focus(visible(QtGui.QDoubleSpinBox, "stepOverPercent"))
     click(QtGui.QDialogButtonBox.Cancel)
     wait_closed()
     pump(1.0)
@@ -259,6 +281,7 @@ def cancel_keeps_path(info: dict, doc, op) -> None:
     applied = path_key(op)
     info["applied_commands"] = len(applied)
     type_into(visible(QtGui.QDoubleSpinBox, "stepOverPercent"), "40")
+    keep_focus(visible(QtGui.QDoubleSpinBox, "stepOverPercent"))
     click(QtGui.QDialogButtonBox.Cancel)
     wait_closed()
     pump(1.0)

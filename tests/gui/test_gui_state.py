@@ -61,12 +61,12 @@ def test_gui_state(tmp_path: Path) -> None:
     assert abs(y - sy) < 1e-3, (x, y, sx, sy)  # the pass nearest the start point first
     assert abs(x - sx) < 1e-3, (x, y, sx, sy)  # at its end nearest it (here: reachable by the zig-zag)
     # Cancel: after a change, after a failed Apply (its message shown as the status), after a good Apply
-    # Not asserted, an open bug (issue 15 item 5): in an existing op's panel, Cancel after a change (and after a
-    # failed Apply) keeps the changed value and its path (cancel_percent / after_failed_cancel_percent are 30, not
-    # 50; path_kept_after_cancel / path_kept_after_failed_apply False), on 0.20 since the merge of 2026-12-02.
+    # (the field keeps the focus up to Cancel: its last editingFinished must not reach the op, panel_state)
+    assert info["path_kept_after_cancel"] and info["cancel_percent"] == 50.0, info
     assert not info["failed_apply_valid"] and info["failed_apply_commands"] == 0
     assert "step-over must be in (0, 100] %" in info["failed_apply_status"], info["failed_apply_status"]
-    assert info["after_failed_cancel_valid"], info
+    assert info["after_failed_cancel_valid"] and info["path_kept_after_failed_apply"], info
+    assert info["after_failed_cancel_percent"] == 50.0
     assert info["applied_path_kept"] and info["after_apply_cancel_percent"] == 25.0, info
     assert info["creation_op_kept"] and info["creation_path_kept"] and info["creation_step_over"] == 4.0, info
     # saved and reopened: the values and path are there, the post kept

@@ -177,6 +177,7 @@ class OpViewProvider(PathOpGui.ViewProvider):
         from tmm_workbench.gui import panel_state
 
         panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
+        panel_state.drop_fields_on_cancel(panel)  # a field left focused writes nothing after Cancel's abort
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
         super().setupTaskPanel(panel)
 
