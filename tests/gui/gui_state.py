@@ -230,7 +230,11 @@ def tx(doc) -> dict:
 
 def keep_focus(widget) -> None:
     """The field keeps the keyboard focus up to Cancel (as after Escape): it emits editingFinished once more as
-    the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure."""
+    the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure on
+    0.20. On 1.0 the panel's widgets closing with the focus crash FreeCAD's own Python QuantitySpinBox event
+    filter (SIGSEGV in PySide's getMetaDataFromQObject, 2026-12-02), so there the focus stays as it comes."""
+    if int(FreeCAD.Version()[0]) >= 1:
+        return
     mw = FreeCADGui.getMainWindow()
     mw.activateWindow()
     QtGui.QApplication.setActiveWindow(mw)
