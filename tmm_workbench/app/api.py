@@ -208,10 +208,7 @@ def _model_values(jm: jobs.JobModel) -> dict:
 
 def _post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, progress: Any) -> SurfaceResult:
     """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller)."""
-    if post in _job_posts(job):
-        job.PostProcessor = post
-        job.PostProcessorArgs = posts.DEFAULT_ARGS.get(post, "")
-
+    jobs.choose_post(job, post)  # when the Job offers it
     _compute(op, progress)
     gcode = posts.export(post, [tc, op], gcode_path)
     return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
@@ -220,13 +217,6 @@ def _post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, p
 def _stock_top(job: Any) -> float:
     stock = getattr(job, "Stock", None)
     return float(stock.Shape.BoundBox.ZMax) if stock is not None and not stock.Shape.isNull() else -math.inf
-
-
-def _job_posts(job: Any) -> list[str]:
-    try:
-        return list(job.getEnumerationsOfProperty("PostProcessor") or [])
-    except Exception:
-        return []
 
 
 def _compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
@@ -585,9 +575,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         if scallop is not None:
             values["Scallop"] = scallop
         op = registry.create(op_multipoint.OP_NAME, job, values)
-        if posts and posts[0] in _job_posts(job):
-            job.PostProcessor = posts[0]
-            job.PostProcessorArgs = posts_mod.DEFAULT_ARGS.get(posts[0], "--no-show-editor")
+        if posts:
+            jobs.choose_post(job, posts[0])  # when the Job offers it
 
         _compute(op, progress)
 
