@@ -41,6 +41,29 @@ class WorkEstimate(FreeCADTestCase):
             work_estimate.estimate(op, {"StepOver": -1.0})
         self.assertIn("step-over must be a positive length, got -1", str(ctx.exception))
 
+    def test_estimate_tells_the_cutting_time(self) -> None:
+        """The status line's time: the cut length the boxes and the spacing imply at the tool controller's
+        feed, near the cutting time of the path the op then computes; none without a feed."""
+        from tmm_workbench.app.simulation import _toolpath_and_feeds
+        from tmm_workbench.core.sim.cycle_time import three_axis_time
+
+        doc = new_doc("TmmEstimateTime")
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"BoundaryShape": "Model", "StepOver": 1.5,
+                                                              "SampleStep": 0.4})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        tp, feeds = _toolpath_and_feeds(op)
+        cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
+        self.assertGreater(cutting, 0.0)
+        self.assertAlmostEqual(est.feed, tc.HorizFeed.Value)
+        self.assertTrue(0.6 * cutting < est.cutting_seconds < 1.6 * cutting, (est.cutting_seconds, cutting))
+        self.assertIn("cutting about 00:", est.text())
+        slower = work_estimate.estimate(op, {"StepOver": 0.75})  # half the spacing, twice the passes' length
+        self.assertAlmostEqual(slower.cutting_seconds, 2.0 * est.cutting_seconds, delta=1e-6)
+        tc.HorizFeed = 0.0  # no feed: no time, the rest of the estimate stays
+        self.assertIsNone(work_estimate.estimate(op).cutting_seconds)
+        self.assertNotIn("cutting", work_estimate.estimate(op).text())
+
     def test_part_model_refused_before_tessellation(self) -> None:
         """A Part model with a tessellation tolerance below the range, or a raster above the limit: the op fails
         at once, from the bounding boxes, without tessellating the sphere."""

@@ -91,7 +91,18 @@ def simulate_panel(info: dict, r) -> None:
     FreeCADGui.runCommand(simulate_cmd.COMMAND_NAME)
     pump(1.0)
     page = find_panel(simulate_cmd.PANEL_NAME)
-    page.findChild(QtGui.QDoubleSpinBox, "cell").setValue(0.5)
+    cell, button = page.findChild(QtGui.QDoubleSpinBox, "cell"), page.findChild(QtGui.QPushButton, "simulate")
+    estimate = page.findChild(QtGui.QLabel, "estimate")
+    info["sim_cell_range"] = [cell.minimum(), cell.maximum(), cell.suffix()]
+    assert info["sim_cell_range"] == [0.005, 10.0, " mm"], info["sim_cell_range"]
+    cell.setValue(0.005)  # a grid above the work limits: told at once, nothing simulated
+    info["sim_estimate_fine"] = estimate.text()
+    assert "will fail" in info["sim_estimate_fine"] and "simulation cells" in info["sim_estimate_fine"], info
+    assert not button.isEnabled(), "Simulate stays enabled for a refused cell size"
+    cell.setValue(0.5)
+    info["sim_estimate"] = estimate.text()
+    assert info["sim_estimate"].startswith("about ") and " cells (" in info["sim_estimate"], info
+    assert button.isEnabled()
     page.findChild(QtGui.QPushButton, "simulate").click()  # returns when done (the progress dialog pumps)
     pump(1.0)
 
@@ -206,6 +217,17 @@ def zlevel_panels(info: dict) -> None:
             step_over = page.findChild(QtGui.QDoubleSpinBox, "stepOver")
             info["roughing_step_over"] = [step_over.value(), step_over.suffix().strip()]
             assert info["roughing_step_over"] == [op.StepOver, "%"], info["roughing_step_over"]
+            good = step_over.value()
+            step_over.setValue(0.0)  # 0 % is outside (0, 100) %: marked, never written to the op
+            step_over.editingFinished.emit()
+            pump(0.3)
+            info["roughing_zero_step_over"] = [step_over.property("tmmRefused"), op.StepOver]
+            assert "step-over must be in (0, 100) %" in (info["roughing_zero_step_over"][0] or ""), info
+            assert info["roughing_zero_step_over"][1] == good, info["roughing_zero_step_over"]
+            step_over.setValue(good)
+            step_over.editingFinished.emit()
+            pump(0.3)
+            assert not step_over.property("tmmRefused"), step_over.property("tmmRefused")
         info[f"{key}_step_down"] = page.findChild(QtGui.QWidget, "stepDown").property("rawValue")
         assert abs(info[f"{key}_step_down"] - op.StepDown.Value) < 1e-9, info[f"{key}_step_down"]
         FreeCADGui.activeDocument().activeView().viewIsometric()

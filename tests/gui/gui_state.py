@@ -261,7 +261,12 @@ def cancel_keeps_path(info: dict, doc, op) -> None:
     info["path_kept_after_cancel"] = path_key(op) == before
 
     edit(op)
-    type_into(visible(QtGui.QDoubleSpinBox, "stepOverPercent"), "0")
+    spin = visible(QtGui.QDoubleSpinBox, "stepOverPercent")
+    type_into(spin, "0")  # outside (0, 100] %: refused in the field, never written
+    info["zero_percent"] = [spin.property("tmmRefused"), op.StepOverPercent, visible(QtGui.QLabel, "status").text()]
+    type_into(spin, "50")
+    # a failure only the compute finds: an STL file that is not there
+    type_into(visible(QtGui.QLineEdit, "stlFile"), "/nonexistent/tmm_missing.stl")
     click(QtGui.QDialogButtonBox.Apply)
     pump(1.0)
     info["failed_apply_valid"] = op.isValid()
@@ -275,6 +280,7 @@ def cancel_keeps_path(info: dict, doc, op) -> None:
     pump(1.0)
     info["after_failed_cancel_valid"] = op.isValid()
     info["after_failed_cancel_percent"] = op.StepOverPercent
+    info["after_failed_cancel_stl"] = op.StlFile
     info["path_kept_after_failed_apply"] = path_key(op) == before
     info["png_cancel"] = screenshot("state_5_after_cancel")
 

@@ -215,6 +215,7 @@ def session(info: dict) -> dict:
     info["status_estimate"] = status()
     assert not sample.property("tmmRefused"), sample.property("tmmRefused")
     assert "about" in info["status_estimate"][0] and "CL points" in info["status_estimate"][0], info
+    assert "passes, cutting about 00:" in info["status_estimate"][0], info["status_estimate"]  # and its time
     button(QtGui.QDialogButtonBox.Apply).click()
     pump(1.5)
     info["status_apply"] = status()

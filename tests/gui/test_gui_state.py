@@ -63,10 +63,14 @@ def test_gui_state(tmp_path: Path) -> None:
     # Cancel: after a change, after a failed Apply (its message shown as the status), after a good Apply
     # (the field keeps the focus up to Cancel: its last editingFinished must not reach the op, panel_state)
     assert info["path_kept_after_cancel"] and info["cancel_percent"] == 50.0, info
+    refusal, percent, status_line = info["zero_percent"]
+    assert "step-over must be in (0, 100] %" in (refusal or "") and percent == 50.0, info["zero_percent"]
+    assert "step-over must be in (0, 100] %" in status_line, info["zero_percent"]
     assert not info["failed_apply_valid"] and info["failed_apply_commands"] == 0
-    assert "step-over must be in (0, 100] %" in info["failed_apply_status"], info["failed_apply_status"]
+    assert "tmm_missing.stl" in info["failed_apply_status"], info["failed_apply_status"]
+    assert "tmm_missing.stl" in info["failed_apply_status_line"], info["failed_apply_status_line"]
     assert info["after_failed_cancel_valid"] and info["path_kept_after_failed_apply"], info
-    assert info["after_failed_cancel_percent"] == 50.0
+    assert info["after_failed_cancel_percent"] == 50.0 and info["after_failed_cancel_stl"] == "", info
     assert info["applied_path_kept"] and info["after_apply_cancel_percent"] == 25.0, info
     assert info["creation_op_kept"] and info["creation_path_kept"] and info["creation_step_over"] == 4.0, info
     # saved and reopened: the values and path are there, the post kept

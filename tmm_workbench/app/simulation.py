@@ -193,6 +193,19 @@ def bucket_regions(grid: Grid, design: np.ndarray, size: float = BUCKET_MM) -> d
     return out
 
 
+def simulation_grid(target: Any, cell: float) -> Grid:
+    """The grid a simulation of `target` (a Job or an op) would use at `cell` mm: TmmError, before anything is
+    allocated, when the cell is not a length > 0 or the grid is above the work limits (the panel asks this
+    as a cell size is entered)."""
+    job = job_of(target)
+    if job is None:
+        raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
+    if getattr(job, "Stock", None) is None or job.Stock.Shape.isNull():
+        raise TmmError(f"Job '{job.Label}' has no stock to simulate")
+    bb = job.Stock.Shape.BoundBox
+    return Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, cell)
+
+
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
                  progress: Optional[Callable[[float], bool]] = None) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
@@ -203,8 +216,7 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     ops = operations(job) if target is job else [target]
     if not ops:
         raise TmmError(f"Job '{job.Label}' has no active operation with a tool path")
-    bb = job.Stock.Shape.BoundBox
-    grid = Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, cell)
+    grid = simulation_grid(job, cell)
     initial = _stock_heights(job, grid)
     design = _design_heights(job, ops, grid)
     heights, done = initial, []

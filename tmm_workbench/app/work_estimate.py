@@ -25,6 +25,10 @@ EXTRA_SPECS: dict[str, Spec] = {
     "BottomZ": Spec("bottom", "mm", low=-10_000.0, high=10_000.0),
     "PlungeAngle": Spec("plunge angle", "deg", low=0.0, high=90.0),
     "SampleStep": Spec("sample step", "mm", low=0.0, high=1000.0, optional=True),  # waterline: 0 derives it
+    # the 3-axis Surface's depths (app.surface_passes): as core.strategies.finish_passes checks them
+    "StepOverPercent": Spec("step-over", "%", low=0.0, high=100.0, low_open=True),
+    "StepDown": Spec("finishing step-down", "mm", low=0.0, high=1000.0, low_open=True),
+    "FinalDepth": Spec("final depth", "mm", low=-10_000.0, high=10_000.0),
 }
 # a side of a range the params leave open, for the panel's minimum / maximum
 OPEN_HIGH = {"mm": 10_000.0, "deg": 360.0, "%": 100.0}
@@ -35,10 +39,23 @@ class Estimate:
     count: float   # what the strategy estimates: CL points, tool positions, loop points...
     what: str
     passes: Optional[int] = None
+    cut_length: Optional[float] = None   # mm of cutting moves, from the boxes and the spacing (not a path)
+    feed: Optional[float] = None         # mm/s, the tool controller's horizontal feed
+
+    @property
+    def cutting_seconds(self) -> Optional[float]:
+        """The cutting time the estimate implies (cut length at the horizontal feed); None without a feed."""
+        if self.cut_length is None or not self.feed or self.feed <= 0:
+            return None
+        return self.cut_length / self.feed
 
     def text(self) -> str:
+        from tmm_workbench.core.sim.cycle_time import hms
+
         passes = f", {self.passes} passes" if self.passes else ""
-        return f"about {self.count:.3g} {self.what}{passes}"
+        t = self.cutting_seconds
+        time = f", cutting about {hms(t)} at {self.feed * 60:.4g} mm/min" if t is not None else ""
+        return f"about {self.count:.3g} {self.what}{passes}{time}"
 
 
 def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
@@ -143,6 +160,14 @@ def _cutter(obj: Any) -> Any:
     return cutter_from_tool(obj.ToolController.Tool)
 
 
+def _feed(obj: Any) -> Optional[float]:
+    """The tool controller's horizontal feed in mm/s (None without one: no time is told)."""
+    tc = getattr(obj, "ToolController", None)
+    feed = getattr(tc, "HorizFeed", None) if tc is not None else None
+    value = float(getattr(feed, "Value", feed)) if feed is not None else 0.0
+    return value if value > 0 else None
+
+
 def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
     from tmm_workbench.core.footprint.cusp import stepover_for_cusp
     from tmm_workbench.core.footprint.raster import pass_count
@@ -164,7 +189,8 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
         stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
     count = raster_drop.estimate_work(replace(params, stepover=stepover))
     w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
-    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover))
+    # passes cover the boundary at the step-over: their length is its area over the spacing
+    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover, _feed(obj))
 
 
 def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
@@ -190,7 +216,10 @@ def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
         extra.update(top_z=top, bottom_z=bottom)
     params = _params(proxy, obj, ov, **extra)
     count = waterline.estimate_work(params, cutter, top, bottom)
-    return Estimate(count, "waterline drops and points", len(waterline.levels(top, bottom, params.step_down)))
+    n = len(waterline.levels(top, bottom, params.step_down))
+    # a level's loops run round the model: its box's outline offset by the tool radius, per level
+    outline = 2 * (b[3] - b[0] + b[4] - b[1]) + 2 * math.pi * cutter.radius
+    return Estimate(count, "waterline drops and points", n, n * outline, _feed(obj))
 
 
 def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
@@ -205,7 +234,13 @@ def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> 
     final_z = _value(obj, "FinalZ", ov) if obj.UseFinalZ else None
     params = _params(proxy, obj, ov, final_z=final_z, stock_box=stock_box_of(stock))
     params.validate()
-    return Estimate(zlevel_rough.estimate_work(params, _cutter(obj)), "roughing loop points")
+    cutter = _cutter(obj)
+    layers = zlevel_rough.layer_count(params, cutter)
+    b = params.stock_box
+    # an upper bound: every layer clears the whole stock outline at the step-over
+    length = layers * (b[3] - b[0]) * (b[4] - b[1]) / params.stepover(cutter)
+    return Estimate(zlevel_rough.estimate_work(params, cutter, layers), "roughing loop points", None, length,
+                    _feed(obj))
 
 
 def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
@@ -221,8 +256,10 @@ def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -
     m = float(params.margin)
     rect = (bb.XMin - m, bb.YMin - m, bb.XMax + m, bb.YMax + m)
     count = multipoint.estimate_work(rect, params)
+    area = (rect[2] - rect[0]) * (rect[3] - rect[1])
     return Estimate(count, "tool positions",
-                    pass_count(math.hypot(rect[2] - rect[0], rect[3] - rect[1]), params.side_step))
+                    pass_count(math.hypot(rect[2] - rect[0], rect[3] - rect[1]), params.side_step),
+                    area / params.side_step, _feed(obj))
 
 
 _BY_CLASS = {"ObjectTmmSurface": _surface, "ObjectTmmWaterline": _waterline, "ObjectTmmRoughing": _roughing,

@@ -57,10 +57,13 @@ class FieldGuard:
         self.widgets = {prop: getattr(page.form, w) for w, prop in page.SPIN_BOXES.items()}
         for prop, widget in self.widgets.items():
             self.bind(widget, prop)
-        for w, prop in getattr(page, "PERCENTS", {}).items():  # plain spin boxes in % of the tool diameter
+        # plain spin boxes in % of the tool diameter (those the page's form has: a subclass may have its own)
+        self.percents = {prop: getattr(page.form, w) for w, prop in getattr(page, "PERCENTS", {}).items()
+                         if hasattr(page.form, w)}
+        for prop, widget in self.percents.items():
             spec = work_estimate.spec_for(obj.Proxy, prop)
             if spec is not None and spec.low is not None:
-                getattr(page.form, w).setRange(spec.low, spec.high if spec.high is not None else 100.0)
+                widget.setRange(spec.low, spec.high if spec.high is not None else 100.0)
         self.estimate_text = self.estimate(obj, {})
 
     @staticmethod
@@ -130,14 +133,19 @@ class FieldGuard:
                 entered[prop] = value
             except TmmError as exc:
                 refused[prop] = str(exc)
-        for w, prop in getattr(self.page, "PERCENTS", {}).items():
-            value = float(getattr(self.page.form, w).value())
-            if abs(value - float(getattr(obj, prop))) > 1e-9:
+        for prop, widget in self.percents.items():
+            value = float(widget.value())
+            if not widget.isEnabled() or abs(value - float(getattr(obj, prop))) <= 1e-9:
+                continue
+            try:  # the spin box's range is closed: an open end (0 % step-over) is refused here
+                work_estimate.check_value(obj.Proxy, prop, value)
                 entered[prop] = value
+            except TmmError as exc:
+                refused[prop] = str(exc)
         self.estimate_text = self.estimate(obj, entered)
         failing = self.estimate_text.startswith("will fail: ")
         if failing and entered and self.estimate(obj, {}) != self.estimate_text:  # caused by what was entered
-            hit = [prop for prop in entered if prop in self.widgets]
+            hit = [prop for prop in entered if prop in self.widgets or prop in self.percents]
             for prop in hit:
                 refused[prop] = self.estimate_text[len("will fail: "):]
             if hit:
@@ -149,7 +157,7 @@ class FieldGuard:
         return set(refused)
 
     def mark(self) -> None:
-        for prop, widget in self.widgets.items():
+        for prop, widget in {**self.widgets, **self.percents}.items():
             message = self.refused.get(prop, "")
             widget.setProperty("tmmRefused", message)
             widget.setStyleSheet(REFUSED_STYLE if message else "")

@@ -26,7 +26,10 @@ class PercentFields:
     PERCENTS: dict[str, str] = {}
 
     def get_percents(self, obj: Any) -> None:
+        guard = getattr(self, "guard", None)
         for widget, prop in self.PERCENTS.items():
+            if guard is not None and prop in guard.refused:
+                continue  # a refused value never reaches the op
             value = getattr(self.form, widget).value()
             if abs(getattr(obj, prop) - value) > 1e-9:
                 setattr(obj, prop, value)

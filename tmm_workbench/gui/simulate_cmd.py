@@ -193,7 +193,32 @@ class SimulatePanel:
         self.button.setObjectName("simulate")
         self.button.clicked.connect(self.simulate)
         grid.addRow(self.button)
+        self.estimate = QtGui.QLabel("")
+        self.estimate.setObjectName("estimate")
+        self.estimate.setWordWrap(True)
+        grid.addRow(self.estimate)
+        self.cell.valueChanged.connect(lambda *_: self.check_cell())
+        self.check_cell()
         return box
+
+    def check_cell(self) -> bool:
+        """The grid the entered cell size makes, told before any simulation: its cells, or the refusal (a
+        grid above the work limits) with Simulate disabled."""
+        from tmm_workbench.app.op_base import apply_work_limits
+        from tmm_workbench.app.simulation import simulation_grid
+
+        try:
+            apply_work_limits()
+            g = simulation_grid(self.target, self.cell.value())
+        except TmmError as exc:
+            self.estimate.setText(f"will fail: {exc}")
+            self.estimate.setStyleSheet(RED)
+            self.button.setEnabled(False)
+            return False
+        self.estimate.setText(f"about {g.nx * g.ny:.3g} cells ({g.nx} x {g.ny})")
+        self.estimate.setStyleSheet("")
+        self.button.setEnabled(True)
+        return True
 
     def _results_box(self) -> QtGui.QGroupBox:
         box = QtGui.QGroupBox("Results (deviation: vertical, + material left, - gouge)")
@@ -282,7 +307,7 @@ class SimulatePanel:
             return
         finally:
             QtGui.QApplication.restoreOverrideCursor()
-            self.button.setEnabled(True)
+            self.check_cell()
         self.show_report(report, time.monotonic() - t0)
         try:
             self.show_node(report)

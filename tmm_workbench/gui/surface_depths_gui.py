@@ -11,6 +11,7 @@ from typing import Any
 import FreeCAD
 
 from tmm_workbench.app.surface_passes import PERCENT
+from tmm_workbench.core.strategies.finish_passes import MAX_PASSES
 
 # widget name -> property, merged into op_surface_gui's tables
 SPIN_BOXES = {"finalDepth": "FinalDepth", "stepDown": "StepDown"}
@@ -24,6 +25,7 @@ class DepthFields:
     """A page mix-in: get_depths / set_depths / depth_signals / enable_depths, called from the page's hooks."""
 
     form: Any
+    PERCENTS = {"stepOverPercent": "StepOverPercent"}  # checked by gui.field_limits (range, work estimate)
 
     def has_depths(self) -> bool:
         return hasattr(self.form, "depthsGroup")
@@ -32,7 +34,9 @@ class DepthFields:
         if not self.has_depths():
             return
         percent = self.form.stepOverPercent.value()
-        if abs(obj.StepOverPercent - percent) > 1e-9:
+        guard = getattr(self, "guard", None)
+        refused = guard is not None and "StepOverPercent" in guard.refused  # held by gui.field_limits
+        if not refused and abs(obj.StepOverPercent - percent) > 1e-9:
             obj.StepOverPercent = percent
         passes = self.form.finishPasses.value()
         if obj.FinishPasses != passes:
@@ -45,6 +49,7 @@ class DepthFields:
     def set_depths(self, obj: Any) -> None:
         if not self.has_depths():
             return
+        self.form.finishPasses.setRange(1, MAX_PASSES)
         self.form.stepOverPercent.setValue(float(obj.StepOverPercent))
         self.form.finishPasses.setValue(int(obj.FinishPasses))
         self.form.startX.setValue(float(obj.StartPoint.x))

@@ -167,6 +167,16 @@ def layer_heights(mesh: TriMesh, cutter: Cutter, params: RoughingParams, top: fl
     return zs
 
 
+def layer_count(params: RoughingParams, cutter: Cutter) -> int:
+    """Layers over the stock's height at the step-down (tolerance mode: the shallowest layer eq. 3.11
+    allows), before the model is known: what the estimates count."""
+    b = params.stock_box
+    depth = params.step_down
+    if params.layer_mode == "tolerance":
+        depth = min(depth, layers_mod.tolerance_depth(cutter, params.remaining_height, 0.0))
+    return max(1, math.ceil((b[5] - b[2]) / depth))
+
+
 def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] = None) -> float:
     """Loop points over all layers (layers x loops x points, an upper bound: every loop as long as the
     stock's outline, at the waterline's sample spacing), refused above the limits before any is made.
@@ -174,10 +184,7 @@ def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] 
     b = params.stock_box
     w, h = b[3] - b[0], b[4] - b[1]
     if layers is None:
-        depth = params.step_down
-        if params.layer_mode == "tolerance":
-            depth = min(depth, layers_mod.tolerance_depth(cutter, params.remaining_height, 0.0))
-        layers = max(1, math.ceil((b[5] - b[2]) / depth))
+        layers = layer_count(params, cutter)
     s = params.stepover(cutter)
     loops = math.ceil(min(w, h) / (2 * s)) + 2
     spacing = wl.default_sample_step(cutter, (0, 0, w + 2 * cutter.diameter, h + 2 * cutter.diameter))
