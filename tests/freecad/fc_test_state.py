@@ -95,7 +95,7 @@ class SurfaceExpectations(FreeCADTestCase):
         pc.StepOverPercent = 0.0
         doc.recompute()
         self.assertFalse(pc.isValid())
-        self.assertIn("step-over must be in (0, 100] % of the tool diameter, got 0 %", pc.getStatusString())
+        self.assertIn("step-over must be in (0, 100] %, got 0", pc.getStatusString())
 
     def test_finishing_passes_leave_the_stated_stock_simulated(self) -> None:
         doc = new_doc("TmmPasses")
@@ -141,6 +141,39 @@ class SurfaceExpectations(FreeCADTestCase):
         op.FinishPasses = 0
         doc.recompute()
         self.assertIn("finishing passes must be a whole number in [1, 50], got 0", op.getStatusString())
+
+    def test_run_surface_takes_the_depths_and_start_point(self) -> None:
+        """The headless API sets what the panel's Depths group sets; a bad value is named by its argument."""
+        from tmm_workbench.app.api import run_surface
+        from tmm_workbench.core.errors import TmmError
+
+        lo_x, lo_y = -30.0, -30.0
+        r = run_surface(str(bump_stl()), diameter=4.0, stepover=9.0, stepover_percent=50.0, sample_step=0.5,
+                        boundary="model", pattern="oneway", stock_to_leave=0.2, final_depth=0.5, finish_passes=2,
+                        finish_step_down=0.3, start_point=(lo_x, lo_y), doc_name="TmmApiDepths", progress=False)
+        op = r.op
+        self.assertTrue(op.isValid(), op.getStatusString())
+        self.assertEqual((op.StepOverUnit, op.StepOverPercent, op.FinishPasses), ("%", 50.0, 2))
+        self.assertEqual((op.UseFinalDepth, op.FinalDepth.Value, op.StepDown.Value), (True, 0.5, 0.3))
+        self.assertEqual((op.UseStartPoint, op.StartPoint.x, op.StartPoint.y), (True, lo_x, lo_y))
+        doc = r.doc
+        _, _, ref = job_with_op(doc, str(bump_stl()), values=dict(FAST, StepOver=2.0, Pattern="OneWay",
+                                                                  StockToLeave=0.2))
+        ratio = len(op.Proxy.toolpath.cutting_points()) / len(ref.Proxy.toolpath.cutting_points())
+        self.assertAlmostEqual(ratio, 2.0, delta=0.1)  # 50 % of D4 = 2 mm, two pass sets
+        cut_z = [p["Z"] for name, p in moves(op) if name == "G1"]
+        self.assertGreaterEqual(min(cut_z), 0.5 - 1e-6)
+        x, y = first_cut(op)
+        lo, _ = op.Proxy.mesh.bounds
+        self.assertLess(math.hypot(x - float(lo[0]), y - float(lo[1])), 1e-6)  # the corner nearest the point
+        for kwargs, fragment in (({"stepover_percent": 0.0}, "stepover_percent must be in (0, 100] %, got 0"),
+                                 ({"finish_passes": 0}, "finish_passes must be a whole number in [1, 50], got 0"),
+                                 ({"finish_step_down": -1.0}, "finish_step_down must be"),
+                                 ({"start_point": (1.0,)}, "start_point must be two numbers (x, y)"),
+                                 ({"start_point": (1.0, float("nan"))}, "start_point (x, y) must be finite")):
+            with self.assertRaises(TmmError) as ctx:
+                run_surface(str(bump_stl()), progress=False, doc_name="TmmApiBad", **kwargs)
+            self.assertIn(fragment, str(ctx.exception))
 
 
 class CycleTime(FreeCADTestCase):

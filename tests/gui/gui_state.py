@@ -233,7 +233,7 @@ def keep_focus(widget) -> None:
     the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure on
     0.20. On 1.0 the panel's widgets closing with the focus crash FreeCAD's own Python QuantitySpinBox event
     filter (SIGSEGV in PySide's getMetaDataFromQObject, 2026-12-02), so there the focus stays as it comes."""
-    if int(FreeCAD.Version()[0]) >= 1:
+    if int(FreeCAD.Version()[0]) >= 1 and not os.environ.get("TMM_GUI_FORCE_FOCUS"):
         return
     mw = FreeCADGui.getMainWindow()
     mw.activateWindow()

@@ -69,7 +69,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 forward_step: str = "sample", arcs: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
-                progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+                progress: Union[bool, Callable[[float], bool]] = True,
+                stepover_percent: Optional[float] = None, final_depth: Optional[float] = None,
+                finish_passes: Optional[int] = None, finish_step_down: Optional[float] = None,
+                start_point: Optional[tuple[float, float]] = None) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
 
     tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose), or a
@@ -94,7 +97,12 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     linuxcnc: lines there, with a warning).
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
+    Depths (app.surface_passes, as the op's panel): stepover_percent (of the tool diameter, in (0, 100], instead
+    of `stepover`); final_depth (mm, no tool tip below it); finish_passes (1-50: the first ones leave
+    stock_to_leave + k x finish_step_down, the last stock_to_leave); start_point (x, y): each pass set begins at
+    the raster's end nearest it.
     """
+    from tmm_workbench.app import surface_passes
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
     _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
@@ -118,6 +126,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     if not isinstance(arcs, bool):
         raise TmmError(f"arcs must be True or False, got {arcs!r}")
     extra["ArcFitting"] = arcs
+    extra.update(surface_passes.api_values(stepover_percent, final_depth, finish_passes, finish_step_down,
+                                           start_point))
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)

@@ -12,7 +12,7 @@ from typing import Any
 import FreeCAD
 
 from tmm_workbench.app.op_base import Prop
-from tmm_workbench.core.strategies.finish_passes import FinishParams, stepover_of_percent
+from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT, FinishParams, stepover_of_percent
 from tmm_workbench.core.strategies.raster_drop import STEPOVER
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -45,6 +45,41 @@ def params_extra(obj: Any, cutter: Cutter) -> dict[str, Any]:
     if obj.StepOverUnit == PERCENT and obj.StepOverMode == _spacing_name(STEPOVER):
         return {"stepover": stepover_of_percent(float(obj.StepOverPercent), cutter)}
     return {}
+
+
+def api_values(stepover_percent: Any, final_depth: Any, finish_passes: Any, finish_step_down: Any,
+               start_point: Any) -> dict[str, Any]:
+    """The op's property values for run_surface's arguments (None: the op's default), each checked by its
+    argument's name as the core checks the field: a % step-over (in (0, 100]: the mm step-over is then
+    ignored), a final depth, the finishing passes and their step-down, a start point (x, y)."""
+    from dataclasses import replace
+
+    from tmm_workbench.core.errors import TmmError
+    from tmm_workbench.core.params import check, check_finite, spec_of
+
+    values: dict[str, Any] = {}
+    if stepover_percent is not None:
+        check(replace(STEPOVER_PERCENT, label="stepover_percent"), stepover_percent)
+        values.update(StepOverUnit=PERCENT, StepOverPercent=float(stepover_percent))
+    for name, field, value in (("final_depth", "final_depth", final_depth),
+                               ("finish_passes", "passes", finish_passes),
+                               ("finish_step_down", "step_down", finish_step_down)):
+        if value is not None:
+            check(replace(spec_of(FinishParams, field), label=name), value)
+    if final_depth is not None:
+        values.update(UseFinalDepth=True, FinalDepth=float(final_depth))
+    if finish_passes is not None:
+        values["FinishPasses"] = int(finish_passes)
+    if finish_step_down is not None:
+        values["StepDown"] = float(finish_step_down)
+    if start_point is not None:
+        try:
+            x, y = (float(c) for c in start_point)
+        except (TypeError, ValueError):
+            raise TmmError(f"start_point must be two numbers (x, y) in mm, got {start_point!r}") from None
+        check_finite("start_point (x, y)", (x, y))
+        values.update(UseStartPoint=True, StartPoint=FreeCAD.Vector(x, y, 0.0))
+    return values
 
 
 def finish_params(obj: Any) -> FinishParams:

@@ -14,6 +14,7 @@ from typing import Any, Mapping, Optional
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, check, spec_of
+from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT
 
 # properties that name no params field: their allowed range (a length beyond 10 m is a typing slip)
 EXTRA_SPECS: dict[str, Spec] = {
@@ -26,7 +27,7 @@ EXTRA_SPECS: dict[str, Spec] = {
     "PlungeAngle": Spec("plunge angle", "deg", low=0.0, high=90.0),
     "SampleStep": Spec("sample step", "mm", low=0.0, high=1000.0, optional=True),  # waterline: 0 derives it
     # the 3-axis Surface's depths (app.surface_passes): as core.strategies.finish_passes checks them
-    "StepOverPercent": Spec("step-over", "%", low=0.0, high=100.0, low_open=True),
+    "StepOverPercent": STEPOVER_PERCENT,
     "StepDown": Spec("finishing step-down", "mm", low=0.0, high=1000.0, low_open=True),
     "FinalDepth": Spec("final depth", "mm", low=-10_000.0, high=10_000.0),
 }

@@ -18,7 +18,7 @@ import numpy as np
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
-from tmm_workbench.core.params import StrategyParams, check_finite, param
+from tmm_workbench.core.params import Spec, StrategyParams, check_finite, param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies import raster_drop
@@ -28,6 +28,7 @@ from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
 MAX_PASSES = 50
+STEPOVER_PERCENT = Spec("step-over", "%", low=0.0, high=100.0, low_open=True)  # of the tool diameter
 
 
 @dataclass
