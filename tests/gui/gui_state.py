@@ -230,11 +230,8 @@ def tx(doc) -> dict:
 
 def keep_focus(widget) -> None:
     """The field keeps the keyboard focus up to Cancel (as after Escape): it emits editingFinished once more as
-    the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure on
-    0.20. On 1.0 the panel's widgets closing with the focus crash FreeCAD's own Python QuantitySpinBox event
-    filter (SIGSEGV in PySide's getMetaDataFromQObject, 2026-12-02), so there the focus stays as it comes."""
-    if int(FreeCAD.Version()[0]) >= 1 and not os.environ.get("TMM_GUI_FORCE_FOCUS"):
-        return
+    the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure.
+    (On 1.0 this once crashed FreeCAD in its own field controller's event filter: gui.panel_state.pin_on_close.)"""
     mw = FreeCADGui.getMainWindow()
     mw.activateWindow()
     QtGui.QApplication.setActiveWindow(mw)

@@ -41,6 +41,7 @@ def test_gui_smoke(tmp_path: Path) -> None:
     assert info.get("reopened_panel") or not freecadcmd
     assert info.get("roughing_valid") and info.get("waterline_valid"), info  # made by their commands, OK: a path
     assert info.get("mp_anchor") == ["Tip", ["Axis", "Tip"]] and abs(info.get("mp_extension", 0) - 12.7) < 1e-9
+    assert "cam_integration" not in out, out[-6000:]  # no traceback of TMM's CAM toolbar manipulator (1.x)
     assert PNG.is_file() and PNG.stat().st_size > 10_000
     assert not _blank(PNG), "the screenshot is blank"
     # TMM Simulate: the panel's numbers, the coloured stock shown and removed on Close, nothing left behind

@@ -23,10 +23,21 @@ def tmm_commands() -> list[str]:
     return [job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS] + [simulate_cmd.COMMAND_NAME]
 
 
+def active_workbench_name() -> str:
+    """The active workbench's name. FreeCAD 1.x asks manipulators while a workbench is being set up, before
+    its Python object has its `__Workbench__` (name() then raises AttributeError): its class name is its name."""
+    wb = FreeCADGui.activeWorkbench()
+    if wb is None:
+        return ""
+    try:
+        return wb.name()
+    except AttributeError:
+        return type(wb).__name__
+
+
 class CamManipulator:
     def modifyToolBars(self) -> list[dict[str, Any]]:
-        wb = FreeCADGui.activeWorkbench()
-        if wb is None or wb.name() != CAM_WORKBENCH:
+        if active_workbench_name() != CAM_WORKBENCH:
             return []
         try:
             commands = tmm_commands()

@@ -178,6 +178,7 @@ class OpViewProvider(PathOpGui.ViewProvider):
 
         panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
         panel_state.drop_fields_on_cancel(panel)  # a field left focused writes nothing after Cancel's abort
+        panel_state.pin_on_close(panel)  # FreeCAD's field controllers outlive the panel as long as their fields
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
         super().setupTaskPanel(panel)
 

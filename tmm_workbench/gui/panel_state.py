@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from PySide import QtGui
+from PySide import QtCore, QtGui
 
 TRANSACTION = "TMM operation"
 
@@ -42,6 +42,38 @@ def drop_fields_on_cancel(panel: Any) -> None:
         return reject(resetEdit)
 
     panel.reject = rejected
+
+
+def pin_spin_controllers(panel: Any) -> None:
+    """FreeCAD's CAM pages bind each quantity field through a parentless Python QObject
+    (PathGuiUtil.QuantitySpinBox) installed as the field's event filter. When the panel closes the page, and
+    with it that object, can go before the field does, and an event still queued for the field (its focus
+    leaving) then reaches a filter whose Python side is gone: FreeCAD 1.0 crashed so once (SIGSEGV in PySide's
+    getMetaDataFromQObject, a field focused at Cancel). Each controller is held by a connection to its field's
+    `destroyed` signal, so it lives exactly as long as the field it filters."""
+    for page in getattr(panel, "featurePages", []):
+        for value in list(vars(page).values()):
+            for c in value.values() if isinstance(value, dict) else (value,):
+                widget = getattr(c, "widget", None)
+                if isinstance(c, QtCore.QObject) and hasattr(c, "eventFilter") and isinstance(widget, QtCore.QObject):
+                    if not c.property("tmmPinned"):
+                        c.setProperty("tmmPinned", True)
+                        widget.destroyed.connect(lambda *_, c=c: c)
+
+
+def pin_on_close(panel: Any) -> None:
+    """pin_spin_controllers as OK or Cancel closes the panel (the pages have all their fields by then)."""
+    accept, reject = panel.accept, panel.reject
+
+    def accepted(resetEdit: bool = True) -> Any:
+        pin_spin_controllers(panel)
+        return accept(resetEdit)
+
+    def rejected(resetEdit: bool = True) -> Any:
+        pin_spin_controllers(panel)
+        return reject(resetEdit)
+
+    panel.accept, panel.reject = accepted, rejected
 
 
 def _unless(cancelled: list[bool], get_fields: Any) -> Any:
