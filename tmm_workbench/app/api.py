@@ -18,9 +18,10 @@ from __future__ import annotations
 
 import math
 import os
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, Optional, Sequence, Union
 
 import FreeCAD
 
@@ -137,19 +138,26 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     own_doc = isinstance(model, (str, os.PathLike))
     if own_doc and not Path(model).expanduser().is_file():
         raise TmmError(f"STL file not found: {model}")
-    doc = FreeCAD.newDocument(doc_name) if own_doc else model.Document
+    with _api_document(own_doc, doc_name, None if own_doc else model.Document, fcstd_path) as doc:
+        return _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
+                      pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height,
+                      clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress, extra)
+
+
+@contextmanager
+def _api_document(own: bool, name: str, existing: Any, fcstd_path: Any) -> Iterator[Any]:
+    """The document an API call works in: a new one named `name` (`own`; closed again when the call fails, so
+    no half-made document is left) or `existing`; saved to `fcstd_path` (when given) once the call succeeded."""
+    doc = FreeCAD.newDocument(name) if own else existing
     try:
-        result = _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
-                        pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height,
-                        clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress, extra)
+        yield doc
     except BaseException:
-        if own_doc:
+        if own:
             FreeCAD.closeDocument(doc.Name)
         raise
     if fcstd_path:
         Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
         doc.saveAs(str(fcstd_path))
-    return result
 
 
 def _option(label: str, value: Any, names: dict[str, str], shown: Optional[Sequence[str]] = None) -> str:
@@ -438,8 +446,8 @@ def _run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, 
     own_doc = job is None and isinstance(model, (str, os.PathLike))
     if own_doc and not Path(model).expanduser().is_file():
         raise TmmError(f"STL file not found: {model}")
-    doc = FreeCAD.newDocument(doc_name) if own_doc else (job.Document if job is not None else model.Document)
-    try:
+    existing = None if own_doc else (job.Document if job is not None else model.Document)
+    with _api_document(own_doc, doc_name, existing, fcstd_path) as doc:
         values = dict(values)
         if job is None:
             jm = jobs.prepare_model(doc, model)
@@ -462,13 +470,6 @@ def _run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, 
         values["ToolController"] = tc
         op = registry.create(op_name, job, values)
         result = _post_op(doc, job, tc, op, post, gcode_path, progress)
-    except BaseException:
-        if own_doc:
-            FreeCAD.closeDocument(doc.Name)
-        raise
-    if fcstd_path:
-        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
-        doc.saveAs(str(fcstd_path))
     return result
 
 
@@ -554,8 +555,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
 
     source_obj, sub = _face_pair(face_source)
     own_doc = source_obj is None
-    doc = FreeCAD.newDocument(doc_name) if own_doc else source_obj.Document
-    try:
+    with _api_document(own_doc, doc_name, None if own_doc else source_obj.Document, fcstd_path) as doc:
         if own_doc:
             source_obj, sub = _surface_feature(doc, face_source), "Face1"
         doc.recompute()
@@ -600,13 +600,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
             gcode[post] = posts_mod.export(post, [tc, op], target)
             if target is not None:
                 files[post] = target
-    except BaseException:
-        if own_doc:
-            FreeCAD.closeDocument(doc.Name)
-        raise
     if fcstd_path:
-        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
-        doc.saveAs(str(fcstd_path))
         files["fcstd"] = Path(fcstd_path)
     p = op.Proxy
     return MultipointResult(doc, job, op, (clone, sub), p.toolpath, p.segments, p.results, gcode, files)
