@@ -142,10 +142,6 @@ def run() -> dict:
     return info
 
 
-def main() -> None:
-    """gui_smoke's runner (the JSON outcome, the exit code) around this test's steps."""
-    gui_smoke.smoke, gui_smoke.RESULT = run, RESULT
-    gui_smoke.main()
+import gui_runner  # noqa: E402
 
-
-QtCore.QTimer.singleShot(500, main)
+gui_runner.run(lambda info: info.update(run()), RESULT)

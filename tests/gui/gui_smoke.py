@@ -11,16 +11,17 @@ reopened and its op's panel opens; the GUI progress dialog reports a Cancel; Fre
 goes to env TMM_GUI_RESULT (a JSON file) and the exit code (os._exit: the GUI would otherwise swallow
 SystemExit). Screenshot: env TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
 """
-import json
 import os
 import sys
 import time
-import traceback
 from pathlib import Path
 
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
+
+sys.path.insert(0, str(Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "tests" / "gui"))
+import gui_runner  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui_smoke.png")
@@ -366,20 +367,5 @@ def smoke() -> dict:
     return info
 
 
-def main() -> None:
-    code, info = 1, {}
-    try:
-        info = smoke()
-        code = 0
-    except BaseException:  # noqa: B902 - every failure must reach the exit code
-        info["error"] = traceback.format_exc()
-        sys.stderr.write(info["error"])
-    info["ok"] = code == 0
-    RESULT.parent.mkdir(parents=True, exist_ok=True)
-    RESULT.write_text(json.dumps(info, indent=1, default=str))
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)  # quit now: no save-changes dialog, a reliable exit code
 
-
-QtCore.QTimer.singleShot(500, main)  # run once the main window and its event loop are up
+gui_runner.run(lambda info: info.update(smoke()), RESULT)

@@ -10,16 +10,17 @@ into env TMM_GUI_SHOTS (a folder):
    (parameters and path); a change without Apply and Cancel keep it too;
 5. the document saved, closed and reopened: the stand-in box is still hidden, the op's path is there.
 The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code (os._exit)."""
-import json
 import os
 import sys
 import time
-import traceback
 from pathlib import Path
 
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
+
+sys.path.insert(0, str(Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "tests" / "gui"))
+import gui_runner  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 SHOTS = Path(os.environ.get("TMM_GUI_SHOTS") or ROOT / "out" / "gui")
@@ -386,21 +387,10 @@ def session(info: dict) -> dict:
     return info
 
 
-def main() -> None:
-    code, info = 1, {}
-    try:
-        session(info)
-        info.pop("_timer").stop()
-        code = 0
-    except BaseException:  # noqa: B902 - every failure must reach the exit code
-        info["error"] = traceback.format_exc()
-        sys.stderr.write(info["error"])
-    info["ok"] = code == 0
-    RESULT.parent.mkdir(parents=True, exist_ok=True)
-    RESULT.write_text(json.dumps(info, indent=1, default=str))
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)  # quit now: no save-changes dialog, a reliable exit code
+
+def whole_session(info: dict) -> None:
+    session(info)
+    info.pop("_timer").stop()
 
 
-QtCore.QTimer.singleShot(500, main)  # run once the main window and its event loop are up
+gui_runner.run(whole_session, RESULT)

@@ -17,16 +17,17 @@ are found among the top-level widgets and closed, as a user does:
 A screenshot per step goes to env TMM_GUI_SHOTS (a folder; docs/gui by default); the outcome to env
 TMM_GUI_RESULT (JSON) and the exit code.
 """
-import json
 import os
 import sys
 import time
-import traceback
 from pathlib import Path
 
 import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
+
+sys.path.insert(0, str(Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "tests" / "gui"))
+import gui_runner  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 SHOTS = Path(os.environ.get("TMM_GUI_SHOTS") or ROOT / "out" / "gui")
@@ -342,20 +343,5 @@ def waterline_panel(info: dict) -> None:
     pump(0.3)
 
 
-def main() -> None:
-    code, info = 1, {}
-    try:
-        session(info)  # fills info step by step: a failure keeps what was seen before it
-        code = 0
-    except BaseException:  # noqa: B902 - every failure must reach the exit code
-        info["error"] = traceback.format_exc()
-        sys.stderr.write(info["error"])
-    info["ok"] = code == 0
-    RESULT.parent.mkdir(parents=True, exist_ok=True)
-    RESULT.write_text(json.dumps(info, indent=1, default=str))
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)  # quit now: no save-changes dialog, a reliable exit code
 
-
-QtCore.QTimer.singleShot(500, main)  # run once the main window and its event loop are up
+gui_runner.run(session, RESULT)
