@@ -136,3 +136,27 @@ def parse_gcode(text: str) -> list[tuple[str, float, float, float, Optional[floa
 class FreeCADTestCase(unittest.TestCase):
     def tearDown(self) -> None:
         close_all()
+
+
+class BadInputCase(FreeCADTestCase):
+    """An op (`self.doc`, `self.op`, made valid by setUp) recomputed with a bad value must fail at once: invalid,
+    its status naming what is wrong, no path left (partial or stale)."""
+
+    doc: Any
+    op: Any
+    FAIL_SECONDS = 5.0   # the default time allowed for the refusal
+
+    def assertFails(self, *fragments: str, seconds: Optional[float] = None) -> str:
+        import time
+
+        t0 = time.perf_counter()
+        self.op.touch()
+        self.doc.recompute()
+        self.assertLess(time.perf_counter() - t0, self.FAIL_SECONDS if seconds is None else seconds)
+        status = self.op.getStatusString()
+        self.assertFalse(self.op.isValid(), "op should be invalid")
+        for f in fragments:
+            self.assertIn(f.lower(), status.lower())
+        self.assertEqual(len(self.op.Path.Commands), 0, "no partial or stale path")
+        self.assertIsNone(self.op.Proxy.toolpath)
+        return status
