@@ -128,3 +128,17 @@ def test_bad_input_is_refused_with_the_parameter(extra, words):
     mesh = _bump()
     with pytest.raises(TmmError, match=words):
         compute(mesh, BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), verify_cusp=True, **extra))
+
+
+def test_the_work_is_estimated_before_the_simulation():
+    from tmm_workbench.core import limits
+    from tmm_workbench.core.errors import WorkLimitError
+
+    previous = limits.set_limits(max_points=20000)
+    try:
+        # the raster itself is about 3,000 points; the verification's dense raster 0.06 mm apart 140,000
+        with pytest.raises(WorkLimitError, match="verify cusp: cusp height 0.01 mm measured on 0.0612 mm cells"):
+            compute(_bump(), BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), stepover=0.5, sample_step=0.25,
+                                                 verify_cusp=True))
+    finally:
+        limits.set_limits(previous.max_points, previous.max_memory_bytes / 1e9, previous.max_positions)

@@ -25,6 +25,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment, SegmentKind
@@ -102,6 +103,19 @@ def measure_cell(cutter: Cutter, tolerance: float) -> float:
 
 def _nanmax(a: np.ndarray) -> float:
     return float(np.nanmax(a)) if np.isfinite(a).any() else 0.0
+
+
+def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float) -> float:
+    """The dense raster's CL points (a cell apart both ways, over the boundary grown by the tool radius across),
+    refused above the limits before anything runs; the grid's cells are checked by Grid.covering."""
+    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT
+
+    w, h = boundary[2] - boundary[0], boundary[3] - boundary[1] + 2 * cutter.radius
+    count = (w / cell + 2) * (h / cell + 2)
+    check_work("CL points", count, _BYTES_PER_POINT,
+               f"verify cusp: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
+               f"{_CELLS_PER_STEP}) over a {w:.6g} x {boundary[3] - boundary[1]:.6g} mm boundary")
+    return count
 
 
 class _Passes:
@@ -201,6 +215,7 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"verify cusp tolerance must be a length > 0 mm, got {tolerance!r}")
     cell = measure_cell(cutter, tolerance) if cell is None else float(cell)
+    estimate_work(boundary, cutter, tolerance, cell)
     surface = surface or DropSurface(mesh)
     passes = _Passes(angle_deg)
     for seg in segments:
