@@ -142,3 +142,18 @@ def test_the_work_is_estimated_before_the_simulation():
                                                  verify_cusp=True))
     finally:
         limits.set_limits(previous.max_points, previous.max_memory_bytes / 1e9, previous.max_positions)
+
+
+def test_cancel_stops_the_verification():
+    from tmm_workbench.core.errors import Cancelled
+
+    calls: list = []
+
+    def progress(f: float) -> bool:
+        calls.append(f)
+        return len(calls) < 5  # the raster's drop reports 3 times; cancelled in the verification's dense raster
+
+    with pytest.raises(Cancelled):
+        compute(_bump(), BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), stepover=0.5, sample_step=0.25,
+                                             verify_cusp=True), progress)
+    assert len(calls) == 5

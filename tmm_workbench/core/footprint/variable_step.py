@@ -21,13 +21,13 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
-from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.sim.cusp_field import CuspField, cusp_field
 from tmm_workbench.core.sim.grid import Grid
@@ -82,8 +82,9 @@ class VerifyReport:
 
     def summary(self) -> str:
         head = (f"verify cusp {self.tolerance:g} mm: simulated max cusp {self.max_cusp_before:.4f} -> "
-                f"{self.max_cusp_after:.4f} mm (crests {self.ridge_before:.4f} -> {self.ridge_after:.4f}), {self.passes_added} partial passes added ({self.length_added:.0f} mm) "
-                f"in {len({(b.lower, b.upper) for b in self.buckets})} gaps, {self.rounds} rounds")
+                f"{self.max_cusp_after:.4f} mm (crests {self.ridge_before:.4f} -> {self.ridge_after:.4f}), "
+                f"{self.passes_added} partial passes added ({self.length_added:.0f} mm) in "
+                f"{len({(b.lower, b.upper) for b in self.buckets})} gaps, {self.rounds} rounds")
         tail = f"; {self.unreachable} cells out of the tool's reach, {self.steep} steeper than the slope limit " \
                f"(not measured, of {self.measured + self.unreachable + self.steep})"
         if not self.within:
@@ -206,11 +207,12 @@ def _extra_segments(start: np.ndarray, end: np.ndarray, drop: Drop, sample_step:
 def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], boundary: Rect, angle_deg: float,
                 tolerance: float, drop: Drop, *, sample_step: float = 0.5, gouge_tol: float = 0.005,
                 chord_tol: float = 0.001, stock_to_leave: float = 0.0, slope_limit_deg: float = 75.0,
-                cell: Optional[float] = None, rounds: int = ROUNDS, surface: Optional[DropSurface] = None
-                ) -> tuple[list[CutSegment], VerifyReport]:
+                cell: Optional[float] = None, rounds: int = ROUNDS, surface: Optional[DropSurface] = None,
+                progress: Optional[Progress] = None) -> tuple[list[CutSegment], VerifyReport]:
     """`segments` (a raster's pass set over `boundary`, passes along `angle_deg`) with extra partial passes
     appended where the simulated cusp exceeds `tolerance`, and the report (see the module). `drop` drops the
-    tool at XY points as the raster did (stock to leave, floor, air)."""
+    tool at XY points as the raster did (stock to leave, floor, air). `progress` (fraction -> False to cancel)
+    follows the dense raster, the bulk of the work, and is asked again before each round."""
     t0 = time.perf_counter()
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"verify cusp tolerance must be a length > 0 mm, got {tolerance!r}")
@@ -225,7 +227,7 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         raise TmmError("verify cusp needs straight raster passes (ZigZag or OneWay), found none")
     # the envelope sampled a cell apart along its passes too: the path's own chords count as cusp
     fld: CuspField = cusp_field(mesh, cutter, boundary, tolerance, cell, slope_limit_deg, cell, stock_to_leave,
-                                surface)
+                                surface, progress=progress)
     policy = LinkPolicy(fld.stock_top + 1.0, fld.stock_top + 5.0)
     heights = fld.cut(link(segments, policy), cutter)
     before = fld.ridge_cusp(heights)
@@ -244,6 +246,8 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         bad = np.nan_to_num(cusp, nan=0.0) > _EXCEED * tolerance
         if not bad.any():
             break
+        if progress is not None and progress(1.0) is False:
+            raise Cancelled("verify cusp cancelled")
         report.rounds = k + 1
         buckets = _buckets(cusp, bad, fld.grid, to_tip, passes, 2 * cutter.radius, k + 1, tolerance)
         if not buckets:
@@ -300,7 +304,8 @@ def validate_params(params) -> None:
 
 
 def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegment], drop: Drop,
-                  surface: Optional[DropSurface], diagnostics: dict) -> list[CutSegment]:
+                  surface: Optional[DropSurface], diagnostics: dict,
+                  progress: Optional[Progress] = None) -> list[CutSegment]:
     """raster_drop's call: its pass set verified against `params.cusp` (diagnostics["verify"]; the report is
     appended to params.verify_notes when given)."""
     if params.cusp > cutter.radius:
@@ -308,7 +313,7 @@ def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegme
     segments, report = verify_cusp(mesh, cutter, segments, params.boundary, params.angle_deg, params.cusp, drop,
                                    sample_step=params.sample_step, gouge_tol=params.gouge_tol,
                                    chord_tol=params.chord_tol, stock_to_leave=params.stock_to_leave,
-                                   slope_limit_deg=params.max_slope_deg, surface=surface)
+                                   slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress)
     diagnostics["verify"] = report.as_dict()
     if params.verify_notes is not None:
         params.verify_notes.append(report)

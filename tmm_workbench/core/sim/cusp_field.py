@@ -17,7 +17,7 @@ import numpy as np
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
-from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
@@ -103,7 +103,8 @@ def measure_grid(boundary: Rect, cutter: Cutter, cell: float) -> Grid:
 
 def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, cell: float,
                slope_limit_deg: float = SLOPE_LIMIT_DEG, sample_step: float = 0.25, stock_to_leave: float = 0.0,
-               surface: Optional[DropSurface] = None, grid: Optional[Grid] = None) -> CuspField:
+               surface: Optional[DropSurface] = None, grid: Optional[Grid] = None,
+               progress: Optional[Progress] = None) -> CuspField:
     """The field for rasters over `boundary` (xmin, ymin, xmax, ymax) with `cutter`; `cell` is the simulation's
     cell and the dense raster's step-over. With `stock_to_leave` the dense raster leaves it too, and a cell is
     reachable when the envelope comes within tolerance + stock_to_leave of the design."""
@@ -116,7 +117,7 @@ def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, 
     top = float(mesh.bounds[1][2]) + stock_to_leave
     dense = compute(mesh, cutter, SurfaceParams(boundary=(boundary[0], boundary[1] - r, boundary[2], boundary[3] + r),
                                                 stepover=grid.cell, sample_step=sample_step,
-                                                stock_to_leave=stock_to_leave), surface=surface)
+                                                stock_to_leave=stock_to_leave), progress, surface)
     stock_top = top + STOCK_ABOVE_MM
     path = link(dense.segments, LinkPolicy(stock_top, stock_top + 5))
     envelope = simulate(path, cutter, grid, box_heights(grid, stock_top)).heights

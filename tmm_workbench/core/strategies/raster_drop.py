@@ -206,7 +206,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if params.verify_cusp:  # issue 14 item 4
         from tmm_workbench.core.footprint.variable_step import verify_params
 
-        segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics)
+        segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress)
     return StrategyResult(segments, diagnostics)
 
 
