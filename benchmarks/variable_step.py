@@ -117,8 +117,8 @@ def run(mesh, region, label: str) -> list[str]:
         out.append(f"| {name} | {nseg} | {npass} | {length / 1000:.2f} | {mx:.4f} | {vol:.2f} | {above} | {s:.1f} |")
     out.append(f"verify: partial passes {v['passes_added']} ({v['length_added'] / 1000:.2f} m), its own measure "
                f"{v['max_cusp_before']:.4f} -> {v['max_cusp_after']:.4f} mm (crests {v['ridge_before']:.4f} -> "
-               f"{v['ridge_after']:.4f}), {v['exceeding_after']} cells left above, {v['seconds']:.1f} s of which the "
-               f"simulation and dense raster")
+               f"{v['ridge_after']:.4f}), {v['exceeding_after']} cells left above; {v['seconds']:.1f} s in the verification "
+               f"(dense raster, simulation, partial passes)")
     return out
 
 

@@ -25,6 +25,15 @@ def simulated_max_cusp(op) -> float:
     return field.max_cusp(field.cut(op.Proxy.toolpath, Cutter.ball(4.0)))
 
 
+def reopened(doc, op, filename: str):
+    """The op, from its document saved as `filename`, closed and opened again."""
+    path = OUT / filename
+    doc.saveAs(str(path))
+    name = op.Name
+    close_all()
+    return FreeCAD.openDocument(str(path)).getObject(name)
+
+
 class VerifyCusp(FreeCADTestCase):
     def test_verify_cusp_adds_passes_keeps_the_tolerance_and_reopens(self) -> None:
         doc = new_doc("TmmVerify")
@@ -40,12 +49,8 @@ class VerifyCusp(FreeCADTestCase):
         self.assertLessEqual(simulated_max_cusp(op), TOL)
         plunges = lambda mv: sum(1 for (n0, _), (n1, _) in zip(mv, mv[1:]) if n0 == "G0" and n1 == "G1")  # noqa
         self.assertGreater(plunges(checked), plunges(plain))      # partial passes, lifts between them
-        path = OUT / "verify.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "verify.FCStd")
+        doc = op.Document
         self.assertIs(op.VerifyCusp, True)
         self.assertEqual(len(moves(op)), len(checked))
         op.Proxy.progress_enabled = False
@@ -59,12 +64,8 @@ class VerifyCusp(FreeCADTestCase):
         _, _, op = job_with_op(doc, str(bump_stl()), values=VALUES)
         plain = moves(op)
         op.removeProperty("VerifyCusp")                           # as saved by an older TMM
-        path = OUT / "old_verify.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_verify.FCStd")
+        doc = op.Document
         self.assertIs(op.VerifyCusp, False)
         op.Proxy.progress_enabled = False
         op.touch()
