@@ -5,7 +5,9 @@ the same, and against the constant cusp mode (the planar step-over at the steepe
 The maximum cusp of every raster is measured the same way, independently of how it was placed: the raster and a
 dense raster (0.1 mm apart) are cut into the stock simulation (core.sim, 0.1 mm cells), and the cusp is the
 largest difference along the normal where the slope is at most the cusp slope limit and the dense raster comes
-within the tolerance of the model (elsewhere the tool cannot reach: not a cusp).
+within the tolerance of the model (elsewhere the tool cannot reach: not a cusp): core.sim.cusp_field. The rows
+"+ verify" are the constant cusp mode and the adaptive raster with the verification pass (issue 14 item 4,
+core.footprint.variable_step: partial passes added where the simulated cusp exceeds the tolerance).
 
     .venv/bin/python benchmarks/cusp_spacing.py            # sphere_on_plate and mount_rush, ball D6, 0.01 mm
     .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
@@ -28,26 +30,14 @@ sys.path.insert(0, str(ROOT))
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.sim.compare import slope_deg  # noqa: E402
+from tmm_workbench.core.sim.cusp_field import cusp_field, measure  # noqa: E402
 from tmm_workbench.core.sim.cycle_time import three_axis_time, toolpath_feeds  # noqa: E402
-from tmm_workbench.core.sim.grid import Grid  # noqa: E402
-from tmm_workbench.core.sim.simulate import simulate  # noqa: E402
-from tmm_workbench.core.sim.stock import box_heights, mesh_heights  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 CELL = 0.1
 SLOPE_LIMIT = 75.0
 FEED, PLUNGE = 1000.0 / 60, 300.0 / 60  # mm/s
-
-
-def measure(mesh, cutter, path, envelope, design, grid, tol):
-    """The largest cusp of `path` (see the module) and the share of cells measured."""
-    cut = simulate(path, cutter, grid, box_heights(grid, float(mesh.bounds[1][2]) + 5)).heights
-    slope = slope_deg(envelope, grid.cell)
-    cos = np.cos(np.radians(slope))
-    ok = np.isfinite(design) & (slope <= SLOPE_LIMIT) & ((envelope - design) * cos <= tol)
-    return float(((cut - envelope) * cos)[ok].max()), float(ok.mean())
 
 
 def raster(mesh, cutter, boundary, sample_step=0.25, **kw):
@@ -73,19 +63,16 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
         boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     # measured inside, clear of the boundary's edges by the tool radius (the passes' ends)
     r = cutter.radius
-    grid = Grid.covering(boundary[0] + r, boundary[1] + r, boundary[2] - r, boundary[3] - r, cell)
-    design = mesh_heights(mesh, grid)
-    dense, _, _ = raster(mesh, cutter, (boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=cell)
-    envelope = simulate(dense, cutter, grid, box_heights(grid, float(hi[2]) + 5)).heights
+    field = cusp_field(mesh, cutter, boundary, tol, cell, SLOPE_LIMIT, sample_step=0.25)
 
     rows = []
     path, secs, n_adaptive = raster(mesh, cutter, boundary, stepover_mode="adaptive", cusp=tol,
                                     max_slope_deg=SLOPE_LIMIT)
-    cusp, share = measure(mesh, cutter, path, envelope, design, grid, tol)
+    cusp, share = measure(field, path, cutter)
     rows.append(("adaptive", n_adaptive, cusp, cycle(path), secs, len(path)))
 
     path, secs, n = raster(mesh, cutter, boundary, stepover_mode="cusp", cusp=tol, max_slope_deg=SLOPE_LIMIT)
-    c, _ = measure(mesh, cutter, path, envelope, design, grid, tol)
+    c, _ = measure(field, path, cutter)
     rows.append(("constant cusp mode", n, c, cycle(path), secs, len(path)))
 
     # the constant step-over whose simulated maximum cusp is the adaptive raster's (bisection on the step)
@@ -94,13 +81,26 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     for _ in range(7):
         s = 0.5 * (lo_s + hi_s)
         path, secs, n = raster(mesh, cutter, boundary, stepover=s)
-        c, _ = measure(mesh, cutter, path, envelope, design, grid, tol)
+        c, _ = measure(field, path, cutter)
         if c <= cusp:
             lo_s, best = s, (f"constant step-over {s:.3f} mm", n, c, cycle(path), secs, len(path))
         else:
             hi_s = s
     if best is not None:
         rows.append(best)
+
+    # --- the verification pass (issue 14 item 4, core.footprint.variable_step): partial passes where the
+    # simulated cusp exceeds the tolerance; passes shown as the set's + the partial ones
+    for label, mode in (("constant cusp mode + verify", "cusp"), ("adaptive + verify", "adaptive")):
+        t0 = time.perf_counter()
+        result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, stepover_mode=mode, cusp=tol,
+                                                     max_slope_deg=SLOPE_LIMIT, verify_cusp=True))
+        top = float(mesh.bounds[1][2])
+        path = link(result.segments, LinkPolicy(top + 5, top + 10))
+        secs, v = time.perf_counter() - t0, result.diagnostics["verify"]
+        c, _ = measure(field, path, cutter)
+        rows.append((label, f"{result.diagnostics['passes']} + {v['passes_added']} partial "
+                            f"({v['length_added'] / 1000:.2f} m)", c, cycle(path), secs, len(path)))
 
     out = [f"\n{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm (slopes up to "
            f"{SLOPE_LIMIT:g} deg; {share:.0%} of the cells measured)",

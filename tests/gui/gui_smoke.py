@@ -308,6 +308,9 @@ def smoke() -> dict:
     assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
     info["panel_slope_max"] = page.findChild(QtGui.QWidget, "slopeMax").property("rawValue")
     assert info["panel_slope_max"] == 90.0, info["panel_slope_max"]
+    verify = page.findChild(QtGui.QCheckBox, "verifyCusp")  # issue 14 item 4: off, as the new op
+    info["panel_verify_cusp"] = None if verify is None else verify.isChecked()
+    assert info["panel_verify_cusp"] is False and ops[-1].VerifyCusp is False, info["panel_verify_cusp"]
     mw = FreeCADGui.getMainWindow()
     for dock in mw.findChildren(QtGui.QDockWidget):
         if dock.isVisible() and dock.isAncestorOf(page):

@@ -68,6 +68,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                 forward_step: str = "sample", arcs: bool = False,
+                verify_cusp: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                 progress: Union[bool, Callable[[float], bool]] = True,
@@ -96,6 +97,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     moves within +-chord_tolerance of the exact tool path: lean passes; more compute, in Python for now); arcs:
     G2/G3 in the pass's plane (XZ/YZ, rasters at 0/90 deg) with 'tolerance', where the post writes K (not
     linuxcnc: lines there, with a warning).
+    verify_cusp: cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds
+    `cusp` (the op's VerifyCusp; issue 14 item 4), any stepover_mode, zigzag or oneway over the box.
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     Depths (app.surface_passes, as the op's panel): stepover_percent (of the tool diameter, in (0, 100], instead
@@ -129,6 +132,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     extra["ArcFitting"] = arcs
     extra.update(surface_passes.api_values(stepover_percent, final_depth, finish_passes, finish_step_down,
                                            start_point))
+    if not isinstance(verify_cusp, bool):
+        raise TmmError(f"verify_cusp must be True or False, got {verify_cusp!r}")
+    extra["VerifyCusp"] = verify_cusp
     shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
     pattern_name = _option("pattern", pattern, PATTERN_NAMES)

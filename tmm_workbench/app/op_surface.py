@@ -21,6 +21,7 @@ import Path
 
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
 from tmm_workbench.app import surface_passes
+from tmm_workbench.app import surface_verify
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
@@ -112,6 +113,8 @@ _PLANE_CODES = {"XZ": "G18", "YZ": "G19"}
 PROPERTIES += surface_passes.PROPERTIES
 CHOICES.update(surface_passes.CHOICES)
 DEFAULTS.update(surface_passes.DEFAULTS)
+# the verification pass: partial passes where the simulated cusp exceeds CuspHeight (issue 14 item 4)
+PROPERTIES += surface_verify.PROPERTIES
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -155,9 +158,11 @@ class ObjectTmmSurface(op_base.TmmOp):
                 f"{obj.Label}: ArcFitting off: the Job's post '{self.post_without_k(obj)}' writes no K, so arcs in "
                 "XZ/YZ would be wrong; lines within ChordTolerance instead\n")
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
+        notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, surface_passes.finish_params(obj),
                                                              policy, cb)
+        surface_verify.report(obj, notes)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 

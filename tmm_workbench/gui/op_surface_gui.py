@@ -26,6 +26,7 @@ COMBOS.update(region_panel.COMBOS)
 SPIN_BOXES["chordTolerance"] = "ChordTolerance"
 COMBOS["forwardStep"] = "ForwardStep"
 CHECKS = {"arcFitting": "ArcFitting"}
+CHECKS["verifyCusp"] = "VerifyCusp"  # the verification pass (issue 14 item 4)
 # the group 'Depths, passes and start point' (issue 15 item 6)
 SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
 COMBOS.update(surface_depths_gui.COMBOS)

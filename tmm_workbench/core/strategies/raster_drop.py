@@ -84,6 +84,10 @@ class SurfaceParams(StrategyParams):
     # lean passes (issue 14 item 2, core.strategies.raster_lean): the forward step by the chord tolerance
     forward_step: str = param(SAMPLED, "forward step", choices=(SAMPLED, TOLERANCE))
     arcs: bool = param(False, "arc fitting", choices=(True, False))  # G2/G3 in XZ/YZ (TOLERANCE only)
+    # --- verification pass (issue 14 item 4, core.footprint.variable_step): the pass set cut in the simulation,
+    # extra partial passes where its cusp exceeds `cusp`; each pass set's VerifyReport is appended to verify_notes
+    verify_cusp: bool = param(False, "verify cusp", choices=(True, False))
+    verify_notes: Optional[list] = None
 
     def validate(self) -> None:
         super().validate()
@@ -93,6 +97,10 @@ class SurfaceParams(StrategyParams):
         from tmm_workbench.core.strategies import raster_region
 
         raster_region.validate(self)
+        if self.verify_cusp:
+            from tmm_workbench.core.footprint.variable_step import validate_params
+
+            validate_params(self)
 
 
 def estimate_work(params: SurfaceParams) -> float:
@@ -195,6 +203,10 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         segments, diagnostics["arcs"], stats = raster_lean.lean_segments(
             segments, lambda p: drop(p), params.chord_tol, params.arcs, min(params.sample_step / 4, 0.05))
         diagnostics["lean"] = stats.as_dict()
+    if params.verify_cusp:  # issue 14 item 4
+        from tmm_workbench.core.footprint.variable_step import verify_params
+
+        segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress)
     return StrategyResult(segments, diagnostics)
 
 

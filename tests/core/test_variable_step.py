@@ -1,0 +1,159 @@
+"""Variable side step (core.footprint.variable_step, issue 14 item 4): the raster's pass set cut into the stock
+simulation, extra partial passes where its cusp exceeds the tolerance. Checked independently: the final path
+and a dense raster cut again into a grid of finer cells than the verification used (core.sim.cusp_field's
+measure), the design compared with the simulated stock for gouges, the extra passes counted and located."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks.seed000_surfaces import INCH, seed000_mesh
+from tests.conftest import grid_mesh
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.footprint.variable_step import measure_cell
+from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.segments import SegmentKind
+from tmm_workbench.core.sim.cusp_field import cusp_field
+from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
+from tmm_workbench.core.tools.cutter import Cutter
+
+BALL = Cutter.ball(6)
+TOL = 0.01
+
+
+def _path(mesh, result):
+    top = float(mesh.bounds[1][2])
+    return link(result.segments, LinkPolicy(top + 6, top + 10))
+
+
+def _independent(mesh, cutter, boundary, tol, path, cell):
+    """(max cusp, deepest cut below the design) of `path` on a grid of `cell` mm, from scratch."""
+    field = cusp_field(mesh, cutter, boundary, tol, cell, sample_step=cell)
+    heights = field.cut(path, cutter)
+    on = np.isfinite(field.design)
+    return field.max_cusp(heights), float(np.max(field.design[on] - heights[on]))
+
+
+def _passes(result):
+    return [s for s in result.segments if s.kind is SegmentKind.PASS]
+
+
+def test_constant_cusp_mode_on_seed000_concave_window_is_brought_within_the_tolerance():
+    mesh, _ = seed000_mesh("concave", nt=201, ns=21)  # a coarse mesh: the surface itself is not the point
+    lo, hi = mesh.bounds
+    c = 0.5 * (lo + hi)
+    box = (float(c[0] - 20), float(c[1] - 20), float(c[0] + 20), float(c[1] + 20))
+    ball, tol = Cutter.ball(0.5 * INCH), 0.002 * INCH
+    plain = compute(mesh, ball, SurfaceParams(boundary=box, stepover_mode="cusp", cusp=tol, sample_step=0.25))
+    notes: list = []
+    checked = compute(mesh, ball, SurfaceParams(boundary=box, stepover_mode="cusp", cusp=tol, sample_step=0.25,
+                                                verify_cusp=True, verify_notes=notes))
+    cell = 0.5 * measure_cell(ball, tol)  # finer than the verification's own cells
+    before, _ = _independent(mesh, ball, box, tol, _path(mesh, plain), cell)
+    after, deepest = _independent(mesh, ball, box, tol, _path(mesh, checked), cell)
+    assert before > tol                                   # the planar rule undershoots this surface
+    assert after <= tol
+    assert deepest < 0.005                                # no gouge (the raster's own gouge tolerance)
+    (report,) = notes
+    assert report.within and report.max_cusp_after <= tol and report.unreachable == 0
+    n_plain, n_extra = len(_passes(plain)), len(_passes(checked)) - len(_passes(plain))
+    assert n_extra == report.passes_added > 0
+    assert n_extra < n_plain                              # at most one extra pass per gap here (cusp ~ 1.03 tol)
+    assert checked.diagnostics["verify"]["passes_added"] == n_extra
+    # the pass set itself is unchanged: the extra passes come after it
+    for a, b in zip(plain.segments, checked.segments):
+        assert np.array_equal(a.tips, b.tips)
+
+
+def _bump():
+    """A 4 mm bump on a plate (slopes to 39 deg) under a 24 x 16 mm box."""
+    return grid_mesh(lambda x, y: 4.0 * np.exp(-((x - 12) ** 2 + (y - 8) ** 2) / 18.0), 96, 64, (-6, -6, 30, 22),
+                     "bump")
+
+
+def test_extra_passes_go_only_where_the_cusp_exceeds():
+    """A step-over that keeps the cusp on the plate but not on the bump's slopes: extra passes over the bump
+    only, partial (shorter than the box), and the whole box within the tolerance afterwards."""
+    mesh, box = _bump(), (0.0, 0.0, 24.0, 16.0)
+    step = stepover_for_cusp(BALL, 0.8 * TOL, 0.0)
+    params = dict(boundary=box, stepover=step, sample_step=0.25)
+    plain = compute(mesh, BALL, SurfaceParams(**params))
+    notes: list = []
+    checked = compute(mesh, BALL, SurfaceParams(**params, verify_cusp=True, verify_notes=notes))
+    cell = 0.6 * measure_cell(BALL, TOL)  # finer than the verification's own cells
+    before, _ = _independent(mesh, BALL, box, TOL, _path(mesh, plain), cell)
+    after, deepest = _independent(mesh, BALL, box, TOL, _path(mesh, checked), cell)
+    assert before > 1.2 * TOL and after <= TOL and deepest < 0.005
+    extra = _passes(checked)[len(_passes(plain)):]
+    (report,) = notes
+    assert len(extra) == report.passes_added
+    assert len(extra) > 0
+    tips = np.vstack([s.tips for s in extra])
+    # only over the bump's slopes steeper than 23 deg (within 6.2 mm of its top: 0.8 / cos^2 of the tolerance and
+    # more), the tips a radius downhill of their contacts, and a pass's run-on
+    assert np.all(np.hypot(tips[:, 0] - 12, tips[:, 1] - 8) < 6.2 + BALL.radius + 1.0)
+    assert all(np.ptp(s.tips[:, 0]) < 24.0 - 1.0 for s in extra)  # partial passes
+    # a uniform step-over for the steepest slope would double the raster's length; a third of it is added
+    assert report.length_added < 0.35 * len(_passes(plain)) * 24.0
+
+
+def test_a_path_within_the_tolerance_is_left_as_it_is():
+    mesh, box = _bump(), (0.0, 0.0, 24.0, 16.0)
+    params = dict(boundary=box, stepover=stepover_for_cusp(BALL, 0.5 * TOL, 45.0), sample_step=0.25)
+    plain = compute(mesh, BALL, SurfaceParams(**params))
+    notes: list = []
+    checked = compute(mesh, BALL, SurfaceParams(**params, verify_cusp=True, verify_notes=notes))
+    assert len(checked.segments) == len(plain.segments) and notes[0].passes_added == 0 and notes[0].rounds == 0
+
+
+def test_unreachable_cells_are_counted_not_chased():
+    """A groove narrower than the ball: its bottom is out of reach, reported, and no pass is added for it."""
+    def groove(x, y):
+        return np.where(np.abs(y - 8) < 1.0, -2.0, 0.0)
+    mesh, box = grid_mesh(groove, 48, 320, (-6, -6, 30, 22), "groove"), (0.0, 0.0, 24.0, 16.0)
+    notes: list = []
+    compute(mesh, BALL, SurfaceParams(boundary=box, stepover=stepover_for_cusp(BALL, 0.8 * TOL, 0.0),
+                                      sample_step=0.25, verify_cusp=True, verify_notes=notes))
+    (report,) = notes
+    assert report.unreachable > 0 and report.within
+
+
+@pytest.mark.parametrize("extra, words", [
+    (dict(pattern="spiral"), "spiral"),
+    (dict(slope_min_deg=10.0), "slope range"),
+    (dict(cusp=4.0), "cusp height"),
+])
+def test_bad_input_is_refused_with_the_parameter(extra, words):
+    mesh = _bump()
+    with pytest.raises(TmmError, match=words):
+        compute(mesh, BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), verify_cusp=True, **extra))
+
+
+def test_the_work_is_estimated_before_the_simulation():
+    from tmm_workbench.core import limits
+    from tmm_workbench.core.errors import WorkLimitError
+
+    previous = limits.set_limits(max_points=20000)
+    try:
+        # the raster itself is about 3,000 points; the verification's dense raster 0.06 mm apart 140,000
+        with pytest.raises(WorkLimitError, match="verify cusp: cusp height 0.01 mm measured on 0.0612 mm cells"):
+            compute(_bump(), BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), stepover=0.5, sample_step=0.25,
+                                                 verify_cusp=True))
+    finally:
+        limits.set_limits(previous.max_points, previous.max_memory_bytes / 1e9, previous.max_positions)
+
+
+def test_cancel_stops_the_verification():
+    from tmm_workbench.core.errors import Cancelled
+
+    calls: list = []
+
+    def progress(f: float) -> bool:
+        calls.append(f)
+        return len(calls) < 5  # the raster's drop reports 3 times; cancelled in the verification's dense raster
+
+    with pytest.raises(Cancelled):
+        compute(_bump(), BALL, SurfaceParams(boundary=(0.0, 0.0, 24.0, 16.0), stepover=0.5, sample_step=0.25,
+                                             verify_cusp=True), progress)
+    assert len(calls) == 5

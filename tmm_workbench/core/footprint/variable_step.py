@@ -1,0 +1,320 @@
+"""Variable side step (issue 14 item 4; seed 003 section 4.1): a verification pass over a raster's pass set.
+
+The pass set is cut into the stock simulation and its cusp measured as core.sim.cusp_field defines it (along the
+normal, slopes up to the slope limit, reachable cells only). Cells whose cusp exceeds the tolerance are grouped
+into buckets as the seed does: by the gap between two neighbouring passes they lie in (the passes that cover the
+cell's position along the raster) and by the stretch along the passes (cells closer than two tool radii along
+the gap join one stretch). Each bucket gets extra passes in its gap, evenly spaced at the smaller step its
+largest cusp needs (the cusp grows about as the step squared), over its stretch only and extended by a tool
+radius at both ends: partial passes, with lifts between them, clipped to the boundary. They are dropped like
+the raster's own (same drop, gouge check between CL points, chord thinning), cut into the simulation strip by
+strip (only the cells under the new pass are simulated again), and the round repeats until no measured cell
+exceeds the tolerance or the round limit is reached; what stays is reported, as are the cells the tool cannot
+reach (not cusps: pencil or a smaller tool's work) and the steep cells (waterline's).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.segments import CutSegment, SegmentKind
+from tmm_workbench.core.sim.cusp_field import CuspField, cusp_field
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.tools.cutter import Cutter
+
+Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy -> (tip z, air flags): raster_drop's drop
+ROUNDS = 4
+# Cells count as exceeding above this share of the tolerance (the cells sample the ridge: a finer grid finds it a
+# little higher), and the extra passes aim at TARGET of it.
+_EXCEED = 0.95
+_TARGET = 0.8
+_CELLS_PER_STEP = 8     # the measuring cell: the planar step-over for the tolerance / 8 (0.06 mm for D6, 0.01)
+_MIN_CELL, _MAX_CELL = 0.02, 1.0
+
+
+@dataclass
+class Bucket:
+    round: int
+    lower: float            # across-offsets of the gap's passes, mm
+    upper: float
+    start: float            # along the passes: the stretch's cells, mm
+    end: float
+    cells: int              # exceeding cells
+    max_cusp: float         # mm
+    added: int              # extra passes put in the gap over the stretch
+
+
+@dataclass
+class VerifyReport:
+    tolerance: float
+    cell: float
+    max_cusp_before: float        # mm, the cells' largest (core.sim.cusp_field: what the benchmarks measure)
+    max_cusp_after: float = 0.0
+    ridge_before: float = 0.0     # mm, with the crests between cells (CuspField.ridge_cusp: what decides)
+    ridge_after: float = 0.0
+    exceeding_before: int = 0     # measured cells above the tolerance
+    exceeding_after: int = 0
+    measured: int = 0             # cells measured
+    unreachable: int = 0          # cells on the model, not steep, out of the tool's reach
+    steep: int = 0                # cells steeper than the slope limit
+    deepest: float = 0.0          # mm the simulated stock lies below the design at most (a gouge when > 0)
+    rounds: int = 0
+    passes_added: int = 0         # extra (partial) passes
+    length_added: float = 0.0     # mm of cutting along them
+    buckets: list = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def within(self) -> bool:
+        return self.exceeding_after == 0
+
+    def summary(self) -> str:
+        head = (f"verify cusp {self.tolerance:g} mm: simulated max cusp {self.max_cusp_before:.4f} -> "
+                f"{self.max_cusp_after:.4f} mm (crests {self.ridge_before:.4f} -> {self.ridge_after:.4f}), "
+                f"{self.passes_added} partial passes added ({self.length_added:.0f} mm) in "
+                f"{len({(b.lower, b.upper) for b in self.buckets})} gaps, {self.rounds} rounds")
+        tail = f"; {self.unreachable} cells out of the tool's reach, {self.steep} steeper than the slope limit " \
+               f"(not measured, of {self.measured + self.unreachable + self.steep})"
+        if not self.within:
+            head += f"; {self.exceeding_after} cells still above the tolerance after the round limit"
+        return head + tail
+
+    def as_dict(self) -> dict:
+        out = {k: v for k, v in self.__dict__.items() if k != "buckets"}
+        out["buckets"] = len(self.buckets)
+        return out
+
+
+def measure_cell(cutter: Cutter, tolerance: float) -> float:
+    """The simulation cell for `tolerance`: an eighth of the planar step-over (0.06 mm for a ball D6 at 0.01 mm)."""
+    return float(np.clip(stepover_for_cusp(cutter, tolerance, 0.0) / _CELLS_PER_STEP, _MIN_CELL, _MAX_CELL))
+
+
+def _nanmax(a: np.ndarray) -> float:
+    return float(np.nanmax(a)) if np.isfinite(a).any() else 0.0
+
+
+def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float) -> float:
+    """The dense raster's CL points (a cell apart both ways, over the boundary grown by the tool radius across),
+    refused above the limits before anything runs; the grid's cells are checked by Grid.covering."""
+    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT
+
+    w, h = boundary[2] - boundary[0], boundary[3] - boundary[1] + 2 * cutter.radius
+    count = (w / cell + 2) * (h / cell + 2)
+    check_work("CL points", count, _BYTES_PER_POINT,
+               f"verify cusp: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
+               f"{_CELLS_PER_STEP}) over a {w:.6g} x {boundary[3] - boundary[1]:.6g} mm boundary")
+    return count
+
+
+class _Passes:
+    """The straight passes of the set: across-offset and the along-range each covers (a pass split by air is
+    several)."""
+
+    def __init__(self, angle_deg: float) -> None:
+        a = math.radians(angle_deg)
+        self.d = np.array([math.cos(a), math.sin(a)])
+        self.n = np.array([-math.sin(a), math.cos(a)])
+        self.rows: list[tuple[float, float, float]] = []  # (offset, u0, u1)
+
+    def add(self, tips: np.ndarray) -> bool:
+        xy = tips[:, :2]
+        v = xy @ self.n
+        if len(xy) < 2 or np.ptp(v) > 1e-6:
+            return False
+        u = xy @ self.d
+        self.rows.append((float(np.median(v)), float(u.min()), float(u.max())))
+        return True
+
+    def gaps(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per point (u along, v across): the nearest covering pass's offset at or below v and above it (NaN
+        when there is none on that side)."""
+        lower = np.full(len(u), -np.inf)
+        upper = np.full(len(u), np.inf)
+        for c, u0, u1 in self.rows:
+            cover = (u >= u0 - 1e-6) & (u <= u1 + 1e-6)
+            below, above = cover & (c <= v), cover & (c > v)
+            lower[below] = np.maximum(lower[below], c)
+            upper[above] = np.minimum(upper[above], c)
+        return np.where(np.isfinite(lower), lower, np.nan), np.where(np.isfinite(upper), upper, np.nan)
+
+
+def _buckets(cusp: np.ndarray, bad: np.ndarray, grid: Grid, to_tip: np.ndarray, passes: _Passes, join: float,
+             round_: int, tolerance: float) -> list[Bucket]:
+    """Exceeding cells grouped by gap and by stretch along it (see the module); a cell counts where the tool
+    tip stands when it touches there (`to_tip`: (ny, nx, 2) offsets), since the passes are tip positions."""
+    centres = grid.centres()[bad.ravel()] + to_tip.reshape(-1, 2)[bad.ravel()]
+    values = cusp.ravel()[bad.ravel()]
+    u, v = centres @ passes.d, centres @ passes.n
+    lower, upper = passes.gaps(u, v)
+    inside = np.isfinite(lower) & np.isfinite(upper)
+    out: list[Bucket] = []
+    keys = np.column_stack([lower[inside], upper[inside]])
+    u, values = u[inside], values[inside]
+    if not len(keys):
+        return out
+    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+    for k, (lo, hi) in enumerate(uniq):
+        sel = np.flatnonzero(inverse.ravel() == k)
+        order = sel[np.argsort(u[sel])]
+        breaks = np.flatnonzero(np.diff(u[order]) > join) + 1
+        for part in np.split(order, breaks):
+            top = float(values[part].max())
+            # cusp ~ step^2: m sub-gaps of width w / m give top / m^2 <= TARGET x tolerance
+            m = max(2, math.ceil(math.sqrt(top / (_TARGET * tolerance)) - 1e-9))
+            out.append(Bucket(round_, float(lo), float(hi), float(u[part].min()), float(u[part].max()), len(part),
+                              top, m - 1))
+    return out
+
+
+def _strip(grid: Grid, tips: np.ndarray, reach: float) -> Optional[tuple[Grid, slice, slice]]:
+    """The sub-grid of the cells within `reach` of the tips' XY box (where a pass can lower the stock)."""
+    i0 = max(0, int(math.floor((tips[:, 0].min() - reach - grid.x0) / grid.cell)))
+    i1 = min(grid.nx, int(math.ceil((tips[:, 0].max() + reach - grid.x0) / grid.cell)))
+    j0 = max(0, int(math.floor((tips[:, 1].min() - reach - grid.y0) / grid.cell)))
+    j1 = min(grid.ny, int(math.ceil((tips[:, 1].max() + reach - grid.y0) / grid.cell)))
+    if i1 <= i0 or j1 <= j0:
+        return None
+    sub = Grid(grid.x0 + i0 * grid.cell, grid.y0 + j0 * grid.cell, grid.cell, i1 - i0, j1 - j0)
+    return sub, slice(j0, j1), slice(i0, i1)
+
+
+def _extra_segments(start: np.ndarray, end: np.ndarray, drop: Drop, sample_step: float, gouge_tol: float,
+                    chord_tol: float) -> list[CutSegment]:
+    """One partial pass, dropped and checked as raster_drop drops its own (split where it crosses air)."""
+    from tmm_workbench.core.strategies import raster_drop, raster_refine
+
+    xy = sample_segment(start, end, sample_step)
+    z, air = drop(xy)
+    runs = [(False, xy)]
+    if gouge_tol > 0:
+        runs, z, air, _ = raster_refine.refine(runs, z, air, drop, gouge_tol, chained=False)
+    return raster_drop._segments(runs, z, air, raster_drop.ONEWAY, chord_tol)
+
+
+def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], boundary: Rect, angle_deg: float,
+                tolerance: float, drop: Drop, *, sample_step: float = 0.5, gouge_tol: float = 0.005,
+                chord_tol: float = 0.001, stock_to_leave: float = 0.0, slope_limit_deg: float = 75.0,
+                cell: Optional[float] = None, rounds: int = ROUNDS, surface: Optional[DropSurface] = None,
+                progress: Optional[Progress] = None) -> tuple[list[CutSegment], VerifyReport]:
+    """`segments` (a raster's pass set over `boundary`, passes along `angle_deg`) with extra partial passes
+    appended where the simulated cusp exceeds `tolerance`, and the report (see the module). `drop` drops the
+    tool at XY points as the raster did (stock to leave, floor, air). `progress` (fraction -> False to cancel)
+    follows the dense raster, the bulk of the work, and is asked again before each round."""
+    t0 = time.perf_counter()
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise TmmError(f"verify cusp tolerance must be a length > 0 mm, got {tolerance!r}")
+    cell = measure_cell(cutter, tolerance) if cell is None else float(cell)
+    estimate_work(boundary, cutter, tolerance, cell)
+    surface = surface or DropSurface(mesh)
+    passes = _Passes(angle_deg)
+    for seg in segments:
+        if seg.kind is SegmentKind.PASS:
+            passes.add(seg.tips)
+    if not passes.rows:
+        raise TmmError("verify cusp needs straight raster passes (ZigZag or OneWay), found none")
+    # the envelope sampled a cell apart along its passes too: the path's own chords count as cusp
+    fld: CuspField = cusp_field(mesh, cutter, boundary, tolerance, cell, slope_limit_deg, cell, stock_to_leave,
+                                surface, progress=progress)
+    policy = LinkPolicy(fld.stock_top + 1.0, fld.stock_top + 5.0)
+    heights = fld.cut(link(segments, policy), cutter)
+    before = fld.ridge_cusp(heights)
+    report = VerifyReport(tolerance, cell, fld.max_cusp(heights), ridge_before=_nanmax(before),
+                          exceeding_before=int(np.sum(np.nan_to_num(before, nan=0.0) > tolerance)),
+                          measured=int(fld.measured.sum()),
+                          unreachable=int(fld.unreachable.sum()), steep=int(fld.steep.sum()))
+    reach = cutter.native.max_radius
+    to_tip = fld.contact_offset(cutter)
+    # past a partial pass's end its tool still cuts the ridge beside it down to within the tolerance for about
+    # sqrt(2 R tol) (the ball's end: a height (a^2 + t^2) / 2R); twice that, and a cell
+    run_on = 2.0 * math.sqrt(2.0 * cutter.radius * tolerance) + cell
+    extra: list[CutSegment] = []
+    cusp = before
+    for k in range(rounds):
+        bad = np.nan_to_num(cusp, nan=0.0) > _EXCEED * tolerance
+        if not bad.any():
+            break
+        if progress is not None and progress(1.0) is False:
+            raise Cancelled("verify cusp cancelled")
+        report.rounds = k + 1
+        buckets = _buckets(cusp, bad, fld.grid, to_tip, passes, 2 * cutter.radius, k + 1, tolerance)
+        if not buckets:
+            break
+        report.buckets += buckets
+        flip = False
+        for b in sorted(buckets, key=lambda b: (b.lower, b.start)):
+            for i in range(1, b.added + 1):
+                c = b.lower + (b.upper - b.lower) * i / (b.added + 1)
+                line = clip_line_to_rect(c * passes.n, passes.d, boundary)
+                if line is None:
+                    continue
+                ua, ub = line @ passes.d
+                ua, ub = max(min(ua, ub), b.start - run_on), min(max(ua, ub), b.end + run_on)
+                if ub - ua <= 1e-9:
+                    continue
+                ends = [c * passes.n + ua * passes.d, c * passes.n + ub * passes.d]
+                if flip:  # serpentine order: the next partial pass starts near the last one's end
+                    ends.reverse()
+                flip = not flip
+                new = _extra_segments(ends[0], ends[1], drop, sample_step, gouge_tol, chord_tol)
+                for seg in new:
+                    passes.add(seg.tips)
+                    report.passes_added += 1
+                    report.length_added += float(np.linalg.norm(np.diff(seg.tips[:, :2], axis=0), axis=1).sum())
+                    strip = _strip(fld.grid, seg.tips, reach)
+                    if strip is None:
+                        continue
+                    sub, rows, cols = strip
+                    heights[rows, cols] = simulate(link([seg], policy), cutter, sub, heights[rows, cols]).heights
+                extra += new
+        cusp = fld.ridge_cusp(heights)
+    report.max_cusp_after, report.ridge_after = fld.max_cusp(heights), _nanmax(cusp)
+    report.exceeding_after = int(np.sum(np.nan_to_num(cusp, nan=0.0) > tolerance))
+    on_model = np.isfinite(fld.design)
+    report.deepest = float(max(0.0, np.max(fld.design[on_model] + stock_to_leave - heights[on_model]))) \
+        if on_model.any() else 0.0
+    report.seconds = time.perf_counter() - t0
+    return segments + [CutSegment(s.tips, s.kind, joined=False, pass_index=s.pass_index) for s in extra], report
+
+
+def validate_params(params) -> None:
+    """What the verification pass needs of raster_drop's SurfaceParams (refused before any work)."""
+    from tmm_workbench.core.strategies.raster_drop import SPIRAL
+
+    if params.pattern == SPIRAL:
+        raise TmmError("verify cusp works on straight raster passes (pattern zigzag or oneway), not spiral")
+    if params.region is not None:
+        raise TmmError("verify cusp works on the boundary box only for now (region Box), not on a face or sketch "
+                       "region")
+    if params.slope_min_deg > 0 or params.slope_max_deg < 90:
+        raise TmmError(f"verify cusp measures every slope up to the cusp slope limit: set the slope range to 0..90 "
+                       f"deg (got {params.slope_min_deg:g}..{params.slope_max_deg:g})")
+
+
+def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegment], drop: Drop,
+                  surface: Optional[DropSurface], diagnostics: dict,
+                  progress: Optional[Progress] = None) -> list[CutSegment]:
+    """raster_drop's call: its pass set verified against `params.cusp` (diagnostics["verify"]; the report is
+    appended to params.verify_notes when given)."""
+    if params.cusp > cutter.radius:
+        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
+    segments, report = verify_cusp(mesh, cutter, segments, params.boundary, params.angle_deg, params.cusp, drop,
+                                   sample_step=params.sample_step, gouge_tol=params.gouge_tol,
+                                   chord_tol=params.chord_tol, stock_to_leave=params.stock_to_leave,
+                                   slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress)
+    diagnostics["verify"] = report.as_dict()
+    if params.verify_notes is not None:
+        params.verify_notes.append(report)
+    return segments

@@ -1,0 +1,138 @@
+"""The simulated cusp of a 3-axis raster, measured the same way whatever placed its passes (issue 14 items 1, 4, 7).
+
+The path and a dense raster of the same tool (passes one cell apart: its own cusp, cell^2 / 8R for a ball, is
+negligible against the tolerance) are cut into the stock simulation. The dense raster leaves the reachable
+envelope E: the surface the tool can bring out at all. The cusp of a cell is (H - E) cos(slope), H the path's
+simulated height, i.e. along the normal; it is measured where the slope is at most the slope limit (walls are
+waterline's) and the envelope comes within the tolerance of the design along the normal (elsewhere the tool cannot
+reach the model: a concave corner narrower than the tool; those cells are `unreachable`, not cusps).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from tmm_workbench.core.footprint.raster import Rect
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.sim.compare import slope_deg
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.sim.stock import box_heights, mesh_heights
+from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
+
+SLOPE_LIMIT_DEG = 75.0
+STOCK_ABOVE_MM = 5.0  # the box stock's top above the model: every cut starts in material
+
+
+@dataclass
+class CuspField:
+    grid: Grid
+    design: np.ndarray       # (ny, nx) the model's heights, NaN off the model
+    envelope: np.ndarray     # (ny, nx) what the dense raster leaves
+    cos: np.ndarray          # (ny, nx) cos of the envelope's slope (vertical -> along the normal)
+    measured: np.ndarray     # (ny, nx) bool: cells where the cusp is measured
+    unreachable: np.ndarray  # (ny, nx) bool: on the model, not steep, but out of the tool's reach
+    steep: np.ndarray        # (ny, nx) bool: on the model, steeper than the slope limit
+    stock_top: float
+    tolerance: float
+    normal_xy: np.ndarray    # (ny, nx, 2) the envelope's unit normal, its XY part (where a tool touches it from)
+
+    def contact_offset(self, cutter: Cutter) -> np.ndarray:
+        """(ny, nx, 2) from each cell (a contact point) to the tool tip touching there, in XY: a torus's (ball:
+        R n_xy; flat: R along n_xy's direction; bull: both parts), so that cells are matched to the passes that
+        cut them (on a 35 deg slope a ball D6 touches 1.7 mm uphill of its tip)."""
+        rc = min(cutter.corner_radius, cutter.radius)
+        norm = np.linalg.norm(self.normal_xy, axis=2, keepdims=True)
+        unit = np.divide(self.normal_xy, norm, out=np.zeros_like(self.normal_xy), where=norm > 1e-12)
+        return (cutter.radius - rc) * unit + rc * self.normal_xy
+
+    def stock(self) -> np.ndarray:
+        return box_heights(self.grid, self.stock_top)
+
+    def cut(self, path: Toolpath, cutter: Cutter, heights: Optional[np.ndarray] = None) -> np.ndarray:
+        """The stock (`heights`, default the box) after `path` is cut into it."""
+        return simulate(path, cutter, self.grid, self.stock() if heights is None else heights).heights
+
+    def cusp(self, heights: np.ndarray) -> np.ndarray:
+        """(ny, nx) cusp along the normal of simulated `heights`, NaN where not measured."""
+        return np.where(self.measured, (heights - self.envelope) * self.cos, np.nan)
+
+    def ridge_cusp(self, heights: np.ndarray) -> np.ndarray:
+        """cusp() with each cell that is a local maximum along X or Y raised to the crest between its neighbours:
+        a cusp's ridge is where two tool surfaces cross, a V along any line across it (slopes +-k), which cells
+        sample up to k x cell / 2 below its crest; through f-, f0, f+ with f0 the largest, the crest of the
+        symmetric V is f0 + |f+ - f-| / 2 (the verification pass decides with it, so that a finer grid does not
+        find more)."""
+        c = self.cusp(heights)
+        filled = np.nan_to_num(c, nan=-np.inf)
+        out = c.copy()
+        for axis in (0, 1):
+            lo = np.roll(filled, 1, axis=axis)
+            hi = np.roll(filled, -1, axis=axis)
+            edge = [slice(None)] * 2
+            for index in (0, -1):  # no neighbour across the grid's edges
+                edge[axis] = index
+                lo[tuple(edge)] = hi[tuple(edge)] = -np.inf
+            peak = np.isfinite(lo) & np.isfinite(hi) & (filled >= lo) & (filled >= hi)
+            with np.errstate(invalid="ignore"):  # -inf - -inf off the peaks, not used
+                crest = np.where(peak, filled + 0.5 * np.abs(np.where(peak, hi - lo, 0.0)), -np.inf)
+            out = np.where(np.isfinite(out), np.maximum(out, crest), out)
+        return out
+
+    def max_cusp(self, heights: np.ndarray) -> float:
+        c = self.cusp(heights)
+        return float(np.nanmax(c)) if self.measured.any() else 0.0
+
+    @property
+    def share(self) -> float:
+        """The share of the grid's cells measured."""
+        return float(self.measured.mean())
+
+
+def measure_grid(boundary: Rect, cutter: Cutter, cell: float) -> Grid:
+    """The cells measured for a raster over `boundary`: inside it, clear of its edges by the tool radius (the
+    passes' ends and the outermost passes' far sides are not the spacing's)."""
+    r = cutter.radius
+    return Grid.covering(boundary[0] + r, boundary[1] + r, boundary[2] - r, boundary[3] - r, cell)
+
+
+def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, cell: float,
+               slope_limit_deg: float = SLOPE_LIMIT_DEG, sample_step: float = 0.25, stock_to_leave: float = 0.0,
+               surface: Optional[DropSurface] = None, grid: Optional[Grid] = None,
+               progress: Optional[Progress] = None) -> CuspField:
+    """The field for rasters over `boundary` (xmin, ymin, xmax, ymax) with `cutter`; `cell` is the simulation's
+    cell and the dense raster's step-over. With `stock_to_leave` the dense raster leaves it too, and a cell is
+    reachable when the envelope comes within tolerance + stock_to_leave of the design."""
+    from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # the strategy uses this module
+
+    grid = grid or measure_grid(boundary, cutter, cell)
+    surface = surface or DropSurface(mesh)
+    design = mesh_heights(mesh, grid, surface)
+    r = cutter.radius
+    top = float(mesh.bounds[1][2]) + stock_to_leave
+    dense = compute(mesh, cutter, SurfaceParams(boundary=(boundary[0], boundary[1] - r, boundary[2], boundary[3] + r),
+                                                stepover=grid.cell, sample_step=sample_step,
+                                                stock_to_leave=stock_to_leave), progress, surface)
+    stock_top = top + STOCK_ABOVE_MM
+    path = link(dense.segments, LinkPolicy(stock_top, stock_top + 5))
+    envelope = simulate(path, cutter, grid, box_heights(grid, stock_top)).heights
+    slope = slope_deg(envelope, grid.cell)
+    gy, gx = np.gradient(envelope, grid.cell)
+    normal_xy = -np.stack([gx, gy], axis=2) / np.sqrt(1.0 + gx * gx + gy * gy)[:, :, None]
+    cos = np.cos(np.radians(slope))
+    on_model = np.isfinite(design)
+    steep = on_model & (slope > slope_limit_deg)
+    near = (envelope - np.where(on_model, design, -np.inf)) * cos <= tolerance + stock_to_leave
+    measured = on_model & ~steep & near
+    return CuspField(grid, design, envelope, cos, measured, on_model & ~steep & ~near, steep, stock_top, tolerance,
+                     normal_xy)
+
+
+def measure(field: CuspField, path: Toolpath, cutter: Cutter) -> tuple[float, float]:
+    """The largest cusp of `path` and the share of cells measured."""
+    return field.max_cusp(field.cut(path, cutter)), field.share
