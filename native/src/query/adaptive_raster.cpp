@@ -51,15 +51,14 @@ struct Instance {
 };
 
 // The instances of a pass (tip heights z along a's x) near one section, lowest bound first; those whose
-// bound is inf (farther along the pass than the tool's radius) never reach it.
-void gather(const double* z, const std::vector<std::size_t>& near, const std::vector<double>& dx,
-            std::size_t first, std::size_t count, const Profile& h, std::vector<Instance>& out) {
+// bound is inf (farther along the pass than the tool's radius) never reach it. dx2 and hdx = h(|dx|) of the
+// section's neighbours along the pass are the same for every pass.
+void gather(const double* z, const std::vector<std::size_t>& near, const std::vector<double>& dx2,
+            const std::vector<double>& hdx, std::size_t first, std::size_t count, std::vector<Instance>& out) {
   out.clear();
-  for (std::size_t k = 0; k < count; ++k) {
-    const double d = dx[first + k], dx2 = d * d;
-    const double zk = z[near[first + k]];
-    const double bound = zk + h(std::sqrt(dx2));
-    if (bound < kInf) out.push_back({bound, zk, dx2, 0.0});
+  for (std::size_t k = first; k < first + count; ++k) {
+    const double zk = z[near[k]], bound = zk + hdx[k];
+    if (bound < kInf) out.push_back({bound, zk, dx2[k], 0.0});
   }
   std::sort(out.begin(), out.end(), [](const Instance& a, const Instance& b) { return a.bound < b.bound; });
   double rest = kInf;
@@ -187,13 +186,16 @@ class Placer {
       if (!(x1 - x0 > 4 * r) || (x_[i] >= x0 + r && x_[i] <= x1 - r)) sections_.push_back(i);
     const std::size_t S = sections_.size(), K = static_cast<std::size_t>(2 * reach_ + 1);
     near_.resize(S * K);
-    dx_.resize(S * K);
+    dx2_.resize(S * K);
+    hdx_.resize(S * K);
     for (std::size_t s = 0; s < S; ++s)
       for (std::size_t k = 0; k < K; ++k) {
         const long j = std::clamp(static_cast<long>(sections_[s]) + static_cast<long>(k) - reach_, 0L,
                                   static_cast<long>(n) - 1);
+        const double dx = x_[static_cast<std::size_t>(j)] - x_[sections_[s]];
         near_[s * K + k] = static_cast<std::size_t>(j);
-        dx_[s * K + k] = x_[static_cast<std::size_t>(j)] - x_[sections_[s]];
+        dx2_[s * K + k] = dx * dx;
+        hdx_[s * K + k] = h_(std::sqrt(dx * dx));
       }
     // ys as numpy's arange(y0 - r, y0 + s_max + r + spacing, spacing): start + i * delta
     const double start = y0_ - r, stop = y0_ + o_.step_max + r + kSpacing;
@@ -246,7 +248,7 @@ class Placer {
     });
     out_.drops += S * ny;
     a_.assign(S, {});
-    for (std::size_t s = 0; s < S; ++s) gather(za_.data(), near_, dx_, s * K, K, h_, a_[s]);
+    for (std::size_t s = 0; s < S; ++s) gather(za_.data(), near_, dx2_, hdx_, s * K, K, a_[s]);
     // a's surface on the sections: the same for every candidate
     std::vector<Across> at(ny);
     for (std::size_t j = 0; j < ny; ++j) at[j] = across(ys_[j] - y0_, h_);
@@ -286,7 +288,7 @@ class Placer {
       std::vector<double> pa(N), pb(N), env(N), cosv(N);
       std::vector<char> ok(N);
       for (std::size_t s = begin; s < end; ++s) {
-        for (int p = 0; p < kDense; ++p) gather(z.data() + p * n, near_, dx_, s * K, K, h_, pass[p]);
+        for (int p = 0; p < kDense; ++p) gather(z.data() + p * n, near_, dx2_, hdx_, s * K, K, pass[p]);
         const std::vector<Instance>& A = a_[s];
         const std::vector<Instance>& B = pass[kDense - 1];
         for (std::size_t j = 0; j < N; ++j) {
@@ -370,7 +372,7 @@ class Placer {
   Frame frame_{};
   long reach_ = 0;
   // the strip of pass a
-  std::vector<double> x_, za_, ys_, design_, dx_, pa_;
+  std::vector<double> x_, za_, ys_, design_, dx2_, hdx_, pa_;
   std::vector<std::size_t> sections_, near_;
   std::vector<std::vector<Instance>> a_;
   double y0_ = 0;

@@ -20,6 +20,10 @@ above `max_slope_deg`) are not measured (walls are waterline's), and the step ne
 constant-mode step at `max_slope_deg` (core.footprint.cusp); gaps that still exceed the cusp there are counted
 as `limited`. Passes run along `angle_deg` from +X; the work is done in a frame turned so that they run along +X'
 (the cutter is a solid of revolution: its drop does not change when the mesh turns about Z).
+
+The kernel's port (native.adaptive_raster, native/src/query/adaptive_raster.cpp) does the work when the kernel
+has it: the same samples, bracket and search, tens of times faster. This module's numpy code stays as the slow
+reference it is tested against (`reference=True`; tests/core/test_adaptive_raster.py).
 """
 from __future__ import annotations
 
