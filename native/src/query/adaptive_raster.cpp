@@ -45,24 +45,28 @@ struct Profile {
 };
 
 // One pass's instance that may reach a section: its lower surface there is z + h(sqrt(dx2 + dy^2)), never
-// below `bound` = z + h(|dx|) nor below z + h(|dy|); `rest` is the least z of it and the instances after it.
+// below `bound` = z + h(|dx|) nor below z + h(|dy|).
 struct Instance {
-  double bound, z, dx2, rest;
+  double bound, z, dx2;
 };
 
-// The instances of a pass (tip heights z along a's x) near one section, lowest bound first; those whose
-// bound is inf (farther along the pass than the tool's radius) never reach it. dx2 and hdx = h(|dx|) of the
-// section's neighbours along the pass are the same for every pass.
+// The instances of a pass (tip heights z along a's x) near one section (listed nearest first) that can be
+// the least somewhere across it, lowest first. An instance no lower than a nearer one (dx2 no larger) never
+// is: h rises with rho, so the nearer one's z + h(sqrt(dx2 + dy^2)) is no higher at any dy. Those kept
+// therefore get lower as they get farther; those whose bound is inf (farther along the pass than the tool's
+// radius) never reach the section. dx2 and hdx = h(|dx|) are the same for every pass.
 void gather(const double* z, const std::vector<std::size_t>& near, const std::vector<double>& dx2,
             const std::vector<double>& hdx, std::size_t first, std::size_t count, std::vector<Instance>& out) {
   out.clear();
+  double lowest_z = kInf;
   for (std::size_t k = first; k < first + count; ++k) {
     const double zk = z[near[k]], bound = zk + hdx[k];
-    if (bound < kInf) out.push_back({bound, zk, dx2[k], 0.0});
+    if (zk < lowest_z && bound < kInf) {
+      out.push_back({bound, zk, dx2[k]});
+      lowest_z = zk;
+    }
   }
-  std::sort(out.begin(), out.end(), [](const Instance& a, const Instance& b) { return a.bound < b.bound; });
-  double rest = kInf;
-  for (std::size_t k = out.size(); k-- > 0;) out[k].rest = rest = std::min(rest, out[k].z);
+  std::reverse(out.begin(), out.end());
 }
 
 // What lowest() needs of one dy across the section, the same for every section: dy^2, h(|dy|) and the
@@ -80,16 +84,28 @@ Across across(double dy, const Profile& h) {
 
 // The least over `in` of z + h(rho) at dy across the section (inf where none reaches): exactly the
 // reference's min over all instances, skipping those whose bound (kMargin under it, so that no rounding can
-// matter) shows they cannot go lower, and stopping where none of the rest can.
-double lowest(const std::vector<Instance>& in, const Across& a, const Profile& h) {
-  double best = kInf;
+// matter) shows they cannot go lower, and stopping where none of the rest can (they stand higher, and
+// h(sqrt(dx2 + dy^2)) >= h(|dy|) in floating point too). `hint`, if given, is an
+// instance tried first (the previous sample's least: its value prunes the rest); on return, this one's.
+double lowest(const std::vector<Instance>& in, const Across& a, const Profile& h, std::size_t* hint = nullptr) {
   if (!(a.lift < kInf)) return kInf;  // beyond the tool's reach across: no instance reaches
-  for (const Instance& i : in) {
-    if (i.bound >= best || i.rest + a.lift >= best) break;
-    if (i.z + a.lift + a.bend * i.dx2 - kMargin >= best) continue;
-    const double v = i.z + h(std::sqrt(i.dx2 + a.dy2));
-    if (v < best) best = v;
+  double best = kInf;
+  std::size_t first = in.size(), won = in.size();
+  if (hint && *hint < in.size()) {
+    first = won = *hint;
+    best = in[first].z + h(std::sqrt(in[first].dx2 + a.dy2));
   }
+  for (std::size_t k = 0; k < in.size(); ++k) {
+    const Instance& i = in[k];
+    if (i.z + a.lift >= best) break;
+    if (k == first || i.bound >= best || i.z + a.lift + a.bend * i.dx2 - kMargin >= best) continue;
+    const double v = i.z + h(std::sqrt(i.dx2 + a.dy2));
+    if (v < best) {
+      best = v;
+      won = k;
+    }
+  }
+  if (hint) *hint = won;
   return best;
 }
 
@@ -97,7 +113,7 @@ double lowest(const std::vector<Instance>& in, double dy, const Profile& h) { re
 
 // A lower bound of lowest(in, a, h): no instance of the pass comes lower there.
 double floor_of(const std::vector<Instance>& in, const Across& a) {
-  return in.empty() ? kInf : in.front().rest + a.lift;
+  return in.empty() ? kInf : in.front().z + a.lift;
 }
 
 struct Frame {
@@ -188,15 +204,22 @@ class Placer {
     near_.resize(S * K);
     dx2_.resize(S * K);
     hdx_.resize(S * K);
-    for (std::size_t s = 0; s < S; ++s)
+    std::vector<std::pair<double, std::size_t>> by_dx(K);
+    for (std::size_t s = 0; s < S; ++s) {  // each section's neighbours along the pass, nearest first
       for (std::size_t k = 0; k < K; ++k) {
         const long j = std::clamp(static_cast<long>(sections_[s]) + static_cast<long>(k) - reach_, 0L,
                                   static_cast<long>(n) - 1);
         const double dx = x_[static_cast<std::size_t>(j)] - x_[sections_[s]];
-        near_[s * K + k] = static_cast<std::size_t>(j);
-        dx2_[s * K + k] = dx * dx;
-        hdx_[s * K + k] = h_(std::sqrt(dx * dx));
+        by_dx[k] = {dx * dx, static_cast<std::size_t>(j)};
       }
+      std::stable_sort(by_dx.begin(), by_dx.end(),
+                       [](const auto& p, const auto& q) { return p.first < q.first; });
+      for (std::size_t k = 0; k < K; ++k) {
+        near_[s * K + k] = by_dx[k].second;
+        dx2_[s * K + k] = by_dx[k].first;
+        hdx_[s * K + k] = h_(std::sqrt(by_dx[k].first));
+      }
+    }
     // ys as numpy's arange(y0 - r, y0 + s_max + r + spacing, spacing): start + i * delta
     const double start = y0_ - r, stop = y0_ + o_.step_max + r + kSpacing;
     const double delta = (start + kSpacing) - start;
@@ -254,8 +277,10 @@ class Placer {
     for (std::size_t j = 0; j < ny; ++j) at[j] = across(ys_[j] - y0_, h_);
     pa_.resize(S * ny);
     parallel_chunks(S, kSectionChunk, threads_, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t s = begin; s < end; ++s)
-        for (std::size_t j = 0; j < ny; ++j) pa_[s * ny + j] = lowest(a_[s], at[j], h_);
+      for (std::size_t s = begin; s < end; ++s) {
+        std::size_t hint = 0;
+        for (std::size_t j = 0; j < ny; ++j) pa_[s * ny + j] = lowest(a_[s], at[j], h_, &hint);
+      }
     });
     unreachable_ = false;
   }
@@ -291,9 +316,10 @@ class Placer {
         for (int p = 0; p < kDense; ++p) gather(z.data() + p * n, near_, dx2_, hdx_, s * K, K, pass[p]);
         const std::vector<Instance>& A = a_[s];
         const std::vector<Instance>& B = pass[kDense - 1];
+        std::array<std::size_t, kDense> hint{};  // each pass's least at the previous sample
         for (std::size_t j = 0; j < N; ++j) {
           pa[j] = pa_[s * ny + j];
-          pb[j] = lowest(B, at[(kDense - 1) * N + j], h_);
+          pb[j] = lowest(B, at[(kDense - 1) * N + j], h_, &hint[kDense - 1]);
           double e = std::min(pa[j], pb[j]);
           // the dense passes nearest first (the least is the same in any order); one that cannot come lower
           // is skipped
@@ -304,7 +330,7 @@ class Placer {
               const int p = side ? near + d : near - d;
               if (p < 0 || p > kDense - 2) continue;
               const Across& ap = at[p * N + j];
-              if (floor_of(pass[p], ap) < e) e = std::min(e, lowest(pass[p], ap, h_));
+              if (floor_of(pass[p], ap) < e) e = std::min(e, lowest(pass[p], ap, h_, &hint[p]));
             }
           env[j] = e;
         }
