@@ -37,8 +37,9 @@ struct AdaptiveRasterOptions {
   double step_max = 0;         // the largest (mm, step_min <= step_max < 2 x the cutter's max radius)
 };
 
-// The most samples of one pass's section grid (sections x samples across, doubles): about 400 MB.
-constexpr std::size_t kMaxAdaptiveSectionSamples = 50'000'000;
+// The most samples of one pass's section grid (sections x samples across; two grids of doubles, the design
+// and the previous pass's surface): about 400 MB.
+constexpr std::size_t kMaxAdaptiveSectionSamples = 25'000'000;
 
 struct AdaptiveRasterResult {
   std::vector<double> offsets;       // (k,) across-offsets of the passes, from the boundary's lowest to its highest
