@@ -13,6 +13,7 @@ core.footprint.variable_step: partial passes added where the simulated cusp exce
     .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
     .venv/bin/python benchmarks/cusp_spacing.py --seed000  # seed 000's convex and concave surfaces (ball D 0.5 in,
                                                            # cusp 0.002 in; benchmarks/seed000_surfaces.py)
+    ... --reference   # the adaptive passes placed by the numpy reference (as before the kernel port) to compare
 """
 from __future__ import annotations
 
@@ -119,7 +120,15 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=100.0,
                     help="with --seed000: the side in mm of the square region centred on the surface (0: all of "
                          "its 254 x 270 mm, which takes hours in the Python adaptive raster)")
+    ap.add_argument("--reference", action="store_true",
+                    help="place the adaptive passes with the numpy reference instead of the kernel")
     args = ap.parse_args()
+    if args.reference:  # the strategy imported the function by name: swap it there
+        import functools
+
+        from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
+        from tmm_workbench.core.strategies import raster_drop
+        raster_drop.adaptive_pass_offsets = functools.partial(adaptive_pass_offsets, reference=True)
     if args.seed000:
         from seed000_surfaces import INCH, seed000_mesh
         for name in ("convex", "concave"):

@@ -109,3 +109,49 @@ def test_cancel_and_work_limit():
         limits.set_limits(max_points=old.max_points)
     with pytest.raises(TmmError, match=r"adaptive slope limit must be in \(0, 90\) deg, got 90"):
         adaptive_pass_offsets(mesh, Cutter.ball(6), BOX, 0.0, 0.01, 0.25, -30.0, max_slope_deg=90.0)
+
+
+# --- the kernel's port (native.adaptive_raster) against this numpy reference ------------------------------------
+# The kernel computes the same samples, bracket and search (only the least over a pass's instances is pruned,
+# which does not change it): the offsets agree to floating-point rounding. A rounding difference could flip one
+# step's comparison with the target and shift the rest of the set by up to the 2 % bracket, so the stated
+# tolerance is 1e-6 mm on every offset and cusp, and the same counts.
+OFFSET_TOL = 1e-6
+
+
+def _same(kernel, reference):
+    assert len(kernel.offsets) == len(reference.offsets)
+    assert np.abs(kernel.offsets - reference.offsets).max() <= OFFSET_TOL
+    assert np.abs(kernel.cusps - reference.cusps).max() <= OFFSET_TOL
+    assert (kernel.limited, kernel.unreachable, kernel.evaluations) == \
+        (reference.limited, reference.unreachable, reference.evaluations)
+
+
+@pytest.mark.parametrize("cutter, angle, stock", [(Cutter.ball(6), 0.0, 0.0), (Cutter.bull(8, 2), 0.0, 0.0),
+                                                  (Cutter.ball(6), 30.0, 0.2)], ids=["ball", "bull", "ball-30deg-stock"])
+def test_the_kernel_matches_the_reference_on_the_bump(cutter, angle, stock):
+    from tmm_workbench.core.kernel import native
+    assert hasattr(native, "adaptive_raster"), "the kernel lacks adaptive_raster: rebuild it (scripts/setup.sh)"
+    mesh = bump()
+    floor_z = float(mesh.bounds[0][2])
+    args = (mesh, cutter, BOX, angle, 0.01, 0.25, floor_z, stock)
+    kernel = adaptive_pass_offsets(*args)
+    reference = adaptive_pass_offsets(*args, reference=True)
+    _same(kernel, reference)
+    assert len(kernel.offsets) > 20 and kernel.cusps.max() > 0.005  # a real curved case, not a plane
+
+
+def test_the_kernel_matches_the_reference_on_sphere_on_plate():
+    """A 24 x 16 mm window over the sphere's flank and the plate (slopes to the 75 deg limit, the foot's
+    concave corner that the ball cannot reach)."""
+    from tests.conftest import SHARED_STL
+    from tmm_workbench.core.geometry.mesh import load_stl
+    stl = SHARED_STL / "sphere_on_plate.stl"
+    assert stl.exists(), f"{stl} missing: the shared benchmark files are part of the test set-up"
+    mesh = load_stl(stl)
+    window = (26.0, 4.0, 50.0, 20.0)
+    args = (mesh, Cutter.ball(6), window, 0.0, 0.01, 0.25, float(mesh.bounds[0][2]))
+    kernel = adaptive_pass_offsets(*args)
+    reference = adaptive_pass_offsets(*args, reference=True)
+    _same(kernel, reference)
+    assert kernel.unreachable > 0 and np.ptp(np.diff(kernel.offsets)[:-1]) > 0.05  # the corner, varied gaps

@@ -20,6 +20,10 @@ above `max_slope_deg`) are not measured (walls are waterline's), and the step ne
 constant-mode step at `max_slope_deg` (core.footprint.cusp); gaps that still exceed the cusp there are counted
 as `limited`. Passes run along `angle_deg` from +X; the work is done in a frame turned so that they run along +X'
 (the cutter is a solid of revolution: its drop does not change when the mesh turns about Z).
+
+The kernel's port (native.adaptive_raster, native/src/query/adaptive_raster.cpp) does the work when the kernel
+has it: the same samples, bracket and search, tens of times faster. This module's numpy code stays as the slow
+reference it is tested against (`reference=True`; tests/core/test_adaptive_raster.py).
 """
 from __future__ import annotations
 
@@ -33,6 +37,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.cusp import profile_height, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.kernel import native
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.tools.cutter import Cutter
@@ -68,9 +73,12 @@ class _Frame:
 
 def adaptive_pass_offsets(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: float, cusp: float,
                           sample_step: float, floor_z: float, stock_to_leave: float = 0.0,
-                          max_slope_deg: float = 75.0, progress: Optional[Progress] = None) -> AdaptivePasses:
+                          max_slope_deg: float = 75.0, progress: Optional[Progress] = None,
+                          reference: bool = False) -> AdaptivePasses:
     """The across-offsets of raster passes over `boundary` (as core.footprint.raster.raster_lines places them:
-    the first and last on the boundary's edges) with at most `cusp` mm between neighbours (see the module)."""
+    the first and last on the boundary's edges) with at most `cusp` mm between neighbours (see the module).
+    The kernel's port (native.adaptive_raster) does the work when the kernel has it; `reference` runs this
+    module's numpy code instead, the slow reference the kernel is tested against."""
     if not (math.isfinite(max_slope_deg) and 0 < max_slope_deg < 90):
         raise TmmError(f"adaptive slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
     frame = _Frame(angle_deg)
@@ -87,6 +95,9 @@ def adaptive_pass_offsets(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_d
                f"{sample_step:g} mm over a {hi - lo:.6g} mm wide boundary")
     turned = frame.mesh(mesh)
     surface = DropSurface(turned)
+    if not reference and hasattr(native, "adaptive_raster"):
+        return _kernel_offsets(surface, cutter, boundary, angle_deg, cusp, sample_step, floor_z, stock_to_leave,
+                               max_slope_deg, s_min, s_max, progress)
     needle = Cutter.flat(2e-4) if stock_to_leave == 0 else Cutter.ball(2 * stock_to_leave)
     tool = cutter.offset(stock_to_leave)
 
@@ -257,3 +268,22 @@ def adaptive_pass_offsets(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_d
     out.offsets = np.array(offsets)
     out.cusps = np.array(cusps)
     return out
+
+
+def _kernel_offsets(surface: DropSurface, cutter: Cutter, boundary: Rect, angle_deg: float, cusp: float,
+                    sample_step: float, floor_z: float, stock_to_leave: float, max_slope_deg: float, s_min: float,
+                    s_max: float, progress: Optional[Progress]) -> AdaptivePasses:
+    """The same placement in the kernel (native/src/query/adaptive_raster.cpp): `surface` holds the turned mesh."""
+    o = native.AdaptiveRasterOptions()
+    o.xmin, o.ymin, o.xmax, o.ymax = (float(v) for v in boundary)
+    o.angle, o.max_slope = math.radians(angle_deg), math.radians(max_slope_deg)
+    o.cusp, o.sample_step, o.floor_z, o.stock_to_leave = cusp, sample_step, floor_z, stock_to_leave
+    o.step_min, o.step_max = s_min, s_max
+    try:
+        offsets, cusps, info = native.adaptive_raster(surface.index, cutter.offset(stock_to_leave).native,
+                                                      cutter.native, o, progress=progress)
+    except native.Cancelled as exc:
+        raise Cancelled("tool path computation cancelled") from exc
+    except ValueError as exc:
+        raise TmmError(f"adaptive raster: {exc}") from exc
+    return AdaptivePasses(offsets, cusps, info["limited"], info["unreachable"], info["evaluations"])
