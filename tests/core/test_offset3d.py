@@ -72,19 +72,19 @@ def test_flat_plate_gaps_are_the_planar_rule_and_loops_nest():
         assert _distances(np.vstack(by_level[k]), by_level[k - 1]).max() <= step + 1e-6
         pts = max(by_level[k], key=lambda p: abs(polygons.signed_area(p[:-1])))  # the level's loop, not a speck
         gap = _distances(pts, by_level[k - 1])
-        assert np.abs(gap - (step if k < r.levels - 1 else 0.5 * step)).max() <= 1e-6, k
+        off = np.abs(gap - (step if k < r.levels - 1 else 0.5 * step)) > 1e-6
+        # but the corner spikes (out along the bisector, toward the loop before)
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        corners = np.array([lo, hi, [lo[0], hi[1]], [hi[0], lo[1]]])
+        to_corner = np.hypot(*(pts[off, None, :] - corners[None]).transpose(2, 0, 1)).min(axis=1)
+        assert to_corner.max(initial=0.0) <= 0.25 * step, k
         outer = [p[:-1] for p in by_level[k - 1]]
         assert polygons.covers(outer, [p[:-1] for p in by_level[k]], tol_area=1e-9)  # nested
     # covered: every point of the region lies within half a step of a loop (no strip left between the last
-    # ones) but on the diagonals of the corners, within 0.586 of it there (the module's limitation)
-    xs, ys = np.meshgrid(np.linspace(0, 40, 81), np.linspace(0, 30, 61))
+    # ones; on the corners' bisectors, thanks to the spikes); the probes include the bisectors x - y = 0, 10
+    xs, ys = np.meshgrid(np.linspace(0, 40, 161), np.linspace(0, 30, 121))
     probe = np.column_stack([xs.ravel(), ys.ravel()])
-    far = _distances(probe, [lp.points for lp in r.loops])
-    assert far.max() <= 0.586 * step + 1e-3
-    x, y = probe.T   # the corners' bisectors: x - y = 0 and 10, x + y = 30 and 40
-    diagonal = np.minimum(np.minimum(np.abs(x - y), np.abs(x - y - 10)), np.minimum(np.abs(x + y - 30),
-                                                                                     np.abs(x + y - 40)))
-    assert far[diagonal > 1.0].max() <= 0.5 * step + 1e-6
+    assert _distances(probe, [lp.points for lp in r.loops]).max() <= 0.5 * step + 1e-6
 
 
 def test_region_with_a_hole_grows_the_hole_and_splits():
@@ -108,7 +108,7 @@ def test_region_with_a_hole_grows_the_hole_and_splits():
     probe = probe[[polygons.contains_point(region, p) for p in probe]]
     # (by sharp corners within 4 %: the distances there are rounded down on a grid of the step / 25, and
     # specks under a quarter step square are not given loops of their own)
-    assert _distances(probe, [lp.points for lp in r.loops]).max() <= 0.586 * step + 1e-3
+    assert _distances(probe, [lp.points for lp in r.loops]).max() <= 0.5 * step + 1e-6
 
 
 def test_flat_plate_path_through_the_strategy():
@@ -149,10 +149,10 @@ def test_dome_cusp_within_the_height_and_no_gouge_in_the_simulated_stock():
     cos = np.cos(np.radians(slope_deg(dense, grid.cell)))
     assert np.abs(dense - design).max() < 0.5 * tol               # reachable everywhere here
     cusp = (cut - dense) * cos
-    # within the cusp height but along the box corners' diagonals (the loops keep the corners sharp: up to
-    # 1.37 x there, module doc; measured 1.28 x on 0.1 % of the cells)
-    assert (cusp > tol).mean() <= 3e-3
-    assert cusp.max() <= 1.37 * tol
+    # within the cusp height but at a few spots (measured: 0.017 % of the cells, up to 1.084 x, beside two of the
+    # loops' starts; the planar rule on a curved surface and the 0.25 mm chords along the loops: stated 10 %)
+    assert (cusp > tol).mean() <= 1e-3
+    assert cusp.max() <= 1.10 * tol
     assert cusp.max() >= 0.5 * tol                                # not much finer than asked
     assert (cut - design).min() >= -1e-3                          # no gouge
     # fewer loops than a constant raster at the steepest crossing would need passes

@@ -23,11 +23,11 @@ rule), each group swept by a disc of its radius (round ends, so neighbouring gro
 united and subtracted from the region left. Round ends are chords inside the circle, within `arc_tol` of
 it: the XY gap can exceed d by that much (0 on straight edges, where the flat-plate test holds to 1e-6 mm).
 A piece narrower than two steps (a strip, a wedge's tip, the middle) gets a last loop half a step in, so
-points there lie within d / 2 of a loop too. Not handled: an erosion keeps a sharp convex corner sharp, and on
-its bisector the point between two loops' corners lies d / (1 + sin(half the corner's angle)) from both
-(0.586 d at a right angle: the cusp there up to 1.37 x the flat rule's, along a thin line on the diagonal).
-Shrinking d near corners was tried: the next loop then has steps that are sharp corners of their own, and the
-loops degrade level by level.
+points there lie within d / 2 of a loop too. An erosion keeps a sharp convex corner sharp, and on its bisector
+the point between two loops' corners lies d / (1 + sin(half the corner's angle)) from both (0.586 d at a right
+angle: 1.37 x the cusp): the cut loop gets a short spike out along the bisector there (_spiked), which brings
+it to d / 2. (Shrinking d near corners was tried first: the next loop then has steps that are sharp corners of
+their own, and the loops degrade level by level.)
 """
 from __future__ import annotations
 
@@ -49,6 +49,7 @@ Heights = Callable[[np.ndarray], np.ndarray]   # XY (n, 2) -> CL tip heights (n,
 Progress = Callable[[float], bool]
 _BUCKETS = 25          # distance grid: the flat step / 25 (4 %), rounded down
 _SLOPE_GRID_DEG = 5.0  # the rule's step is tabulated every 5 deg and interpolated (concave: under the rule)
+_SHARP_RAD = math.radians(20.0)  # turns above this are corners (Clipper's round joins turn less per vertex)
 _MIN_AREA_FRACTION = 1e-4  # left-over pieces smaller than (this x flat step^2) are Clipper's crumbs
 
 
@@ -164,6 +165,35 @@ def _running_min(d: np.ndarray, reach: int) -> np.ndarray:
     return np.append(out, out[0])
 
 
+def _spiked(loop: np.ndarray, before: list[np.ndarray], sample_step: float) -> np.ndarray:
+    """The loop with a spike out of each sharp convex corner along its bisector, toward the loop before (a
+    corner clean-up: the erosion keeps corners sharp, and between two loops' corners the point on the bisector
+    lies g / (1 + s) from both, g the gap, s = cos(turn / 2): 0.586 g at a right angle). A spike of length
+    e = g (1 - s) / (2 s) brings it to g / 2 (the tool goes out and back, dropped like any point). Only the cut
+    path has spikes; the next loop is made from the loop without them."""
+    p = loop[:-1]
+    a = p - np.roll(p, 1, axis=0)
+    b = np.roll(p, -1, axis=0) - p
+    la, lb = np.hypot(*a.T), np.hypot(*b.T)
+    turn = np.arctan2(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0], (a * b).sum(axis=1))  # left: convex (region left)
+    sharp = np.flatnonzero((turn > _SHARP_RAD) & (la > 1e-9) & (lb > 1e-9))
+    if not len(sharp):
+        return loop
+    gap, _ = _gaps(p[sharp], before)
+    parts, last = [], 0
+    for i, g in zip(sharp, gap):
+        s = math.cos(min(float(turn[i]), math.radians(150.0)) / 2)
+        e = g * (1 - s) / (2 * s)
+        out_dir = a[i] / la[i] - b[i] / lb[i]
+        out_dir /= max(float(np.hypot(*out_dir)), 1e-300)
+        n = max(1, math.ceil(e / sample_step))
+        there = p[i] + np.outer(np.arange(1, n + 1) / n, out_dir * e)
+        parts += [p[last:i + 1], there, there[-2::-1], p[i:i + 1]]
+        last = i + 1
+    body = np.vstack(parts + [p[last:]])
+    return np.vstack([body, body[:1]])
+
+
 def _sweep(loop: np.ndarray, d: np.ndarray, quantum: float, flat: float, arc_tol: float) -> Shape:
     """What discs of radius d (per point, rounded down to the grid) sweep along the closed loop."""
     seg = np.minimum(d[:-1], d[1:])                             # per segment: the smaller end's distance
@@ -263,11 +293,12 @@ def offset_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sa
         if level >= max_levels:
             raise TmmError(f"3D offset: more than {max_levels} loops")
         nxt: list[polygons.Region] = []
+        cut_before = [lp.points for lp in out.loops if lp.level == level - 1]
         for piece in left:  # each connected piece on its own: one may be covered while others go on
             swept: list[tuple[np.ndarray, np.ndarray]] = []
             for p in piece.shape:
                 loop = _sample_polyline(_closed(_clean(p, arc_tol)), sample_step)
-                out.loops.append(Loop(loop, level))
+                out.loops.append(Loop(_spiked(loop, cut_before, sample_step) if cut_before else loop, level))
                 slope, curvature = _across(loop, heights, flat)
                 # a concave CL section of curvature k leaves (1 + R k) times the flat cusp for the same spacing
                 # (a ball of radius R: module doc); the cusp grows as the step squared. Convex places keep the
