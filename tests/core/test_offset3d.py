@@ -201,3 +201,13 @@ def test_slope_narrows_the_xy_gap_by_the_rule():
     on_slope = (second[:, 0] > 3) & (second[:, 0] < 37)
     assert np.abs(gap[on_slope] - stepover_for_cusp(BALL, 0.01, 30.0)).max() <= 0.04 * r.flat_step
     assert gap[on_slope].max() <= stepover_for_cusp(BALL, 0.01, 30.0) + 1e-6
+
+
+def test_cancel_stops_before_any_path():
+    from tmm_workbench.core.errors import Cancelled
+
+    params = SurfaceParams(boundary=(0, 0, 40, 30), sample_step=0.5, stepover_mode=OFFSET3D, cusp=0.01)
+    seen = []
+    with pytest.raises(Cancelled):
+        compute(plate(), BALL, params, progress=lambda f: seen.append(f) or f < 0.2)
+    assert seen and max(seen) <= 0.5  # cancelled while the loops were made (their half of the progress)
