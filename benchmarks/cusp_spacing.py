@@ -11,6 +11,8 @@ core.footprint.variable_step: partial passes added where the simulated cusp exce
 
     .venv/bin/python benchmarks/cusp_spacing.py            # sphere_on_plate and mount_rush, ball D6, 0.01 mm
     .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
+    .venv/bin/python benchmarks/cusp_spacing.py --quick --offset3d-only   # only the 3D offset row (and the
+                                                           # dense raster it is measured against)
     .venv/bin/python benchmarks/cusp_spacing.py --seed000  # seed 000's convex and concave surfaces (ball D 0.5 in,
                                                            # cusp 0.002 in; benchmarks/seed000_surfaces.py)
     ... --reference   # the adaptive passes placed by the numpy reference (as before the kernel port) to compare
@@ -56,7 +58,8 @@ def cycle(path) -> float:
     return three_axis_time(tips, toolpath_feeds(path, FEED, PLUNGE)).seconds
 
 
-def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundary=None) -> list[str]:
+def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundary=None,
+        offset3d_only: bool = False) -> list[str]:
     """The table for one model; `cell` is the simulation's cell and the dense raster's step-over (its own cusp
     is negligible against `tol`); `boundary` (x0, y0, x1, y1) the region, by default the model's box."""
     lo, hi = mesh.bounds
@@ -67,6 +70,12 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     field = cusp_field(mesh, cutter, boundary, tol, cell, SLOPE_LIMIT, sample_step=0.25)
 
     rows = []
+    # --- 3D offset (constant scallop loops from the boundary inward; core.footprint.offset3d) ---
+    path, secs, n = raster(mesh, cutter, boundary, stepover_mode="offset3d", cusp=tol, max_slope_deg=SLOPE_LIMIT)
+    c, share = measure(field, path, cutter)
+    rows.append(("3D offset (loops)", n, c, cycle(path), secs, len(path)))
+    if offset3d_only:
+        return _table(name, mesh, cutter, tol, share, rows)
     path, secs, n_adaptive = raster(mesh, cutter, boundary, stepover_mode="adaptive", cusp=tol,
                                     max_slope_deg=SLOPE_LIMIT)
     cusp, share = measure(field, path, cutter)
@@ -103,19 +112,25 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
         rows.append((label, f"{result.diagnostics['passes']} + {v['passes_added']} partial "
                             f"({v['length_added'] / 1000:.2f} m)", c, cycle(path), secs, len(path)))
 
+    out = _table(name, mesh, cutter, tol, share, rows)
+    if best is not None:
+        out.append(f"passes: constant step-over at the same max cusp / adaptive = {best[1] / n_adaptive:.2f}")
+    return out
+
+
+def _table(name, mesh, cutter, tol, share, rows) -> list[str]:
     out = [f"\n{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm (slopes up to "
            f"{SLOPE_LIMIT:g} deg; {share:.0%} of the cells measured)",
            "| spacing | passes | simulated max cusp mm | cycle min | compute s | moves |", "|---|---|---|---|---|---|"]
     for label, n, c, t, secs, moves in rows:
         out.append(f"| {label} | {n} | {c:.4f} | {t / 60:.1f} | {secs:.1f} | {moves} |")
-    if best is not None:
-        out.append(f"passes: constant step-over at the same max cusp / adaptive = {best[1] / n_adaptive:.2f}")
     return out
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
+    ap.add_argument("--offset3d-only", action="store_true", help="only the 3D offset row")
     ap.add_argument("--seed000", action="store_true", help="seed 000's convex and concave surfaces only")
     ap.add_argument("--window", type=float, default=100.0,
                     help="with --seed000: the side in mm of the square region centred on the surface (0: all of "
@@ -146,7 +161,8 @@ def main() -> None:
     if not args.quick:
         cases.append(("mount_rush", stl / "mount_rush.stl"))
     for name, path in cases:
-        print("\n".join(run(name, load_stl(path), Cutter.ball(6.0), 0.01)), flush=True)
+        print("\n".join(run(name, load_stl(path), Cutter.ball(6.0), 0.01, offset3d_only=args.offset3d_only)),
+              flush=True)
 
 
 if __name__ == "__main__":

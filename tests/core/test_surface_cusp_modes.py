@@ -69,7 +69,8 @@ def test_bad_cusp_input_is_named():
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="cusp", cusp=4.0))
     with pytest.raises(TmmError, match="cusp height must be a positive length, got 0"):
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="adaptive", cusp=0.0))
-    with pytest.raises(TmmError, match="step-over mode must be 'stepover' or 'cusp' or 'adaptive', got 'x'"):
+    with pytest.raises(TmmError,
+                       match="step-over mode must be 'stepover' or 'cusp' or 'adaptive' or 'offset3d', got 'x'"):
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="x"))
     with pytest.raises(TmmError, match=r"cusp slope limit must be in \(0, 90\) deg, got 90"):
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="cusp", max_slope_deg=90.0))

@@ -192,7 +192,7 @@ class CuspSpacing(FreeCADTestCase):
         doc = new_doc("TmmCusp")
         _, _, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.5})
         self.assertEqual(op.StepOverMode, "StepOver")                  # a new op: the step-over, as before
-        self.assertEqual(op.getEnumerationsOfProperty("StepOverMode"), ["StepOver", "Cusp", "Adaptive"])
+        self.assertEqual(op.getEnumerationsOfProperty("StepOverMode"), ["StepOver", "Cusp", "Adaptive", "Offset3D"])
         ys = lambda: sorted({round(p["Y"], 6) for n, p in moves(op) if n == "G1"})  # noqa: E731
         fixed = ys()
         for mode in ("Cusp", "Adaptive"):

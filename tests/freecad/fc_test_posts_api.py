@@ -204,7 +204,8 @@ class Api(FreeCADTestCase):
                              ({"boundary": "custom"}, "boundary"),
                              ({"tool": "bullnose", "corner_radius": 4.0}, "larger than the tool radius"),
                              ({"stepover": 0.0}, "must be a positive length"),
-                             ({"stepover_mode": "scallop"}, "stepover_mode must be one of stepover, cusp, adaptive, got 'scallop'"),
+                             ({"stepover_mode": "scallop"},
+                              "stepover_mode must be one of stepover, cusp, adaptive, offset3d, got 'scallop'"),
                              ({"cusp": -1.0}, "cusp must be a positive length, got -1")):
             with self.subTest(**kwargs):
                 with self.assertRaises(TmmError) as ctx:

@@ -45,6 +45,7 @@ BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
 FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes (issue 14 item 2)
+STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region's edge inward (issue 14 item 1)
 
 
 @dataclass
@@ -88,6 +89,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
     `cusp` on the boundary's steepest crossing) | 'adaptive' (each pass placed from the previous one's tool
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
+    stepover_mode 'offset3d': closed loops from the region's boundary inward, spaced so the cusp between
+    neighbours is `cusp` across the local slope (3D offset / constant scallop; pattern 'zigzag' links them,
+    'oneway' lifts before each).
     region (where the tool centre may go; app.region_source): None (the boundary box), a sketch or any
     object with closed edges (inner loops are holes), or faces of the model seen from above: face names
     ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.

@@ -33,6 +33,7 @@ from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL
                                                        STEPOVER, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
 from tmm_workbench.core.strategies.raster_drop import SAMPLED, TOLERANCE
+from tmm_workbench.core.strategies.raster_drop import OFFSET3D  # the 3D offset spacing
 from tmm_workbench.core.strategies.raster_lean import arc_offsets
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
@@ -97,6 +98,9 @@ PROPERTIES: list[Prop] = [
          "Cut only where the surface slope is at most this (steeper walls left to waterline)", "slope_max_deg"),
 ]
 SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE}
+# 3D offset (issue 14 item 1): closed loops from the region's edge inward, CuspHeight apart across the surface
+# (core.strategies.raster_offset3d); a document saved before it gets the choice on restore (op_base)
+SPACINGS["Offset3D"] = OFFSET3D
 FORWARD_STEPS = {"Tolerance": TOLERANCE, "SampleStep": SAMPLED}
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
            "StepOverMode": SPACINGS, "ForwardStep": FORWARD_STEPS}

@@ -38,6 +38,7 @@ OUTWARD, INWARD = "outward", "inward"
 # hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
 # is split, the tool lifts to the safe height and plunges again where the model resumes.
 STEPOVER, CUSP, ADAPTIVE = "stepover", "cusp", "adaptive"
+OFFSET3D = "offset3d"  # closed loops from the region's edge inward by the cusp height (core.strategies.raster_offset3d)
 OFF_MODEL_FLOOR = "floor"
 OFF_MODEL_SKIP = "skip"
 # The forward step along a pass: SAMPLED keeps the samples (reduce_chords thins them, above only); TOLERANCE
@@ -70,7 +71,7 @@ class SurfaceParams(StrategyParams):
     # cusp height on the region's steepest crossing, up to max_slope_deg; planar, core.footprint.cusp) or
     # ADAPTIVE (each pass placed from the previous one's CL points so the cusp between them is the cusp height;
     # core.footprint.adaptive_raster)
-    stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE))
+    stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE, OFFSET3D))
     cusp: float = param(0.01, "cusp height", "mm", low=0, low_open=True, kind="length")
     max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
     # --- machining region, spiral and slope range (issue 14 item 3: core.strategies.raster_region) ---
@@ -145,13 +146,20 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
     floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
     diagnostics: dict = {}
-    lines = _pass_lines(mesh, cutter, params, floor_z, diagnostics, progress)
+    lines = [] if params.stepover_mode == OFFSET3D else _pass_lines(mesh, cutter, params, floor_z, diagnostics, progress)
     if params.pattern == ZIGZAG:
         lines = [ln if i % 2 == 0 else ln[::-1] for i, ln in enumerate(lines)]
     # Runs of XY points: passes, and for zig-zag the links between them, dropped in one batch.
     runs: list[tuple[bool, np.ndarray]] = []  # (is_link, xy)
     chains = None  # a region or the spiral: runs in chains cut with the tool down, jumps between them
-    if params.region is not None or params.pattern == SPIRAL:
+    if params.stepover_mode == OFFSET3D:  # 3D offset: loops from the region's edge inward
+        from tmm_workbench.core.strategies import raster_offset3d, raster_region
+
+        surface = surface or DropSurface(mesh)
+        chains = raster_offset3d.chains(mesh, surface, cutter, params, floor_z, diagnostics,
+                                        None if progress is None else lambda f: progress(0.5 * f))
+        runs = raster_region.flatten(chains)
+    elif params.region is not None or params.pattern == SPIRAL:
         from tmm_workbench.core.strategies import raster_region
 
         chains = raster_region.chains(lines, cutter, params, diagnostics)
@@ -174,7 +182,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
         return np.maximum(zz, floor_z), aa
 
-    if progress is not None and params.stepover_mode == ADAPTIVE:  # the placement reported the first half
+    if progress is not None and params.stepover_mode in (ADAPTIVE, OFFSET3D):  # the placement reported the first half
         report = progress
         progress = lambda f: report(0.5 + 0.5 * f)  # noqa: E731
     z, air = drop(xy, progress)
@@ -304,8 +312,8 @@ def reduce_chords(pts: np.ndarray, tol: float) -> np.ndarray:
     xy = pts[:, :2]
     d = xy[-1] - xy[0]
     length = float(np.hypot(*d))
-    if length <= 0:
-        return pts[[0, -1]] if np.ptp(pts[:, 2]) <= _COLLINEAR_MM else pts
+    if length <= 0:  # all on one XY point (a closed 3D offset loop also ends where it starts: kept as it is)
+        return pts[[0, -1]] if np.ptp(pts[:, 2]) <= _COLLINEAR_MM and np.ptp(xy, axis=0).max() <= _COLLINEAR_MM else pts
     u = d / length
     s = (xy - xy[0]) @ u                                   # distance along the pass
     off = np.abs((xy - xy[0]) @ np.array([-u[1], u[0]]))  # off the pass line (none, for a raster pass)
