@@ -28,10 +28,9 @@ def expect_like_reference(level: list[WaterlineLoop], ref: list[WaterlineLoop], 
         d = min(distance_to_polylines(r.xy, *segments_of([lp])).max() for lp in level if lp.island == r.island)
         assert d <= fine, f"a reference loop of area {r.area:.4g} lies {d:.4g} mm from ours"
     a, b = segments_of(level)
-    # the reference's points are exact crossings too: our chords near the tolerance of them (probed at the
-    # chords' middles and quarters only: up to 24 % more on the relief where the farthest point lies between
-    # the probes, docs/waterline.md)
-    assert distance_to_polylines(np.vstack([r.xy for r in ref]), a, b).max() <= 1.25 * tol
+    # the reference's points are exact crossings too: within the tolerance of our chords (probed at 3/4 of it at
+    # the middles and quarters: 4/3 of that bounds a loop bending one way between two points, docs/waterline.md)
+    assert distance_to_polylines(np.vstack([r.xy for r in ref]), a, b).max() <= tol + 1e-6
 
 
 @pytest.mark.parametrize("cutter", CUTTERS, ids=lambda c: c.kind)

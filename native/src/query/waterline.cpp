@@ -509,19 +509,28 @@ bool Level::off_chord(Probe& pr, const Point& p, const Point& q, double t, Point
   const double nx = -dy / length, ny = dx / length;  // left normal: the blocked side
   const Point m{p.x + t * dx, p.y + t * dy, true};
   const bool m_blocked = blocked(pr, m.x, m.y);
-  // The boundary lies towards the free side of m (right if m is blocked, left if free): within chord_tol
-  // when the state changes there already.
+  // The boundary lies towards the free side of m (right if m is blocked, left if free): within the probe
+  // distance when the state changes there already. The probe distance is 3/4 of chord_tol: where the loop
+  // bends one way between p and q, its distance from the chord is at most 4/3 of the largest of its distances
+  // at the quarters and the middle (a concave function through the five points: the secants extended), so
+  // chords pass only when that bound is within chord_tol.
   const double sign = m_blocked ? -1.0 : 1.0;
   auto along = [&](double s) { return Point{m.x + sign * s * nx, m.y + sign * s * ny, true}; };
-  double s_in = 0.0, s_out = o_.chord_tol;
+  const double probe = 0.75 * o_.chord_tol;
+  // Past the chord's length the search goes on in steps of that length (at least the finest square) up to a
+  // grid step: a spike of the loop (the tip of a narrow free crack or of a blocked sliver, a notch between two
+  // discs of a flat end mill) runs that far from its chord between the nodes of the squares.
+  const double walk = std::max(length, std::max(g_.dx, g_.dy) / static_cast<double>(g_.k));
+  const double reach = std::max(length, std::max(g_.dx, g_.dy));
+  double s_in = 0.0, s_out = probe;
   Point out_pt = along(s_out);
   while (blocked(pr, out_pt.x, out_pt.y) == m_blocked) {
     s_in = s_out;
-    s_out *= 2.0;
-    if (s_out > length) return false;  // no boundary within a chord length: leave the chord
+    s_out = s_out < length ? 2.0 * s_out : s_out + walk;
+    if (s_out > reach) return false;  // no boundary within reach: leave the chord
     out_pt = along(s_out);
   }
-  if (s_in == 0.0) return false;  // the exact loop is within chord_tol of the chord here
+  if (s_in == 0.0) return false;  // the exact loop is within the probe distance of the chord here
   const Point in_pt = along(s_in);
   const Point& f = m_blocked ? out_pt : in_pt;
   const Point& b = m_blocked ? in_pt : out_pt;
