@@ -158,7 +158,13 @@ class Level {
   // Whether the exact loop crosses the perpendicular through p + t (q - p) farther than chord_tol from the
   // chord (inside the bounds); c: that crossing.
   bool off_chord(Probe& pr, const Point& p, const Point& q, double t, Point& c) const;
-  void refine(Probe& pr, const Point& p, const Point& q, int depth, std::vector<Point>& out) const;
+  // The first change of state along m + s (ux, uy), s from the probe distance (3/4 chord_tol) on, doubling up to
+  // `length`, then in steps of `length` (at least the finest square) up to a grid step; c: its exact crossing
+  // (inside the bounds). False when the state changes within the probe distance or not within reach.
+  bool walk(Probe& pr, const Point& m, bool m_blocked, double ux, double uy, double length, Point& c) const;
+  // Refines chord p -> q; u and w: the loop's points before p and after q (the directions it arrives and leaves).
+  void refine(Probe& pr, const Point& u, const Point& p, const Point& q, const Point& w, int depth,
+              std::vector<Point>& out) const;
 
   const MeshIndex& index_;
   const Cutter& cutter_;
@@ -509,28 +515,32 @@ bool Level::off_chord(Probe& pr, const Point& p, const Point& q, double t, Point
   const double nx = -dy / length, ny = dx / length;  // left normal: the blocked side
   const Point m{p.x + t * dx, p.y + t * dy, true};
   const bool m_blocked = blocked(pr, m.x, m.y);
-  // The boundary lies towards the free side of m (right if m is blocked, left if free): within the probe
-  // distance when the state changes there already. The probe distance is 3/4 of chord_tol: where the loop
-  // bends one way between p and q, its distance from the chord is at most 4/3 of the largest of its distances
-  // at the quarters and the middle (a concave function through the five points: the secants extended), so
-  // chords pass only when that bound is within chord_tol.
+  // The boundary lies towards the free side of m (right if m is blocked, left if free).
   const double sign = m_blocked ? -1.0 : 1.0;
-  auto along = [&](double s) { return Point{m.x + sign * s * nx, m.y + sign * s * ny, true}; };
+  return walk(pr, m, m_blocked, sign * nx, sign * ny, length, c);
+}
+
+bool Level::walk(Probe& pr, const Point& m, bool m_blocked, double ux, double uy, double length, Point& c) const {
+  auto along = [&](double s) { return Point{m.x + s * ux, m.y + s * uy, true}; };
+  // The probe distance is 3/4 of chord_tol: where the loop bends one way between two points, its distance
+  // from their chord is at most 4/3 of the largest of its distances at the quarters and the middle (a concave
+  // function through the five points: the secants extended), so chords pass only when that bound is within
+  // chord_tol.
   const double probe = 0.75 * o_.chord_tol;
   // Past the chord's length the search goes on in steps of that length (at least the finest square) up to a
   // grid step: a spike of the loop (the tip of a narrow free crack or of a blocked sliver, a notch between two
   // discs of a flat end mill) runs that far from its chord between the nodes of the squares.
-  const double walk = std::max(length, std::max(g_.dx, g_.dy) / static_cast<double>(g_.k));
+  const double step = std::max(length, std::max(g_.dx, g_.dy) / static_cast<double>(g_.k));
   const double reach = std::max(length, std::max(g_.dx, g_.dy));
   double s_in = 0.0, s_out = probe;
   Point out_pt = along(s_out);
   while (blocked(pr, out_pt.x, out_pt.y) == m_blocked) {
     s_in = s_out;
-    s_out = s_out < length ? 2.0 * s_out : s_out + walk;
+    s_out = s_out < length ? 2.0 * s_out : s_out + step;
     if (s_out > reach) return false;  // no boundary within reach: leave the chord
     out_pt = along(s_out);
   }
-  if (s_in == 0.0) return false;  // the exact loop is within the probe distance of the chord here
+  if (s_in == 0.0) return false;  // the exact loop is within the probe distance here
   const Point in_pt = along(s_in);
   const Point& f = m_blocked ? out_pt : in_pt;
   const Point& b = m_blocked ? in_pt : out_pt;
@@ -540,18 +550,35 @@ bool Level::off_chord(Probe& pr, const Point& p, const Point& q, double t, Point
   return c.x >= o_.xmin - slack && c.x <= o_.xmax + slack && c.y >= o_.ymin - slack && c.y <= o_.ymax + slack;
 }
 
-void Level::refine(Probe& pr, const Point& p, const Point& q, int depth, std::vector<Point>& out) const {
-  if (depth >= o_.max_depth || std::hypot(q.x - p.x, q.y - p.y) < o_.min_segment) return;
+void Level::refine(Probe& pr, const Point& u, const Point& p, const Point& q, const Point& w, int depth,
+                   std::vector<Point>& out) const {
+  const double length = std::hypot(q.x - p.x, q.y - p.y);
+  if (depth >= o_.max_depth || length < o_.min_segment) return;
+  auto split_at = [&](const Point& c) {
+    refine(pr, u, p, c, q, depth + 1, out);
+    out.push_back(c);
+    refine(pr, p, c, q, w, depth + 1, out);
+  };
   // The midpoint, then the quarters: on a faceted mesh the loop's curvature changes along a chord, so its
   // farthest point need not lie at the middle.
   Point c;
   for (double t : {0.5, 0.25, 0.75}) {
     if (!off_chord(pr, p, q, t, c)) continue;
-    refine(pr, p, c, depth + 1, out);
-    out.push_back(c);
-    refine(pr, c, q, depth + 1, out);
+    split_at(c);
     return;
   }
+  // The loop turning back by more than a right angle over the chord (arriving at p against the way it leaves
+  // q): the tip of a spike, a crack or a notch may lie beyond the chord's ends, where no perpendicular through
+  // it reaches. It is searched from the middle along the way the loop points there (the two directions' mean).
+  const double ia = std::hypot(p.x - u.x, p.y - u.y), ob = std::hypot(w.x - q.x, w.y - q.y);
+  if (!(ia > 0.0 && ob > 0.0)) return;
+  const double ix = (p.x - u.x) / ia, iy = (p.y - u.y) / ia, ox = (w.x - q.x) / ob, oy = (w.y - q.y) / ob;
+  if (ix * ox + iy * oy >= 0.0) return;
+  const double dx = ix - ox, dy = iy - oy, dl = std::hypot(dx, dy);
+  const Point m{0.5 * (p.x + q.x), 0.5 * (p.y + q.y), true};
+  // A crossing there beyond the probe distance is inserted even when it lies beside the chord (on a crack's
+  // side): the chords from it reach across towards the tip, and their own walks go on.
+  if (walk(pr, m, blocked(pr, m.x, m.y), dx / dl, dy / dl, length, c)) split_at(c);
 }
 
 std::vector<WaterlineLoop> Level::loops() {
@@ -646,9 +673,10 @@ std::vector<WaterlineLoop> Level::loops() {
     for (std::size_t c = begin; c < end; ++c) {
       const auto& pts = loops_pts[chords[c].first];
       const std::size_t i = chords[c].second;
+      const std::size_t n = pts.size();
       const Point& p = pts[i];
-      const Point& q = pts[(i + 1) % pts.size()];
-      if (p.contact && q.contact) refine(pr, p, q, 0, inserted[c]);
+      const Point& q = pts[(i + 1) % n];
+      if (p.contact && q.contact) refine(pr, pts[(i + n - 1) % n], p, q, pts[(i + 2) % n], 0, inserted[c]);
     }
     worker_drops += pr.drops;
   });
