@@ -311,9 +311,10 @@ bool Level::split_wanted(const Square& q) {
   const double pocket_band = std::max(band, R - std::sqrt(std::max(R * R - r * r, 0.0)));
   bool near = false;
   for (double v : h) near = near || (v <= z_ ? z_ - v < band : v - z_ < pocket_band);
-  if (!near && q.L == g_.k) {
+  if (!near && q.L == g_.k && (blocked_corners == 0 || blocked_corners == 4)) {
     // The drop height bending between the grid nodes: its range inside the cell by the cubic through the
-    // 4 x 4 nodes around it (no drops), for the smooth dips and crests the corners do not show.
+    // 4 x 4 nodes around it (no drops), for the smooth dips and crests the corners do not show. Only for cells
+    // of one state: a cell the loop already crosses has a range about z whatever it hides.
     double lo = kInf, hi = -kInf;
     if (cubic_range(q.X / g_.k, q.Y / g_.k, lo, hi)) near = lo < z_ + pocket_band && hi > z_ - band;
   }
