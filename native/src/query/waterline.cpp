@@ -155,10 +155,16 @@ class Level {
   bool cell_refined(std::size_t I, std::size_t J) const {
     return !tree_of_.empty() && tree_of_[J * (g_.NX - 1) + I] >= 0;
   }
-  // Whether the exact loop crosses the perpendicular through p + t (q - p) farther than chord_tol from the
-  // chord (inside the bounds); c: that crossing.
+  // Whether the exact loop crosses the perpendicular through p + t (q - p) farther than 3/4 chord_tol from the
+  // chord (within reach, inside the bounds); c: that crossing.
   bool off_chord(Probe& pr, const Point& p, const Point& q, double t, Point& c) const;
-  void refine(Probe& pr, const Point& p, const Point& q, int depth, std::vector<Point>& out) const;
+  // The first change of state along m + s (ux, uy), sampled at s = 3/4 chord_tol, then doubling up to
+  // `length`, then in steps of `length` (at least the finest square) up to a grid step: whether it lies beyond
+  // the first sample (within reach, inside the bounds); c: its exact crossing.
+  bool walk(Probe& pr, const Point& m, bool m_blocked, double ux, double uy, double length, Point& c) const;
+  // Refines chord p -> q; u and w: the loop's points before p and after q (the directions it arrives and leaves).
+  void refine(Probe& pr, const Point& u, const Point& p, const Point& q, const Point& w, int depth,
+              std::vector<Point>& out) const;
 
   const MeshIndex& index_;
   const Cutter& cutter_;
@@ -305,9 +311,10 @@ bool Level::split_wanted(const Square& q) {
   const double pocket_band = std::max(band, R - std::sqrt(std::max(R * R - r * r, 0.0)));
   bool near = false;
   for (double v : h) near = near || (v <= z_ ? z_ - v < band : v - z_ < pocket_band);
-  if (!near && q.L == g_.k) {
+  if (!near && q.L == g_.k && (blocked_corners == 0 || blocked_corners == 4)) {
     // The drop height bending between the grid nodes: its range inside the cell by the cubic through the
-    // 4 x 4 nodes around it (no drops), for the smooth dips and crests the corners do not show.
+    // 4 x 4 nodes around it (no drops), for the smooth dips and crests the corners do not show. Only for cells
+    // of one state: a cell the loop already crosses has a range about z whatever it hides.
     double lo = kInf, hi = -kInf;
     if (cubic_range(q.X / g_.k, q.Y / g_.k, lo, hi)) near = lo < z_ + pocket_band && hi > z_ - band;
   }
@@ -509,19 +516,28 @@ bool Level::off_chord(Probe& pr, const Point& p, const Point& q, double t, Point
   const double nx = -dy / length, ny = dx / length;  // left normal: the blocked side
   const Point m{p.x + t * dx, p.y + t * dy, true};
   const bool m_blocked = blocked(pr, m.x, m.y);
-  // The boundary lies towards the free side of m (right if m is blocked, left if free): within chord_tol
-  // when the state changes there already.
+  // The boundary lies towards the free side of m (right if m is blocked, left if free).
   const double sign = m_blocked ? -1.0 : 1.0;
-  auto along = [&](double s) { return Point{m.x + sign * s * nx, m.y + sign * s * ny, true}; };
-  double s_in = 0.0, s_out = o_.chord_tol;
+  return walk(pr, m, m_blocked, sign * nx, sign * ny, length, c);
+}
+
+bool Level::walk(Probe& pr, const Point& m, bool m_blocked, double ux, double uy, double length, Point& c) const {
+  auto along = [&](double s) { return Point{m.x + s * ux, m.y + s * uy, true}; };
+  const double probe = 0.75 * o_.chord_tol;
+  // Past the chord's length the search goes on in steps of that length (at least the finest square) up to a
+  // grid step: a spike of the loop (the tip of a narrow free crack or of a blocked sliver, a notch between two
+  // discs of a flat end mill) runs that far from its chord between the nodes of the squares.
+  const double step = std::max(length, std::max(g_.dx, g_.dy) / static_cast<double>(g_.k));
+  const double reach = std::max(length, std::max(g_.dx, g_.dy));
+  double s_in = 0.0, s_out = probe;
   Point out_pt = along(s_out);
   while (blocked(pr, out_pt.x, out_pt.y) == m_blocked) {
     s_in = s_out;
-    s_out *= 2.0;
-    if (s_out > length) return false;  // no boundary within a chord length: leave the chord
+    s_out = s_out < length ? 2.0 * s_out : s_out + step;
+    if (s_out > reach) return false;  // no boundary within reach: leave the chord
     out_pt = along(s_out);
   }
-  if (s_in == 0.0) return false;  // the exact loop is within chord_tol of the chord here
+  if (s_in == 0.0) return false;  // the exact loop is within the probe distance here
   const Point in_pt = along(s_in);
   const Point& f = m_blocked ? out_pt : in_pt;
   const Point& b = m_blocked ? in_pt : out_pt;
@@ -531,18 +547,35 @@ bool Level::off_chord(Probe& pr, const Point& p, const Point& q, double t, Point
   return c.x >= o_.xmin - slack && c.x <= o_.xmax + slack && c.y >= o_.ymin - slack && c.y <= o_.ymax + slack;
 }
 
-void Level::refine(Probe& pr, const Point& p, const Point& q, int depth, std::vector<Point>& out) const {
-  if (depth >= o_.max_depth || std::hypot(q.x - p.x, q.y - p.y) < o_.min_segment) return;
-  // The midpoint, then the quarters: on a faceted mesh the loop's curvature changes along a chord, so its
-  // farthest point need not lie at the middle.
-  Point c;
-  for (double t : {0.5, 0.25, 0.75}) {
-    if (!off_chord(pr, p, q, t, c)) continue;
-    refine(pr, p, c, depth + 1, out);
+void Level::refine(Probe& pr, const Point& u, const Point& p, const Point& q, const Point& w, int depth,
+                   std::vector<Point>& out) const {
+  const double length = std::hypot(q.x - p.x, q.y - p.y);
+  if (depth >= o_.max_depth || length < o_.min_segment) return;
+  auto split_at = [&](const Point& c) {
+    refine(pr, u, p, c, q, depth + 1, out);
     out.push_back(c);
-    refine(pr, c, q, depth + 1, out);
-    return;
-  }
+    refine(pr, p, c, q, w, depth + 1, out);
+  };
+  // The midpoint, then the quarters (on a faceted mesh the loop's curvature changes along a chord, so its
+  // farthest point need not lie at the middle), each at 3/4 chord_tol: where the loop bends one way between p
+  // and q, its distance from the chord is at most 4/3 of the largest of its distances at these three points
+  // (a concave function through five points: the secants extended). (The middle alone at chord_tol / 2 bounds
+  // a loop bending one way as well, but not one that bends both ways: 1.16 chord_tol on the relief test.)
+  Point c;
+  for (double t : {0.5, 0.25, 0.75})
+    if (off_chord(pr, p, q, t, c)) return split_at(c);
+  // The loop turning back by more than a right angle over the chord (arriving at p against the way it leaves
+  // q): the tip of a spike, a crack or a notch may lie beyond the chord's ends, where no perpendicular through
+  // it reaches. It is searched from the middle along the way the loop points there (the two directions' mean).
+  const double ia = std::hypot(p.x - u.x, p.y - u.y), ob = std::hypot(w.x - q.x, w.y - q.y);
+  if (!(ia > 0.0 && ob > 0.0)) return;
+  const double ix = (p.x - u.x) / ia, iy = (p.y - u.y) / ia, ox = (w.x - q.x) / ob, oy = (w.y - q.y) / ob;
+  if (ix * ox + iy * oy >= 0.0) return;
+  const double dx = ix - ox, dy = iy - oy, dl = std::hypot(dx, dy);
+  const Point m{0.5 * (p.x + q.x), 0.5 * (p.y + q.y), true};
+  // A crossing there beyond the probe distance is inserted even when it lies beside the chord (on a crack's
+  // side): the chords from it reach across towards the tip, and their own walks go on.
+  if (walk(pr, m, blocked(pr, m.x, m.y), dx / dl, dy / dl, length, c)) split_at(c);
 }
 
 std::vector<WaterlineLoop> Level::loops() {
@@ -637,9 +670,10 @@ std::vector<WaterlineLoop> Level::loops() {
     for (std::size_t c = begin; c < end; ++c) {
       const auto& pts = loops_pts[chords[c].first];
       const std::size_t i = chords[c].second;
+      const std::size_t n = pts.size();
       const Point& p = pts[i];
-      const Point& q = pts[(i + 1) % pts.size()];
-      if (p.contact && q.contact) refine(pr, p, q, 0, inserted[c]);
+      const Point& q = pts[(i + 1) % n];
+      if (p.contact && q.contact) refine(pr, pts[(i + n - 1) % n], p, q, pts[(i + 2) % n], 0, inserted[c]);
     }
     worker_drops += pr.drops;
   });
