@@ -50,7 +50,7 @@ double drop_on_owned(const Cutter& c, double x, double y, const IndexedTriangle&
 }  // namespace
 
 double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double y, double floor_z,
-                  DropStats* stats, int32_t* hint) {
+                  DropStats* stats, int32_t* hint, double ceiling) {
   double best = floor_z;
   int32_t winner = -1;
   std::size_t tested = 0;
@@ -63,16 +63,20 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
       winner = *hint;
     }
   }
+  // The walk prunes with `prune`: best, or +inf once best is above the ceiling (every box fails then).
+  double prune = best > ceiling ? INFINITY : best;
   const int32_t skip = winner;
-  index.walk(x, y, cutter, best, [&](const IndexedTriangle& t, int32_t i) {
-    if (i == skip) return;
-    ++tested;
-    const double z = drop_on_owned(cutter, x, y, t, best);
-    if (z > best) {
-      best = z;
-      winner = i;
-    }
-  });
+  if (prune != INFINITY)
+    index.walk(x, y, cutter, prune, [&](const IndexedTriangle& t, int32_t i) {
+      if (i == skip || prune == INFINITY) return;
+      ++tested;
+      const double z = drop_on_owned(cutter, x, y, t, best);
+      if (z > best) {
+        best = z;
+        winner = i;
+        prune = best > ceiling ? INFINITY : best;
+      }
+    });
   if (stats) stats->triangles_tested += tested;
   if (hint) *hint = winner;
   return best;
@@ -227,7 +231,7 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
 // best): most fail, and a mispredicted branch per candidate cost more than the exact tests.
 template <Reach kReach>
 double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x,
-                          double y, double floor_z, std::size_t& tested, int32_t& hint) {
+                          double y, double floor_z, std::size_t& tested, int32_t& hint, double ceiling) {
   const auto& tris = index.triangles();
   const double r2 = cutter.max_radius() * cutter.max_radius();
   double best = floor_z;
@@ -252,14 +256,14 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
   if (hint >= 0) test(static_cast<std::size_t>(hint));
   const std::size_t skip = static_cast<std::size_t>(hint);
   const std::size_t m = c.zmax.size();  // a multiple of kBlock
-  for (std::size_t k = 0; k < m; k += kBlock) {
+  for (std::size_t k = 0; k < m && !(best > ceiling); k += kBlock) {
     if (c.zmax[k] <= best) break;  // sorted: nothing from here on can hold the cutter above best
     unsigned mask = block_mask<kReach>(c, k, x, y, r2, best, cutter.corner_radius(), cutter.arc_centre_radius());
     while (mask) {
       const std::size_t q = k + static_cast<std::size_t>(__builtin_ctz(mask));
       mask &= mask - 1;
       const double top = c.zmax[q];
-      if (!(top > best) || q == skip) continue;  // best may have risen within the block
+      if (!(top > best) || q == skip || best > ceiling) continue;  // best may have risen within the block
       if (kReach != Reach::Scalar) {
         test(q);  // within reach of a lower best: the exact test prunes with its own bounds
         continue;
@@ -278,9 +282,10 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
 namespace {
 
 // drop_batch with the floor of point i = floors ? floors[i] : floor_z.
+// ceiling: each point's scan stops at its first contact above it and reports min(h, ceiling).
 void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                        const double* floors, double floor_z, double* z_out, const BatchOptions& options,
-                       DropStats* stats) {
+                       DropStats* stats, double ceiling = INFINITY) {
   auto floor_of = [&](std::size_t i) { return floors ? floors[i] : floor_z; };
   // Tiles: points sorted by tile (stable within a tile, so a raster keeps its order and the warm-start
   // hint its value); points with a non-finite coordinate go alone through drop_point (the floor). Heights
@@ -354,7 +359,8 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
         DropStats s;
         for (std::size_t k = a; k < b; ++k) {
           const std::size_t i = order[k];
-          z_out[i] = drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_of(i), &s, &hint);
+          z_out[i] = std::min(drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_of(i), &s, &hint, ceiling),
+                              ceiling);
         }
         local += s.triangles_tested;
         continue;
@@ -362,7 +368,7 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
       for (std::size_t k = a; k < b; ++k) {
         const std::size_t i = order[k];
         const double x = xy[2 * i], y = xy[2 * i + 1], floor_i = floor_of(i);
-        z_out[i] = drop_in_tile(index, cutter, cands, x, y, floor_i, local, hint);
+        z_out[i] = std::min(drop_in_tile(index, cutter, cands, x, y, floor_i, local, hint, ceiling), ceiling);
       }
     }
     tested.fetch_add(local);
@@ -375,6 +381,11 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {
   drop_batch_floors(index, cutter, xy, n, nullptr, floor_z, z_out, options, stats);
+}
+
+void drop_batch_capped(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
+                       double floor_z, double ceiling, double* z_out, const BatchOptions& options) {
+  drop_batch_floors(index, cutter, xy, n, nullptr, floor_z, z_out, options, nullptr, ceiling);
 }
 
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,

@@ -73,6 +73,20 @@ struct Grid {
   bool ring(std::size_t I, std::size_t J) const { return I == 0 || J == 0 || I + 1 == NX || J + 1 == NY; }
 };
 
+// How far above a level the Illinois search keeps drop heights exact (the span it brackets below z); higher
+// ones are capped there (the drop stops at the first contact above).
+double height_margin(const Cutter& cutter, const Grid& g) {
+  return 2.0 * std::max({cutter.max_radius(), g.dx, g.dy}) + cutter.height(cutter.max_radius());
+}
+
+// How far above the highest level the grid's heights are exact, higher ones capped there: above every band of
+// split_wanted (the lift h(side) <= h(2 side), the pocket band <= max(that, 2 side), the sagitta of a chord 2
+// side long at most that long), so every split decision but the cubic's sees the same.
+double grid_margin(const Cutter& cutter, const Grid& g) {
+  const double side = std::max(g.dx, g.dy);
+  return 2.0 * side + cutter.height(std::min(2.0 * side, cutter.max_radius()));
+}
+
 // One level: marching squares, exact crossings, loops, refinement. Drops from one thread, with hints.
 class Level {
  public:
@@ -80,7 +94,8 @@ class Level {
   Level(const MeshIndex& index, const Cutter& cutter, const Grid& grid, const WaterlineOptions& o, double z,
         const BatchOptions& batch)
       : index_(index), cutter_(cutter), g_(grid), o_(o), batch_(batch), z_(z),
-        eval_floor_(z - 2.0 * std::max({cutter.max_radius(), grid.dx, grid.dy})) {}
+        eval_floor_(z - 2.0 * std::max({cutter.max_radius(), grid.dx, grid.dy})),
+        eval_ceiling_(z + height_margin(cutter, grid)) {}
 
   std::vector<WaterlineLoop> loops();
   std::size_t drops() const { return main_.drops + worker_drops_; }
@@ -92,14 +107,17 @@ class Level {
     int32_t hint = -1;
     std::size_t drops = 0;
   };
+  // (The drop stops at the first contact above z: only the state is asked.)
   bool blocked(Probe& pr, double x, double y) const {
     ++pr.drops;
-    return drop_point(index_, cutter_, x, y, z_, nullptr, &pr.hint) > z_;
+    return drop_point(index_, cutter_, x, y, z_, nullptr, &pr.hint, z_) > z_;
   }
-  // z - h, h clamped to a floor below z (Illinois needs finite values where nothing is under the tool).
+  // z - h, h clamped to a floor below z (Illinois needs finite values where nothing is under the tool) and to
+  // a ceiling above it (the drop stops at the first contact above; every band test stays below it).
   double clearance(Probe& pr, double x, double y) const {
     ++pr.drops;
-    return z_ - drop_point(index_, cutter_, x, y, eval_floor_, nullptr, &pr.hint);
+    return z_ - std::min(drop_point(index_, cutter_, x, y, eval_floor_, nullptr, &pr.hint, eval_ceiling_),
+                         eval_ceiling_);
   }
   // The boundary on the segment from a free point f (clearance cf >= 0) to a blocked point b (cb < 0): the
   // free end of a bracket narrower than o_.bracket.
@@ -171,7 +189,7 @@ class Level {
   const Grid& g_;
   const WaterlineOptions& o_;
   const BatchOptions& batch_;
-  const double z_, eval_floor_;
+  const double z_, eval_floor_, eval_ceiling_;
   Probe main_;                   // the marching's drops (this thread)
   std::size_t worker_drops_ = 0;  // the crossings' and chords' drops (parallel within the level)
   std::unordered_map<uint64_t, double> fine_;   // drop heights of the fine nodes (not grid nodes)
@@ -719,7 +737,7 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
                                                   const BatchOptions& batch, WaterlineStats* stats) {
   std::size_t nx = 0, ny = 0;
   waterline_grid_size(o, nx, ny);
-  double zlow = kInf;
+  double zlow = kInf, zhigh = -kInf;
   for (double z : zs) {
     if (!std::isfinite(z)) {
       std::ostringstream msg;
@@ -727,6 +745,7 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
       throw std::invalid_argument(msg.str());
     }
     zlow = std::min(zlow, z);
+    zhigh = std::max(zhigh, z);
   }
   std::vector<std::vector<WaterlineLoop>> result(zs.size());
   if (zs.empty()) return result;
@@ -758,7 +777,10 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
         xy[2 * (j * nx + i) + 1] = g.y(j + 1);
       }
     // Any floor below the lowest level: a height at the floor is free at every level.
-    drop_batch(index, cutter, xy.data(), nx * ny, zlow - 1.0, z.data(), grid_batch);
+    // Heights far above the highest level are capped (the scan stops at the first contact above): they only
+    // say "blocked" to every level and every band test (docs/waterline.md, "Adaptive grid").
+    drop_batch_capped(index, cutter, xy.data(), nx * ny, zlow - 1.0, zhigh + grid_margin(cutter, g), z.data(),
+                      grid_batch);
     g.h.assign(g.NX * g.NY, -kInf);
     for (std::size_t j = 0; j < ny; ++j)
       std::copy(z.begin() + j * nx, z.begin() + (j + 1) * nx, g.h.begin() + (j + 1) * g.NX + 1);
