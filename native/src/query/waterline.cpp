@@ -95,7 +95,7 @@ class Level {
         const BatchOptions& batch)
       : index_(index), cutter_(cutter), g_(grid), o_(o), batch_(batch), z_(z),
         eval_floor_(z - 2.0 * std::max({cutter.max_radius(), grid.dx, grid.dy})),
-        eval_ceiling_(z + height_margin(cutter, grid)) {}
+        eval_ceiling_(z + height_margin(cutter, grid)), node_margin_(grid_margin(cutter, grid)) {}
 
   std::vector<WaterlineLoop> loops();
   std::size_t drops() const { return main_.drops + worker_drops_; }
@@ -118,6 +118,13 @@ class Level {
     ++pr.drops;
     return z_ - std::min(drop_point(index_, cutter_, x, y, eval_floor_, nullptr, &pr.hint, eval_ceiling_),
                          eval_ceiling_);
+  }
+  // A fine node's height, exact within grid_margin of z and clamped to that window (every split band lies
+  // inside it; Illinois takes any clamped value): the drop prunes and stops early outside it.
+  double node_drop(double x, double y) {
+    ++main_.drops;
+    const double low = z_ - node_margin_, cap = z_ + node_margin_;
+    return std::min(drop_point(index_, cutter_, x, y, low, nullptr, &main_.hint, cap), cap);
   }
   // The boundary on the segment from a free point f (clearance cf >= 0) to a blocked point b (cb < 0): the
   // free end of a bracket narrower than o_.bracket.
@@ -189,7 +196,7 @@ class Level {
   const Grid& g_;
   const WaterlineOptions& o_;
   const BatchOptions& batch_;
-  const double z_, eval_floor_, eval_ceiling_;
+  const double z_, eval_floor_, eval_ceiling_, node_margin_;
   Probe main_;                   // the marching's drops (this thread)
   std::size_t worker_drops_ = 0;  // the crossings' and chords' drops (parallel within the level)
   std::unordered_map<uint64_t, double> fine_;   // drop heights of the fine nodes (not grid nodes)
@@ -262,14 +269,14 @@ double Level::height(std::size_t X, std::size_t Y) {
   if (fine_ring(X, Y)) return -kInf;
   const auto it = fine_.find(node_id(X, Y));
   if (it != fine_.end()) return it->second;
-  return z_ - clearance(main_, fx(X), fy(Y));  // (not a node: not kept)
+  return node_drop(fx(X), fy(Y));  // (not a node: not kept)
 }
 
 void Level::add_node(std::size_t X, std::size_t Y) {
   if (coarse_node(X, Y)) return;
   const uint64_t id = node_id(X, Y);
   if (fine_.count(id)) return;
-  fine_.emplace(id, fine_ring(X, Y) ? -kInf : z_ - clearance(main_, fx(X), fy(Y)));
+  fine_.emplace(id, fine_ring(X, Y) ? -kInf : node_drop(fx(X), fy(Y)));
   if (fine_.size() > kMaxWaterlineFineNodes) {
     std::ostringstream msg;
     msg << "waterline minimum step samples more than " << kMaxWaterlineFineNodes << " fine nodes at level z "
