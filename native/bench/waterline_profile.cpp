@@ -6,6 +6,7 @@
 // chord tolerance 0.003].
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -48,16 +49,21 @@ int main(int argc, char** argv) {
   double best = 1e300;
   tmm::WaterlineStats stats;
   std::size_t points = 0, loops = 0;
+  double checksum = 0;  // sum of |x| + |y| over the points: the same loops give the same sum
   for (int r = 0; r < reps; ++r) {
     const auto t0 = std::chrono::steady_clock::now();
     const auto out = tmm::waterline(index, cutter, zs, o, batch, &stats);
     best = std::min(best, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
     loops = out[0].size();
     points = 0;
-    for (const auto& l : out[0]) points += l.size();
+    checksum = 0;
+    for (const auto& l : out[0]) {
+      points += l.size();
+      for (double v : l.xy) checksum += std::abs(v);
+    }
   }
   std::printf("%s %s z %.4f: best %.2f ms of %d on %d threads; grid %zu, level drops %zu, refined cells %zu, "
-              "loops %zu, points %zu\n", argv[1], kind.c_str(), zs[0], best * 1e3, reps, threads, stats.grid_nodes,
-              stats.drops, stats.refined_cells, loops, points);
+              "loops %zu, points %zu, checksum %.9f\n", argv[1], kind.c_str(), zs[0], best * 1e3, reps, threads,
+              stats.grid_nodes, stats.drops, stats.refined_cells, loops, points, checksum);
   return 0;
 }

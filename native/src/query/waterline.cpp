@@ -121,11 +121,17 @@ class Level {
   }
   // A fine node's height, exact within grid_margin of z and clamped to that window (every split band lies
   // inside it; Illinois takes any clamped value): the drop prunes and stops early outside it.
-  double node_drop(double x, double y) {
-    ++main_.drops;
+  double node_drop(Probe& pr, double x, double y) const {
+    ++pr.drops;
     const double low = z_ - node_margin_, cap = z_ + node_margin_;
-    return std::min(drop_point(index_, cutter_, x, y, low, nullptr, &main_.hint, cap), cap);
+    return std::min(drop_point(index_, cutter_, x, y, low, nullptr, &pr.hint, cap), cap);
   }
+  // Where fine nodes are sampled: the level's own (fine_, main_) or, while cells grow in parallel, a chunk's.
+  struct Nodes {
+    Probe& pr;
+    std::unordered_map<uint64_t, double>& fine;
+    std::atomic<std::size_t>* sampled = nullptr;  // in parallel: the nodes all chunks sampled (the limit)
+  };
   // The boundary on the segment from a free point f (clearance cf >= 0) to a blocked point b (cb < 0): the
   // free end of a bracket narrower than o_.bracket.
   Point crossing(Probe& pr, Point f, Point b, double cf, double cb) const;
@@ -154,8 +160,12 @@ class Level {
   bool coarse_node(std::size_t X, std::size_t Y) const { return X % g_.k == 0 && Y % g_.k == 0; }
   // A node is a corner of some square of the level: every grid node, and the fine nodes of refined cells.
   bool has_node(std::size_t X, std::size_t Y) const { return coarse_node(X, Y) || fine_.count(node_id(X, Y)); }
-  double height(std::size_t X, std::size_t Y);  // drop height at a node (ring nodes -inf)
-  void add_node(std::size_t X, std::size_t Y);   // samples a fine node, once
+  double height(std::size_t X, std::size_t Y, Nodes& nd) const;  // drop height at a node (ring nodes -inf)
+  double height(std::size_t X, std::size_t Y) {
+    Nodes nd{main_, fine_};
+    return height(X, Y, nd);
+  }
+  void add_node(std::size_t X, std::size_t Y, Nodes& nd) const;  // samples a fine node, once
   bool state(std::size_t X, std::size_t Y) { return height(X, Y) > z_; }
   // Whether a triangle can hold the tool above z somewhere over the rectangle (the drop's own pruning).
   bool may_block(double x0, double y0, double x1, double y1) const;
@@ -165,9 +175,14 @@ class Level {
   // Whether one triangle above z lies under the whole rectangle (then every position in it is blocked).
   bool under_one_triangle(double x0, double y0, double x1, double y1) const;
   // Whether a square could hide a feature between its corners (docs/waterline.md, "Adaptive grid").
-  bool split_wanted(const Square& q);
+  bool split_wanted(const Square& q, Nodes& nd) const;
   // Replaces leaf i of cell tree t by its four quarters (appended after it in order).
-  void split(std::size_t t, std::size_t i);
+  void split(std::vector<Square>& tree, std::size_t i, Nodes& nd) const;
+  void split(std::size_t t, std::size_t i) {
+    Nodes nd{main_, fine_};
+    split(trees_[t], i, nd);
+  }
+  void check_fine_nodes(std::size_t n) const;  // throws above kMaxWaterlineFineNodes
   void refine_cells();
   // The nodes on a square's boundary, counter-clockwise from its lower-left corner: its corners and, with
   // `scan`, the nodes of smaller neighbouring squares on its sides.
@@ -264,20 +279,24 @@ Point Level::crossing(Probe& pr, Point f, Point b, double cf, double cb) const {
   return at(a);
 }
 
-double Level::height(std::size_t X, std::size_t Y) {
+double Level::height(std::size_t X, std::size_t Y, Nodes& nd) const {
   if (coarse_node(X, Y)) return g_.h[(Y / g_.k) * g_.NX + X / g_.k];
   if (fine_ring(X, Y)) return -kInf;
-  const auto it = fine_.find(node_id(X, Y));
-  if (it != fine_.end()) return it->second;
-  return node_drop(fx(X), fy(Y));  // (not a node: not kept)
+  const auto it = nd.fine.find(node_id(X, Y));
+  if (it != nd.fine.end()) return it->second;
+  return node_drop(nd.pr, fx(X), fy(Y));  // (not a node: not kept)
 }
 
-void Level::add_node(std::size_t X, std::size_t Y) {
+void Level::add_node(std::size_t X, std::size_t Y, Nodes& nd) const {
   if (coarse_node(X, Y)) return;
   const uint64_t id = node_id(X, Y);
-  if (fine_.count(id)) return;
-  fine_.emplace(id, fine_ring(X, Y) ? -kInf : node_drop(fx(X), fy(Y)));
-  if (fine_.size() > kMaxWaterlineFineNodes) {
+  if (nd.fine.count(id)) return;
+  nd.fine.emplace(id, fine_ring(X, Y) ? -kInf : node_drop(nd.pr, fx(X), fy(Y)));
+  check_fine_nodes(nd.sampled ? ++*nd.sampled : nd.fine.size());
+}
+
+void Level::check_fine_nodes(std::size_t n) const {
+  if (n > kMaxWaterlineFineNodes) {
     std::ostringstream msg;
     msg << "waterline minimum step samples more than " << kMaxWaterlineFineNodes << " fine nodes at level z "
         << z_ << " (" << refined_count_ << " cells refined " << g_.k << " times), over the kernel's limit; use "
@@ -318,10 +337,10 @@ bool Level::may_block(double x0, double y0, double x1, double y1) const {
   return any;
 }
 
-bool Level::split_wanted(const Square& q) {
+bool Level::split_wanted(const Square& q, Nodes& nd) const {
   if (q.L < 2) return false;
-  const double h[4] = {height(q.X, q.Y), height(q.X + q.L, q.Y), height(q.X + q.L, q.Y + q.L),
-                       height(q.X, q.Y + q.L)};
+  const double h[4] = {height(q.X, q.Y, nd), height(q.X + q.L, q.Y, nd), height(q.X + q.L, q.Y + q.L, nd),
+                       height(q.X, q.Y + q.L, nd)};
   int blocked_corners = 0;
   for (double v : h) blocked_corners += v > z_;
   if (blocked_corners == 2 && (h[0] > z_) == (h[2] > z_)) return true;  // a saddle
@@ -389,15 +408,15 @@ bool Level::under_one_triangle(double x0, double y0, double x1, double y1) const
   return found;
 }
 
-void Level::split(std::size_t t, std::size_t i) {
-  const Square q = trees_[t][i];
+void Level::split(std::vector<Square>& tree, std::size_t i, Nodes& nd) const {
+  const Square q = tree[i];
   const std::size_t h = q.L / 2;
   for (std::size_t b = 0; b <= 2; ++b)
-    for (std::size_t a = 0; a <= 2; ++a) add_node(q.X + a * h, q.Y + b * h);
-  trees_[t][i] = Square{q.X, q.Y, h};
-  trees_[t].push_back(Square{q.X + h, q.Y, h});
-  trees_[t].push_back(Square{q.X + h, q.Y + h, h});
-  trees_[t].push_back(Square{q.X, q.Y + h, h});
+    for (std::size_t a = 0; a <= 2; ++a) add_node(q.X + a * h, q.Y + b * h, nd);
+  tree[i] = Square{q.X, q.Y, h};
+  tree.push_back(Square{q.X + h, q.Y, h});
+  tree.push_back(Square{q.X + h, q.Y + h, h});
+  tree.push_back(Square{q.X, q.Y + h, h});
 }
 
 bool Level::neighbour_refined(std::size_t I, std::size_t J) const {
@@ -450,23 +469,45 @@ void Level::refine_cells() {
     ++refined_count_;
     return trees_.size() - 1;
   };
-  // Split squares while a feature could hide in them, depth first.
-  auto grow = [&](std::size_t t) {
-    for (std::size_t i = 0; i < trees_[t].size();) {
-      if (split_wanted(trees_[t][i])) split(t, i);
-      else ++i;
-    }
-  };
   const double band = cutter_.height(std::min(std::max(g_.dx, g_.dy), cutter_.max_radius()));
+  std::vector<std::size_t> cells;  // the cells of the rows within the band, in scan order
   for (std::size_t J = 0; J < CY; ++J) {
     if (z_ - band >= g_.row_hi[J]) continue;  // all free, farther below z than the band
     if (z_ + band <= g_.row_lo[J]) continue;  // all blocked, farther above z than the band
-    for (std::size_t I = 0; I < CX; ++I) {
-      if (!split_wanted(Square{I * k, J * k, k})) continue;
-      const std::size_t t = make_tree(I, J);
-      split(t, 0);
-      grow(t);
+    for (std::size_t I = 0; I < CX; ++I) cells.push_back(J * CX + I);
+  }
+  // Each cell's squares split while a feature could hide in them, depth first, cells in parallel (fixed
+  // chunks, each sampling its own fine nodes: a node on a side shared by two chunks is sampled twice, to the
+  // same height), then the trees taken in scan order: the same trees and nodes as one after the other.
+  const std::size_t chunk = 16;
+  std::vector<std::vector<Square>> grown(cells.size());
+  std::vector<std::unordered_map<uint64_t, double>> chunk_fine((cells.size() + chunk - 1) / chunk);
+  std::atomic<std::size_t> drops{0}, sampled{0};
+  parallel_chunks(cells.size(), chunk, BatchOptions{batch_.threads, {}}, [&](std::size_t begin, std::size_t end) {
+    Probe pr;
+    Nodes nd{pr, chunk_fine[begin / chunk], &sampled};
+    for (std::size_t c = begin; c < end; ++c) {
+      const Square cell{cells[c] % CX * k, cells[c] / CX * k, k};
+      if (!split_wanted(cell, nd)) continue;
+      std::vector<Square>& tree = grown[c];
+      tree.push_back(cell);
+      split(tree, 0, nd);
+      for (std::size_t i = 0; i < tree.size();) {
+        if (split_wanted(tree[i], nd)) split(tree, i, nd);
+        else ++i;
+      }
     }
+    drops += pr.drops;
+  });
+  worker_drops_ += drops.load();
+  for (auto& fine : chunk_fine) {
+    fine_.insert(fine.begin(), fine.end());
+    fine = {};
+  }
+  check_fine_nodes(fine_.size());
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (grown[c].empty()) continue;
+    trees_[make_tree(cells[c] % CX, cells[c] / CX)] = std::move(grown[c]);
   }
   // Closure: a square whose boundary (with its smaller neighbours' nodes) changes state more than twice is
   // split, so that every square's loop piece is one segment and both sides of a boundary segment agree.
