@@ -133,6 +133,16 @@ def parse_gcode(text: str) -> list[tuple[str, float, float, float, Optional[floa
     return out
 
 
+
+def reopened(doc: Any, obj: Any, filename: str) -> Any:
+    """`obj`, from its document saved as OUT/`filename`, closed (with every other) and opened again; its new
+    document is `.Document`."""
+    path = OUT / filename
+    doc.saveAs(str(path))
+    name = obj.Name
+    close_all()
+    return FreeCAD.openDocument(str(path)).getObject(name)
+
 class FreeCADTestCase(unittest.TestCase):
     def tearDown(self) -> None:
         close_all()

@@ -8,9 +8,8 @@ from __future__ import annotations
 import re
 import unittest
 
-import FreeCAD
 
-from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase, close_all, job_with_op, new_doc
+from fc_helpers import SPHERE_ON_PLATE, FreeCADTestCase, close_all, job_with_op, new_doc, reopened
 from tmm_workbench.app.api import run_surface, simulate
 
 SETTINGS = dict(tool="ballend", diameter=6.0, stepover=2.0, sample_step=0.25, margin=-20.0, progress=False)
@@ -67,12 +66,8 @@ class LeanPasses(FreeCADTestCase):
         lean = len(op.Path.Commands)
         op.removeProperty("ForwardStep")            # as saved by an older TMM
         op.removeProperty("ArcFitting")
-        path = OUT / "old_forward_step.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_forward_step.FCStd")
+        doc = op.Document
         self.assertEqual(op.ForwardStep, "SampleStep")
         self.assertFalse(op.ArcFitting)
         op.Proxy.progress_enabled = False

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import FreeCAD
 
-from fc_helpers import OUT, FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc
+from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
 
@@ -35,12 +35,8 @@ class Offset3D(FreeCADTestCase):
         first = loops[0]
         self.assertIn(first, loops[1:len(loops) // 2])
         commands = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
-        path = OUT / "offset3d.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "offset3d.FCStd")
+        doc = op.Document
         self.assertEqual((op.StepOverMode, round(op.CuspHeight.Value, 9)), ("Offset3D", 0.02))
         doc.recompute()
         self.assertEqual(len(op.Path.Commands), len(commands))
@@ -56,12 +52,7 @@ class Offset3D(FreeCADTestCase):
         _, _, op = job_with_op(doc, str(bump_stl()))
         op.StepOverMode = ["StepOver", "Cusp", "Adaptive"]            # as saved by an older TMM
         op.StepOverMode = "Cusp"
-        path = OUT / "old_offset3d.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_offset3d.FCStd")
         self.assertEqual(op.StepOverMode, "Cusp")
         self.assertIn("Offset3D", op.getEnumerationsOfProperty("StepOverMode"))
         close_all()

@@ -8,7 +8,7 @@ import FreeCAD
 import Part
 
 from fc_helpers import (OUT, SPHERE_ON_PLATE, FreeCADTestCase, bump_stl, bump_triangles, close_all,
-                        job_with_op, mesh_feature, moves, new_doc)
+                        job_with_op, mesh_feature, moves, new_doc, reopened)
 from tmm_workbench.app import model_proxy
 from tmm_workbench.app.op_surface import ObjectTmmSurface
 
@@ -201,12 +201,8 @@ class CuspSpacing(FreeCADTestCase):
             self.assertTrue(op.isValid(), op.getStatusString())
             self.assertNotEqual(ys(), fixed)
         adaptive = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
-        path = OUT / "cusp.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "cusp.FCStd")
+        doc = op.Document
         self.assertEqual((op.StepOverMode, round(op.CuspHeight.Value, 9)), ("Adaptive", 0.02))
         self.assertEqual(len(op.Path.Commands), len(adaptive))
         op.CuspHeight = 50.0                                           # above the tool radius
@@ -221,12 +217,7 @@ class CuspSpacing(FreeCADTestCase):
         _, _, op = job_with_op(doc, str(bump_stl()))
         for prop in ("StepOverMode", "CuspHeight", "CuspSlopeLimit"):
             op.removeProperty(prop)                                    # as saved by an older TMM
-        path = OUT / "old_cusp.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_cusp.FCStd")
         self.assertEqual(op.StepOverMode, "StepOver")
         self.assertAlmostEqual(op.CuspHeight.Value, 0.01)
         close_all()
@@ -239,12 +230,8 @@ class SaveAndReopen(FreeCADTestCase):
         self.assertAlmostEqual(op.ChordTolerance.Value, 0.001)   # a new op: longer moves where they fit
         lean = len(op.Path.Commands)
         op.removeProperty("ChordTolerance")                      # as saved by an older TMM
-        path = OUT / "old_chord.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_chord.FCStd")
+        doc = op.Document
         self.assertEqual(op.ChordTolerance.Value, 0.0)           # what it was computed with
         op.Proxy.progress_enabled = False
         op.touch()

@@ -9,7 +9,7 @@ import math
 import FreeCAD
 import Part
 
-from fc_helpers import OUT, FreeCADTestCase, close_all, job_with_op, moves, new_doc
+from fc_helpers import FreeCADTestCase, job_with_op, moves, new_doc, reopened
 
 V = FreeCAD.Vector
 CENTRE, RADIUS = (20.0, 20.0), 8.0
@@ -146,12 +146,8 @@ class RegionFromSketch(FreeCADTestCase):
             self.assertTrue(5 - 1e-3 <= x <= 50 + 1e-3 and 5 - 1e-3 <= y <= 35 + 1e-3, (x, y))
         self.assertGreaterEqual(min(dist(p) for p in pts), 10.0 - 0.011)    # the inner loop is a hole
         count = len(op.Path.Commands)
-        path = OUT / "region_sketch.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "region_sketch.FCStd")
+        doc = op.Document
         self.assertEqual(op.Region, "Sketch")
         self.assertEqual(op.RegionSketch.Name, "Region")
         self.assertIn("Spiral", op.getEnumerationsOfProperty("Pattern"))
@@ -206,12 +202,8 @@ class RegionFromSketch(FreeCADTestCase):
             op.removeProperty(prop)                                    # as saved by an older TMM
         op.Pattern = ["ZigZag", "OneWay"]                              # its enumeration then
         op.Pattern = "OneWay"
-        path = OUT / "old_region.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "old_region.FCStd")
+        doc = op.Document
         self.assertEqual(op.Region, "Box")
         self.assertEqual((op.SlopeMin.Value, op.SlopeMax.Value), (0.0, 90.0))
         self.assertEqual(op.Pattern, "OneWay")

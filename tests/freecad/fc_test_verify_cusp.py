@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import unittest
 
-import FreeCAD
 
-from fc_helpers import OUT, FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc
+from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.sim.cusp_field import cusp_field
@@ -23,15 +22,6 @@ def simulated_max_cusp(op) -> float:
     mesh = op.Proxy.mesh
     field = cusp_field(mesh, Cutter.ball(4.0), op.Proxy.boundary(op, mesh), TOL, 0.03, sample_step=0.03)
     return field.max_cusp(field.cut(op.Proxy.toolpath, Cutter.ball(4.0)))
-
-
-def reopened(doc, op, filename: str):
-    """The op, from its document saved as `filename`, closed and opened again."""
-    path = OUT / filename
-    doc.saveAs(str(path))
-    name = op.Name
-    close_all()
-    return FreeCAD.openDocument(str(path)).getObject(name)
 
 
 class VerifyCusp(FreeCADTestCase):

@@ -11,7 +11,7 @@ import unittest
 import FreeCAD
 import numpy as np
 
-from fc_helpers import OUT, BadInputCase, SPHERE_ON_PLATE, FreeCADTestCase, close_all, moves, new_doc
+from fc_helpers import OUT, SPHERE_ON_PLATE, BadInputCase, FreeCADTestCase, moves, new_doc, reopened
 from fc_test_roughing import BLOCK, GOUGE_MM, POCKET, check_feeds_and_heights, job_with, levels, pocket_block
 from tmm_workbench.app import op_base, op_waterline, registry
 from tmm_workbench.app.api import run_waterline, simulate
@@ -69,12 +69,8 @@ class WaterlineInJob(FreeCADTestCase):
         job, tc, op = job_with(doc, pocket_block(doc), "TMM_Waterline", diameter=4.0, values=values)
         self.assertTrue(op.isValid(), op.getStatusString())
         before = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
-        path = OUT / "waterline_reopen.FCStd"
-        doc.saveAs(str(path))
-        name = op.Name
-        close_all()
-        doc = FreeCAD.openDocument(str(path))
-        op = doc.getObject(name)
+        op = reopened(doc, op, "waterline_reopen.FCStd")
+        doc = op.Document
         self.assertIsInstance(op.Proxy, op_waterline.ObjectTmmWaterline)
         for prop, value in values.items():
             got = getattr(op, prop)
