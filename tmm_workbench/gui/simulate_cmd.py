@@ -201,7 +201,7 @@ class SimulatePanel:
         self.check_cell()
         return box
 
-    def check_cell(self) -> bool:
+    def check_cell(self) -> None:
         """The grid the entered cell size makes, told before any simulation: its cells, or the refusal (a
         grid above the work limits) with Simulate disabled."""
         from tmm_workbench.app.op_base import apply_work_limits
@@ -214,11 +214,10 @@ class SimulatePanel:
             self.estimate.setText(f"will fail: {exc}")
             self.estimate.setStyleSheet(RED)
             self.button.setEnabled(False)
-            return False
+            return
         self.estimate.setText(f"about {g.nx * g.ny:.3g} cells ({g.nx} x {g.ny})")
         self.estimate.setStyleSheet("")
         self.button.setEnabled(True)
-        return True
 
     def _results_box(self) -> QtGui.QGroupBox:
         box = QtGui.QGroupBox("Results (deviation: vertical, + material left, - gouge)")
