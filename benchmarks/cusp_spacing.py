@@ -23,7 +23,9 @@ import argparse
 import math
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
@@ -58,6 +60,47 @@ def cycle(path) -> float:
     return three_axis_time(tips, toolpath_feeds(path, FEED, PLUNGE)).seconds
 
 
+@dataclass
+class Bisection:
+    """The largest constant step-over whose simulated maximum cusp is at most `target`: `row` (None when no
+    step in the range got there), the bracket (step_lo, cusp_lo) <= target < (step_hi, cusp_hi) (a cusp None
+    where that end was never measured: the range's own ends)."""
+    row: Optional[tuple]
+    step_lo: float
+    cusp_lo: Optional[float]
+    step_hi: float
+    cusp_hi: Optional[float]
+
+
+def equal_cusp_stepover(mesh, cutter: Cutter, boundary, field, target: float, rounds: int = 7) -> Bisection:
+    """Bisection on the step-over between 0.02 mm and the planar step for the field's tolerance, each step's
+    raster measured in `field`."""
+    lo_s, hi_s = 0.02, 2 * math.sqrt(2 * cutter.radius * field.tolerance)
+    cusp_lo = cusp_hi = best = None
+    for _ in range(rounds):
+        s = 0.5 * (lo_s + hi_s)
+        path, secs, n = raster(mesh, cutter, boundary, stepover=s)
+        c, _ = measure(field, path, cutter)
+        if c <= target:
+            lo_s, cusp_lo, best = s, c, (f"constant step-over {s:.3f} mm", n, c, cycle(path), secs, len(path))
+        else:
+            hi_s, cusp_hi = s, c
+    return Bisection(best, lo_s, cusp_lo, hi_s, cusp_hi)
+
+
+def verified(mesh, cutter: Cutter, boundary, field, mode: str, tol: float, label: str) -> tuple[tuple, dict]:
+    """The row of the `mode` raster with the verification pass, and the strategy's diagnostics."""
+    t0 = time.perf_counter()
+    result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, stepover_mode=mode, cusp=tol,
+                                                 max_slope_deg=SLOPE_LIMIT, verify_cusp=True))
+    top = float(mesh.bounds[1][2])
+    path = link(result.segments, LinkPolicy(top + 5, top + 10))
+    secs, v = time.perf_counter() - t0, result.diagnostics["verify"]
+    c, _ = measure(field, path, cutter)
+    return (label, f"{result.diagnostics['passes']} + {v['passes_added']} partial ({v['length_added'] / 1000:.2f} m)",
+            c, cycle(path), secs, len(path)), result.diagnostics
+
+
 def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundary=None,
         offset3d_only: bool = False) -> list[str]:
     """The table for one model; `cell` is the simulation's cell and the dense raster's step-over (its own cusp
@@ -66,7 +109,6 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     if boundary is None:
         boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     # measured inside, clear of the boundary's edges by the tool radius (the passes' ends)
-    r = cutter.radius
     field = cusp_field(mesh, cutter, boundary, tol, cell, SLOPE_LIMIT, sample_step=0.25)
 
     rows = []
@@ -86,31 +128,15 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     rows.append(("constant cusp mode", n, c, cycle(path), secs, len(path)))
 
     # the constant step-over whose simulated maximum cusp is the adaptive raster's (bisection on the step)
-    lo_s, hi_s = 0.02, 2 * math.sqrt(2 * r * tol)
-    best = None
-    for _ in range(7):
-        s = 0.5 * (lo_s + hi_s)
-        path, secs, n = raster(mesh, cutter, boundary, stepover=s)
-        c, _ = measure(field, path, cutter)
-        if c <= cusp:
-            lo_s, best = s, (f"constant step-over {s:.3f} mm", n, c, cycle(path), secs, len(path))
-        else:
-            hi_s = s
+    best = equal_cusp_stepover(mesh, cutter, boundary, field, cusp).row
     if best is not None:
         rows.append(best)
 
     # --- the verification pass (issue 14 item 4, core.footprint.variable_step): partial passes where the
     # simulated cusp exceeds the tolerance; passes shown as the set's + the partial ones
     for label, mode in (("constant cusp mode + verify", "cusp"), ("adaptive + verify", "adaptive")):
-        t0 = time.perf_counter()
-        result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, stepover_mode=mode, cusp=tol,
-                                                     max_slope_deg=SLOPE_LIMIT, verify_cusp=True))
-        top = float(mesh.bounds[1][2])
-        path = link(result.segments, LinkPolicy(top + 5, top + 10))
-        secs, v = time.perf_counter() - t0, result.diagnostics["verify"]
-        c, _ = measure(field, path, cutter)
-        rows.append((label, f"{result.diagnostics['passes']} + {v['passes_added']} partial "
-                            f"({v['length_added'] / 1000:.2f} m)", c, cycle(path), secs, len(path)))
+        row, _ = verified(mesh, cutter, boundary, field, mode, tol, label)
+        rows.append(row)
 
     out = _table(name, mesh, cutter, tol, share, rows)
     if best is not None:

@@ -1,0 +1,225 @@
+"""Issue 14 item 7 in one run: passes and cycle time at equal maximum cusp, constant step-over against the
+constant cusp mode, the adaptive raster (with and without the verification pass) and the 3D offset (the
+verification needs straight raster passes: none there), on sphere_on_plate.stl and mount_rush.stl (ball D6,
+cusp 0.01 mm) and seed 000's convex and concave surfaces (ball D 0.5 in, cusp 0.002 in, a 100 x 100 mm window
+at the centre by default); then the wait a user sees on sphere_on_plate (OK to path and FreeCAD's linuxcnc
+post, through `freecadcmd` and `run_surface`) for each spacing, "before" being the constant step-over op.
+
+Every row is measured as `benchmarks/cusp_spacing.py` measures (its functions, not a copy): the strategies are
+called through `core.strategies.raster_drop.compute` (the op's own entry), the path linked, cut into the stock
+simulation beside a dense raster, and its cusp read in `core.sim.cusp_field`; the constant step-over is the
+largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7 rounds). The cycle time is
+`core.sim.cycle_time.three_axis_time` at 1000 mm/min cutting and 300 mm/min plunging, rapids 5000 mm/min.
+
+    .venv/bin/python benchmarks/cusp_item7.py            # all four models, then the end-to-end table
+    .venv/bin/python benchmarks/cusp_item7.py --quick    # sphere_on_plate only (and the end-to-end table)
+    ... --no-e2e       # without the FreeCAD table;  --window 0: seed 000's whole surfaces
+The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field as dc_field
+from pathlib import Path
+from typing import Callable, Optional
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from cusp_spacing import (FEED, PLUNGE, SLOPE_LIMIT, cycle, equal_cusp_stepover, raster,  # noqa: E402
+                          verified)
+
+from tmm_workbench.core.errors import TmmError  # noqa: E402
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
+from tmm_workbench.core.sim.cusp_field import cusp_field, measure  # noqa: E402
+from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
+
+BASE = "constant step-over"
+
+
+@dataclass
+class Row:
+    label: str
+    passes: int         # passes; closed loops for the 3D offset
+    partial: int        # partial passes added by the verification
+    cusp: float         # simulated maximum cusp, mm (cusp_field.measure)
+    cycle_s: float
+    compute_s: float    # strategy and linker
+    moves: int
+    note: str = ""
+
+
+@dataclass
+class ModelTable:
+    name: str
+    header: str
+    rows: list[Row]
+    bisection: object               # cusp_spacing.Bisection
+    failed: list[str] = dc_field(default_factory=list)  # rows a strategy refused: "label: message"
+
+    def base(self) -> Optional[Row]:
+        return next((r for r in self.rows if r.label.startswith(BASE)), None)
+
+
+def _row(t: tuple, partial: int = 0, passes: Optional[int] = None, note: str = "") -> Row:
+    label, n, c, cyc, secs, moves = t
+    return Row(label, int(n if passes is None else passes), partial, float(c), float(cyc), float(secs), int(moves),
+               note)
+
+
+def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float, boundary=None,
+               log: Callable[[str], None] = lambda s: None) -> ModelTable:
+    """Every item-7 row for one model over `boundary` (default the model's box), measured in one cusp field."""
+    lo, hi = mesh.bounds
+    if boundary is None:
+        boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+    t0 = time.perf_counter()
+    field = cusp_field(mesh, cutter, boundary, tol, cell, SLOPE_LIMIT, sample_step=0.25)
+    log(f"  {name}: cusp field {time.perf_counter() - t0:.1f} s")
+    found: dict[str, Row] = {}
+    failed: list[str] = []
+
+    def spacing(label: str, mode: str) -> None:
+        try:
+            path, secs, n = raster(mesh, cutter, boundary, stepover_mode=mode, cusp=tol, max_slope_deg=SLOPE_LIMIT)
+        except TmmError as e:
+            failed.append(f"{label}: {e}")
+            return
+        found[label] = _row((label, n, measure(field, path, cutter)[0], cycle(path), secs, len(path)))
+        log(f"  {name}: {label} {secs:.1f} s")
+
+    def checked(label: str, mode: str) -> None:
+        try:
+            t, diag = verified(mesh, cutter, boundary, field, mode, tol, label)
+        except TmmError as e:
+            failed.append(f"{label}: {e}")
+            return
+        v = diag["verify"]
+        found[label] = _row(t, v["passes_added"], diag["passes"], f"{v['length_added'] / 1000:.2f} m partial")
+        log(f"  {name}: {label} {t[4]:.1f} s")
+
+    spacing("adaptive", "adaptive")
+    target = found["adaptive"].cusp if "adaptive" in found else tol
+    t0 = time.perf_counter()
+    bis = equal_cusp_stepover(mesh, cutter, boundary, field, target)
+    if bis.row is not None:
+        found[BASE] = _row(bis.row, note=f"bisection: {bis.step_lo:.3f} mm -> {_mm(bis.cusp_lo)}, "
+                                          f"{bis.step_hi:.3f} mm -> {_mm(bis.cusp_hi)}")
+    else:
+        failed.append(f"{BASE}: no step-over in [0.02, {bis.step_hi:.3f}] mm keeps the cusp under {target:.4f} mm")
+    log(f"  {name}: bisection {time.perf_counter() - t0:.1f} s")
+    spacing("constant cusp mode", "cusp")
+    checked("adaptive + verify", "adaptive")
+    spacing("3D offset (loops)", "offset3d")
+    # no "3D offset + verify": the verification needs straight raster passes (core.footprint.variable_step)
+    order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset (loops)"]
+    rows = [found[k] for k in order if k in found]
+    header = (f"{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm, region "
+              f"{', '.join(f'{v:.1f}' for v in boundary)}; {field.share:.0%} of the cells measured "
+              f"({cell:g} mm cells, slopes up to {SLOPE_LIMIT:g} deg)")
+    return ModelTable(name, header, rows, bis, failed)
+
+
+def _mm(c: Optional[float]) -> str:
+    return "not measured" if c is None else f"{c:.4f} mm"
+
+
+def ratios(row: Row, base: Optional[Row]) -> tuple[float, float]:
+    """(constant step-over's passes / the row's passes + partial ones, its cycle / the row's): > 1 is better."""
+    if base is None:
+        return math.nan, math.nan
+    return base.passes / (row.passes + row.partial), base.cycle_s / row.cycle_s
+
+
+def table(models: list[ModelTable]) -> list[str]:
+    out = ["| model | spacing | passes | simulated max cusp mm | cycle min | compute s | moves | passes: constant / "
+           "this | cycle: constant / this |", "|---|---|---|---|---|---|---|---|---|"]
+    for m in models:
+        base = m.base()
+        for r in m.rows:
+            p, c = ratios(r, base)
+            passes = f"{r.passes} + {r.partial} partial" if r.partial or "verify" in r.label else str(r.passes)
+            label = r.label if r is not base else r.label.replace(BASE, BASE + " (before)")
+            out.append(f"| {m.name} | {label} | {passes} | {r.cusp:.4f} | {r.cycle_s / 60:.1f} | "
+                       f"{r.compute_s:.1f} | {r.moves} | {p:.2f}x | {c:.2f}x |")
+    return out
+
+
+def notes(models: list[ModelTable]) -> list[str]:
+    out = []
+    for m in models:
+        out.append(f"- {m.header}")
+        out += [f"  - {r.label}: {r.note}" for r in m.rows if r.note]
+        out += [f"  - refused: {f}" for f in m.failed]
+    return out
+
+
+# --- the wait a user sees (FreeCAD) ---
+
+E2E_MODES = [("before: constant step-over", dict(stepover_mode="stepover")),
+             ("constant cusp mode", dict(stepover_mode="cusp")),
+             ("adaptive", dict(stepover_mode="adaptive")),
+             ("adaptive + verify", dict(stepover_mode="adaptive", verify_cusp=True)),
+             ("3D offset", dict(stepover_mode="offset3d"))]
+
+
+def end_to_end(stepover: float, timeout_s: float = 3600) -> list[str]:
+    """The second table, from `benchmarks/cusp_item7_e2e.py` under freecadcmd (sphere_on_plate, ball D6, cusp
+    0.01 mm, 0.25 mm sampling; the constant step-over at `stepover`)."""
+    env = dict(os.environ, TMM_ITEM7_STEPOVER=repr(stepover), TMM_ITEM7_ROOT=str(HERE.parent))
+    done = subprocess.run(["freecadcmd", "-c", f"exec(open({str(HERE / 'cusp_item7_e2e.py')!r}).read())"],
+                          env=env, cwd=str(HERE.parent), capture_output=True, text=True, timeout=timeout_s)
+    rows = [ln for ln in done.stdout.splitlines() if ln.startswith("|")]
+    if done.returncode != 0 or not rows:
+        return [f"end-to-end run failed (exit {done.returncode}):", done.stdout[-2000:], done.stderr[-2000:]]
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
+    ap.add_argument("--no-e2e", action="store_true", help="without the FreeCAD end-to-end table")
+    ap.add_argument("--window", type=float, default=100.0,
+                    help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
+    args = ap.parse_args()
+
+    def log(s: str) -> None:
+        print(s, file=sys.stderr, flush=True)
+
+    print(f"# cycle time: three_axis_time, cutting {FEED * 60:g} mm/min, plunge {PLUNGE * 60:g} mm/min; load: "
+          f"{os.getloadavg()[0]:.2f} {os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f} (1, 5, 15 min)", flush=True)
+    t_start = time.perf_counter()
+    stl = shared_dir() / "benchmarks" / "stl"
+    models: list[ModelTable] = []
+    ball6 = Cutter.ball(6.0)
+    sop = model_rows("sphere_on_plate", load_stl(stl / "sphere_on_plate.stl"), ball6, 0.01, 0.1, log=log)
+    models.append(sop)
+    print("\n".join(table([sop]) + notes([sop])), flush=True)
+    if not args.no_e2e and sop.bisection.row is not None:
+        print(f"\n# the wait a user sees, sphere_on_plate through freecadcmd (run_surface, linuxcnc post); before: "
+              f"constant step-over {sop.bisection.step_lo:.3f} mm", flush=True)
+        print("\n".join(end_to_end(sop.bisection.step_lo)), flush=True)
+    if not args.quick:
+        models.append(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log))
+        from seed000_surfaces import INCH, seed000_mesh
+        for name in ("convex", "concave"):
+            mesh, deviation = seed000_mesh(name)
+            lo, hi = mesh.bounds
+            c, h = 0.5 * (lo + hi), 0.5 * args.window
+            region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if args.window else None
+            models.append(model_rows(f"seed 000 {name}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
+                                     boundary=region, log=log))
+        print("\n# all models")
+        print("\n".join(table(models) + notes(models)), flush=True)
+    print(f"\n# {time.perf_counter() - t_start:.0f} s in all; load: {os.getloadavg()[0]:.2f} "
+          f"{os.getloadavg()[1]:.2f} {os.getloadavg()[2]:.2f}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
