@@ -2,8 +2,8 @@
 constant cusp mode, the adaptive raster (with and without the verification pass) and the 3D offset (the
 verification needs straight raster passes: none there), on sphere_on_plate.stl and mount_rush.stl (ball D6,
 cusp 0.01 mm) and seed 000's convex and concave surfaces (ball D 0.5 in, cusp 0.002 in, a 100 x 100 mm window
-at the centre by default); then the wait a user sees on sphere_on_plate (OK to path and FreeCAD's linuxcnc
-post, through `freecadcmd` and `run_surface`) for each spacing, "before" being the constant step-over op.
+at the centre, then the whole surfaces); then the wait a user sees on sphere_on_plate (OK to path and FreeCAD's
+linuxcnc post, through `freecadcmd` and `run_surface`) for each spacing, "before" being the constant step-over op.
 
 Every row is measured as `benchmarks/cusp_spacing.py` measures (its functions, not a copy): the strategies are
 called through `core.strategies.raster_drop.compute` (the op's own entry), the path linked, cut into the stock
@@ -13,7 +13,8 @@ largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7
 
     .venv/bin/python benchmarks/cusp_item7.py            # all four models, then the end-to-end table
     .venv/bin/python benchmarks/cusp_item7.py --quick    # sphere_on_plate only (and the end-to-end table)
-    ... --no-e2e       # without the FreeCAD table;  --window 0: seed 000's whole surfaces
+    ... --no-e2e       # without the FreeCAD table;  --no-whole: seed 000 on the window only (the whole
+                       # surfaces take about 15 min more)
 The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
 """
 from __future__ import annotations
@@ -116,9 +117,9 @@ def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float
     log(f"  {name}: bisection {time.perf_counter() - t0:.1f} s")
     spacing("constant cusp mode", "cusp")
     checked("adaptive + verify", "adaptive")
-    spacing("3D offset (loops)", "offset3d")
+    spacing("3D offset", "offset3d")
     # no "3D offset + verify": the verification needs straight raster passes (core.footprint.variable_step)
-    order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset (loops)"]
+    order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset"]
     rows = [found[k] for k in order if k in found]
     header = (f"{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm, region "
               f"{', '.join(f'{v:.1f}' for v in boundary)}; {field.share:.0%} of the cells measured "
@@ -145,7 +146,8 @@ def table(models: list[ModelTable]) -> list[str]:
         for r in m.rows:
             p, c = ratios(r, base)
             passes = f"{r.passes} + {r.partial} partial" if r.partial or "verify" in r.label else str(r.passes)
-            label = r.label if r is not base else r.label.replace(BASE, BASE + " (before)")
+            passes += " loops" if r.label.startswith("3D offset") else ""
+            label = r.label if r is not base else r.label + " (before)"
             out.append(f"| {m.name} | {label} | {passes} | {r.cusp:.4f} | {r.cycle_s / 60:.1f} | "
                        f"{r.compute_s:.1f} | {r.moves} | {p:.2f}x | {c:.2f}x |")
     return out
@@ -187,6 +189,7 @@ def main() -> None:
     ap.add_argument("--no-e2e", action="store_true", help="without the FreeCAD end-to-end table")
     ap.add_argument("--window", type=float, default=100.0,
                     help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
+    ap.add_argument("--no-whole", action="store_true", help="seed 000 on the window only, not also on the whole")
     args = ap.parse_args()
 
     def log(s: str) -> None:
@@ -206,15 +209,22 @@ def main() -> None:
               f"constant step-over {sop.bisection.step_lo:.3f} mm", flush=True)
         print("\n".join(end_to_end(sop.bisection.step_lo)), flush=True)
     if not args.quick:
-        models.append(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log))
+        def add(m: ModelTable) -> None:  # each model's table as soon as it is measured
+            models.append(m)
+            print("\n" + "\n".join(table([m]) + notes([m])), flush=True)
+
+        add(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log))
         from seed000_surfaces import INCH, seed000_mesh
-        for name in ("convex", "concave"):
-            mesh, deviation = seed000_mesh(name)
-            lo, hi = mesh.bounds
-            c, h = 0.5 * (lo + hi), 0.5 * args.window
-            region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if args.window else None
-            models.append(model_rows(f"seed 000 {name}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
-                                     boundary=region, log=log))
+        windows = [args.window] + ([] if args.no_whole or not args.window else [0.0])
+        for side in windows:
+            for name in ("convex", "concave"):
+                mesh, _ = seed000_mesh(name)
+                lo, hi = mesh.bounds
+                c, h = 0.5 * (lo + hi), 0.5 * side
+                region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if side else None
+                where = f"{side:g} mm window" if side else "whole"
+                add(model_rows(f"seed 000 {name}, {where}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
+                               boundary=region, log=log))
         print("\n# all models")
         print("\n".join(table(models) + notes(models)), flush=True)
     print(f"\n# {time.perf_counter() - t_start:.0f} s in all; load: {os.getloadavg()[0]:.2f} "
