@@ -20,9 +20,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.cwd()
 sys.path.insert(0, str(ROOT))
 
-import FreeCAD  # noqa: E402
-
-from tmm_workbench.app import posts  # noqa: E402
+from benchmarks.user_wait import user_wait  # noqa: E402
 from tmm_workbench.app.api import run_surface  # noqa: E402
 from tmm_workbench.core.footprint import adaptive_raster  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
@@ -41,13 +39,7 @@ def run(label: str, out: Path, reference: bool) -> dict:
         total = time.perf_counter() - t0
     finally:
         raster_drop.adaptive_pass_offsets = placed
-    t1 = time.perf_counter()
-    posts.export("linuxcnc", [r.op.ToolController, r.op], str(out / f"{label}_again.ngc"))
-    post_s = time.perf_counter() - t1
-    row = dict(moves=len(r.toolpath.moves), lines=len(r.gcode.splitlines()), ok_to_path=total - post_s,
-               post_s=post_s, total=total)
-    FreeCAD.closeDocument(r.doc.Name)
-    return row
+    return user_wait(r, total, out / f"{label}_again.ngc")
 
 
 def main() -> None:

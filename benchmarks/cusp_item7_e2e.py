@@ -18,11 +18,9 @@ ROOT = Path(os.environ.get("TMM_ITEM7_ROOT") or Path.cwd())
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-import FreeCAD  # noqa: E402
-
 from cusp_item7 import E2E_MODES  # noqa: E402
+from user_wait import user_wait  # noqa: E402
 
-from tmm_workbench.app import posts  # noqa: E402
 from tmm_workbench.app.api import run_surface  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 
@@ -33,14 +31,7 @@ def wait(label: str, out: Path, stepover: float, **kw) -> dict:
     r = run_surface(str(shared_dir() / "benchmarks" / "stl" / "sphere_on_plate.stl"), doc_name=f"item7_{name}",
                     diameter=6.0, sample_step=0.25, stepover=stepover, cusp=0.01, progress=False,
                     gcode_path=str(out / f"{name}.ngc"), **kw)
-    total = time.perf_counter() - t0
-    t1 = time.perf_counter()
-    posts.export("linuxcnc", [r.op.ToolController, r.op], str(out / f"{name}_again.ngc"))
-    post_s = time.perf_counter() - t1
-    row = dict(moves=len(r.toolpath.moves), lines=len(r.gcode.splitlines()), ok_to_path=total - post_s,
-               post_s=post_s, total=total)
-    FreeCAD.closeDocument(r.doc.Name)
-    return row
+    return user_wait(r, time.perf_counter() - t0, out / f"{name}_again.ngc")
 
 
 def main() -> None:
