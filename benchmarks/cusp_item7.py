@@ -32,8 +32,8 @@ from typing import Callable, Optional
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from cusp_spacing import (FEED, PLUNGE, SLOPE_LIMIT, cycle, equal_cusp_stepover, raster,  # noqa: E402
-                          verified)
+from cusp_spacing import (FEED, PLUNGE, SLOPE_LIMIT, Bisection, cycle, equal_cusp_stepover,  # noqa: E402
+                          raster, verified)
 
 from tmm_workbench.core.errors import TmmError  # noqa: E402
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl  # noqa: E402
@@ -61,7 +61,7 @@ class ModelTable:
     name: str
     header: str
     rows: list[Row]
-    bisection: object               # cusp_spacing.Bisection
+    bisection: Bisection
     failed: list[str] = dc_field(default_factory=list)  # rows a strategy refused: "label: message"
 
     def base(self) -> Optional[Row]:
