@@ -88,10 +88,10 @@ def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: f
     s_max = min(2 * r_max * 0.98, s_level)   # as the adaptive raster's: no wider than on a level plane (what
     # the samples do not measure, creases and places out of reach, gets no wider step than a plane would)
     spacing = float(np.clip(s_level / _SAMPLES_PER_STEP, _MIN_SPACING, _MAX_SPACING))
-    while True:  # samples a quarter step apart at most: coarser ones misplace b between them (a bull's flat)
+    while True:  # samples half a step apart at most: coarser ones misplace b between them (a bull's flat)
         step = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar, surface,
                              d, n, along, across, s_min, s_max, spacing)
-        if step.stepover >= 4 * spacing or spacing <= _MIN_SPACING:
+        if step.stepover >= 2 * spacing or spacing <= _MIN_SPACING:
             return step
         spacing = max(_MIN_SPACING, step.stepover / _SAMPLES_PER_STEP)
 
