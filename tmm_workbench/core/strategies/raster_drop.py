@@ -68,7 +68,8 @@ class SurfaceParams(StrategyParams):
     # slopes become a few long moves; never below a CL point: 0 keeps every point off a straight line)
     chord_tol: float = param(0.001, "chord tolerance", "mm", low=0, high=1.0)
     # how the passes are spaced: STEPOVER (the step-over above), CUSP (constant: the step-over that keeps the
-    # cusp height on the region's steepest crossing, up to max_slope_deg; planar, core.footprint.cusp) or
+    # cusp height at the region's worst crossing, slope and curvature, up to max_slope_deg;
+    # core.footprint.cusp_section) or
     # ADAPTIVE (each pass placed from the previous one's CL points so the cusp between them is the cusp height;
     # core.footprint.adaptive_raster)
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE, OFFSET3D))
