@@ -98,6 +98,11 @@ def test_extra_passes_go_only_where_the_cusp_exceeds():
     assert all(np.ptp(s.tips[:, 0]) < 24.0 - 1.0 for s in extra)  # partial passes
     # a uniform step-over for the steepest slope would double the raster's length; a third of it is added
     assert report.length_added < 0.35 * len(_passes(plain)) * 24.0
+    # consecutive partial passes are joined on the surface (dropped, gouge-checked links; `deepest` above covers
+    # them) instead of lifting between them
+    added = checked.segments[len(plain.segments):]
+    assert report.links > 0 and sum(s.kind is SegmentKind.LINK for s in added) == report.links
+    assert sum(not s.joined for s in added) == len(extra) - report.links
 
 
 def test_a_path_within_the_tolerance_is_left_as_it_is():
