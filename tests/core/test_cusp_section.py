@@ -85,3 +85,17 @@ def test_bad_input_names_the_parameter():
         section_stepover(plane, Cutter.ball(6), (-5, -5, 5, 5), 0.0, 4.0, -1.0)
     with pytest.raises(TmmError, match="cusp slope limit must be in"):
         section_stepover(plane, Cutter.ball(6), (-5, -5, 5, 5), 0.0, 0.01, -1.0, max_slope_deg=90.0)
+
+
+def test_work_refused_before_the_samples_are_made():
+    from tmm_workbench.core import limits
+
+    plane = grid_mesh(lambda x, y: 0 * x, 2, 2, (-5, -5, 5, 5))
+    old = limits.set_limits(max_points=100_000)
+    try:
+        from tmm_workbench.core.errors import TmmError
+
+        with pytest.raises(TmmError, match=r"cusp height 0.01 mm \(samples .* apart across the passes\) over a 2e\+06"):
+            section_stepover(plane, Cutter.ball(6), (-5, -1e6, 5, 1e6), 0.0, CUSP, -1.0)
+    finally:
+        limits.set_limits(max_points=old.max_points)

@@ -103,15 +103,17 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     """section_stepover with samples `spacing` apart across the sections."""
     r_max = cutter.native.max_radius
     y_lo, y_hi = float(across.min()), float(across.max())
-    ys = np.arange(y_lo - r_max - spacing, y_hi + r_max + 2 * spacing, spacing)   # E needs the tool's reach
+    # samples across, E needs the tool's reach beyond the region: counted before any is made
+    samples = (y_hi - y_lo + 2 * r_max + 3 * spacing) / spacing + 1
     # sections inside the region, clear of the passes' ends by the tool radius (the measured cells' rule)
     x0, x1 = float(along.min()) + cutter.radius, float(along.max()) - cutter.radius
     if x1 <= x0:
         x0 = x1 = 0.5 * float(along.min() + along.max())
-    count = max(1, min(_SECTIONS_MOST, _POINTS_MOST // max(len(ys), 1), int((x1 - x0) / spacing) + 1))
-    check_work("CL points", float(count) * len(ys), _BYTES_PER_POINT,
+    count = max(1, min(_SECTIONS_MOST, int(_POINTS_MOST // samples), int((x1 - x0) / spacing) + 1))
+    check_work("CL points", float(count) * samples, _BYTES_PER_POINT,
                f"cusp height {cusp:g} mm (samples {spacing:.3g} mm apart across the passes) over a "
                f"{y_hi - y_lo:.6g} mm wide boundary")
+    ys = np.arange(y_lo - r_max - spacing, y_hi + r_max + 2 * spacing, spacing)
     xs = np.linspace(x0, x1, count) if count > 1 else np.array([x0])
     X, Y = np.meshgrid(xs, ys, indexing="ij")                       # (sections, samples)
     world = X[..., None] * d + Y[..., None] * n
@@ -185,7 +187,8 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     # meets it at a finite slope (flat, cone); a ball's or a torus's wall is vertical: the next instance is
     # always lower there, and the instances that are (many, for a small step) are not in the pair.
     edge = r_max * 1e-3
-    walls = float(profile_height(cutter, np.array([r_max]))[0] - profile_height(cutter, np.array([r_max - edge]))[0]) < 10 * edge
+    rise = profile_height(cutter, np.array([r_max - edge, r_max]))
+    walls = float(rise[1] - rise[0]) < 10 * edge
 
     def worst(s: float, rows: np.ndarray, ay: np.ndarray, ca: np.ndarray) -> np.ndarray:
         """The cusp (mm, 0 where not counted) of each pair (ay, ay + s) on its section."""
