@@ -16,6 +16,8 @@ core.footprint.variable_step: partial passes added where the simulated cusp exce
     .venv/bin/python benchmarks/cusp_spacing.py --seed000  # seed 000's convex and concave surfaces (ball D 0.5 in,
                                                            # cusp 0.002 in; benchmarks/seed000_surfaces.py)
     ... --reference   # the adaptive passes placed by the numpy reference (as before the kernel port) to compare
+    .venv/bin/python benchmarks/cusp_spacing.py --cusp-mode-only   # only the constant cusp mode row (and its
+                                                           # dense raster), sphere_on_plate and mount_rush
 """
 from __future__ import annotations
 
@@ -102,7 +104,7 @@ def verified(mesh, cutter: Cutter, boundary, field, mode: str, tol: float, label
 
 
 def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundary=None,
-        offset3d_only: bool = False) -> list[str]:
+        offset3d_only: bool = False, cusp_mode_only: bool = False) -> list[str]:
     """The table for one model; `cell` is the simulation's cell and the dense raster's step-over (its own cusp
     is negligible against `tol`); `boundary` (x0, y0, x1, y1) the region, by default the model's box."""
     lo, hi = mesh.bounds
@@ -112,6 +114,16 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     field = cusp_field(mesh, cutter, boundary, tol, cell, SLOPE_LIMIT, sample_step=0.25)
 
     rows = []
+    if cusp_mode_only:  # the constant cusp mode (core.footprint.cusp_section) alone, with its step's diagnostics
+        result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, stepover_mode="cusp",
+                                                     cusp=tol, max_slope_deg=SLOPE_LIMIT))
+        d = result.diagnostics
+        path, secs, n = raster(mesh, cutter, boundary, stepover_mode="cusp", cusp=tol, max_slope_deg=SLOPE_LIMIT)
+        c, share = measure(field, path, cutter)
+        rows.append((f"constant cusp mode {d['stepover']:.4f} mm (planar {d['cusp_planar_stepover']:.4f}; section "
+                     f"rule's worst {d['cusp_section']:.4f}{', limited' if d['cusp_limited'] else ''})", n, c,
+                     cycle(path), secs, len(path)))
+        return _table(name, mesh, cutter, tol, share, rows)
     # --- 3D offset (constant scallop loops from the boundary inward; core.footprint.offset3d) ---
     path, secs, n = raster(mesh, cutter, boundary, stepover_mode="offset3d", cusp=tol, max_slope_deg=SLOPE_LIMIT)
     c, share = measure(field, path, cutter)
@@ -158,6 +170,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
     ap.add_argument("--offset3d-only", action="store_true", help="only the 3D offset row")
     ap.add_argument("--seed000", action="store_true", help="seed 000's convex and concave surfaces only")
+    ap.add_argument("--cusp-mode-only", action="store_true", help="only the constant cusp mode row")
     ap.add_argument("--window", type=float, default=100.0,
                     help="with --seed000: the side in mm of the square region centred on the surface (0: all of "
                          "its 254 x 270 mm, which takes hours in the Python adaptive raster)")
@@ -187,8 +200,8 @@ def main() -> None:
     if not args.quick:
         cases.append(("mount_rush", stl / "mount_rush.stl"))
     for name, path in cases:
-        print("\n".join(run(name, load_stl(path), Cutter.ball(6.0), 0.01, offset3d_only=args.offset3d_only)),
-              flush=True)
+        print("\n".join(run(name, load_stl(path), Cutter.ball(6.0), 0.01, offset3d_only=args.offset3d_only,
+                             cusp_mode_only=args.cusp_mode_only)), flush=True)
 
 
 if __name__ == "__main__":

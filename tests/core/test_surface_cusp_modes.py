@@ -34,7 +34,11 @@ def test_constant_cusp_mode_spaces_by_the_steepest_crossing():
     r = compute(plane, ball, SurfaceParams(boundary=BOX, stepover_mode="cusp", cusp=0.01, sample_step=1.0))
     s = stepover_for_cusp(ball, 0.01, 20.0)
     assert r.diagnostics["cusp_slope_deg"] == pytest.approx(20.0, abs=1e-9)
-    assert r.diagnostics["stepover"] == pytest.approx(s)
+    # on a plane the section rule (core.footprint.cusp_section) is the planar rule at its aim, 3 % under the cusp
+    aim = stepover_for_cusp(ball, 0.01 * 0.97, 20.0)
+    assert r.diagnostics["stepover"] == pytest.approx(aim, rel=0.01)
+    assert r.diagnostics["cusp_planar_stepover"] == pytest.approx(s)
+    s = r.diagnostics["stepover"]
     gaps = np.diff(pass_offsets(r))
     assert gaps.max() <= s + 1e-9 and gaps.min() >= s * 0.9     # spread evenly, at most the cusp's step-over
     default = compute(plane, ball, SurfaceParams(boundary=BOX, sample_step=1.0))  # the step-over, 1 mm

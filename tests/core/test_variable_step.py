@@ -10,7 +10,7 @@ import pytest
 from benchmarks.seed000_surfaces import INCH, seed000_mesh
 from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import steepest_crossing_deg, stepover_for_cusp
 from tmm_workbench.core.footprint.variable_step import measure_cell
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import SegmentKind
@@ -45,9 +45,11 @@ def test_constant_cusp_mode_on_seed000_concave_window_is_brought_within_the_tole
     c = 0.5 * (lo + hi)
     box = (float(c[0] - 20), float(c[1] - 20), float(c[0] + 20), float(c[1] + 20))
     ball, tol = Cutter.ball(0.5 * INCH), 0.002 * INCH
-    plain = compute(mesh, ball, SurfaceParams(boundary=box, stepover_mode="cusp", cusp=tol, sample_step=0.25))
+    # the planar rule at the steepest crossing (constant cusp mode before core.footprint.cusp_section)
+    planar = stepover_for_cusp(ball, tol, steepest_crossing_deg(mesh, box, 0.0, 75.0))
+    plain = compute(mesh, ball, SurfaceParams(boundary=box, stepover=planar, cusp=tol, sample_step=0.25))
     notes: list = []
-    checked = compute(mesh, ball, SurfaceParams(boundary=box, stepover_mode="cusp", cusp=tol, sample_step=0.25,
+    checked = compute(mesh, ball, SurfaceParams(boundary=box, stepover=planar, cusp=tol, sample_step=0.25,
                                                 verify_cusp=True, verify_notes=notes))
     cell = 0.5 * measure_cell(ball, tol)  # finer than the verification's own cells
     before, _ = _independent(mesh, ball, box, tol, _path(mesh, plain), cell)
@@ -96,6 +98,11 @@ def test_extra_passes_go_only_where_the_cusp_exceeds():
     assert all(np.ptp(s.tips[:, 0]) < 24.0 - 1.0 for s in extra)  # partial passes
     # a uniform step-over for the steepest slope would double the raster's length; a third of it is added
     assert report.length_added < 0.35 * len(_passes(plain)) * 24.0
+    # consecutive partial passes are joined on the surface (dropped, gouge-checked links; `deepest` above covers
+    # them) instead of lifting between them
+    added = checked.segments[len(plain.segments):]
+    assert report.links > 0 and sum(s.kind is SegmentKind.LINK for s in added) == report.links
+    assert sum(not s.joined for s in added) == len(extra) - report.links
 
 
 def test_a_path_within_the_tolerance_is_left_as_it_is():

@@ -41,6 +41,24 @@ class WorkEstimate(FreeCADTestCase):
             work_estimate.estimate(op, {"StepOver": -1.0})
         self.assertIn("step-over must be a positive length, got -1", str(ctx.exception))
 
+    def test_estimate_of_the_cusp_modes_and_the_verification(self) -> None:
+        """Cusp mode: an upper bound of the points the section rule's raster drops; VerifyCusp adds its dense
+        raster (known before it runs) and says that its partial passes are not counted (issue 14)."""
+        doc = new_doc("TmmEstimateVerify")
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"BoundaryShape": "Model", "SampleStep": 0.4,
+                                                              "StepOverMode": "Cusp", "CuspHeight": 0.01})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        mesh = op.Proxy.mesh
+        params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
+        points = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params).diagnostics["points"]
+        self.assertGreaterEqual(est.count, points)
+        self.assertEqual(est.note, "")
+        checked = work_estimate.estimate(op, {"VerifyCusp": True})
+        self.assertGreater(checked.count, est.count)
+        self.assertIn("up to 4 rounds of partial passes", checked.text())
+        self.assertIs(op.VerifyCusp, False)  # an override only
+
     def test_estimate_tells_the_cutting_time(self) -> None:
         """The status line's time: the cut length the boxes and the spacing imply at the tool controller's
         feed, near the cutting time of the path the op then computes; none without a feed."""

@@ -87,7 +87,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     chord_tolerance: how far above the CL points a longer straight move may pass where it replaces them
     (mm; default the op's, 0.001; 0 keeps every point off a straight line).
     stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
-    `cusp` on the boundary's steepest crossing) | 'adaptive' (each pass placed from the previous one's tool
+    `cusp` on the boundary's worst crossing, slope and curvature) | 'adaptive' (each pass placed from the previous one's tool
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
     stepover_mode 'offset3d': closed loops from the region's boundary inward, spaced so the cusp between
     neighbours is `cusp` across the local slope (3D offset / constant scallop; pattern 'zigzag' links them,

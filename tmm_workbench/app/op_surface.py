@@ -52,8 +52,8 @@ PROPERTIES: list[Prop] = [
          "Grows (positive) or shrinks (negative) the boundary on every side"),
     Prop("App::PropertyDistance", "StepOver", "Surface", "Distance between raster passes", "stepover"),
     Prop("App::PropertyEnumeration", "StepOverMode", "Surface",
-         "StepOver: passes StepOver apart; Cusp: the step-over that keeps CuspHeight on the steepest crossing of "
-         "the boundary (up to CuspSlopeLimit); Adaptive: each pass placed from the previous one's tool positions "
+         "StepOver: passes StepOver apart; Cusp: the step-over that keeps CuspHeight on the worst crossing of "
+         "the boundary, slope and curvature (up to CuspSlopeLimit); Adaptive: each pass placed from the previous one's tool positions "
          "so that the cusp between them is CuspHeight", "stepover_mode"),
     Prop("App::PropertyDistance", "CuspHeight", "Surface",
          "Largest scallop left between passes (Cusp and Adaptive spacing), along the surface normal", "cusp"),

@@ -42,6 +42,7 @@ class Estimate:
     passes: Optional[int] = None
     cut_length: Optional[float] = None   # mm of cutting moves, from the boxes and the spacing (not a path)
     feed: Optional[float] = None         # mm/s, the tool controller's horizontal feed
+    note: str = ""                       # what the count leaves out (VerifyCusp's partial passes)
 
     @property
     def cutting_seconds(self) -> Optional[float]:
@@ -56,7 +57,8 @@ class Estimate:
         passes = f", {self.passes} passes" if self.passes else ""
         t = self.cutting_seconds
         time = f", cutting about {hms(t)} at {self.feed * 60:.4g} mm/min" if t is not None else ""
-        return f"about {self.count:.3g} {self.what}{passes}{time}"
+        note = f" {self.note}" if self.note else ""
+        return f"about {self.count:.3g} {self.what}{passes}{time}{note}"
 
 
 def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
@@ -188,10 +190,21 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
     stepover = params.stepover
     if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
         stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
+        if params.stepover_mode == raster_drop.CUSP:  # the section rule's smallest step (core.footprint.cusp_section)
+            stepover *= 0.5
     count = raster_drop.estimate_work(replace(params, stepover=stepover))
     w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
+    note = ""
+    if params.verify_cusp:  # issue 14 item 4: its dense raster is known before it runs, its partial passes are not
+        from tmm_workbench.core.footprint import variable_step
+
+        cutter = _cutter(obj)
+        count += variable_step.estimate_work(params.boundary, cutter, params.cusp,
+                                             variable_step.measure_cell(cutter, params.cusp))
+        note = (f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial passes "
+                "where the simulated cusp is over, not counted)")
     # passes cover the boundary at the step-over: their length is its area over the spacing
-    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover, _feed(obj))
+    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover, _feed(obj), note)
 
 
 def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:

@@ -336,6 +336,24 @@ class Placer {
             }
           env[j] = e;
         }
+        // out of reach only between the two passes' contacts (each one's least height above the design, the
+        // first such sample: numpy's argmin): before a's contact the material is the previous pass's
+        double ya = ys_[0], yb = ys_[0];
+        {
+          double ga = kInf, gb = kInf;
+          for (std::size_t j = 0; j < N; ++j) {
+            const double d = design_[s * ny + j];
+            if (!std::isfinite(d)) continue;
+            if (std::isfinite(pa[j]) && pa[j] - d < ga) {
+              ga = pa[j] - d;
+              ya = ys_[j];
+            }
+            if (std::isfinite(pb[j]) && pb[j] - d < gb) {
+              gb = pb[j] - d;
+              yb = ys_[j];
+            }
+          }
+        }
         // the slope across (numpy's gradient over the envelope, the floor where nothing reaches)
         auto g = [&](std::size_t j) { return std::isfinite(env[j]) ? env[j] : floor_z; };
         double b = 0.0;
@@ -349,7 +367,7 @@ class Placer {
           cosv[j] = 1.0 / std::sqrt(1.0 + grad * grad);
           bool good = std::isfinite(env[j]) && env[j] > floor_z + 1e-6 && cosv[j] >= cos_limit;
           const bool reached = (env[j] - design_[s * ny + j]) * cosv[j] <= tol;
-          if (good && !reached && ys_[j] >= y0 && ys_[j] <= y1) un = true;
+          if (good && !reached && ys_[j] >= ya && ys_[j] <= yb) un = true;
           good = good && reached;
           ok[j] = good;
           if (good) b = std::max(b, (std::min(pa[j], pb[j]) - env[j]) * cosv[j]);

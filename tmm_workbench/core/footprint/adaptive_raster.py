@@ -179,9 +179,15 @@ def adaptive_pass_offsets(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_d
             grad = np.gradient(np.where(finite, envelope, floor_z), _SPACING, axis=1)
             cos = 1.0 / np.sqrt(1.0 + grad * grad)
             ok = finite & (envelope > floor_z + 1e-6) & (cos >= math.cos(math.radians(max_slope_deg)))
-            reached = (envelope - self.design[:, :len(ys)]) * cos <= cusp
-            between = (ys >= self.y0) & (ys <= y1)
-            self.unreachable = bool((ok & ~reached & between[None, :]).any())
+            design = self.design[:, :len(ys)]
+            reached = (envelope - design) * cos <= cusp
+            # out of reach only between the two passes' contacts (where each touches the design: its least
+            # height above it): before a's contact the material is the previous pass's, which the strip leaves
+            # out (on a slope across the passes a ball touches R sin(slope) uphill of its axis)
+            ya = ys[np.argmin(np.where(np.isfinite(pa) & np.isfinite(design), pa - design, np.inf), axis=1)]
+            yb = ys[np.argmin(np.where(np.isfinite(pb) & np.isfinite(design), pb - design, np.inf), axis=1)]
+            between = (ys[None, :] >= ya[:, None]) & (ys[None, :] <= yb[:, None])
+            self.unreachable = bool((ok & ~reached & between).any())
             ok &= reached
             with np.errstate(invalid="ignore"):
                 best = float(np.where(ok, (both - envelope) * cos, 0.0).max())

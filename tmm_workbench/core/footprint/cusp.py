@@ -12,7 +12,10 @@ This is exact for any convex profile (the kernel's h(rho): ball, flat, bull-nose
 cusp on a curved surface differs by the curvature, which is why the adaptive raster measures it on the real
 cutter positions instead (seed 000 section 3.5.2.2).
 
-Constant mode keeps the cusp everywhere: the step-over for the steepest crossing of the region.
+Constant mode keeps the cusp everywhere: the planar step-over for the steepest crossing of the region was its
+rule; it undershoots where the surface bends across the passes (seed 000's concave window: 0.0606 mm against
+0.0508), so the mode now takes the worst crossing's slope and curvature on sampled CL sections
+(core.footprint.cusp_section), with this module's planar step reported beside it.
 """
 from __future__ import annotations
 

@@ -72,6 +72,8 @@ class VerifyReport:
     deepest: float = 0.0          # mm the simulated stock lies below the design at most (a gouge when > 0)
     rounds: int = 0
     passes_added: int = 0         # extra (partial) passes
+    links: int = 0                # of them, reached from the previous one on the surface (no lift)
+    link_length: float = 0.0      # mm of those links (cutting on the surface, not in length_added)
     length_added: float = 0.0     # mm of cutting along them
     buckets: list = field(default_factory=list)
     seconds: float = 0.0
@@ -204,6 +206,26 @@ def _extra_segments(start: np.ndarray, end: np.ndarray, drop: Drop, sample_step:
     return raster_drop._segments(runs, z, air, raster_drop.ONEWAY, chord_tol)
 
 
+def _surface_link(a: np.ndarray, b: np.ndarray, drop: Drop, sample_step: float,
+                  gouge_tol: float) -> Optional[CutSegment]:
+    """A LINK from tip a to tip b on the surface (dropped points, gouge-checked between them as raster_drop's
+    zig-zag links; the tool stays down), or None where it crosses air."""
+    from tmm_workbench.core.strategies import raster_refine
+
+    xy = sample_segment(a[:2], b[:2], sample_step)
+    z, air = drop(xy)
+    if air.any():
+        return None
+    runs = [(True, xy)]
+    if gouge_tol > 0:
+        runs, z, air, _ = raster_refine.refine(runs, z, air, drop, gouge_tol, chained=False)
+        if air.any():
+            return None
+    pts = np.column_stack([runs[0][1], z])
+    # the ends are a's last and b's first tips (the same drop): only what lies between is the link's
+    return CutSegment(pts[1:-1], SegmentKind.LINK, joined=True) if len(pts) > 2 else None
+
+
 def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], boundary: Rect, angle_deg: float,
                 tolerance: float, drop: Drop, *, sample_step: float = 0.5, gouge_tol: float = 0.005,
                 chord_tol: float = 0.001, stock_to_leave: float = 0.0, slope_limit_deg: float = 75.0,
@@ -241,6 +263,9 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     # sqrt(2 R tol) (the ball's end: a height (a^2 + t^2) / 2R); twice that, and a cell
     run_on = 2.0 * math.sqrt(2.0 * cutter.radius * tolerance) + cell
     extra: list[CutSegment] = []
+    # consecutive partial passes (serpentine, mostly a gap's few passes over one stretch) closer than this are
+    # joined on the surface instead of a lift (issue 14 item 4: 432 lifts on mount_rush)
+    join_max = 2.0 * cutter.diameter
     cusp = before
     for k in range(rounds):
         bad = np.nan_to_num(cusp, nan=0.0) > _EXCEED * tolerance
@@ -269,6 +294,19 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
                     ends.reverse()
                 flip = not flip
                 new = _extra_segments(ends[0], ends[1], drop, sample_step, gouge_tol, chord_tol)
+                if new and extra and extra[-1].kind is SegmentKind.PASS and \
+                        np.hypot(*(new[0].tips[0, :2] - extra[-1].tips[-1, :2])) <= join_max:
+                    bridge = _surface_link(extra[-1].tips[-1], new[0].tips[0], drop, sample_step, gouge_tol)
+                    if bridge is not None:
+                        new[0] = CutSegment(new[0].tips, new[0].kind, joined=True, pass_index=new[0].pass_index)
+                        extra.append(bridge)
+                        report.links += 1
+                        report.link_length += float(np.linalg.norm(np.diff(bridge.tips[:, :2], axis=0), axis=1).sum())
+                        strip = _strip(fld.grid, bridge.tips, reach)
+                        if strip is not None:
+                            sub, rows, cols = strip
+                            heights[rows, cols] = simulate(link([bridge], policy), cutter, sub,
+                                                           heights[rows, cols]).heights
                 for seg in new:
                     passes.add(seg.tips)
                     report.passes_added += 1
@@ -286,7 +324,9 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     report.deepest = float(max(0.0, np.max(fld.design[on_model] + stock_to_leave - heights[on_model]))) \
         if on_model.any() else 0.0
     report.seconds = time.perf_counter() - t0
-    return segments + [CutSegment(s.tips, s.kind, joined=False, pass_index=s.pass_index) for s in extra], report
+    # the first extra segment follows the pass set after a lift; the others keep their own (joined: on the surface)
+    return segments + [CutSegment(s.tips, s.kind, joined=s.joined and i > 0, pass_index=s.pass_index)
+                       for i, s in enumerate(extra)], report
 
 
 def validate_params(params) -> None:

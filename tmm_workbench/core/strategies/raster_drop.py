@@ -68,7 +68,8 @@ class SurfaceParams(StrategyParams):
     # slopes become a few long moves; never below a CL point: 0 keeps every point off a straight line)
     chord_tol: float = param(0.001, "chord tolerance", "mm", low=0, high=1.0)
     # how the passes are spaced: STEPOVER (the step-over above), CUSP (constant: the step-over that keeps the
-    # cusp height on the region's steepest crossing, up to max_slope_deg; planar, core.footprint.cusp) or
+    # cusp height at the region's worst crossing, slope and curvature, up to max_slope_deg;
+    # core.footprint.cusp_section) or
     # ADAPTIVE (each pass placed from the previous one's CL points so the cusp between them is the cusp height;
     # core.footprint.adaptive_raster)
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE, OFFSET3D))
@@ -222,7 +223,8 @@ def _pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: f
                 progress: Optional[Progress]) -> list[np.ndarray]:
     """The raster's passes ((2, 2) start and end each, across the boundary in order) by the step-over mode;
     the work is estimated before any pass is dropped. diagnostics: "stepover" (the largest gap, mm) and, by
-    cusp, "cusp_slope_deg" (constant) or "cusps" / "cusp_limited" / "cusp_unreachable" (adaptive)."""
+    cusp, "cusp_slope_deg" / "cusp_planar_stepover" / "cusp_section" / "cusp_limited" / "cusp_creases" (constant; the
+    section rule's worst cusp, core.footprint.cusp_section) or "cusps" / "cusp_limited" / "cusp_unreachable" (adaptive)."""
     b = params.boundary
     mode = params.stepover_mode
     if mode != STEPOVER and params.cusp > cutter.radius:
@@ -231,8 +233,15 @@ def _pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: f
         stepover = params.stepover
     elif mode == CUSP:
         slope = steepest_crossing_deg(mesh, b, params.angle_deg, params.max_slope_deg)
-        stepover = stepover_for_cusp(cutter, params.cusp, slope)
-        diagnostics["cusp_slope_deg"] = slope
+        # issue 14 item 1: the planar rule at the steepest crossing ignores the curvature across the passes; the
+        # step is the worst pair's over sampled CL sections (core.footprint.cusp_section)
+        from tmm_workbench.core.footprint.cusp_section import section_stepover
+
+        step = section_stepover(mesh, cutter, b, params.angle_deg, params.cusp, floor_z, params.stock_to_leave,
+                                params.max_slope_deg, stepover_for_cusp(cutter, params.cusp, slope))
+        stepover = step.stepover
+        diagnostics.update(cusp_slope_deg=slope, cusp_planar_stepover=step.planar, cusp_section=step.cusp,
+                           cusp_limited=int(step.limited), cusp_creases=step.creases)
     else:
         # the adaptive placement drops its passes on the way (its own work estimate, then pass by pass)
         estimate_work(replace(params, stepover=stepover_for_cusp(cutter, params.cusp, params.max_slope_deg)))

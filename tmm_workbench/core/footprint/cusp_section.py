@@ -1,0 +1,257 @@
+"""Constant cusp mode that holds the tolerance on curved surfaces (issue 14 item 1, first bullet).
+
+The planar rule (core.footprint.cusp) keeps the cusp on a plane at the region's steepest crossing; on a surface
+that bends across the passes it does not: a concave section of radius rho lifts a ball's cusp by about
+rho / (rho - R) (seed 000's concave window: 0.0606 mm against 0.0508). Seed 000 (section 3.5.2.2, eq. 3.54-3.58)
+intersects the cutter's section with the surface's section at each CC point; the same exact 2D rule is taken
+here on the CL surface itself, which carries the slope AND the curvature across the passes for any cutter:
+
+- a coarse drop grid: sections across the passes (x' fixed, y' every `spacing`), the CL tip heights c(y') of
+  the real cutter, and the design (a needle's drop);
+- E(y) = min_t c(t) + h(|y - t|) over the section's samples: what a dense raster leaves, the reachable envelope
+  (the benchmark's and core.sim.cusp_field's reference, in 2D);
+- for a step s, every pair of instances a, b = a + s along the section (every sample a phase: the passes may
+  fall anywhere) leaves H = the least of a, b and their outer neighbours a - s, b + s; its cusp is
+  (H - E) cos(E's slope) at the ridge (where a's and b's lower surfaces cross, solved exactly: their
+  difference only grows across the section for a convex profile) and beyond each side wall (a flat bottom's
+  sawtooth, as plane_cusp does);
+- ridges steeper than the slope limit (walls: waterline's), off the model, or where E stays farther than the
+  cusp from the design (out of the tool's reach: a corner narrower than the tool, pencil work) are not counted,
+  as the simulated measure leaves them out;
+- the step is the largest with the worst pair's cusp at most the tolerance (bisection), at least half the
+  planar step at the slope limit (as the adaptive raster's smallest step); `limited` when even that leaves more.
+
+The 2D section leaves out the neighbours along a pass (a slope along the pass lowers the swept tool by the same
+amount in H and in E, to first order: the planar ball's cusp along the normal is the same).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.cusp import profile_height, stepover_for_cusp
+from tmm_workbench.core.footprint.raster import Rect
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.tools.cutter import Cutter
+
+_SAFETY = 0.97            # aim under the tolerance: E's own cusp (samples `spacing` apart) and cells on the ridge
+_SAMPLES_PER_STEP = 8     # samples across per planar step on a level plane
+_MIN_SPACING, _MAX_SPACING = 0.02, 0.25   # mm between samples across a section
+_SECTIONS_MOST = 160      # sections along the passes (the worst crossing is looked for in as many)
+_POINTS_MOST = 400_000    # CL points of the drop grid at most (sections x samples): the section spacing grows
+_CREASE_RAD = 0.1         # slope turn (rad) between neighbouring samples beyond which the CL surface has a crease
+_RIDGE_HALVINGS = 26      # the ridge within 2 R / 2^26
+_STEP_HALVINGS = 18       # the step within (s_max - s_min) / 2^18
+_BYTES_PER_POINT = 200    # the grid's heights, design, envelope and pair arrays per sample
+
+
+@dataclass
+class SectionStep:
+    stepover: float       # mm, the largest step whose worst pair cusp is within the aim
+    cusp: float           # mm, that worst cusp (along E's normal)
+    planar: float         # mm, the planar rule's step at the steepest crossing (for comparison)
+    sections: int         # sections across the passes sampled
+    spacing: float        # mm between samples across a section
+    limited: bool         # even the smallest allowed step leaves more than the tolerance somewhere
+    unreachable: int      # samples on the model where E stays farther than the cusp from the design
+    creases: int          # samples on a crease of the CL surface (pairs across one are not measured)
+
+
+def _section_frame(angle_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    a = math.radians(angle_deg)
+    return np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
+
+
+def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: float, cusp: float, floor_z: float,
+                     stock_to_leave: float = 0.0, max_slope_deg: float = 75.0, planar: Optional[float] = None,
+                     surface: Optional[DropSurface] = None) -> SectionStep:
+    """The constant step-over over `boundary` (passes at `angle_deg` from +X) that keeps the cusp at most `cusp`
+    mm at every sampled crossing (see the module). `planar`: the planar rule's step at the steepest crossing,
+    reported beside it."""
+    if not (math.isfinite(cusp) and 0 < cusp <= cutter.radius):
+        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {cusp!r}")
+    if not (math.isfinite(max_slope_deg) and 0 < max_slope_deg < 90):
+        raise TmmError(f"cusp slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
+    d, n = _section_frame(angle_deg)
+    corners = np.array([[boundary[0], boundary[1]], [boundary[2], boundary[1]], [boundary[2], boundary[3]],
+                        [boundary[0], boundary[3]]])
+    along, across = corners @ d, corners @ n
+    r_max = cutter.native.max_radius
+    s_level = stepover_for_cusp(cutter, cusp, 0.0, 2 * r_max * 0.98)
+    s_min = 0.5 * stepover_for_cusp(cutter, cusp, max_slope_deg)
+    s_max = min(2 * r_max * 0.98, s_level)   # as the adaptive raster's: no wider than on a level plane (what
+    # the samples do not measure, creases and places out of reach, gets no wider step than a plane would)
+    spacing = float(np.clip(s_level / _SAMPLES_PER_STEP, _MIN_SPACING, _MAX_SPACING))
+    while True:  # samples half a step apart at most: coarser ones misplace b between them (a bull's flat)
+        step = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar, surface,
+                             d, n, along, across, s_min, s_max, spacing)
+        if step.stepover >= 2 * spacing or spacing <= _MIN_SPACING:
+            return step
+        spacing = max(_MIN_SPACING, step.stepover / _SAMPLES_PER_STEP)
+
+
+def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, floor_z: float, stock_to_leave: float,
+                  max_slope_deg: float, planar: Optional[float], surface: Optional[DropSurface], d: np.ndarray,
+                  n: np.ndarray, along: np.ndarray, across: np.ndarray, s_min: float, s_max: float,
+                  spacing: float) -> SectionStep:
+    """section_stepover with samples `spacing` apart across the sections."""
+    r_max = cutter.native.max_radius
+    y_lo, y_hi = float(across.min()), float(across.max())
+    # samples across, E needs the tool's reach beyond the region: counted before any is made
+    samples = (y_hi - y_lo + 2 * r_max + 3 * spacing) / spacing + 1
+    # sections inside the region, clear of the passes' ends by the tool radius (the measured cells' rule)
+    x0, x1 = float(along.min()) + cutter.radius, float(along.max()) - cutter.radius
+    if x1 <= x0:
+        x0 = x1 = 0.5 * float(along.min() + along.max())
+    count = max(1, min(_SECTIONS_MOST, int(_POINTS_MOST // samples), int((x1 - x0) / spacing) + 1))
+    check_work("CL points", float(count) * samples, _BYTES_PER_POINT,
+               f"cusp height {cusp:g} mm (samples {spacing:.3g} mm apart across the passes) over a "
+               f"{y_hi - y_lo:.6g} mm wide boundary")
+    ys = np.arange(y_lo - r_max - spacing, y_hi + r_max + 2 * spacing, spacing)
+    xs = np.linspace(x0, x1, count) if count > 1 else np.array([x0])
+    X, Y = np.meshgrid(xs, ys, indexing="ij")                       # (sections, samples)
+    world = X[..., None] * d + Y[..., None] * n
+    # points of a section outside the boundary (a turned raster over a rectangle) are no part of it
+    inside = ((world[..., 0] >= boundary[0] - 1e-9) & (world[..., 0] <= boundary[2] + 1e-9)
+              & (world[..., 1] >= boundary[1] - 1e-9) & (world[..., 1] <= boundary[3] + 1e-9))
+    surface = surface or DropSurface(mesh)
+    xy = world.reshape(-1, 2)
+    tool = cutter.offset(stock_to_leave)
+    c = np.maximum(surface.drop(tool, xy, floor_z - stock_to_leave) + stock_to_leave, floor_z).reshape(X.shape)
+    needle = Cutter.flat(2e-4) if stock_to_leave == 0 else Cutter.ball(2 * stock_to_leave)
+    design = surface.drop(needle, xy, floor_z - 1.0) + stock_to_leave
+    design = np.where(design > floor_z - 0.5, design, -np.inf).reshape(X.shape)
+
+    # E: every sample an instance of the dense raster
+    m = int(math.floor(r_max / spacing))
+    envelope = np.full(c.shape, np.inf)
+    for k in range(-m, m + 1):
+        hk = float(profile_height(cutter, np.array([abs(k) * spacing]))[0])
+        shifted = np.full(c.shape, np.inf)
+        if k >= 0:
+            shifted[:, k:] = c[:, :c.shape[1] - k]
+        else:
+            shifted[:, :k] = c[:, -k:]
+        np.minimum(envelope, shifted + hk, out=envelope)
+    grad = np.gradient(envelope, spacing, axis=1)
+    cos = 1.0 / np.sqrt(1.0 + grad * grad)
+    on_model = np.isfinite(design)
+    reach = (envelope - design) * cos <= cusp + stock_to_leave
+    # steep as the measured cells are: the full slope, along the passes too (between sections); the cusp itself
+    # stays along the across-normal (a ball on a plane sloped along the passes: the section's vertical cusp)
+    steep_along = np.gradient(envelope, xs[1] - xs[0], axis=0) if count > 1 else np.zeros(c.shape)
+    full_cos = 1.0 / np.sqrt(1.0 + grad * grad + steep_along * steep_along)
+    counted = (inside & on_model & reach & (full_cos >= math.cos(math.radians(max_slope_deg)))
+               & (envelope > floor_z + 1e-6))
+    unreachable = int((inside & on_model & ~reach).sum())
+    # a ridge counts where the measured cells would lie: inside the boundary, clear of its edges by the radius
+    core = inside & (Y >= y_lo + cutter.radius) & (Y <= y_hi - cutter.radius)
+    counted &= core if core.any() else inside
+
+    def at(field: np.ndarray, y: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """`field` (sections, samples) linearly between samples at y (the rows' sections)."""
+        f = np.clip((y - ys[0]) / spacing, 0.0, len(ys) - 1.000001)
+        i = f.astype(int)
+        w = f - i
+        return field[rows, i] * (1 - w) + field[rows, i + 1] * w
+
+    # creases of the CL surface (a concave edge of the model the tool rides across, the foot of a wall): its
+    # slope turns by more than _CREASE_RAD from one sample to the next, which the samples cannot resolve (their
+    # linear interpolation and E misplace the V by up to a spacing); pairs that span one are not measured here
+    # but counted (`creases`)
+    turn = np.zeros(c.shape, dtype=bool)
+    angle = np.arctan(np.diff(c, axis=1) / spacing)
+    turn[:, 1:-1] = np.abs(np.diff(angle, axis=1)) > _CREASE_RAD
+    turn &= on_model
+    crease_before = np.concatenate([np.zeros((c.shape[0], 1)), np.cumsum(turn, axis=1)], axis=1)  # creases < j
+
+    def creases_between(rows: np.ndarray, y0: np.ndarray, y1: np.ndarray) -> np.ndarray:
+        j0 = np.clip(np.floor((y0 - ys[0]) / spacing).astype(int), 0, len(ys))
+        j1 = np.clip(np.ceil((y1 - ys[0]) / spacing).astype(int) + 1, 0, len(ys))
+        return crease_before[rows, j1] - crease_before[rows, j0]
+
+    a_rows, a_cols = np.nonzero(inside & (Y >= y_lo - 1e-9) & (Y <= y_hi + 1e-9))
+    a_y = ys[a_cols]
+    c_a = c[a_rows, a_cols]
+
+    def lower(tip: np.ndarray, axis: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return tip + profile_height(cutter, y - axis)
+
+    # A side wall makes the surface left jump (the sawtooth of a flat bottom on a slope) only where the profile
+    # meets it at a finite slope (flat, cone); a ball's or a torus's wall is vertical: the next instance is
+    # always lower there, and the instances that are (many, for a small step) are not in the pair.
+    edge = r_max * 1e-3
+    rise = profile_height(cutter, np.array([r_max - edge, r_max]))
+    walls = float(rise[1] - rise[0]) < 10 * edge
+
+    def worst(s: float, rows: np.ndarray, ay: np.ndarray, ca: np.ndarray) -> np.ndarray:
+        """The cusp (mm, 0 where not counted) of each pair (ay, ay + s) on its section."""
+        by = ay + s
+        ok = (by <= y_hi + 1e-9) & (creases_between(rows, ay - s, by + s) == 0)
+        cb, ca0, cb1 = at(c, by, rows), at(c, ay - s, rows), at(c, by + s, rows)
+        # the ridge: a's lower surface minus b's grows with y (convex profile); bracket where both reach
+        lo, hi = by - r_max, ay + r_max
+        for _ in range(_RIDGE_HALVINGS):
+            mid = 0.5 * (lo + hi)
+            up = lower(ca, ay, mid) >= lower(cb, by, mid)
+            hi = np.where(up, mid, hi)
+            lo = np.where(up, lo, mid)
+        ridge = 0.5 * (lo + hi)
+        out = np.zeros(len(ay))
+        eps = 1e-9
+        points = [(ridge, ((ca, ay), (cb, by), (ca0, ay - s), (cb1, by + s)))]
+        if walls:
+            points += [(ay + r_max + eps, ((cb, by), (cb1, by + s))),          # beyond a's wall
+                       (by - r_max - eps, ((ca, ay), (ca0, ay - s)))]          # before b's wall
+        for y, parts in points:
+            h = np.full(len(ay), np.inf)
+            for tip, axis in parts:
+                h = np.minimum(h, lower(tip, axis, y))
+            col = np.clip(np.round((y - ys[0]) / spacing).astype(int), 0, len(ys) - 1)
+            good = ok & counted[rows, col] & np.isfinite(h) & (y >= ys[0]) & (y <= ys[-1])
+            with np.errstate(invalid="ignore"):
+                value = (h - at(envelope, y, rows)) * at(cos, y, rows)
+            out = np.maximum(out, np.where(good & np.isfinite(value), value, 0.0))
+        return out
+
+    target = cusp * _SAFETY
+    all_rows = a_rows
+    # the worst pairs at one step stay the worst near it: search the step on those, then check all of them
+    s_try = planar if planar is not None else stepover_for_cusp(cutter, cusp, 0.0, s_max)
+    s_try = float(np.clip(s_try, s_min, s_max))
+    values = worst(s_try, all_rows, a_y, c_a)
+    for _ in range(4):
+        keep = values >= 0.5 * values.max() if values.max() > 0 else np.zeros(len(values), dtype=bool)
+        keep |= values >= np.quantile(values, 0.99) if len(values) else keep
+        rows, ay, ca = all_rows[keep], a_y[keep], c_a[keep]
+
+        def peak(s: float) -> float:
+            v = worst(s, rows, ay, ca)
+            return float(v.max()) if len(v) else 0.0
+
+        if peak(s_max) <= target:
+            s = s_max
+        elif peak(s_min) > target:
+            s = s_min
+        else:
+            lo_s, hi_s = s_min, s_max
+            for _ in range(_STEP_HALVINGS):
+                mid = 0.5 * (lo_s + hi_s)
+                if peak(mid) <= target:
+                    lo_s = mid
+                else:
+                    hi_s = mid
+            s = lo_s
+        values = worst(s, all_rows, a_y, c_a)
+        if values.max(initial=0.0) <= target or s <= s_min:
+            break
+    worst_cusp = float(values.max(initial=0.0))
+    return SectionStep(stepover=s, cusp=worst_cusp, planar=float(planar) if planar is not None else math.nan,
+                       sections=count, spacing=spacing, limited=worst_cusp > cusp, unreachable=unreachable,
+                       creases=int(turn.sum()))
