@@ -75,6 +75,11 @@ def seed000_mesh(name: str, nt: int = 401, ns: int = 41) -> tuple[TriMesh, float
     tt, ss = (g.ravel() for g in np.meshgrid(np.linspace(0, 1, nt), np.linspace(0, 1, ns), indexing="ij"))
     pts = ruled_points(sections, tt, ss)
     tri = _grid_triangles(nt, ns)
+    # a height field faces up: wind every triangle so (its normal).z >= 0 (the grid's (t, s) may map onto (x, y)
+    # either way round; down-facing triangles made core.footprint.cusp's steepest crossing read 0 deg)
+    e1, e2 = pts[tri[:, 1]] - pts[tri[:, 0]], pts[tri[:, 2]] - pts[tri[:, 0]]
+    down = (e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]) < 0
+    tri[down] = tri[down][:, ::-1]
     # the deviation at each triangle's centroid: the surface at the centroid's parameters against the plane
     uv = np.stack([tt, ss], 1)[tri].mean(axis=1)
     deviation = float(np.linalg.norm(ruled_points(sections, uv[:, 0], uv[:, 1]) - pts[tri].mean(axis=1),

@@ -128,6 +128,7 @@ def test_unreachable_cells_are_counted_not_chased():
 
 @pytest.mark.parametrize("extra, words", [
     (dict(pattern="spiral"), "spiral"),
+    (dict(stepover_mode="offset3d", cusp=0.01), "offset3d"),
     (dict(slope_min_deg=10.0), "slope range"),
     (dict(cusp=4.0), "cusp height"),
 ])

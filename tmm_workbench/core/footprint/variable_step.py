@@ -331,10 +331,13 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
 
 def validate_params(params) -> None:
     """What the verification pass needs of raster_drop's SurfaceParams (refused before any work)."""
-    from tmm_workbench.core.strategies.raster_drop import SPIRAL
+    from tmm_workbench.core.strategies.raster_drop import OFFSET3D, SPIRAL
 
     if params.pattern == SPIRAL:
         raise TmmError("verify cusp works on straight raster passes (pattern zigzag or oneway), not spiral")
+    if params.stepover_mode == OFFSET3D:
+        raise TmmError("verify cusp works on straight raster passes, not on the 3D offset's loops (step-over mode "
+                       "offset3d): choose stepover, cusp or adaptive")
     if params.region is not None:
         raise TmmError("verify cusp works on the boundary box only for now (region Box), not on a face or sketch "
                        "region")
