@@ -10,7 +10,7 @@ import pytest
 from benchmarks.seed000_surfaces import INCH, seed000_mesh
 from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.cusp import steepest_crossing_deg, stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.variable_step import measure_cell
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import SegmentKind
@@ -45,8 +45,9 @@ def test_constant_cusp_mode_on_seed000_concave_window_is_brought_within_the_tole
     c = 0.5 * (lo + hi)
     box = (float(c[0] - 20), float(c[1] - 20), float(c[0] + 20), float(c[1] + 20))
     ball, tol = Cutter.ball(0.5 * INCH), 0.002 * INCH
-    # the planar rule at the steepest crossing (constant cusp mode before core.footprint.cusp_section)
-    planar = stepover_for_cusp(ball, tol, steepest_crossing_deg(mesh, box, 0.0, 75.0))
+    # the planar rule on the level plane: it ignores this window's slope and curvature (with the mesh wound upside
+    # down, steepest_crossing_deg read 0 deg here and constant cusp mode used exactly this step)
+    planar = stepover_for_cusp(ball, tol, 0.0)
     plain = compute(mesh, ball, SurfaceParams(boundary=box, stepover=planar, cusp=tol, sample_step=0.25))
     notes: list = []
     checked = compute(mesh, ball, SurfaceParams(boundary=box, stepover=planar, cusp=tol, sample_step=0.25,
