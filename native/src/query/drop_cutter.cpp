@@ -372,6 +372,8 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
                             : cutter.kind() == CutterKind::Bull ? &drop_point_in_tile<Reach::Bull>
                                                                 : &drop_point_in_tile<Reach::Scalar>;
   std::atomic<std::size_t> tested{0};
+  const bool capped = ceiling < INFINITY;
+  const auto& tris = index.triangles();
   parallel_chunks(runs, 16, options, [&](std::size_t begin, std::size_t end) {
     std::size_t local = 0;
     TileCandidates cands;
@@ -379,22 +381,52 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
       const std::size_t a = run_start[r], b = run_start[r + 1];
       int32_t hint = -1;
       bool listed = b - a >= kMinTilePoints && key[order[a]] != ~std::uint64_t{0};
+      // Capped heights (a waterline's grid): while the tile's points stand above the ceiling (over the top of
+      // a part) they are solved without its list: the last winner alone lifting the tool above the ceiling
+      // gives the ceiling, else a walk that stops at the first contact above it; the list is gathered at the
+      // first point below the ceiling.
+      int32_t last = -1;  // the last winner, a position in tris
+      std::size_t k = a;
+      if (capped && listed) {
+        DropStats s;
+        for (; k < b; ++k) {
+          const std::size_t i = order[k];
+          const double x = xy[2 * i], y = xy[2 * i + 1];
+          if (last >= 0) {
+            ++s.triangles_tested;
+            if (drop_on_owned(cutter, x, y, tris[static_cast<std::size_t>(last)], floor_of(i)) > ceiling) {
+              z_out[i] = ceiling;
+              continue;
+            }
+          }
+          int32_t winner = last;
+          const double h = drop_point(index, cutter, x, y, floor_of(i), &s, &winner, ceiling);
+          z_out[i] = std::min(h, ceiling);
+          if (!(h > ceiling)) {
+            ++k;
+            break;
+          }
+          last = winner;
+        }
+        local += s.triangles_tested;
+        if (k == b) continue;
+      }
       if (listed) {
         double tx0 = INFINITY, ty0 = INFINITY, tx1 = -INFINITY, ty1 = -INFINITY;
-        for (std::size_t k = a; k < b; ++k) {
-          const std::size_t i = order[k];
+        for (std::size_t j = a; j < b; ++j) {
+          const std::size_t i = order[j];
           tx0 = std::min(tx0, xy[2 * i]);
           tx1 = std::max(tx1, xy[2 * i]);
           ty0 = std::min(ty0, xy[2 * i + 1]);
           ty1 = std::max(ty1, xy[2 * i + 1]);
         }
         double tile_floor = INFINITY;  // the lowest floor of the tile's points bounds the list
-        for (std::size_t k = a; k < b; ++k) tile_floor = std::min(tile_floor, floor_of(order[k]));
+        for (std::size_t j = a; j < b; ++j) tile_floor = std::min(tile_floor, floor_of(order[j]));
         listed = cands.gather(index, cutter, tx0, ty0, tx1, ty1, tile_floor, kMaxCandidatesPerPoint * (b - a));
       }
       if (!listed) {
         DropStats s;
-        for (std::size_t k = a; k < b; ++k) {
+        for (; k < b; ++k) {
           const std::size_t i = order[k];
           z_out[i] = std::min(drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_of(i), &s, &hint, ceiling),
                               ceiling);
@@ -402,7 +434,7 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
         local += s.triangles_tested;
         continue;
       }
-      for (std::size_t k = a; k < b; ++k) {
+      for (; k < b; ++k) {
         const std::size_t i = order[k];
         const double x = xy[2 * i], y = xy[2 * i + 1], floor_i = floor_of(i);
         z_out[i] = std::min(drop_in_tile(index, cutter, cands, x, y, floor_i, local, hint, ceiling), ceiling);

@@ -1,5 +1,5 @@
 // DropTiles (drop_cutter.hpp): drops at scattered points through lists gathered once per tile, as a
-// waterline level asks them. Checked against the maximum over all triangles (every cutter kind, floors,
+// waterline level asks them; and drop_batch_capped, a waterline's grid. Checked against the maximum over all triangles (every cutter kind, floors,
 // ceilings, hints, points outside the tiles), a triangle just above the lists' floor beside the tile (the
 // lists' pruning rule: within the cutter's radius of the tile, top above the floor), and threads sharing
 // the tiles.
@@ -119,6 +119,43 @@ TEST(DropTiles, ThreadsSharingTheTilesGetTheSameHeights) {
   for (auto& th : threads) th.join();
   for (int t = 0; t < 4; ++t)
     for (std::size_t i = 0; i < single.size(); ++i) ASSERT_NEAR(got[t][i], single[i], 1e-12) << t << " " << i;
+}
+
+// drop_batch_capped (a waterline's grid) solves the points of a tile standing above the ceiling without the
+// tile's list (the last winner, else a walk stopping above the ceiling) and gathers the list at the first
+// point below it: every height is min(h, ceiling), whichever way, and the same bits on 1 and 2 threads.
+TEST(DropBatch, CappedHeightsAreTheHeightOrTheCeiling) {
+  const int n = 30;
+  std::mt19937_64 rng(13);
+  const auto [V, F] = tmm_test::bumpy_grid(n, 4, 6, rng);
+  const tmm::MeshIndex index(V, F);
+  std::vector<double> xy;
+  for (int i = 0; i <= 60; ++i)
+    for (int j = 0; j <= 60; ++j) {
+      xy.push_back(-2 + 0.56 * j);
+      xy.push_back(-2 + 0.56 * i);
+    }
+  const std::size_t m = xy.size() / 2;
+  for (const Cutter& cut : {Cutter(2, 2), Cutter(2, 0), Cutter(3, 1)}) {
+    std::vector<double> exact(m);
+    for (std::size_t i = 0; i < m; ++i) exact[i] = brute_drop(index, cut, xy[2 * i], xy[2 * i + 1], -10);
+    for (double ceiling : {-2.0, 0.0, 1.5, 2.5}) {  // most points above it .. a few
+      std::vector<double> z1(m), z2(m);
+      tmm::BatchOptions one, two;
+      one.threads = 1;
+      two.threads = 2;
+      tmm::drop_batch_capped(index, cut, xy.data(), m, -10, ceiling, z1.data(), one);
+      tmm::drop_batch_capped(index, cut, xy.data(), m, -10, ceiling, z2.data(), two);
+      int above = 0;
+      for (std::size_t i = 0; i < m; ++i) {
+        ASSERT_EQ(z1[i], z2[i]);
+        above += exact[i] > ceiling;
+        ASSERT_NEAR(z1[i], std::min(exact[i], ceiling), 1e-12) << "point " << i << " ceiling " << ceiling;
+      }
+      EXPECT_GT(above, 0);
+      EXPECT_LT(above, static_cast<int>(m));
+    }
+  }
 }
 
 TEST(DropTiles, RefusesNonFiniteOrEmptyBounds) {
