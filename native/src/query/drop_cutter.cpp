@@ -4,6 +4,8 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <stdexcept>
 #include <vector>
 
 #if defined(__SSE2__)
@@ -226,35 +228,39 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
   return mask;
 }
 
-// drop_point over a tile's candidate list; same result as the walk (the same bounds, a different order).
-// Candidates are filtered in blocks without branches (top above best, box within reach, plane bound above
-// best): most fail, and a mispredicted branch per candidate cost more than the exact tests.
-template <Reach kReach>
-double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x,
-                          double y, double floor_z, std::size_t& tested, int32_t& hint, double ceiling) {
-  const auto& tris = index.triangles();
-  const double r2 = cutter.max_radius() * cutter.max_radius();
-  double best = floor_z;
-  int32_t winner = -1;  // position in the tile's list
-  // drop_on_owned with the tile's precomputed plane drop (the same value up to rounding), for the warm start
-  // and the scan alike.
-  auto test = [&](std::size_t q) {
-    ++tested;
+// drop_on_owned for candidate q of a tile: raises best (and winner, the position in the list) when its
+// contact is higher. kExact: drop_on_owned itself, the very value drop_point gets; else with the tile's
+// precomputed plane drop (the same value up to rounding, fewer operations).
+template <bool kExact>
+inline void test_candidate(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, std::size_t q,
+                           double x, double y, double& best, int32_t& winner, std::size_t& tested) {
+  ++tested;
+  const IndexedTriangle& t = index.triangles()[c.id[q]];
+  double z;
+  if (kExact) {
+    z = drop_on_owned(cutter, x, y, t, best);
+  } else {
     const double zp = c.plane_a[q] * x + c.plane_b[q] * y + c.plane_c[q];
     if (zp <= best) return;  // the plane bounds the triangle (+inf for a plane not facing up: edges only)
-    const IndexedTriangle& t = tris[c.id[q]];
-    const double z =
-        zp != INFINITY && inside_xy(t.p[0], t.p[1], t.p[2], x + c.contact_dx[q], y + c.contact_dy[q])
+    z = zp != INFINITY && inside_xy(t.p[0], t.p[1], t.p[2], x + c.contact_dx[q], y + c.contact_dy[q])
             ? zp
             : owned_edges_drop(cutter, x, y, t, best);
-    if (z > best) {
-      best = z;
-      winner = static_cast<int32_t>(q);
-    }
-  };
-  // Warm start: the previous point's winner (a position in this list) gives a true lower bound at once.
-  if (hint >= 0) test(static_cast<std::size_t>(hint));
-  const std::size_t skip = static_cast<std::size_t>(hint);
+  }
+  if (z > best) {
+    best = z;
+    winner = static_cast<int32_t>(q);
+  }
+}
+
+// The scan of a tile's list from a lower bound `best` (winner: the position in the list that gave it, or -1)
+// up to the first contact above `ceiling`, skipping position `skip` (a warm start's, already tested).
+// Candidates are filtered in blocks without branches (top above best, box within reach, plane bound above
+// best, each a bound of the exact test's own pruning): most fail, and a mispredicted branch per candidate
+// cost more than the exact tests.
+template <Reach kReach, bool kExact = false>
+double scan_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x, double y,
+                 double best, int32_t& winner, std::size_t skip, std::size_t& tested, double ceiling) {
+  const double r2 = cutter.max_radius() * cutter.max_radius();
   const std::size_t m = c.zmax.size();  // a multiple of kBlock
   for (std::size_t k = 0; k < m && !(best > ceiling); k += kBlock) {
     if (c.zmax[k] <= best) break;  // sorted: nothing from here on can hold the cutter above best
@@ -265,14 +271,28 @@ double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const Ti
       const double top = c.zmax[q];
       if (!(top > best) || q == skip || best > ceiling) continue;  // best may have risen within the block
       if (kReach != Reach::Scalar) {
-        test(q);  // within reach of a lower best: the exact test prunes with its own bounds
+        // within reach of a lower best: the exact test prunes with its own bounds
+        test_candidate<kExact>(index, cutter, c, q, x, y, best, winner, tested);
         continue;
       }
       const double dx = maxd(maxd(c.xmin[q] - x, x - c.xmax[q]), 0.0);
       const double dy = maxd(maxd(c.ymin[q] - y, y - c.ymax[q]), 0.0);
-      if (dx * dx + dy * dy < cutter.reach2(top - best)) test(q);
+      if (dx * dx + dy * dy < cutter.reach2(top - best))
+        test_candidate<kExact>(index, cutter, c, q, x, y, best, winner, tested);
     }
   }
+  return best;
+}
+
+// drop_point over a tile's candidate list; same result as the walk (the same bounds, a different order).
+template <Reach kReach>
+double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x,
+                          double y, double floor_z, std::size_t& tested, int32_t& hint, double ceiling) {
+  double best = floor_z;
+  int32_t winner = -1;  // position in the tile's list
+  // Warm start: the previous point's winner (a position in this list) gives a true lower bound at once.
+  if (hint >= 0) test_candidate<false>(index, cutter, c, static_cast<std::size_t>(hint), x, y, best, winner, tested);
+  best = scan_tile<kReach>(index, cutter, c, x, y, best, winner, static_cast<std::size_t>(hint), tested, ceiling);
   hint = winner;
   return best;
 }
@@ -314,9 +334,26 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
     }
   }
   std::vector<std::size_t> order(n);
-  for (std::size_t i = 0; i < n; ++i) order[i] = i;
-  if (tiled)
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  // By a counting sort on the tile's place in the box when the tiles are not many more than the points (a
+  // grid, a raster: O(n)), else a stable sort of the keys; the same order.
+  const double tiles_x = tiled ? std::floor((x1 - x0) / tile) + 1.0 : 0.0;
+  const double tiles_y = tiled ? std::floor((y1 - y0) / tile) + 1.0 : 0.0;
+  if (tiled && tiles_x * tiles_y <= 4.0 * static_cast<double>(n) + 1024.0) {
+    const auto ntx = static_cast<std::uint64_t>(tiles_x);
+    const std::size_t buckets = static_cast<std::size_t>(tiles_x * tiles_y) + 1;  // the last: untiled points
+    auto bucket = [&](std::size_t i) {
+      const std::uint64_t k = key[i];
+      return k == ~std::uint64_t{0} ? buckets - 1 : static_cast<std::size_t>((k >> 27) * ntx + (k & ((1u << 27) - 1)));
+    };
+    std::vector<std::size_t> start(buckets + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++start[bucket(i) + 1];
+    for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+    for (std::size_t i = 0; i < n; ++i) order[start[bucket(i)]++] = i;
+  } else {
+    for (std::size_t i = 0; i < n; ++i) order[i] = i;
+    if (tiled)
+      std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  }
   // Runs of one key; untiled points (and tiles too sparse for a list) are runs of one point.
   std::vector<std::size_t> run_start;
   for (std::size_t k = 0; k < n;) {
@@ -335,6 +372,8 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
                             : cutter.kind() == CutterKind::Bull ? &drop_point_in_tile<Reach::Bull>
                                                                 : &drop_point_in_tile<Reach::Scalar>;
   std::atomic<std::size_t> tested{0};
+  const bool capped = ceiling < INFINITY;
+  const auto& tris = index.triangles();
   parallel_chunks(runs, 16, options, [&](std::size_t begin, std::size_t end) {
     std::size_t local = 0;
     TileCandidates cands;
@@ -342,22 +381,52 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
       const std::size_t a = run_start[r], b = run_start[r + 1];
       int32_t hint = -1;
       bool listed = b - a >= kMinTilePoints && key[order[a]] != ~std::uint64_t{0};
+      // Capped heights (a waterline's grid): while the tile's points stand above the ceiling (over the top of
+      // a part) they are solved without its list: the last winner alone lifting the tool above the ceiling
+      // gives the ceiling, else a walk that stops at the first contact above it; the list is gathered at the
+      // first point below the ceiling.
+      int32_t last = -1;  // the last winner, a position in tris
+      std::size_t k = a;
+      if (capped && listed) {
+        DropStats s;
+        for (; k < b; ++k) {
+          const std::size_t i = order[k];
+          const double x = xy[2 * i], y = xy[2 * i + 1];
+          if (last >= 0) {
+            ++s.triangles_tested;
+            if (drop_on_owned(cutter, x, y, tris[static_cast<std::size_t>(last)], floor_of(i)) > ceiling) {
+              z_out[i] = ceiling;
+              continue;
+            }
+          }
+          int32_t winner = last;
+          const double h = drop_point(index, cutter, x, y, floor_of(i), &s, &winner, ceiling);
+          z_out[i] = std::min(h, ceiling);
+          if (!(h > ceiling)) {
+            ++k;
+            break;
+          }
+          last = winner;
+        }
+        local += s.triangles_tested;
+        if (k == b) continue;
+      }
       if (listed) {
         double tx0 = INFINITY, ty0 = INFINITY, tx1 = -INFINITY, ty1 = -INFINITY;
-        for (std::size_t k = a; k < b; ++k) {
-          const std::size_t i = order[k];
+        for (std::size_t j = a; j < b; ++j) {
+          const std::size_t i = order[j];
           tx0 = std::min(tx0, xy[2 * i]);
           tx1 = std::max(tx1, xy[2 * i]);
           ty0 = std::min(ty0, xy[2 * i + 1]);
           ty1 = std::max(ty1, xy[2 * i + 1]);
         }
         double tile_floor = INFINITY;  // the lowest floor of the tile's points bounds the list
-        for (std::size_t k = a; k < b; ++k) tile_floor = std::min(tile_floor, floor_of(order[k]));
+        for (std::size_t j = a; j < b; ++j) tile_floor = std::min(tile_floor, floor_of(order[j]));
         listed = cands.gather(index, cutter, tx0, ty0, tx1, ty1, tile_floor, kMaxCandidatesPerPoint * (b - a));
       }
       if (!listed) {
         DropStats s;
-        for (std::size_t k = a; k < b; ++k) {
+        for (; k < b; ++k) {
           const std::size_t i = order[k];
           z_out[i] = std::min(drop_point(index, cutter, xy[2 * i], xy[2 * i + 1], floor_of(i), &s, &hint, ceiling),
                               ceiling);
@@ -365,7 +434,7 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
         local += s.triangles_tested;
         continue;
       }
-      for (std::size_t k = a; k < b; ++k) {
+      for (; k < b; ++k) {
         const std::size_t i = order[k];
         const double x = xy[2 * i], y = xy[2 * i + 1], floor_i = floor_of(i);
         z_out[i] = std::min(drop_in_tile(index, cutter, cands, x, y, floor_i, local, hint, ceiling), ceiling);
@@ -393,4 +462,108 @@ void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, 
   drop_batch_floors(index, cutter, xy, n, floors, 0.0, z_out, options, stats);
 }
 
+// Tiles of a DropTiles: null until gathered, then the list, or kWalk where drop_point serves the tile.
+struct DropTiles::Impl {
+  const MeshIndex& index;
+  const Cutter& cutter;
+  double x0 = 0, y0 = 0, tile = 1, floor = 0;
+  std::size_t nx = 0, ny = 0;
+  double (*scan)(const MeshIndex&, const Cutter&, const TileCandidates&, double, double, double, int32_t&,
+                 std::size_t, std::size_t&, double);
+  std::unique_ptr<std::atomic<TileCandidates*>[]> slots;
+  std::atomic<std::size_t> kept{0};  // candidates in all lists: bounded by kDropTilesBudget
+  static TileCandidates* walk() { return reinterpret_cast<TileCandidates*>(std::uintptr_t{1}); }
+
+  Impl(const MeshIndex& i, const Cutter& c) : index(i), cutter(c) {}
+  ~Impl() {
+    for (std::size_t k = 0; slots && k < nx * ny; ++k) {
+      TileCandidates* c = slots[k].load();
+      if (c != walk()) delete c;
+    }
+  }
+  // Tile (i, j)'s list, gathered by the first thread that asks (another gathering the same one at the same
+  // time throws its copy away: both are equal); null for a tile served by drop_point.
+  const TileCandidates* candidates(std::size_t i, std::size_t j) {
+    std::atomic<TileCandidates*>& slot = slots[j * nx + i];
+    TileCandidates* c = slot.load(std::memory_order_acquire);
+    if (!c) {
+      auto made = std::make_unique<TileCandidates>();
+      const double tx = x0 + static_cast<double>(i) * tile, ty = y0 + static_cast<double>(j) * tile;
+      const std::size_t used = kept.load(std::memory_order_relaxed);
+      const std::size_t most = std::min(kDropTilesMostPerTile, kDropTilesBudget - std::min(used, kDropTilesBudget));
+      TileCandidates* fresh = walk();
+      if (made->gather(index, cutter, tx, ty, tx + tile, ty + tile, floor, most)) {
+        made->sorted = {};  // (scratch of the gather)
+        fresh = made.get();
+      }
+      if (slot.compare_exchange_strong(c, fresh, std::memory_order_acq_rel, std::memory_order_acquire)) {
+        c = fresh;
+        if (fresh != walk()) kept.fetch_add(made.release()->id.size(), std::memory_order_relaxed);
+      }
+    }
+    return c == walk() ? nullptr : c;
+  }
+};
+
+DropTiles::DropTiles(const MeshIndex& index, const Cutter& cutter, double x0, double y0, double x1, double y1,
+                     double tile, double floor)
+    : impl_(std::make_unique<Impl>(index, cutter)) {
+  for (double v : {x0, y0, x1, y1, tile, floor})
+    if (!std::isfinite(v)) throw std::invalid_argument("drop tiles: bounds, tile and floor must be finite");
+  if (!(x1 >= x0 && y1 >= y0)) throw std::invalid_argument("drop tiles: empty bounds");
+  // Tiles no smaller than the lattice of kDropTilesMost tiles needs (their slots are allocated at once).
+  tile = std::max(tile, std::sqrt((x1 - x0) * (y1 - y0) / static_cast<double>(kDropTilesMost)));
+  tile = std::max({tile, (x1 - x0) / 65536.0, (y1 - y0) / 65536.0, 1e-9});
+  Impl& d = *impl_;
+  d.x0 = x0;
+  d.y0 = y0;
+  d.tile = tile;
+  d.floor = floor;
+  d.nx = static_cast<std::size_t>((x1 - x0) / tile) + 1;
+  d.ny = static_cast<std::size_t>((y1 - y0) / tile) + 1;
+  d.slots = std::make_unique<std::atomic<TileCandidates*>[]>(d.nx * d.ny);
+  for (std::size_t k = 0; k < d.nx * d.ny; ++k) d.slots[k].store(nullptr, std::memory_order_relaxed);
+  d.scan = cutter.kind() == CutterKind::Flat   ? &scan_tile<Reach::Flat, true>
+           : cutter.kind() == CutterKind::Ball ? &scan_tile<Reach::Ball, true>
+           : cutter.kind() == CutterKind::Bull ? &scan_tile<Reach::Bull, true>
+                                               : &scan_tile<Reach::Scalar, true>;
+}
+
+DropTiles::~DropTiles() = default;
+
+double DropTiles::drop(double x, double y, double floor_z, int32_t* hint, double ceiling) const {
+  Impl& d = *impl_;
+  const double fi = std::floor((x - d.x0) / d.tile), fj = std::floor((y - d.y0) / d.tile);
+  const TileCandidates* c = nullptr;
+  if (fi >= 0 && fj >= 0 && fi < static_cast<double>(d.nx) && fj < static_cast<double>(d.ny) && floor_z >= d.floor)
+    c = d.candidates(static_cast<std::size_t>(fi), static_cast<std::size_t>(fj));
+  if (!c) return drop_point(d.index, d.cutter, x, y, floor_z, nullptr, hint, ceiling);
+  // Warm start from the hint's triangle, exactly as drop_point; the scan then skips it (found among the
+  // list's entries of its height: the list is by decreasing height).
+  const auto& tris = d.index.triangles();
+  double best = floor_z;
+  int32_t from_hint = -1;
+  std::size_t skip = ~std::size_t{0}, tested = 0;
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) {
+    const IndexedTriangle& t = tris[*hint];
+    const double z = drop_on_owned(d.cutter, x, y, t, best);
+    if (z > best) {
+      best = z;
+      from_hint = *hint;
+      const std::size_t m = c->id.size();
+      std::size_t q = static_cast<std::size_t>(
+          std::lower_bound(c->zmax.begin(), c->zmax.begin() + static_cast<std::ptrdiff_t>(m), t.zmax,
+                           [](double a, double b) { return a > b; }) - c->zmax.begin());
+      for (; q < m && c->zmax[q] == t.zmax; ++q)
+        if (c->id[q] == from_hint) {
+          skip = q;
+          break;
+        }
+    }
+  }
+  int32_t winner = -1;
+  best = d.scan(d.index, d.cutter, *c, x, y, best, winner, skip, tested, ceiling);
+  if (hint) *hint = winner >= 0 ? c->id[static_cast<std::size_t>(winner)] : from_hint;
+  return best;
+}
 }  // namespace tmm

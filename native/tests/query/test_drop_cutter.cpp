@@ -25,6 +25,7 @@ namespace {
 using tmm::Cutter;
 using Eigen::Vector3d;
 
+using tmm_test::bumpy_grid;
 using tmm_test::one_triangle;
 
 double drop1(const Cutter& c, double x, double y, const Vector3d& a, const Vector3d& b, const Vector3d& p) {
@@ -315,27 +316,6 @@ TEST(DropReference, RandomCutterSizes) {
     const double r = R * u(rng);
     check_against_references(Cutter(R, r), 40, 100 + k);
   }
-}
-
-// A bumpy random mesh: n x n unit cells, vertices jittered by up to 0.3 in X, Y and Z over the wave
-// z = 3 sin(x / wx) cos(y / wy).
-std::pair<tmm::Vertices, tmm::Triangles> bumpy_grid(int n, double wx, double wy, std::mt19937_64& rng) {
-  tmm::Vertices V((n + 1) * (n + 1), 3);
-  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const double x = i + jitter(rng), y = j + jitter(rng);
-      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / wx) * std::cos(y / wy) + jitter(rng);
-    }
-  tmm::Triangles F(2 * n * n, 3);
-  int t = 0;
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j) {
-      const int v = i * (n + 1) + j;
-      F.row(t++) << v, v + n + 1, v + 1;
-      F.row(t++) << v + 1, v + n + 1, v + n + 2;
-    }
-  return {V, F};
 }
 
 // The index finds exactly the maximum over all triangles, on a bumpy random mesh.

@@ -378,6 +378,67 @@ TEST(WaterlineAdaptive, FindsAThinRidgeBetweenTwoGridLines) {
   EXPECT_NEAR(fine[0][0].area(), loop.area(), 1e-3 * loop.area());
 }
 
+// A plateau at height 10 with a conical pit: apex (0, 0, 5), walls at 45 degrees up to radius 5; polar rings
+// of 64 sectors out to radius 20.
+MeshIndex plateau_with_pit() {
+  const int sectors = 64;
+  const std::vector<double> radii = {0.625, 1.25, 1.875, 2.5, 3.125, 3.75, 4.375, 5, 8, 12, 20};
+  tmm::Vertices V(1 + sectors * static_cast<int>(radii.size()), 3);
+  V.row(0) << 0, 0, 5;
+  for (std::size_t r = 0; r < radii.size(); ++r)
+    for (int j = 0; j < sectors; ++j) {
+      const double a = 2 * kPi * j / sectors, rho = radii[r];
+      V.row(1 + static_cast<int>(r) * sectors + j) << rho * std::cos(a), rho * std::sin(a), std::min(5 + rho, 10.0);
+    }
+  auto id = [&](std::size_t r, int j) { return 1 + static_cast<int>(r) * sectors + j % sectors; };
+  std::vector<std::array<int, 3>> F;
+  for (int j = 0; j < sectors; ++j) F.push_back({0, id(0, j), id(0, j + 1)});
+  for (std::size_t r = 0; r + 1 < radii.size(); ++r)
+    for (int j = 0; j < sectors; ++j) {
+      F.push_back({id(r, j), id(r + 1, j), id(r + 1, j + 1)});
+      F.push_back({id(r, j), id(r + 1, j + 1), id(r, j + 1)});
+    }
+  tmm::Triangles T(static_cast<Eigen::Index>(F.size()), 3);
+  for (std::size_t t = 0; t < F.size(); ++t) T.row(static_cast<Eigen::Index>(t)) << F[t][0], F[t][1], F[t][2];
+  return MeshIndex(V, T);
+}
+
+// A free pocket narrower than the grid whose four corners stand above z by more than the pocket band: only
+// the cubic through the 4 x 4 nodes around the cell shows the dip, which it must keep showing where its
+// samples are skipped (a bound of the cubic from the nodes' range: 1.5625 half-ranges about the mid-range;
+// with 1 half-range, the nodes' own range, this pocket is lost).
+TEST(WaterlineAdaptive, FindsADipBetweenTheNodesByTheCubic) {
+  const Cutter ball(3, 3);
+  const MeshIndex index = plateau_with_pit();
+  const double bottom = tmm::drop_point(index, ball, 0, 0, 0);  // the ball in the pit: h rises about 1 per mm
+  const double z = bottom + 0.12;
+  // The pit's axis at the centre of a 0.5 mm cell: its corners 0.35 mm away, about 0.23 above z, above the
+  // pocket band (0.17 for the ball over 2 x 0.5 mm).
+  const WaterlineOptions coarse = options(-10.25, -10.25, 10.25, 10.25, 0.5, 1e-4);
+  for (double c : {0.25, -0.25})
+    ASSERT_GT(tmm::drop_point(index, ball, c, c, 0) - z, ball.max_radius() - std::sqrt(9.0 - 1.0));
+  auto pockets = [](const std::vector<WaterlineLoop>& level) {
+    std::vector<const WaterlineLoop*> found;
+    for (const auto& loop : level)
+      if (loop.area() < 0) found.push_back(&loop);
+    return found;
+  };
+  EXPECT_TRUE(pockets(tmm::waterline(index, ball, {z}, coarse, {})[0]).empty());
+  const auto level = tmm::waterline(index, ball, {z}, adaptive(coarse, 0.05), {})[0];
+  const auto found = pockets(level);
+  ASSERT_EQ(found.size(), 1u);
+  for (std::size_t i = 0; i < found[0]->size(); ++i)
+    ASSERT_LT(std::hypot(found[0]->xy[2 * i], found[0]->xy[2 * i + 1]), 0.2) << "point " << i;
+  expect_contacts(index, ball, *found[0]);
+  expect_simple(level);
+  // A uniform grid at the fine step sees the same pocket.
+  WaterlineOptions fine = coarse;
+  fine.sample_step = 0.03125;
+  const auto ref = pockets(tmm::waterline(index, ball, {z}, fine, {})[0]);
+  ASSERT_EQ(ref.size(), 1u);
+  EXPECT_NEAR(found[0]->area(), ref[0]->area(), 0.02 * std::abs(ref[0]->area()));
+}
+
 // Count, orientation and area of each loop (sorted by area) equal to a uniform grid's at the fine step.
 void expect_same_loops(const std::vector<WaterlineLoop>& a, const std::vector<WaterlineLoop>& b, double tol) {
   ASSERT_EQ(a.size(), b.size());

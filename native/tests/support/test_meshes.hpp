@@ -3,6 +3,10 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
+#include <random>
+#include <utility>
+
 #include "tmm/mesh/mesh_index.hpp"
 
 namespace tmm_test {
@@ -16,6 +20,27 @@ inline tmm::MeshIndex one_triangle(const Eigen::Vector3d& a, const Eigen::Vector
   tmm::Triangles F(1, 3);
   F << 0, 1, 2;
   return tmm::MeshIndex(V, F);
+}
+
+// A bumpy random mesh: n x n unit cells, vertices jittered by up to 0.3 in X, Y and Z over the wave
+// z = 3 sin(x / wx) cos(y / wy).
+inline std::pair<tmm::Vertices, tmm::Triangles> bumpy_grid(int n, double wx, double wy, std::mt19937_64& rng) {
+  tmm::Vertices V((n + 1) * (n + 1), 3);
+  std::uniform_real_distribution<double> jitter(-0.3, 0.3);
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j) {
+      const double x = i + jitter(rng), y = j + jitter(rng);
+      V.row(i * (n + 1) + j) << x, y, 3 * std::sin(x / wx) * std::cos(y / wy) + jitter(rng);
+    }
+  tmm::Triangles F(2 * n * n, 3);
+  int t = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const int v = i * (n + 1) + j;
+      F.row(t++) << v, v + n + 1, v + 1;
+      F.row(t++) << v + 1, v + n + 1, v + n + 2;
+    }
+  return {V, F};
 }
 
 }  // namespace tmm_test

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 #include "tmm/cutter/cutter.hpp"
@@ -45,5 +46,35 @@ void drop_batch_capped(const MeshIndex& index, const Cutter& cutter, const doubl
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 const double* floors, double* z_out, const BatchOptions& options,
                 DropStats* stats = nullptr);
+
+// Drops at many scattered points of a region, in an order not known in advance (a waterline level's crossings
+// and chords), each scanning the candidate list of its tile as drop_batch does: square tiles of side `tile`
+// (or larger: at most kDropTilesMost of them) over [x0, x1] x [y0, y1], each list (the triangles within the
+// cutter's radius of the tile whose top is above `floor`, by decreasing height) gathered the first time a
+// point falls in its tile and kept. Points outside the region, floors below `floor`, tiles of more than
+// kDropTilesMostPerTile candidates and tiles past kDropTilesBudget candidates in all use drop_point.
+// drop() may be called from several threads at once.
+constexpr std::size_t kDropTilesMost = 1 << 16;
+constexpr std::size_t kDropTilesMostPerTile = 4096;
+constexpr std::size_t kDropTilesBudget = 1 << 18;  // about 22 MB of lists
+
+class DropTiles {
+ public:
+  // Throws std::invalid_argument on non-finite or empty bounds or a non-finite tile or floor.
+  DropTiles(const MeshIndex& index, const Cutter& cutter, double x0, double y0, double x1, double y1, double tile,
+            double floor);
+  ~DropTiles();
+  DropTiles(const DropTiles&) = delete;
+  DropTiles& operator=(const DropTiles&) = delete;
+  // drop_point(index, cutter, x, y, floor_z, nullptr, hint, ceiling): the same height (the same exact test of
+  // each triangle that can raise it; the lists' filters are bounds of that test's own pruning), the hint as
+  // there (a position in index.triangles(); -1 for none).
+  double drop(double x, double y, double floor_z, int32_t* hint,
+              double ceiling = std::numeric_limits<double>::infinity()) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace tmm
