@@ -336,6 +336,26 @@ def _start_at(loop: np.ndarray, i: int, q: np.ndarray) -> np.ndarray:
     return body[keep]
 
 
+def _closed_loop(p: np.ndarray) -> bool:
+    return len(p) > 2 and float(np.hypot(*(p[0] - p[-1]))) < 1e-9
+
+
+def _entry(loop: np.ndarray, p: np.ndarray) -> tuple[float, int, np.ndarray]:
+    """Where the tool enters the pass from p: a closed loop at its nearest point (distance, segment, point), an
+    open one (the passes beside a start curve, clipped by the region) at its nearer end (segment 0 or -1)."""
+    if _closed_loop(loop):
+        return _nearest(loop, p)
+    a, b = float(np.hypot(*(loop[0] - p))), float(np.hypot(*(loop[-1] - p)))
+    return (a, 0, loop[0]) if a <= b else (b, -1, loop[-1])
+
+
+def _entered(loop: np.ndarray, i: int, q: np.ndarray) -> np.ndarray:
+    """The pass cut from its entry (_entry's segment i and point q)."""
+    if _closed_loop(loop):
+        return _start_at(loop, i, q)
+    return loop if i == 0 else loop[::-1]
+
+
 def loop_chains(result: OffsetLoops, shape: Shape, max_link: float, linked: bool = True) -> list[Chain]:
     """The loops in cutting order, outside in, as region_order chains: after a loop, the nearest loop one
     level further in whose straight link from here stays in the region and is at most `max_link` long (the
@@ -350,7 +370,7 @@ def loop_chains(result: OffsetLoops, shape: Shape, max_link: float, linked: bool
         pick = None
         if here is not None and linked:
             level = result.loops[chains[-1][-1][2]].level + 1 if chains else 0
-            cands = [(_nearest(result.loops[k].points, here), k) for k in todo if result.loops[k].level == level]
+            cands = [(_entry(result.loops[k].points, here), k) for k in todo if result.loops[k].level == level]
             for (dist, i, q), k in sorted(cands, key=lambda c: c[0][0]):
                 if dist <= max_link and segment_inside(here, q, shape, edges):
                     pick = (k, i, q, np.array([here, q]))
@@ -363,11 +383,11 @@ def loop_chains(result: OffsetLoops, shape: Shape, max_link: float, linked: bool
                 pts = result.loops[k].points
                 pick = (k, 0, pts[0], None)
             else:
-                best = min(((_nearest(result.loops[k].points, here), k) for k in cands), key=lambda c: c[0][0])
+                best = min(((_entry(result.loops[k].points, here), k) for k in cands), key=lambda c: c[0][0])
                 (_, i, q), k = best
                 pick = (k, i, q, None)
         k, i, q, link = pick
-        loop = _start_at(result.loops[k].points, i, q)
+        loop = _entered(result.loops[k].points, i, q)
         if link is None:
             chains.append([(None, loop, k)])  # type: ignore[list-item]
         else:

@@ -16,7 +16,7 @@ import numpy as np
 
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint import offset3d, region_order
+from tmm_workbench.core.footprint import offset3d, offset_field, region_order
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface, Progress
@@ -69,8 +69,8 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: Any, flo
     def heights(xy: np.ndarray) -> np.ndarray:
         return np.maximum(surface.drop(tool, xy, floor_z - s) + s, floor_z)
 
-    loops = offset3d.offset_loops(shape, heights, cutter, params.cusp, params.sample_step, params.max_slope_deg,
-                                  progress)
+    loops = offset_field.field_loops(shape, heights, cutter, params.cusp, params.sample_step, params.max_slope_deg,
+                                     params.offset_from, progress)
     ordered = offset3d.loop_chains(loops, shape, max_link(loops.flat_step, cutter), params.pattern != ONEWAY)
     diagnostics.update(passes=len(loops.loops), jumps=len(ordered) - 1, levels=loops.levels,
                        stepover=loops.flat_step, least_step=loops.least_step, region_area=polygons.area(shape))
