@@ -39,6 +39,8 @@ _SLOPE_TABLE = 76        # the rule's step tabulated at this many slopes from 0 
                          # interpolates linearly; StepRule itself interpolates a 5 deg table)
 _BAND_CELLS = 1.5        # start nodes: within this many cells of the start set (both ends of every cut edge)
 _WALK = 0.75            # the half level is cut where T reaches k + 1 within this many local steps (_half_level)
+_SIMPLIFY = 0.005        # contour vertices within this many flat steps of the line through their neighbours go
+                         # (the pass moves by at most 0.5 % of the step: the cusp by 1 %)
 _PROBE = 0.5            # slope and curvature across from heights this many flat steps either side (offset3d's band)
 _BYTES_PER_NODE = 64     # heights, T, masks, the node coordinates and the drop's work arrays
 
@@ -127,9 +129,21 @@ def grid_cell(flat_step: float) -> float:
     return flat_step / _CELLS_PER_STEP
 
 
-def node_count(shape: Shape, flat_step: float) -> float:
-    """Nodes of the field's grid over the region's box (for the work estimate, before any is allocated)."""
+def field_box(shape: Shape, start: Optional[Sequence[np.ndarray]] = None) -> tuple[float, float, float, float]:
+    """The field's box: the region's, and the start curves' (the passes beside a curve are offsets of all of it,
+    its parts outside the region too; a grid that ended at the region's edge would make T there from one side
+    only, and that error would run along the passes into the region)."""
     x0, y0, x1, y1 = polygons.bounds(shape)
+    for c in start or ():
+        c = np.asarray(c, float)
+        x0, y0 = min(x0, float(c[:, 0].min())), min(y0, float(c[:, 1].min()))
+        x1, y1 = max(x1, float(c[:, 0].max())), max(y1, float(c[:, 1].max()))
+    return x0, y0, x1, y1
+
+
+def node_count(shape: Shape, flat_step: float, start: Optional[Sequence[np.ndarray]] = None) -> float:
+    """Nodes of the field's grid over field_box (for the work estimate, before any is allocated)."""
+    x0, y0, x1, y1 = field_box(shape, start)
     cell = grid_cell(flat_step)
     return (math.ceil((x1 - x0) / cell) + 6) * (math.ceil((y1 - y0) / cell) + 6)
 
@@ -242,11 +256,14 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
     flat = rule.flat
     least = float(rule.step(np.array([max_slope_deg]))[0])
     cell = grid_cell(flat)
-    count = node_count(shape, flat)
+    if start is not None and not polygons.clip_open(list(start), polygons.offset(shape, 2 * cell)):
+        raise TmmError("3D offset start curve: it lies outside the machining region (no point of it within "
+                       f"{2 * cell:.3g} mm of the region)")
+    count = node_count(shape, flat, start)
     check_work("field nodes", count, _BYTES_PER_NODE,
-               f"3D offset: cusp height {cusp:g} mm (flat step {flat:.3g} mm, field cell {cell:.3g} mm) over a "
-               f"{polygons.area(shape):.6g} mm^2 region", )
-    x0, y0, x1, y1 = polygons.bounds(shape)
+               f"3D offset: cusp height {cusp:g} mm (flat step {flat:.3g} mm, field cell {cell:.3g} mm) over the "
+               f"{polygons.area(shape):.6g} mm^2 region and the start curve's box", )
+    x0, y0, x1, y1 = field_box(shape, start)
     xs = x0 - 3 * cell + cell * np.arange(math.ceil((x1 - x0) / cell) + 7)
     ys = y0 - 3 * cell + cell * np.arange(math.ceil((y1 - y0) / cell) + 7)
     gx, gy = np.meshgrid(xs, ys)
@@ -258,11 +275,8 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
         dist, normal = _band([_closed(np.asarray(p, float)) for p in shape], xs, ys, reach)
         dist = np.where(inside, dist, -dist)       # outside: before the start (negative T)
     else:
-        active = _inside(polygons.offset(shape, 2 * cell), xs, ys)
+        active = np.ones(z.shape, dtype=bool)
         dist, normal = _band([np.asarray(c, float) for c in start], xs, ys, reach)
-        if not np.isfinite(dist[active]).any():
-            raise TmmError("3D offset start curve: it lies outside the machining region (no point of it within "
-                           f"{2 * cell:.3g} mm of the region)")
     slopes = np.linspace(0.0, max_slope_deg, _SLOPE_TABLE)
     steps = rule.step(slopes)
     args = dict(steps=steps, dslope=math.radians(slopes[1]), radius=float(cutter.radius), probe=_PROBE * flat,
@@ -325,7 +339,7 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         raise TmmError(f"cusp slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
     field, rule = arrival(shape, heights, cutter, cusp, max_slope_deg, start)
     flat = rule.flat
-    arc_tol = min(polygons.ARC_TOL, 0.002 * flat)
+    arc_tol = min(polygons.ARC_TOL, _SIMPLIFY * flat)
     finite = field.t[np.isfinite(field.t)]
     top = float(finite.max()) if len(finite) else 0.0
     levels = int(math.floor(top))
