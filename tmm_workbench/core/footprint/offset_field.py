@@ -41,6 +41,7 @@ _BAND_CELLS = 1.5        # start nodes: within this many cells of the start set 
 _WALK = 0.75            # the half level is cut where T reaches k + 1 within this many local steps (_half_level)
 _SIMPLIFY = 0.005        # contour vertices within this many flat steps of the line through their neighbours go
                          # (the pass moves by at most 0.5 % of the step: the cusp by 1 %)
+_MIN_HALF = 2.0          # half-level pieces shorter than this many flat steps are left out
 _PROBE = 0.5            # slope and curvature across from heights this many flat steps either side (offset3d's band)
 _BYTES_PER_NODE = 64     # heights, T, masks, the node coordinates and the drop's work arrays
 
@@ -383,7 +384,7 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         current = keep(field.lines(float(k))) if k <= levels else []
         # (pieces shorter than half a flat step are left out: the points they would serve lie within a few
         # hundredths of a step more than half a step from the passes)
-        caps = [c for c in keep(_half_level(field, k - 1)) if float(np.hypot(*np.diff(c, axis=0).T).sum()) > 0.5 * flat]
+        caps = [c for c in keep(_half_level(field, k - 1)) if float(np.hypot(*np.diff(c, axis=0).T).sum()) > _MIN_HALF * flat]
         for line in current + caps:
             add(line, k, previous)
         previous = current + caps if current or caps else previous
