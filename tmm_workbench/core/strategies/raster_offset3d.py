@@ -1,8 +1,9 @@
 """3-axis finishing by the "3D offset" (constant scallop) step-over mode (issue 14 item 1): what raster_drop
 does when SurfaceParams.stepover_mode is OFFSET3D.
 
-The loops (core.footprint.offset3d) follow the machining region (its polygons, or the boundary box) from its
-edge inward, spaced by the cusp height across the local slope; they are put in chains outside in
+The passes (core.footprint.offset_field: the level sets of one arrival-time field) follow the machining region
+(its polygons, or the boundary box) from its edge inward, or a chosen curve (offset_from) to both sides, spaced by
+the cusp height across the local slope; they are put in chains outside in
 (offset3d.loop_chains) and handed back as region_order runs, so raster_drop drops, refines (no gouge between
 CL points, links included) and cuts them exactly as it does a region's raster: within a chain the tool stays
 down over short links inside the region, between chains it lifts. Pattern OneWay: no links (a lift before
