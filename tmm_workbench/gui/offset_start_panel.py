@@ -5,23 +5,16 @@ from __future__ import annotations
 
 from typing import Any
 
+from tmm_workbench.gui import object_chooser
+
 COMBOS = {"offsetStart": "OffsetStart"}
-NO_CURVE = "(none)"
 
 
 def curve_candidates(obj: Any) -> list[Any]:
     """Objects whose edges can start the passes: sketches and other 2D objects, and edge-only shapes (the Job's
     model clones and stock are solids: never among them)."""
-    out = []
-    for o in obj.Document.Objects:
-        if not hasattr(o, "Shape") or hasattr(o, "PathResource"):
-            continue
-        shape = o.Shape
-        if shape.isNull() or not shape.Edges:
-            continue
-        if o.isDerivedFrom("Part::Part2DObject") or not shape.Faces:
-            out.append(o)
-    return out
+    return [o for o in object_chooser.edge_objects(obj.Document)
+            if o.isDerivedFrom("Part::Part2DObject") or not o.Shape.Faces]
 
 
 def _has_rows(page: Any) -> bool:
@@ -29,26 +22,13 @@ def _has_rows(page: Any) -> bool:
 
 
 def get_fields(page: Any, obj: Any) -> None:
-    if not _has_rows(page):
-        return
-    name = page.form.offsetCurve.currentData()
-    target = obj.Document.getObject(name) if name else None
-    if obj.OffsetCurve != target:
-        obj.OffsetCurve = target
+    if _has_rows(page):
+        object_chooser.write(page.form.offsetCurve, obj, "OffsetCurve")
 
 
 def set_fields(page: Any, obj: Any) -> None:
-    if not _has_rows(page):
-        return
-    combo = page.form.offsetCurve
-    combo.blockSignals(True)
-    combo.clear()
-    combo.addItem(NO_CURVE, "")
-    for o in curve_candidates(obj):
-        combo.addItem(o.Label, o.Name)
-    index = combo.findData(obj.OffsetCurve.Name) if obj.OffsetCurve is not None else 0
-    combo.setCurrentIndex(max(index, 0))
-    combo.blockSignals(False)
+    if _has_rows(page):
+        object_chooser.fill(page.form.offsetCurve, curve_candidates(obj), obj.OffsetCurve)
 
 
 def signals(page: Any) -> list[Any]:
