@@ -237,16 +237,6 @@ class Field:
         gy, gx = self._grad
         return np.column_stack([self.at(xy, gx), self.at(xy, gy)])
 
-    def enclosed(self, poly: np.ndarray) -> np.ndarray:
-        """T at the nodes inside the closed polyline."""
-        x0, y0, x1, y1 = poly[:, 0].min(), poly[:, 1].min(), poly[:, 0].max(), poly[:, 1].max()
-        i = np.flatnonzero((self.xs >= x0) & (self.xs <= x1))
-        j = np.flatnonzero((self.ys >= y0) & (self.ys <= y1))
-        if not len(i) or not len(j):
-            return np.empty(0)
-        inside = _inside([poly[:-1] if np.allclose(poly[0], poly[-1]) else poly], self.xs[i], self.ys[j])
-        return self.t[np.ix_(j, i)][inside]
-
 
 def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slope_deg: float,
             start: Optional[Sequence[np.ndarray]] = None) -> tuple[Field, StepRule]:
