@@ -68,3 +68,131 @@ class Offset3D(FreeCADTestCase):
         with self.assertRaises(TmmError) as ctx:
             run_surface(bump_stl(), stepover_mode="offset3d", cusp=10.0, progress=False, doc_name="TmmApiBad3D")
         self.assertIn("cusp height must be in (0, 3] mm", str(ctx.exception))
+
+
+def line_sketch(doc, a, b, name="Start"):
+    """An open sketch: one line from a to b (XY)."""
+    import Part
+
+    sk = doc.addObject("Sketcher::SketchObject", name)
+    sk.addGeometry(Part.LineSegment(FreeCAD.Vector(a[0], a[1], 0), FreeCAD.Vector(b[0], b[1], 0)))
+    doc.recompute()
+    return sk
+
+
+def on_line(p, a, b) -> float:
+    """XY distance of p from the infinite line through a and b."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    return abs((p[0] - a[0]) * dy - (p[1] - a[1]) * dx) / (dx * dx + dy * dy) ** 0.5
+
+
+class Offset3DFromCurve(FreeCADTestCase):
+    """OffsetStart Curve (issue 14 item 1): the passes offset from an open sketch line to both sides."""
+
+    def test_start_curve_save_reopen_and_bad_input(self) -> None:
+        doc = new_doc("TmmOffsetCurve")
+        _, _, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.5, "BoundaryShape": "Model"})
+        self.assertEqual(op.OffsetStart, "Boundary")                     # a new op: from the boundary, as before
+        a, b = (-10.0, -4.0), (10.0, 4.0)
+        sk = line_sketch(doc, a, b)
+        op.StepOverMode, op.CuspHeight, op.OffsetStart, op.OffsetCurve = "Offset3D", 0.02, "Curve", sk
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        pts = cut_xy(op)
+        # the first pass is the line (its drop), across the whole box; the passes go to both sides of it
+        first = [p for p in pts[:200] if on_line(p, a, b) < 1e-6]
+        self.assertGreater(len(first), 20)
+        side = [((p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0])) for p in pts]
+        self.assertTrue(min(side) < -50 and max(side) > 50, (min(side), max(side)))
+        # the next pass lies about one step from the line (the flat step at 0.02 mm with the 4 mm ball is 0.56
+        # mm; smaller on the bump's slopes)
+        dists = sorted({round(on_line(p, a, b), 3) for p in pts if on_line(p, a, b) > 1e-3})
+        self.assertTrue(0.15 < dists[0] < 0.6, dists[:5])
+        commands = len(op.Path.Commands)
+        op = reopened(doc, op, "offset3d_curve.FCStd")
+        doc = op.Document
+        self.assertEqual((op.OffsetStart, op.OffsetCurve.Name), ("Curve", "Start"))
+        doc.recompute()
+        self.assertEqual(len(op.Path.Commands), commands)
+        # bad input: a message naming the property, no path
+        far = line_sketch(doc, (100.0, 100.0), (120.0, 100.0), "Far")
+        for value, fragment in ((far, "start curve: it lies outside the machining region"),
+                                (None, "OffsetStart 'Curve': no curve chosen (OffsetCurve is empty)")):
+            op.OffsetCurve = value
+            doc.recompute()
+            self.assertFalse(op.isValid())
+            self.assertIn(fragment, op.getStatusString())
+            self.assertEqual(len(op.Path.Commands), 0)
+        point = doc.addObject("Part::Feature", "Point")
+        import Part
+
+        point.Shape = Part.Vertex(FreeCAD.Vector(0, 0, 0))
+        op.OffsetCurve = point
+        doc.recompute()
+        self.assertIn("OffsetStart 'Curve': 'Point' has no edges", op.getStatusString())
+        op.OffsetCurve, op.StepOverMode = doc.getObject("Start"), "Cusp"
+        doc.recompute()
+        self.assertIn("OffsetStart 'Curve' needs StepOverMode 'Offset3D'", op.getStatusString())
+        self.assertEqual(len(op.Path.Commands), 0)
+        close_all()
+
+    def test_a_document_from_before_the_start_choice_restores_from_the_boundary(self) -> None:
+        doc = new_doc("TmmOldOffsetStart")
+        _, _, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.5, "BoundaryShape": "Model",
+                                                             "StepOverMode": "Offset3D", "CuspHeight": 0.02})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        before = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
+        for prop in ("OffsetStart", "OffsetCurve"):                  # as saved by an older TMM
+            op.removeProperty(prop)
+        op = reopened(doc, op, "old_offset_start.FCStd")
+        self.assertEqual(op.OffsetStart, "Boundary")
+        op.Document.recompute()
+        # the same path (to the 6 decimals a saved Path keeps)
+        after = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
+        self.assertEqual([(n, sorted(p)) for n, p in after], [(n, sorted(p)) for n, p in before])
+        self.assertLess(max(abs(p[k] - q[k]) for (_, p), (_, q) in zip(after, before) for k in p), 2e-6)
+        close_all()
+
+    def test_run_surface_offset_from(self) -> None:
+        import Mesh
+
+        doc = new_doc("TmmApiOffsetCurve")
+        mesh = doc.addObject("Mesh::Feature", "Bump")
+        mesh.Mesh = Mesh.Mesh(str(bump_stl()))
+        sk = line_sketch(doc, (-10.0, 0.0), (10.0, 0.0))
+        r = run_surface(mesh, sample_step=0.5, stepover_mode="offset3d", cusp=0.02, offset_from=sk, progress=False)
+        self.assertEqual((r.op.OffsetStart, r.op.OffsetCurve.Name), ("Curve", sk.Name))
+        ys = [p[1] for p in r.toolpath.cutting_points()]
+        self.assertTrue(min(ys) < -9 and max(ys) > 9)
+        with self.assertRaises(TmmError) as ctx:
+            run_surface(mesh, stepover_mode="cusp", offset_from=sk, progress=False)
+        self.assertIn("offset_from needs stepover_mode 'offset3d', got 'cusp'", str(ctx.exception))
+        close_all()
+
+
+class Offset3DEstimate(FreeCADTestCase):
+    def test_estimate_is_what_the_op_computes(self) -> None:
+        """The panel's estimate for StepOverMode Offset3D (not the raster's): the passes' points and cutting time
+        within 0.5-2x of what the op computes."""
+        from tmm_workbench.app import work_estimate
+        from tmm_workbench.app.simulation import _toolpath_and_feeds
+        from tmm_workbench.app.tools import cutter_from_tool
+        from tmm_workbench.core.sim.cycle_time import three_axis_time
+        from tmm_workbench.core.strategies import raster_drop
+
+        doc = new_doc("TmmOffsetEstimate")
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.4, "BoundaryShape": "Model",
+                                                              "StepOverMode": "Offset3D", "CuspHeight": 0.02})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        mesh = op.Proxy.mesh
+        params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
+        result = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params)
+        points = result.diagnostics["points"]
+        self.assertTrue(0.5 * points <= est.count <= 2.0 * points, (est.count, points))
+        tp, feeds = _toolpath_and_feeds(op)
+        cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
+        self.assertTrue(0.5 * cutting < est.cutting_seconds < 2.0 * cutting, (est.cutting_seconds, cutting))
+        self.assertTrue(0.5 * result.diagnostics["levels"] <= est.passes <= 2.0 * result.diagnostics["levels"],
+                        (est.passes, result.diagnostics["levels"]))
+        close_all()

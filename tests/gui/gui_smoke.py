@@ -306,6 +306,12 @@ def smoke() -> dict:
     assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch"]], info["panel_region"]
     pattern = page.findChild(QtGui.QComboBox, "pattern")
     assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
+    # the 3D offset's start (issue 14 item 1): Boundary as the new op, the curve chooser empty
+    start = page.findChild(QtGui.QComboBox, "offsetStart")
+    curve = page.findChild(QtGui.QComboBox, "offsetCurve")
+    info["panel_offset_start"] = [start.currentText(), [start.itemText(i) for i in range(start.count())],
+                                  curve.currentText()]
+    assert info["panel_offset_start"] == ["Boundary", ["Boundary", "Curve"], "(none)"], info["panel_offset_start"]
     info["panel_slope_max"] = page.findChild(QtGui.QWidget, "slopeMax").property("rawValue")
     assert info["panel_slope_max"] == 90.0, info["panel_slope_max"]
     verify = page.findChild(QtGui.QCheckBox, "verifyCusp")  # issue 14 item 4: off, as the new op

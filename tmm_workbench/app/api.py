@@ -75,7 +75,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 progress: Union[bool, Callable[[float], bool]] = True,
                 stepover_percent: Optional[float] = None, final_depth: Optional[float] = None,
                 finish_passes: Optional[int] = None, finish_step_down: Optional[float] = None,
-                start_point: Optional[tuple[float, float]] = None) -> SurfaceResult:
+                start_point: Optional[tuple[float, float]] = None,
+                offset_from: Any = None) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
 
     tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose), or a
@@ -91,7 +92,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
     stepover_mode 'offset3d': closed loops from the region's boundary inward, spaced so the cusp between
     neighbours is `cusp` across the local slope (3D offset / constant scallop; pattern 'zigzag' links them,
-    'oneway' lifts before each).
+    'oneway' lifts before each). offset_from: None (from the region's boundary) or a sketch / an object with
+    edges, open or closed, of the model's document (the op's OffsetStart Curve): the passes are offset from it,
+    seen from above, to both sides across the region.
     region (where the tool centre may go; app.region_source): None (the boundary box), a sketch or any
     object with closed edges (inner loops are holes), or faces of the model seen from above: face names
     ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.
@@ -130,6 +133,12 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     from tmm_workbench.app import region_source
 
     extra.update(region_source.api_values(region, model, spiral_direction, slope_range, region_tolerance))
+    if offset_from is not None:  # the 3D offset from a chosen curve (issue 14 item 1; app.offset_start)
+        from tmm_workbench.app import offset_start
+
+        if stepover_mode != "offset3d":
+            raise TmmError(f"offset_from needs stepover_mode 'offset3d', got {stepover_mode!r}")
+        extra.update(offset_start.api_values(offset_from, model))
     extra["ForwardStep"] = _option("forward_step", forward_step, FORWARD_STEP_NAMES)
     if not isinstance(arcs, bool):
         raise TmmError(f"arcs must be True or False, got {arcs!r}")

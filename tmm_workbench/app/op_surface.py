@@ -22,6 +22,7 @@ import Path
 from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
 from tmm_workbench.app import surface_passes
 from tmm_workbench.app import surface_verify
+from tmm_workbench.app import offset_start
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
@@ -119,6 +120,10 @@ CHOICES.update(surface_passes.CHOICES)
 DEFAULTS.update(surface_passes.DEFAULTS)
 # the verification pass: partial passes where the simulated cusp exceeds CuspHeight (issue 14 item 4)
 PROPERTIES += surface_verify.PROPERTIES
+# the 3D offset's start: the region's boundary or a chosen curve (issue 14 item 1; app.offset_start)
+PROPERTIES += offset_start.PROPERTIES
+CHOICES.update(offset_start.CHOICES)
+DEFAULTS.update(offset_start.DEFAULTS)
 
 
 class ObjectTmmSurface(op_base.TmmOp):
@@ -156,6 +161,7 @@ class ObjectTmmSurface(op_base.TmmOp):
         params = self.params_from(obj, boundary=boundary, region=region,
                                   forward_step=FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""), SAMPLED),
                                   **surface_passes.params_extra(obj, cutter))
+        params.offset_from = offset_start.curves_of(obj, params.stepover_mode == OFFSET3D)
         if params.arcs and self.post_without_k(obj):
             params.arcs = False
             FreeCAD.Console.PrintWarning(
@@ -245,7 +251,8 @@ def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
 
 def SetupProperties() -> list[str]:
     """Properties the Job's SetupSheet may hold defaults for."""
-    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model", "RegionFaces", "RegionSketch"))
+    return op_base.setup_properties(ObjectTmmSurface, exclude=("StlFile", "Model", "RegionFaces", "RegionSketch",
+                                                                     "OffsetCurve"))
 
 
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,

@@ -187,6 +187,8 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
     m = _value(obj, "BoundaryMargin", ov)
     params = _params(proxy, obj, ov, boundary=(x0 - m, y0 - m, x1 + m, y1 + m))
     params.validate()
+    if params.stepover_mode == raster_drop.OFFSET3D:  # the 3D offset's passes (issue 14 item 1)
+        return _offset3d(obj, params)
     stepover = params.stepover
     if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
         stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
@@ -205,6 +207,21 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
                 "where the simulated cusp is over, not counted)")
     # passes cover the boundary at the step-over: their length is its area over the spacing
     return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover, _feed(obj), note)
+
+
+def _offset3d(obj: Any, params: Any) -> Estimate:
+    """The 3D offset's passes over the boundary box: their points and length on a plane (the region's area over
+    the flat step and its boundary: raster_offset3d.loop_length), the loops from the box's edge to its middle."""
+    from tmm_workbench.core.footprint import offset_field, region
+    from tmm_workbench.core.strategies import raster_offset3d
+
+    cutter = _cutter(obj)
+    shape = region.box_region(params.boundary)
+    count = raster_offset3d.estimate_work(shape, cutter, params)
+    length = raster_offset3d.loop_length(shape, cutter, params)
+    x0, y0, x1, y1 = params.boundary
+    flat = offset_field.step_rule(cutter, params.cusp, params.max_slope_deg).flat
+    return Estimate(count, "CL points", math.ceil(0.5 * min(x1 - x0, y1 - y0) / flat) + 1, length, _feed(obj))
 
 
 def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:

@@ -9,6 +9,7 @@ from PySide import QtGui
 from tmm_workbench.app import model_proxy, registry
 from tmm_workbench.app.compat import PathUtils
 from tmm_workbench.gui import op_page, region_panel, resources, surface_depths_gui
+from tmm_workbench.gui import offset_start_panel
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
@@ -31,6 +32,7 @@ CHECKS["verifyCusp"] = "VerifyCusp"  # the verification pass (issue 14 item 4)
 SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
 COMBOS.update(surface_depths_gui.COMBOS)
 CHECKS.update(surface_depths_gui.CHECKS)
+COMBOS.update(offset_start_panel.COMBOS)  # the 3D offset's start (issue 14 item 1)
 
 
 class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
@@ -81,6 +83,7 @@ class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
         if obj.Model != target:
             obj.Model = target
         region_panel.get_fields(self, obj)
+        offset_start_panel.get_fields(self, obj)
         self.get_depths(obj)
 
     def set_extra(self, obj: Any) -> None:
@@ -95,11 +98,12 @@ class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
         region_panel.set_fields(self, obj)
+        offset_start_panel.set_fields(self, obj)
         self.set_depths(obj)
 
     def extra_signals(self) -> list[Any]:
         return ([self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + region_panel.signals(self)
-                + self.depth_signals())
+                + self.depth_signals() + offset_start_panel.signals(self))
 
     def updateData(self, obj: Any, prop: str) -> None:
         super().updateData(obj, prop)

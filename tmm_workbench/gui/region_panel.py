@@ -8,6 +8,7 @@ from typing import Any
 import FreeCADGui
 
 from tmm_workbench.app import region_source
+from tmm_workbench.gui import object_chooser
 
 SPIN_BOXES = {"regionTolerance": "RegionTolerance", "slopeMin": "SlopeMin", "slopeMax": "SlopeMax"}
 COMBOS = {"region": "Region", "spiralDirection": "SpiralDirection"}
@@ -17,16 +18,8 @@ NO_SKETCH = "(none)"
 def sketch_candidates(obj: Any) -> list[Any]:
     """Objects whose edges can bound a region: sketches and other 2D objects, and edge-only shapes whose
     wires are all closed (the Job's model clones and stock are solids: never among them)."""
-    out = []
-    for o in obj.Document.Objects:
-        if not hasattr(o, "Shape") or hasattr(o, "PathResource"):
-            continue
-        shape = o.Shape
-        if shape.isNull() or not shape.Edges:
-            continue
-        if o.isDerivedFrom("Part::Part2DObject") or (not shape.Faces and all(w.isClosed() for w in shape.Wires)):
-            out.append(o)
-    return out
+    return [o for o in object_chooser.edge_objects(obj.Document) if o.isDerivedFrom("Part::Part2DObject")
+            or (not o.Shape.Faces and all(w.isClosed() for w in o.Shape.Wires))]
 
 
 def faces_text(obj: Any) -> str:
@@ -66,24 +59,13 @@ def init_fields(page: Any, obj: Any) -> None:
 def get_fields(page: Any, obj: Any) -> None:
     if not _has_group(page):
         return
-    name = page.form.regionSketch.currentData()
-    target = obj.Document.getObject(name) if name else None
-    if obj.RegionSketch != target:
-        obj.RegionSketch = target
+    object_chooser.write(page.form.regionSketch, obj, "RegionSketch")
 
 
 def set_fields(page: Any, obj: Any) -> None:
     if not _has_group(page):
         return
-    combo = page.form.regionSketch
-    combo.blockSignals(True)
-    combo.clear()
-    combo.addItem(NO_SKETCH, "")
-    for o in sketch_candidates(obj):
-        combo.addItem(o.Label, o.Name)
-    index = combo.findData(obj.RegionSketch.Name) if obj.RegionSketch is not None else 0
-    combo.setCurrentIndex(max(index, 0))
-    combo.blockSignals(False)
+    object_chooser.fill(page.form.regionSketch, sketch_candidates(obj), obj.RegionSketch)
     page.form.regionFacesInfo.setText(faces_text(obj))
 
 

@@ -79,6 +79,9 @@ class SurfaceParams(StrategyParams):
     # polygons with holes (core.polygons Shape) where the tool centre may go; None: the boundary rectangle.
     # `boundary` is then the region's box.
     region: Optional[list] = None
+    # 3D offset from a chosen curve (issue 14 item 1): XY polylines (open or closed, (n, 2) each) the passes are
+    # offset from, to both sides across the region; None: from the region's boundary inward
+    offset_from: Optional[list] = None
     spiral_direction: str = param(OUTWARD, "spiral direction", choices=(OUTWARD, INWARD))
     # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
     slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
