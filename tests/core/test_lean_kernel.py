@@ -45,14 +45,13 @@ def both_fits(mesh, cutter, params):
     sampled = compute(mesh, cutter, replace(params, forward_step="sample", chord_tol=0.0)).segments
     surface = DropSurface(mesh)
     floor = float(mesh.bounds[0][2])
-    step = min(params.sample_step / 4, 0.05)
-    kern, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL, step,
-                                        lower_bound=True)
+    kern, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
+                                        params.sample_step / 2, lower_bound=True)  # as raster_drop
 
     def drop(p):
         return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
 
-    py, _, pstats = raster_lean.lean_segments(sampled, drop, TOL, False, step)
+    py, _, pstats = raster_lean.lean_segments(sampled, drop, TOL, False, min(params.sample_step / 4, 0.05))
     return kern, kstats, py, pstats
 
 
@@ -110,3 +109,14 @@ def test_bad_tolerance_refused(bump_mesh):
             lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), tol)
     with pytest.raises(TmmError, match="lean tolerance"):
         lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), 5.0)
+
+
+def test_cancel(bump_mesh):
+    from tmm_workbench.core.errors import Cancelled
+
+    cutter = Cutter.ball(4.0)
+    surface = DropSurface(bump_mesh)
+    segs = compute(bump_mesh, cutter, SurfaceParams(boundary=(2, 2, 38, 18), stepover=0.5, sample_step=0.25,
+                                                    chord_tol=0.0)).segments
+    with pytest.raises(Cancelled):
+        lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), TOL, progress=lambda f: False)

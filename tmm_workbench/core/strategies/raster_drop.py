@@ -211,7 +211,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         exact = ExactDrop(surface.index, cutter.offset(s), (air_floor if skip else floor_z) - s, s, floor_z,
                           air_floor + 1.0 if skip else -math.inf)
         segments, diagnostics["lean"] = lean_segments_kernel(segments, exact, params.chord_tol,
-                                                             min(params.sample_step / 4, 0.05))
+                                                             params.sample_step / 2, progress=progress)
         diagnostics["arcs"] = {}
     elif lean:
         from tmm_workbench.core.strategies import raster_lean
