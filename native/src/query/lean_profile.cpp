@@ -22,6 +22,7 @@ constexpr double kExactSlack = 1e-9;     // mm: the band at a vertex that stays 
 constexpr double kMaxSlope = 1e4;        // |dz/ds| of a move (steeper: a vertical move, split before)
 constexpr double kMaxLeanDrops = 5e7;    // the profile's drops at max_step over all runs, at most
 constexpr double kCheckFailure = 0.98;   // of tol: a check point farther from its move fails
+constexpr double kTurnFraction = 0.1;    // of eps: a winner change with a smaller midpoint offset is not refined
 
 struct Point {
   double z0, m;
@@ -184,7 +185,6 @@ class RunLean {
   bool refine(double ta, double za, int32_t wa, double tb, double zb, int32_t wb) {
     const double len = tb - ta;
     if (len <= o_.min_step) {
-      if (wa != wb) ++breakpoints_;
       push(tb, zb, wb);
       return true;
     }
@@ -193,7 +193,12 @@ class RunLean {
     bool air = false;
     const double zm = exact(tm, &wm, &air);
     if (air) return false;
-    const bool split = len > o_.max_step || std::fabs(zm - 0.5 * (za + zb)) > eps_ || wa != wb || wm != wa;
+    // A kink (a breakpoint) in a convex or concave stretch leaves the chord by at most twice the midpoint's
+    // offset, so the offset alone bounds the polyline's error there; where the triangle holding the cutter
+    // changes, the breakpoint is still located (to min_step) unless the profile is straight to 0.1 eps there
+    // (a smooth tessellation's small turns), in case two turns of opposite sign hide each other at the midpoint.
+    const double off = std::fabs(zm - 0.5 * (za + zb));
+    const bool split = len > o_.max_step || off > eps_ || ((wa != wb || wm != wa) && off > kTurnFraction * eps_);
     if (!split) {
       push(tm, zm, wm);
       push(tb, zb, wb);
@@ -236,6 +241,7 @@ class RunLean {
       if (flags[i + 1] & kLeanFixed) fixed_.back() = 1;
     }
     fixed_.back() = 1;
+    for (std::size_t i = 0; i + 1 < win_.size(); ++i) breakpoints_ += !keep_[i] && win_[i] != win_[i + 1];
     out.drops += drops_;
     out.breakpoints += breakpoints_;
     drops_ = breakpoints_ = 0;

@@ -3,9 +3,11 @@
 //
 // Per run: (1) the exact profile between the given samples, by adaptive exact drops: an interval is halved while
 // it is longer than max_step, while its midpoint leaves the chord of its ends by more than rep_fraction x tol,
-// or while the triangle holding the cutter (the drop's winner) differs at its ends and midpoint, down to
-// min_step: so every breakpoint of the profile (the cutter leaving a facet for an edge or vertex roll) is
-// located to min_step and the polyline through the drops represents the profile within rep_fraction x tol.
+// or while the triangle holding the cutter (the drop's winner) differs at its ends and midpoint and the midpoint
+// is off the chord by more than a tenth of that, down to min_step: so every breakpoint of the profile that turns
+// it (the cutter leaving a facet for an edge or vertex roll) is located to min_step, and the polyline through the
+// drops represents the profile within about 2 x rep_fraction x tol (a convex or concave stretch leaves its chord by
+// at most twice the midpoint's offset).
 // (2) Between vertices that must stay (the ends, both ends of vertical moves, moves kept as sampled), the
 // min-link polyline in the band +-fit_fraction x tol about those drops by windows: each move reaches as far as
 // any line from the previous move's window of end heights can, then the vertices are placed backwards in the
@@ -63,7 +65,7 @@ struct LeanResult {
   std::vector<std::size_t> offsets;  // runs + 1, into s / z
   std::vector<double> s, z;          // the vertices of each run (first and last as given)
   std::size_t drops = 0;             // exact drops made (profile and checks)
-  std::size_t breakpoints = 0;       // drop intervals refined to min_step where the winner triangle changes
+  std::size_t breakpoints = 0;       // drop intervals where the triangle holding the cutter changes
   std::size_t refits = 0;            // stretches fitted again after a failed check
   std::size_t kept_dense = 0;        // stretches that kept every drop after `rounds`
   std::size_t lower_bound = 0;       // with options.lower_bound: moves at least, over all runs (see below)
