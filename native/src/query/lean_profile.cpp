@@ -22,7 +22,6 @@ constexpr double kExactSlack = 1e-9;     // mm: the band at a vertex that stays 
 constexpr double kMaxSlope = 1e4;        // |dz/ds| of a move (steeper: a vertical move, split before)
 constexpr double kMaxLeanDrops = 5e7;    // the profile's drops at max_step over all runs, at most
 constexpr double kCheckFailure = 0.98;   // of tol: a check point farther from its move fails
-constexpr double kTurnFraction = 0.1;    // of eps: a winner change with a smaller midpoint offset is not refined
 
 struct Point {
   double z0, m;
@@ -193,12 +192,9 @@ class RunLean {
     bool air = false;
     const double zm = exact(tm, &wm, &air);
     if (air) return false;
-    // A kink (a breakpoint) in a convex or concave stretch leaves the chord by at most twice the midpoint's
-    // offset, so the offset alone bounds the polyline's error there; where the triangle holding the cutter
-    // changes, the breakpoint is still located (to min_step) unless the profile is straight to 0.1 eps there
-    // (a smooth tessellation's small turns), in case two turns of opposite sign hide each other at the midpoint.
-    const double off = std::fabs(zm - 0.5 * (za + zb));
-    const bool split = len > o_.max_step || off > eps_ || ((wa != wb || wm != wa) && off > kTurnFraction * eps_);
+    // every change of the triangle holding the cutter is located to min_step: cheaper rules (refining it only
+    // where the midpoint leaves the chord) let two turns hide each other and the fit leave the band by 4 %
+    const bool split = len > o_.max_step || std::fabs(zm - 0.5 * (za + zb)) > eps_ || wa != wb || wm != wa;
     if (!split) {
       push(tm, zm, wm);
       push(tb, zb, wb);
@@ -336,8 +332,8 @@ void validate(const LeanRuns& r, const LeanOptions& o) {
   require(std::isfinite(o.min_step) && o.min_step > 0 && o.min_step <= o.max_step,
           value("lean min_step (mm)", o.min_step, "in (0, max_step]"));
   require(o.rep_fraction > 0 && o.rep_fraction < 0.5, value("lean rep_fraction", o.rep_fraction, "in (0, 0.5)"));
-  require(o.fit_fraction > 0.5 && o.fit_fraction + o.rep_fraction < 1.0,
-          value("lean fit_fraction", o.fit_fraction, "in (0.5, 1 - rep_fraction)"));
+  require(o.fit_fraction > 0.5 && o.fit_fraction + 2 * o.rep_fraction < 1.0,
+          value("lean fit_fraction", o.fit_fraction, "in (0.5, 1 - 2 rep_fraction)"));
   require(o.rounds >= 0 && o.rounds <= 100, value("lean rounds", o.rounds, "in [0, 100]"));
   require(!r.offsets.empty() && r.offsets.front() == 0 && r.offsets.back() == r.s.size(),
           "lean runs: offsets must start at 0 and end at the sample count");

@@ -3,11 +3,10 @@
 //
 // Per run: (1) the exact profile between the given samples, by adaptive exact drops: an interval is halved while
 // it is longer than max_step, while its midpoint leaves the chord of its ends by more than rep_fraction x tol,
-// or while the triangle holding the cutter (the drop's winner) differs at its ends and midpoint and the midpoint
-// is off the chord by more than a tenth of that, down to min_step: so every breakpoint of the profile that turns
-// it (the cutter leaving a facet for an edge or vertex roll) is located to min_step, and the polyline through the
-// drops represents the profile within about 2 x rep_fraction x tol (a convex or concave stretch leaves its chord by
-// at most twice the midpoint's offset).
+// or while the triangle holding the cutter (the drop's winner) differs at its ends and midpoint, down to
+// min_step: so every breakpoint of the profile (the cutter leaving a facet for an edge or vertex roll) is
+// located to min_step and the polyline through the drops represents the profile within about 2 x rep_fraction
+// x tol (a convex or concave stretch leaves its chord by at most twice the midpoint's offset).
 // (2) Between vertices that must stay (the ends, both ends of vertical moves, moves kept as sampled), the
 // min-link polyline in the band +-fit_fraction x tol about those drops by windows: each move reaches as far as
 // any line from the previous move's window of end heights can, then the vertices are placed backwards in the
@@ -42,7 +41,8 @@ struct LeanOptions {
   double max_step = 0.05;      // mm: exact drops at least this close along a move
   double min_step = 0.002;     // mm: breakpoints located to this
   double rep_fraction = 0.05;  // of tol: the drops' polyline against the profile (midpoint test)
-  double fit_fraction = 0.9;   // of tol: the band the fit uses (the rest covers the profile between drops)
+  double fit_fraction = 0.85;  // of tol: the band the fit uses (the rest, > 2 rep_fraction, covers the profile
+                               // between drops)
   int rounds = 4;              // refits after failed checks before a stretch keeps every drop
   bool lower_bound = false;    // also count the least lines any fit within +-tol can use (see below)
   LeanDrop drop;
