@@ -49,11 +49,14 @@ struct Piece {
   double zlo, zhi;     // the window of its start heights
 };
 
-// The band at drop i of a stretch of n drops: the ends exact.
+// The band at drop i of a stretch of n drops: the ends exact, never below the floor (a final depth holds).
 struct Band {
   const std::vector<double>& e;
   double half;
-  double lo(std::size_t i) const { return e[i] - (i == 0 || i + 1 == e.size() ? kExactSlack : half); }
+  double floor;
+  double lo(std::size_t i) const {
+    return std::max(e[i] - (i == 0 || i + 1 == e.size() ? kExactSlack : half), std::min(floor, e[i]));
+  }
   double hi(std::size_t i) const { return e[i] + (i == 0 || i + 1 == e.size() ? kExactSlack : half); }
 };
 
@@ -92,9 +95,9 @@ std::size_t reach(const std::vector<double>& t, const Band& band, std::size_t w,
 }
 
 // Min-link polyline (vertex indices and heights) through the band about e at t, both ends exact.
-void fit(const std::vector<double>& t, const std::vector<double>& e, double half, std::vector<std::size_t>& vi,
-         std::vector<double>& vz) {
-  const Band band{e, half};
+void fit(const std::vector<double>& t, const std::vector<double>& e, double half, double floor,
+         std::vector<std::size_t>& vi, std::vector<double>& vz) {
+  const Band band{e, half, floor};
   const std::size_t n = t.size();
   std::vector<Piece> pieces;
   Polygon poly, next;
@@ -130,8 +133,8 @@ void fit(const std::vector<double>& t, const std::vector<double>& e, double half
 }
 
 // Least groups of consecutive drops each within the band of one line (the lower bound of the header).
-std::size_t stab_count(const std::vector<double>& t, const std::vector<double>& e, double half) {
-  const Band band{e, half};
+std::size_t stab_count(const std::vector<double>& t, const std::vector<double>& e, double half, double floor) {
+  const Band band{e, half, floor};
   const std::size_t n = t.size();
   Polygon poly, next;
   std::size_t groups = 0, w = 0;
@@ -247,11 +250,11 @@ class RunLean {
   void stretch(std::size_t a, std::size_t b, RunOut& out) {
     std::vector<double> t(t_.begin() + a, t_.begin() + b + 1), e(e_.begin() + a, e_.begin() + b + 1);
     std::vector<int32_t> win(win_.begin() + a, win_.begin() + b + 1);
-    if (o_.lower_bound) out.lower_bound += stab_count(t, e, o_.tol);
+    if (o_.lower_bound) out.lower_bound += stab_count(t, e, o_.tol, o_.drop.clamp_floor);
     std::vector<std::size_t> vi;
     std::vector<double> vz;
     for (int round = 0;; ++round) {
-      fit(t, e, o_.fit_fraction * o_.tol, vi, vz);
+      fit(t, e, o_.fit_fraction * o_.tol, o_.drop.clamp_floor, vi, vz);
       // the checks: midpoints of the drop intervals where a move comes near the edge of the fit's band
       std::vector<std::pair<double, double>> add;  // (t, exact z) of failed checks
       std::vector<int32_t> add_w;

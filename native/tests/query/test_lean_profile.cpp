@@ -137,6 +137,22 @@ TEST(LeanProfile, BullOverAFacetedCylinderStaysInTheBand) {
   expect_within_band(cyl, Cutter(2.0, 1.0), {0.7, 6.0}, 0.001, 2.0);
 }
 
+TEST(LeanProfile, NeverBelowTheFloor) {
+  // the sphere cap clamped at z 5 (a final depth): the moves stay within the band and never go below it
+  const MeshIndex cap = grid(sphere_cap, -25, -25, 25, 25, 20, 20);
+  const Cutter ball(3.0, 3.0);
+  LeanRuns runs = runs_over(cap, ball, {0.0, 6.3}, -18.0, 18.0, 0.25, -50);
+  for (double& z : runs.z) z = std::max(z, 5.0);
+  LeanOptions o;
+  o.drop.drop_floor = -50;
+  o.drop.clamp_floor = 5.0;
+  const LeanResult r = tmm::lean_profiles(cap, ball, runs, o);
+  for (double z : r.z) EXPECT_GE(z, 5.0);  // the moves are straight: their vertices bound them
+  std::size_t on_floor = 0;
+  for (double z : runs.z) on_floor += z == 5.0;
+  EXPECT_GT(on_floor, 10u);
+}
+
 TEST(LeanProfile, AirKeepsTheSampledMoves) {
   // a plate over [0, 10] x [0, 10] only: a run from -5 to 15 crosses air at both ends
   const MeshIndex plate = grid([](double, double) { return 1.0; }, 0, 0, 10, 10, 4, 4);
