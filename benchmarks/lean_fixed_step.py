@@ -27,6 +27,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
@@ -61,19 +62,10 @@ def moves(segments) -> int:
     return sum(max(0, len(s) - 1) for s in segments)
 
 
-def demo_cases():
-    """scripts/demo.py loaded under another name: imported as "demo" it runs the whole demo."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("tmm_demo_cases", ROOT / "scripts" / "demo.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
-
-
 def main() -> None:
-    demo = demo_cases()
+    from demo_jobs import load_demo
+
+    demo = load_demo()
 
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")

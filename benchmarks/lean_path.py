@@ -32,6 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.cwd()
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import FreeCAD  # noqa: E402
 
@@ -88,19 +89,10 @@ def run(case, label: str, post: str, cutter: Cutter, out: Path, **extra) -> dict
     return row
 
 
-def demo_cases():
-    """scripts/demo.py loaded under another name: imported as "demo" it runs the whole demo first."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("tmm_demo_cases", ROOT / "scripts" / "demo.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # its dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
-
-
 def main() -> None:
-    demo = demo_cases()
+    from demo_jobs import load_demo
+
+    demo = load_demo()
 
     out = Path(tempfile.mkdtemp(prefix="tmm_lean_"))
     quick = bool(os.environ.get("TMM_LEAN_QUICK"))

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "tmm/query/lean_profile.hpp"
+#include "util/arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -26,12 +27,7 @@ std::vector<T> to_vector(const Arr<T>& a, const char* name, py::ssize_t width = 
   return std::vector<T>(a.data(), a.data() + a.size());
 }
 
-template <class T>
-py::array_t<T> to_array(const std::vector<T>& v) {
-  py::array_t<T> a(static_cast<py::ssize_t>(v.size()));
-  std::copy(v.begin(), v.end(), a.mutable_data());
-  return a;
-}
+using tmm_bindings::to_array;
 
 }  // namespace
 

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "support/test_meshes.hpp"
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/query/lean_profile.hpp"
 
@@ -26,23 +27,7 @@ using tmm::LeanResult;
 using tmm::LeanRuns;
 using tmm::MeshIndex;
 
-template <class F>
-MeshIndex grid(F z, double x0, double y0, double x1, double y1, int nx, int ny) {
-  tmm::Vertices V((nx + 1) * (ny + 1), 3);
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) {
-      const double x = x0 + (x1 - x0) * i / nx, y = y0 + (y1 - y0) * j / ny;
-      V.row(j * (nx + 1) + i) << x, y, z(x, y);
-    }
-  tmm::Triangles T(2 * nx * ny, 3);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 1, d = c + 1;
-      T.row(2 * (j * nx + i)) << a, b, d;
-      T.row(2 * (j * nx + i) + 1) << a, d, c;
-    }
-  return MeshIndex(V, T);
-}
+using tmm_test::grid_mesh;
 
 double sphere_cap(double x, double y) { return std::sqrt(std::max(0.0, 30.0 * 30.0 - x * x - y * y)) - 20.0; }
 
@@ -88,7 +73,7 @@ double worst_deviation(const MeshIndex& index, const Cutter& c, const LeanRuns& 
 }
 
 TEST(LeanProfile, LineOverAPlaneIsOneMove) {
-  const MeshIndex plane = grid([](double x, double y) { return 0.1 * x + 0.05 * y; }, -10, -10, 40, 20, 20, 12);
+  const MeshIndex plane = grid_mesh([](double x, double y) { return 0.1 * x + 0.05 * y; }, -10, -10, 40, 20, 20, 12);
   const Cutter ball(3.0, 3.0);
   const LeanRuns runs = runs_over(plane, ball, {0.0, 3.3}, 0.0, 30.0, 0.25, -50);
   LeanOptions o;
@@ -125,21 +110,21 @@ void expect_within_band(const MeshIndex& mesh, const Cutter& c, const std::vecto
 }
 
 TEST(LeanProfile, BallOverAFacetedSphereStaysInTheBand) {
-  const MeshIndex cap = grid(sphere_cap, -25, -25, 25, 25, 20, 20);  // 2.5 mm facets
+  const MeshIndex cap = grid_mesh(sphere_cap, -25, -25, 25, 25, 20, 20);  // 2.5 mm facets
   expect_within_band(cap, Cutter(3.0, 3.0), {-7.3, 0.0, 4.1}, 0.001, 3.0);
   expect_within_band(cap, Cutter(3.0, 3.0), {2.2}, 0.01, 6.0);
 }
 
 TEST(LeanProfile, BullOverAFacetedCylinderStaysInTheBand) {
   // a cylinder of radius 15 along Y (crossed by the runs), 1.25 mm facets, and a bull-nose D4 r1
-  const MeshIndex cyl = grid([](double x, double) { return std::sqrt(std::max(0.0, 225.0 - x * x)) - 5.0; }, -14,
+  const MeshIndex cyl = grid_mesh([](double x, double) { return std::sqrt(std::max(0.0, 225.0 - x * x)) - 5.0; }, -14,
                              -20, 14, 20, 24, 8);
   expect_within_band(cyl, Cutter(2.0, 1.0), {0.7, 6.0}, 0.001, 2.0);
 }
 
 TEST(LeanProfile, NeverBelowTheFloor) {
   // the sphere cap clamped at z 5 (a final depth): the moves stay within the band and never go below it
-  const MeshIndex cap = grid(sphere_cap, -25, -25, 25, 25, 20, 20);
+  const MeshIndex cap = grid_mesh(sphere_cap, -25, -25, 25, 25, 20, 20);
   const Cutter ball(3.0, 3.0);
   LeanRuns runs = runs_over(cap, ball, {0.0, 6.3}, -18.0, 18.0, 0.25, -50);
   for (double& z : runs.z) z = std::max(z, 5.0);
@@ -155,7 +140,7 @@ TEST(LeanProfile, NeverBelowTheFloor) {
 
 TEST(LeanProfile, AirKeepsTheSampledMoves) {
   // a plate over [0, 10] x [0, 10] only: a run from -5 to 15 crosses air at both ends
-  const MeshIndex plate = grid([](double, double) { return 1.0; }, 0, 0, 10, 10, 4, 4);
+  const MeshIndex plate = grid_mesh([](double, double) { return 1.0; }, 0, 0, 10, 10, 4, 4);
   const Cutter ball(1.0, 1.0);
   LeanRuns runs = runs_over(plate, ball, {5.0}, -5.0, 15.0, 0.5, -100);
   runs.offsets.resize(2);  // the +X run only
@@ -176,7 +161,7 @@ TEST(LeanProfile, AirKeepsTheSampledMoves) {
 }
 
 TEST(LeanProfile, CancelThrows) {
-  const MeshIndex cap = grid(sphere_cap, -25, -25, 25, 25, 20, 20);
+  const MeshIndex cap = grid_mesh(sphere_cap, -25, -25, 25, 25, 20, 20);
   const Cutter ball(3.0, 3.0);
   const LeanRuns runs = runs_over(cap, ball, {-8, -6, -4, -2, 0, 2, 4, 6, 8, 10, 12, 14}, -18, 18, 0.25, -50);
   LeanOptions o;
@@ -188,7 +173,7 @@ TEST(LeanProfile, CancelThrows) {
 }
 
 TEST(LeanProfile, BadInputRefusedByName) {
-  const MeshIndex plane = grid([](double, double) { return 0.0; }, 0, 0, 10, 10, 2, 2);
+  const MeshIndex plane = grid_mesh([](double, double) { return 0.0; }, 0, 0, 10, 10, 2, 2);
   const Cutter ball(1.0, 1.0);
   const LeanRuns runs = runs_over(plane, ball, {5.0}, 0, 10, 0.5, -50);
   for (double tol : {0.0, -0.001, std::nan(""), 2.0}) {
