@@ -120,3 +120,12 @@ def test_cancel(bump_mesh):
                                                     chord_tol=0.0)).segments
     with pytest.raises(Cancelled):
         lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), TOL, progress=lambda f: False)
+
+
+def test_too_much_work_refused_before_dropping(bump_mesh):
+    from tmm_workbench.core.segments import CutSegment
+
+    surface = DropSurface(bump_mesh)
+    run = CutSegment(np.array([[0.0, 5.0, 0.0], [1e6, 5.0, 0.0]]))
+    with pytest.raises(TmmError, match="lean work"):
+        lean_segments_kernel([run], ExactDrop(surface.index, Cutter.ball(4.0), -10.0), TOL, max_step=0.01)

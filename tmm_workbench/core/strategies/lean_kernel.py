@@ -72,8 +72,8 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
             air_below=float(exact.air_below), lower_bound=lower_bound, threads=threads, progress=progress)
     except native.Cancelled as exc:
         raise Cancelled("tool path computation cancelled") from exc
-    except ValueError as exc:
-        raise TmmError(str(exc)) from exc
+    except ValueError as exc:  # named by the kernel; max_step is the op's sample step / 2
+        raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
     verts = {key: np.column_stack([r.origin + s[off[n]:off[n + 1], None] * r.u, z[off[n]:off[n + 1]]])
              for n, (key, r) in enumerate(zip(keys, runs))}
     out = list(segments)
