@@ -32,6 +32,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.cwd()
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "scripts"))
+sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import FreeCAD  # noqa: E402
 
@@ -89,7 +90,9 @@ def run(case, label: str, post: str, cutter: Cutter, out: Path, **extra) -> dict
 
 
 def main() -> None:
-    import demo
+    from demo_jobs import load_demo
+
+    demo = load_demo()
 
     out = Path(tempfile.mkdtemp(prefix="tmm_lean_"))
     quick = bool(os.environ.get("TMM_LEAN_QUICK"))

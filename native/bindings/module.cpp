@@ -13,6 +13,7 @@ void bind_sim(py::module_& m);    // sim/bind_sim.cpp: the z-map stock and 3-axi
 void bind_sim5(py::module_& m);   // sim/bind_sim5.cpp: 5-axis cutting simulation (moving tool axis)
 void bind_adaptive_raster(py::module_& m);  // query/bind_adaptive_raster.cpp: adaptive raster pass placement
 void bind_arrival_field(py::module_& m);  // query/bind_arrival_field.cpp: the 3D offset's arrival-time field
+void bind_lean_profile(py::module_& m);  // query/bind_lean_profile.cpp: lean passes, the kernel fit
 
 PYBIND11_MODULE(_native, m) {
   m.doc() = "TMM geometry kernel (C++17, Eigen)";
@@ -26,4 +27,5 @@ PYBIND11_MODULE(_native, m) {
   bind_sim5(m);
   bind_adaptive_raster(m);
   bind_arrival_field(m);
+  bind_lean_profile(m);
 }

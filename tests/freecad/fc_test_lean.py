@@ -1,5 +1,5 @@
-"""Lean passes in FreeCAD (issue 14 item 2): the Surface op's ForwardStep "Tolerance" (an option; new ops keep
-"SampleStep" until the fit is in the kernel) writes fewer
+"""Lean passes in FreeCAD (issue 14 item 2): the Surface op's ForwardStep "Tolerance" (the default of new ops and
+run_surface since the fit is in the kernel; lines from the kernel, arcs from the Python fit) writes fewer
 G-code lines than "SampleStep" and posts with linuxcnc; ArcFitting writes G18/G19 + G2/G3 with K that the
 grbl post passes and TMM's simulation reads (no gouge beyond the tolerance against the model); with the
 linuxcnc post (no K) the op writes lines; documents from before keep their sampled passes."""
@@ -56,6 +56,15 @@ class LeanPasses(FreeCADTestCase):
         self.assertTrue(r.op.ArcFitting)
         self.assertFalse([c for c in r.op.Path.Commands if c.Name in ("G2", "G3", "G18", "G19")])
         self.assertNotRegex(r.gcode, r"\bG[23]\b")
+        close_all()
+
+    def test_new_ops_default_to_tolerance(self) -> None:
+        r = run_surface(str(SPHERE_ON_PLATE), doc_name="LeanDefault", **SETTINGS)
+        self.assertEqual(r.op.ForwardStep, "Tolerance")
+        self.assertFalse(r.toolpath.arcs)
+        doc = new_doc("TmmLeanNew")
+        _, _, op = job_with_op(doc, str(SPHERE_ON_PLATE), diameter=6.0, values={"SampleStep": 0.25, "StepOver": 4.0})
+        self.assertEqual(op.ForwardStep, "Tolerance")
         close_all()
 
     def test_old_document_keeps_sampled_passes(self) -> None:

@@ -68,7 +68,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 spiral_direction: str = "outward", region_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
-                forward_step: str = "sample", arcs: bool = False,
+                forward_step: str = "tolerance", arcs: bool = False,
                 verify_cusp: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
@@ -100,8 +100,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.
     pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
     max) deg, cut only where the surface slope lies in it (default all).
-    forward_step: 'sample' (default: a point every sample_step, thinned above only) | 'tolerance' (the fewest
-    moves within +-chord_tolerance of the exact tool path: lean passes; more compute, in Python for now); arcs:
+    forward_step: 'tolerance' (default: the fewest moves within +-chord_tolerance of the exact tool path, lean
+    passes fitted in the kernel) | 'sample' (a point every sample_step, thinned above only; before 2026-12); arcs:
     G2/G3 in the pass's plane (XZ/YZ, rasters at 0/90 deg) with 'tolerance', where the post writes K (not
     linuxcnc: lines there, with a warning).
     verify_cusp: cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds

@@ -110,6 +110,9 @@ DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, 
 CHOICES.update({"Region": {r: r for r in region_source.REGIONS},
                 "SpiralDirection": {"Outward": OUTWARD, "Inward": INWARD}})
 DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
+# lean passes by default for new ops since the fit is in the kernel (issue 14 item 2); documents saved without
+# the property restore with SampleStep (RESTORED_DEFAULTS)
+DEFAULTS["ForwardStep"] = "Tolerance"
 # FreeCAD posts whose parameter list has no K: an arc in XZ or YZ would lose its centre's Z (0.20-1.1)
 POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
                    "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")

@@ -6,19 +6,12 @@
 #include <algorithm>
 
 #include "tmm/query/adaptive_raster.hpp"
+#include "util/arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
 
-namespace {
-
-py::array_t<double> to_array(const std::vector<double>& v) {
-  py::array_t<double> a(static_cast<py::ssize_t>(v.size()));
-  std::copy(v.begin(), v.end(), a.mutable_data());
-  return a;
-}
-
-}  // namespace
+using tmm_bindings::to_array;
 
 void bind_adaptive_raster(py::module_& m) {
   using O = tmm::AdaptiveRasterOptions;

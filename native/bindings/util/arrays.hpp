@@ -5,6 +5,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -12,6 +13,7 @@
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include "tmm/mesh/mesh.hpp"
 
@@ -74,6 +76,14 @@ inline tmm::Triangles triangles_from(const pybind11::handle& obj) {
   if (kind == 'u') fill(py::array_t<std::uint64_t, py::array::forcecast>(a));
   else fill(py::array_t<std::int64_t, py::array::forcecast>(a));
   return F;
+}
+
+// A 1-d numpy array holding a copy of v (kernel results).
+template <class T>
+pybind11::array_t<T> to_array(const std::vector<T>& v) {
+  pybind11::array_t<T> a(static_cast<pybind11::ssize_t>(v.size()));
+  std::copy(v.begin(), v.end(), a.mutable_data());
+  return a;
 }
 
 }  // namespace tmm_bindings

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "support/test_meshes.hpp"
 #include "tmm/query/adaptive_raster.hpp"
 
 namespace {
@@ -21,24 +22,7 @@ using tmm::AdaptiveRasterOptions;
 using tmm::Cutter;
 using tmm::MeshIndex;
 
-// A grid mesh of z(x, y) over [x0, x1] x [y0, y1], nx x ny cells, two triangles each.
-template <class F>
-MeshIndex grid(F z, double x0, double y0, double x1, double y1, int nx, int ny) {
-  tmm::Vertices V((nx + 1) * (ny + 1), 3);
-  for (int j = 0; j <= ny; ++j)
-    for (int i = 0; i <= nx; ++i) {
-      const double x = x0 + (x1 - x0) * i / nx, y = y0 + (y1 - y0) * j / ny;
-      V.row(j * (nx + 1) + i) << x, y, z(x, y);
-    }
-  tmm::Triangles T(2 * nx * ny, 3);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) {
-      const int a = j * (nx + 1) + i, b = a + 1, c = a + nx + 1, d = c + 1;
-      T.row(2 * (j * nx + i)) << a, b, d;
-      T.row(2 * (j * nx + i) + 1) << a, d, c;
-    }
-  return MeshIndex(V, T);
-}
+using tmm_test::grid_mesh;
 
 AdaptiveRasterOptions options(double cusp) {
   AdaptiveRasterOptions o;
@@ -55,7 +39,7 @@ AdaptiveRasterOptions options(double cusp) {
 double ball_plane_step(double R, double cusp) { return 2 * std::sqrt(2 * R * cusp - cusp * cusp); }
 
 TEST(AdaptiveRaster, LevelPlaneGivesThePlanarStep) {
-  const MeshIndex plane = grid([](double, double) { return 0.0; }, -20, -20, 40, 40, 4, 4);
+  const MeshIndex plane = grid_mesh([](double, double) { return 0.0; }, -20, -20, 40, 40, 4, 4);
   const Cutter ball(3.0, 3.0);
   const AdaptiveRasterOptions o = options(0.01);
   const auto r = tmm::adaptive_raster(plane, ball, ball, o, {});
@@ -115,7 +99,7 @@ TEST(AdaptiveRaster, ConvexCylinderKeepsTheExactCusp) {
 }
 
 TEST(AdaptiveRaster, SameForAnyThreadCountProgressAndCancel) {
-  const MeshIndex bump = grid([](double x, double y) { return 2.0 * std::exp(-((x - 10) * (x - 10) + (y - 6) * (y - 6)) / 18.0); },
+  const MeshIndex bump = grid_mesh([](double x, double y) { return 2.0 * std::exp(-((x - 10) * (x - 10) + (y - 6) * (y - 6)) / 18.0); },
                               -10, -9, 30, 21, 80, 60);
   const Cutter bull(4.0, 2.0);
   AdaptiveRasterOptions o = options(0.01);
@@ -145,7 +129,7 @@ TEST(AdaptiveRaster, SameForAnyThreadCountProgressAndCancel) {
 }
 
 TEST(AdaptiveRaster, BadOptionsAreRefusedByName) {
-  const MeshIndex plane = grid([](double, double) { return 0.0; }, -20, -20, 40, 40, 2, 2);
+  const MeshIndex plane = grid_mesh([](double, double) { return 0.0; }, -20, -20, 40, 40, 2, 2);
   const Cutter ball(3.0, 3.0);
   auto refused = [&](AdaptiveRasterOptions o, const std::string& words) {
     try {

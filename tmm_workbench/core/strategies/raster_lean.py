@@ -18,6 +18,10 @@ exact: the neighbouring segments, the linker and raster_refine's cliff corners s
 
 Arcs (G2/G3) are fitted where the pass lies in a principal vertical plane: a raster at 0 or 180 deg in
 XZ (G18), at 90 or 270 deg in YZ (G19); elsewhere only lines. An arc's end point is exact.
+
+Lines without arcs are fitted in the kernel (core.strategies.lean_kernel, native/src/query/lean_profile.cpp:
+exact breakpoints, min-link windows, fewer moves and 5-10x faster); this fit serves ArcFitting and is the
+slow reference of tests/core/test_lean_kernel.py.
 """
 from __future__ import annotations
 

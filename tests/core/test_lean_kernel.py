@@ -1,0 +1,131 @@
+"""Lean passes fitted in the kernel (core.strategies.lean_kernel over native.lean_profiles, issue 14 item 2),
+against independent references with the real kernel: every move of the lean path sampled every 0.005 mm lies
+within +-tol of the exact drop height there (dense drops: the reference), the kernel's fit uses no more moves
+than the Python fit (raster_lean.lean_segments, the slow reference kept for this) on the same samples, at least
+the lower bound it reports, and the off-model (skip) moves stay as sampled. The simulated stock against the
+design is checked in tests/core/test_raster_lean.py (lines: the kernel path)."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tests.conftest import grid_mesh
+from tests.core.test_raster_lean import TOL, bump, move_points
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import load_stl
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.shared_data import shared_dir
+from tmm_workbench.core.strategies import raster_lean
+from tmm_workbench.core.strategies.lean_kernel import ExactDrop, lean_segments_kernel
+from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
+from tmm_workbench.core.tools.cutter import Cutter
+
+
+@pytest.fixture(scope="module")
+def bump_mesh():
+    return grid_mesh(bump, 160, 80, (0, 0, 40, 20))
+
+
+@pytest.fixture(scope="module")
+def sphere_on_plate():
+    return load_stl(str(shared_dir() / "benchmarks" / "stl" / "sphere_on_plate.stl"))
+
+
+def worst(mesh, cutter, segments) -> float:
+    pts = move_points(segments, {})
+    exact = DropSurface(mesh).drop(cutter, pts[:, :2], float(mesh.bounds[0][2]))
+    return float(np.abs(pts[:, 2] - exact).max())
+
+
+def both_fits(mesh, cutter, params):
+    """(kernel segments, its stats, Python segments, its stats) from the same unthinned samples."""
+    sampled = compute(mesh, cutter, replace(params, forward_step="sample", chord_tol=0.0)).segments
+    surface = DropSurface(mesh)
+    floor = float(mesh.bounds[0][2])
+    kern, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
+                                        params.sample_step / 2, lower_bound=True)  # as raster_drop
+
+    def drop(p):
+        return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
+
+    py, _, pstats = raster_lean.lean_segments(sampled, drop, TOL, False, min(params.sample_step / 4, 0.05))
+    return kern, kstats, py, pstats
+
+
+@pytest.mark.parametrize("angle", [0.0, 90.0, 30.0])
+def test_kernel_fit_within_tolerance_and_not_more_moves_than_python(bump_mesh, angle):
+    cutter = Cutter.ball(4.0)
+    params = SurfaceParams(boundary=(2, 2, 38, 18), stepover=1.0, sample_step=0.25, angle_deg=angle,
+                           forward_step="tolerance", chord_tol=TOL)
+    kern, kstats, py, pstats = both_fits(bump_mesh, cutter, params)
+    assert worst(bump_mesh, cutter, kern) <= TOL + 1e-6
+    n_k, n_p = sum(len(s) for s in kern), sum(len(s) for s in py)
+    assert n_k <= n_p, (n_k, n_p)
+    assert kstats["lower_bound"] <= n_k and kstats["points_out"] == n_k
+    # the op's path (compute with forward_step "tolerance", lines) is the kernel's
+    res = compute(bump_mesh, cutter, params)
+    assert sum(len(s) for s in res.segments) == n_k and res.diagnostics["lean"]["checked"] > 0
+
+
+def test_bull_nose_on_sphere_on_plate(sphere_on_plate):
+    """A real STL (2-3 mm facets) with the demo's other cutter kind: within the band, fewer moves than the
+    Python fit, and a fraction of the samples."""
+    cutter = Cutter.bull(4.0, 1.0)
+    params = SurfaceParams(boundary=(20, 30, 56, 40), stepover=2.0, sample_step=0.2, forward_step="tolerance",
+                           chord_tol=TOL)
+    kern, kstats, py, _ = both_fits(sphere_on_plate, cutter, params)
+    assert worst(sphere_on_plate, cutter, kern) <= TOL + 1e-6
+    n_k, n_p = sum(len(s) for s in kern), sum(len(s) for s in py)
+    assert kstats["lower_bound"] <= n_k < n_p and n_k < kstats["points_in"] / 2, (n_k, n_p, kstats)
+
+
+def test_stock_to_leave_and_air_are_the_raster_s(bump_mesh):
+    """Off-model skip and a stock to leave: the kernel's exact height is the raster's (drop of the grown cutter
+    raised by the stock), so the path stays within the band of that; moves beside air keep their samples."""
+    cutter = Cutter.ball(4.0)
+    params = SurfaceParams(boundary=(-6, 2, 46, 18), stepover=2.0, sample_step=0.25, forward_step="tolerance",
+                           chord_tol=TOL, stock_to_leave=0.3, off_model="skip")
+    res = compute(bump_mesh, cutter, params)
+    pts = move_points(res.segments, {})
+    grown = cutter.offset(0.3)
+    floor = float(bump_mesh.bounds[0][2])
+    exact = DropSurface(bump_mesh).drop(grown, pts[:, :2], floor - 1e6) + 0.3
+    on = exact > floor - 10  # off the model there is no exact path; beside it the raster's floor holds the tool
+    assert np.abs(pts[on, 2] - np.maximum(exact[on], floor)).max() <= TOL + 1e-6
+    sampled = compute(bump_mesh, cutter, replace(params, forward_step="sample", chord_tol=0.0))
+    # (fewer only: the ball rolling off the model's edges is a tight circle, many moves within the band)
+    assert sum(len(s) for s in res.segments) < 0.8 * sum(len(s) for s in sampled.segments)
+
+
+def test_bad_tolerance_refused(bump_mesh):
+    cutter = Cutter.ball(4.0)
+    surface = DropSurface(bump_mesh)
+    segs = compute(bump_mesh, cutter, SurfaceParams(boundary=(2, 2, 38, 18), stepover=4.0, sample_step=0.5)).segments
+    for tol in (0.0, -1.0, math.nan):
+        with pytest.raises(TmmError, match="tolerance"):
+            lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), tol)
+    with pytest.raises(TmmError, match="lean tolerance"):
+        lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), 5.0)
+
+
+def test_cancel(bump_mesh):
+    from tmm_workbench.core.errors import Cancelled
+
+    cutter = Cutter.ball(4.0)
+    surface = DropSurface(bump_mesh)
+    segs = compute(bump_mesh, cutter, SurfaceParams(boundary=(2, 2, 38, 18), stepover=0.5, sample_step=0.25,
+                                                    chord_tol=0.0)).segments
+    with pytest.raises(Cancelled):
+        lean_segments_kernel(segs, ExactDrop(surface.index, cutter, -10.0), TOL, progress=lambda f: False)
+
+
+def test_too_much_work_refused_before_dropping(bump_mesh):
+    from tmm_workbench.core.segments import CutSegment
+
+    surface = DropSurface(bump_mesh)
+    run = CutSegment(np.array([[0.0, 5.0, 0.0], [1e6, 5.0, 0.0]]))
+    with pytest.raises(TmmError, match="lean work"):
+        lean_segments_kernel([run], ExactDrop(surface.index, Cutter.ball(4.0), -10.0), TOL, max_step=0.01)

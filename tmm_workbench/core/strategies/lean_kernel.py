@@ -1,0 +1,92 @@
+"""Lean passes fitted in the kernel (issue 14 item 2): native.lean_profiles (native/src/query/lean_profile.cpp).
+
+The straight runs of the segments (raster_lean's: passes and zig-zag links, split where the XY direction
+turns) go to the kernel with their samples; it rebuilds each run's exact CL profile by adaptive exact drops
+(breakpoints located where the triangle holding the cutter changes), fits the fewest lines within +-tol of it
+by min-link windows and checks them at the drop intervals' midpoints near the band's edge (see the header).
+Lines only: with arcs the Python fit (raster_lean.lean_segments) runs. The ends of a run, both ends of a
+vertical move and the moves beside air stay as sampled, as in the Python fit.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Callable, Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.kernel import native
+from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.tools.cutter import Cutter
+
+Progress = Callable[[float], bool]
+MIN_STEP_MM = 0.002  # breakpoints of the profile located to this
+
+
+@dataclass(frozen=True)
+class ExactDrop:
+    """The exact CL height as the raster computes it: the drop of `tool` (the cutter grown by the stock to
+    leave) at `drop_floor`, raised by `z_shift`, at least `clamp_floor`; air (off-model, skip) where the raised
+    drop is at or below `air_below` (-inf: never)."""
+    index: "native.MeshIndex"
+    tool: Cutter
+    drop_floor: float
+    z_shift: float = 0.0
+    clamp_floor: float = -math.inf
+    air_below: float = -math.inf
+
+
+def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: float, max_step: float = 0.05,
+                         lower_bound: bool = False, progress: Optional[Progress] = None, threads: int = 0
+                         ) -> tuple[list[CutSegment], dict]:
+    """The segments with each straight run's points replaced by the kernel's lean vertices, and the counts
+    (points_in, points_out, arcs 0, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and
+    with `lower_bound` the least lines any fit within +-tol can use on these runs)."""
+    from tmm_workbench.core.strategies.raster_lean import _as_run, _straight_parts
+
+    if not tol > 0:
+        raise TmmError(f"chord tolerance must be > 0 mm for lean passes, got {tol:g}")
+    parts = {i: _straight_parts(seg.tips) if len(seg) >= 2 and seg.axes is None else []
+             for i, seg in enumerate(segments)}
+    keys, runs = [], []
+    for i in parts:
+        for k, (a, b) in enumerate(parts[i]):
+            r = _as_run(segments[i], segments[i].tips[a:b + 1])
+            if r is not None:
+                keys.append((i, k))
+                runs.append(r)
+    stats = dict(points_in=sum(len(seg) for seg in segments), arcs=0, checked=0, breakpoints=0, refits=0,
+                 kept_dense=0, lower_bound=0)
+    if not runs:
+        stats["points_out"] = stats["points_in"]
+        return list(segments), stats
+    flags = [np.where(r.fixed, native.LEAN_FIXED, 0) | np.where(r.settled, native.LEAN_KEEP, 0) for r in runs]
+    offsets = np.concatenate([[0], np.cumsum([len(r.s) for r in runs])]).astype(np.int64)
+    try:
+        off, s, z, info = native.lean_profiles(
+            exact.index, exact.tool.native, np.array([r.origin for r in runs]), np.array([r.u for r in runs]),
+            offsets, np.concatenate([r.s for r in runs]), np.concatenate([r.e for r in runs]),
+            np.concatenate(flags).astype(np.uint8), tol=float(tol), max_step=float(max_step), min_step=MIN_STEP_MM,
+            drop_floor=float(exact.drop_floor), z_shift=float(exact.z_shift), clamp_floor=float(exact.clamp_floor),
+            air_below=float(exact.air_below), lower_bound=lower_bound, threads=threads, progress=progress)
+    except native.Cancelled as exc:
+        raise Cancelled("tool path computation cancelled") from exc
+    except ValueError as exc:  # named by the kernel; max_step is the op's sample step / 2
+        raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
+    verts = {key: np.column_stack([r.origin + s[off[n]:off[n + 1], None] * r.u, z[off[n]:off[n + 1]]])
+             for n, (key, r) in enumerate(zip(keys, runs))}
+    out = list(segments)
+    for i, seg in enumerate(segments):
+        if not any((i, k) in verts for k in range(len(parts[i]))):
+            continue
+        tips = []
+        for k, (a, b) in enumerate(parts[i]):
+            v = verts.get((i, k))
+            v = seg.tips[a:b + 1] if v is None else v
+            tips.append(v if k == 0 else v[1:])  # the shared point once
+        out[i] = replace(seg, tips=np.vstack(tips))
+    stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),
+                 breakpoints=int(info["breakpoints"]), refits=int(info["refits"]),
+                 kept_dense=int(info["kept_dense"]), lower_bound=int(info["lower_bound"]))
+    return out, stats
