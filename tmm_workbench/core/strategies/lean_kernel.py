@@ -10,7 +10,7 @@ vertical move and the moves beside air stay as sampled, as in the Python fit.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 import numpy as np
@@ -43,19 +43,12 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
     """The segments with each straight run's points replaced by the kernel's lean vertices, and the counts
     (points_in, points_out, arcs 0, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and
     with `lower_bound` the least lines any fit within +-tol can use on these runs)."""
-    from tmm_workbench.core.strategies.raster_lean import _as_run, _straight_parts
+    from tmm_workbench.core.strategies.raster_lean import straight_runs, with_runs_replaced
 
     if not tol > 0:
         raise TmmError(f"chord tolerance must be > 0 mm for lean passes, got {tol:g}")
-    parts = {i: _straight_parts(seg.tips) if len(seg) >= 2 and seg.axes is None else []
-             for i, seg in enumerate(segments)}
-    keys, runs = [], []
-    for i in parts:
-        for k, (a, b) in enumerate(parts[i]):
-            r = _as_run(segments[i], segments[i].tips[a:b + 1])
-            if r is not None:
-                keys.append((i, k))
-                runs.append(r)
+    parts, by_key = straight_runs(segments)
+    keys, runs = list(by_key), list(by_key.values())
     stats = dict(points_in=sum(len(seg) for seg in segments), arcs=0, checked=0, breakpoints=0, refits=0,
                  kept_dense=0, lower_bound=0)
     if not runs:
@@ -76,16 +69,7 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
         raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
     verts = {key: np.column_stack([r.origin + s[off[n]:off[n + 1], None] * r.u, z[off[n]:off[n + 1]]])
              for n, (key, r) in enumerate(zip(keys, runs))}
-    out = list(segments)
-    for i, seg in enumerate(segments):
-        if not any((i, k) in verts for k in range(len(parts[i]))):
-            continue
-        tips = []
-        for k, (a, b) in enumerate(parts[i]):
-            v = verts.get((i, k))
-            v = seg.tips[a:b + 1] if v is None else v
-            tips.append(v if k == 0 else v[1:])  # the shared point once
-        out[i] = replace(seg, tips=np.vstack(tips))
+    out = with_runs_replaced(segments, parts, verts, verts.__getitem__)
     stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),
                  breakpoints=int(info["breakpoints"]), refits=int(info["refits"]),
                  kept_dense=int(info["kept_dense"]), lower_bound=int(info["lower_bound"]))

@@ -329,9 +329,7 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
     # bull-nose (convex stretches of a CL path curve no tighter than the cutter's corner)
     margin = tol * (1 - _BAND_USED)
     tol = tol * _BAND_USED
-    parts = {i: _straight_parts(seg.tips) if len(seg) >= 2 and seg.axes is None else [] for i, seg in enumerate(segments)}
-    runs = {(i, k): _as_run(segments[i], segments[i].tips[a:b + 1]) for i in parts for k, (a, b) in enumerate(parts[i])}
-    runs = {key: r for key, r in runs.items() if r is not None}
+    parts, runs = straight_runs(segments)
     stats.points_in = sum(len(seg) for seg in segments)
     for round_ in range(rounds + insert_rounds):
         todo = [r for r in runs.values() if not r.done]
@@ -396,19 +394,37 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
                 r.fixed = np.insert(r.fixed, at, False)
                 r.settled = np.insert(r.settled, at, False)
                 stats.inserted += len(adds_s)
-    out = list(segments)
     arc_map: dict = {}
+    out = with_runs_replaced(segments, parts, runs, lambda key: _vertices(runs[key], arc_map, stats))
+    stats.points_out = sum(len(seg) for seg in out)
+    return out, arc_map, stats
+
+
+Parts = dict[int, list[tuple[int, int]]]  # segment index -> its straight parts (first, last point index)
+
+
+def straight_runs(segments: list[CutSegment]) -> tuple[Parts, dict[tuple[int, int], "_Run"]]:
+    """Each segment's straight parts and the runs a lean fit may replace, keyed (segment, part), in that order
+    (tool-axis segments and single points have none; parts that are no profile are left out)."""
+    parts = {i: _straight_parts(seg.tips) if len(seg) >= 2 and seg.axes is None else [] for i, seg in enumerate(segments)}
+    runs = {(i, k): _as_run(segments[i], segments[i].tips[a:b + 1]) for i in parts for k, (a, b) in enumerate(parts[i])}
+    return parts, {key: r for key, r in runs.items() if r is not None}
+
+
+def with_runs_replaced(segments: list[CutSegment], parts: Parts, keys, vertices: Callable[[tuple[int, int]], np.ndarray]
+                       ) -> list[CutSegment]:
+    """The segments with the points of each run in `keys` replaced by `vertices(key)` (its first and last point
+    the run's), called in segment and part order; the other parts keep their points."""
+    out = list(segments)
     for i, seg in enumerate(segments):
-        if not any((i, k) in runs for k in range(len(parts[i]))):
+        if not any((i, k) in keys for k in range(len(parts[i]))):
             continue
         tips = []
         for k, (a, b) in enumerate(parts[i]):
-            r = runs.get((i, k))
-            verts = seg.tips[a:b + 1] if r is None else _vertices(r, arc_map, stats)
-            tips.append(verts if k == 0 else verts[1:])  # the shared point once
+            v = vertices((i, k)) if (i, k) in keys else seg.tips[a:b + 1]
+            tips.append(v if k == 0 else v[1:])  # the shared point once
         out[i] = replace(seg, tips=np.vstack(tips))
-    stats.points_out = sum(len(seg) for seg in out)
-    return out, arc_map, stats
+    return out
 
 
 def _vertices(r: _Run, arc_map: dict, stats: LeanStats) -> np.ndarray:
