@@ -2,6 +2,7 @@
 main window and its event loop are up, its outcome as JSON for the pytest side, and FreeCAD's exit code."""
 from __future__ import annotations
 
+import faulthandler
 import json
 import os
 import sys
@@ -11,6 +12,8 @@ from typing import Callable
 
 from PySide import QtCore
 
+_STDERR = os.fdopen(os.dup(2), "w")  # the process's stderr (FreeCAD's sys.stderr has no file descriptor)
+
 
 def run(session: Callable[[dict], None], result: Path) -> None:
     """Schedules `session(info)`; `info` (filled step by step, so a failure keeps what was seen before it),
@@ -18,6 +21,9 @@ def run(session: Callable[[dict], None], result: Path) -> None:
     dialog) with 0 when the session returned, 1 when it raised."""
 
     def main() -> None:
+        # FreeCAD's own SIGSEGV handler prints only the C stack; faulthandler (installed over it, and chaining to
+        # it) first prints the Python stack of every thread, so a crash in CI names the line that led to it.
+        faulthandler.enable(file=_STDERR, all_threads=True)
         code, info = 1, {}
         try:
             session(info)

@@ -178,9 +178,10 @@ class OpViewProvider(PathOpGui.ViewProvider):
 
         panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
         panel_state.drop_fields_on_cancel(panel)  # a field left focused writes nothing after Cancel's abort
-        panel_state.pin_on_close(panel)  # FreeCAD's field controllers outlive the panel as long as their fields
+        panel_state.release_fields_on_close(panel)  # again at OK / Cancel: fields a page added later
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
         super().setupTaskPanel(panel)
+        panel_state.release_field_filters(panel)  # no Python event filter on the fields (a crash on 1.0)
 
 
 def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:

@@ -44,33 +44,41 @@ def drop_fields_on_cancel(panel: Any) -> None:
     panel.reject = rejected
 
 
-def pin_spin_controllers(panel: Any) -> None:
-    """FreeCAD's CAM pages bind each quantity field through a parentless Python QObject
-    (PathGuiUtil.QuantitySpinBox) installed as the field's event filter. When the panel closes the page, and
-    with it that object, can go before the field does, and an event still queued for the field (its focus
-    leaving) then reaches a filter whose Python side is gone: FreeCAD 1.0 crashed so once (SIGSEGV in PySide's
-    getMetaDataFromQObject, a field focused at Cancel). Each controller is held by a connection to its field's
-    `destroyed` signal, so it lives exactly as long as the field it filters."""
+def field_controllers(panel: Any) -> list[tuple[Any, Any]]:
+    """(controller, field) for each of FreeCAD's quantity field controllers (PathGuiUtil.QuantitySpinBox: a
+    parentless Python QObject installed as its field's event filter) held by the panel's pages."""
+    found = []
     for page in getattr(panel, "featurePages", []):
         for value in list(vars(page).values()):
             for c in value.values() if isinstance(value, dict) else (value,):
                 widget = getattr(c, "widget", None)
                 if isinstance(c, QtCore.QObject) and hasattr(c, "eventFilter") and isinstance(widget, QtCore.QObject):
-                    if not c.property("tmmPinned"):
-                        c.setProperty("tmmPinned", True)
-                        widget.destroyed.connect(lambda *_, c=c: c)
+                    found.append((c, widget))
+    return found
 
 
-def pin_on_close(panel: Any) -> None:
-    """pin_spin_controllers as OK or Cancel closes the panel (the pages have all their fields by then)."""
+def release_field_filters(panel: Any) -> None:
+    """Each field controller stops filtering its field, once the panel is set up and again as OK or Cancel
+    closes it (a page may add fields on the way). On FreeCAD 1.0 (Debian's PySide2 on Python 3.13) a Python
+    eventFilter can be handed an event whose address a deleted Qt object's wrapper still holds: PySide then reads
+    the event as that object and crashes (SIGSEGV in getMetaDataFromQObject, at `event.type()` in the
+    controller's eventFilter; in CI, and every time in a loop of focus changes and Cancels). Without the
+    filter no event crosses into Python there. What the filter did, show the property's value when the field
+    gets the focus, the pages do on every change of the op (setFields), so the panel shows the same values."""
+    for controller, widget in field_controllers(panel):
+        widget.removeEventFilter(controller)
+
+
+def release_fields_on_close(panel: Any) -> None:
+    """release_field_filters as OK or Cancel closes the panel."""
     accept, reject = panel.accept, panel.reject
 
     def accepted(resetEdit: bool = True) -> Any:
-        pin_spin_controllers(panel)
+        release_field_filters(panel)
         return accept(resetEdit)
 
     def rejected(resetEdit: bool = True) -> Any:
-        pin_spin_controllers(panel)
+        release_field_filters(panel)
         return reject(resetEdit)
 
     panel.accept, panel.reject = accepted, rejected
