@@ -16,11 +16,13 @@ from tests.conftest import grid_mesh
 from tests.core.test_raster_lean import TOL, bump, move_points
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import load_stl
+from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.shared_data import shared_dir
 from tmm_workbench.core.strategies import raster_lean
 from tmm_workbench.core.strategies.lean_kernel import ExactDrop, lean_segments_kernel
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
+from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.core.tools.cutter import Cutter
 
 
@@ -80,6 +82,34 @@ def test_bull_nose_on_sphere_on_plate(sphere_on_plate):
     assert worst(sphere_on_plate, cutter, kern) <= TOL + 1e-6
     n_k, n_p = sum(len(s) for s in kern), sum(len(s) for s in py)
     assert kstats["lower_bound"] <= n_k < n_p and n_k < kstats["points_in"] / 2, (n_k, n_p, kstats)
+
+
+def feed_points(segments, arc_map, step=0.005) -> np.ndarray:
+    """Points every `step` mm along every FEED move of the linked path (arcs as 1e-6 mm chords): also the moves
+    the linker makes between segments it joins, which no segment holds."""
+    tp = raster_lean.chorded(raster_lean.attach_arcs(link(segments, LinkPolicy(50.0, 55.0)), arc_map), 1e-6)
+    p, out = tp.points(), []
+    for i in range(1, len(p)):
+        if tp.moves[i].kind is MoveKind.FEED:
+            n = max(1, int(math.ceil(math.hypot(*(p[i, :2] - p[i - 1, :2])) / step)))
+            out.append(p[i - 1] + np.arange(n + 1)[:, None] / n * (p[i] - p[i - 1]))
+    return np.vstack(out)
+
+
+@pytest.mark.parametrize("arcs", [False, True])
+def test_moves_between_joined_segments_within_tolerance(bump_mesh, arcs):
+    """The zig-zag links cross the dome's slopes (the boundary's edges at x 10 and 30) with one sample between
+    two passes: the moves into and out of a link are fitted and checked like the passes' (they were not, and
+    left the band: -0.0047 mm on mount_rush). The kernel's fit and the Python one (arcs)."""
+    cutter = Cutter.ball(4.0)
+    params = SurfaceParams(boundary=(10, 2, 30, 18), stepover=0.6, sample_step=0.5, forward_step="tolerance",
+                           chord_tol=TOL, arcs=arcs)
+    res = compute(bump_mesh, cutter, params)
+    assert sum(s.kind.name == "LINK" for s in res.segments) > 20
+    pts = feed_points(res.segments, res.diagnostics["arcs"])
+    floor = float(bump_mesh.bounds[0][2])
+    exact = np.maximum(DropSurface(bump_mesh).drop(cutter, pts[:, :2], floor), floor)
+    assert np.abs(pts[:, 2] - exact).max() <= TOL + 1e-6
 
 
 def test_stock_to_leave_and_air_are_the_raster_s(bump_mesh):
