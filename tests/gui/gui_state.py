@@ -322,6 +322,24 @@ def cancel_in_creation_session(info: dict, doc, job) -> None:
     info["creation_step_over"] = kept.StepOver.Value if kept is not None else None
 
 
+def focus_rounds(info: dict, doc, op, rounds: int = 6) -> None:
+    """Step 4d: the panel opened, the focus moved through quantity fields (each bound by FreeCAD's field
+    controller), Cancel; several times. FreeCAD 1.0 crashed in the controllers' event filter on the first round of
+    such a loop before panel_state.release_field_filters (SIGSEGV in PySide's getMetaDataFromQObject); the op must
+    come out as it went in."""
+    before = (path_key(op), op.StepOverPercent)
+    for _ in range(rounds):
+        edit(op)
+        for name in ("safeHeight", "clearanceHeight", "stepDown", "sampleStep"):
+            visible(QtGui.QWidget, name).setFocus()
+            pump(0.05)
+        keep_focus(visible(QtGui.QDoubleSpinBox, "stepOverPercent"))
+        click(QtGui.QDialogButtonBox.Cancel)
+        wait_closed()
+        pump(0.2)
+    info["focus_rounds_unchanged"] = (path_key(op), op.StepOverPercent) == before
+
+
 def reopen(info: dict, doc, job) -> None:
     """Step 5: save, close, open again."""
     SAVED.parent.mkdir(parents=True, exist_ok=True)
@@ -373,6 +391,7 @@ def session(info: dict) -> dict:
     op = new_op(info, doc, job)
     cancel_keeps_path(info, doc, op)
     cancel_in_creation_session(info, doc, job)
+    focus_rounds(info, doc, op)
     reopen(info, doc, job)
     headless = os.environ.get("TMM_GUI_REOPEN")
     if headless:  # a document saved without the GUI (make_headless_doc.py): no view state saved at all

@@ -73,6 +73,7 @@ def test_gui_state(tmp_path: Path) -> None:
     assert info["after_failed_cancel_percent"] == 50.0 and info["after_failed_cancel_stl"] == "", info
     assert info["applied_path_kept"] and info["after_apply_cancel_percent"] == 25.0, info
     assert info["creation_op_kept"] and info["creation_path_kept"] and info["creation_step_over"] == 4.0, info
+    assert info["focus_rounds_unchanged"], info  # focus moved through the fields and Cancel, 6 times (1.0 crashed)
     # saved and reopened: the values and path are there, the post kept
     assert info["reopened_post"] == "linuxcnc" and info["reopened_ops"] == 2, info
     assert info["reopened_values"] == ["%", 2, True] and info["reopened_commands"] == info["applied_commands"], info

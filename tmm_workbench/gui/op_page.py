@@ -181,7 +181,7 @@ class OpViewProvider(PathOpGui.ViewProvider):
         panel_state.release_fields_on_close(panel)  # again at OK / Cancel: fields a page added later
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
         super().setupTaskPanel(panel)
-        panel_state.release_field_filters(panel)  # no Python event filter on the fields (a crash on 1.0)
+        panel_state.release_field_filters(panel)  # on 1.0 no Python event filter on the fields (a crash)
 
 
 def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:

@@ -10,6 +10,7 @@ transaction; its value then reached the op outside any transaction (kept, and co
 So once Cancel is pressed, the pages' update handler does nothing (`drop_fields_on_cancel`)."""
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 from PySide import QtCore, QtGui
@@ -57,14 +58,23 @@ def field_controllers(panel: Any) -> list[tuple[Any, Any]]:
     return found
 
 
+# Where a Python event filter is unsafe: PySide2 (Qt 5) on Python 3.13 and later, i.e. Debian 13's FreeCAD 1.0
+# (0.20 runs PySide2 on 3.11, 1.1 PySide6: no crash seen there in any run).
+FILTERS_CRASH = QtCore.qVersion().startswith("5.") and sys.version_info >= (3, 13)
+
+
 def release_field_filters(panel: Any) -> None:
-    """Each field controller stops filtering its field, once the panel is set up and again as OK or Cancel
-    closes it (a page may add fields on the way). On FreeCAD 1.0 (Debian's PySide2 on Python 3.13) a Python
-    eventFilter can be handed an event whose address a deleted Qt object's wrapper still holds: PySide then reads
-    the event as that object and crashes (SIGSEGV in getMetaDataFromQObject, at `event.type()` in the
-    controller's eventFilter; in CI, and every time in a loop of focus changes and Cancels). Without the
-    filter no event crosses into Python there. What the filter did, show the property's value when the field
-    gets the focus, the pages do on every change of the op (setFields), so the panel shows the same values."""
+    """Where FILTERS_CRASH: each field controller stops filtering its field, once the panel is set up and again
+    as OK or Cancel closes it (a page may add fields on the way). There a Python eventFilter can be handed an
+    event whose address a deleted Qt object's wrapper still holds: PySide then reads the event as that object and
+    crashes (SIGSEGV in getMetaDataFromQObject at `event.type()` in the controller's eventFilter; in CI, and at
+    the first round of a loop of focus changes and Cancels, also with the filters removed only at close).
+    Without the filter no event crosses into Python there. What the filter did, show the op's value when the
+    field gets the focus, is lost there; the pages show every change of the op anyway (setFields). Elsewhere
+    the filters stay: on 1.1 a field left showing a refused value in another unit (0.1 um) would read the
+    next typed number in that unit."""
+    if not FILTERS_CRASH:
+        return
     for controller, widget in field_controllers(panel):
         widget.removeEventFilter(controller)
 
