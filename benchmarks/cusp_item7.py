@@ -15,6 +15,7 @@ largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7
     .venv/bin/python benchmarks/cusp_item7.py --quick    # sphere_on_plate only (and the end-to-end table)
     ... --no-e2e       # without the FreeCAD table;  --no-whole: seed 000 on the window only (the whole
                        # surfaces take about 15 min more)
+    ... --modes cusp   # only these rows (from stepover,cusp,adaptive,verify,offset3d), e.g. the constant cusp mode
 The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
 """
 from __future__ import annotations
@@ -74,9 +75,13 @@ def _row(t: tuple, partial: int = 0, passes: Optional[int] = None, note: str = "
                note)
 
 
+MODES = ("stepover", "cusp", "adaptive", "verify", "offset3d")  # the rows, by --modes
+
+
 def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float, boundary=None,
-               log: Callable[[str], None] = lambda s: None) -> ModelTable:
-    """Every item-7 row for one model over `boundary` (default the model's box), measured in one cusp field."""
+               log: Callable[[str], None] = lambda s: None, modes: tuple[str, ...] = MODES) -> ModelTable:
+    """Every item-7 row for one model over `boundary` (default the model's box), measured in one cusp field;
+    `modes` picks the rows (the constant step-over's target is the tolerance when the adaptive row is left out)."""
     lo, hi = mesh.bounds
     if boundary is None:
         boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
@@ -105,19 +110,26 @@ def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float
         found[label] = _row(t, v["passes_added"], diag["passes"], f"{v['length_added'] / 1000:.2f} m partial")
         log(f"  {name}: {label} {t[4]:.1f} s")
 
-    spacing("adaptive", "adaptive")
+    if "adaptive" in modes:
+        spacing("adaptive", "adaptive")
     target = found["adaptive"].cusp if "adaptive" in found else tol
-    t0 = time.perf_counter()
-    bis = equal_cusp_stepover(mesh, cutter, boundary, field, target)
-    if bis.row is not None:
-        found[BASE] = _row(bis.row, note=f"bisection: {bis.step_lo:.3f} mm -> {_mm(bis.cusp_lo)}, "
-                                          f"{bis.step_hi:.3f} mm -> {_mm(bis.cusp_hi)}")
-    else:
-        failed.append(f"{BASE}: no step-over in [0.02, {bis.step_hi:.3f}] mm keeps the cusp under {target:.4f} mm")
-    log(f"  {name}: bisection {time.perf_counter() - t0:.1f} s")
-    spacing("constant cusp mode", "cusp")
-    checked("adaptive + verify", "adaptive")
-    spacing("3D offset", "offset3d")
+    bis = Bisection(None, 0.0, None, 0.0, None)
+    if "stepover" in modes:
+        t0 = time.perf_counter()
+        bis = equal_cusp_stepover(mesh, cutter, boundary, field, target)
+        if bis.row is not None:
+            found[BASE] = _row(bis.row, note=f"bisection: {bis.step_lo:.3f} mm -> {_mm(bis.cusp_lo)}, "
+                                              f"{bis.step_hi:.3f} mm -> {_mm(bis.cusp_hi)}")
+        else:
+            failed.append(f"{BASE}: no step-over in [0.02, {bis.step_hi:.3f}] mm keeps the cusp under "
+                          f"{target:.4f} mm")
+        log(f"  {name}: bisection {time.perf_counter() - t0:.1f} s")
+    if "cusp" in modes:
+        spacing("constant cusp mode", "cusp")
+    if "verify" in modes:
+        checked("adaptive + verify", "adaptive")
+    if "offset3d" in modes:
+        spacing("3D offset", "offset3d")
     # no "3D offset + verify": the verification needs straight raster passes (core.footprint.variable_step)
     order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset"]
     rows = [found[k] for k in order if k in found]
@@ -190,7 +202,13 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=100.0,
                     help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
     ap.add_argument("--no-whole", action="store_true", help="seed 000 on the window only, not also on the whole")
+    ap.add_argument("--modes", default=",".join(MODES),
+                    help=f"the rows to measure, comma-separated from {','.join(MODES)} (e.g. --modes cusp: the "
+                         f"constant cusp mode rows only)")
     args = ap.parse_args()
+    modes = tuple(m.strip() for m in args.modes.split(",") if m.strip())
+    if not modes or any(m not in MODES for m in modes):
+        ap.error(f"--modes must name rows from {','.join(MODES)}, got {args.modes!r}")
 
     def log(s: str) -> None:
         print(s, file=sys.stderr, flush=True)
@@ -201,7 +219,8 @@ def main() -> None:
     stl = shared_dir() / "benchmarks" / "stl"
     models: list[ModelTable] = []
     ball6 = Cutter.ball(6.0)
-    sop = model_rows("sphere_on_plate", load_stl(stl / "sphere_on_plate.stl"), ball6, 0.01, 0.1, log=log)
+    sop = model_rows("sphere_on_plate", load_stl(stl / "sphere_on_plate.stl"), ball6, 0.01, 0.1, log=log,
+                     modes=modes)
     models.append(sop)
     print("\n".join(table([sop]) + notes([sop])), flush=True)
     if not args.no_e2e and sop.bisection.row is not None:
@@ -213,7 +232,7 @@ def main() -> None:
             models.append(m)
             print("\n" + "\n".join(table([m]) + notes([m])), flush=True)
 
-        add(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log))
+        add(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log, modes=modes))
         from seed000_surfaces import INCH, seed000_mesh
         windows = [args.window] + ([] if args.no_whole or not args.window else [0.0])
         for side in windows:
@@ -224,7 +243,7 @@ def main() -> None:
                 region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if side else None
                 where = f"{side:g} mm window" if side else "whole"
                 add(model_rows(f"seed 000 {name}, {where}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
-                               boundary=region, log=log))
+                               boundary=region, log=log, modes=modes))
         print("\n# all models")
         print("\n".join(table(models) + notes(models)), flush=True)
     print(f"\n# {time.perf_counter() - t_start:.0f} s in all; load: {os.getloadavg()[0]:.2f} "

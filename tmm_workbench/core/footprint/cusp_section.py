@@ -19,10 +19,19 @@ here on the CL surface itself, which carries the slope AND the curvature across 
   cusp from the design (out of the tool's reach: a corner narrower than the tool, pencil work) are not counted,
   as the simulated measure leaves them out;
 - the step is the largest with the worst pair's cusp at most the tolerance (bisection), at least half the
-  planar step at the slope limit (as the adaptive raster's smallest step); `limited` when even that leaves more.
+  planar step at the slope limit (as the adaptive raster's smallest step); `limited` when even that leaves more;
+- every pair is taken both ways, anchored at a sample by its a and by its b (the other end's phase then sweeps
+  smoothly with the step), and the step is checked on all pairs, searched again on a growing subset until it
+  holds (a free border of the model moves the worst pair with the step);
+- a pair above the aim is checked against every pass of its phase within the tool's reach (not only four);
+- a second look: sections placed densely between the neighbours of the worst sections (the first ones lie up to
+  the region's length / 160 apart), the samples across only near their worst pairs.
 
 The 2D section leaves out the neighbours along a pass (a slope along the pass lowers the swept tool by the same
-amount in H and in E, to first order: the planar ball's cusp along the normal is the same).
+amount in H and in E, to first order: the planar ball's cusp along the normal is the same). Not at a free border
+of the model just above the raster's floor (the passes beyond it sit on the floor, and the border runs at an
+angle to them): there the simulated cusp exceeded the rule's by up to 1.6x on a 30 deg sheet (docs/results.md,
+"Constant cusp mode by the section rule", 2026-12-02 cusp4).
 """
 from __future__ import annotations
 
@@ -48,7 +57,11 @@ _POINTS_MOST = 400_000    # CL points of the drop grid at most (sections x sampl
 _CREASE_RAD = 0.1         # slope turn (rad) between neighbouring samples beyond which the CL surface has a crease
 _RIDGE_HALVINGS = 26      # the ridge within 2 R / 2^26
 _STEP_HALVINGS = 18       # the step within (s_max - s_min) / 2^18
+_SEARCH_ROUNDS = 8        # step searches on growing subsets of the pairs before one on all of them
+_AROUND_MOST = 64         # failing pairs whose section neighbours (within a step) join the subset, the worst first
 _BYTES_PER_POINT = 200    # the grid's heights, design, envelope and pair arrays per sample
+_REFINE_SPOTS = 3         # the worst sections around which sections are placed densely (a second look)
+_REFINE_SECTIONS = 24     # sections between a worst section's two neighbours
 
 
 @dataclass
@@ -88,33 +101,59 @@ def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: f
     s_max = min(2 * r_max * 0.98, s_level)   # as the adaptive raster's: no wider than on a level plane (what
     # the samples do not measure, creases and places out of reach, gets no wider step than a plane would)
     spacing = float(np.clip(s_level / _SAMPLES_PER_STEP, _MIN_SPACING, _MAX_SPACING))
+    surface = surface or DropSurface(mesh)
     while True:  # samples half a step apart at most: coarser ones misplace b between them (a bull's flat)
-        step = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar, surface,
-                             d, n, along, across, s_min, s_max, spacing)
+        step, spots = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar,
+                                    surface, d, n, along, across, s_min, s_max, spacing)
         if step.stepover >= 2 * spacing or spacing <= _MIN_SPACING:
-            return step
+            break
         spacing = max(_MIN_SPACING, step.stepover / _SAMPLES_PER_STEP)
+    # A second look where the first found the worst crossings: the sections lie up to the region's length / 160
+    # apart (36 on seed 000's whole surfaces, 7 mm apart: its concave surface's steep end bends along the passes,
+    # and the worst crossing fell between two sections: 0.0546 mm simulated at the rule's 0.502 mm, 0.4315 mm with
+    # sections 0.4 mm apart there). Around each of the worst sections, sections between its two neighbours, the
+    # samples across only near its worst pair (the pair, its outer neighbours and the tool's reach on each side).
+    half = 2 * s_max + 2 * r_max
+    for x_lo, x_hi, y_at in spots:
+        fine, _ = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar,
+                                surface, d, n, along, across, s_min, min(s_max, step.stepover), spacing,
+                                np.linspace(x_lo, x_hi, _REFINE_SECTIONS), (y_at - half, y_at + half))
+        if fine.stepover < step.stepover:
+            step = SectionStep(fine.stepover, fine.cusp, step.planar, step.sections + fine.sections, spacing,
+                               fine.limited, step.unreachable, step.creases)
+        else:
+            step.sections += fine.sections
+    return step
 
 
 def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, floor_z: float, stock_to_leave: float,
                   max_slope_deg: float, planar: Optional[float], surface: Optional[DropSurface], d: np.ndarray,
                   n: np.ndarray, along: np.ndarray, across: np.ndarray, s_min: float, s_max: float,
-                  spacing: float) -> SectionStep:
-    """section_stepover with samples `spacing` apart across the sections."""
+                  spacing: float, at_xs: Optional[np.ndarray] = None,
+                  window: Optional[tuple[float, float]] = None) -> tuple[SectionStep, list[tuple[float, float, float]]]:
+    """section_stepover with samples `spacing` apart across the sections (at `at_xs` along the passes if given,
+    else spread over the region; only pairs whose a lies in `window` across if given), and the places to look
+    at again: (x_lo, x_hi, y) around each of the worst sections (its neighbours' x, its worst pair's a)."""
     r_max = cutter.native.max_radius
     y_lo, y_hi = float(across.min()), float(across.max())
+    # the pairs' a: the region, or the window in it; samples: the ridges' reach (R) and E's (R) beyond them
+    a_lo, a_hi = (y_lo, y_hi) if window is None else (max(y_lo, window[0]), min(y_hi, window[1]))
+    reach_y = r_max if window is None else 2 * r_max
     # samples across, E needs the tool's reach beyond the region: counted before any is made
-    samples = (y_hi - y_lo + 2 * r_max + 3 * spacing) / spacing + 1
+    samples = (a_hi - a_lo + 2 * reach_y + 3 * spacing) / spacing + 1
     # sections inside the region, clear of the passes' ends by the tool radius (the measured cells' rule)
     x0, x1 = float(along.min()) + cutter.radius, float(along.max()) - cutter.radius
     if x1 <= x0:
         x0 = x1 = 0.5 * float(along.min() + along.max())
     count = max(1, min(_SECTIONS_MOST, int(_POINTS_MOST // samples), int((x1 - x0) / spacing) + 1))
+    if at_xs is not None:
+        count = len(at_xs)
     check_work("CL points", float(count) * samples, _BYTES_PER_POINT,
                f"cusp height {cusp:g} mm (samples {spacing:.3g} mm apart across the passes) over a "
                f"{y_hi - y_lo:.6g} mm wide boundary")
-    ys = np.arange(y_lo - r_max - spacing, y_hi + r_max + 2 * spacing, spacing)
-    xs = np.linspace(x0, x1, count) if count > 1 else np.array([x0])
+    ys = np.arange(a_lo - reach_y - spacing, a_hi + reach_y + 2 * spacing, spacing)
+    xs = np.asarray(at_xs, dtype=float) if at_xs is not None else (np.linspace(x0, x1, count) if count > 1
+                                                                    else np.array([x0]))
     X, Y = np.meshgrid(xs, ys, indexing="ij")                       # (sections, samples)
     world = X[..., None] * d + Y[..., None] * n
     # points of a section outside the boundary (a turned raster over a rectangle) are no part of it
@@ -176,7 +215,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         j1 = np.clip(np.ceil((y1 - ys[0]) / spacing).astype(int) + 1, 0, len(ys))
         return crease_before[rows, j1] - crease_before[rows, j0]
 
-    a_rows, a_cols = np.nonzero(inside & (Y >= y_lo - 1e-9) & (Y <= y_hi + 1e-9))
+    a_rows, a_cols = np.nonzero(inside & (Y >= a_lo - 1e-9) & (Y <= a_hi + 1e-9))
     a_y = ys[a_cols]
     c_a = c[a_rows, a_cols]
 
@@ -190,10 +229,12 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     rise = profile_height(cutter, np.array([r_max - edge, r_max]))
     walls = float(rise[1] - rise[0]) < 10 * edge
 
+    target = cusp * _SAFETY
+
     def worst(s: float, rows: np.ndarray, ay: np.ndarray, ca: np.ndarray) -> np.ndarray:
         """The cusp (mm, 0 where not counted) of each pair (ay, ay + s) on its section."""
         by = ay + s
-        ok = (by <= y_hi + 1e-9) & (creases_between(rows, ay - s, by + s) == 0)
+        ok = (ay >= y_lo - 1e-9) & (by <= y_hi + 1e-9) & (creases_between(rows, ay - s, by + s) == 0)
         cb, ca0, cb1 = at(c, by, rows), at(c, ay - s, rows), at(c, by + s, rows)
         # the ridge: a's lower surface minus b's grows with y (convex profile); bracket where both reach
         lo, hi = by - r_max, ay + r_max
@@ -209,6 +250,11 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         if walls:
             points += [(ay + r_max + eps, ((cb, by), (cb1, by + s))),          # beyond a's wall
                        (by - r_max - eps, ((ca, ay), (ca0, ay - s)))]          # before b's wall
+        # the pairs above the aim are checked against every pass of their phase within the tool's reach, not
+        # only the four: where the CL surface is much higher than E around them (a groove narrower than the tool
+        # beside them, reached from passes farther off; mount_rush: 0.40 mm from the four, none from all)
+        over = np.zeros(len(ay), dtype=bool)
+        values = []
         for y, parts in points:
             h = np.full(len(ay), np.inf)
             for tip, axis in parts:
@@ -216,42 +262,107 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
             col = np.clip(np.round((y - ys[0]) / spacing).astype(int), 0, len(ys) - 1)
             good = ok & counted[rows, col] & np.isfinite(h) & (y >= ys[0]) & (y <= ys[-1])
             with np.errstate(invalid="ignore"):
-                value = (h - at(envelope, y, rows)) * at(cos, y, rows)
-            out = np.maximum(out, np.where(good & np.isfinite(value), value, 0.0))
+                e_cos = (at(envelope, y, rows), at(cos, y, rows))
+                value = (h - e_cos[0]) * e_cos[1]
+            value = np.where(good & np.isfinite(value), value, 0.0)
+            values.append((y, h, good, e_cos))
+            over |= value > target
+            out = np.maximum(out, value)
+        if over.any():
+            k_most = int(math.ceil(2 * r_max / s)) + 1
+            i = np.nonzero(over)[0]
+            redo = np.zeros(len(i))
+            for y, h, good, (e, cs) in values:
+                y, h = y[i], h[i].copy()
+                for k in range(-k_most, k_most + 1):
+                    if k not in (-1, 0, 1, 2):   # a - s, a, b, b + s are in h already
+                        axis = ay[i] + k * s
+                        h = np.minimum(h, at(c, axis, rows[i]) + profile_height(cutter, y - axis))
+                with np.errstate(invalid="ignore"):
+                    v = (h - e[i]) * cs[i]
+                redo = np.maximum(redo, np.where(good[i] & np.isfinite(v), v, 0.0))
+            out[i] = redo
         return out
 
-    target = cusp * _SAFETY
+    def both(s: float, rows: np.ndarray, ay: np.ndarray, ca: np.ndarray) -> np.ndarray:
+        """The worse of the pairs (ay, ay + s) and (ay - s, ay): a pair's cusp may hang on either instance's
+        place (b on the foot of the tool's roll over a free border: the last pass beyond it sits on the floor);
+        with one end on a sample for every step, the other end's phase sweeps smoothly with the step (with a
+        only, the worst pair's b jumped a sample as the step grew: a saw of +-10 % in the worst cusp)."""
+        return np.maximum(worst(s, rows, ay, ca), worst(s, rows, ay - s, at(c, ay - s, rows)))
+
     all_rows = a_rows
-    # the worst pairs at one step stay the worst near it: search the step on those, then check all of them
+    # the worst pairs at one step stay the worst near it: search the step on those, then check all of them. Not
+    # always: at a free border of the model the worst pair is the one whose b has just rolled over the edge
+    # down onto the floor beyond it (the foot of the roll), a different a for every step (seed 000's whole convex
+    # surface: 4 rounds of the old search stopped at 0.636 mm, 0.0656 mm left, `limited`). So the pairs kept grow
+    # from round to round: each round adds the pairs worst at its step and, around the worst of those that fail,
+    # every pair of their section within one step (where the worst a moves to); the step found on a subset is an
+    # upper bound of the answer (a subset leaves at most what all pairs leave), and one that fails bounds the next
     s_try = planar if planar is not None else stepover_for_cusp(cutter, cusp, 0.0, s_max)
     s_try = float(np.clip(s_try, s_min, s_max))
-    values = worst(s_try, all_rows, a_y, c_a)
-    for _ in range(4):
-        keep = values >= 0.5 * values.max() if values.max() > 0 else np.zeros(len(values), dtype=bool)
-        keep |= values >= np.quantile(values, 0.99) if len(values) else keep
+    values = both(s_try, all_rows, a_y, c_a)
+    keep = np.zeros(len(values), dtype=bool)
+    s_hi = s_max
+    for _ in range(_SEARCH_ROUNDS):
+        if len(values):
+            keep |= (values >= 0.5 * values.max()) if values.max() > 0 else keep
+            keep |= values >= np.quantile(values, 0.99)
         rows, ay, ca = all_rows[keep], a_y[keep], c_a[keep]
-
-        def peak(s: float) -> float:
-            v = worst(s, rows, ay, ca)
-            return float(v.max()) if len(v) else 0.0
-
-        if peak(s_max) <= target:
-            s = s_max
-        elif peak(s_min) > target:
-            s = s_min
-        else:
-            lo_s, hi_s = s_min, s_max
-            for _ in range(_STEP_HALVINGS):
-                mid = 0.5 * (lo_s + hi_s)
-                if peak(mid) <= target:
-                    lo_s = mid
-                else:
-                    hi_s = mid
-            s = lo_s
-        values = worst(s, all_rows, a_y, c_a)
+        s = _largest_step(lambda t: both(t, rows, ay, ca), s_min, s_hi, target)
+        values = both(s, all_rows, a_y, c_a)
         if values.max(initial=0.0) <= target or s <= s_min:
             break
+        s_hi = s
+        failing = np.argsort(values)[-_AROUND_MOST:]
+        keep |= _around(failing[values[failing] > target], all_rows, int(math.ceil(s / spacing)))
+    else:  # not settled on the subsets: the same search on every pair (exact; ~20 passes over all of them)
+        s = _largest_step(lambda t: both(t, all_rows, a_y, c_a), s_min, s_hi, target)
+        values = both(s, all_rows, a_y, c_a)
     worst_cusp = float(values.max(initial=0.0))
+    # the worst sections at this step (a section's worst pair), to look at again between their neighbours
+    spots: list[tuple[float, float, float]] = []
+    if count > 2 and len(values):
+        per = np.zeros(count)
+        np.maximum.at(per, all_rows, values)
+        for r in np.argsort(per)[::-1][:_REFINE_SPOTS]:
+            if per[r] > 0:
+                mine = np.nonzero(all_rows == r)[0]
+                spots.append((float(xs[max(r - 1, 0)]), float(xs[min(r + 1, count - 1)]),
+                              float(a_y[mine[np.argmax(values[mine])]])))
     return SectionStep(stepover=s, cusp=worst_cusp, planar=float(planar) if planar is not None else math.nan,
                        sections=count, spacing=spacing, limited=worst_cusp > cusp, unreachable=unreachable,
-                       creases=int(turn.sum()))
+                       creases=int(turn.sum())), spots
+
+
+def _largest_step(cusps, s_min: float, s_max: float, target: float) -> float:
+    """The largest step in [s_min, s_max] whose pairs' worst cusp (`cusps(step)`: one value a pair) is at most
+    `target` (bisection: the worst over all phases grows with the step); s_min when even that leaves more."""
+    def peak(s: float) -> float:
+        v = cusps(s)
+        return float(v.max()) if len(v) else 0.0
+
+    if peak(s_max) <= target:
+        return s_max
+    if peak(s_min) > target:
+        return s_min
+    lo, hi = s_min, s_max
+    for _ in range(_STEP_HALVINGS):
+        mid = 0.5 * (lo + hi)
+        if peak(mid) <= target:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def _around(pairs: np.ndarray, rows: np.ndarray, reach: int) -> np.ndarray:
+    """Mask of the pairs within `reach` samples of `pairs` (indices) on the same section (`rows`: each pair's
+    section; a section's pairs are contiguous and in order across it)."""
+    mask = np.zeros(len(rows), dtype=bool)
+    if not len(pairs):
+        return mask
+    near = np.clip(pairs[:, None] + np.arange(-reach, reach + 1)[None, :], 0, len(rows) - 1)
+    near = near[rows[near] == rows[pairs][:, None]]
+    mask[near] = True
+    return mask
