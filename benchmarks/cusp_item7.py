@@ -15,6 +15,7 @@ largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7
     .venv/bin/python benchmarks/cusp_item7.py --quick    # sphere_on_plate only (and the end-to-end table)
     ... --no-e2e       # without the FreeCAD table;  --no-whole: seed 000 on the window only (the whole
                        # surfaces take about 15 min more)
+    ... --offset3d-only  # only the 3D offset's rows (each model's cusp field and that path; no FreeCAD table)
 The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
 """
 from __future__ import annotations
@@ -75,7 +76,7 @@ def _row(t: tuple, partial: int = 0, passes: Optional[int] = None, note: str = "
 
 
 def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float, boundary=None,
-               log: Callable[[str], None] = lambda s: None) -> ModelTable:
+               log: Callable[[str], None] = lambda s: None, offset3d_only: bool = False) -> ModelTable:
     """Every item-7 row for one model over `boundary` (default the model's box), measured in one cusp field."""
     lo, hi = mesh.bounds
     if boundary is None:
@@ -105,6 +106,11 @@ def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float
         found[label] = _row(t, v["passes_added"], diag["passes"], f"{v['length_added'] / 1000:.2f} m partial")
         log(f"  {name}: {label} {t[4]:.1f} s")
 
+    if offset3d_only:  # (--offset3d-only: the 3D offset's row alone, measured in the same field)
+        spacing("3D offset", "offset3d")
+        header = (f"{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm; "
+                  f"{field.share:.0%} of the cells measured ({cell:g} mm cells)")
+        return ModelTable(name, header, list(found.values()), Bisection(None, 0.0, None, 0.0, None), failed)
     spacing("adaptive", "adaptive")
     target = found["adaptive"].cusp if "adaptive" in found else tol
     t0 = time.perf_counter()
@@ -149,7 +155,7 @@ def table(models: list[ModelTable]) -> list[str]:
             passes += " loops" if r.label.startswith("3D offset") else ""
             label = r.label if r is not base else r.label + " (before)"
             out.append(f"| {m.name} | {label} | {passes} | {r.cusp:.4f} | {r.cycle_s / 60:.1f} | "
-                       f"{r.compute_s:.1f} | {r.moves} | {p:.2f}x | {c:.2f}x |")
+                       f"{r.compute_s:.1f} | {r.moves} | " + (" | |" if math.isnan(p) else f"{p:.2f}x | {c:.2f}x |"))
     return out
 
 
@@ -190,7 +196,10 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=100.0,
                     help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
     ap.add_argument("--no-whole", action="store_true", help="seed 000 on the window only, not also on the whole")
+    ap.add_argument("--offset3d-only", action="store_true", help="only the 3D offset's rows (no end-to-end table)")
     args = ap.parse_args()
+    if args.offset3d_only:
+        args.no_e2e = True
 
     def log(s: str) -> None:
         print(s, file=sys.stderr, flush=True)
@@ -201,7 +210,8 @@ def main() -> None:
     stl = shared_dir() / "benchmarks" / "stl"
     models: list[ModelTable] = []
     ball6 = Cutter.ball(6.0)
-    sop = model_rows("sphere_on_plate", load_stl(stl / "sphere_on_plate.stl"), ball6, 0.01, 0.1, log=log)
+    sop = model_rows("sphere_on_plate", load_stl(stl / "sphere_on_plate.stl"), ball6, 0.01, 0.1, log=log,
+                     offset3d_only=args.offset3d_only)
     models.append(sop)
     print("\n".join(table([sop]) + notes([sop])), flush=True)
     if not args.no_e2e and sop.bisection.row is not None:
@@ -213,7 +223,8 @@ def main() -> None:
             models.append(m)
             print("\n" + "\n".join(table([m]) + notes([m])), flush=True)
 
-        add(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log))
+        add(model_rows("mount_rush", load_stl(stl / "mount_rush.stl"), ball6, 0.01, 0.1, log=log,
+                       offset3d_only=args.offset3d_only))
         from seed000_surfaces import INCH, seed000_mesh
         windows = [args.window] + ([] if args.no_whole or not args.window else [0.0])
         for side in windows:
@@ -224,7 +235,7 @@ def main() -> None:
                 region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if side else None
                 where = f"{side:g} mm window" if side else "whole"
                 add(model_rows(f"seed 000 {name}, {where}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
-                               boundary=region, log=log))
+                               boundary=region, log=log, offset3d_only=args.offset3d_only))
         print("\n# all models")
         print("\n".join(table(models) + notes(models)), flush=True)
     print(f"\n# {time.perf_counter() - t_start:.0f} s in all; load: {os.getloadavg()[0]:.2f} "

@@ -97,7 +97,8 @@ def where(name, mesh, cutter: Cutter, tol: float, cell: float, boundary=None) ->
         out.append(f"| {c} | {int(m.sum())} | {m.mean() if len(m) else 0:.0%} | {big} |")
     if len(p):
         worst = int(np.argmax(excess))
-        out.append(f"worst cell at CL ({p[worst, 0]:.2f}, {p[worst, 1]:.2f}): T {float(t.at(p[worst:worst + 1])[0]):.2f}, "
+        t_worst = float(t.at(p[worst:worst + 1])[0])
+        out.append(f"worst cell at CL ({p[worst, 0]:.2f}, {p[worst, 1]:.2f}): T {t_worst:.2f}, "
                    f"turn {turn[worst]:.0f} deg, R k {rk[worst]:.3f}, slope {slope[worst]:.1f} deg, "
                    f"{edge[worst]:.1f} mm from the edge")
     return out

@@ -162,18 +162,39 @@ def test_dome_cusp_within_the_height_and_no_gouge_in_the_simulated_stock():
     cos = np.cos(np.radians(slope_deg(dense, grid.cell)))
     assert np.abs(dense - design).max() < 0.5 * tol               # reachable everywhere here
     cusp = (cut - dense) * cos
-    # within the cusp height but on the crests' tops and by the corners' bisectors (measured: 0.74 % of the cells
-    # above it, 0.067 % above 1.1 x, the 99.9th percentile 1.085 x, the largest 1.39 x on a bisector at the foot).
-    # The passes are spaced at the planar rule's step exactly (the level sets of T), so the sampling's errors show:
-    # the 0.25 mm chords along the passes, the field's first order in its cell (the flat step / 8), the rule's
-    # slope secant over half a step; and a corner's spike on a slope is sized for the plane
-    assert (cusp > tol).mean() <= 0.01
-    assert np.percentile(cusp, 99.9) <= 1.10 * tol
-    assert cusp.max() <= 1.5 * tol
+    # within the cusp height but on the dome's flank (measured: 0.079 % of the cells above it, the 99.9th
+    # percentile 0.989 x, the largest 1.157 x, at slopes of 16-25 deg: the rule's slope and curvature are secants
+    # over half a step either side). Before the rule aimed under the cusp (offset_field.CUSP_AIM 0.92) and the
+    # half level was cut at uncovered ridge points: 0.74 % above, 99.9th percentile 1.085 x, the largest 1.39 x on
+    # a corner's bisector at the foot
+    assert (cusp > tol).mean() <= 0.002
+    assert np.percentile(cusp, 99.9) <= 1.0 * tol
+    assert cusp.max() <= 1.25 * tol
     assert cusp.max() >= 0.5 * tol                                # not much finer than asked
     assert (cut - design).min() >= -1e-3                          # no gouge
     # fewer loops than a constant raster at the steepest crossing would need passes
     assert result.diagnostics["least_step"] < result.diagnostics["stepover"]
+
+
+@pytest.mark.parametrize("width", [16.3, 17.6])
+def test_hilltop_of_a_rectangle_holds_the_cusp_in_the_simulated_stock(width):
+    """Where the fronts end (T's top: a rectangle's middle segment) the last loop is a sliver or nothing and its
+    ends lie on the bisectors: the points there must still lie within half a step of a pass. Simulated at 0.02 mm
+    cells against a dense raster: before the ridge check (offset_field._uncovered) 1.37 x / 1.39 x the cusp height
+    at the segment's ends, as on seed 000's windows (1.38 x); measured now 0.918 x on both."""
+    mesh, tol, box = plate(), 0.01, (0.0, 0.0, width, 15.0)
+    params = SurfaceParams(boundary=box, sample_step=0.25, stepover_mode=OFFSET3D, cusp=tol, gouge_tol=5e-4)
+    r = BALL.radius
+    grid = Grid.covering(box[0] + r, box[1] + r, box[2] - r, box[3] - r, 0.02)
+    stock = box_heights(grid, 10)
+    cut = simulate(_path(mesh, BALL, params), BALL, grid, stock).heights
+    dense = simulate(_path(mesh, BALL, SurfaceParams(boundary=(box[0], box[1] - r, box[2], box[3] + r),
+                                                     sample_step=0.1, stepover=0.02)), BALL, grid, stock).heights
+    cusp = cut - dense                                                # a plane: vertical is the normal
+    # the margin: the dense raster's own cusp (0.02^2 / 8R) and the cells' sampling of the ridges (0.5 %)
+    assert cusp.max() <= 1.005 * tol
+    assert cusp.max() >= 0.8 * tol                                    # not much finer than asked
+    assert (cut - mesh_heights(mesh, grid)).min() >= -1e-6            # no gouge
 
 
 def test_bad_inputs_are_refused_by_name_before_any_path():
@@ -291,9 +312,10 @@ def test_relief_patch_holds_the_cusp_with_long_loops_and_no_gouge():
     cusp = field.cusp(heights)
     measured = cusp[np.isfinite(cusp)]
     assert field.share >= 0.4                       # most of the patch is reachable and not too steep
-    # NOT held to the cusp height on a relief, stated: measured 1.4 % of the cells above it, the 99.9th percentile
-    # 1.385 x, the largest 1.60 x (the planar rule with the CL section's curvature over half a step either side
-    # misses detail finer than that; probes of a quarter or a whole step were worse: 1.60 / 1.69 x at 99.9 %)
+    # NOT held to the cusp height on a relief, stated: measured 0.96 % of the cells above it, the 99.9th percentile
+    # 1.38 x, the largest 1.69 x (1.4 %, 1.385 x, 1.60 x before the aim and the ridge check: the planar rule with
+    # the CL section's curvature over half a step either side misses detail finer than that; probes of a quarter
+    # or a whole step were worse: 1.60 / 1.69 x at 99.9 %)
     assert np.percentile(measured, 99.9) <= 1.5 * tol
     assert (measured > tol).mean() <= 0.02
     assert measured.max() <= 2.0 * tol
@@ -302,5 +324,5 @@ def test_relief_patch_holds_the_cusp_with_long_loops_and_no_gouge():
     lengths = [float(np.hypot(*np.diff(s.tips[:, :2], axis=0).T).sum()) for s in result.segments
                if s.kind != SegmentKind.LINK]
     d = result.diagnostics
-    assert d["passes"] <= 2 * d["levels"]                    # measured: 20 passes, 16 levels
-    assert sum(lengths) / len(lengths) >= 15.0               # measured: 22.8 mm on average
+    assert d["passes"] <= 2 * d["levels"]                    # measured: 21 passes, 17 levels (20, 16 before the aim)
+    assert sum(lengths) / len(lengths) >= 15.0               # measured: 22.6 mm on average (22.8 before)
