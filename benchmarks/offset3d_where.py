@@ -14,6 +14,7 @@ cell plus core.sim.cusp_field's contact offset), where the arrival field T lives
 
     .venv/bin/python benchmarks/offset3d_where.py --quick      # sphere_on_plate
     .venv/bin/python benchmarks/offset3d_where.py              # and mount_rush, seed 000's windows
+    .venv/bin/python benchmarks/offset3d_where.py --only convex,concave --window 0   # seed 000's whole surfaces
 """
 from __future__ import annotations
 
@@ -108,6 +109,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="sphere_on_plate only")
     ap.add_argument("--only", default="", help="comma-separated: sphere_on_plate, mount_rush, convex, concave")
+    ap.add_argument("--window", type=float, default=100.0, help="seed 000: the square region's side, mm (0: whole)")
     args = ap.parse_args()
     only = set(filter(None, args.only.split(",")))
     stl = shared_dir() / "benchmarks" / "stl"
@@ -124,9 +126,10 @@ def main() -> None:
             continue
         mesh, _ = seed000_mesh(name)
         lo, hi = mesh.bounds
-        c = 0.5 * (lo + hi)
-        region = (float(c[0] - 50), float(c[1] - 50), float(c[0] + 50), float(c[1] + 50))
-        print("\n".join(where(f"seed 000 {name}, 100 mm window", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
+        c, h = 0.5 * (lo + hi), 0.5 * args.window
+        region = (float(c[0] - h), float(c[1] - h), float(c[0] + h), float(c[1] + h)) if args.window else None
+        where_ = f"{args.window:g} mm window" if args.window else "whole"
+        print("\n".join(where(f"seed 000 {name}, {where_}", mesh, Cutter.ball(0.5 * INCH), 0.002 * INCH, 0.2,
                               region)), flush=True)
     print(f"\n# {time.perf_counter() - t0:.0f} s")
 
