@@ -145,6 +145,18 @@ def _path(mesh, cutter, params):
     return link(compute(mesh, cutter, params).segments, LinkPolicy(top + 5, top + 10))
 
 
+def _cut_and_dense(mesh, params, cell=0.02):
+    """The stock (cells `cell` mm, clear of the boundary's edges by the radius) cut by the path of `params` and by a
+    dense raster (passes a cell apart: what the tool can reach), and the grid."""
+    box, r = params.boundary, BALL.radius
+    grid = Grid.covering(box[0] + r, box[1] + r, box[2] - r, box[3] - r, cell)
+    stock = box_heights(grid, 10)
+    cut = simulate(_path(mesh, BALL, params), BALL, grid, stock).heights
+    dense = simulate(_path(mesh, BALL, SurfaceParams(boundary=(box[0], box[1] - r, box[2], box[3] + r),
+                                                     sample_step=0.1, stepover=cell)), BALL, grid, stock).heights
+    return cut, dense, grid
+
+
 def test_dome_cusp_within_the_height_and_no_gouge_in_the_simulated_stock():
     mesh = dome()
     tol = 0.01
@@ -152,12 +164,7 @@ def test_dome_cusp_within_the_height_and_no_gouge_in_the_simulated_stock():
     # gouge_tol: how deep a straight move may pass below the exact drop between CL points (raster_refine)
     params = SurfaceParams(boundary=box, sample_step=0.25, stepover_mode=OFFSET3D, cusp=tol, gouge_tol=5e-4)
     result = compute(mesh, BALL, params)
-    r = BALL.radius
-    grid = Grid.covering(box[0] + r, box[1] + r, box[2] - r, box[3] - r, 0.02)
-    stock = box_heights(grid, 10)
-    cut = simulate(_path(mesh, BALL, params), BALL, grid, stock).heights
-    dense = simulate(_path(mesh, BALL, SurfaceParams(boundary=(box[0], box[1] - r, box[2], box[3] + r),
-                                                     sample_step=0.1, stepover=0.02)), BALL, grid, stock).heights
+    cut, dense, grid = _cut_and_dense(mesh, params)
     design = mesh_heights(mesh, grid)
     cos = np.cos(np.radians(slope_deg(dense, grid.cell)))
     assert np.abs(dense - design).max() < 0.5 * tol               # reachable everywhere here
@@ -184,12 +191,7 @@ def test_hilltop_of_a_rectangle_holds_the_cusp_in_the_simulated_stock(width):
     at the segment's ends, as on seed 000's windows (1.38 x); measured now 0.918 x on both."""
     mesh, tol, box = plate(), 0.01, (0.0, 0.0, width, 15.0)
     params = SurfaceParams(boundary=box, sample_step=0.25, stepover_mode=OFFSET3D, cusp=tol, gouge_tol=5e-4)
-    r = BALL.radius
-    grid = Grid.covering(box[0] + r, box[1] + r, box[2] - r, box[3] - r, 0.02)
-    stock = box_heights(grid, 10)
-    cut = simulate(_path(mesh, BALL, params), BALL, grid, stock).heights
-    dense = simulate(_path(mesh, BALL, SurfaceParams(boundary=(box[0], box[1] - r, box[2], box[3] + r),
-                                                     sample_step=0.1, stepover=0.02)), BALL, grid, stock).heights
+    cut, dense, grid = _cut_and_dense(mesh, params)
     cusp = cut - dense                                                # a plane: vertical is the normal
     # the margin: the dense raster's own cusp (0.02^2 / 8R) and the cells' sampling of the ridges (0.5 %)
     assert cusp.max() <= 1.005 * tol

@@ -18,6 +18,11 @@ half level {T = k + 1/2} is cut there too, so every point lies within half a loc
 the speed is the flat step in every direction: T is the distance over the step, exact for straight fronts, and
 the passes are the boundary's offsets by k steps (sharp convex corners stay sharp: offset3d._spiked adds the
 same short spike out along the bisector as there).
+
+The rule aims under the cusp height (CUSP_AIM) for the field's first-order sampling. Where a corner's contour is
+too irregular to rebuild and spike (a bisector meeting a slope's foot) or a hilltop's last loop is a sliver, points
+on T's ridges may still lie more than half a step from both levels: those of the half level are checked against the
+passes as cut and the uncovered runs cut too (_uncovered; on flats, where the XY distance is the cusp rule).
 """
 from __future__ import annotations
 
