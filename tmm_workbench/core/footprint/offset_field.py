@@ -348,8 +348,8 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
 
     field = Field(xs, ys, t, steps_at)
     field.probe = args["probe"]
-    gy, gx = np.gradient(z, cell)
-    field.slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    dz_dy, dz_dx = np.gradient(z, cell)
+    field.slope = np.degrees(np.arctan(np.hypot(dz_dx, dz_dy)))
     return field, rule
 
 
