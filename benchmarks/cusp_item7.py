@@ -16,6 +16,7 @@ largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7
     ... --no-e2e       # without the FreeCAD table;  --no-whole: seed 000 on the window only (the whole
                        # surfaces take about 15 min more)
     ... --modes cusp   # only these rows (from stepover,cusp,adaptive,verify,offset3d), e.g. the constant cusp mode
+    ... --offset3d-only  # the same as --modes offset3d --no-e2e
 The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
 """
 from __future__ import annotations
@@ -161,7 +162,7 @@ def table(models: list[ModelTable]) -> list[str]:
             passes += " loops" if r.label.startswith("3D offset") else ""
             label = r.label if r is not base else r.label + " (before)"
             out.append(f"| {m.name} | {label} | {passes} | {r.cusp:.4f} | {r.cycle_s / 60:.1f} | "
-                       f"{r.compute_s:.1f} | {r.moves} | {p:.2f}x | {c:.2f}x |")
+                       f"{r.compute_s:.1f} | {r.moves} | " + (" | |" if math.isnan(p) else f"{p:.2f}x | {c:.2f}x |"))
     return out
 
 
@@ -202,10 +203,13 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=100.0,
                     help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
     ap.add_argument("--no-whole", action="store_true", help="seed 000 on the window only, not also on the whole")
+    ap.add_argument("--offset3d-only", action="store_true", help="the same as --modes offset3d --no-e2e")
     ap.add_argument("--modes", default=",".join(MODES),
                     help=f"the rows to measure, comma-separated from {','.join(MODES)} (e.g. --modes cusp: the "
                          f"constant cusp mode rows only)")
     args = ap.parse_args()
+    if args.offset3d_only:
+        args.modes, args.no_e2e = "offset3d", True
     modes = tuple(m.strip() for m in args.modes.split(",") if m.strip())
     if not modes or any(m not in MODES for m in modes):
         ap.error(f"--modes must name rows from {','.join(MODES)}, got {args.modes!r}")

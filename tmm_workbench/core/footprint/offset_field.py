@@ -18,6 +18,11 @@ half level {T = k + 1/2} is cut there too, so every point lies within half a loc
 the speed is the flat step in every direction: T is the distance over the step, exact for straight fronts, and
 the passes are the boundary's offsets by k steps (sharp convex corners stay sharp: offset3d._spiked adds the
 same short spike out along the bisector as there).
+
+The rule aims under the cusp height (CUSP_AIM) for the field's first-order sampling. Where a corner's contour is
+too irregular to rebuild and spike (a bisector meeting a slope's foot) or a hilltop's last loop is a sliver, points
+on T's ridges may still lie more than half a step from both levels: those of the half level are checked against the
+passes as cut and the uncovered runs cut too (_uncovered; on flats, where the XY distance is the cusp rule).
 """
 from __future__ import annotations
 
@@ -28,7 +33,7 @@ import numpy as np
 
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.footprint.offset3d import Heights, Loop, OffsetLoops, StepRule, _clean, _closed, _spiked
+from tmm_workbench.core.footprint.offset3d import Heights, Loop, OffsetLoops, StepRule, _closed, _spiked
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.polygons import Shape
 from tmm_workbench.core.tools.cutter import Cutter
@@ -39,11 +44,24 @@ _SLOPE_TABLE = 76        # the rule's step tabulated at this many slopes from 0 
                          # interpolates linearly; StepRule itself interpolates a 5 deg table)
 _BAND_CELLS = 1.5        # start nodes: within this many cells of the start set (both ends of every cut edge)
 _WALK = 0.75            # the half level is cut where T reaches k + 1 within this many local steps (_half_level)
-_SIMPLIFY = 0.005        # contour vertices within this many flat steps of the line through their neighbours go
-                         # (the pass moves by at most 0.5 % of the step: the cusp by 1 %)
+_SIMPLIFY = 0.005        # contour vertices within this many flat steps of the chord kept over them go (and within
+                         # polygons.ARC_TOL; Douglas-Peucker: the pass moves by at most 0.5 % of the step, the cusp
+                         # by 1 %; at 1 % sphere_on_plate's maximum was 0.0101 mm)
 _MIN_HALF = 2.0          # half-level pieces shorter than this many flat steps are left out
 _PROBE = 0.5            # slope and curvature across from heights this many flat steps either side (offset3d's band)
 _BYTES_PER_NODE = 64     # heights, T, masks, the node coordinates and the drop's work arrays
+CUSP_AIM = 0.92          # the rule's cusp: this share of the tolerance (the step 4 % narrower for a ball), for
+                         # what the field samples only to first order: the marching in its cell, the 0.25 mm
+                         # chords along the passes, the slope and curvature as secants over half a step
+                         # (measured: benchmarks/offset3d_where.py, results.md "### 3D offset")
+_RIDGE_DEG = 45.0        # a half-level point lies on a ridge of T where grad T turns by more than this across
+                         # _RIDGE_CELLS either side (a corner's bisector, fronts meeting, a hilltop)
+_RIDGE_CELLS = 1.5
+_COVER_SLACK = 1.04      # a ridge point is uncovered beyond this x half the aimed step (on a plane: a cusp of
+                         # 0.92 x 1.04^2 = 0.995 x the tolerance)
+_COVER_SLOPE = 10.0      # deg: ridge points checked on CL slopes up to this (corners on flats, hilltops); on a
+                         # relief the check flagged a thousand short pieces that barely moved the simulated cusp
+_COVER_RUN = 0.25        # flat steps added at either end of an uncovered run of the half level (_uncovered)
 
 
 _RULES: dict[tuple, StepRule] = {}
@@ -55,7 +73,7 @@ def step_rule(cutter: Cutter, cusp: float, max_slope_deg: float) -> StepRule:
     key = (cutter.describe(), float(cusp), float(max_slope_deg))
     if key not in _RULES:
         _RULES.clear()
-        _RULES[key] = StepRule(cutter, cusp, max_slope_deg)
+        _RULES[key] = StepRule(cutter, CUSP_AIM * cusp, max_slope_deg)   # aimed under the tolerance (CUSP_AIM)
     return _RULES[key]
 
 
@@ -67,6 +85,45 @@ def resampled(p: np.ndarray, step: float) -> np.ndarray:
     seg = np.repeat(np.arange(len(d)), n)
     t = (np.arange(len(seg)) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
     return np.vstack([p[seg] + t[:, None] * d[seg], p[-1:]])
+
+
+def simplified(line: np.ndarray, tol: float) -> np.ndarray:
+    """The polyline with the vertices dropped that lie within `tol` mm of the chord kept over them (Douglas-Peucker:
+    no point of the result is farther than `tol` from the line, nor the other way round). Not Clipper's
+    CleanPolygon, which drops each vertex against its current neighbours and so, on a long gently curved contour,
+    ate a bulge away vertex by vertex (0.47 mm, 30 % of the step, on seed 000's whole convex surface)."""
+    n = len(line)
+    if n < 3:
+        return line
+    keep = np.zeros(n, dtype=bool)
+    keep[[0, -1]] = True
+    stack = [(0, n - 1)]
+    while stack:
+        a, b = stack.pop()
+        if b <= a + 1:
+            continue
+        d = line[a + 1:b] - line[a]
+        chord = line[b] - line[a]
+        length = float(np.hypot(*chord))
+        off = (np.abs(d[:, 0] * chord[1] - d[:, 1] * chord[0]) / length if length > 1e-12 else np.hypot(*d.T))
+        i = int(np.argmax(off))
+        if off[i] > tol:
+            keep[a + 1 + i] = True
+            stack += [(a, a + 1 + i), (a + 1 + i, b)]
+    return line[keep]
+
+
+def simplified_ring(ring: np.ndarray, tol: float) -> np.ndarray:
+    """simplified() for a closed ring (first point not repeated): split at its first point and the vertex farthest
+    from it."""
+    if len(ring) < 4:
+        return ring
+    far = int(np.argmax(np.hypot(*(ring - ring[0]).T)))
+    if far == 0:
+        return ring
+    a = simplified(ring[:far + 1], tol)
+    b = simplified(np.vstack([ring[far:], ring[:1]]), tol)
+    return np.vstack([a, b[1:-1]])
 
 
 def sharpened(loop: np.ndarray, reach: float) -> np.ndarray:
@@ -199,8 +256,13 @@ def _band(curves: Sequence[np.ndarray], xs: np.ndarray, ys: np.ndarray, reach: f
 class Field:
     """The arrival-time field over a grid: T (ny, nx) at nodes (xs[i], ys[j]), in steps."""
 
-    def __init__(self, xs: np.ndarray, ys: np.ndarray, t: np.ndarray) -> None:
+    def __init__(self, xs: np.ndarray, ys: np.ndarray, t: np.ndarray,
+                 steps: Optional[Callable[[np.ndarray, np.ndarray, float], np.ndarray]] = None) -> None:
         self.xs, self.ys, self.t = xs, ys, t
+        self.probe = 0.0        # mm: the probe the marching took the slope and curvature over
+        self.slope: Optional[np.ndarray] = None   # (ny, nx) the CL surface's slope (deg) at the nodes
+        self.steps = steps      # (xy, u, probe) -> the speed's step (mm) at XY points for fronts along u, the
+                                # slope and curvature from heights `probe` mm either side (the kernel's)
         self._gen = None
         self._grad: Optional[list[np.ndarray]] = None
 
@@ -278,7 +340,17 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
         f = native.arrival_steps(z, cell, np.column_stack([gx[band] - xs[0], gy[band] - ys[0]]), normal[band], **args)
         t0[band] = dist[band] / f
     t = native.arrival_field(z, cell, active.astype(np.uint8), t0, **args)
-    return Field(xs, ys, t), rule
+    origin = np.array([xs[0], ys[0]])
+
+    def steps_at(xy: np.ndarray, u: np.ndarray, probe: float) -> np.ndarray:
+        return native.arrival_steps(z, cell, np.asarray(xy, float) - origin, np.asarray(u, float),
+                                    **dict(args, probe=probe))
+
+    field = Field(xs, ys, t, steps_at)
+    field.probe = args["probe"]
+    dz_dy, dz_dx = np.gradient(z, cell)
+    field.slope = np.degrees(np.arctan(np.hypot(dz_dx, dz_dy)))
+    return field, rule
 
 
 def _half_level(field: Field, k: int) -> list[np.ndarray]:
@@ -320,6 +392,85 @@ def _half_level(field: Field, k: int) -> list[np.ndarray]:
     return out
 
 
+def _ridge(field: Field, p: np.ndarray) -> np.ndarray:
+    """(n,) bool: the points where grad T turns by more than _RIDGE_DEG across _RIDGE_CELLS cells either side,
+    along X or Y (two fronts meet there: a corner's bisector, a strip's middle, a hilltop)."""
+    h = _RIDGE_CELLS * (field.xs[1] - field.xs[0])
+    out = np.zeros(len(p), dtype=bool)
+    for d in (np.array([h, 0.0]), np.array([0.0, h])):
+        ga, gb = field.gradient(p + d), field.gradient(p - d)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            c = (ga * gb).sum(axis=1) / (np.hypot(*ga.T) * np.hypot(*gb.T))
+        out |= ~(c >= math.cos(math.radians(_RIDGE_DEG)))   # NaN (beside unreached nodes): a ridge too
+    return out
+
+
+def _step_across(field: Field, p: np.ndarray, passes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) each point's XY distance to the nearest pass, and the speed's step (mm) there for a front crossing
+    along that distance's direction (the gap the point lies in; on a ridge grad T itself is smeared, along the
+    bisector), the slope and curvature over that distance (the CL surface between the point and the pass, not
+    half a flat step that may reach a slope's foot beyond it)."""
+    from tmm_workbench.core.footprint.offset3d import _gaps
+
+    gap, seg = _gaps(p, passes)
+    a = np.vstack([q[:-1] for q in passes])[seg]
+    ab = np.vstack([q[1:] for q in passes])[seg] - a
+    t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
+    u = a + t[:, None] * ab - p
+    u[np.hypot(*u.T) <= 1e-12] = (1.0, 0.0)
+    probe = max(float(np.median(gap)) if len(gap) else 0.0, 2 * (field.xs[1] - field.xs[0]))
+    return gap, np.maximum(field.steps(p, u, probe), field.steps(p, u, field.probe))
+
+
+def _uncovered(field: Field, level: float, passes: list[np.ndarray], flat: float) -> list[np.ndarray]:
+    """The pieces of the half level {T = level} whose points on a ridge of T lie farther than half the local step
+    from every pass in `passes` (the two levels either side as cut: spikes and caps included): a corner whose
+    contour was too irregular to rebuild and spike (a bisector meeting a slope's foot), the corners of a
+    hilltop's last small loop, a short cap left out. Each uncovered run, _COVER_RUN flat steps longer at either
+    end, is cut too: every point there then lies within half a step of a pass, which is the cusp rule itself."""
+    if field.steps is None or not passes:
+        return []
+    out = []
+    for line in field.lines(level):
+        ridge = _ridge(field, line)
+        if field.slope is not None:   # (on steeper ground the XY distance misjudges the cusp: see _COVER_SLOPE)
+            with np.errstate(invalid="ignore"):
+                ridge &= field.at(line, field.slope) <= _COVER_SLOPE
+        if not ridge.any():
+            continue
+        idx = np.flatnonzero(ridge)
+        gap, step = _step_across(field, line[idx], passes)
+        bad = np.zeros(len(line), dtype=bool)
+        bad[idx] = gap > 0.5 * _COVER_SLACK * step
+        if not bad.any():
+            continue
+        closed = len(line) > 3 and np.allclose(line[0], line[-1])
+        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(line, axis=0).T))])
+        reach = _COVER_RUN * flat
+        if closed:   # arc length around the loop: runs may wrap
+            total = s[-1]
+            grow = np.zeros(len(line), dtype=bool)
+            for i in np.flatnonzero(bad):
+                d = np.abs(s - s[i])
+                grow |= np.minimum(d, total - d) <= reach
+            if grow.all():
+                out.append(line)
+                continue
+            first = int(np.flatnonzero(~grow)[0])
+            body, flag = np.roll(line[:-1], -first, axis=0), np.roll(grow[:-1], -first)
+        else:
+            grow = np.zeros(len(line), dtype=bool)
+            for i in np.flatnonzero(bad):
+                grow |= np.abs(s - s[i]) <= reach
+            body, flag = line, grow
+        edges = np.flatnonzero(np.diff(np.concatenate([[0], flag.astype(int), [0]])))
+        for a, b in zip(edges[::2], edges[1::2]):
+            lo, hi = max(a - 1, 0), min(b + 1, len(body))
+            if hi - lo >= 2:
+                out.append(body[lo:hi])
+    return out
+
+
 def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sample_step: float,
                 max_slope_deg: float = 75.0, start: Optional[Sequence[np.ndarray]] = None,
                 progress: Optional[Progress] = None) -> OffsetLoops:
@@ -345,29 +496,33 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
             clipped.extend(polygons.clip_open([line], shape))
         return clipped
 
-    def add(line: np.ndarray, level: int, before: list[np.ndarray]) -> None:
+    def add(line: np.ndarray, level: int, before: list[np.ndarray]) -> Optional[np.ndarray]:
+        """Pass `line` at `level` appended as cut (spiked, resampled); that polyline, None if left out."""
         closed = len(line) > 3 and np.hypot(*(line[0] - line[-1])) < 1e-9
         if closed:
-            ring = _clean(sharpened(line, 2 * grid_cell(flat))[:-1], arc_tol)
+            ring = simplified_ring(sharpened(line, 2 * grid_cell(flat))[:-1], arc_tol)
             if len(ring) < 3:
-                return
+                return None
             loop = resampled(_closed(ring), sample_step)
             # contourpy puts higher T on a line's left: the region still to cut, as offset3d's loops have it
             spike = before and start is None  # (clip_open does not keep a direction: no spikes beside a curve)
             out.loops.append(Loop(_spiked(loop, before, sample_step) if spike else loop, level))
         elif len(line) >= 2 and float(np.hypot(*np.diff(line, axis=0).T).sum()) > 1e-6:
             out.loops.append(Loop(resampled(line, sample_step), level))
+        else:
+            return None
+        return out.loops[-1].points
 
     if start is None:
         previous = [_closed(np.asarray(p, float)) for p in shape]
         for p in previous:
             out.loops.append(Loop(resampled(p, sample_step), 0))
+        cut_before = [lp.points for lp in out.loops]
     else:
         previous = keep([np.asarray(c, float) for c in start])
         if not previous:
             raise TmmError("3D offset start curve: it lies outside the machining region")
-        for p in previous:
-            add(p, 0, [])
+        cut_before = [c for c in (add(p, 0, []) for p in previous) if c is not None]
     for k in range(1, levels + 2):
         if progress is not None and progress(min(k / max(levels, 1), 1.0)) is False:
             raise Cancelled("tool path computation cancelled")
@@ -375,9 +530,14 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         # (pieces shorter than half a flat step are left out: the points they would serve lie within a few
         # hundredths of a step more than half a step from the passes)
         caps = [c for c in keep(_half_level(field, k - 1)) if float(np.hypot(*np.diff(c, axis=0).T).sum()) > _MIN_HALF * flat]
-        for line in current + caps:
-            add(line, k, previous)
+        cut = [c for c in (add(line, k, previous) for line in current + caps) if c is not None]
+        # the half level's points on a ridge of T still farther than half a local step from both levels as cut
+        for line in keep(_uncovered(field, k - 0.5, cut_before + cut, flat)):
+            c = add(line, k, [])
+            if c is not None:
+                cut.append(c)
         previous = current + caps if current or caps else previous
+        cut_before = cut if cut else cut_before
     out.levels = max(lp.level for lp in out.loops) + 1
     if not out.loops:
         raise TmmError("3D offset: the machining region has no area to follow")

@@ -42,6 +42,10 @@ def check(params: Any, cutter: Cutter) -> None:
             raise TmmError(f"3D offset start curve {k}: it has no length (seen from above)")
 
 
+_POINTS_OVER_PLANE = 1.15   # CL points over the plane's length / sample step: on a surface the passes are longer
+                            # (1.15-1.5x, loop_length) and keep their contours' vertices (within 0.5 % of the step)
+
+
 def _perimeter(shape: list) -> float:
     return sum(float(np.hypot(*np.diff(np.vstack([p, p[:1]]), axis=0).T).sum()) for p in shape)
 
@@ -68,7 +72,7 @@ def estimate_work(shape: list, cutter: Cutter, params: Any) -> float:
                f"3D offset: cusp height {params.cusp:g} mm (smallest step {least:.3g} mm at the {params.max_slope_deg:g}"
                f" deg slope limit, {nodes:.3g} field nodes) and sample step {params.sample_step:g} mm over a "
                f"{polygons.area(shape):.6g} mm^2 region")
-    return loop_length(shape, cutter, params) / params.sample_step
+    return _POINTS_OVER_PLANE * loop_length(shape, cutter, params) / params.sample_step
 
 
 def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: Any, floor_z: float, diagnostics: dict,
