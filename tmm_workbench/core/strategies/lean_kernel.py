@@ -43,7 +43,7 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
     """The segments with each straight run's points replaced by the kernel's lean vertices, and the counts
     (points_in, points_out, arcs 0, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and
     with `lower_bound` the least lines any fit within +-tol can use on these runs)."""
-    from tmm_workbench.core.strategies.raster_lean import straight_runs, with_runs_replaced
+    from tmm_workbench.core.strategies.raster_lean import run_xy, straight_runs, with_runs_replaced
 
     if not tol > 0:
         raise TmmError(f"chord tolerance must be > 0 mm for lean passes, got {tol:g}")
@@ -67,7 +67,7 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
         raise Cancelled("tool path computation cancelled") from exc
     except ValueError as exc:  # named by the kernel; max_step is the op's sample step / 2
         raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
-    verts = {key: np.column_stack([r.origin + s[off[n]:off[n + 1], None] * r.u, z[off[n]:off[n + 1]]])
+    verts = {key: np.column_stack([run_xy(r, s[off[n]:off[n + 1]]), z[off[n]:off[n + 1]]])
              for n, (key, r) in enumerate(zip(keys, runs))}
     out = with_runs_replaced(segments, parts, verts, verts.__getitem__)
     stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),

@@ -232,6 +232,8 @@ class _Run:
     pieces: list = None
     done: bool = False
     keep: int = 0             # pieces before this one passed their checks and stay
+    end_xy: np.ndarray = None  # xy of the last point as given: origin + s u misses it by an ulp, and the next
+                               # part (or segment) and the arcs keyed by their ends must meet it exactly
 
 
 def _straight_parts(pts: np.ndarray) -> list[tuple[int, int]]:
@@ -271,7 +273,7 @@ def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[_Run]:
     fixed[vertical] = fixed[vertical + 1] = True
     settled = np.zeros(len(s), dtype=bool)
     settled[vertical] = True
-    return _Run(seg, xy[0].copy(), u, s.copy(), pts[:, 2].copy(), fixed, settled)
+    return _Run(seg, xy[0].copy(), u, s.copy(), pts[:, 2].copy(), fixed, settled, end_xy=xy[-1].copy())
 
 
 def _plane(u: np.ndarray) -> Optional[str]:
@@ -448,11 +450,11 @@ def _vertices(r: _Run, arc_map: dict, stats: LeanStats) -> np.ndarray:
     """The run's vertices (its samples when it never passed its checks); its arcs into `arc_map`."""
     if not r.done:  # still outside the band after every round: its samples, exact
         stats.kept_as_sampled += 1
-        return np.column_stack([r.origin + r.s[:, None] * r.u, r.e])
+        return np.column_stack([run_xy(r, r.s), r.e])
     plane = _plane(r.u)
     verts = [np.array([*(r.origin + r.s[0] * r.u), r.pieces[0].za])]
     for p in r.pieces:
-        end = np.array([*(r.origin + r.s[p.b] * r.u), p.zb])
+        end = np.array([*run_xy(r, r.s[p.b:p.b + 1])[0], p.zb])
         if p.circle is not None and plane is not None:
             cs, cz, _ = p.circle
             centre = (*(r.origin + cs * r.u), cz)
@@ -460,6 +462,13 @@ def _vertices(r: _Run, arc_map: dict, stats: LeanStats) -> np.ndarray:
             stats.arcs += 1
         verts.append(end)
     return np.array(verts)
+
+
+def run_xy(r: _Run, s: np.ndarray) -> np.ndarray:
+    """The XY points at distances `s` along the run, its last point exactly as given."""
+    xy = r.origin + s[:, None] * r.u
+    xy[s >= r.s[-1]] = r.end_xy
+    return xy
 
 
 def _piece_z(run: _Run, t: np.ndarray, who: np.ndarray) -> np.ndarray:
