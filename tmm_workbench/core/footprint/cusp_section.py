@@ -178,36 +178,31 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     shifts, layers, swept = _swept_layers(surface, tool, cutter, world, d, c, design, inside, floor_z, stock_to_leave,
                                    ys, y_lo, y_hi, cusp, spacing)
 
-    # E: every sample an instance of the dense raster (of every layer: the swept tool)
+    # E: every sample an instance of the dense raster (of every layer on the swept sections: the swept tool)
     m = int(math.floor(r_max / spacing))
     envelope = np.full(c.shape, np.inf)
-    for delta, layer in zip(shifts, layers):
-        for k in range(-m, m + 1):
-            hk = float(profile_height(cutter, np.array([math.hypot(k * spacing, delta)]))[0])
-            if not math.isfinite(hk):
-                continue
-            shifted = np.full(c.shape, np.inf)
-            if k >= 0:
-                shifted[:, k:] = layer[:, :c.shape[1] - k]
-            else:
-                shifted[:, :k] = layer[:, -k:]
-            np.minimum(envelope, shifted + hk, out=envelope)
-    # on the swept sections E also from instances between the samples: its lowest instance there is at the foot
-    # of the roll onto the floor, a corner of c the samples miss (0.06 mm apart, the tool's flank 1.3 mm off: E
-    # 0.003 mm too high on the 30 deg sheet, which put its worst cells out of reach)
+    _envelope_add(envelope, c, cutter, spacing, 0.0, m)
     if len(swept):
         sub = envelope[swept]
+        for delta, layer in zip(shifts[1:], layers[1:]):
+            _envelope_add(sub, layer[swept], cutter, spacing, delta, m)
+        # and from instances between the samples where the CL section turns: the lowest instance on the 30 deg
+        # sheet is at the foot of the roll onto the floor, a corner the samples (0.06 mm apart) cut off: E 0.003 mm
+        # too high there put its worst cells out of reach
+        k_all = np.arange(-m, m + 2)
         for f in _SUBSAMPLES:
             for delta, layer in zip(shifts, layers):
-                mid = _between(surface, tool, floor_z, stock_to_leave, layer[swept], world[swept],
-                               delta * d + f * spacing * n, f, spacing)          # at ys[j] + f spacing
-                for k in range(-m, m + 2):
-                    hk = float(profile_height(cutter, np.array([math.hypot((k - f) * spacing, delta)]))[0])
-                    if not math.isfinite(hk):
-                        continue
-                    j0, j1 = max(0, -k), min(mid.shape[1], c.shape[1] - k)   # mid's j reaches sample j + k
-                    if j1 > j0:
-                        np.minimum(sub[:, j0 + k:j1 + k], mid[:, j0:j1] + hk, out=sub[:, j0 + k:j1 + k])
+                r_i, j_i, v = _corners(surface, tool, floor_z, stock_to_leave, layer[swept], world[swept],
+                                       delta * d + f * spacing * n, spacing)     # at ys[j] + f spacing
+                if not len(v):
+                    continue
+                hk = profile_height(cutter, np.hypot((k_all - f) * spacing, delta))
+                k = k_all[np.isfinite(hk)]
+                hk = hk[np.isfinite(hk)]
+                col = j_i[:, None] + k[None, :]
+                ok = (col >= 0) & (col < c.shape[1])
+                np.minimum.at(sub, (np.broadcast_to(r_i[:, None], col.shape)[ok], col[ok]),
+                              (v[:, None] + hk[None, :])[ok])
         envelope[swept] = sub
     grad = np.gradient(envelope, spacing, axis=1)
     cos = 1.0 / np.sqrt(1.0 + grad * grad)
@@ -253,14 +248,18 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     a_rows, a_cols = np.nonzero(inside & (Y >= a_lo - 1e-9) & (Y <= a_hi + 1e-9))
     a_y = ys[a_cols]
     c_a = np.stack([layer[a_rows, a_cols] for layer in layers])
+    rises = [_least_rise(cutter, delta) for delta in shifts]
 
     def lower(tip: np.ndarray, axis: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The pass at `axis` (its tips `tip`, one row a layer) at y: the swept tool's lower surface."""
-        u = y - axis
+        u = np.broadcast_to(y - axis, tip[0].shape)
         out = tip[0] + profile_height(cutter, u)
-        for delta, t in zip(shifts[1:], tip[1:]):
-            if (t < tip[0]).any():   # an instance off the section no lower than the section's never undercuts it
-                np.minimum(out, t + profile_height(cutter, np.hypot(u, delta)), out=out)
+        for delta, t, rise in zip(shifts[1:], tip[1:], rises[1:]):
+            # an instance delta off the section undercuts the section's only where its tip is lower by more than
+            # the least of h(hypot(u, delta)) - h(u) (h(delta) for a ball): most of them are not (the pairs' cost)
+            i = np.nonzero(t < tip[0] - rise)[0]
+            if len(i):
+                out[i] = np.minimum(out[i], t[i] + profile_height(cutter, np.hypot(u[i], delta)))
         return out
 
     # A side wall makes the surface left jump (the sawtooth of a flat bottom on a slope) only where the profile
@@ -445,18 +444,42 @@ def _swept_layers(surface: DropSurface, tool: Cutter, cutter: Cutter, world: np.
     return shifts, layers, rows
 
 
-def _between(surface: DropSurface, tool: Cutter, floor_z: float, stock_to_leave: float, c: np.ndarray,
-             world: np.ndarray, shift: np.ndarray, f: float, spacing: float) -> np.ndarray:
-    """(sections, samples - 1): c at f of the way from each sample to the next (`world`: the samples' XY,
-    `shift`: the XY from a sample to its layer's instance): the chord, but dropped where c turns by more than
-    _CREASE_RAD at either sample (the foot of a slope on the floor: a corner the chord cuts off)."""
-    out = c[:, :-1] * (1 - f) + c[:, 1:] * f
+
+def _envelope_add(envelope: np.ndarray, tips: np.ndarray, cutter: Cutter, spacing: float, delta: float, m: int) -> None:
+    """Lowers `envelope` (sections, samples) by every sample's instance of `tips` (delta off the section along
+    the pass) within m samples across."""
+    for k in range(-m, m + 1):
+        hk = float(profile_height(cutter, np.array([math.hypot(k * spacing, delta)]))[0])
+        if not math.isfinite(hk):
+            continue
+        if k >= 0:
+            np.minimum(envelope[:, k:], tips[:, :tips.shape[1] - k] + hk, out=envelope[:, k:])
+        else:
+            np.minimum(envelope[:, :k], tips[:, -k:] + hk, out=envelope[:, :k])
+
+
+def _corners(surface: DropSurface, tool: Cutter, floor_z: float, stock_to_leave: float, c: np.ndarray,
+             world: np.ndarray, shift: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tips between the samples where c turns by more than _CREASE_RAD at either end (the foot of a slope on
+    the floor: a corner the chord cuts off), dropped at `shift` from their left sample (`world`: the samples'
+    XY): their section (row), left sample and height."""
     angle = np.arctan(np.diff(c, axis=1) / spacing)
     turn = np.zeros(c.shape, dtype=bool)
     turn[:, 1:-1] = np.abs(np.diff(angle, axis=1)) > _CREASE_RAD
-    flag = turn[:, :-1] | turn[:, 1:]
-    if flag.any():
-        check_work("CL points", float(flag.sum()), _BYTES_PER_POINT, "cusp height: corners of the CL sections")
-        xy = world[:, :-1][flag] + shift
-        out[flag] = np.maximum(surface.drop(tool, xy, floor_z - stock_to_leave) + stock_to_leave, floor_z)
-    return out
+    rows, cols = np.nonzero(turn[:, :-1] | turn[:, 1:])
+    if not len(rows):
+        return rows, cols, np.zeros(0)
+    check_work("CL points", float(len(rows)), _BYTES_PER_POINT, "cusp height: corners of the CL sections")
+    xy = world[rows, cols] + shift
+    return rows, cols, np.maximum(surface.drop(tool, xy, floor_z - stock_to_leave) + stock_to_leave, floor_z)
+
+
+def _least_rise(cutter: Cutter, delta: float) -> float:
+    """min over u of h(hypot(u, delta)) - h(u), where both are on the tool (a little under it: the samples)."""
+    if delta == 0:
+        return 0.0
+    r_max = cutter.native.max_radius
+    u = np.linspace(0.0, r_max, 257)
+    rise = profile_height(cutter, np.hypot(u, delta)) - profile_height(cutter, u)
+    rise = rise[np.isfinite(rise)]
+    return max(0.0, float(rise.min()) - 1e-9) if len(rise) else 0.0
