@@ -29,9 +29,12 @@ here on the CL surface itself, which carries the slope AND the curvature across 
 
 The 2D section leaves out the neighbours along a pass (a slope along the pass lowers the swept tool by the same
 amount in H and in E, to first order: the planar ball's cusp along the normal is the same). Not at a free border
-of the model just above the raster's floor (the passes beyond it sit on the floor, and the border runs at an
-angle to them): there the simulated cusp exceeded the rule's by up to 1.6x on a 30 deg sheet (docs/results.md,
-"Constant cusp mode by the section rule", 2026-12-02 cusp4).
+of the model just above the raster's floor (the passes beyond it roll onto the floor, and the border runs at an
+angle to them): there the simulated cusp exceeded the rule's by up to 1.6x on a 30 deg sheet. So the sections
+that cross such a border get the swept tool: drops at 0.05, 0.2 and 0.5 R either side along the passes too (H
+and E from every offset's instance at its 3D distance), and E there also from instances between the samples,
+dropped where the CL section turns (the foot of the roll onto the floor, a corner the samples cut off)
+(docs/results.md, "Constant cusp mode by the section rule", 2026-12-02 cusp4 and cusp5).
 """
 from __future__ import annotations
 
@@ -62,6 +65,9 @@ _AROUND_MOST = 64         # failing pairs whose section neighbours (within a ste
 _BYTES_PER_POINT = 200    # the grid's heights, design, envelope and pair arrays per sample
 _REFINE_SPOTS = 3         # the worst sections around which sections are placed densely (a second look)
 _REFINE_SECTIONS = 24     # sections between a worst section's two neighbours
+# the swept tool along a pass at a low free border: drops at these offsets (x R) either side of the section too
+_SWEEP = (0.05, 0.2, 0.5)
+_SUBSAMPLES = (0.25, 0.5, 0.75)   # E's instances between the samples there (fractions of the spacing)
 
 
 @dataclass
@@ -166,18 +172,38 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     needle = Cutter.flat(2e-4) if stock_to_leave == 0 else Cutter.ball(2 * stock_to_leave)
     design = surface.drop(needle, xy, floor_z - 1.0) + stock_to_leave
     design = np.where(design > floor_z - 0.5, design, -np.inf).reshape(X.shape)
+    # the tool swept along the pass: layers of tips at offsets `shifts` along it (the section's own first); only
+    # sections with a low free border get drops of their own (elsewhere a layer repeats the section's tips, which
+    # an instance off the section never undercuts)
+    shifts, layers, swept = _swept_layers(surface, tool, cutter, world, d, c, design, inside, floor_z, stock_to_leave,
+                                   ys, y_lo, y_hi, cusp, spacing)
 
-    # E: every sample an instance of the dense raster
+    # E: every sample an instance of the dense raster (of every layer on the swept sections: the swept tool)
     m = int(math.floor(r_max / spacing))
     envelope = np.full(c.shape, np.inf)
-    for k in range(-m, m + 1):
-        hk = float(profile_height(cutter, np.array([abs(k) * spacing]))[0])
-        shifted = np.full(c.shape, np.inf)
-        if k >= 0:
-            shifted[:, k:] = c[:, :c.shape[1] - k]
-        else:
-            shifted[:, :k] = c[:, -k:]
-        np.minimum(envelope, shifted + hk, out=envelope)
+    _envelope_add(envelope, c, cutter, spacing, 0.0, m)
+    if len(swept):
+        sub = envelope[swept]
+        for delta, layer in zip(shifts[1:], layers[1:]):
+            _envelope_add(sub, layer[swept], cutter, spacing, delta, m)
+        # and from instances between the samples where the CL section turns: the lowest instance on the 30 deg
+        # sheet is at the foot of the roll onto the floor, a corner the samples (0.06 mm apart) cut off: E 0.003 mm
+        # too high there put its worst cells out of reach
+        k_all = np.arange(-m, m + 2)
+        for f in _SUBSAMPLES:
+            for delta, layer in zip(shifts, layers):
+                r_i, j_i, v = _corners(surface, tool, floor_z, stock_to_leave, layer[swept], world[swept],
+                                       delta * d + f * spacing * n, spacing)     # at ys[j] + f spacing
+                if not len(v):
+                    continue
+                hk = profile_height(cutter, np.hypot((k_all - f) * spacing, delta))
+                k = k_all[np.isfinite(hk)]
+                hk = hk[np.isfinite(hk)]
+                col = j_i[:, None] + k[None, :]
+                ok = (col >= 0) & (col < c.shape[1])
+                np.minimum.at(sub, (np.broadcast_to(r_i[:, None], col.shape)[ok], col[ok]),
+                              (v[:, None] + hk[None, :])[ok])
+        envelope[swept] = sub
     grad = np.gradient(envelope, spacing, axis=1)
     cos = 1.0 / np.sqrt(1.0 + grad * grad)
     on_model = np.isfinite(design)
@@ -200,6 +226,10 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         w = f - i
         return field[rows, i] * (1 - w) + field[rows, i + 1] * w
 
+    def tips(y: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(layers, n): the tips of the passes at y (the rows' sections) at each offset along them."""
+        return np.stack([at(layer, y, rows) for layer in layers])
+
     # creases of the CL surface (a concave edge of the model the tool rides across, the foot of a wall): its
     # slope turns by more than _CREASE_RAD from one sample to the next, which the samples cannot resolve (their
     # linear interpolation and E misplace the V by up to a spacing); pairs that span one are not measured here
@@ -217,10 +247,20 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
 
     a_rows, a_cols = np.nonzero(inside & (Y >= a_lo - 1e-9) & (Y <= a_hi + 1e-9))
     a_y = ys[a_cols]
-    c_a = c[a_rows, a_cols]
+    c_a = np.stack([layer[a_rows, a_cols] for layer in layers])
+    rises = [_least_rise(cutter, delta) for delta in shifts]
 
     def lower(tip: np.ndarray, axis: np.ndarray, y: np.ndarray) -> np.ndarray:
-        return tip + profile_height(cutter, y - axis)
+        """The pass at `axis` (its tips `tip`, one row a layer) at y: the swept tool's lower surface."""
+        u = np.broadcast_to(y - axis, tip[0].shape)
+        out = tip[0] + profile_height(cutter, u)
+        for delta, t, rise in zip(shifts[1:], tip[1:], rises[1:]):
+            # an instance delta off the section undercuts the section's only where its tip is lower by more than
+            # the least of h(hypot(u, delta)) - h(u) (h(delta) for a ball): most of them are not (the pairs' cost)
+            i = np.nonzero(t < tip[0] - rise)[0]
+            if len(i):
+                out[i] = np.minimum(out[i], t[i] + profile_height(cutter, np.hypot(u[i], delta)))
+        return out
 
     # A side wall makes the surface left jump (the sawtooth of a flat bottom on a slope) only where the profile
     # meets it at a finite slope (flat, cone); a ball's or a torus's wall is vertical: the next instance is
@@ -235,7 +275,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         """The cusp (mm, 0 where not counted) of each pair (ay, ay + s) on its section."""
         by = ay + s
         ok = (ay >= y_lo - 1e-9) & (by <= y_hi + 1e-9) & (creases_between(rows, ay - s, by + s) == 0)
-        cb, ca0, cb1 = at(c, by, rows), at(c, ay - s, rows), at(c, by + s, rows)
+        cb, ca0, cb1 = tips(by, rows), tips(ay - s, rows), tips(by + s, rows)
         # the ridge: a's lower surface minus b's grows with y (convex profile); bracket where both reach
         lo, hi = by - r_max, ay + r_max
         for _ in range(_RIDGE_HALVINGS):
@@ -277,7 +317,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
                 for k in range(-k_most, k_most + 1):
                     if k not in (-1, 0, 1, 2):   # a - s, a, b, b + s are in h already
                         axis = ay[i] + k * s
-                        h = np.minimum(h, at(c, axis, rows[i]) + profile_height(cutter, y - axis))
+                        h = np.minimum(h, lower(tips(axis, rows[i]), axis, y))
                 with np.errstate(invalid="ignore"):
                     v = (h - e[i]) * cs[i]
                 redo = np.maximum(redo, np.where(good[i] & np.isfinite(v), v, 0.0))
@@ -289,7 +329,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         place (b on the foot of the tool's roll over a free border: the last pass beyond it sits on the floor);
         with one end on a sample for every step, the other end's phase sweeps smoothly with the step (with a
         only, the worst pair's b jumped a sample as the step grew: a saw of +-10 % in the worst cusp)."""
-        return np.maximum(worst(s, rows, ay, ca), worst(s, rows, ay - s, at(c, ay - s, rows)))
+        return np.maximum(worst(s, rows, ay, ca), worst(s, rows, ay - s, tips(ay - s, rows)))
 
     all_rows = a_rows
     # the worst pairs at one step stay the worst near it: search the step on those, then check all of them. Not
@@ -308,7 +348,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         if len(values):
             keep |= (values >= 0.5 * values.max()) if values.max() > 0 else keep
             keep |= values >= np.quantile(values, 0.99)
-        rows, ay, ca = all_rows[keep], a_y[keep], c_a[keep]
+        rows, ay, ca = all_rows[keep], a_y[keep], c_a[:, keep]
         s = _largest_step(lambda t: both(t, rows, ay, ca), s_min, s_hi, target)
         values = both(s, all_rows, a_y, c_a)
         if values.max(initial=0.0) <= target or s <= s_min:
@@ -366,3 +406,80 @@ def _around(pairs: np.ndarray, rows: np.ndarray, reach: int) -> np.ndarray:
     near = near[rows[near] == rows[pairs][:, None]]
     mask[near] = True
     return mask
+
+
+def _swept_layers(surface: DropSurface, tool: Cutter, cutter: Cutter, world: np.ndarray, d: np.ndarray, c: np.ndarray,
+                  design: np.ndarray, inside: np.ndarray, floor_z: float, stock_to_leave: float, ys: np.ndarray,
+                  y_lo: float, y_hi: float, cusp: float, spacing: float
+                  ) -> tuple[list[float], list[np.ndarray], np.ndarray]:
+    """The offsets along the passes (mm, 0 first), the CL tips there (sections, samples) and the swept sections
+    (indices). Drops of their own only on the sections that cross a low free border of the model inside the
+    region (a sample on the model, its neighbour off it, the design there within the tool's reach of the floor:
+    the passes beyond it roll over the edge onto the floor, and as the edge runs at an angle to them, differently
+    along the pass; the section's instances alone missed the swept tool's reach there by 0.0046 mm on a 30 deg
+    sheet, docs/results.md). A whole section or none, so that H and E of a pair come from the same tool."""
+    r_max = cutter.native.max_radius
+    on = np.isfinite(design)
+    edge = np.zeros(c.shape, dtype=bool)
+    edge[:, :-1] |= on[:, :-1] & ~on[:, 1:]
+    edge[:, 1:] |= on[:, 1:] & ~on[:, :-1]
+    reach = float(profile_height(cutter, np.array([r_max]))[0]) + cusp + stock_to_leave
+    with np.errstate(invalid="ignore"):
+        edge &= inside & (design <= floor_z + reach)
+    edge &= ((ys >= y_lo + 0.5 * r_max) & (ys <= y_hi - 0.5 * r_max))[None, :]
+    rows = np.nonzero(edge.any(axis=1))[0]
+    if not len(rows):
+        return [0.0], [c], rows
+    shifts = [0.0] + [sign * f * r_max for f in _SWEEP for sign in (-1.0, 1.0)]
+    check_work("CL points", float(len(rows) * c.shape[1] * (len(shifts) - 1)), _BYTES_PER_POINT,
+               f"cusp height {cusp:g} mm (samples {spacing:.3g} mm apart across the passes, the tool swept along "
+               f"the passes at {len(rows)} sections with a low free border)")
+    layers = [c]
+    xy = world[rows].reshape(-1, 2)
+    for delta in shifts[1:]:
+        layer = c.copy()
+        layer[rows] = np.maximum(surface.drop(tool, xy + delta * d, floor_z - stock_to_leave) + stock_to_leave,
+                                 floor_z).reshape(len(rows), c.shape[1])
+        layers.append(layer)
+    return shifts, layers, rows
+
+
+
+def _envelope_add(envelope: np.ndarray, tips: np.ndarray, cutter: Cutter, spacing: float, delta: float, m: int) -> None:
+    """Lowers `envelope` (sections, samples) by every sample's instance of `tips` (delta off the section along
+    the pass) within m samples across."""
+    for k in range(-m, m + 1):
+        hk = float(profile_height(cutter, np.array([math.hypot(k * spacing, delta)]))[0])
+        if not math.isfinite(hk):
+            continue
+        if k >= 0:
+            np.minimum(envelope[:, k:], tips[:, :tips.shape[1] - k] + hk, out=envelope[:, k:])
+        else:
+            np.minimum(envelope[:, :k], tips[:, -k:] + hk, out=envelope[:, :k])
+
+
+def _corners(surface: DropSurface, tool: Cutter, floor_z: float, stock_to_leave: float, c: np.ndarray,
+             world: np.ndarray, shift: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tips between the samples where c turns by more than _CREASE_RAD at either end (the foot of a slope on
+    the floor: a corner the chord cuts off), dropped at `shift` from their left sample (`world`: the samples'
+    XY): their section (row), left sample and height."""
+    angle = np.arctan(np.diff(c, axis=1) / spacing)
+    turn = np.zeros(c.shape, dtype=bool)
+    turn[:, 1:-1] = np.abs(np.diff(angle, axis=1)) > _CREASE_RAD
+    rows, cols = np.nonzero(turn[:, :-1] | turn[:, 1:])
+    if not len(rows):
+        return rows, cols, np.zeros(0)
+    check_work("CL points", float(len(rows)), _BYTES_PER_POINT, "cusp height: corners of the CL sections")
+    xy = world[rows, cols] + shift
+    return rows, cols, np.maximum(surface.drop(tool, xy, floor_z - stock_to_leave) + stock_to_leave, floor_z)
+
+
+def _least_rise(cutter: Cutter, delta: float) -> float:
+    """min over u of h(hypot(u, delta)) - h(u), where both are on the tool (a little under it: the samples)."""
+    if delta == 0:
+        return 0.0
+    r_max = cutter.native.max_radius
+    u = np.linspace(0.0, r_max, 257)
+    rise = profile_height(cutter, np.hypot(u, delta)) - profile_height(cutter, u)
+    rise = rise[np.isfinite(rise)]
+    return max(0.0, float(rise.min()) - 1e-9) if len(rise) else 0.0
