@@ -232,7 +232,7 @@ def tx(doc) -> dict:
 def keep_focus(widget) -> None:
     """The field keeps the keyboard focus up to Cancel (as after Escape): it emits editingFinished once more as
     the panel closes. Under Xvfb the window is not always active and the focus then is not real: made sure.
-    (On 1.0 this crashed FreeCAD in its field controller's event filter: gui.panel_state.release_fields_on_close.)"""
+    (On 1.0 this crashed FreeCAD in its field controller's event filter: gui.panel_state.release_field_filters.)"""
     mw = FreeCADGui.getMainWindow()
     mw.activateWindow()
     QtGui.QApplication.setActiveWindow(mw)

@@ -178,7 +178,6 @@ class OpViewProvider(PathOpGui.ViewProvider):
 
         panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
         panel_state.drop_fields_on_cancel(panel)  # a field left focused writes nothing after Cancel's abort
-        panel_state.release_fields_on_close(panel)  # again at OK / Cancel: fields a page added later
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused
         super().setupTaskPanel(panel)
         panel_state.release_field_filters(panel)  # on 1.0 no Python event filter on the fields (a crash)

@@ -64,8 +64,8 @@ FILTERS_CRASH = QtCore.qVersion().startswith("5.") and sys.version_info >= (3, 1
 
 
 def release_field_filters(panel: Any) -> None:
-    """Where FILTERS_CRASH: each field controller stops filtering its field, once the panel is set up and again
-    as OK or Cancel closes it (a page may add fields on the way). There a Python eventFilter can be handed an
+    """Where FILTERS_CRASH: each field controller stops filtering its field, once the panel is set up (FreeCAD's
+    pages make all their controllers in initPage, during setupUi). There a Python eventFilter can be handed an
     event whose address a deleted Qt object's wrapper still holds: PySide then reads the event as that object and
     crashes (SIGSEGV in getMetaDataFromQObject at `event.type()` in the controller's eventFilter; in CI, and at
     the first round of a loop of focus changes and Cancels, also with the filters removed only at close).
@@ -77,21 +77,6 @@ def release_field_filters(panel: Any) -> None:
         return
     for controller, widget in field_controllers(panel):
         widget.removeEventFilter(controller)
-
-
-def release_fields_on_close(panel: Any) -> None:
-    """release_field_filters as OK or Cancel closes the panel."""
-    accept, reject = panel.accept, panel.reject
-
-    def accepted(resetEdit: bool = True) -> Any:
-        release_field_filters(panel)
-        return accept(resetEdit)
-
-    def rejected(resetEdit: bool = True) -> Any:
-        release_field_filters(panel)
-        return reject(resetEdit)
-
-    panel.accept, panel.reject = accepted, rejected
 
 
 def _unless(cancelled: list[bool], get_fields: Any) -> Any:
