@@ -47,3 +47,15 @@ def run(cmd: Sequence[str], cwd: Path, timeout: float, **env: str) -> tuple[int,
         out, err = proc.communicate()
         return -1, f"timed out after {timeout} s\n" + readable((out or "") + "\n" + (err or ""))
     return proc.returncode, readable(out + "\n" + err)
+
+
+def failure_text(out: str, tail: int = 6000) -> str:
+    """What an assertion message shows of a FreeCAD run: the end of its output and, when it crashed, first the
+    Python stack faulthandler printed (tests/gui/gui_runner.py), which the long C stack after it pushes out of
+    any tail."""
+    start = out.find("Fatal Python error")
+    if start < 0:
+        return out[-tail:]
+    stack = out[start:start + 4000]
+    end = stack.find("\n\n", stack.find("most recent call first"))
+    return (stack if end < 0 else stack[:end]) + "\n[...]\n" + out[-tail:]

@@ -139,6 +139,7 @@ def run() -> dict:
     screenshot(PNG.with_name("multipoint_simulate.png"))
     FreeCAD.closeDocument(r.doc.Name)
     pump(0.3)
+    gui_runner.forget_found_widgets()
     return info
 
 

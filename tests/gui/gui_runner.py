@@ -3,6 +3,7 @@ main window and its event loop are up, its outcome as JSON for the pytest side, 
 from __future__ import annotations
 
 import faulthandler
+import gc
 import json
 import os
 import sys
@@ -12,7 +13,27 @@ from typing import Callable
 
 from PySide import QtCore
 
+try:
+    import shiboken6 as shiboken
+except ImportError:  # FreeCAD 0.20 and 1.0: PySide2
+    import shiboken2 as shiboken
+
 _STDERR = os.fdopen(os.dup(2), "w")  # the process's stderr (FreeCAD's sys.stderr has no file descriptor)
+
+
+def forget_found_widgets() -> None:
+    """Call once a task panel (or a document) has closed. PySide's findChildren makes the parent's wrapper keep a
+    wrapper of each child it found, and PySide is not told when Qt deletes a child it did not create: the main
+    window's wrapper then keeps wrappers of the closed panel's widgets, and a new Qt object at a reused address
+    comes back to Python as one of them, typed as what was there before (FreeCAD 1.1 crashed in
+    QDialogButtonBox::button called on another widget, after about 36 panels closed with the collector off).
+    Every wrapper the main window holds so is invalidated (with the wrappers held by those): a later search
+    wraps what is there anew."""
+    import FreeCADGui
+
+    for child in gc.get_referents(FreeCADGui.getMainWindow()):
+        if isinstance(child, QtCore.QObject) and shiboken.isValid(child):
+            shiboken.invalidate(child)
 
 
 def run(session: Callable[[dict], None], result: Path) -> None:

@@ -48,6 +48,7 @@ def close_panel(op) -> None:
     op.ViewObject.Proxy.panel.reject()
     pump(0.3)
     assert not FreeCADGui.Control.activeDialog(), "the task panel stayed open"
+    gui_runner.forget_found_widgets()
 
 
 def screenshot(png: Path) -> None:
@@ -75,6 +76,7 @@ def click_close() -> None:
         if button is not None and button.isVisible():
             button.click()
             pump(0.5)
+            gui_runner.forget_found_widgets()
             return
     raise AssertionError("the task panel has no visible Close button")
 
@@ -185,6 +187,7 @@ def multipoint_panel(info: dict) -> None:
     close_panel(ops[0])  # Cancel: the new op goes again
     FreeCAD.closeDocument(r.doc.Name)
     pump(0.3)
+    gui_runner.forget_found_widgets()
 
 
 def zlevel_panels(info: dict) -> None:
@@ -244,6 +247,7 @@ def zlevel_panels(info: dict) -> None:
         assert op in job.Operations.Group
     FreeCAD.closeDocument(doc.Name)
     pump(0.3)
+    gui_runner.forget_found_widgets()
 
 
 def smoke() -> dict:
@@ -360,6 +364,7 @@ def smoke() -> dict:
         close_panel(op)
         FreeCAD.closeDocument(doc.Name)
         pump(0.3)
+        gui_runner.forget_found_widgets()
 
     # the GUI progress: a dialog with Cancel that turns into a False from the callback
     from tmm_workbench.app import progress

@@ -69,6 +69,7 @@ def wait_closed(seconds: float = 60.0) -> None:
     while FreeCADGui.Control.activeDialog() and time.monotonic() < end:
         pump(0.2)
     assert not FreeCADGui.Control.activeDialog(), "the task panel stayed open"
+    gui_runner.forget_found_widgets()
 
 
 def screenshot(name: str) -> str:
@@ -347,6 +348,7 @@ def reopen(info: dict, doc, job) -> None:
     doc.saveAs(str(SAVED))
     FreeCAD.closeDocument(doc.Name)
     pump(0.5)
+    gui_runner.forget_found_widgets()
     doc = FreeCAD.openDocument(str(SAVED))
     pump(1.5)
     info["bounds_visible_reopened"] = [o.ViewObject.Visibility for o in bounds_objects(doc)]

@@ -290,6 +290,7 @@ def session(info: dict) -> dict:
     pump(0.5)
     FreeCAD.closeDocument(doc.Name)
     pump(0.3)
+    gui_runner.forget_found_widgets()
     waterline_panel(info)
     return info
 
@@ -341,6 +342,7 @@ def waterline_panel(info: dict) -> None:
     assert text.startswith("post 'tarus': ") and "--a-min" in text, text
     FreeCAD.closeDocument(doc.Name)
     pump(0.3)
+    gui_runner.forget_found_widgets()
 
 
 

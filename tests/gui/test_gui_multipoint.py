@@ -26,7 +26,8 @@ def test_gui_multipoint(tmp_path: Path) -> None:
         cwd=tmp_path, timeout=TIMEOUT_S, TMM_GUI_PNG=str(PNG), TMM_GUI_RESULT=str(result),
         QTWEBENGINE_DISABLE_SANDBOX="1")
     info = json.loads(result.read_text()) if result.is_file() else {}
-    assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
+    assert code == 0 and info.get("ok"), \
+        f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     assert info["axes_shown"] > 0 and info["axes_hidden"] == 0 and info["axes_every_1"] == info["positions"]
     assert info["contact_colours_match"] and info["tilt_colours_distinct"] > 10
     assert info["pass_spacing"][0] == "Scallop" and abs(info["scallop_field"][0] - 0.5) < 1e-9

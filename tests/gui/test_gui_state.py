@@ -40,7 +40,8 @@ def test_gui_state(tmp_path: Path) -> None:
         TMM_GUI_SAVED=str(tmp_path / "gui_state.FCStd"), TMM_GUI_REOPEN=str(headless), TMM_GUI_STL=STL,
         QTWEBENGINE_DISABLE_SANDBOX="1")
     info = json.loads(result.read_text()) if result.is_file() else {}
-    assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
+    assert code == 0 and info.get("ok"), \
+        f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
 
     # item 5: the post, the heights before the first compute, the stand-in box
     assert info["job_post"] == "linuxcnc" and info["job_post_first_offered"] != "linuxcnc", info

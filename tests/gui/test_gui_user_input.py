@@ -30,7 +30,8 @@ def test_gui_user_input(tmp_path: Path) -> None:
         cwd=tmp_path, timeout=TIMEOUT_S, TMM_GUI_RESULT=str(result), TMM_GUI_SHOTS=str(SHOTS), TMM_GUI_STL=STL,
         QTWEBENGINE_DISABLE_SANDBOX="1")
     info = json.loads(result.read_text()) if result.is_file() else {}
-    assert code == 0 and info.get("ok"), f"FreeCAD exit code {code}\n{info.get('error', '')}\n{out[-6000:]}"
+    assert code == 0 and info.get("ok"), \
+        f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     # what the session asserted, checked again from its record
     assert abs(info["sample_raw"] - 1.5) < 1e-12 and abs(info["sample_prop"] - 1.5) < 1e-12, info
     assert "CL points" in info["limit_refused"] and "Not computed" in info["box_limit"], info

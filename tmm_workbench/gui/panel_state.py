@@ -7,9 +7,12 @@ stays. A failed Apply is not committed: Cancel restores the path from before it.
 Cancel must also be the panel's last word: PathOpGui never disconnects the fields' update signals, and a field
 that still has the keyboard focus when the panel closes emits editingFinished after reject() has aborted the
 transaction; its value then reached the op outside any transaction (kept, and computed by reject's recompute).
-So once Cancel is pressed, the pages' update handler does nothing (`drop_fields_on_cancel`)."""
+So once Cancel is pressed, the pages' update handler does nothing (`drop_fields_on_cancel`).
+
+A closed panel must not leave Python wrappers of its Qt widgets behind (`forget_widgets_on_close`)."""
 from __future__ import annotations
 
+import gc
 import sys
 from typing import Any
 
@@ -77,6 +80,30 @@ def release_field_filters(panel: Any) -> None:
         return
     for controller, widget in field_controllers(panel):
         widget.removeEventFilter(controller)
+
+
+def forget_widgets_on_close(panel: Any) -> None:
+    """Once the panel has closed, the Python wrappers of its Qt widgets are freed at once. The closed panel lives
+    on in reference cycles (its pages hold its bound methods, our wrappers above hold it) until Python's
+    collector runs, and with it wrappers of widgets Qt has deleted: its button box (PathOpGui keeps it from
+    modifyStandardButtons), its forms. PySide is not told of the deletion: a new Qt object at the same address
+    comes back to Python as the stale wrapper, typed as what was there before, and any code that then searches
+    the main window for a button box (`findChildren`) can be handed another widget as one and crash FreeCAD (as
+    our GUI test did on 1.1 through its own searches: tests/gui/gui_runner.forget_found_widgets). The button box
+    is dropped by name, the rest by a collection once the task view has let the panel go (the next turn of the
+    event loop)."""
+    cleanup = panel.cleanup
+
+    def cleanup_and_forget(resetEdit: bool) -> Any:
+        try:
+            return cleanup(resetEdit)
+        finally:
+            for holder in (panel, *getattr(panel, "featurePages", [])):
+                if getattr(holder, "buttonBox", None) is not None:
+                    holder.buttonBox = None
+            QtCore.QTimer.singleShot(0, gc.collect)
+
+    panel.cleanup = cleanup_and_forget
 
 
 def _unless(cancelled: list[bool], get_fields: Any) -> Any:
