@@ -36,11 +36,16 @@ def pump(seconds: float) -> None:
         time.sleep(0.02)
 
 
-def visible(cls, name: str):
-    for w in FreeCADGui.getMainWindow().findChildren(cls, name):
-        if w.isVisible() or w.window().isVisible():
-            return w
-    raise AssertionError(f"no widget {name} in the open task panel")
+def visible(cls, name: str, seconds: float = 10.0):
+    """The open panel's widget `name`; waits for it (a panel opens later on a loaded machine)."""
+    end = time.monotonic() + seconds
+    while True:
+        for w in FreeCADGui.getMainWindow().findChildren(cls, name):
+            if w.isVisible() or w.window().isVisible():
+                return w
+        if time.monotonic() > end:
+            raise AssertionError(f"no widget {name} in the open task panel")
+        pump(0.2)
 
 
 def type_into(widget, text: str) -> None:
