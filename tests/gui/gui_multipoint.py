@@ -13,7 +13,6 @@ import os
 import sys
 from pathlib import Path
 
-import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 
@@ -137,9 +136,7 @@ def run() -> dict:
     info["sim_min_deviation"] = sim.findChild(QtGui.QLabel, "minDeviation").property("value")
     assert info["sim_max_left"] is not None, f"TMM Simulate gave no 5-axis result: {info['sim_status']}"
     screenshot(PNG.with_name("multipoint_simulate.png"))
-    FreeCAD.closeDocument(r.doc.Name)
-    pump(0.3)
-    gui_runner.forget_found_widgets()
+    gui_runner.close_document(r.doc)
     return info
 
 

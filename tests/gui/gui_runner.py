@@ -7,11 +7,12 @@ import gc
 import json
 import os
 import sys
+import time
 import traceback
 from pathlib import Path
 from typing import Callable
 
-from PySide import QtCore
+from PySide import QtCore, QtGui
 
 try:
     import shiboken6 as shiboken
@@ -21,19 +22,53 @@ except ImportError:  # FreeCAD 0.20 and 1.0: PySide2
 _STDERR = os.fdopen(os.dup(2), "w")  # the process's stderr (FreeCAD's sys.stderr has no file descriptor)
 
 
+def pump(seconds: float) -> None:
+    """Lets FreeCAD's event loop run for `seconds` (what a user's pause gives it)."""
+    end = time.monotonic() + seconds
+    while time.monotonic() < end:
+        QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
+        time.sleep(0.02)
+
+
 def forget_found_widgets() -> None:
     """Call once a task panel (or a document) has closed. PySide's findChildren makes the parent's wrapper keep a
-    wrapper of each child it found, and PySide is not told when Qt deletes a child it did not create: the main
-    window's wrapper then keeps wrappers of the closed panel's widgets, and a new Qt object at a reused address
-    comes back to Python as one of them, typed as what was there before (FreeCAD 1.1 crashed in
-    QDialogButtonBox::button called on another widget, after about 36 panels closed with the collector off).
-    Every wrapper the main window holds so is invalidated (with the wrappers held by those): a later search
-    wraps what is there anew."""
+    wrapper of each child it found. When Qt deletes such a child, FreeCAD (Gui::WrapperManager, for wrappers it
+    made itself, e.g. the task dialog's button box) only marks the wrapper dead and PySide (for other children)
+    is not told at all: either way the wrapper stays in PySide's address map, and a new Qt object at a reused
+    address comes back to Python as it, typed as what was there before: dead ("Internal C++ object
+    (QDialogButtonBox) already deleted" for a combo box of the next panel, FreeCAD 0.20) or alive (1.1 crashed
+    in QDialogButtonBox::button called on another widget). Every wrapper the main window holds so, dead or not,
+    is taken out of the map (shiboken.invalidate, with the wrappers held by those): a later search wraps what is
+    there anew."""
     import FreeCADGui
 
     for child in gc.get_referents(FreeCADGui.getMainWindow()):
-        if isinstance(child, QtCore.QObject) and shiboken.isValid(child):
+        if isinstance(child, QtCore.QObject):
             shiboken.invalidate(child)
+
+
+def dead_wrappers(found_too: bool = True) -> list[str]:
+    """Type names of the wrappers in PySide's address map whose Qt object is gone: each would be handed out for
+    the next Qt object made at its address (getAllValidWrappers lists the whole map, dead ones included). Without
+    `found_too`, only those held by something other than the main window (which holds our searches' results):
+    what the product keeps."""
+    import FreeCADGui
+
+    registered = shiboken.getAllValidWrappers()
+    dead = [w for w in registered if not shiboken.isValid(w)]
+    if not found_too:
+        ignored = {id(FreeCADGui.getMainWindow()), id(registered), id(dead)}
+        dead = [w for w in dead if any(id(r) not in ignored for r in gc.get_referrers(w))]
+    return sorted(type(w).__name__ for w in dead)
+
+
+def close_document(doc) -> None:
+    """Closes `doc` as the GUI does and forgets the wrappers our searches found in its views."""
+    import FreeCAD
+
+    FreeCAD.closeDocument(doc.Name)
+    pump(0.3)
+    forget_found_widgets()
 
 
 def run(session: Callable[[dict], None], result: Path) -> None:

@@ -13,7 +13,6 @@ SystemExit). Screenshot: env TMM_GUI_PNG, default <repo>/out/gui_smoke.png.
 """
 import os
 import sys
-import time
 from pathlib import Path
 
 import FreeCAD
@@ -22,17 +21,12 @@ from PySide import QtCore, QtGui
 
 sys.path.insert(0, str(Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "tests" / "gui"))
 import gui_runner  # noqa: E402
+from gui_runner import pump  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui_smoke.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_smoke.json")
 
-
-def pump(seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
-        time.sleep(0.02)
 
 
 def find_panel(name: str = "TmmSurfaceOpPage") -> QtGui.QWidget:
@@ -185,9 +179,7 @@ def multipoint_panel(info: dict) -> None:
     find_panel("TmmMultipointOpPage")
     info["multipoint_command_panel"] = True
     close_panel(ops[0])  # Cancel: the new op goes again
-    FreeCAD.closeDocument(r.doc.Name)
-    pump(0.3)
-    gui_runner.forget_found_widgets()
+    gui_runner.close_document(r.doc)
 
 
 def zlevel_panels(info: dict) -> None:
@@ -245,9 +237,7 @@ def zlevel_panels(info: dict) -> None:
         info[f"{key}_commands"] = len(op.Path.Commands)
         assert op.isValid() and len(op.Path.Commands) > 10, (name, op.getStatusString())
         assert op in job.Operations.Group
-    FreeCAD.closeDocument(doc.Name)
-    pump(0.3)
-    gui_runner.forget_found_widgets()
+    gui_runner.close_document(doc)
 
 
 def smoke() -> dict:
@@ -362,9 +352,7 @@ def smoke() -> dict:
         info["reopened_panel"] = FreeCADGui.Control.activeDialog()
         assert info["reopened_panel"], "no task panel for the reopened op"
         close_panel(op)
-        FreeCAD.closeDocument(doc.Name)
-        pump(0.3)
-        gui_runner.forget_found_widgets()
+        gui_runner.close_document(doc)
 
     # the GUI progress: a dialog with Cancel that turns into a False from the callback
     from tmm_workbench.app import progress

@@ -19,7 +19,6 @@ TMM_GUI_RESULT (JSON) and the exit code.
 """
 import os
 import sys
-import time
 from pathlib import Path
 
 import FreeCAD
@@ -28,6 +27,7 @@ from PySide import QtCore, QtGui
 
 sys.path.insert(0, str(Path(__file__).resolve().parent if "__file__" in globals() else Path.cwd() / "tests" / "gui"))
 import gui_runner  # noqa: E402
+from gui_runner import pump  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 SHOTS = Path(os.environ.get("TMM_GUI_SHOTS") or ROOT / "out" / "gui")
@@ -35,12 +35,6 @@ RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_user_input
 PAGE = "TmmSurfaceOpPage"
 TYPED: dict = {}
 
-
-def pump(seconds: float) -> None:
-    end = time.monotonic() + seconds
-    while time.monotonic() < end:
-        QtGui.QApplication.processEvents(QtCore.QEventLoop.AllEvents, 50)
-        time.sleep(0.02)
 
 
 def page() -> QtGui.QWidget:
@@ -288,9 +282,7 @@ def session(info: dict) -> dict:
     assert not op.isValid(), "an op with feed 0 computed"
     op.ViewObject.Proxy.panel.reject()
     pump(0.5)
-    FreeCAD.closeDocument(doc.Name)
-    pump(0.3)
-    gui_runner.forget_found_widgets()
+    gui_runner.close_document(doc)
     waterline_panel(info)
     return info
 
@@ -340,9 +332,7 @@ def waterline_panel(info: dict) -> None:
         info["post_error"] = str(exc)
     text = take_box(info, "box_post")
     assert text.startswith("post 'tarus': ") and "--a-min" in text, text
-    FreeCAD.closeDocument(doc.Name)
-    pump(0.3)
-    gui_runner.forget_found_widgets()
+    gui_runner.close_document(doc)
 
 
 

@@ -86,21 +86,18 @@ def forget_widgets_on_close(panel: Any) -> None:
     """Once the panel has closed, the Python wrappers of its Qt widgets are freed at once. The closed panel lives
     on in reference cycles (its pages hold its bound methods, our wrappers above hold it) until Python's
     collector runs, and with it wrappers of widgets Qt has deleted: its button box (PathOpGui keeps it from
-    modifyStandardButtons), its forms. PySide is not told of the deletion: a new Qt object at the same address
-    comes back to Python as the stale wrapper, typed as what was there before, and any code that then searches
-    the main window for a button box (`findChildren`) can be handed another widget as one and crash FreeCAD (as
-    our GUI test did on 1.1 through its own searches: tests/gui/gui_runner.forget_found_widgets). The button box
-    is dropped by name, the rest by a collection once the task view has let the panel go (the next turn of the
-    event loop)."""
+    modifyStandardButtons), its forms. Such a wrapper stays in PySide's address map (FreeCAD only marks the
+    wrappers it made dead, PySide is not told of the others' deletion), and a new Qt object at the same address
+    comes back to Python as it, typed as what was there before: dead ("already deleted") or alive as the wrong
+    class (a crash). The button box is dropped at once, the rest by a collection once the task view has let the
+    panel go (the next turn of the event loop)."""
     cleanup = panel.cleanup
 
     def cleanup_and_forget(resetEdit: bool) -> Any:
         try:
             return cleanup(resetEdit)
         finally:
-            for holder in (panel, *getattr(panel, "featurePages", [])):
-                if getattr(holder, "buttonBox", None) is not None:
-                    holder.buttonBox = None
+            panel.buttonBox = None
             QtCore.QTimer.singleShot(0, gc.collect)
 
     panel.cleanup = cleanup_and_forget
