@@ -240,6 +240,23 @@ def zlevel_panels(info: dict) -> None:
     gui_runner.close_document(doc)
 
 
+def stale_form_attribute(info: dict) -> None:
+    """gui/form_wrappers.rewrapped: a panel's check box handed out as a plain QWidget wrapper (what a stale wrapper
+    at a reused address gives: FreeCAD 1.0 in CI) comes back as a QCheckBox; a right one stays as it is."""
+    from tmm_workbench.gui import form_wrappers, resources
+
+    form = FreeCADGui.PySideUic.loadUi(resources.panel("surface_op"))
+    right, name = form.verifyCusp, "arcFitting"
+    box = form.findChild(QtGui.QCheckBox, name)
+    setattr(form, name, gui_runner.shiboken.wrapInstance(gui_runner.shiboken.getCppPointer(box)[0], QtGui.QWidget))
+    info["stale_attribute_type"] = type(getattr(form, name)).__name__
+    form_wrappers.rewrapped(form)
+    info["rewrapped_type"] = type(getattr(form, name)).__name__
+    info["rewrapped_same_object"] = getattr(form, name).objectName() == name
+    info["right_kept"] = form.verifyCusp is right
+    form.deleteLater()
+
+
 def smoke() -> dict:
     info: dict = {}
     if str(ROOT) not in sys.path:
@@ -334,6 +351,7 @@ def smoke() -> dict:
     if r.doc.getObject("RegionBox") is not None:  # Cancel undoes what the panel did, the box too
         r.doc.removeObject("RegionBox")
 
+    stale_form_attribute(info)
     simulate_panel(info, r)
 
     multipoint_panel(info)

@@ -37,6 +37,8 @@ def test_gui_smoke(tmp_path: Path) -> None:
     info = json.loads(result.read_text()) if result.is_file() else {}
     assert code == 0 and info.get("ok"), \
         f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
+    assert (info["stale_attribute_type"], info["rewrapped_type"]) == ("QWidget", "QCheckBox"), info
+    assert info["rewrapped_same_object"] and info["right_kept"], info
     assert info["workbench"] == "TMMWorkbench" and info["panel_open"] and info["cancel_seen"]
     assert info["multipoint_command_panel"] and "two" in info["multipoint_contacts"]
     assert info.get("reopened_panel") or not freecadcmd

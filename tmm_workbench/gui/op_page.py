@@ -14,7 +14,7 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from tmm_workbench.app.compat import PathOp, PathUtils, command_prefix, import_gui
-from tmm_workbench.gui import field_limits, messages, resources
+from tmm_workbench.gui import field_limits, form_wrappers, messages, resources
 
 PathOpGui = import_gui("op_gui")
 PathGui = import_gui("path_gui")
@@ -38,7 +38,7 @@ class OpPage(PathOpGui.TaskPanelPage):
     STATUS_PROPS: tuple[str, ...] = ("Path",)  # a change of these refreshes the status line
 
     def getForm(self) -> Any:
-        return FreeCADGui.PySideUic.loadUi(resources.panel(self.PANEL))
+        return form_wrappers.rewrapped(FreeCADGui.PySideUic.loadUi(resources.panel(self.PANEL)))
 
     def setIcon(self, icon: Any) -> None:
         super().setIcon(self.ICON)  # the view provider hands over a Qt resource path we do not ship

@@ -1,0 +1,40 @@
+"""A loaded panel's widgets as Python wrappers of what they are.
+
+FreeCAD's .ui loader sets each named widget as an attribute of the form, through PySide's one-wrapper-per-address
+map. A wrapper of a widget Qt has deleted can still be in that map (FreeCAD marks the wrappers it made dead and
+leaves them there; PySide is not told when Qt deletes a widget it did not create; a closed panel or a search's
+results keep them alive until Python's collector runs), and a new widget at the same address is then handed out
+as it: dead ("Internal C++ object already deleted"), or alive but typed as what was there before (a check box as
+a plain QWidget: "'QWidget' object has no attribute 'isChecked'", FreeCAD 1.0 in CI). Such an attribute is taken
+out of the map and wrapped anew. (docs/gui/README.md, "Python wrappers of deleted widgets".)"""
+from __future__ import annotations
+
+from typing import Any
+
+from PySide import QtCore, QtGui
+
+try:
+    import shiboken6 as shiboken
+except ImportError:  # FreeCAD 0.20 and 1.0: PySide2
+    import shiboken2 as shiboken
+
+
+def _stale(widget: Any) -> bool:
+    """Dead, or typed as a class other than the Qt object's own where PySide has that class."""
+    if not shiboken.isValid(widget):
+        return True
+    real = widget.metaObject().className()
+    return real != type(widget).__name__ and isinstance(getattr(QtGui, real, None), type)
+
+
+def rewrapped(form: Any) -> Any:
+    """`form` with every named-widget attribute that is a stale wrapper replaced by a new one of the widget there
+    (found by its name); returns `form`."""
+    for name, widget in list(vars(form).items()):
+        if not isinstance(widget, QtCore.QObject) or not _stale(widget):
+            continue
+        shiboken.invalidate(widget)  # out of the map: the search below wraps what is at that address now
+        found = form.findChild(QtCore.QObject, name)
+        if found is not None:
+            setattr(form, name, found)
+    return form
