@@ -248,7 +248,9 @@ def stale_form_attribute(info: dict) -> None:
     form = FreeCADGui.PySideUic.loadUi(resources.panel("surface_op"))
     right, name = form.verifyCusp, "arcFitting"
     box = form.findChild(QtGui.QCheckBox, name)
-    setattr(form, name, gui_runner.shiboken.wrapInstance(gui_runner.shiboken.getCppPointer(box)[0], QtGui.QWidget))
+    address = gui_runner.shiboken.getCppPointer(box)[0]
+    gui_runner.shiboken.invalidate(box)  # out of PySide's map: the next wrapper of that address is registered there
+    setattr(form, name, gui_runner.shiboken.wrapInstance(address, QtGui.QWidget))
     info["stale_attribute_type"] = type(getattr(form, name)).__name__
     form_wrappers.rewrapped(form)
     info["rewrapped_type"] = type(getattr(form, name)).__name__
