@@ -28,7 +28,6 @@ PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui_smoke.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_smoke.json")
 
 
-
 def find_panel(name: str = "TmmSurfaceOpPage") -> QtGui.QWidget:
     for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, name):
         if w.isVisible():

@@ -36,7 +36,6 @@ PAGE = "TmmSurfaceOpPage"
 TYPED: dict = {}
 
 
-
 def page() -> QtGui.QWidget:
     for w in FreeCADGui.getMainWindow().findChildren(QtGui.QWidget, PAGE):
         if w.isVisible():
