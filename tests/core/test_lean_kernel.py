@@ -2,7 +2,8 @@
 against independent references with the real kernel: every move of the lean path sampled every 0.005 mm lies
 within +-tol of the exact drop height there (dense drops: the reference), the kernel's fit uses no more moves
 than the Python fit (raster_lean.lean_segments, the slow reference kept for this) on the same samples, at least
-the lower bound it reports, and the off-model (skip) moves stay as sampled. The simulated stock against the
+the lower bound it reports, and the off-model (skip) moves stay as sampled; with arcs, the same band with fewer
+moves. The simulated stock against the
 design is checked in tests/core/test_raster_lean.py (lines: the kernel path)."""
 from __future__ import annotations
 
@@ -47,8 +48,8 @@ def both_fits(mesh, cutter, params):
     sampled = compute(mesh, cutter, replace(params, forward_step="sample", chord_tol=0.0)).segments
     surface = DropSurface(mesh)
     floor = float(mesh.bounds[0][2])
-    kern, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
-                                        params.sample_step / 2, lower_bound=True)  # as raster_drop
+    kern, _, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
+                                           params.sample_step / 2, lower_bound=True)  # as raster_drop
 
     def drop(p):
         return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
@@ -82,6 +83,36 @@ def test_bull_nose_on_sphere_on_plate(sphere_on_plate):
     assert worst(sphere_on_plate, cutter, kern) <= TOL + 1e-6
     n_k, n_p = sum(len(s) for s in kern), sum(len(s) for s in py)
     assert kstats["lower_bound"] <= n_k < n_p and n_k < kstats["points_in"] / 2, (n_k, n_p, kstats)
+
+
+@pytest.mark.parametrize("angle", [0.0, 90.0])
+def test_kernel_arcs_within_tolerance_and_fewer_moves(sphere_on_plate, angle):
+    """ArcFitting in the kernel (moves merged into G18 / G19 arcs where they hold the band and its checks) on a
+    real STL with the demo's ball: every move, arcs as circles, within +-tol of the exact drop every 0.005 mm;
+    fewer moves than the kernel's lines and no more than the Python arc fit on the same samples (the slow
+    reference, whose checks every 0.05 mm missed bumps of the exact path: +0.0027 mm on mount_rush)."""
+    cutter = Cutter.ball(6.0)
+    params = SurfaceParams(boundary=(20, 30, 56, 40), stepover=2.0, sample_step=0.25, angle_deg=angle,
+                           forward_step="tolerance", chord_tol=TOL, arcs=True)
+    sampled = compute(sphere_on_plate, cutter, replace(params, forward_step="sample", chord_tol=0.0)).segments
+    surface = DropSurface(sphere_on_plate)
+    floor = float(sphere_on_plate.bounds[0][2])
+    exact = ExactDrop(surface.index, cutter, floor, 0.0, floor)
+    segs, arcs, stats = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2, arcs=True)
+    lines, no_arcs, _ = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2)
+
+    def drop(p):
+        return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
+
+    py, py_arcs, _ = raster_lean.lean_segments(sampled, drop, TOL, True, min(params.sample_step / 4, 0.05))
+    pts = move_points(segs, arcs)
+    assert np.abs(pts[:, 2] - np.maximum(surface.drop(cutter, pts[:, :2], floor), floor)).max() <= TOL + 1e-6
+    assert stats["arcs"] == len(arcs) > 20 and not no_arcs and py_arcs
+    assert ("XZ" if angle == 0.0 else "YZ") in {a.plane for a in arcs.values()}  # (links run across: the other)
+    n_a, n_l, n_p = (sum(len(s) for s in x) for x in (segs, lines, py))
+    assert n_a < n_l and n_a <= n_p, (n_a, n_l, n_p)
+    res = compute(sphere_on_plate, cutter, params)  # the op's path is the kernel's, arcs included
+    assert sum(len(s) for s in res.segments) == n_a and len(res.diagnostics["arcs"]) == len(arcs)
 
 
 def feed_points(tp, step=0.005) -> np.ndarray:

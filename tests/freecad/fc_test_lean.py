@@ -1,5 +1,5 @@
 """Lean passes in FreeCAD (issue 14 item 2): the Surface op's ForwardStep "Tolerance" (the default of new ops and
-run_surface since the fit is in the kernel; lines from the kernel, arcs from the Python fit) writes fewer
+run_surface since the fit is in the kernel; lines and arcs from the kernel) writes fewer
 G-code lines than "SampleStep" and posts with linuxcnc; ArcFitting writes G18/G19 + G2/G3 with K that the
 grbl post passes and TMM's simulation reads (no gouge beyond the tolerance against the model); with the
 linuxcnc post (no K) the op writes lines; documents from before keep their sampled passes."""

@@ -5,11 +5,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
+#include "lean_arcs.hpp"
 #include "tmm/query/drop_cutter.hpp"
 
 namespace tmm {
@@ -149,26 +151,29 @@ std::size_t stab_count(const std::vector<double>& t, const std::vector<double>& 
 }
 
 struct RunOut {
-  std::vector<double> s, z;
-  std::size_t drops = 0, breakpoints = 0, refits = 0, kept_dense = 0, lower_bound = 0;
+  std::vector<double> s, z, arc_s, arc_z;
+  std::size_t drops = 0, breakpoints = 0, refits = 0, kept_dense = 0, lower_bound = 0, arcs = 0;
 };
 
 class RunLean {
  public:
   RunLean(const MeshIndex& index, const Cutter& tool, const LeanOptions& o, double x0, double y0, double ux,
-          double uy)
-      : index_(index), tool_(tool), o_(o), x0_(x0), y0_(y0), ux_(ux), uy_(uy) {}
+          double uy, bool with_arcs)
+      : index_(index), tool_(tool), o_(o), x0_(x0), y0_(y0), ux_(ux), uy_(uy), with_arcs_(with_arcs) {}
 
-  void run(const double* s, const double* z, const std::uint8_t* flags, std::size_t n, RunOut& out) {
+  void run(const double* s, const double* z, const std::uint8_t* flags, std::size_t n, bool arcs, RunOut& out) {
+    arcs_ = arcs;
     profile(s, z, flags, n, out);
     out.s.push_back(t_[0]);
     out.z.push_back(e_[0]);
+    line_to(out, 1);
     std::size_t a = 0;
     for (std::size_t b = 1; b < t_.size(); ++b) {
       if (!fixed_[b] && b + 1 < t_.size()) continue;
       if (keep_[a]) {  // a kept move (both ends fixed: b == a + 1)
         out.s.push_back(t_[b]);
         out.z.push_back(e_[b]);
+        line_to(out, 1);
         if (o_.lower_bound) ++out.lower_bound;
       } else {
         stretch(a, b, out);
@@ -178,6 +183,13 @@ class RunLean {
   }
 
  private:
+  // n line moves (no arc centre) in out's centres when some run has arcs
+  void line_to(RunOut& out, std::size_t n) const {
+    if (!with_arcs_) return;
+    out.arc_s.insert(out.arc_s.end(), n, std::numeric_limits<double>::quiet_NaN());
+    out.arc_z.insert(out.arc_z.end(), n, std::numeric_limits<double>::quiet_NaN());
+  }
+
   double exact(double t, int32_t* hint, bool* air) {
     ++drops_;
     return lean_exact(index_, tool_, o_.drop, x0_ + t * ux_, y0_ + t * uy_, hint, air);
@@ -298,6 +310,21 @@ class RunLean {
       }
       t.swap(t2), e.swap(e2), win.swap(w2);
     }
+    if (arcs_) {
+      const lean::Stretch p{t, e, win, o_.fit_fraction * o_.tol, o_.drop.clamp_floor,
+                            (2 * o_.fit_fraction - 1) * o_.tol, kCheckFailure * o_.tol};
+      const lean::ArcLimits limits{o_.arc_min_radius, o_.arc_max_radius, o_.arc_max_slope};
+      std::vector<double> cs, cz;
+      out.arcs += lean::merge_arcs(p, limits, [this](double tm, int32_t h, double& z) {
+        bool air = false;
+        z = exact(tm, &h, &air);
+        return !air;
+      }, vi, vz, cs, cz);
+      out.arc_s.insert(out.arc_s.end(), cs.begin() + 1, cs.end());
+      out.arc_z.insert(out.arc_z.end(), cz.begin() + 1, cz.end());
+    } else {
+      line_to(out, vi.size() - 1);
+    }
     for (std::size_t k = 1; k < vi.size(); ++k) {
       out.s.push_back(t[vi[k]]);
       out.z.push_back(vz[k]);
@@ -312,7 +339,9 @@ class RunLean {
   const Cutter& tool_;
   const LeanOptions& o_;
   double x0_, y0_, ux_, uy_;
+  bool with_arcs_;  // some run has arcs: every vertex gets a centre (NaN for lines)
   double eps_ = 0.0;
+  bool arcs_ = false;  // this run fits arcs
   std::vector<double> t_, e_;
   std::vector<int32_t> win_;
   std::vector<std::uint8_t> fixed_, keep_;
@@ -343,6 +372,10 @@ void validate(const LeanRuns& r, const LeanOptions& o) {
   const std::size_t runs = r.offsets.size() - 1;
   require(r.origin.size() == 2 * runs && r.dir.size() == 2 * runs, "lean runs: 2 origin and 2 dir values per run");
   require(r.z.size() == r.s.size() && r.flags.size() == r.s.size(), "lean runs: s, z and flags of equal length");
+  require(r.arcs.empty() || r.arcs.size() == runs, "lean runs: arcs must be empty or one flag per run");
+  require(std::isfinite(o.arc_min_radius) && o.arc_min_radius > 0 && o.arc_max_radius > o.arc_min_radius &&
+              o.arc_max_slope > 0,
+          value("lean arc radius (mm)", o.arc_min_radius, "> 0, below arc_max_radius (and arc_max_slope > 0)"));
   double drops = 0;
   for (std::size_t k = 0; k < runs; ++k) {
     const std::size_t a = r.offsets[k], b = r.offsets[k + 1];
@@ -376,8 +409,9 @@ LeanResult lean_profiles(const MeshIndex& index, const Cutter& tool, const LeanR
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t a = runs.offsets[k];
       RunLean lean(index, tool, options, runs.origin[2 * k], runs.origin[2 * k + 1], runs.dir[2 * k],
-                   runs.dir[2 * k + 1]);
-      lean.run(&runs.s[a], &runs.z[a], &runs.flags[a], runs.offsets[k + 1] - a, outs[k]);
+                   runs.dir[2 * k + 1], !runs.arcs.empty());
+      lean.run(&runs.s[a], &runs.z[a], &runs.flags[a], runs.offsets[k + 1] - a, !runs.arcs.empty() && runs.arcs[k],
+               outs[k]);
     }
   });
   LeanResult r;
@@ -386,13 +420,16 @@ LeanResult lean_profiles(const MeshIndex& index, const Cutter& tool, const LeanR
   for (RunOut& o : outs) {
     r.s.insert(r.s.end(), o.s.begin(), o.s.end());
     r.z.insert(r.z.end(), o.z.begin(), o.z.end());
+    r.arc_s.insert(r.arc_s.end(), o.arc_s.begin(), o.arc_s.end());
+    r.arc_z.insert(r.arc_z.end(), o.arc_z.begin(), o.arc_z.end());
     r.offsets.push_back(r.s.size());
+    r.arcs += o.arcs;
     r.drops += o.drops;
     r.breakpoints += o.breakpoints;
     r.refits += o.refits;
     r.kept_dense += o.kept_dense;
     r.lower_bound += o.lower_bound;
-    RunOut().s.swap(o.s);
+    o = RunOut();  // freed as we go
   }
   return r;
 }

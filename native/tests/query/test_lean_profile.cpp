@@ -53,7 +53,8 @@ LeanRuns runs_over(const MeshIndex& index, const Cutter& c, const std::vector<do
   return r;
 }
 
-// The largest |move - exact| over every move of `res`, the exact drop sampled every `h` mm.
+// The largest |move - exact| over every move of `res` (an arc: the circle about its centre through its start), the
+// exact drop sampled every `h` mm.
 double worst_deviation(const MeshIndex& index, const Cutter& c, const LeanRuns& runs, const LeanResult& res,
                        double floor_z, double h) {
   double worst = 0;
@@ -61,10 +62,14 @@ double worst_deviation(const MeshIndex& index, const Cutter& c, const LeanRuns& 
     const double ox = runs.origin[2 * k], oy = runs.origin[2 * k + 1], ux = runs.dir[2 * k], uy = runs.dir[2 * k + 1];
     for (std::size_t v = res.offsets[k]; v + 1 < res.offsets[k + 1]; ++v) {
       const double sa = res.s[v], sb = res.s[v + 1], za = res.z[v], zb = res.z[v + 1];
+      const bool arc = !res.arc_s.empty() && std::isfinite(res.arc_s[v + 1]);
+      const double cs = arc ? res.arc_s[v + 1] : 0, cz = arc ? res.arc_z[v + 1] : 0;
+      const double r = std::hypot(sa - cs, za - cz), side = za > cz ? 1.0 : -1.0;
       const int n = std::max(1, static_cast<int>(std::ceil((sb - sa) / h)));
       for (int i = 0; i <= n; ++i) {
         const double s = sa + (sb - sa) * i / n;
-        const double z = za + (zb - za) * i / n;
+        const double z = arc ? cz + side * std::sqrt(std::max(r * r - (s - cs) * (s - cs), 0.0))
+                             : za + (zb - za) * i / n;
         worst = std::max(worst, std::fabs(z - tmm::drop_point(index, c, ox + s * ux, oy + s * uy, floor_z)));
       }
     }
@@ -120,6 +125,64 @@ TEST(LeanProfile, BullOverAFacetedCylinderStaysInTheBand) {
   const MeshIndex cyl = grid_mesh([](double x, double) { return std::sqrt(std::max(0.0, 225.0 - x * x)) - 5.0; }, -14,
                              -20, 14, 20, 24, 8);
   expect_within_band(cyl, Cutter(2.0, 1.0), {0.7, 6.0}, 0.001, 2.0);
+}
+
+// Runs marked for arcs over a cylinder fine enough to be a circle to a controller: the arcs (G-code valid: both ends
+// on the circle, radius within the limits) hold the band, cut the moves several times, and a run not marked for
+// arcs is fitted exactly as without them.
+LeanResult expect_arcs_within_band(const MeshIndex& mesh, const Cutter& c, double tol, double fewer) {
+  LeanRuns runs = runs_over(mesh, c, {0.7, 6.0}, -13.0, 13.0, 0.25, -50);
+  LeanOptions o;
+  o.tol = tol;
+  o.drop.drop_floor = -50;
+  const LeanResult lines = tmm::lean_profiles(mesh, c, runs, o);
+  runs.arcs = {1, 1, 0};  // the 30 deg run lies in no principal plane
+  const LeanResult r = tmm::lean_profiles(mesh, c, runs, o);
+  EXPECT_LE(worst_deviation(mesh, c, runs, r, -50, 0.002), tol * (1 + 1e-6));
+  EXPECT_GT(r.arcs, 0u);
+  const auto moves = [](const LeanResult& x, std::size_t k) { return x.offsets[k + 1] - x.offsets[k] - 1; };
+  for (std::size_t k = 0; k < 2; ++k)
+    EXPECT_LE(moves(r, k) * fewer, moves(lines, k)) << "run " << k << ": " << moves(r, k) << " with arcs, "
+                                                    << moves(lines, k) << " lines";
+  EXPECT_TRUE(std::equal(r.s.begin() + r.offsets[2], r.s.end(), lines.s.begin() + lines.offsets[2],
+                         lines.s.end()));
+  EXPECT_TRUE(std::equal(r.z.begin() + r.offsets[2], r.z.end(), lines.z.begin() + lines.offsets[2],
+                         lines.z.end()));
+  for (std::size_t k = 0; k + 1 < r.offsets.size(); ++k) {
+    EXPECT_TRUE(std::isnan(r.arc_s[r.offsets[k]])) << "a run starts with a vertex, not a move";
+    for (std::size_t v = r.offsets[k] + 1; v < r.offsets[k + 1]; ++v) {
+      if (std::isnan(r.arc_s[v])) continue;
+      EXPECT_LT(k, 2u) << "an arc in the run not marked for arcs";
+      const double ra = std::hypot(r.s[v - 1] - r.arc_s[v], r.z[v - 1] - r.arc_z[v]);
+      const double rb = std::hypot(r.s[v] - r.arc_s[v], r.z[v] - r.arc_z[v]);
+      EXPECT_NEAR(ra, rb, 1e-9 * ra);
+      EXPECT_GE(ra, o.arc_min_radius);
+      EXPECT_LE(ra, o.arc_max_radius);
+    }
+  }
+  tmm::BatchOptions one;
+  one.threads = 1;
+  const LeanResult r1 = tmm::lean_profiles(mesh, c, runs, o, one);
+  EXPECT_EQ(r1.s, r.s);
+  EXPECT_EQ(r1.arc_z.size(), r.arc_z.size());
+  for (std::size_t v = 0; v < std::min(r.arc_z.size(), r1.arc_z.size()); ++v)
+    EXPECT_TRUE(r1.arc_z[v] == r.arc_z[v] || (std::isnan(r1.arc_z[v]) && std::isnan(r.arc_z[v]))) << v;
+  std::cout << "arcs " << r.arcs << ", moves " << r.s.size() - 3 << " (lines alone " << lines.s.size() - 3 << ")\n";
+  return r;
+}
+
+TEST(LeanProfile, ArcsOverAFinelyFacetedCylinder) {
+  // radius 15 along Y, 0.047 mm facets (1.8e-5 mm from the circle): ball r 1 and bull-nose D4 r1
+  const MeshIndex cyl = grid_mesh([](double x, double) { return std::sqrt(std::max(0.0, 225.0 - x * x)) - 5.0; }, -14,
+                             -20, 14, 20, 600, 8);
+  expect_arcs_within_band(cyl, Cutter(1.0, 1.0), 0.001, 4.0);
+  expect_arcs_within_band(cyl, Cutter(2.0, 1.0), 0.001, 4.0);
+}
+
+TEST(LeanProfile, ArcsOverAFacetedSphereStayInTheBand) {
+  // 2.5 mm facets: an arc takes a roll over an edge, no more (results.md, "the least number of moves")
+  const MeshIndex cap = grid_mesh(sphere_cap, -25, -25, 25, 25, 20, 20);
+  expect_arcs_within_band(cap, Cutter(3.0, 3.0), 0.001, 1.0);
 }
 
 TEST(LeanProfile, NeverBelowTheFloor) {

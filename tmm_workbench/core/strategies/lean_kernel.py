@@ -4,8 +4,10 @@ The straight runs of the segments (raster_lean's: passes and zig-zag links, spli
 turns) go to the kernel with their samples; it rebuilds each run's exact CL profile by adaptive exact drops
 (breakpoints located where the triangle holding the cutter changes), fits the fewest lines within +-tol of it
 by min-link windows and checks them at the drop intervals' midpoints near the band's edge (see the header).
-Lines only: with arcs the Python fit (raster_lean.lean_segments) runs. The ends of a run, both ends of a
-vertical move and the moves beside air stay as sampled, as in the Python fit.
+With `arcs`, in runs that lie in a principal vertical plane (XZ or YZ) the kernel then merges consecutive moves
+into one arc (G2/G3) or one longer line where that holds the same band and checks (native/src/query/lean_arcs.cpp).
+The ends of a run, both ends of a vertical move and the moves beside air stay as sampled, as in the Python fit
+(raster_lean.lean_segments, the slow reference).
 """
 from __future__ import annotations
 
@@ -38,12 +40,13 @@ class ExactDrop:
 
 
 def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: float, max_step: float = 0.05,
-                         lower_bound: bool = False, progress: Optional[Progress] = None, threads: int = 0
-                         ) -> tuple[list[CutSegment], dict]:
-    """The segments with each straight run's points replaced by the kernel's lean vertices, and the counts
-    (points_in, points_out, arcs 0, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and
-    with `lower_bound` the least lines any fit within +-tol can use on these runs)."""
-    from tmm_workbench.core.strategies.raster_lean import run_xy, straight_runs, with_runs_replaced
+                         lower_bound: bool = False, progress: Optional[Progress] = None, threads: int = 0,
+                         arcs: bool = False) -> tuple[list[CutSegment], dict, dict]:
+    """The segments with each straight run's points replaced by the kernel's lean vertices, the arcs
+    ({(start xyz, end xyz): Arc} for raster_lean.attach_arcs; empty without `arcs`) and the counts (points_in,
+    points_out, arcs, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and with `lower_bound`
+    the least lines any fit within +-tol can use on these runs)."""
+    from tmm_workbench.core.strategies.raster_lean import arc_entry, plane_of, run_xy, straight_runs, with_runs_replaced
 
     if not tol > 0:
         raise TmmError(f"chord tolerance must be > 0 mm for lean passes, got {tol:g}")
@@ -53,7 +56,8 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
                  kept_dense=0, lower_bound=0)
     if not runs:
         stats["points_out"] = stats["points_in"]
-        return list(segments), stats
+        return list(segments), {}, stats
+    planes = [plane_of(r.u) if arcs else None for r in runs]
     flags = [np.where(r.fixed, native.LEAN_FIXED, 0) | np.where(r.settled, native.LEAN_KEEP, 0) for r in runs]
     offsets = np.concatenate([[0], np.cumsum([len(r.s) for r in runs])]).astype(np.int64)
     try:
@@ -62,15 +66,26 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
             offsets, np.concatenate([r.s for r in runs]), np.concatenate([r.e for r in runs]),
             np.concatenate(flags).astype(np.uint8), tol=float(tol), max_step=float(max_step), min_step=MIN_STEP_MM,
             drop_floor=float(exact.drop_floor), z_shift=float(exact.z_shift), clamp_floor=float(exact.clamp_floor),
-            air_below=float(exact.air_below), lower_bound=lower_bound, threads=threads, progress=progress)
+            air_below=float(exact.air_below), lower_bound=lower_bound,
+            arcs=np.array([p is not None for p in planes], dtype=np.uint8) if arcs else None, threads=threads,
+            progress=progress)
     except native.Cancelled as exc:
         raise Cancelled("tool path computation cancelled") from exc
     except ValueError as exc:  # named by the kernel; max_step is the op's sample step / 2
         raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
     verts = {key: np.column_stack([run_xy(r, s[off[n]:off[n + 1]]), z[off[n]:off[n + 1]]])
              for n, (key, r) in enumerate(zip(keys, runs))}
+    arc_map: dict = {}
+    for n, (key, r) in enumerate(zip(keys, runs)):
+        if planes[n] is None:
+            continue
+        v, cs, cz = verts[key], info["arc_s"][off[n]:off[n + 1]], info["arc_z"][off[n]:off[n + 1]]
+        for i in np.flatnonzero(np.isfinite(cs)):
+            centre = np.array([*(r.origin + cs[i] * r.u), cz[i]])
+            key, arc = arc_entry(v[i - 1], v[i], centre, planes[n])
+            arc_map[key] = arc
     out = with_runs_replaced(segments, parts, verts, verts.__getitem__)
     stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),
                  breakpoints=int(info["breakpoints"]), refits=int(info["refits"]),
-                 kept_dense=int(info["kept_dense"]), lower_bound=int(info["lower_bound"]))
-    return out, stats
+                 kept_dense=int(info["kept_dense"]), lower_bound=int(info["lower_bound"]), arcs=int(info["arcs"]))
+    return out, arc_map, stats

@@ -209,20 +209,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     else:  # lean passes start from the unthinned points
         segments = raster_region.segments(runs, z, air, replace(params, chord_tol=0.0) if lean else params, chains,
                                           _segments)
-    if lean and not params.arcs:  # lines: the kernel's fit (core.strategies.lean_kernel); arcs: the Python fit
+    if lean:  # the kernel's fit (core.strategies.lean_kernel): lines, and arcs where the pass lies in XZ / YZ
         from tmm_workbench.core.strategies.lean_kernel import ExactDrop, lean_segments_kernel
 
         exact = ExactDrop(surface.index, cutter.offset(s), (air_floor if skip else floor_z) - s, s, floor_z,
                           air_floor + 1.0 if skip else -math.inf)
-        segments, diagnostics["lean"] = lean_segments_kernel(segments, exact, params.chord_tol,
-                                                             params.sample_step / 2, progress=progress)
-        diagnostics["arcs"] = {}
-    elif lean:
-        from tmm_workbench.core.strategies import raster_lean
-
-        segments, diagnostics["arcs"], stats = raster_lean.lean_segments(
-            segments, lambda p: drop(p), params.chord_tol, params.arcs, min(params.sample_step / 4, 0.05))
-        diagnostics["lean"] = stats.as_dict()
+        segments, diagnostics["arcs"], diagnostics["lean"] = lean_segments_kernel(
+            segments, exact, params.chord_tol, params.sample_step / 2, progress=progress, arcs=params.arcs)
     if params.verify_cusp:  # issue 14 item 4
         from tmm_workbench.core.footprint.variable_step import verify_params
 

@@ -19,9 +19,10 @@ exact: the neighbouring segments, the linker and raster_refine's cliff corners s
 Arcs (G2/G3) are fitted where the pass lies in a principal vertical plane: a raster at 0 or 180 deg in
 XZ (G18), at 90 or 270 deg in YZ (G19); elsewhere only lines. An arc's end point is exact.
 
-Lines without arcs are fitted in the kernel (core.strategies.lean_kernel, native/src/query/lean_profile.cpp:
-exact breakpoints, min-link windows, fewer moves and 5-10x faster); this fit serves ArcFitting and is the
-slow reference of tests/core/test_lean_kernel.py.
+The op's passes are fitted in the kernel (core.strategies.lean_kernel, native/src/query/lean_profile.cpp and
+lean_arcs.cpp: exact breakpoints, min-link windows, arcs merged from the lines against the exact profile; fewer
+moves and 5-10x faster); this fit is the slow reference of tests/core/test_lean_kernel.py, and this module
+holds what both share (the runs of a path, the arcs' G-code form).
 """
 from __future__ import annotations
 
@@ -276,7 +277,8 @@ def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[_Run]:
     return _Run(seg, xy[0].copy(), u, s.copy(), pts[:, 2].copy(), fixed, settled, end_xy=xy[-1].copy())
 
 
-def _plane(u: np.ndarray) -> Optional[str]:
+def plane_of(u: np.ndarray) -> Optional[str]:
+    """The principal vertical plane ("XZ", "YZ") a run along the XY unit vector u lies in, or None."""
     if abs(u[1]) < _AXIS_TOL:
         return "XZ"
     if abs(u[0]) < _AXIS_TOL:
@@ -341,7 +343,7 @@ def lean_segments(segments: list[CutSegment], drop: Drop, tol: float, arcs: bool
         for r in todo:
             head = (r.pieces or [])[:r.keep]
             start = (head[-1].b, head[-1].zb) if head else (0, math.nan)
-            r.pieces = head + fit_profile(r.s, r.e, tol, r.fixed, arcs and _plane(r.u) is not None, start)
+            r.pieces = head + fit_profile(r.s, r.e, tol, r.fixed, arcs and plane_of(r.u) is not None, start)
             checks.append(_check_points(r, check_step, r.keep))
         xy = np.vstack([r.origin + c[0][:, None] * r.u for r, c in zip(todo, checks)])
         exact, air = drop(xy) if len(xy) else (np.zeros(0), np.zeros(0, dtype=bool))
@@ -451,14 +453,15 @@ def _vertices(r: _Run, arc_map: dict, stats: LeanStats) -> np.ndarray:
     if not r.done:  # still outside the band after every round: its samples, exact
         stats.kept_as_sampled += 1
         return np.column_stack([run_xy(r, r.s), r.e])
-    plane = _plane(r.u)
+    plane = plane_of(r.u)
     verts = [np.array([*(r.origin + r.s[0] * r.u), r.pieces[0].za])]
     for p in r.pieces:
         end = np.array([*run_xy(r, r.s[p.b:p.b + 1])[0], p.zb])
         if p.circle is not None and plane is not None:
             cs, cz, _ = p.circle
             centre = (*(r.origin + cs * r.u), cz)
-            arc_map[(_key(verts[-1]), _key(end))] = _arc(verts[-1], end, np.array(centre), plane)
+            key, arc = arc_entry(verts[-1], end, np.array(centre), plane)
+            arc_map[key] = arc
             stats.arcs += 1
         verts.append(end)
     return np.array(verts)
@@ -539,10 +542,12 @@ def _key(p: np.ndarray) -> tuple[float, float, float]:
     return (float(p[0]), float(p[1]), float(p[2]))
 
 
-def _arc(start: np.ndarray, end: np.ndarray, centre: np.ndarray, plane: str) -> Arc:
-    normal = np.cross(start - centre, end - centre)  # sweep < 180 deg: its sense
+def arc_entry(start: np.ndarray, end: np.ndarray, centre: np.ndarray, plane: str
+              ) -> tuple[tuple[tuple[float, float, float], tuple[float, float, float]], Arc]:
+    """The arc_map entry of the move start -> end about `centre` (its sweep under 180 deg): (start, end) -> Arc."""
+    normal = np.cross(start - centre, end - centre)
     axis = 1 if plane == "XZ" else 0
-    return Arc(_key(centre), bool(normal[axis] < 0), plane)
+    return (_key(start), _key(end)), Arc(_key(centre), bool(normal[axis] < 0), plane)
 
 
 def attach_arcs(toolpath: Toolpath, arc_map: dict) -> Toolpath:

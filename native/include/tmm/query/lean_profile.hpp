@@ -13,7 +13,8 @@
 // middle of what is feasible. (3) Checks: the exact drop at the midpoint of every drop interval where a move
 // comes within (1 - fit_fraction) x tol of the band's edge; a move that leaves +-tol there gets the point
 // as a drop and its stretch is fitted again (up to `rounds`), else the stretch keeps every drop (a polyline
-// within rep_fraction x tol).
+// within rep_fraction x tol). (4) In runs marked for arcs: consecutive moves merged into one arc (G2/G3 in the
+// run's vertical plane) or one longer line where that holds the same band and checks (src/query/lean_arcs.hpp).
 #pragma once
 
 #include <cstddef>
@@ -45,6 +46,9 @@ struct LeanOptions {
                                // between drops)
   int rounds = 4;              // refits after failed checks before a stretch keeps every drop
   bool lower_bound = false;    // also count the least lines any fit within +-tol can use (see below)
+  double arc_min_radius = 0.5;     // mm: arcs (runs marked for them) no tighter than this
+  double arc_max_radius = 1000.0;  // mm: nor flatter
+  double arc_max_slope = 1.0;      // nor where their chord rises more steeply than this
   LeanDrop drop;
 };
 
@@ -59,11 +63,15 @@ struct LeanRuns {
   std::vector<std::size_t> offsets;     // runs + 1
   std::vector<double> s, z;
   std::vector<std::uint8_t> flags;
+  std::vector<std::uint8_t> arcs;       // per run: 1 fits arcs in its vertical plane (empty: none anywhere)
 };
 
 struct LeanResult {
   std::vector<std::size_t> offsets;  // runs + 1, into s / z
   std::vector<double> s, z;          // the vertices of each run (first and last as given)
+  std::vector<double> arc_s, arc_z;  // per vertex (with arcs): the centre (s, z) of the arc ending there, NaN for
+                                     // a line and at a run's first vertex; empty when no run is marked for arcs
+  std::size_t arcs = 0;              // arcs made
   std::size_t drops = 0;             // exact drops made (profile and checks)
   std::size_t breakpoints = 0;       // drop intervals where the triangle holding the cutter changes
   std::size_t refits = 0;            // stretches fitted again after a failed check
