@@ -74,6 +74,18 @@ def test_ball_raster_leaves_the_closed_form_cusp_and_a_lowered_path_gouges():
     assert cmp.gouged and cmp.overall.min_deviation == pytest.approx(-0.05 + off, abs=1e-9)
 
 
+def test_design_heights_exact_on_a_steep_wall():
+    """The design under each cell is the mesh on the cell centre's vertical line: on a plane at 88 deg (a relief's
+    wall) within 1e-4 mm of it (the needle's radius times the slope; a 1e-4 mm needle read 0.0029 mm high, a false
+    gouge for a path within 0.001 mm of the exact CL path)."""
+    k = math.tan(math.radians(88.0))
+    mesh = grid_mesh(lambda x, y: k * x, 4, 4, (0.0, 0.0, 0.2, 1.0))
+    grid = Grid.covering(0.02, 0.1, 0.18, 0.9, 0.01)
+    design = mesh_heights(mesh, grid)
+    exact = k * grid.centres()[:, 0].reshape(grid.ny, grid.nx)
+    assert np.isfinite(design).all() and np.abs(design - exact).max() <= 1e-4
+
+
 def test_rapid_through_the_stock_is_a_collision():
     grid = Grid.covering(0, 0, 20, 20, 0.1)
     tp = Toolpath()
