@@ -4,6 +4,8 @@ of them is the single finishing pass's (earlier sets never cut below the finish)
 raster_drop's tool path unchanged; the start point picks the end of the raster nearest it; bad input by name."""
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -87,6 +89,33 @@ def test_start_point_picks_the_nearest_pass(pattern, corner, stepover):
     got = path.cutting_points()
     assert len(got) == len(plain)
     assert np.allclose(np.sort(got[:, 2]), np.sort(plain[:, 2]), atol=1e-6)
+
+
+@pytest.mark.parametrize("corner", [(0.0, 0.0), (20.0, 12.0)])
+def test_arcs_kept_when_the_pass_set_runs_backwards(corner):
+    """ArcFitting with two pass sets and a start point (the sets begun at the corner nearest it, run backwards
+    for the far corner): every arc the raster fitted reaches the path, in the sense of the way it is run, and the
+    finishing set's moves, arcs as circles, stay within the chord tolerance of the exact CL path."""
+    from tmm_workbench.core.query.drop import DropSurface
+    from tmm_workbench.core.strategies.raster_lean import chorded
+
+    mesh, tol = bump(), 0.001
+    params = SurfaceParams(boundary=BOX, stepover=2.0, sample_step=0.5, forward_step="tolerance", chord_tol=tol,
+                           arcs=True)
+    finish = FinishParams(passes=2, step_down=0.5, start_xy=corner)
+    path = compute_finish_toolpath(mesh, BALL, params, finish, POLICY)
+    fitted = sum(len(compute(mesh, BALL, params if k else replace(params, stock_to_leave=0.5)).diagnostics["arcs"])
+                 for k in (0, 1))
+    assert len(path.arcs) == fitted > 20
+    assert {a.clockwise for a in path.arcs.values()} == {True, False}
+    # the finishing set: the moves after the last retract
+    tp = chorded(path, 1e-6)
+    p = tp.points()
+    last_rapid = max(i for i, m in enumerate(tp.moves) if m.kind is MoveKind.RAPID and i < len(tp.moves) - 3)
+    feed = [i for i in range(last_rapid + 1, len(p)) if tp.moves[i].kind is MoveKind.FEED and i > 0]
+    pts = np.vstack([p[i - 1] + np.linspace(0, 1, 20)[:, None] * (p[i] - p[i - 1]) for i in feed])
+    exact = DropSurface(mesh).drop(BALL, pts[:, :2], float(mesh.bounds[0][2]))
+    assert len(feed) > 100 and np.abs(pts[:, 2] - exact).max() <= tol + 1e-6
 
 
 def test_reverse_path_keeps_joins():

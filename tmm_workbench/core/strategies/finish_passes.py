@@ -23,6 +23,7 @@ from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import STEPOVER, SurfaceParams
+from tmm_workbench.core.strategies.raster_lean import attach_arcs, both_ways
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
@@ -119,22 +120,21 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
     policy.validate()
     if finish.passes == 1 and finish.final_depth is None and finish.start_xy is None:
         return raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, progress, surface)  # as before
-    if params.arcs:  # arcs are matched to moves by their ends: a pass set run backwards would lose them
-        raise TmmError("arc fitting (ArcFitting) does not work yet with finishing passes, a final depth or a start "
-                       "point: turn it off (the lean lines keep the chord tolerance)")
     estimate_work(params, finish)
     if finish.final_depth is not None:
         params = replace(params, floor_z=float(finish.final_depth))
     levels = finish.stock_levels(params.stock_to_leave)
     surface = surface or DropSurface(mesh)
     segments: list[CutSegment] = []
+    arcs: dict = {}  # the pass sets' arcs, by their moves' ends either way (a set may run backwards)
     top = -np.inf
     for i, stock in enumerate(levels):
         report = None
         if progress is not None:
             report = lambda f, i=i: progress((i + f) / len(levels))  # noqa: E731
-        top_i, pass_set = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy, report,
-                                    surface)
+        top_i, pass_set, arcs_i = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy,
+                                            report, surface)
+        arcs.update(both_ways(arcs_i))
         top = max(top, top_i)
         if pass_set:
             pass_set[0] = replace(pass_set[0], joined=False)  # a retract between the sets
@@ -142,19 +142,20 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    return link(segments, policy)
+    return attach_arcs(link(segments, policy), arcs)
 
 
 def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Optional[tuple[float, float]],
-              progress: Optional[Progress], surface: DropSurface) -> tuple[float, list[CutSegment]]:
-    """(highest tip, segments) of one pass set, begun nearest the start point. A zig-zag can only be run
+              progress: Optional[Progress], surface: DropSurface) -> tuple[float, list[CutSegment], dict]:
+    """(highest tip, segments, arcs as fitted: raster_lean's arc map) of one pass set, begun nearest the start
+    point. A zig-zag can only be run
     forwards or backwards; the raster turned by 180 degrees (the same passes in the other order, each run the
     other way) starts at the mirror image of these ends through the boundary's centre, and is computed when that
     would start nearer (an even pass count: the other two corners)."""
     result = raster_drop.compute(mesh, cutter, params, progress, surface)
     segments = start_order(result.segments, start_xy)
     if start_xy is None or not segments:
-        return result.diagnostics["top"], segments
+        return result.diagnostics["top"], segments, result.diagnostics.get("arcs") or {}
     b = params.boundary
     centre = np.array([(b[0] + b[2]) / 2.0, (b[1] + b[3]) / 2.0, 0.0])
     best = start_key(segments[0].tips, start_xy)
@@ -164,5 +165,5 @@ def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Op
                                     surface)
         other_segments = start_order(other.segments, start_xy)
         if other_segments and start_key(other_segments[0].tips, start_xy) < best:
-            return other.diagnostics["top"], other_segments
-    return result.diagnostics["top"], segments
+            return other.diagnostics["top"], other_segments, other.diagnostics.get("arcs") or {}
+    return result.diagnostics["top"], segments, result.diagnostics.get("arcs") or {}

@@ -550,6 +550,15 @@ def arc_entry(start: np.ndarray, end: np.ndarray, centre: np.ndarray, plane: str
     return (_key(start), _key(end)), Arc(_key(centre), bool(normal[axis] < 0), plane)
 
 
+def both_ways(arc_map: dict) -> dict:
+    """`arc_map` with each arc also under its move run backwards (the same circle, the other sense): for a pass
+    set a start point or the pass sets' order runs the other way (core.strategies.finish_passes)."""
+    out = dict(arc_map)
+    for (start, end), arc in arc_map.items():
+        out.setdefault((end, start), replace(arc, clockwise=not arc.clockwise))
+    return out
+
+
 def attach_arcs(toolpath: Toolpath, arc_map: dict) -> Toolpath:
     """Marks the FEED moves of `toolpath` that are arcs (toolpath.arcs: move index -> Arc): the linker copies
     the segments' tips, so a move is found by its start and end."""
