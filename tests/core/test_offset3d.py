@@ -216,6 +216,36 @@ def test_contours_are_simplified_within_the_tolerance_on_a_long_gentle_curve():
     assert _distances(ring, [np.vstack([before, before[:1]])]).max() > 10 * tol
 
 
+
+def _square_with_a_smeared_corner(seed: int, noise: float, cell: float = 0.2, side: float = 20.0) -> np.ndarray:
+    """A closed counter-clockwise square contour, vertices `cell` apart, each moved by up to `noise` mm (the
+    first-order wobble of a contour), its corner at (side, 0) rounded over 0.5 mm (the smeared ridge of T)."""
+    rng = np.random.default_rng(seed)
+    corners = np.array([(0.0, 0.0), (side, 0.0), (side, side), (0.0, side)])
+    s = np.arange(0.0, side, cell)[:, None]
+    p = np.vstack([a + s * (b - a) / side for a, b in zip(corners, np.roll(corners, -1, axis=0))])
+    far = np.hypot(*(p - corners[1]).T) >= 0.5
+    p[far] += rng.uniform(-noise, noise, (int(far.sum()), 2))
+    near = np.flatnonzero(~far)
+    ang = np.linspace(-0.5 * math.pi, 0.0, len(near) + 2)[1:-1]
+    p[near] = corners[1] + np.array([-0.5, 0.5]) + 0.5 * np.column_stack([np.cos(ang), np.sin(ang)])
+    return np.vstack([p, p[:1]])
+
+
+def test_a_smeared_corner_is_rebuilt_from_its_fitted_edges():
+    """offset_field.sharpened rebuilds a corner from the straight edges either side, each the least-squares line of
+    the contour over 2-4 reaches from the corner: within 0.04 mm of the exact corner for a wobble of 0.01 mm (30
+    seeds). Through two vertices a cell apart (before) the wobble was extrapolated up to 0.094 mm; on seed 000's
+    whole convex surface a corner so rebuilt lay 0.14 mm out, 1.07 x half a step from the next pass (2 % over the
+    cusp)."""
+    worst = 0.0
+    for seed in range(30):
+        out = offset_field.sharpened(_square_with_a_smeared_corner(seed, 0.01), 0.4)
+        worst = max(worst, float(np.hypot(*(out[:-1] - (20.0, 0.0)).T).min()))
+    assert worst <= 0.04
+    exact = offset_field.sharpened(_square_with_a_smeared_corner(0, 0.0), 0.4)    # no wobble: the corner exactly
+    assert float(np.hypot(*(exact[:-1] - (20.0, 0.0)).T).min()) <= 1e-9
+
 def test_bad_inputs_are_refused_by_name_before_any_path():
     mesh = plate()
     with pytest.raises(TmmError, match=r"cusp height must be in \(0, 3\] mm .* got 4"):

@@ -48,11 +48,16 @@ _SIMPLIFY = 0.005        # contour vertices within this many flat steps of the c
                          # polygons.ARC_TOL; Douglas-Peucker: the pass moves by at most 0.5 % of the step, the cusp
                          # by 1 %; at 1 % sphere_on_plate's maximum was 0.0101 mm)
 _MIN_HALF = 2.0          # half-level pieces shorter than this many flat steps are left out
-_PROBE = 0.5            # slope and curvature across from heights this many flat steps either side (offset3d's band)
+_PROBE = 0.4            # slope and curvature across from heights this many flat steps either side. At half a flat
+                         # step (offset3d's band: 1.5 local steps at 72 deg, where the step moves by tan(slope) = 3 x
+                         # the slope's error in rad) seed 000's concave surface read 69.7 deg and R k 0.02 where the
+                         # section peaks at 72.3 deg bending up with R k 0.22: passes 0.49 mm apart where the exact
+                         # cusp allows 0.44, 1.13 x the tolerance. Not smaller: on a convex flank the larger half
+                         # secant is the margin (at 0.3 the dome's 99.9th percentile, test_offset3d, went to 1.03 x)
 _BYTES_PER_NODE = 64     # heights, T, masks, the node coordinates and the drop's work arrays
 CUSP_AIM = 0.92          # the rule's cusp: this share of the tolerance (the step 4 % narrower for a ball), for
                          # what the field samples only to first order: the marching in its cell, the 0.25 mm
-                         # chords along the passes, the slope and curvature as secants over half a step
+                         # chords along the passes, the slope and curvature as secants over _PROBE of a step
                          # (measured: benchmarks/offset3d_where.py, results.md "### 3D offset")
 _RIDGE_DEG = 45.0        # a half-level point lies on a ridge of T where grad T turns by more than this across
                          # _RIDGE_CELLS either side (a corner's bisector, fronts meeting, a hilltop)
@@ -62,6 +67,8 @@ _COVER_SLACK = 1.04      # a ridge point is uncovered beyond this x half the aim
 _COVER_SLOPE = 10.0      # deg: ridge points checked on CL slopes up to this (corners on flats, hilltops); on a
                          # relief the check flagged a thousand short pieces that barely moved the simulated cusp
 _COVER_RUN = 0.25        # flat steps added at either end of an uncovered run of the half level (_uncovered)
+_FIT_REACH = 4.0         # sharpened: each edge fitted over 2 to this many reaches from the corner
+_EDGE_TURN = 10.0        # deg: ... as long as it turns by no more than this (not round a short side's corner)
 
 
 _RULES: dict[tuple, StepRule] = {}
@@ -126,12 +133,34 @@ def simplified_ring(ring: np.ndarray, tol: float) -> np.ndarray:
     return np.vstack([a, b[1:-1]])
 
 
+def _fitted_line(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The least-squares line of the points (at least two): its centroid and unit direction, oriented from the
+    first point toward the last."""
+    c = pts.mean(axis=0)
+    q = pts - c
+    d = np.linalg.eigh(q.T @ q)[1][:, -1] if len(pts) > 2 else q[-1] - q[0]
+    d = d / max(float(np.hypot(*d)), 1e-300)
+    return c, (d if float(d @ (pts[-1] - pts[0])) >= 0 else -d)
+
+
+def _straight(turn: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """The leading vertices of `idx` (walked away from a corner) before the turns past its first add up to more
+    than _EDGE_TURN either way (the next corner of a short side), at least two."""
+    if len(idx) < 3:
+        return idx
+    bend = np.maximum.accumulate(np.abs(np.cumsum(turn[idx[1:-1]])))
+    return idx[:max(2, 2 + int(np.searchsorted(bend, math.radians(_EDGE_TURN), side="right")))]
+
+
 def sharpened(loop: np.ndarray, reach: float) -> np.ndarray:
     """The closed loop with its contoured corners made sharp again. At a convex corner's bisector T has a ridge
     (two fronts meet), where first-order fast marching solves across the ridge (T a little low there) and the
     contour cuts the corner over a few cells: the left turns within `reach` mm either side of a vertex add up to
-    more than offset3d's sharp turn. The vertices there are replaced by the crossing of the edges either side
-    (the two vertices just outside), the corner the exact offset has, so that offset3d._spiked sees it."""
+    more than offset3d's sharp turn. The vertices there are replaced by the crossing of the edges either side,
+    the corner the exact offset has, so that offset3d._spiked sees it. Each edge is the least-squares line of the
+    contour's vertices 2 to _FIT_REACH reaches from the corner: the line through two vertices a cell apart,
+    extrapolated several times their spacing, amplified the contour's first-order wobble (seed 000's convex
+    surface: a corner 0.14 mm out, 1.07 x half a step from the next pass, 2 % over the cusp)."""
     from tmm_workbench.core.footprint.offset3d import _SHARP_RAD
 
     p = loop[:-1]
@@ -154,22 +183,26 @@ def sharpened(loop: np.ndarray, reach: float) -> np.ndarray:
     corner: dict[int, np.ndarray] = {}
     taken = np.zeros(n, dtype=bool)
     at = lambda d: np.searchsorted(s3, mid + d, side="left")  # noqa: E731 (vertex indices at arc offsets)
-    run_lo, run_hi, in_lo, out_hi = at(-2 * reach), at(2 * reach), at(-3 * reach), at(3 * reach)
+    run_lo, run_hi = at(-2 * reach), at(2 * reach)
+    in_lo, out_hi = at(-_FIT_REACH * reach), at(_FIT_REACH * reach)
     for i in np.argsort(-window):
         if window[i] <= _SHARP_RAD:
             break
         run = np.arange(run_lo[i], run_hi[i]) % n    # replaced: the smeared stretch, clear of the ridge's reach
         if taken[run].any() or turn[np.arange(lo[i], hi[i]) % n].min() < -math.radians(1.0):
             continue
-        p0, p1 = p[in_lo[i] % n], p[(run_lo[i] - 1) % n]   # the straight edge coming in, the one going out
-        q0, q1 = p[run_hi[i] % n], p[out_hi[i] % n]
-        d1, d2 = p1 - p0, q1 - q0
+        edge_in = p[_straight(turn, np.arange(run_lo[i] - 1, in_lo[i] - 1, -1) % n)][::-1]   # the edge coming in,
+        edge_out = p[_straight(turn, np.arange(run_hi[i], out_hi[i] + 1) % n)]              # the one going out
+        if len(edge_in) < 2 or len(edge_out) < 2:
+            continue
+        (p0, d1), (q0, d2) = _fitted_line(edge_in), _fitted_line(edge_out)
         den = d1[0] * d2[1] - d1[1] * d2[0]
-        if abs(den) < 1e-12 or float(np.hypot(*d1)) < 1e-9 or float(np.hypot(*d2)) < 1e-9:
+        if abs(den) < 1e-12:
             continue
         t = ((q0[0] - p0[0]) * d2[1] - (q0[1] - p0[1]) * d2[0]) / den
         x = p0 + t * d1
-        if t < 0.5 or float(np.hypot(*(x - p[i]))) > 2 * reach:
+        # the corner ahead of the edge coming in and before the one going out, near the smeared one
+        if t <= 0 or float((q0 - x) @ d2) <= 0 or float(np.hypot(*(x - p[i]))) > 2 * reach:
             continue
         taken[run] = True
         corner[int(run[0])] = x
