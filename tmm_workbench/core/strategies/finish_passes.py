@@ -20,7 +20,7 @@ from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.params import Spec, StrategyParams, check_finite, param
 from tmm_workbench.core.query.drop import DropSurface, Progress
-from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.segments import CutSegment, StrategyResult
 from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import STEPOVER, SurfaceParams
 from tmm_workbench.core.strategies.raster_lean import attach_arcs, both_ways
@@ -132,10 +132,10 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
         report = None
         if progress is not None:
             report = lambda f, i=i: progress((i + f) / len(levels))  # noqa: E731
-        top_i, pass_set, arcs_i = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy,
-                                            report, surface)
-        arcs.update(both_ways(arcs_i))
-        top = max(top, top_i)
+        result, pass_set = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy, report,
+                                     surface)
+        arcs.update(both_ways(result.diagnostics.get("arcs") or {}))
+        top = max(top, result.diagnostics["top"])
         if pass_set:
             pass_set[0] = replace(pass_set[0], joined=False)  # a retract between the sets
         segments += pass_set
@@ -146,16 +146,16 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
 
 
 def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Optional[tuple[float, float]],
-              progress: Optional[Progress], surface: DropSurface) -> tuple[float, list[CutSegment], dict]:
-    """(highest tip, segments, arcs as fitted: raster_lean's arc map) of one pass set, begun nearest the start
-    point. A zig-zag can only be run
-    forwards or backwards; the raster turned by 180 degrees (the same passes in the other order, each run the
+              progress: Optional[Progress], surface: DropSurface
+              ) -> tuple[StrategyResult, list[CutSegment]]:
+    """(the raster's result, its segments begun nearest the start point) of one pass set. A zig-zag can only be
+    run forwards or backwards; the raster turned by 180 degrees (the same passes in the other order, each run the
     other way) starts at the mirror image of these ends through the boundary's centre, and is computed when that
     would start nearer (an even pass count: the other two corners)."""
     result = raster_drop.compute(mesh, cutter, params, progress, surface)
     segments = start_order(result.segments, start_xy)
     if start_xy is None or not segments:
-        return result.diagnostics["top"], segments, result.diagnostics.get("arcs") or {}
+        return result, segments
     b = params.boundary
     centre = np.array([(b[0] + b[2]) / 2.0, (b[1] + b[3]) / 2.0, 0.0])
     best = start_key(segments[0].tips, start_xy)
@@ -165,5 +165,5 @@ def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Op
                                     surface)
         other_segments = start_order(other.segments, start_xy)
         if other_segments and start_key(other_segments[0].tips, start_xy) < best:
-            return other.diagnostics["top"], other_segments, other.diagnostics.get("arcs") or {}
-    return result.diagnostics["top"], segments, result.diagnostics.get("arcs") or {}
+            return other, other_segments
+    return result, segments

@@ -82,8 +82,8 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
         v, cs, cz = verts[key], info["arc_s"][off[n]:off[n + 1]], info["arc_z"][off[n]:off[n + 1]]
         for i in np.flatnonzero(np.isfinite(cs)):
             centre = np.array([*(r.origin + cs[i] * r.u), cz[i]])
-            key, arc = arc_entry(v[i - 1], v[i], centre, planes[n])
-            arc_map[key] = arc
+            move, arc = arc_entry(v[i - 1], v[i], centre, planes[n])
+            arc_map[move] = arc
     out = with_runs_replaced(segments, parts, verts, verts.__getitem__)
     stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),
                  breakpoints=int(info["breakpoints"]), refits=int(info["refits"]),
