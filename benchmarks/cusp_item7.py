@@ -1,9 +1,9 @@
 """Issue 14 item 7 in one run: passes and cycle time at equal maximum cusp, constant step-over against the
-constant cusp mode, the adaptive raster (with and without the verification pass) and the 3D offset (the
-verification needs straight raster passes: none there), on sphere_on_plate.stl and mount_rush.stl (ball D6,
-cusp 0.01 mm) and seed 000's convex and concave surfaces (ball D 0.5 in, cusp 0.002 in, a 100 x 100 mm window
-at the centre, then the whole surfaces); then the wait a user sees on sphere_on_plate (OK to path and FreeCAD's
-linuxcnc post, through `freecadcmd` and `run_surface`) for each spacing, "before" being the constant step-over op.
+constant cusp mode, the adaptive raster and the 3D offset (each with and without the verification pass), on
+sphere_on_plate.stl and mount_rush.stl (ball D6, cusp 0.01 mm) and seed 000's convex and concave surfaces (ball
+D 0.5 in, cusp 0.002 in, a 100 x 100 mm window at the centre, then the whole surfaces); then the wait a user sees
+on sphere_on_plate (OK to path and FreeCAD's linuxcnc post, through `freecadcmd` and `run_surface`) for each
+spacing, "before" being the constant step-over op.
 
 Every row is measured as `benchmarks/cusp_spacing.py` measures (its functions, not a copy): the strategies are
 called through `core.strategies.raster_drop.compute` (the op's own entry), the path linked, cut into the stock
@@ -15,8 +15,9 @@ largest step whose simulated maximum cusp is the adaptive raster's (bisection, 7
     .venv/bin/python benchmarks/cusp_item7.py --quick    # sphere_on_plate only (and the end-to-end table)
     ... --no-e2e       # without the FreeCAD table;  --no-whole: seed 000 on the window only (the whole
                        # surfaces take about 15 min more)
-    ... --modes cusp   # only these rows (from stepover,cusp,adaptive,verify,offset3d), e.g. the constant cusp mode
-    ... --offset3d-only  # the same as --modes offset3d --no-e2e
+    ... --modes cusp   # only these rows (from stepover,cusp,adaptive,verify,offset3d,offset3d-verify), e.g. the
+                       # constant cusp mode
+    ... --offset3d-only  # the same as --modes offset3d,offset3d-verify --no-e2e
 The end-to-end table needs `freecadcmd` and a HOME whose FreeCAD Mod/TMM is this checkout.
 """
 from __future__ import annotations
@@ -76,7 +77,7 @@ def _row(t: tuple, partial: int = 0, passes: Optional[int] = None, note: str = "
                note)
 
 
-MODES = ("stepover", "cusp", "adaptive", "verify", "offset3d")  # the rows, by --modes
+MODES = ("stepover", "cusp", "adaptive", "verify", "offset3d", "offset3d-verify")  # the rows, by --modes
 
 
 def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float, boundary=None,
@@ -131,8 +132,9 @@ def model_rows(name: str, mesh: TriMesh, cutter: Cutter, tol: float, cell: float
         checked("adaptive + verify", "adaptive")
     if "offset3d" in modes:
         spacing("3D offset", "offset3d")
-    # no "3D offset + verify": the verification needs straight raster passes (core.footprint.variable_step)
-    order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset"]
+    if "offset3d-verify" in modes:
+        checked("3D offset + verify", "offset3d")
+    order = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset", "3D offset + verify"]
     rows = [found[k] for k in order if k in found]
     header = (f"{name}: {len(mesh.triangles)} triangles, {cutter.describe()}, cusp {tol:g} mm, region "
               f"{', '.join(f'{v:.1f}' for v in boundary)}; {field.share:.0%} of the cells measured "
@@ -203,13 +205,14 @@ def main() -> None:
     ap.add_argument("--window", type=float, default=100.0,
                     help="seed 000: the side in mm of the square region centred on the surface (0: the whole)")
     ap.add_argument("--no-whole", action="store_true", help="seed 000 on the window only, not also on the whole")
-    ap.add_argument("--offset3d-only", action="store_true", help="the same as --modes offset3d --no-e2e")
+    ap.add_argument("--offset3d-only", action="store_true",
+                    help="the same as --modes offset3d,offset3d-verify --no-e2e")
     ap.add_argument("--modes", default=",".join(MODES),
                     help=f"the rows to measure, comma-separated from {','.join(MODES)} (e.g. --modes cusp: the "
                          f"constant cusp mode rows only)")
     args = ap.parse_args()
     if args.offset3d_only:
-        args.modes, args.no_e2e = "offset3d", True
+        args.modes, args.no_e2e = "offset3d,offset3d-verify", True
     modes = tuple(m.strip() for m in args.modes.split(",") if m.strip())
     if not modes or any(m not in MODES for m in modes):
         ap.error(f"--modes must name rows from {','.join(MODES)}, got {args.modes!r}")

@@ -76,6 +76,16 @@ class VerifyCusp(FreeCADTestCase):
             run_surface(str(bump_stl()), doc_name="TmmApiBad", verify_cusp="yes", **kw)
         close_all()
 
+    def test_run_surface_verify_cusp_on_the_3d_offset(self) -> None:
+        """The 3D offset's loops verified (their gaps read from the arrival field): the op computes, the path holds
+        the cusp, the report is in the diagnostics."""
+        r = run_surface(str(bump_stl()), doc_name="TmmApiVerify3D", diameter=4.0, sample_step=0.5, cusp=TOL,
+                        stepover_mode="offset3d", verify_cusp=True, progress=False)
+        self.assertEqual(r.op.StepOverMode, "Offset3D")
+        self.assertIs(r.op.VerifyCusp, True)
+        self.assertLessEqual(simulated_max_cusp(r.op), TOL)
+        close_all()
+
 
 if __name__ == "__main__":
     unittest.main()

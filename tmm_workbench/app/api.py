@@ -105,7 +105,8 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     G2/G3 in the pass's plane (XZ/YZ, rasters at 0/90 deg) with 'tolerance', where the post writes K (not
     linuxcnc: lines there, with a warning).
     verify_cusp: cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds
-    `cusp` (the op's VerifyCusp; issue 14 item 4), stepover_mode stepover, cusp or adaptive (not offset3d), zigzag or oneway over the box.
+    `cusp` (the op's VerifyCusp; issue 14 item 4), any stepover_mode (offset3d: the extra passes are level sets
+    of its field between two loops), zigzag or oneway over the box.
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     Depths (app.surface_passes, as the op's panel): stepover_percent (of the tool diameter, in (0, 100], instead

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -48,6 +48,7 @@ class OffsetLoops:
     flat_step: float = 0.0   # the rule's step on a plane (mm)
     least_step: float = 0.0  # the smallest XY distance between passes allowed (mm)
     levels: int = 0
+    field: Any = None        # offset_field.Field: the arrival field whose level sets the loops are (3D offset)
 
 
 class StepRule:

@@ -44,7 +44,7 @@ _SLOPE_TABLE = 76        # the rule's step tabulated at this many slopes from 0 
                          # interpolates linearly; StepRule itself interpolates a 5 deg table)
 _BAND_CELLS = 1.5        # start nodes: within this many cells of the start set (both ends of every cut edge)
 _WALK = 0.75            # the half level is cut where T reaches k + 1 within this many local steps (_half_level)
-_SIMPLIFY = 0.005        # contour vertices within this many flat steps of the chord kept over them go (and within
+SIMPLIFY = 0.005         # contour vertices within this many flat steps of the chord kept over them go (and within
                          # polygons.ARC_TOL; Douglas-Peucker: the pass moves by at most 0.5 % of the step, the cusp
                          # by 1 %; at 1 % sphere_on_plate's maximum was 0.0101 mm)
 _MIN_HALF = 2.0          # half-level pieces shorter than this many flat steps are left out
@@ -293,6 +293,7 @@ class Field:
                  steps: Optional[Callable[[np.ndarray, np.ndarray, float], np.ndarray]] = None) -> None:
         self.xs, self.ys, self.t = xs, ys, t
         self.probe = 0.0        # mm: the probe the marching took the slope and curvature over
+        self.flat_step = 0.0    # mm: the rule's step on a plane (one unit of T there)
         self.slope: Optional[np.ndarray] = None   # (ny, nx) the CL surface's slope (deg) at the nodes
         self.steps = steps      # (xy, u, probe) -> the speed's step (mm) at XY points for fronts along u, the
                                 # slope and curvature from heights `probe` mm either side (the kernel's)
@@ -380,7 +381,7 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
                                     **dict(args, probe=probe))
 
     field = Field(xs, ys, t, steps_at)
-    field.probe = args["probe"]
+    field.probe, field.flat_step = args["probe"], flat
     dz_dy, dz_dx = np.gradient(z, cell)
     field.slope = np.degrees(np.arctan(np.hypot(dz_dx, dz_dy)))
     return field, rule
@@ -514,11 +515,11 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         raise TmmError(f"cusp slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
     field, rule = arrival(shape, heights, cutter, cusp, max_slope_deg, start)
     flat = rule.flat
-    arc_tol = min(polygons.ARC_TOL, _SIMPLIFY * flat)
+    arc_tol = min(polygons.ARC_TOL, SIMPLIFY * flat)
     finite = field.t[np.isfinite(field.t)]
     top = float(finite.max()) if len(finite) else 0.0
     levels = int(math.floor(top))
-    out = OffsetLoops(flat_step=flat, least_step=flat)
+    out = OffsetLoops(flat_step=flat, least_step=flat, field=field)
     out.least_step = float(rule.step(np.array([max_slope_deg]))[0]) * 0.5
 
     def keep(lines: list[np.ndarray]) -> list[np.ndarray]:

@@ -11,13 +11,17 @@ the raster's own (same drop, gouge check between CL points, chord thinning), cut
 strip (only the cells under the new pass are simulated again), and the round repeats until no measured cell
 exceeds the tolerance or the round limit is reached; what stays is reported, as are the cells the tool cannot
 reach (not cusps: pencil or a smaller tool's work) and the steep cells (waterline's).
+
+The 3D offset's loops (step-over mode offset3d) are verified the same way; their gaps are read from the
+arrival field whose level sets they are, and a bucket's extra pass is the level set half way between its two
+loops, over its cells (`_Levels`).
 """
 from __future__ import annotations
 
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -54,6 +58,7 @@ class Bucket:
     cells: int              # exceeding cells
     max_cusp: float         # mm
     added: int              # extra passes put in the gap over the stretch
+    where: Optional[np.ndarray] = None   # the 3D offset's: the cells' tips (XY), the stretch's place
 
 
 @dataclass
@@ -122,8 +127,11 @@ def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float)
 
 
 class _Passes:
-    """The straight passes of the set: across-offset and the along-range each covers (a pass split by air is
-    several)."""
+    """A raster's gaps: the straight passes of the set, their across-offset and the along-range each covers (a
+    pass split by air is several). A bucket's extra passes are evenly spaced in its gap, over its stretch."""
+
+    serpentine = True   # consecutive partial passes alternate their direction
+    join = 2.0          # tool diameters: partial passes closer than this are joined on the surface
 
     def __init__(self, angle_deg: float) -> None:
         a = math.radians(angle_deg)
@@ -152,33 +160,122 @@ class _Passes:
             upper[above] = np.minimum(upper[above], c)
         return np.where(np.isfinite(lower), lower, np.nan), np.where(np.isfinite(upper), upper, np.nan)
 
+    def buckets(self, tips: np.ndarray, values: np.ndarray, round_: int, tolerance: float,
+                join: float) -> list[Bucket]:
+        """The exceeding cells' tips grouped by gap and by stretch along it (see the module)."""
+        u, v = tips @ self.d, tips @ self.n
+        lower, upper = self.gaps(u, v)
+        inside = np.isfinite(lower) & np.isfinite(upper)
+        out: list[Bucket] = []
+        keys = np.column_stack([lower[inside], upper[inside]])
+        u, values = u[inside], values[inside]
+        if not len(keys):
+            return out
+        uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
+        for k, (lo, hi) in enumerate(uniq):
+            sel = np.flatnonzero(inverse.ravel() == k)
+            order = sel[np.argsort(u[sel])]
+            breaks = np.flatnonzero(np.diff(u[order]) > join) + 1
+            for part in np.split(order, breaks):
+                top = float(values[part].max())
+                # cusp ~ step^2: m sub-gaps of width w / m give top / m^2 <= TARGET x tolerance
+                m = max(2, math.ceil(math.sqrt(top / (_TARGET * tolerance)) - 1e-9))
+                out.append(Bucket(round_, float(lo), float(hi), float(u[part].min()), float(u[part].max()),
+                                  len(part), top, m - 1))
+        return sorted(out, key=lambda b: (b.lower, b.start))
 
-def _buckets(cusp: np.ndarray, bad: np.ndarray, grid: Grid, to_tip: np.ndarray, passes: _Passes, join: float,
-             round_: int, tolerance: float) -> list[Bucket]:
-    """Exceeding cells grouped by gap and by stretch along it (see the module); a cell counts where the tool
-    tip stands when it touches there (`to_tip`: (ny, nx, 2) offsets), since the passes are tip positions."""
-    centres = grid.centres()[bad.ravel()] + to_tip.reshape(-1, 2)[bad.ravel()]
-    values = cusp.ravel()[bad.ravel()]
-    u, v = centres @ passes.d, centres @ passes.n
-    lower, upper = passes.gaps(u, v)
-    inside = np.isfinite(lower) & np.isfinite(upper)
-    out: list[Bucket] = []
-    keys = np.column_stack([lower[inside], upper[inside]])
-    u, values = u[inside], values[inside]
-    if not len(keys):
+    def lines(self, b: Bucket, boundary: Rect, run_on: float, sample_step: float) -> list[np.ndarray]:
+        """The bucket's partial passes (XY, sampled), in its gap over its stretch and `run_on` beyond."""
+        out = []
+        for i in range(1, b.added + 1):
+            c = b.lower + (b.upper - b.lower) * i / (b.added + 1)
+            line = clip_line_to_rect(c * self.n, self.d, boundary)
+            if line is None:
+                continue
+            ua, ub = line @ self.d
+            ua, ub = max(min(ua, ub), b.start - run_on), min(max(ua, ub), b.end + run_on)
+            if ub - ua > 1e-9:
+                out.append(sample_segment(c * self.n + ua * self.d, c * self.n + ub * self.d, sample_step))
         return out
-    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-    for k, (lo, hi) in enumerate(uniq):
-        sel = np.flatnonzero(inverse.ravel() == k)
-        order = sel[np.argsort(u[sel])]
-        breaks = np.flatnonzero(np.diff(u[order]) > join) + 1
-        for part in np.split(order, breaks):
-            top = float(values[part].max())
-            # cusp ~ step^2: m sub-gaps of width w / m give top / m^2 <= TARGET x tolerance
-            m = max(2, math.ceil(math.sqrt(top / (_TARGET * tolerance)) - 1e-9))
-            out.append(Bucket(round_, float(lo), float(hi), float(u[part].min()), float(u[part].max()), len(part),
-                              top, m - 1))
-    return out
+
+
+class _Levels:
+    """The 3D offset's gaps (core.footprint.offset_field): its loops are the level sets {T = k} of one arrival
+    field, so the gap a tip lies in is read from T there. In round r the gaps are intervals of T 2^(1-r) wide
+    (between loops k and k + 1 in the first round, halves in the second, ...) and a bucket's extra pass is the
+    level set at its gap's middle (half way between its loops, in local steps), over the bucket's cells and
+    `run_on` beyond. Buckets: a gap's cells closer than `join` to each other. The cusp falls as the step squared,
+    so a halving brings a cusp up to 4 x TARGET within; a higher one is halved again in the next round."""
+
+    serpentine = False  # the partial passes of a round in nearest-first order (_nearest_first)
+    join = 4.0          # tool diameters: partial passes closer than this are joined on the surface (the pieces
+                        # are short and scattered: a lift costs more than a longer link)
+
+    def __init__(self, field: Any) -> None:
+        self.field = field
+        self._lines: dict[float, list[np.ndarray]] = {}
+
+    def add(self, tips: np.ndarray) -> bool:
+        return True
+
+    def buckets(self, tips: np.ndarray, values: np.ndarray, round_: int, tolerance: float,
+                join: float) -> list[Bucket]:
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+        from scipy.spatial import cKDTree
+
+        t = self.field.at(tips)
+        ok = np.isfinite(t)
+        tips, values, t = tips[ok], values[ok], t[ok]
+        width = 0.5 ** (round_ - 1)
+        gap = np.floor(t / width)
+        out: list[Bucket] = []
+        for g in np.unique(gap):
+            sel = np.flatnonzero(gap == g)
+            pairs = cKDTree(tips[sel]).query_pairs(join, output_type="ndarray")
+            graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(sel), len(sel)))
+            _, label = connected_components(graph, directed=False)
+            for part in (sel[label == k] for k in range(label.max() + 1)):
+                worst = part[np.argmax(values[part])]
+                # start = end: T at the worst cell (the fallback level of `lines`)
+                out.append(Bucket(round_, float(g * width), float((g + 1) * width), float(t[worst]),
+                                  float(t[worst]), len(part), float(values[part].max()), 1, where=tips[part]))
+        return sorted(out, key=lambda b: (b.lower, float(b.where[:, 0].min())))
+
+    def _level(self, level: float) -> list[np.ndarray]:
+        if level not in self._lines:
+            self._lines[level] = self.field.lines(level)
+        return self._lines[level]
+
+    def lines(self, b: Bucket, boundary: Rect, run_on: float, sample_step: float) -> list[np.ndarray]:
+        """The level set at the gap's middle near the bucket's cells; where it does not come near them (a
+        hilltop of T below the middle), the level set through the bucket's worst cell."""
+        from scipy.spatial import cKDTree
+
+        from tmm_workbench.core import polygons
+        from tmm_workbench.core.footprint import offset_field
+        from tmm_workbench.core.footprint.region import box_region
+
+        flat = self.field.flat_step
+        reach = run_on + 0.5 * flat   # the cells lie up to half a gap (at most half a flat step) from its middle
+        lo, hi = b.where.min(axis=0) - reach, b.where.max(axis=0) + reach
+        tree = cKDTree(b.where)
+        for level in (0.5 * (b.lower + b.upper), b.start):
+            pieces = []
+            for line in self._level(level):
+                if np.any(line.max(axis=0) < lo) or np.any(line.min(axis=0) > hi):
+                    continue
+                near = tree.query(line, distance_upper_bound=reach)[0] <= reach
+                edges = np.flatnonzero(np.diff(np.concatenate([[0], near.astype(np.int8), [0]])))
+                for a, e in zip(edges[::2], edges[1::2]):
+                    if e - a >= 2:
+                        pieces.append(line[a:e])
+            pieces = polygons.clip_open(pieces, box_region(boundary)) if pieces else []
+            if pieces:
+                tol = min(polygons.ARC_TOL, offset_field.SIMPLIFY * flat)
+                return [offset_field.resampled(offset_field.simplified(p, tol), sample_step) for p in pieces
+                        if float(np.hypot(*np.diff(p, axis=0).T).sum()) > 1e-6]
+        return []
 
 
 def _strip(grid: Grid, tips: np.ndarray, reach: float) -> Optional[tuple[Grid, slice, slice]]:
@@ -193,17 +290,33 @@ def _strip(grid: Grid, tips: np.ndarray, reach: float) -> Optional[tuple[Grid, s
     return sub, slice(j0, j1), slice(i0, i1)
 
 
-def _extra_segments(start: np.ndarray, end: np.ndarray, drop: Drop, sample_step: float, gouge_tol: float,
-                    chord_tol: float) -> list[CutSegment]:
-    """One partial pass, dropped and checked as raster_drop drops its own (split where it crosses air)."""
+def _extra_segments(xy: np.ndarray, drop: Drop, gouge_tol: float, chord_tol: float) -> list[CutSegment]:
+    """One partial pass (XY points at the sample step), dropped and checked as raster_drop drops its own (split
+    where it crosses air)."""
     from tmm_workbench.core.strategies import raster_drop, raster_refine
 
-    xy = sample_segment(start, end, sample_step)
     z, air = drop(xy)
     runs = [(False, xy)]
     if gouge_tol > 0:
         runs, z, air, _ = raster_refine.refine(runs, z, air, drop, gouge_tol, chained=False)
     return raster_drop._segments(runs, z, air, raster_drop.ONEWAY, chord_tol)
+
+
+def _nearest_first(lines: list[np.ndarray], start: np.ndarray) -> list[np.ndarray]:
+    """`lines` in greedy nearest-neighbour order from `start`, each entered at its nearer end (so that more of
+    them are joined on the surface instead of a lift)."""
+    out: list[np.ndarray] = []
+    left = list(lines)
+    here = np.asarray(start, float)
+    while left:
+        ends = np.array([[ln[0], ln[-1]] for ln in left])                 # (n, 2 ends, 2)
+        d = np.hypot(*(ends - here).transpose(2, 0, 1))                    # (n, 2)
+        i, e = np.unravel_index(int(np.argmin(d)), d.shape)
+        line = left.pop(int(i))
+        line = line[::-1] if e == 1 else line
+        out.append(line)
+        here = line[-1]
+    return out
 
 
 def _surface_link(a: np.ndarray, b: np.ndarray, drop: Drop, sample_step: float,
@@ -230,23 +343,25 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
                 tolerance: float, drop: Drop, *, sample_step: float = 0.5, gouge_tol: float = 0.005,
                 chord_tol: float = 0.001, stock_to_leave: float = 0.0, slope_limit_deg: float = 75.0,
                 cell: Optional[float] = None, rounds: int = ROUNDS, surface: Optional[DropSurface] = None,
-                progress: Optional[Progress] = None) -> tuple[list[CutSegment], VerifyReport]:
-    """`segments` (a raster's pass set over `boundary`, passes along `angle_deg`) with extra partial passes
-    appended where the simulated cusp exceeds `tolerance`, and the report (see the module). `drop` drops the
-    tool at XY points as the raster did (stock to leave, floor, air). `progress` (fraction -> False to cancel)
-    follows the dense raster, the bulk of the work, and is asked again before each round."""
+                progress: Optional[Progress] = None, levels: Any = None) -> tuple[list[CutSegment], VerifyReport]:
+    """`segments` (a raster's pass set over `boundary`, passes along `angle_deg`; or the 3D offset's loops, the
+    level sets of the arrival field `levels`, an offset_field.Field) with extra partial passes appended where the
+    simulated cusp exceeds `tolerance`, and the report (see the module). `drop` drops the tool at XY points as the
+    raster did (stock to leave, floor, air). `progress` (fraction -> False to cancel) follows the dense raster,
+    the bulk of the work, and is asked again before each round."""
     t0 = time.perf_counter()
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"verify cusp tolerance must be a length > 0 mm, got {tolerance!r}")
     cell = measure_cell(cutter, tolerance) if cell is None else float(cell)
     estimate_work(boundary, cutter, tolerance, cell)
     surface = surface or DropSurface(mesh)
-    passes = _Passes(angle_deg)
-    for seg in segments:
-        if seg.kind is SegmentKind.PASS:
-            passes.add(seg.tips)
-    if not passes.rows:
-        raise TmmError("verify cusp needs straight raster passes (ZigZag or OneWay), found none")
+    passes: Any = _Passes(angle_deg) if levels is None else _Levels(levels)
+    if levels is None:
+        for seg in segments:
+            if seg.kind is SegmentKind.PASS:
+                passes.add(seg.tips)
+        if not passes.rows:
+            raise TmmError("verify cusp needs straight raster passes (ZigZag or OneWay), found none")
     # the envelope sampled a cell apart along its passes too: the path's own chords count as cusp
     fld: CuspField = cusp_field(mesh, cutter, boundary, tolerance, cell, slope_limit_deg, cell, stock_to_leave,
                                 surface, progress=progress)
@@ -265,7 +380,7 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     extra: list[CutSegment] = []
     # consecutive partial passes (serpentine, mostly a gap's few passes over one stretch) closer than this are
     # joined on the surface instead of a lift (issue 14 item 4: 432 lifts on mount_rush)
-    join_max = 2.0 * cutter.diameter
+    join_max = passes.join * cutter.diameter
     cusp = before
     for k in range(rounds):
         bad = np.nan_to_num(cusp, nan=0.0) > _EXCEED * tolerance
@@ -274,49 +389,43 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         if progress is not None and progress(1.0) is False:
             raise Cancelled("verify cusp cancelled")
         report.rounds = k + 1
-        buckets = _buckets(cusp, bad, fld.grid, to_tip, passes, 2 * cutter.radius, k + 1, tolerance)
+        # a cell counts where the tool tip stands when it touches there (`to_tip`), since the passes are tips
+        tips = fld.grid.centres()[bad.ravel()] + to_tip.reshape(-1, 2)[bad.ravel()]
+        buckets = passes.buckets(tips, cusp.ravel()[bad.ravel()], k + 1, tolerance, 2 * cutter.radius)
         if not buckets:
             break
         report.buckets += buckets
-        flip = False
-        for b in sorted(buckets, key=lambda b: (b.lower, b.start)):
-            for i in range(1, b.added + 1):
-                c = b.lower + (b.upper - b.lower) * i / (b.added + 1)
-                line = clip_line_to_rect(c * passes.n, passes.d, boundary)
-                if line is None:
+        todo = [xy for b in buckets for xy in passes.lines(b, boundary, run_on, sample_step)]
+        if passes.serpentine:  # the next partial pass starts near the last one's end
+            todo = [xy[::-1] if i % 2 else xy for i, xy in enumerate(todo)]
+        else:
+            last = extra or segments
+            todo = _nearest_first(todo, last[-1].tips[-1, :2] if last else todo[0][0]) if todo else todo
+        for xy in todo:
+            new = _extra_segments(xy, drop, gouge_tol, chord_tol)
+            if new and extra and extra[-1].kind is SegmentKind.PASS and \
+                    np.hypot(*(new[0].tips[0, :2] - extra[-1].tips[-1, :2])) <= join_max:
+                bridge = _surface_link(extra[-1].tips[-1], new[0].tips[0], drop, sample_step, gouge_tol)
+                if bridge is not None:
+                    new[0] = CutSegment(new[0].tips, new[0].kind, joined=True, pass_index=new[0].pass_index)
+                    extra.append(bridge)
+                    report.links += 1
+                    report.link_length += float(np.linalg.norm(np.diff(bridge.tips[:, :2], axis=0), axis=1).sum())
+                    strip = _strip(fld.grid, bridge.tips, reach)
+                    if strip is not None:
+                        sub, rows, cols = strip
+                        heights[rows, cols] = simulate(link([bridge], policy), cutter, sub,
+                                                       heights[rows, cols]).heights
+            for seg in new:
+                passes.add(seg.tips)
+                report.passes_added += 1
+                report.length_added += float(np.linalg.norm(np.diff(seg.tips[:, :2], axis=0), axis=1).sum())
+                strip = _strip(fld.grid, seg.tips, reach)
+                if strip is None:
                     continue
-                ua, ub = line @ passes.d
-                ua, ub = max(min(ua, ub), b.start - run_on), min(max(ua, ub), b.end + run_on)
-                if ub - ua <= 1e-9:
-                    continue
-                ends = [c * passes.n + ua * passes.d, c * passes.n + ub * passes.d]
-                if flip:  # serpentine order: the next partial pass starts near the last one's end
-                    ends.reverse()
-                flip = not flip
-                new = _extra_segments(ends[0], ends[1], drop, sample_step, gouge_tol, chord_tol)
-                if new and extra and extra[-1].kind is SegmentKind.PASS and \
-                        np.hypot(*(new[0].tips[0, :2] - extra[-1].tips[-1, :2])) <= join_max:
-                    bridge = _surface_link(extra[-1].tips[-1], new[0].tips[0], drop, sample_step, gouge_tol)
-                    if bridge is not None:
-                        new[0] = CutSegment(new[0].tips, new[0].kind, joined=True, pass_index=new[0].pass_index)
-                        extra.append(bridge)
-                        report.links += 1
-                        report.link_length += float(np.linalg.norm(np.diff(bridge.tips[:, :2], axis=0), axis=1).sum())
-                        strip = _strip(fld.grid, bridge.tips, reach)
-                        if strip is not None:
-                            sub, rows, cols = strip
-                            heights[rows, cols] = simulate(link([bridge], policy), cutter, sub,
-                                                           heights[rows, cols]).heights
-                for seg in new:
-                    passes.add(seg.tips)
-                    report.passes_added += 1
-                    report.length_added += float(np.linalg.norm(np.diff(seg.tips[:, :2], axis=0), axis=1).sum())
-                    strip = _strip(fld.grid, seg.tips, reach)
-                    if strip is None:
-                        continue
-                    sub, rows, cols = strip
-                    heights[rows, cols] = simulate(link([seg], policy), cutter, sub, heights[rows, cols]).heights
-                extra += new
+                sub, rows, cols = strip
+                heights[rows, cols] = simulate(link([seg], policy), cutter, sub, heights[rows, cols]).heights
+            extra += new
         cusp = fld.ridge_cusp(heights)
     report.max_cusp_after, report.ridge_after = fld.max_cusp(heights), _nanmax(cusp)
     report.exceeding_after = int(np.sum(np.nan_to_num(cusp, nan=0.0) > tolerance))
@@ -331,13 +440,11 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
 
 def validate_params(params) -> None:
     """What the verification pass needs of raster_drop's SurfaceParams (refused before any work)."""
-    from tmm_workbench.core.strategies.raster_drop import OFFSET3D, SPIRAL
+    from tmm_workbench.core.strategies.raster_drop import SPIRAL
 
     if params.pattern == SPIRAL:
-        raise TmmError("verify cusp works on straight raster passes (pattern zigzag or oneway), not spiral")
-    if params.stepover_mode == OFFSET3D:
-        raise TmmError("verify cusp works on straight raster passes, not on the 3D offset's loops (step-over mode "
-                       "offset3d): choose stepover, cusp or adaptive")
+        raise TmmError("verify cusp works on straight raster passes or the 3D offset's loops (pattern zigzag or "
+                       "oneway), not spiral")
     if params.region is not None:
         raise TmmError("verify cusp works on the boundary box only for now (region Box), not on a face or sketch "
                        "region")
@@ -347,16 +454,17 @@ def validate_params(params) -> None:
 
 
 def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegment], drop: Drop,
-                  surface: Optional[DropSurface], diagnostics: dict,
-                  progress: Optional[Progress] = None) -> list[CutSegment]:
+                  surface: Optional[DropSurface], diagnostics: dict, progress: Optional[Progress] = None,
+                  levels: Any = None) -> list[CutSegment]:
     """raster_drop's call: its pass set verified against `params.cusp` (diagnostics["verify"]; the report is
-    appended to params.verify_notes when given)."""
+    appended to params.verify_notes when given); `levels` the 3D offset's arrival field (its loops')."""
     if params.cusp > cutter.radius:
         raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
     segments, report = verify_cusp(mesh, cutter, segments, params.boundary, params.angle_deg, params.cusp, drop,
                                    sample_step=params.sample_step, gouge_tol=params.gouge_tol,
                                    chord_tol=params.chord_tol, stock_to_leave=params.stock_to_leave,
-                                   slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress)
+                                   slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress,
+                                   levels=levels)
     diagnostics["verify"] = report.as_dict()
     if params.verify_notes is not None:
         params.verify_notes.append(report)

@@ -156,12 +156,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     # Runs of XY points: passes, and for zig-zag the links between them, dropped in one batch.
     runs: list[tuple[bool, np.ndarray]] = []  # (is_link, xy)
     chains = None  # a region or the spiral: runs in chains cut with the tool down, jumps between them
+    levels = None  # the 3D offset's arrival field (its loops are level sets of it)
     if params.stepover_mode == OFFSET3D:  # 3D offset: loops from the region's edge inward
         from tmm_workbench.core.strategies import raster_offset3d, raster_region
 
         surface = surface or DropSurface(mesh)
-        chains = raster_offset3d.chains(mesh, surface, cutter, params, floor_z, diagnostics,
-                                        None if progress is None else lambda f: progress(0.5 * f))
+        chains, levels = raster_offset3d.chains(mesh, surface, cutter, params, floor_z, diagnostics,
+                                                None if progress is None else lambda f: progress(0.5 * f))
         runs = raster_region.flatten(chains)
     elif params.region is not None or params.pattern == SPIRAL:
         from tmm_workbench.core.strategies import raster_region
@@ -219,7 +220,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if params.verify_cusp:  # issue 14 item 4
         from tmm_workbench.core.footprint.variable_step import verify_params
 
-        segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress)
+        segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress, levels)
     return StrategyResult(segments, diagnostics)
 
 

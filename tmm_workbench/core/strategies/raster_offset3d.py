@@ -76,8 +76,9 @@ def estimate_work(shape: list, cutter: Cutter, params: Any) -> float:
 
 
 def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: Any, floor_z: float, diagnostics: dict,
-           progress: Optional[Progress] = None) -> list[list[region_order.Run]]:
-    """The runs of each chain of loops. diagnostics: "passes" (loops), "jumps", "levels", "stepover" (the flat
+           progress: Optional[Progress] = None) -> tuple[list[list[region_order.Run]], offset_field.Field]:
+    """The runs of each chain of loops, and the arrival field whose level sets they are (the verification pass
+    places its extra passes between them by it). diagnostics: "passes" (loops), "jumps", "levels", "stepover" (the flat
     step, mm), "least_step" (mm), "region_area" (mm^2)."""
     from tmm_workbench.core.footprint import region as region_mod
     from tmm_workbench.core.strategies.raster_drop import ONEWAY
@@ -98,4 +99,4 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: Any, flo
     ordered = offset3d.loop_chains(loops, shape, max_link(loops.flat_step, cutter), params.pattern != ONEWAY)
     diagnostics.update(passes=len(loops.loops), jumps=len(ordered) - 1, levels=loops.levels,
                        stepover=loops.flat_step, least_step=loops.least_step, region_area=polygons.area(shape))
-    return region_order.chain_runs(ordered, params.sample_step)
+    return region_order.chain_runs(ordered, params.sample_step), loops.field
