@@ -58,6 +58,12 @@ class WorkEstimate(FreeCADTestCase):
         self.assertGreater(checked.count, est.count)
         self.assertIn("up to 4 rounds of partial passes", checked.text())
         self.assertIs(op.VerifyCusp, False)  # an override only
+        # the 3D offset's loops are verified too: its estimate gets the same dense raster
+        op.StepOverMode = "Offset3D"
+        loops = work_estimate.estimate(op)
+        loops_checked = work_estimate.estimate(op, {"VerifyCusp": True})
+        self.assertAlmostEqual(loops_checked.count - loops.count, checked.count - est.count, delta=1.0)
+        self.assertIn("up to 4 rounds of partial passes", loops_checked.text())
 
     def test_estimate_tells_the_cutting_time(self) -> None:
         """The status line's time: the cut length the boxes and the spacing imply at the tool controller's

@@ -188,7 +188,7 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
     params = _params(proxy, obj, ov, boundary=(x0 - m, y0 - m, x1 + m, y1 + m))
     params.validate()
     if params.stepover_mode == raster_drop.OFFSET3D:  # the 3D offset's passes (issue 14 item 1)
-        return _offset3d(obj, params)
+        return _verified(_offset3d(obj, params), obj, params)
     stepover = params.stepover
     if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
         stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
@@ -196,17 +196,24 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
             stepover *= 0.5
     count = raster_drop.estimate_work(replace(params, stepover=stepover))
     w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
-    note = ""
-    if params.verify_cusp:  # issue 14 item 4: its dense raster is known before it runs, its partial passes are not
-        from tmm_workbench.core.footprint import variable_step
-
-        cutter = _cutter(obj)
-        count += variable_step.estimate_work(params.boundary, cutter, params.cusp,
-                                             variable_step.measure_cell(cutter, params.cusp))
-        note = (f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial passes "
-                "where the simulated cusp is over, not counted)")
     # passes cover the boundary at the step-over: their length is its area over the spacing
-    return Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover, _feed(obj), note)
+    return _verified(Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover,
+                              _feed(obj)), obj, params)
+
+
+def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
+    """With VerifyCusp (issue 14 item 4): the verification's dense raster added (known before it runs; its partial
+    passes are not)."""
+    if not params.verify_cusp:
+        return est
+    from tmm_workbench.core.footprint import variable_step
+
+    cutter = _cutter(obj)
+    dense = variable_step.estimate_work(params.boundary, cutter, params.cusp,
+                                        variable_step.measure_cell(cutter, params.cusp))
+    return replace(est, count=est.count + dense,
+                   note=f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial "
+                        "passes where the simulated cusp is over, not counted)")
 
 
 def _offset3d(obj: Any, params: Any) -> Estimate:
