@@ -155,6 +155,32 @@ def test_3d_offset_on_a_relief_patch_is_brought_within_the_tolerance():
         assert 0.1 < np.median(t) % 1.0 < 0.9
 
 
+def test_partial_passes_are_lean_with_the_tolerance_forward_step():
+    """With ForwardStep Tolerance the verification's partial passes get the kernel's lean fit too: every move
+    within +-chord_tol of the exact drop (sampled every 0.01 mm); sampled partial passes are not."""
+    from tmm_workbench.core.query.drop import DropSurface
+
+    mesh, box = _bump(), (0.0, 0.0, 24.0, 16.0)
+    params = dict(boundary=box, stepover=stepover_for_cusp(BALL, 0.8 * TOL, 0.0), sample_step=0.25, chord_tol=0.001)
+    surface, floor = DropSurface(mesh), float(mesh.bounds[0][2])
+
+    def extra_deviation(forward_step: str) -> float:
+        n = len(compute(mesh, BALL, SurfaceParams(**params, forward_step=forward_step)).segments)
+        extra = compute(mesh, BALL, SurfaceParams(**params, forward_step=forward_step, verify_cusp=True)).segments[n:]
+        assert len(extra) > 5
+        worst = 0.0
+        for seg in (s for s in extra if len(s.tips) >= 2):
+            a, b = seg.tips[:-1], seg.tips[1:]
+            k = np.maximum(np.ceil(np.hypot(*(b - a)[:, :2].T) / 0.01), 1).astype(int)
+            t = np.concatenate([np.arange(m) / m for m in k])
+            p = np.repeat(a, k, axis=0) + t[:, None] * np.repeat(b - a, k, axis=0)
+            worst = max(worst, float(np.max(np.abs(p[:, 2] - np.maximum(surface.drop(BALL, p[:, :2], floor), floor)))))
+        return worst
+
+    assert extra_deviation("tolerance") <= 0.001 + 1e-6
+    assert extra_deviation("sample") > 0.002
+
+
 def test_a_path_within_the_tolerance_is_left_as_it_is():
     mesh, box = _bump(), (0.0, 0.0, 24.0, 16.0)
     params = dict(boundary=box, stepover=stepover_for_cusp(BALL, 0.5 * TOL, 45.0), sample_step=0.25)

@@ -220,7 +220,15 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if params.verify_cusp:  # issue 14 item 4
         from tmm_workbench.core.footprint.variable_step import verify_params
 
+        n = len(segments)
         segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress, levels)
+        if lean and len(segments) > n:  # its partial passes (cut into its simulation as sampled) fitted as well
+            extra, arcs, stats = lean_segments_kernel(segments[n:], exact, params.chord_tol, params.sample_step / 2,
+                                                      progress=progress, arcs=params.arcs)
+            segments = segments[:n] + extra
+            diagnostics["arcs"].update(arcs)
+            for key, value in stats.items():
+                diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
     return StrategyResult(segments, diagnostics)
 
 
