@@ -24,7 +24,7 @@ esac
 # What the tests need inside: FreeCAD, the kernel's build tools, the test runners, Xvfb for the GUI test.
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib xvfb xauth cmake g++ ninja-build libgtest-dev ca-certificates
-      python3-opencamlib python3-pyclipper python3-contourpy)
+      python3-opencamlib python3-pyclipper python3-contourpy python3-scipy)
 
 MOUNTS=()
 cleanup() {

@@ -7,9 +7,11 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 
+# contourpy: the 3D offset's passes (core.footprint.offset_field); scipy: the verification's buckets on them
+# (core.footprint.variable_step)
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib python3-pyclipper xvfb xauth cmake g++ make ninja-build libgtest-dev
-      python3-contourpy)  # contourpy: the 3D offset's passes (core.footprint.offset_field)
+      python3-contourpy python3-scipy)
 missing=()
 for p in "${DEBS[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then
