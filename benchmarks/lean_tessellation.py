@@ -1,8 +1,9 @@
 """Lean passes on the README's bezier_convex job (scripts/demo.py: seed 001's convex Bezier patch, bull-nose D25.4
 r6, step-over 1.0, sample step 0.5, passes along Y) at finer tessellations of the patch. Core only (no FreeCAD).
 
-The demo tessellates the patch to 0.01 mm (demo.BEZIER_TOLERANCE_MM), 10x the lean fit's chord tolerance, and
-the lean fit follows the tessellated model's exact CL path (a kink at every facet edge). This measures, for each
+The demo tessellated the patch to 0.01 mm, 10x the lean fit's chord tolerance (now 0.001 mm,
+demo.BEZIER_TOLERANCE_MM, after this benchmark), and the lean fit follows the tessellated model's exact CL path (a
+kink at every facet edge). This measures, for each
 tessellation tolerance (the patch written to STL and read back, as the demo does), with raster_drop.compute at
 chord_tol 0.001 mm over the model's XY box:
 
