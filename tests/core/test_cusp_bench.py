@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
 from cusp_item7 import BASE, model_rows, ratios, table  # noqa: E402
 
-ROWS = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset"]
+ROWS = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset", "3D offset + verify"]
 
 
 @pytest.fixture(scope="module")
