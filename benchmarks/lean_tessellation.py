@@ -32,12 +32,11 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from lean_fixed_step import TOL, deviation, moves  # noqa: E402  (puts the repository on sys.path)
 
-from tmm_workbench.core.arcs import arc_points  # noqa: E402
 from tmm_workbench.core.geometry import bezier  # noqa: E402
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
-from tmm_workbench.core.strategies.raster_lean import arc_offsets  # noqa: E402
+from tmm_workbench.core.strategies.raster_lean import arc_chords  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 
@@ -49,12 +48,7 @@ def with_arcs_chorded(segments, arc_map) -> list:
         pts = [t[:1]]
         for a, b in zip(t[:-1], t[1:]):
             arc = arc_map.get((tuple(map(float, a)), tuple(map(float, b))))
-            if arc is None:
-                pts.append(b[None])
-            else:
-                off = arc_offsets(tuple(a), arc)
-                pts.append(arc_points(a, b, off.get("I", 0.0), off.get("J", 0.0), arc.clockwise, 1e-5,
-                                      plane=arc.plane, k=off["K"]))
+            pts.append(b[None] if arc is None else arc_chords(a, b, arc, 1e-5))
         out.append(SimpleNamespace(tips=np.vstack(pts)))
     return out
 

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from tests.conftest import grid_mesh
-from tmm_workbench.core.arcs import arc_points
 from tmm_workbench.core.geometry.mesh import load_stl
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.query.drop import DropSurface
@@ -22,7 +21,7 @@ from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import box_heights, mesh_heights
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute, compute_surface_toolpath
-from tmm_workbench.core.strategies.raster_lean import Arc, arc_offsets, chorded, fit_profile
+from tmm_workbench.core.strategies.raster_lean import Arc, arc_chords, chorded, fit_profile
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.001
@@ -48,9 +47,7 @@ def move_points(segments, arcs, step=0.005):
         for a, b in zip(t[:-1], t[1:]):
             arc = arcs.get((tuple(map(float, a)), tuple(map(float, b))))
             if arc is not None:
-                off = arc_offsets(tuple(a), arc)
-                pts = np.vstack([a, arc_points(a, b, off.get("I", 0.0), off.get("J", 0.0), arc.clockwise, 1e-6,
-                                               plane=arc.plane, k=off["K"])])
+                pts = np.vstack([a, arc_chords(a, b, arc, 1e-6)])
             else:
                 pts = np.vstack([a, b])
             for p, q in zip(pts[:-1], pts[1:]):
@@ -158,8 +155,7 @@ def test_arc_sense_over_a_hump(plane, expected_g3):
     key, arc = arc_entry(start, end, c, plane)
     assert key == (tuple(start), tuple(end))
     assert arc.clockwise == (not expected_g3)
-    off = arc_offsets(tuple(start), arc)
-    pts = arc_points(start, end, off.get("I", 0.0), off.get("J", 0.0), arc.clockwise, 1e-6, plane=plane, k=off["K"])
+    pts = arc_chords(start, end, arc, 1e-6)
     assert np.allclose(np.linalg.norm(pts - c, axis=1), r)
     assert pts[:, 2].max() == pytest.approx(r, abs=1e-5)      # over the top, not the long way round below
     assert np.allclose(pts[:, 1 - ax], c[1 - ax])             # in the plane

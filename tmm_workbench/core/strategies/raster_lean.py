@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Callable, Optional
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 
@@ -580,11 +580,18 @@ def arc_offsets(start: tuple[float, float, float], arc: Arc) -> dict[str, float]
     return {"I": d[0], "K": d[2]} if arc.plane == "XZ" else {"J": d[1], "K": d[2]}
 
 
+def arc_chords(start: Sequence[float], end: Sequence[float], arc: Arc, tolerance: float) -> np.ndarray:
+    """The points after `start` along `arc` to `end` (included) as chords within `tolerance` (core.arcs)."""
+    from tmm_workbench.core.arcs import arc_points
+
+    off = arc_offsets(tuple(start), arc)
+    return arc_points(start, end, off.get("I", 0.0), off.get("J", 0.0), arc.clockwise, tolerance, plane=arc.plane,
+                      k=off["K"])
+
+
 def chorded(toolpath: Toolpath, tolerance: float = 1e-4) -> Toolpath:
     """The tool path with its arcs as chords within `tolerance` (core.arcs): what a simulation of the
     moves as lines reads."""
-    from tmm_workbench.core.arcs import arc_points
-
     if not toolpath.arcs:
         return toolpath
     out = Toolpath()
@@ -594,9 +601,6 @@ def chorded(toolpath: Toolpath, tolerance: float = 1e-4) -> Toolpath:
             out.moves.append(m)
             continue
         p = toolpath.moves[i - 1]
-        start = (p.x, p.y, p.z)
-        off = arc_offsets(start, arc)
-        for q in arc_points(start, (m.x, m.y, m.z), off.get("I", 0.0), off.get("J", 0.0), arc.clockwise,
-                            tolerance, plane=arc.plane, k=off["K"]):
+        for q in arc_chords((p.x, p.y, p.z), (m.x, m.y, m.z), arc, tolerance):
             out.add(m.kind, *q, m.axis)
     return out
