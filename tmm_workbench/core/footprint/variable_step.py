@@ -53,12 +53,12 @@ class Bucket:
     round: int
     lower: float            # across-offsets of the gap's passes, mm
     upper: float
-    start: float            # along the passes: the stretch's cells, mm
+    start: float            # along the passes: the stretch's cells, mm (a raster's; NaN for the 3D offset's)
     end: float
     cells: int              # exceeding cells
     max_cusp: float         # mm
     added: int              # extra passes put in the gap over the stretch
-    where: Optional[np.ndarray] = None   # the 3D offset's: the cells' tips (XY), the stretch's place
+    where: Optional[np.ndarray] = None   # the 3D offset's: the cells' tips (XY), the worst first
 
 
 @dataclass
@@ -236,10 +236,9 @@ class _Levels:
             graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(sel), len(sel)))
             _, label = connected_components(graph, directed=False)
             for part in (sel[label == k] for k in range(label.max() + 1)):
-                worst = part[np.argmax(values[part])]
-                # start = end: T at the worst cell (the fallback level of `lines`)
-                out.append(Bucket(round_, float(g * width), float((g + 1) * width), float(t[worst]),
-                                  float(t[worst]), len(part), float(values[part].max()), 1, where=tips[part]))
+                part = np.roll(part, -int(np.argmax(values[part])))  # the worst cell first
+                out.append(Bucket(round_, float(g * width), float((g + 1) * width), math.nan, math.nan, len(part),
+                                  float(values[part[0]]), 1, where=tips[part]))
         return sorted(out, key=lambda b: (b.lower, float(b.where[:, 0].min())))
 
     def _level(self, level: float) -> list[np.ndarray]:
@@ -260,7 +259,7 @@ class _Levels:
         reach = run_on + 0.5 * flat   # the cells lie up to half a gap (at most half a flat step) from its middle
         lo, hi = b.where.min(axis=0) - reach, b.where.max(axis=0) + reach
         tree = cKDTree(b.where)
-        for level in (0.5 * (b.lower + b.upper), b.start):
+        for level in (0.5 * (b.lower + b.upper), float(self.field.at(b.where[:1])[0])):
             pieces = []
             for line in self._level(level):
                 if np.any(line.max(axis=0) < lo) or np.any(line.min(axis=0) > hi):
@@ -398,9 +397,8 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         todo = [xy for b in buckets for xy in passes.lines(b, boundary, run_on, sample_step)]
         if passes.serpentine:  # the next partial pass starts near the last one's end
             todo = [xy[::-1] if i % 2 else xy for i, xy in enumerate(todo)]
-        else:
-            last = extra or segments
-            todo = _nearest_first(todo, last[-1].tips[-1, :2] if last else todo[0][0]) if todo else todo
+        elif todo:  # from where the tool stands (the pass set is never empty here)
+            todo = _nearest_first(todo, (extra or segments)[-1].tips[-1, :2])
         for xy in todo:
             new = _extra_segments(xy, drop, gouge_tol, chord_tol)
             if new and extra and extra[-1].kind is SegmentKind.PASS and \
