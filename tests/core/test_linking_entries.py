@@ -41,8 +41,9 @@ def test_helix_geometry():
     pol = LinkPolicy(20.0, 25.0, ramp_angle_deg=angle, arc_tol=0.001)
     tp = link([seg], pol)
     moves = tp.moves
-    assert [m.kind for m in moves[:3]] == [MoveKind.RAPID, MoveKind.RAPID, MoveKind.PLUNGE]
-    assert moves[2].z == top                                     # fed through air down to the material
+    assert [m.kind for m in moves[:4]] == [MoveKind.RAPID, MoveKind.RAPID, MoveKind.RAPID, MoveKind.PLUNGE]
+    assert moves[2].z == top + pol.entry_clearance               # a rapid down to just above the material,
+    assert moves[3].z == top                                     # fed from there to where it starts
     pts = descent(tp)
     k_end = next(i for i in range(1, len(pts)) if np.allclose(pts[i], seg.tips[1]))   # the loop's second tip
     helix = pts[:k_end]
@@ -103,15 +104,21 @@ def test_entry_overrides_and_plunge_unchanged():
     plain = link([CutSegment(square_loop(0.0)), CutSegment(square_loop(-2.0))], LinkPolicy(20.0, 25.0))
     assert link([a, b], LinkPolicy(20.0, 25.0)).moves == plain.moves
     assert [m.kind for m in plain.moves[:3]] == [MoveKind.RAPID, MoveKind.RAPID, MoveKind.PLUNGE]
-    # entry_z and helix facts are ignored by a plunge
+    # helix facts are ignored by a plunge; its entry_z (the material's top) ends the rapid down 1 mm above it
     c = CutSegment(square_loop(0.0), entry_z=5.0, helix_centre=(1.0, 1.0))
-    assert link([c], LinkPolicy(20.0, 25.0)).moves == link([CutSegment(square_loop(0.0))],
-                                                          LinkPolicy(20.0, 25.0)).moves
+    moves = link([c], LinkPolicy(20.0, 25.0)).moves
+    assert [(m.kind, m.z) for m in moves[:4]] == [(MoveKind.RAPID, 25.0), (MoveKind.RAPID, 20.0),
+                                                  (MoveKind.RAPID, 6.0), (MoveKind.PLUNGE, 0.0)]
+    assert moves[4:] == link([CutSegment(square_loop(0.0))], LinkPolicy(20.0, 25.0)).moves[3:]
 
 
 def test_bad_entries_refused_by_name():
-    with pytest.raises(TmmError, match="ramp angle must be in \\(0, 90\\] deg, got 0"):
-        link([CutSegment(square_loop(0.0))], LinkPolicy(20.0, 25.0, entry=RAMP, ramp_angle_deg=0.0))
+    for bad in (0.0, 1e-6, 0.4, 46.0, 90.0, math.nan):  # 90 deg made NaN heights, 1e-6 deg gigabytes of ramp
+        with pytest.raises(TmmError, match=f"ramp angle must be in \\[0.5, 45\\] deg, got {bad:g}"):
+            link([CutSegment(square_loop(0.0))], LinkPolicy(20.0, 25.0, entry=RAMP, ramp_angle_deg=bad))
+    for bad in (0.0, 0.05, 51.0):
+        with pytest.raises(TmmError, match=f"entry clearance must be in \\[0.1, 50\\] mm, got {bad:g}"):
+            link([CutSegment(square_loop(0.0))], LinkPolicy(20.0, 25.0, entry_clearance=bad))
     with pytest.raises(TmmError, match="helix centre"):
         link([CutSegment(square_loop(0.0), entry=HELIX, entry_z=3.0)], LinkPolicy(20.0, 25.0))
     with pytest.raises(TmmError, match="entry must be one of plunge, helix, ramp, got 'dive'"):

@@ -9,13 +9,16 @@ strategy made of dropped, gouge-free points, then the next pass) or leaves and r
       everything below the safe height) to `axis_retract` above the next first point on its axis, the
       entry along it.
 Entries (3-axis), rows of ENTRIES; a segment may name its own (CutSegment.entry), else the policy's:
-  PLUNGE  straight down at the vertical feed from the safe height onto the first tip;
-  HELIX   fed straight down through air to where the material starts (CutSegment.entry_z; None: the safe
-          height), then down a helix at `ramp_angle_deg` on the circle about `helix_centre` through the first
-          tip, ending with one full circle at its depth (a flat bottom), at the first tip;
-  RAMP    the same descent through air, then down along the segment's own path at `ramp_angle_deg`:
-          backwards around a closed loop (`closed`) from its first tip, back and forth along an open one,
-          ending at the first tip.
+  PLUNGE  straight down at the vertical feed onto the first tip;
+  HELIX   down a helix at `ramp_angle_deg` on the circle about `helix_centre` through the first tip, from where
+          the material starts (CutSegment.entry_z; else the policy's `material_top` over the helix; else the
+          safe height), ending with one full circle at its depth (a flat bottom), at the first tip;
+  RAMP    the same, down along the segment's own path at `ramp_angle_deg`: backwards around a closed loop
+          (`closed`) from its first tip, back and forth along an open one, ending at the first tip.
+Where the material's top over the entry is known (the segment's `entry_z`, the policy's `material_top`: the
+lower of the two, both being upper bounds), the tool rapids down to `entry_clearance` above it (or above where
+the entry starts, if higher) and is fed only from there, as a machinist does: a plunge from the safe height
+through the air earlier cuts left costs most of a finishing op's time. Unknown: fed from the safe height.
 Helix and ramp are only as gouge-free as the XY they pass over: the strategy gives a centre whose circle
 lies where the tool centre may go at the first tip's height and above (the linker does not see the model).
 The path starts at the clearance height over the first entry (5-axis: upright, then turned there) and
@@ -23,14 +26,15 @@ ends at the clearance height (5-axis: upright again, so any later op starts unti
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable, Optional, Sequence
-
+import dataclasses
 import math
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.params import Spec, check
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
@@ -38,6 +42,16 @@ from tmm_workbench.core.toolpath import MoveKind, Toolpath, Z_AXIS
 VERTICAL, ALONG_AXIS = "vertical", "along_axis"
 PLUNGE, HELIX, RAMP = "plunge", "helix", "ramp"
 Axis = tuple[float, float, float]
+# xy (n, 2) -> (n,): the lowest tip height at which the tool clears the material over each XY (the tool dropped
+# onto what is left; -inf where there is none, +inf where it is not known)
+MaterialTop = Callable[[np.ndarray], np.ndarray]
+# A ramp or helix flatter than 0.5 deg is cutting at depth (115 mm of travel per mm of descent); one steeper than
+# 45 deg is a plunge (the ops feed such descents at the vertical feed): the entries' range, for every op.
+RAMP_ANGLE = Spec("ramp angle", "deg", low=0.5, high=45.0)
+# A rapid ends this far above the known material top: 0.1 mm covers the machine's following error, and more
+# than 50 mm is no longer an approach.
+ENTRY_CLEARANCE = Spec("entry clearance", "mm", low=0.1, high=50.0)
+_BYTES_PER_ENTRY_POINT = 64   # a descent's point: numpy, moves
 
 
 @dataclass
@@ -50,8 +64,10 @@ class LinkPolicy:
     # ALONG_AXIS: how far the lowest point of the tool lies below its tip for a tool axis (tool geometry:
     # core.tools.Cutter.lowest_below_tip); the transit height keeps that point at the safe height.
     lowest_below_tip: Optional[Callable[[Axis], float]] = None
-    ramp_angle_deg: float = 3.0         # HELIX and RAMP: descent angle from the horizontal
+    ramp_angle_deg: float = 3.0         # HELIX and RAMP: descent angle from the horizontal (RAMP_ANGLE)
     arc_tol: float = 0.01               # HELIX: chord deviation of the helix from its circle, mm
+    entry_clearance: float = 1.0        # mm above the known material top where the rapid down ends
+    material_top: Optional[MaterialTop] = None   # 3-axis: what earlier ops left (None: unknown)
 
     def validate(self) -> None:
         check(Spec("safe height", "mm"), self.safe_height)
@@ -64,7 +80,8 @@ class LinkPolicy:
             raise TmmError(f"retract must be '{VERTICAL}' or '{ALONG_AXIS}', got {self.retract!r}")
         if self.entry not in ENTRIES:
             raise TmmError(f"entry must be one of {', '.join(ENTRIES)}, got {self.entry!r}")
-        check(Spec("ramp angle", "deg", low=0, high=90, low_open=True), self.ramp_angle_deg)
+        check(RAMP_ANGLE, self.ramp_angle_deg)
+        check(ENTRY_CLEARANCE, self.entry_clearance)
         check(Spec("arc tolerance", "mm", low=0, low_open=True, kind="length"), self.arc_tol)
         if self.retract == ALONG_AXIS and self.entry != PLUNGE:
             raise TmmError(f"entry {self.entry!r} is 3-axis only; linking along the tool axis enters by "
@@ -98,6 +115,8 @@ def _helix(seg: CutSegment, policy: LinkPolicy) -> np.ndarray:
     pieces = []
     if drop > 0:
         sweep = drop / math.tan(math.radians(policy.ramp_angle_deg)) / r
+        _check_entry(math.ceil(sweep / dt) + 1, policy,
+                     f"on a helix of diameter {2 * r:.3g} mm over a {drop:.3g} mm descent")
         f = np.linspace(0.0, 1.0, max(2, math.ceil(sweep / dt) + 1))
         t = t_end - sense * sweep * (1.0 - f)
         pieces.append(np.column_stack([c[0] + r * np.cos(t), c[1] + r * np.sin(t), end[2] + drop * (1.0 - f)]))
@@ -134,6 +153,7 @@ def _ramp(seg: CutSegment, policy: LinkPolicy) -> np.ndarray:
         if not per > 0:
             raise TmmError(f"ramp entry at ({end[0]:g}, {end[1]:g}): the loop has no length to ramp along")
         turns = math.ceil(length / per) + 1
+        _check_entry(turns * len(loop), policy, f"along a loop of {per:.3g} mm over a {drop:.3g} mm descent")
         back = _walk(np.vstack([loop[:1]] + [loop[1:]] * turns), length)
         path = back[::-1]
     else:
@@ -142,6 +162,7 @@ def _ramp(seg: CutSegment, policy: LinkPolicy) -> np.ndarray:
         if not per > 0:
             raise TmmError(f"ramp entry at ({end[0]:g}, {end[1]:g}): the pass has no length to ramp along")
         turns = math.ceil(length / per) + 1
+        _check_entry(turns * len(there), policy, f"along a pass of {per / 2:.3g} mm over a {drop:.3g} mm descent")
         out = _walk(np.vstack([there[:1]] + [there[1:]] * turns), length / 2)
         path = np.vstack([out, out[-2::-1]])
     s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
@@ -153,6 +174,83 @@ def _ramp(seg: CutSegment, policy: LinkPolicy) -> np.ndarray:
 
 ENTRIES: dict[str, Callable[[CutSegment, LinkPolicy], np.ndarray]] = {PLUNGE: _plunge, HELIX: _helix,
                                                                       RAMP: _ramp}
+
+
+def _check_entry(count: int, policy: LinkPolicy, where: str) -> None:
+    """One descent's points against the work limits before they are made (a flat angle on a small circle)."""
+    check_work("entry points", count, _BYTES_PER_ENTRY_POINT, f"ramp angle {policy.ramp_angle_deg:g} deg {where}")
+
+
+def _descent(seg: CutSegment, policy: LinkPolicy, name: str) -> np.ndarray:
+    """The entry's fed descent; a helix or ramp without the segment's entry_z starts where the policy's material
+    top over its whole path lies (found on the descent from the safe height), if that is lower."""
+    make = ENTRIES[name]
+    descent = make(seg, policy)
+    if len(descent) == 1 or seg.entry_z is not None or policy.material_top is None:
+        return descent
+    top = float(np.max(policy.material_top(descent[:, :2])))
+    if not top < _top(seg, policy):                       # none lower known (or NaN)
+        return descent
+    return make(dataclasses.replace(seg, entry_z=max(top, float(seg.tips[0, 2]))), policy)
+
+
+def _known_top(seg: CutSegment, policy: LinkPolicy, x: float, y: float) -> Optional[float]:
+    """The material's top over the entry at (x, y): the lower of the segment's entry_z and the policy's
+    material_top (each an upper bound); -inf: none there; None: not known."""
+    tops = [] if seg.entry_z is None else [float(seg.entry_z)]
+    if policy.material_top is not None:
+        tops.append(float(np.max(policy.material_top(np.array([[x, y]], dtype=float)))))
+    top = min(tops, default=math.inf)
+    return None if math.isnan(top) or top == math.inf else top
+
+
+def _approach(tp: Toolpath, seg: CutSegment, policy: LinkPolicy, descent: np.ndarray) -> float:
+    """Rapids down from the safe height to `entry_clearance` above the known material top at the descent's start
+    (or above the start, when higher); the height reached."""
+    x0, y0, start = (float(v) for v in descent[0])
+    top = _known_top(seg, policy, x0, y0)
+    if top is None:
+        return policy.safe_height
+    z = max(start, top) + policy.entry_clearance
+    if z >= policy.safe_height:
+        return policy.safe_height
+    tp.add(MoveKind.RAPID, x0, y0, z, seg.axis(0))
+    return z
+
+
+def heights_top(grid: Any, heights: np.ndarray, radius: float,
+                profile: Optional[Callable[[np.ndarray], np.ndarray]] = None,
+                outside: float = -math.inf) -> MaterialTop:
+    """A MaterialTop from material heights at the cell centres of `grid` (x0, y0, cell, nx, ny: core.sim's Grid):
+    the tool of `radius` (its lower surface `profile(rho)` above the tip, vectorised; None: flat) dropped onto the
+    cells within its reach. A cell stands for material anywhere within half its diagonal of its centre, so its
+    rho is taken that much shorter (a rapid never clips a cell's column); `outside`: what lies off the grid
+    (-inf: nothing, +inf: not known)."""
+    h = np.asarray(heights, dtype=float)
+    cell = float(grid.cell)
+    pad = cell * math.sqrt(0.5)
+    reach = radius + pad
+
+    def top(xy: np.ndarray) -> np.ndarray:
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        out = np.full(len(xy), -math.inf)
+        for k, (x, y) in enumerate(xy):
+            i0, i1 = math.floor((x - reach - grid.x0) / cell), math.ceil((x + reach - grid.x0) / cell)
+            j0, j1 = math.floor((y - reach - grid.y0) / cell), math.ceil((y + reach - grid.y0) / cell)
+            if i0 < 0 or j0 < 0 or i1 > grid.nx or j1 > grid.ny:
+                out[k] = outside
+            i0, j0, i1, j1 = max(i0, 0), max(j0, 0), min(i1, grid.nx), min(j1, grid.ny)
+            if i1 <= i0 or j1 <= j0:
+                continue
+            cx = grid.x0 + (np.arange(i0, i1) + 0.5) * cell - x
+            cy = grid.y0 + (np.arange(j0, j1) + 0.5) * cell - y
+            rho = np.maximum(np.hypot(*np.meshgrid(cx, cy)) - pad, 0.0)
+            near = rho <= radius
+            if near.any():
+                lift = profile(rho[near]) if profile is not None else 0.0
+                out[k] = max(out[k], float(np.max(h[j0:j1, i0:i1][near] - lift)))
+        return out
+    return top
 
 
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:
@@ -173,7 +271,7 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
             name = seg.entry or policy.entry
             if name not in ENTRIES:
                 raise TmmError(f"entry must be one of {', '.join(ENTRIES)}, got {name!r}")
-            descent = ENTRIES[name](seg, policy)
+            descent = _descent(seg, policy, name)
             x0, y0, top = descent[0]
             if tp.moves:  # lift straight up, cross over at the safe height
                 last = tp.moves[-1]
@@ -181,10 +279,11 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
             else:
                 tp.add(MoveKind.RAPID, x0, y0, policy.clearance_height)
             tp.add(MoveKind.RAPID, x0, y0, policy.safe_height, seg.axis(0))
+            z = _approach(tp, seg, policy, descent)
             if len(descent) == 1:                 # straight down onto the tip
                 tp.add(MoveKind.PLUNGE, *pts[0], seg.axis(0))
             else:
-                if top < policy.safe_height:      # through air to where the material starts
+                if top < z:                       # through the clearance to where the material starts
                     tp.add(MoveKind.PLUNGE, x0, y0, top, seg.axis(0))
                 for p in descent[1:]:
                     tp.add(MoveKind.FEED, *p, seg.axis(0))

@@ -56,15 +56,17 @@ def default_sample_step(cutter: Cutter, bounds: tuple[float, float, float, float
     return max(cutter.radius / 4.0, math.sqrt(max(w * h, 0.0) / _DEFAULT_GRID_NODES))
 
 
-def estimate_work(bounds: tuple[float, float, float, float], levels: int, sample_step: float) -> float:
+def estimate_work(bounds: tuple[float, float, float, float], levels: int, sample_step: float,
+                  levels_from: str = "") -> float:
     """Drops of the shared grid plus loop points over all levels (crossings of the grid lines, a few per
-    line, refined), refused above core.limits before anything is allocated."""
+    line, refined), refused above core.limits before anything is allocated; `levels_from` names what sets the
+    level count (the strategy's step-down and range)."""
     w, h = bounds[2] - bounds[0], bounds[3] - bounds[1]
     nx, ny = math.ceil(w / sample_step) + 3, math.ceil(h / sample_step) + 3
     nodes = float(nx) * float(ny)
     points = levels * 4.0 * (nx + ny) * _REFINE_FACTOR
-    cause = (f"sample step {sample_step:g} mm over a {w:.6g} x {h:.6g} mm boundary and {levels} waterline "
-             f"level{'s' if levels != 1 else ''}")
+    cause = (f"sample step {sample_step:g} mm over a {w:.6g} x {h:.6g} mm boundary and {levels:.6g} waterline "
+             f"level{'s' if levels != 1 else ''}{f' ({levels_from})' if levels_from else ''}")
     memory = _BYTES_PER_NODE * nodes + _BYTES_PER_POINT * points
     check_work("waterline drops and points", nodes + points, memory / (nodes + points), cause)
     if nodes > native.WATERLINE_MAX_GRID_NODES:

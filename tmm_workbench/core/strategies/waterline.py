@@ -52,6 +52,7 @@ class WaterlineParams(StrategyParams):
     sample_step: Optional[float] = param(None, "sample step", "mm", optional=True, low=0, low_open=True)
     chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
     direction: str = param(CLIMB, "direction", choices=(CLIMB, CONVENTIONAL))
+    stock_z: Optional[tuple[float, float]] = None  # the stock's bottom and top, mm: the levels stay within it
 
     def validate(self) -> None:
         super().validate()
@@ -63,31 +64,48 @@ class WaterlineParams(StrategyParams):
             raise TmmError(f"boundary is empty: x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g}")
         if self.top_z is not None and self.bottom_z is not None and not self.top_z > self.bottom_z:
             raise TmmError(f"top {self.top_z:g} mm must be above bottom {self.bottom_z:g} mm")
+        if self.stock_z is not None:
+            check_finite("stock bottom and top", self.stock_z)
+
+
+def level_count(top: float, bottom: float, step_down: float) -> int:
+    """How many levels `levels` gives (counted, not made)."""
+    if not top > bottom:
+        raise TmmError(f"top {top:g} mm must be above bottom {bottom:g} mm")
+    return max(1, math.ceil((top - bottom) / step_down - _LEVEL_EPS_MM))
 
 
 def levels(top: float, bottom: float, step_down: float) -> list[float]:
     """Tip heights top - step_down, top - 2 step_down, ... above bottom, then bottom itself."""
-    if not top > bottom:
-        raise TmmError(f"top {top:g} mm must be above bottom {bottom:g} mm")
-    count = math.ceil((top - bottom) / step_down - _LEVEL_EPS_MM)
-    zs = [top - k * step_down for k in range(1, count)]
+    zs = [top - k * step_down for k in range(1, level_count(top, bottom, step_down))]
     return [z for z in zs if z > bottom + _LEVEL_EPS_MM] + [bottom]
 
 
 def _range(mesh: TriMesh, params: WaterlineParams) -> tuple[float, float]:
+    """(top, bottom) of the levels: the model's (or the params'), within the stock's (`stock_z`): a top above the
+    stock's is the stock's (levels in air cut nothing), a bottom below the stock's bottom is refused."""
     lo, hi = mesh.bounds
     top = float(hi[2]) if params.top_z is None else float(params.top_z)
     bottom = float(lo[2]) if params.bottom_z is None else float(params.bottom_z)
+    if params.stock_z is not None:
+        floor, ceiling = params.stock_z
+        if bottom < floor - 1e-6:
+            what = "" if params.bottom_z is not None else " (the model's lowest point)"
+            raise TmmError(f"bottom {bottom:g} mm{what} is below the stock's bottom {floor:g} mm")
+        top = min(top, float(ceiling))
+        if not top > bottom:
+            raise TmmError(f"bottom {bottom:g} mm is not below the stock's top {top:g} mm: no level in the stock")
     return top, bottom
 
 
 def estimate_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: float) -> float:
-    """Drops of the shared grid and loop points of all levels (an estimate), refused above core.limits
-    before anything is allocated."""
+    """Drops of the shared grid and loop points of all levels (an estimate; the levels counted, not made),
+    refused above core.limits before anything is allocated."""
     params.validate()
     b = params.boundary
     step = wl.default_sample_step(cutter, b) if params.sample_step is None else params.sample_step
-    return wl.estimate_work(b, len(levels(top, bottom, params.step_down)), step)
+    count = level_count(top, bottom, params.step_down)
+    return wl.estimate_work(b, count, step, f"step-down {params.step_down:g} mm from {top:g} to {bottom:g} mm")
 
 
 def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Optional[Progress] = None,

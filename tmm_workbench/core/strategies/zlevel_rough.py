@@ -50,7 +50,7 @@ from tmm_workbench.core import polygons as P
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
-from tmm_workbench.core.linking import HELIX, PLUNGE, RAMP, LinkPolicy, link
+from tmm_workbench.core.linking import HELIX, PLUNGE, RAMP, RAMP_ANGLE, LinkPolicy, link
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
@@ -68,6 +68,7 @@ _SLIVER = 0.02              # mm: unreachable material thinner than this is the 
 _MIN_RAMP = 0.25            # a ramp follows a pass at least this many tool diameters long; a region whose
                             # whole outline is shorter (its tool centre fits in a spot) is not entered
 _BYTES_PER_POINT = 160      # a loop point: polygons (float and Clipper's integers), segments, moves
+HELIX_MIN_PERCENT = 10.0    # a helix narrower than a tenth of the tool is a plunge turning on the spot
 
 
 @dataclass
@@ -83,8 +84,8 @@ class RoughingParams(StrategyParams):
     pattern: str = param("offset", "pattern", choices=("offset", "zigzag"))
     direction: str = param("climb", "direction", choices=("climb", "conventional"))
     entry: str = param("helix", "entry", choices=("helix", "ramp", "plunge"))       # plunge: the tool can
-    ramp_angle_deg: float = param(3.0, "ramp angle", "deg", low=0, high=90, low_open=True)
-    helix_diameter_percent: float = param(50.0, "helix diameter", "%", low=0, high=100, low_open=True)
+    ramp_angle_deg: float = param(3.0, "ramp angle", "deg", low=RAMP_ANGLE.low, high=RAMP_ANGLE.high)
+    helix_diameter_percent: float = param(50.0, "helix diameter", "%", low=HELIX_MIN_PERCENT, high=100)
     final_z: Optional[float] = param(None, "final depth", "mm", optional=True)  # default: model's lowest + axial stock
     chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
     keep_tool_down: bool = param(True, "keep tool down", choices=(True, False))
@@ -189,11 +190,29 @@ def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] 
     loops = math.ceil(min(w, h) / (2 * s)) + 2
     spacing = wl.default_sample_step(cutter, (0, 0, w + 2 * cutter.diameter, h + 2 * cutter.diameter))
     points = 2 * (w + h + 4 * cutter.diameter) / spacing * wl._REFINE_FACTOR
-    count = float(layers) * loops * points
+    # every loop may be entered (an upper bound), each entry's descent as the linker makes it
+    count = float(layers) * loops * (points + entry_points(params, cutter))
     check_work("roughing loop points", count, _BYTES_PER_POINT,
                f"{layers} layers (step-down {params.step_down:g} mm), step-over {params.stepover_percent:g} % "
-               f"of D{cutter.diameter:g} over a {w:.6g} x {h:.6g} mm stock")
+               f"of D{cutter.diameter:g} over a {w:.6g} x {h:.6g} mm stock, entry {params.entry} at ramp angle "
+               f"{params.ramp_angle_deg:g} deg, helix diameter {params.helix_diameter_percent:g} %")
     return count
+
+
+def entry_points(params: RoughingParams, cutter: Cutter) -> float:
+    """Points of one entry's descent through a layer (the step-down and the clearance above the material) as
+    core.linking makes them: a helix's chords at the arc tolerance; a ramp's walk along a loop, at most as dense
+    as the chords of the shortest loop a ramp follows (a circle _MIN_RAMP tool diameters round)."""
+    if params.entry == PLUNGE:
+        return 1.0
+    run = (params.step_down + _ENTRY_CLEARANCE) / math.tan(math.radians(params.ramp_angle_deg))
+    tol = max(1e-4, params.chord_tol / 2)
+    r = params.helix_diameter_percent / 100.0 * cutter.diameter / 2.0
+    dt = 2.0 * math.acos(1.0 - tol / r) if tol < r else math.pi / 4
+    helix = (run / r + 2 * math.pi) / dt
+    shortest = _MIN_RAMP * cutter.diameter / (2 * math.pi)
+    ramp = run / math.sqrt(8.0 * shortest * tol) + 2
+    return helix + ramp   # a helix that finds no room falls back to a ramp
 
 
 def wall_margin(params: RoughingParams) -> float:
@@ -329,8 +348,9 @@ def _enter(ctx: _Context, z: float, region: P.Region, pas: clearing.Pass, joined
     p = ctx.params
     if joined:
         return CutSegment(_tips(pas.xy, z, pas.closed), joined=True, closed=pas.closed)
-    if p.entry == PLUNGE:
-        return CutSegment(_tips(pas.xy, z, pas.closed), entry=PLUNGE, closed=pas.closed)
+    if p.entry == PLUNGE:   # the linker's rapid down ends above what earlier layers left over the tool
+        top = ctx.material_top([P.circle(pas.xy[0], ctx.R + ctx.arc_tol)])
+        return CutSegment(_tips(pas.xy, z, pas.closed), entry=PLUNGE, entry_z=top, closed=pas.closed)
     if p.entry == HELIX:
         found = _helix_centre(ctx, region, pas)
         if found is not None:
@@ -410,7 +430,8 @@ def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Sha
             joined = float(np.hypot(*(q - prev_end))) <= ctx.D and P.segment_inside(prev_end, q, region.shape)
         if i == 0 and open_region:
             tips = np.vstack([[[air[0], air[1], z]], _tips(pas.xy, z, pas.closed)])
-            seg = CutSegment(tips, entry=PLUNGE, closed=False)   # down through air beside the stock
+            # down through air beside the stock: no material at any height over the tool there (air_free)
+            seg = CutSegment(tips, entry=PLUNGE, entry_z=z, closed=False)
         else:
             try:
                 seg = _enter(ctx, z, region, pas, joined)
