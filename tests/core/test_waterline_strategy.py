@@ -58,7 +58,7 @@ def test_passes_are_closed_at_their_levels_top_down_and_nearest_first():
     assert max(counts.values()) == 2 and counts[zs[-1]] == 1   # two islands high up, one round both below
     surface = DropSurface(mesh)
     for seg in result.segments:
-        assert seg.kind is SegmentKind.PASS and not seg.joined
+        assert seg.kind is SegmentKind.PASS     # joined to the one above or not: test_loops_below_reached_...
         assert np.array_equal(seg.tips[0], seg.tips[-1])          # closed: the first tip repeated
         assert np.all(seg.tips[:, 2] == seg.tips[0, 2])
         assert signed_area(seg.tips[:-1, :2]) < 0                  # climb: islands clockwise
@@ -129,6 +129,53 @@ def test_work_is_refused_before_anything_is_computed():
     finally:
         limits.set_limits(max_points=old.max_points)
     assert estimate_work(WaterlineParams(boundary=(0, 0, 40, 30)), Cutter.ball(4), 8.0, 0.0) > 0
+
+
+def test_a_tiny_step_down_is_refused_at_once_by_name():
+    """1e-6 mm: 8e6 levels; counted, not made (making them took 1.86 GB before the refusal)."""
+    import time
+    import tracemalloc
+
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(TmmError, match=r"8.0\d+e\+06 waterline levels \(step-down 1e-06 mm from 8.00118 to"):
+            compute(bumps(), Cutter.ball(4), WaterlineParams(boundary=(0, 0, 40, 30), step_down=1e-6))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 1.0 and peak < 200e6
+
+
+def test_levels_stay_within_the_stock():
+    mesh = bumps()
+    ball = Cutter.ball(4)
+    far = WaterlineParams(boundary=(0, 0, 40, 30), top_z=-100.0, bottom_z=-200.0, stock_z=(-2.0, 10.0))
+    with pytest.raises(TmmError, match="bottom -200 mm is below the stock's bottom -2 mm"):
+        compute(mesh, ball, far)
+    with pytest.raises(TmmError, match=r"bottom 2.7\d+e-05 mm \(the model's lowest point\) is below the stock's bottom 1 mm"):
+        compute(mesh, ball, WaterlineParams(boundary=(0, 0, 40, 30), stock_z=(1.0, 10.0)))
+    # a top above the stock's: the levels start a step-down below the stock's top (none in the air above it)
+    high = compute(mesh, ball, WaterlineParams(boundary=(0, 0, 40, 30), top_z=30.0, bottom_z=2.0, step_down=1.0,
+                                               stock_z=(0.0, 6.0)))
+    assert high.diagnostics["top"] == pytest.approx(5.0)
+
+
+def test_loops_below_reached_with_the_tool_down_without_gouging():
+    """On the bumps, a loop starting within a tool radius below the end of the previous one is joined to it;
+    every such straight move stays above the drop height."""
+    from tmm_workbench.core.verify.linear_moves import deepest_cut
+
+    mesh = bumps()
+    ball = Cutter.ball(4)
+    res = compute(mesh, ball, WaterlineParams(boundary=(0, 0, 40, 30), step_down=0.5))
+    joined = [k for k, seg in enumerate(res.segments) if seg.joined]
+    assert len(joined) == res.diagnostics["joined"] >= 5
+    surface = DropSurface(mesh)
+    for k in joined:
+        a, b = res.segments[k - 1].tips[-1], res.segments[k].tips[0]
+        assert np.hypot(*(b[:2] - a[:2])) <= ball.radius and b[2] <= a[2]
+        assert deepest_cut(surface, ball, np.vstack([a, b]), np.array([False, True]), step=0.01)[0] <= 1e-4
 
 
 @pytest.mark.parametrize("cutter", [Cutter.ball(6), Cutter.flat(6), Cutter.bull(8, 1.5)], ids=lambda c: c.kind)

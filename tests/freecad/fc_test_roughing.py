@@ -53,20 +53,25 @@ def job_with(doc: Any, model: Any, op_name: str, shape: str = "endmill", diamete
 
 
 def check_feeds_and_heights(test: unittest.TestCase, job: Any, op: Any) -> list:
-    """The op's moves: G0 without F at or above the safe height, G1 at the tool controller's feeds, the safe
-    and clearance heights above the stock (FreeCAD's SetupSheet defaults), the path ending at the clearance."""
+    """The op's moves: G0 without F at or above the safe height but for the straight rapids down to just above
+    the material (the Job simulations see none cut), G1 at the tool controller's feeds, the safe and clearance
+    heights above the stock (FreeCAD's SetupSheet defaults), the path ending at the clearance."""
     mv = moves(op)
     test.assertGreater(len(mv), 20)
     top = job.Stock.Shape.BoundBox.ZMax
     safe, clear = op.SafeHeight.Value, op.ClearanceHeight.Value
     test.assertGreater(safe, top)
     test.assertGreaterEqual(clear, safe)
+    here: dict = {}
     for n, p in mv:
         if n == "G0":
             test.assertNotIn("F", p)
-            test.assertGreaterEqual(p["Z"], safe - 1e-9)
+            if p["Z"] < safe - 1e-9:
+                test.assertEqual((p.get("X", here["X"]), p.get("Y", here["Y"])), (here["X"], here["Y"]))
+                test.assertLess(p["Z"], here["Z"])
         else:
             test.assertIn(round(p["F"] * 60, 6), (H_FEED, V_FEED))
+        here.update({k: p[k] for k in ("X", "Y", "Z") if k in p})
     test.assertIn(H_FEED, {round(p["F"] * 60, 6) for n, p in mv if n == "G1"})
     test.assertAlmostEqual(mv[-1][1]["Z"], clear, places=6)
     test.assertEqual(len(op.Proxy.toolpath), len(mv) - 2)  # + the Z-only start, ObjectOp's final G0

@@ -19,6 +19,8 @@ Where the material's top over the entry is known (the segment's `entry_z`, the p
 lower of the two, both being upper bounds), the tool rapids down to `entry_clearance` above it (or above where
 the entry starts, if higher) and is fed only from there, as a machinist does: a plunge from the safe height
 through the air earlier cuts left costs most of a finishing op's time. Unknown: fed from the safe height.
+A StockHeights as the material top (the stock earlier ops left, as heights) is cut by each segment as it is
+linked, so later entries also see what the op's own earlier passes removed.
 Helix and ramp are only as gouge-free as the XY they pass over: the strategy gives a centre whose circle
 lies where the tool centre may go at the first tip's height and above (the linker does not see the model).
 The path starts at the clearance height over the first entry (5-axis: upright, then turned there) and
@@ -253,6 +255,38 @@ def heights_top(grid: Any, heights: np.ndarray, radius: float,
     return top
 
 
+class StockHeights:
+    """The stock as heights on a grid (what earlier ops left: core.sim), a MaterialTop for a cutter that the
+    linker keeps up to date as it cuts (`cut`, after each segment): an op's later entries then rapid down to
+    just above what its own earlier passes left (a waterline's level above, a verification's finished surface).
+    The grid's cells are updated in place; off the grid lies `outside` (-inf: nothing, +inf: not known)."""
+
+    def __init__(self, grid: Any, heights: np.ndarray, cutter: Any, outside: float = -math.inf) -> None:
+        self.grid, self.cutter = grid, cutter
+        self.heights = np.array(heights, dtype=float)
+        self._top = heights_top(grid, self.heights, cutter.radius, cutter.native.height, outside)
+
+    def __call__(self, xy: np.ndarray) -> np.ndarray:
+        return self._top(xy)
+
+    def cut(self, path: Toolpath) -> None:
+        """`path`'s moves cut into the heights (the cells within the tool's reach of them only)."""
+        from tmm_workbench.core.sim.simulate import simulate  # the simulation links too: imported when used
+
+        if len(path) < 2:
+            return
+        g, pts = self.grid, path.points()
+        reach = self.cutter.native.max_radius
+        i0 = max(0, math.floor((pts[:, 0].min() - reach - g.x0) / g.cell))
+        i1 = min(g.nx, math.ceil((pts[:, 0].max() + reach - g.x0) / g.cell))
+        j0 = max(0, math.floor((pts[:, 1].min() - reach - g.y0) / g.cell))
+        j1 = min(g.ny, math.ceil((pts[:, 1].max() + reach - g.y0) / g.cell))
+        if i1 <= i0 or j1 <= j0:
+            return
+        sub = type(g)(g.x0 + i0 * g.cell, g.y0 + j0 * g.cell, g.cell, i1 - i0, j1 - j0)
+        self.heights[j0:j1, i0:i1] = simulate(path, self.cutter, sub, self.heights[j0:j1, i0:i1]).heights
+
+
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:
     """The tool path through `segments` in order (see the module doc). No segments: an empty path."""
     policy.validate()
@@ -267,6 +301,7 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
     for seg in segments:
         pts = seg.tips
         first = 0
+        start = len(tp.moves) - 1                 # the cut begins where the tool is (joined) ...
         if not tp.moves or not seg.joined:
             name = seg.entry or policy.entry
             if name not in ENTRIES:
@@ -280,6 +315,7 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
                 tp.add(MoveKind.RAPID, x0, y0, policy.clearance_height)
             tp.add(MoveKind.RAPID, x0, y0, policy.safe_height, seg.axis(0))
             z = _approach(tp, seg, policy, descent)
+            start = len(tp.moves) - 1             # ... or where its rapid down ends
             if len(descent) == 1:                 # straight down onto the tip
                 tp.add(MoveKind.PLUNGE, *pts[0], seg.axis(0))
             else:
@@ -290,6 +326,8 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
             first = 1
         for i in range(first, len(pts)):
             tp.add(MoveKind.FEED, *pts[i], seg.axis(i))
+        if hasattr(policy.material_top, "cut"):   # a StockHeights: what this segment cut, for the later entries
+            policy.material_top.cut(Toolpath(tp.moves[start:]))
     last = tp.moves[-1]
     tp.add(MoveKind.RAPID, last.x, last.y, policy.clearance_height, last.axis)
     return tp

@@ -30,7 +30,7 @@ from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
-from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.linking import LinkPolicy, heights_top, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.sim.cusp_field import CuspField, cusp_field
@@ -415,6 +415,8 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
                         heights[rows, cols] = simulate(link([bridge], policy), cutter, sub,
                                                        heights[rows, cols]).heights
             for seg in new:
+                if not seg.joined:  # entered from above: the rapid down ends just above what is already cut
+                    seg.entry_z = _entry_top(fld, heights, cutter, seg.tips[0])
                 passes.add(seg.tips)
                 report.passes_added += 1
                 report.length_added += float(np.linalg.norm(np.diff(seg.tips[:, :2], axis=0), axis=1).sum())
@@ -432,8 +434,25 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         if on_model.any() else 0.0
     report.seconds = time.perf_counter() - t0
     # the first extra segment follows the pass set after a lift; the others keep their own (joined: on the surface)
-    return segments + [CutSegment(s.tips, s.kind, joined=s.joined and i > 0, pass_index=s.pass_index)
-                       for i, s in enumerate(extra)], report
+    return segments + [CutSegment(s.tips, s.kind, joined=s.joined and i > 0, pass_index=s.pass_index,
+                                  entry_z=s.entry_z) for i, s in enumerate(extra)], report
+
+
+def _entry_top(fld: CuspField, heights: np.ndarray, cutter: Cutter, tip: np.ndarray) -> Optional[float]:
+    """The top of the material under the tool at a partial pass's first tip: the surface the pass set and the
+    partial passes before it left (the simulated `heights`, the model plus the cusp), the tool dropped on it;
+    None (not known: entered from the safe height) where the tool reaches a cell they did not cut (the
+    simulation's stock there is a stand-in) or the grid's edge."""
+    g, reach = fld.grid, cutter.radius + fld.grid.cell * 2
+    i0, i1 = math.floor((tip[0] - reach - g.x0) / g.cell), math.ceil((tip[0] + reach - g.x0) / g.cell)
+    j0, j1 = math.floor((tip[1] - reach - g.y0) / g.cell), math.ceil((tip[1] + reach - g.y0) / g.cell)
+    if i0 < 0 or j0 < 0 or i1 > g.nx or j1 > g.ny:
+        return None
+    window = heights[j0:j1, i0:i1]
+    known = np.where(window < fld.stock_top - 1e-9, window, np.inf)
+    sub = Grid(g.x0 + i0 * g.cell, g.y0 + j0 * g.cell, g.cell, i1 - i0, j1 - j0)
+    top = float(heights_top(sub, known, cutter.radius, cutter.native.height)(tip[None, :2])[0])
+    return top if math.isfinite(top) else None
 
 
 def validate_params(params) -> None:

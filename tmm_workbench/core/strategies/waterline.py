@@ -5,8 +5,10 @@ one closed pass at its height; the linker (core.linking, VERTICAL) makes the too
     path = link(result.segments, LinkPolicy(safe_height=40, clearance_height=45))
 
 Levels run top-down from `top_z` - `step_down` (default top: the model's highest point) to `bottom_z` (the
-last level exactly there; default: the model's lowest point). Within a level the loops are cut nearest-first,
-each closed loop starting at its point nearest to where the tool is. Where the blocked region runs past the
+last level exactly there; default: the model's lowest point), within the stock (`stock_z`). Within a level the
+loops are cut nearest-first, each closed loop starting at its point nearest to where the tool is; a loop that
+starts within a tool radius below where the previous one ended is reached with the tool down when that move
+clears the model. Where the blocked region runs past the
 boundary, the loop's points on the boundary split it: those pieces are not cut, the rest are open passes.
 
 Direction, for a right-hand (M3, clockwise seen from above) spindle: the kernel's loops keep the material on
@@ -111,7 +113,8 @@ def estimate_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: f
 def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Optional[Progress] = None,
             surface: Optional[DropSurface] = None) -> StrategyResult:
     """Gouge-free waterline finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments, levels
-    top-down. diagnostics: "levels" (count), "loops", "points", "top" (highest tip)."""
+    top-down. diagnostics: "levels" (count), "loops", "points", "joined" (pieces reached with the tool down
+    from the previous one), "top" (highest tip)."""
     params.validate()
     if cutter.kind not in SUPPORTED_TOOLS:
         raise TmmError(f"the {cutter.describe()} cutter is not supported by waterline finishing")
@@ -142,18 +145,38 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
             if closed:
                 xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
             tips = np.column_stack([xy, np.full(len(xy), z)])
-            # The linker enters each segment from above onto its first tip: gouge-free, since every loop
-            # point is free (its drop height is at most z).
+            # The linker enters each segment from above onto its first tip (gouge-free, since every loop
+            # point is free: its drop height is at most z), unless _join_levels reaches it with the tool down.
             extra = {"closed": closed} if _HAS_CLOSED else {}
             segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
             points += len(tips)
             where = xy[-1]
+    joined = _join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     if not segments:
         raise TmmError(f"no waterline loop within the boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} "
                        f"between {bottom:g} and {top:g} mm: the model lies outside it or below the levels")
-    diagnostics = {"levels": len(zs), "loops": loops, "points": points,
+    diagnostics = {"levels": len(zs), "loops": loops, "points": points, "joined": joined,
                    "top": max(float(seg.tips[0, 2]) for seg in segments)}
     return StrategyResult(segments, diagnostics)
+
+
+def _join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
+    """Pieces that start within a tool radius of where the previous one ended, no higher, reached with the tool
+    down (`joined`: a straight fed move, the next level's loop from the one above) where that move is clear of
+    the model plus stock to leave (sampled as core.verify.linear_moves checks moves); the count. A lift, a rapid
+    and the feed down through the clearance cost more than such a move on short loops."""
+    from tmm_workbench.core.verify.linear_moves import deepest_cut
+
+    count = 0
+    for prev, seg in zip(segments, segments[1:]):
+        a, b = prev.tips[-1], seg.tips[0]
+        if float(np.hypot(*(b[:2] - a[:2]))) > radius or b[2] > a[2] + _LEVEL_EPS_MM:
+            continue
+        move = np.vstack([a, b]) - np.array([0.0, 0.0, s])   # the grown cutter's tips lie s lower
+        if deepest_cut(surface, grown, move, np.array([False, True]))[0] <= 1e-6:
+            seg.joined = True
+            count += 1
+    return count
 
 
 def _clear_of_chords(level: list[wl.WaterlineLoop], bounds: Rect, grow: float) -> list[wl.WaterlineLoop]:
