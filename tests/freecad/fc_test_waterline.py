@@ -145,6 +145,13 @@ class WaterlineBadInput(BadInputCase):
         self.op.SampleStep = -1.0
         self.assertFails("sample step", "got -1")
 
+    def test_levels_below_the_stock(self) -> None:
+        """A level range far below the stock (whose bottom is at -1) is refused as roughing refuses it."""
+        self.op.UseZRange = True
+        self.op.TopZ = -100.0
+        self.op.BottomZ = -200.0
+        self.assertFails("bottom -200 mm is below the stock's bottom -1 mm")
+
     def test_safe_height_below_the_model(self) -> None:
         self.op.setExpression("SafeHeight", None)
         self.op.SafeHeight = 3.0  # the block is 10 mm high
