@@ -40,6 +40,10 @@ def encode(move: Move, feed: Optional[float] = None, with_axis: Optional[bool] =
     """(command name, parameters) for one toolpath move: G0 for rapids (no F), G1 otherwise with F = feed
     (mm/s) when given. Axis words are written when `with_axis` is True, or (None) when the axis is not Z."""
     name = "G0" if move.kind is MoveKind.RAPID else "G1"
+    if not all(math.isfinite(float(c)) for c in (move.x, move.y, move.z, *move.axis)):
+        # a NaN in a Path is read as 'keep the previous value' by some readers: never write one
+        raise TmmError(f"a tool path move is not a finite number (tip {move.x}, {move.y}, {move.z}, axis "
+                       f"{tuple(move.axis)}): nothing was written")
     params: dict[str, float] = {"X": float(move.x), "Y": float(move.y), "Z": float(move.z)}
     if with_axis or (with_axis is None and tuple(move.axis) != Z_AXIS):
         params.update(zip(AXIS_WORDS, (float(v) for v in move.axis)))

@@ -11,11 +11,24 @@ with the least A travel from the block before; unwinding therefore happens only 
 a cut. A block whose A span is wider than the limits cannot be cut without unwinding: RotaryPlanError names
 it (its first and last move) and nothing is emitted.
 
+The vertical (C = 0, the singularity of a head-head machine with C >= 0). A tool axis passing through the
+vertical is a normal event on a free-form face (over a bump, a dip or a saddle point the tilt goes to zero):
+its azimuth, which A follows, swings by about 180 degrees there, the faster the closer the axis passes. Axes
+within `pole_tol` of the vertical are taken as vertical (C = 0; the axis moves by at most `pole_tol`), and a
+cutting move whose axis passes within `pole_tol` of it is routed through it: down to C = 0 at the A it
+had, A turned there (where it moves neither tip nor axis), then on at its new A. A is free at such a pole
+pass, so the whole turns are chosen per stretch between pole passes, not per block: the planner picks the
+way round that keeps the cut inside the A limits (an axis circling the vertical needs no unwinding). Axes
+passing farther than `pole_tol` from the vertical are followed by subdivision (A swings fast but
+continuously beside the pole). Machines with negative tilts stay on one branch through the vertical
+instead (A still, C changes sign): nothing is snapped there.
+
 Subdivision. Between two joint positions a control without tool-centre-point mode moves X Y Z A C linearly;
 the tip then leaves the straight line between the two programmed tips and the axis its interpolation (slerp).
-`subdivide` splits a move into 2, 4, 8, ... equal pieces (tip linear, axis slerp, joints by continuous
-unwrapping) until, at every piece, the tip stays within `tip_tol` of where the straight line has it at the
-same fraction and the axis within `axis_tol` of its slerp, checked at 8 points per piece.
+`subdivide` halves a move (tip linear, axis slerp, joints by continuous unwrapping), and each half again
+where it is still out, until at every piece the tip stays within `tip_tol` of where the straight line has it
+at the same fraction and the axis within `axis_tol` of its slerp, checked at 8 points per piece; only the
+pieces beside the pole need the finest halving.
 """
 from __future__ import annotations
 
@@ -32,7 +45,11 @@ from tmm_workbench.core.machine.tarus import _LIMIT_SLACK, JointLimitError, Join
 TWO_PI = 2.0 * math.pi
 _SAME_AXIS = 1e-12   # 1 - cos(angle) under which two axes are the same orientation
 _CHECKS = 8          # interior points per piece checked by `subdivide`
-_MAX_PIECES = 4096
+_MAX_DEPTH = 16      # halvings of one move (65536 pieces where all of it needs the finest)
+# axes this close to the vertical are vertical: half the post's default axis tolerance (0.05 deg), the other
+# half left for the pieces on the way to and from the pole
+POLE_TOL = math.radians(0.025)
+_CENTRE_WEIGHT = 1e-3  # rad of A travel per rad of A off the middle of its limits: breaks ties only
 
 
 class RotaryPlanError(TmmError):
@@ -77,12 +94,53 @@ def _c_ok(machine: TarusMachine, c: float) -> bool:
     return lo - _LIMIT_SLACK <= c <= hi + _LIMIT_SLACK
 
 
-def _block_joints(machine: TarusMachine, moves: list[Move], first: int, last: int,
-                  previous: Joints) -> np.ndarray:
+def snaps_to_pole(machine: TarusMachine, pole_tol: float) -> bool:
+    """Whether near-vertical axes are taken as vertical: only for a machine without negative tilts (with
+    them a sweep through the vertical keeps its branch and A)."""
+    return pole_tol > 0 and machine.c_limits[0] >= 0
+
+
+def pole_pass(u0: np.ndarray, u1: np.ndarray) -> tuple[float, float]:
+    """(angle, fraction): how close the slerp from unit u0 to unit u1 comes to the vertical +Z, and at
+    which fraction of the move (the great circle's nearest point to +Z when it lies on the arc, else the
+    nearer end)."""
+    u0, u1 = np.asarray(u0, dtype=float), np.asarray(u1, dtype=float)
+    ends = [(math.atan2(math.hypot(u[0], u[1]), u[2]), s) for u, s in ((u0, 0.0), (u1, 1.0))]
+    best = min(ends)
+    n = np.cross(u0, u1)
+    sin_th = float(np.linalg.norm(n))
+    if sin_th < 1e-12:
+        return best
+    n /= sin_th
+    p = np.array([0.0, 0.0, 1.0]) - n[2] * n  # +Z projected on the arc's plane
+    norm = float(np.linalg.norm(p))
+    if norm < 1e-15:
+        return best
+    p /= norm
+    th = math.atan2(sin_th, float(u0 @ u1))
+    a0 = math.atan2(float(np.cross(u0, p) @ n), float(u0 @ p))  # signed angle u0 -> p about n
+    if 0.0 < a0 < th:
+        d = math.atan2(abs(n[2]), norm)  # the angle between +Z and its projection
+        if d < best[0]:
+            return d, a0 / th
+    return best
+
+
+def _snap(machine: TarusMachine, tip: tuple[float, float, float], prev: Joints) -> Joints:
+    """The tool at `tip` with its axis vertical: C = 0, A held from `prev`, the pivot right above the tip."""
+    return Joints(tip[0], tip[1], tip[2] + machine.length, prev.a, 0.0)
+
+
+def _block_joints(machine: TarusMachine, moves: list[Move], first: int, last: int, previous: Joints,
+                  pole_tol: float) -> tuple[np.ndarray, list[int]]:
     """Joints of one block before its whole turns are chosen: each move's branch the one reached from the
     move before in the least joint time (so a sweep through the vertical may change branch where C = 0),
-    A continuous; the first move next to `previous`. JointLimitError for a move whose C is out of limits."""
+    A continuous; the first move next to `previous`. Axes within `pole_tol` of the vertical snapped to it.
+    Also the moves (global indices) after which A is free: a cutting move whose axis passes within
+    `pole_tol` of the vertical. JointLimitError for a move whose C is out of limits."""
     out = np.empty((last - first + 1, 5))
+    free: list[int] = []
+    snap = snaps_to_pole(machine, pole_tol)
     prev = previous
     for k, i in enumerate(range(first, last + 1)):
         cands = [j for j in machine.candidates(moves[i].tip, moves[i].axis, prev) if _c_ok(machine, j.c)]
@@ -91,16 +149,26 @@ def _block_joints(machine: TarusMachine, moves: list[Move], first: int, last: in
             raise JointLimitError(f"move {i}: {TarusMachine._limit_message('C', c, machine.c_limits)} "
                                   f"({machine.name})", "C", c, machine.c_limits, i)
         best = min(cands, key=lambda j: machine.motion_time(prev, j))
+        if snap and 0.0 < abs(best.c) <= pole_tol:
+            best = _snap(machine, moves[i].tip, prev)
         out[k] = best.as_array()
+        if snap and k > 0 and not moves[i].rapid and crosses_pole(machine, out[k - 1], out[k], pole_tol):
+            free.append(i)
         prev = best
-    return out
+    return out, free
 
 
-def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = None) -> np.ndarray:
+def crosses_pole(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, pole_tol: float) -> bool:
+    """The move j0 -> j1 (its ideal: the axis by slerp) passes within `pole_tol` of the vertical."""
+    return pole_pass(machine.forward(j0)[1], machine.forward(j1)[1])[0] <= pole_tol
+
+
+def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = None,
+         pole_tol: float = POLE_TOL) -> np.ndarray:
     """(n, 5) joints x, y, z (pivot point), a, c for `moves`, A planned per block (module doc): the whole
-    turns of all blocks chosen together (dynamic programming over the few that fit each block) for the least
-    A travel in all. JointLimitError for a move out of the X/Y/Z or C limits, RotaryPlanError for a block
-    A cannot follow."""
+    turns of every stretch (a block, or its part between pole passes) chosen together (dynamic programming
+    over the few that fit each) for the least A travel in all. JointLimitError for a move out of the X/Y/Z
+    or C limits, RotaryPlanError for a stretch A cannot follow."""
     n = len(moves)
     joints = np.full((n, 5), np.nan)
     a_prev = machine.a_home if a_start is None else a_start
@@ -108,25 +176,39 @@ def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = No
     if not spans:
         return joints
     parts: list[np.ndarray] = []
+    stretches: list[tuple[int, int, int, int]] = []  # first, last move of a stretch, and of its block
     previous = Joints(math.nan, math.nan, math.nan, a_prev, 0.0)
     for first, last in spans:  # each block continued from the one before, before any whole turns
-        block = _block_joints(machine, moves, first, last, previous)
-        parts.append(block)
+        block, free = _block_joints(machine, moves, first, last, previous, pole_tol)
+        for lo, hi in zip([first] + free, [f - 1 for f in free] + [last]):
+            parts.append(block[lo - first:hi - first + 1])
+            stretches.append((lo, hi, first, last))
         previous = Joints.from_array(block[-1])
+    spans = [(lo, hi) for lo, hi, _, _ in stretches]
     options: list[list[int]] = []
-    for (first, last), block in zip(spans, parts):
-        turns = _turns(machine, block[:, 3])
+    for (lo, hi, first, last), part in zip(stretches, parts):
+        turns = _turns(machine, part[:, 3])
+        if machine.a_limits is None and lo != first:  # a continuous A may turn either way at the pole too
+            turns = [-1, 0, 1]
         if not turns:
-            lo, hi = machine.a_limits  # type: ignore[misc]
-            a = block[:, 3]
+            a_lo, a_hi = machine.a_limits  # type: ignore[misc]
+            a = part[:, 3]
+            where = "" if (lo, hi) == (first, last) else f", moves {lo}..{hi} between passes through the vertical"
             raise RotaryPlanError(
-                f"moves {first}..{last} (a cut with its approach and retract): A turns through "
+                f"moves {first}..{last} (a cut with its approach and retract{where}): A turns through "
                 f"{math.degrees(float(a.max() - a.min())):.6g} deg, more than its limits "
-                f"[{math.degrees(lo):.6g}, {math.degrees(hi):.6g}] deg hold without unwinding inside the cut; "
-                f"split the pass or widen the limits ({machine.name})", first, last)
+                f"[{math.degrees(a_lo):.6g}, {math.degrees(a_hi):.6g}] deg hold without unwinding inside the "
+                f"cut; split the pass or widen the limits ({machine.name})", first, last)
         options.append(turns)
     # cost[k] of the best turns so far ending with turn k of the current block; back pointers per block
-    cost = {k: abs(parts[0][0, 3] + TWO_PI * k - a_prev) for k in options[0]}
+    # ties (a half turn at the pole either way round) go to the stretch nearer the middle of the A limits,
+    # so turns through the vertical alternate instead of winding A up
+    centre = a_prev if machine.a_limits is None else 0.5 * sum(machine.a_limits)
+
+    def off_centre(b: int, k: int) -> float:
+        return _CENTRE_WEIGHT * abs(float(parts[b][:, 3].mean()) + TWO_PI * k - centre)
+
+    cost = {k: abs(parts[0][0, 3] + TWO_PI * k - a_prev) + off_centre(0, k) for k in options[0]}
     back: list[dict[int, int]] = [{}]
     for b in range(1, len(parts)):
         end, start = parts[b - 1][-1, 3], parts[b][0, 3]
@@ -134,7 +216,7 @@ def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = No
         ptr: dict[int, int] = {}
         for k in options[b]:
             best_k = min(cost, key=lambda kp: cost[kp] + abs(start + TWO_PI * k - end - TWO_PI * kp))
-            step[k] = cost[best_k] + abs(start + TWO_PI * k - end - TWO_PI * best_k)
+            step[k] = cost[best_k] + abs(start + TWO_PI * k - end - TWO_PI * best_k) + off_centre(b, k)
             ptr[k] = best_k
         cost, back = step, back + [ptr]
     k = min(cost, key=cost.get)
@@ -191,44 +273,42 @@ def deviation(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, checks: int
 
 def subdivide(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, tip_tol: float, axis_tol: float
               ) -> np.ndarray:
-    """(m, 5) joints of the pieces' ends (the last one j1) for the linear joint move j0 -> j1, m a power of
-    two (module doc). TmmError when even 4096 pieces do not stay within the tolerances."""
+    """(m, 5) joints of the pieces' ends (the last one j1) for the linear joint move j0 -> j1: halved where a
+    piece is out of the tolerances (module doc), the pieces' ends on the ideal move (tip on its line, axis
+    by slerp). TmmError when a piece is still out after _MAX_DEPTH halvings."""
     t0, u0 = machine.forward(j0)
     t1, u1 = machine.forward(j1)
-    pieces = 1
-    while pieces <= _MAX_PIECES:
-        s = np.arange(1, pieces + 1) / pieces
-        tips = t0[None, :] * (1 - s[:, None]) + t1[None, :] * s[:, None]
-        axes = slerp(u0, u1, s)
-        ends = np.empty((pieces, 5))
-        prev = j0
-        ok = True
-        for k in range(pieces):
-            if k == pieces - 1:
-                end = j1
-            else:
-                end = _follow(machine, tips[k], axes[k], prev)
-            ends[k] = end
-            if ok:
-                tip_dev, axis_dev = deviation(machine, prev, end)
-                ok = tip_dev <= tip_tol and axis_dev <= axis_tol
-            prev = end
-        if ok:
-            return ends
-        pieces *= 2
-    raise TmmError(f"a joint move cannot follow its straight line within {tip_tol:g} mm and "
-                   f"{math.degrees(axis_tol):g} deg even in {_MAX_PIECES} pieces (a move through the vertical?)")
+    ends: list[np.ndarray] = []
+    todo = [(0.0, 1.0, j0, j1, 0)]  # pieces still to check, the first one last (a stack)
+    while todo:
+        s0, s1, a, b, depth = todo.pop()
+        tip_dev, axis_dev = deviation(machine, a, b)
+        if tip_dev <= tip_tol and axis_dev <= axis_tol:
+            ends.append(b)
+            continue
+        if depth == _MAX_DEPTH:
+            raise TmmError(f"a joint move cannot follow its straight line within {tip_tol:g} mm and "
+                           f"{math.degrees(axis_tol):g} deg even in pieces of 1/{2 ** _MAX_DEPTH} of it "
+                           f"(tip off by {tip_dev:.3g} mm, axis by {math.degrees(axis_dev):.3g} deg)")
+        s = 0.5 * (s0 + s1)
+        mid = _follow(machine, t0 * (1 - s) + t1 * s, slerp(u0, u1, np.array([s]))[0], a, b)
+        todo.append((s, s1, mid, b, depth + 1))
+        todo.append((s0, s, a, mid, depth + 1))
+    return np.array(ends).reshape(-1, 5)
 
 
-def _follow(machine: TarusMachine, tip: np.ndarray, axis: np.ndarray, prev: np.ndarray) -> np.ndarray:
-    """Joints for (tip, axis) continuing from `prev`: the same C branch, A next to prev's A."""
+def _follow(machine: TarusMachine, tip: np.ndarray, axis: np.ndarray, prev: np.ndarray,
+            after: Optional[np.ndarray] = None) -> np.ndarray:
+    """Joints for (tip, axis) between `prev` and `after` (default: continuing from `prev`): the same C
+    branch, A next to the middle of their A (a piece's A lies between its ends', however fast it swings)."""
     az, tilt = _angles(axis, machine.singular_tol)
     c = math.copysign(tilt, prev[4]) if prev[4] != 0 else tilt
+    ref = float(prev[3]) if after is None else 0.5 * float(prev[3] + after[3])
     if az is None:
         a = float(prev[3])
     else:
         if c < 0:
             az += math.pi
-        a = az + TWO_PI * round((prev[3] - az) / TWO_PI)
+        a = az + TWO_PI * round((ref - az) / TWO_PI)
     pivot = tip + machine.length * axis
     return np.array([pivot[0], pivot[1], pivot[2], a, c])

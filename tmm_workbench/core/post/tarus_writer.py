@@ -12,7 +12,9 @@ cut, with its approach and retract, gets the whole turns (and C branch) that kee
 a cut; a cut that cannot fit raises RotaryPlanError naming its commands.
 Joint mode: a G1 that turns A or C is split into pieces until a control interpolating the joints linearly
 keeps the tip within `tip_tolerance` (default 0.005 mm) of the straight line and the axis within
-`axis_tolerance` (default 0.05 deg) of its interpolation. TCP mode writes the tip and axis as given, split
+`axis_tolerance` (default 0.05 deg) of its interpolation. A G1 whose axis passes within half the axis
+tolerance (at most 0.025 deg) of the vertical goes through it: C down to 0, A turned there (it moves nothing), then on, A's way
+round chosen for the limits (core.machine.rotary). TCP mode writes the tip and axis as given, split
 only where the control's linear A and C would leave the axis interpolation by more than `axis_tolerance`.
 Feeds: a G1 at a constant orientation uses G94 with F in mm/min (in/min); a G1 that turns A or C uses
 inverse time (G93, F = 1 / minutes). Either way the move's time is the longer of tip distance / feed and
@@ -77,6 +79,9 @@ class _Writer:
         self.coolant = "None"
         self.time = 0.0
         self.moves = 0
+        # half the axis tolerance (at most the default's half) for taking the axis through the vertical, the
+        # rest for the pieces around it
+        self.pole_tol = min(0.5 * options.axis_tolerance, rotary.POLE_TOL)
 
     # --- formatting --------------------------------------------------------------------------
     def emit(self, text: str) -> None:
@@ -193,7 +198,7 @@ class _Writer:
         moves = [rotary.Move(tuple(p.tip), tuple(p.axis), name == "G0") for _, name, p in motions]
         a_start = self.joints.a if self.joints is not None else None
         try:
-            return rotary.plan(self.m, moves, a_start)
+            return rotary.plan(self.m, moves, a_start, self.pole_tol)
         except rotary.RotaryPlanError as exc:
             first, last = motions[exc.first][0], motions[exc.last][0]
             raise rotary.RotaryPlanError(f"operation '{op.label}', commands {first}..{last}: {exc}",
@@ -241,21 +246,54 @@ class _Writer:
                       f"F{self.linear_feed(feed)}")
             self.advance(j, tip, seconds)
             return
-        pieces = [planned]
-        if turns and known.all() and not np.isnan(self.tip).any():
-            # TCP: the control keeps the tip on its line but turns A and C linearly, so only the axis is held
-            # to its tolerance; joint mode: both
-            tip_tol = math.inf if self.o.tcp else self.o.tip_tolerance
-            start = prev.as_array()
-            tip_dev, axis_dev = rotary.deviation(m, start, planned)
-            if tip_dev > tip_tol or axis_dev > self.o.axis_tolerance:
-                if abs(prev.c) <= m.singular_tol and abs(j.a - prev.a) > 1e-12:
-                    # leaving the vertical: turn A first, where it moves neither tip nor axis
-                    start = np.array([prev.x, prev.y, prev.z, j.a, prev.c])
-                    self.linear(name, Joints.from_array(start), np.array(self.tip), feed, known)
-                pieces = list(rotary.subdivide(m, start, planned, tip_tol, self.o.axis_tolerance))
-        for piece in pieces:  # the pieces' tips are on the straight line (subdivide's targets)
-            piece_tip = tip if piece is pieces[-1] else m.forward(piece)[0]
+        if not (turns and known.all() and not np.isnan(self.tip).any()):
+            self.linear(name, j, tip, feed, known)
+            return
+        # TCP: the control keeps the tip on its line but turns A and C linearly, so only the axis is held to
+        # its tolerance; joint mode: both
+        tip_tol = math.inf if self.o.tcp else self.o.tip_tolerance
+        start, tip0 = prev.as_array(), np.array(self.tip)
+        tip_dev, axis_dev = rotary.deviation(m, start, planned)
+        if tip_dev <= tip_tol and axis_dev <= self.o.axis_tolerance:  # the control follows it as it is
+            self.linear(name, j, tip, feed, known)
+            return
+        pole = self.pole_crossing(start, planned)
+        if pole is None:
+            if abs(prev.c) <= m.singular_tol and abs(j.a - prev.a) > 1e-12:
+                # leaving the vertical: turn A first, where it moves neither tip nor axis
+                start = np.array([prev.x, prev.y, prev.z, j.a, prev.c])
+                self.linear(name, Joints.from_array(start), tip0, feed, known)
+            self.follow(name, start, planned, tip, feed, known, tip_tol, self.o.axis_tolerance)
+            return
+        # through the vertical: there at the A it has, A turned at C = 0, then on at its new A; the pole point
+        # is off the move's slerp by at most pole_tol, the rest of the tolerance is the pieces'
+        pole_tip = tip0 + (tip - tip0) * pole
+        pivot = pole_tip + np.array([0.0, 0.0, m.length])
+        arrive = np.array([*pivot, prev.a, 0.0])
+        leave = np.array([*pivot, j.a, 0.0])
+        axis_tol = self.o.axis_tolerance - self.pole_tol
+        for a, b, b_tip in ((start, arrive, pole_tip), (arrive, leave, pole_tip), (leave, planned, tip)):
+            if np.abs(b - a).max() > 1e-12:
+                self.follow(name, a, b, b_tip, feed, known, tip_tol, axis_tol)
+
+    def pole_crossing(self, j0: np.ndarray, j1: np.ndarray) -> Optional[float]:
+        """The fraction of the move j0 -> j1 where its axis passes within pole_tol of the vertical (the
+        planner freed A there), None if it does not."""
+        if not rotary.snaps_to_pole(self.m, self.pole_tol):
+            return None
+        d, s = rotary.pole_pass(self.m.forward(j0)[1], self.m.forward(j1)[1])
+        return s if d <= self.pole_tol * (1 + 1e-9) else None  # the slack: the planner's A turns, rounded
+
+    def follow(self, name: str, j0: np.ndarray, j1: np.ndarray, tip: np.ndarray, feed: float, known: np.ndarray,
+               tip_tol: float, axis_tol: float) -> None:
+        """The G1 from j0 (where the machine is) to j1 (tip `tip`), in pieces where the control's linear
+        joints would leave the tolerances (the pieces' tips are on the straight line: subdivide's targets)."""
+        pieces = [j1]
+        tip_dev, axis_dev = rotary.deviation(self.m, j0, j1)
+        if tip_dev > tip_tol or axis_dev > axis_tol:
+            pieces = list(rotary.subdivide(self.m, j0, j1, tip_tol, axis_tol))
+        for k, piece in enumerate(pieces):
+            piece_tip = tip if k == len(pieces) - 1 else self.m.forward(piece)[0]
             self.linear(name, Joints.from_array(piece), piece_tip, feed, known)
 
     def a_steps(self, prev: Optional[Joints], j: Joints) -> list[Joints]:

@@ -1,8 +1,9 @@
 """The machine's view of Tarus G-code: the lines read back, the motion between them as a control without
 tool-centre-point mode makes it (X Y Z A C interpolated linearly), and what a machinist checks on it: A
 inside its limits and never more than 180 degrees in one line, every line doable in its programmed time at
-the joint speeds, the tip within a tolerance of the straight line between programmed tips. It reads only
-the G-code (and the machine settings), never the tool path that made it.
+the joint speeds, the tip within a tolerance of the straight line between programmed tips, A never turning
+a whole turn inside a cut with the tool tilted (A unwinds only at the transits or where the tool is
+vertical), and no number that is not one. It reads only the G-code (and the machine settings), never the tool path that made it.
 """
 from __future__ import annotations
 
@@ -15,6 +16,8 @@ import numpy as np
 from tmm_workbench.core.machine.rotary import deviation
 from tmm_workbench.core.machine.tarus import TarusMachine
 
+_VERTICAL = 1e-9  # rad: C this small is the vertical
+_TURN = math.pi / 2 - 1e-9  # rad: an A step this large is a turn of the head, not the path's
 _WORD = re.compile(r"([A-Z])\s*([-+]?\d*\.?\d+)")
 
 
@@ -65,6 +68,10 @@ class MachineView:
     too_fast: list[int] = field(default_factory=list)  # lines the joints cannot do in the programmed time
     deepest_cut: float = 0.0                # mm into the face along every line, rapids too (with `depth`)
     cycle_time: float = 0.0                 # s, from the programmed feeds and the joint speeds
+    # cutting lines that turn A by a quarter turn or more with the tool tilted: an unwinding (or a half turn
+    # through the vertical) inside a cut; on the vertical, C = 0, A may turn any way (the tool does not move)
+    tilted_a_turns: list[int] = field(default_factory=list)
+    not_numbers: int = 0                    # words that read as NaN or infinity
 
 
 def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, samples: int = 8) -> MachineView:
@@ -80,6 +87,7 @@ def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, sample
             ln.joints[:3] = ln.joints[:3] + machine.length * axis
     v = MachineView(lines=len(lines))
     speeds = machine.speeds.as_array()
+    v.not_numbers = _not_numbers(text)
     prev = None
     for k, ln in enumerate(lines):
         j = ln.joints
@@ -92,6 +100,8 @@ def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, sample
         joint_time = float(np.max(d / speeds))
         v.a_travel += d[3]
         v.largest_a_step = max(v.largest_a_step, d[3])
+        if ln.g == "G1" and d[3] >= _TURN and min(abs(prev[4]), abs(j[4])) > _VERTICAL:
+            v.tilted_a_turns.append(k)
         if ln.g == "G1":
             tip0, _ = machine.forward(prev)
             tip1, _ = machine.forward(j)
@@ -114,6 +124,11 @@ def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, sample
             v.deepest_cut = max(v.deepest_cut, float(depth(*_instances(machine, prev, j, tcp, samples)).max()))
         prev = j
     return v
+
+
+def _not_numbers(text: str) -> int:
+    """Words whose value is NaN or infinite (a post printing 'nan' or 'inf')."""
+    return len(re.findall(r"\b[XYZACF]\s*[-+]?(nan|inf)", text, re.I))
 
 
 def _instances(machine: TarusMachine, j0: np.ndarray, j1: np.ndarray, tcp: bool, samples: int
