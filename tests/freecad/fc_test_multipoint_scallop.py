@@ -120,3 +120,29 @@ class ScallopOp(FreeCADTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class ScallopDefaultAndDegrade(FreeCADTestCase):
+    def test_api_default_is_the_scallop_rule(self) -> None:
+        """run_multipoint without pass_spacing places passes by the scallop, as a new op does (README)."""
+        net = np.zeros((4, 4, 3))
+        net[..., 0], net[..., 1] = np.meshgrid(np.linspace(0, 12, 4), np.linspace(0, 12, 4), indexing="ij")
+        net[..., 2] = 50.0 + 0.02 * (net[..., 0] - 6.0) ** 2
+        r = run_multipoint(net, Ro=2.0, Ri=1.0, doc_name="MpDefault", **QUICK)
+        self.assertTrue(r.op.isValid(), r.op.getStatusString())
+        self.assertEqual(r.op.PassSpacing, "Scallop")
+        self.assertIn("largest scallop", r.op.ContactSummary)
+        self.assertIsNotNone(r.op.Proxy.placement)
+
+    def test_areas_not_held_are_warnings_not_failures(self) -> None:
+        """The op's status names where the scallop is not held; the report view lists the areas."""
+        from tmm_workbench.core.strategies.multipoint_scallop import NOT_REACHED, LeftArea, ScallopPlacement
+        area = LeftArea(0.0, 3.1, (126.0, 142.0), np.array([[0, 126], [3.1, 126], [3.1, 142], [0, 142]], float),
+                        0.032, (1.55, 136.0), 4, NOT_REACHED)
+        placement = ScallopPlacement(offsets=[0.0, 3.1], scallops=[0.0, 0.009], unreached=[area] * 12)
+        params = MultipointParams(pass_spacing="scallop", scallop=0.01)
+        lines = op_multipoint.spacing_warnings(params, Cutter.torus(6.7, 6.0), placement)
+        self.assertTrue(any("not held on 12 areas" in w and "x 0..3.1, y 126..142" in w for w in lines), lines)
+        detail = op_multipoint.area_lines(placement)
+        self.assertEqual(len(detail), op_multipoint.MAX_AREAS_LISTED + 1)
+        self.assertIn("does not reach the face", detail[0])

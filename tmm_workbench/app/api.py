@@ -531,10 +531,12 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     document). Tool: Ro, Ri of the torus (Ro = 0: ball end mill D = 2 Ri; the ToolBit is a bull-nose
     D = 2 (Ro + Ri), corner Ri). method 'vcrf' | 'drd'; tool_shape 'round_insert' (the seed's
     torus, hollow centre) | 'bull_nose' (plus its flat bottom).
-    pass_spacing 'even' (passes spread evenly, at most side_step apart) | 'fixed' (side_step apart from the
-    start edge, a last pass on the far edge: the seed's footprint) | 'scallop' (each pass at the largest side
-    step whose simulated scallop with the pass before is at most `scallop` mm; side_step is the first guess).
-    None: 'scallop' when `scallop` is given, else 'even' (what the API did before the scallop rule).
+    pass_spacing 'scallop' (each pass at the largest side step whose simulated scallop with the pass before
+    is at most `scallop` mm; side_step is the first guess) | 'even' (passes spread evenly, at most side_step
+    apart) | 'fixed' (side_step apart from the start edge, a last pass on the far edge: the seed's footprint).
+    None: 'scallop', as a new op in the GUI (`scallop` None: the op's default height). Where the scallop
+    cannot be held (the tool does not reach the face) the op machines what it reaches and warns: the areas
+    are `result.op.Proxy.placement.unreached` (core LeftArea), its ContactSummary says how many.
     tilt_limit_deg, tolerance: None keeps the core's defaults (45 deg, 1e-3 mm). gouge_tolerance: the deepest
     cut allowed between consecutive positions, positions inserted where a move cuts deeper (None: 0.005 mm;
     0: not checked).
@@ -554,8 +556,8 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
     shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))
     anchor_name = _option("footprint_anchor", footprint_anchor, _by_core_name(op_multipoint.ANCHORS))
-    if pass_spacing is None:  # the scallop rule when a scallop is asked for
-        pass_spacing = "even" if scallop is None else "scallop"
+    if pass_spacing is None:  # the README's and the new op's default: the side step from the scallop
+        pass_spacing = "scallop"
     spacing_name = _option("pass_spacing", pass_spacing, _by_core_name(op_multipoint.PASS_SPACINGS))
     _numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
              side_step=(side_step, spec_of(MultipointParams, "side_step")),

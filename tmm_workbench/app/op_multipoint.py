@@ -29,6 +29,8 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
+import numpy as np
+
 import FreeCAD
 import Path
 
@@ -52,6 +54,7 @@ PASS_SPACINGS = {"Even": "even", "Fixed": "fixed", "Scallop": "scallop"}  # Scal
 # what new ops get (the core's own defaults stay as they were for scripts): the side step from the scallop,
 # the tool's solid from its ToolBit
 NEW_OP_DEFAULTS: dict[str, Any] = {"PassSpacing": "Scallop", "ToolShape": "FromToolBit"}
+MAX_AREAS_LISTED = 10  # areas where the scallop is not held, one warning line each (the rest counted)
 
 PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "Method", "Multipoint",
@@ -157,10 +160,33 @@ def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> l
     if placement is not None:
         out.append(f"{len(placement.offsets)} passes, largest scallop {placement.max_scallop:.4g} mm "
                    f"(tolerance {params.scallop:g} mm)")
-        for a, rows, h, (x, y) in placement.unreached:
-            out.append(f"{rows} rows of the strip from {a:.4g} mm keep up to {h:.4g} mm above the face at any side "
-                       f"step (at x {x:.4g}, y {y:.4g} mm: the tool cannot reach it there; left out of the rule)")
+        areas = placement.unreached
+        if areas:
+            xy = np.vstack([a.outline for a in areas])
+            (x0, y0), (x1, y1) = xy.min(0), xy.max(0)
+            out.append(f"the scallop {params.scallop:g} mm is not held on {len(areas)} areas (within x {x0:.4g}.."
+                       f"{x1:.4g}, y {y0:.4g}..{y1:.4g} mm), up to {max(a.height for a in areas):.4g} mm above the "
+                       "face: machined as reached (the report view lists them)")
     return out
+
+
+def area_lines(placement: Any) -> list[str]:
+    """One line per area where the scallop rule could not hold the tolerance (at most MAX_AREAS_LISTED)."""
+    areas = placement.unreached if placement is not None else []
+    out = [a.describe() for a in areas[:MAX_AREAS_LISTED]]
+    if len(areas) > MAX_AREAS_LISTED:
+        out.append(f"... and {len(areas) - MAX_AREAS_LISTED} more areas")
+    return out
+
+
+def unreached_warning(res: MultipointResults) -> str:
+    """Where no tool position was found (not machined), "" when every footprint point has one."""
+    failed = res.xy[res.status == STATUS_FAILED]
+    if not len(failed):
+        return ""
+    (x0, y0), (x1, y1) = failed.min(0), failed.max(0)
+    return (f"{len(failed)} footprint points have no tool position and are not machined (within x {x0:.4g}.."
+            f"{x1:.4g}, y {y0:.4g}..{y1:.4g} mm)")
 
 
 def summary(res: MultipointResults) -> str:
@@ -179,7 +205,7 @@ def summary(res: MultipointResults) -> str:
 class ObjectTmmMultipoint(op_base.TmmOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath` (the op's tool
     path, linked once by core.linking), `segments` (the strategy's cut segments), `results` (per footprint
-    point), `face`, `radii` (Ro, Ri)."""
+    point), `face`, `radii` (Ro, Ri), `placement` (the scallop rule's report, None for other spacings)."""
 
     PARAMS = MultipointParams
     PROPERTIES = PROPERTIES
@@ -191,6 +217,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     results: Optional[MultipointResults] = None
     face: Optional[BezierFace] = None
     radii: Optional[tuple[float, float]] = None
+    placement: Any = None  # the scallop rule's report (its `unreached`: areas where the scallop is not held)
 
     def opFeatures(self, obj: Any) -> int:
         return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant | PathOp.FeatureBaseFaces
@@ -217,7 +244,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:
-        self.toolpath = self.segments = self.results = self.face = self.radii = None
+        self.toolpath = self.segments = self.results = self.face = self.radii = self.placement = None
 
     def compute(self, obj: Any) -> None:
         base, sub = self.base_face(obj)
@@ -239,9 +266,13 @@ class ObjectTmmMultipoint(op_base.TmmOp):
             raise TmmError(f"no tool position found on the face ({summary(res)})")
         self.face, self.radii, self.results = face, cutter.torus_radii, res
         self.segments, self.toolpath = result.segments, toolpath
+        self.placement = result.diagnostics.get("scallop")
         text = summary(res)
         warnings = spacing_warnings(params, cutter, result.diagnostics.get("scallop"))
-        for w in warnings:
+        unreached = unreached_warning(res)
+        if unreached:
+            warnings.append(unreached)
+        for w in warnings + area_lines(result.diagnostics.get("scallop")):
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {w}\n")
         text = "; ".join([text] + warnings)
         if obj.ContactSummary != text:

@@ -45,6 +45,7 @@ ROTATIONS = ("pseudo_insert", "global_x")
 ANCHORS = ("axis", "tip")
 SUPPORTED_TOOLS = ("ball", "bull")  # Cutter.kind values: the toroidal view needs a corner radius > 0
 SCALLOP = "scallop"
+NOT_FINITE = "the kernel gave a tool position that is not a finite number: not cut"
 _BYTES_PER_POSITION = 1200  # kernel results (about 40 doubles) and their numpy copies, per footprint point
 
 
@@ -242,13 +243,24 @@ def _position(mp, xy: np.ndarray, params: MultipointParams, progress: Optional[P
         data = mp.position_batch(pts, int(params.threads), progress)
     except native.Cancelled as exc:
         raise Cancelled("multipoint tool path computation cancelled") from exc
-    return MultipointResults(pts, np.zeros(len(pts), dtype=int), data, list(native.multipoint_reasons()))
+    reasons = list(native.multipoint_reasons()) + [NOT_FINITE]
+    # a position whose tip or axis is not a usable number is not cut (no NaN may reach a tool path)
+    axis_len = np.linalg.norm(data["axis"], axis=1)
+    bad = ~(np.isfinite(data["tip"]).all(1) & np.isfinite(data["axis"]).all(1) & (axis_len > 0.5))
+    bad &= data["status"] != STATUS_FAILED
+    if bad.any():
+        data["status"] = np.where(bad, STATUS_FAILED, data["status"])
+        data["reason"] = np.where(bad, len(reasons) - 1, data["reason"])
+    return MultipointResults(pts, np.zeros(len(pts), dtype=int), data, reasons)
 
 
 def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
             progress: Optional[Progress] = None) -> StrategyResult:
     """The strategy: multipoint positions over the footprint, as cut segments (runs of good positions of
-    one pass); diagnostics: "results" (MultipointResults per footprint point), "counts"."""
+    one pass); diagnostics: "results" (MultipointResults per footprint point), "counts",
+    "unreached_positions" ((k, 2) XY of the footprint points no position was found for: not cut), "between"
+    (multipoint_refine), and with the scallop rule "scallop" (its ScallopPlacement: `unreached` lists the
+    areas where the scallop is not held). What cannot be reached is reported, never a failure of the op."""
     if not isinstance(surface, BezierFace):
         raise TmmError(f"surface must be a BezierFace, got {type(surface).__name__}")
     Ro, Ri = _torus(tool)
@@ -284,6 +296,8 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
         diagnostics["between"] = multipoint_refine.refine(
             positioner, params, runs, res, lambda pts: _position(positioner, pts, params))
     diagnostics["counts"] = res.counts()
+    # what is not machined, for the report: footprint points the tool could not be placed at
+    diagnostics["unreached_positions"] = res.xy[res.status == STATUS_FAILED]
     tip, axis = res["tip"], res["axis"]
     cut = [CutSegment(tip[r], axes=axis[r], pass_index=int(res.passes[r[0]])) for r in runs]
     return StrategyResult(cut, diagnostics)

@@ -14,6 +14,12 @@ The search per pass brackets the step (the scallop grows about with the square o
 interpolates in sqrt(scallop)), keeps the largest step found within the tolerance and stops when the scallop is
 within SCALLOP_REL of it or the bracket is narrower than STEP_TOL. Rows where one of the two passes has no
 good position near them (failed positions, the ends of the passes) are not measured and are counted.
+
+Where the tolerance cannot be held the placement degrades instead of failing: rows still above it at the
+smallest step tried (material the pass leaves by itself, where the tool does not reach the face: a rim, an
+edge, a steep flank past the tilt limit) are left out of the strip's measure; a strip none of whose rows can
+be held gets the step of the work estimate (`ball_step`) and is measured as it is. Both are reported as
+`LeftArea`s (where, how high), never silently accepted.
 """
 from __future__ import annotations
 
@@ -35,7 +41,6 @@ FINE_ROWS = 4           # rows whose peak is read finely
 SCALLOP_REL = 0.02      # a pass is accepted once its scallop is within 2 % below the tolerance
 STEP_TOL = 0.005        # mm: or once the bracket on the step is this narrow
 MAX_TRIALS = 14         # trial passes per placed pass
-MAX_LEFT_OUT = 0.2      # at most this share of a strip's rows may be left out as not reachable
 _STOCK_ABOVE = 50.0     # mm: needles start this far above the face's top (an uncut needle reads huge)
 _BYTES_PER_NEEDLE = 64
 
@@ -122,16 +127,44 @@ class PassPositions:
         return self.res["status"] != failed
 
 
+NOT_REACHED = "not reached"    # rows no side step holds: left out of the strip's measure
+OVER_SCALLOP = "over scallop"  # a strip none of whose rows a side step holds: placed at the estimate's step
+
+
+@dataclass
+class LeftArea:
+    """Part of a strip between two passes where the scallop tolerance is not held: across from `start` to
+    `end` (mm from the start edge), along the passes from `along[0]` to `along[1]` (the feed coordinate),
+    `outline` its (4, 2) XY corners; `height` the highest value measured there above the face (inf: a needle
+    the tool never cut), at XY `at`; `rows` the needle rows it covers; `reason` NOT_REACHED or OVER_SCALLOP."""
+    start: float
+    end: float
+    along: tuple[float, float]
+    outline: np.ndarray
+    height: float
+    at: tuple[float, float]
+    rows: int
+    reason: str
+
+    def describe(self) -> str:
+        x0, y0 = self.outline.min(0)
+        x1, y1 = self.outline.max(0)
+        what = ("no side step removes it: the tool does not reach the face there" if self.reason == NOT_REACHED
+                else "no side step holds the scallop on this strip: placed at the estimate's step")
+        return (f"{self.rows} rows of the strip {self.start:.4g}..{self.end:.4g} mm from the start edge keep up "
+                f"to {self.height:.4g} mm above the face (highest at x {self.at[0]:.4g}, y {self.at[1]:.4g} mm; "
+                f"area x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm): {what}")
+
+
 @dataclass
 class ScallopPlacement:
     """What the placement did: per placed pass its across offset and the scallop measured against the pass
-    before it (0 for the first); trial passes positioned; rows not measured."""
+    before it (0 for the first; above the tolerance on an OVER_SCALLOP strip); trial passes positioned; rows
+    not measured; `unreached`: the LeftAreas where the tolerance is not held."""
     offsets: list = field(default_factory=list)
     scallops: list = field(default_factory=list)
     trials: int = 0
     rows_skipped: int = 0
-    # (strip start from the start edge, rows left out, their highest value, (x, y) of it): rows no side step
-    # keeps within the tolerance, left out of the strip's measure
     unreached: list = field(default_factory=list)
 
     @property
@@ -158,13 +191,17 @@ def _runs(res: Any, failed: int) -> list[np.ndarray]:
     return out
 
 
-def estimate_passes(width: float, Ri: float, scallop: float) -> int:
-    """An upper bound of the passes over `width`: the step of a ball of half the corner radius leaving the
-    scallop on a plane (a tilted torus on a surface it fits leaves less for the same step)."""
+def ball_step(Ri: float, scallop: float) -> float:
+    """The side step of a ball of half the corner radius leaving `scallop` on a plane (a tilted torus on a
+    surface it fits leaves less for the same step): the estimate's step."""
     r = 0.5 * Ri
     h = min(scallop, r)
-    step = 2.0 * math.sqrt(max(2.0 * r * h - h * h, 1e-12))
-    return int(math.ceil(width / step)) + 1
+    return 2.0 * math.sqrt(max(2.0 * r * h - h * h, 1e-12))
+
+
+def estimate_passes(width: float, Ri: float, scallop: float) -> int:
+    """An upper bound of the passes over `width` at the ball_step."""
+    return int(math.ceil(width / ball_step(Ri, scallop))) + 1
 
 
 def estimate_work(rect: Rect, params: Any, Ri: float) -> float:
@@ -363,27 +400,35 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
         prev, before = placed[-1], placed[-3:-1]
         room = frame.a1 - prev.a
         excluded: list[tuple[float, float]] = []
+        left: list[tuple[list[float], dict]] = []  # rows left out, with the row values they had
         for _attempt in range(3):
             best, over, smallest = _search(make, meter, before, prev, frame, h, min(step, room), room, excluded)
             if best is not None:
                 break
-            # no step keeps these rows within the tolerance (material one pass leaves by itself, e.g. at the
-            # ends of the passes or on a rim: not a scallop between passes): the rows still above it at the
-            # smallest step tried are left out of this strip's measure and reported, never silently accepted
-            bad = [t for t, v in (smallest or {}).items() if v > h]
-            if not bad or len(bad) > max(2, MAX_LEFT_OUT * len(smallest)):
-                break  # not a few rows: the step cannot be chosen by this tolerance (refused below)
+            # rows still above the tolerance at the smallest step tried: material one pass leaves by itself
+            # (not a scallop between passes), left out of this strip's measure and reported
+            rows = smallest or {}
+            bad = [t for t, v in rows.items() if v > h]
+            if not bad or len(bad) == len(rows):
+                break  # nothing to leave out, or every row: no step holds this strip (placed as estimated)
             half = 0.5 * meter.row_spacing
             excluded += [(t - half, t + half) for t in bad]
-            worst = max(bad, key=lambda t: smallest[t])
-            at = frame.to_world(np.array([[prev.a, worst]]))[0]
-            report.unreached.append((prev.a - frame.a0, len(bad), smallest[worst], (float(at[0]), float(at[1]))))
-        if best is None:
-            raise TmmError(f"no side step leaves a scallop within {h:g} mm after the pass at "
-                           f"{prev.a - frame.a0:.4g} mm from the start edge (the smallest tried, "
-                           f"{over[0] if over else 0:.4g} mm, leaves {over[1] if over else math.inf:.4g} mm): "
-                           "the tool does not reach the face there; use a larger scallop or check the boundary")
+            left.append((bad, rows))
+        if best is None:  # the estimate's step, the strip measured as it is
+            s_fall = min(ball_step(Ri, h), room)
+            trial = make(frame.a1 if s_fall >= room - 1e-9 else prev.a + s_fall)
+            if trial is None:
+                raise TmmError(f"no pass fits the boundary after the pass at {prev.a - frame.a0:.4g} mm")
+            value = meter.scallop(before, prev, trial, excluded)
+            best = (step, value, trial)
+            over_rows = [t for t, v in meter.rows.items() if v > h]
+            if not over_rows and value > h:  # nothing measured (no good positions near): the whole strip
+                along = frame.to_frame(trial.xy)[:, 1]
+                over_rows = list(np.arange(along.min(), along.max() + 1e-9, meter.row_spacing))
+            report.unreached += _areas(frame, prev.a, trial.a, meter, over_rows, meter.rows, OVER_SCALLOP)
         s_ok, value, trial = best
+        for bad, rows in left:
+            report.unreached += _areas(frame, prev.a, trial.a, meter, bad, rows, NOT_REACHED)
         placed.append(trial)
         report.offsets.append(trial.a)
         report.scallops.append(value)
@@ -392,6 +437,28 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
             raise Cancelled("multipoint tool path computation cancelled")
     report.rows_skipped = meter.rows_skipped
     return placed, report
+
+
+def _areas(frame: Frame, a0: float, a1: float, meter: ScallopMeter, bad: list[float], values: dict,
+           reason: str) -> list[LeftArea]:
+    """LeftAreas of the strip a0..a1 over the rows `bad` (along coordinates), runs of neighbouring rows
+    joined; `values` the rows' measured heights."""
+    out: list[LeftArea] = []
+    half = 0.5 * meter.row_spacing
+    runs: list[list[float]] = []
+    for t in sorted(bad):
+        if runs and t - runs[-1][-1] <= meter.row_spacing * 1.001:
+            runs[-1].append(t)
+        else:
+            runs.append([t])
+    for run in runs:
+        lo, hi = run[0] - half, run[-1] + half
+        worst = max(run, key=lambda t: values.get(t, math.inf))
+        corners = np.round(frame.to_world(np.array([[a0, lo], [a1, lo], [a1, hi], [a0, hi]])), 9)
+        at = frame.to_world(np.array([[0.5 * (a0 + a1), worst]]))[0]
+        out.append(LeftArea(a0 - frame.a0, a1 - frame.a0, (lo, hi), corners, float(values.get(worst, math.inf)),
+                            (float(at[0]), float(at[1])), len(run), reason))
+    return out
 
 
 def _search(make, meter: ScallopMeter, before, prev: PassPositions, frame: Frame, h: float, s: float,
