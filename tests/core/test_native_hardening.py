@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -225,3 +226,111 @@ def test_patch_index_out_of_range_is_an_error_not_a_crash():
     assert out.returncode == 0, out.stderr
     assert out.stdout.splitlines() == ["patch (1, 0) outside 0..0 x 0..0", "patch (0, -1) outside 0..0 x 0..0",
                                        "patch (100000, 3) outside 0..0 x 0..0"]
+
+
+# --- the kernel's range: |coordinate| < 1e9 mm (tmm/util/constants.hpp kMaxCoordinate)
+
+RANGE = r"is outside the kernel's range: (values must be finite with \|value\| < |lengths must be in \[0, )1e\+09"
+
+
+def plate(scale=10.0):
+    return np.array([[0, 0, 0], [scale, 0, 0], [0, scale, 0], [scale, scale, 1]], float), \
+        np.array([[0, 1, 2], [1, 3, 2]], np.int32)
+
+
+def far_net(pole):
+    net = np.array([[(0.0, 0.0, 0.0), (0.0, 1.0, 0.0)], [(1.0, 0.0, 0.0), (1.0, 1.0, 0.0)]])
+    net[1, 1] = pole
+    return net
+
+
+@pytest.mark.parametrize("scale", [1e150, 1e300, -2e9])
+@pytest.mark.parametrize("make", [
+    lambda V, F: native.MeshIndex(V, F),
+    lambda V, F: native.DirectionalIndex(V, F, np.array([0.0, 0.0, -1.0])),
+    lambda V, F: native.face_normals(V, F),
+    lambda V, F: native.vertex_normals(V, F),
+])
+def test_meshes_outside_the_range_are_refused_naming_the_vertex(make, scale):
+    V, F = plate(scale)
+    with pytest.raises(ValueError, match=rf"vertex 1 coordinate x = {re.escape(f'{scale:g}')} {RANGE}"):
+        make(V, F)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda: native.weld(np.array([[0, 0, 0, 1e150, 0, 0, 0, 1, 0]], float), 1e-6),
+     "triangle 0 corner 1 coordinate x = 1e\\+150 "),
+    (lambda: native.PatchSurface.from_net(far_net((1e300, 1e300, 0.0))), "Bezier pole 3 coordinate x = 1e\\+300 "),
+    (lambda: native.Cutter(1e10, 0.0), "cutter radius = 1e\\+10 "),
+    (lambda: native.ZMap(1e300, 0.0, 1.0, 10, 10, 0.0), "z-map x0 = 1e\\+300 "),
+    (lambda: native.drop_cutter(native.MeshIndex(*plate()), native.Cutter(1.0, 1.0), np.array([[5.0, 1e150]]), 0.0),
+     r"points row 0 \(5, 1e\+150\) "),
+    (lambda: native.drop_cutter(native.MeshIndex(*plate()), native.Cutter(1.0, 1.0), np.array([[5.0, 5.0]]), 1e300),
+     "floor_z = 1e\\+300 "),
+    (lambda: native.cut_5axis(native.ZMap(0.0, 0.0, 1.0, 10, 10, 5.0), 1.0, 1.0, "round_insert",
+                              np.array([[0.0, 0.0, 0.0], [1e150, 0.0, 0.0]]), np.array([[0.0, 0.0, 1.0]] * 2),
+                              np.array([0])), r"tips row 1 \(1e\+150, 0, 0\) "),
+    (lambda: native.MultipointPositioner(seed_convex(), options(Ri=1e300)), "minor radius Ri = 1e\\+300 "),
+])
+def test_inputs_outside_the_range_are_refused_by_name(call, message):
+    with pytest.raises(ValueError, match=message + RANGE):
+        call()
+
+
+def test_a_nan_floor_is_refused_by_name():
+    from tmm_workbench.core.errors import TmmError
+    from tmm_workbench.core.geometry.mesh import TriMesh
+    from tmm_workbench.core.query.drop import DropSurface
+    from tmm_workbench.core.tools.cutter import Cutter
+    V, F = plate()
+    with pytest.raises(ValueError, match="floor_z = nan "):
+        native.drop_cutter(native.MeshIndex(V, F), native.Cutter(1.0, 1.0), np.array([[5.0, 5.0]]), math.nan)
+    surface = DropSurface(TriMesh(V, F, "plate"))
+    with pytest.raises(TmmError, match="drop floor_z is NaN"):
+        surface.drop(Cutter.ball(2), np.array([[5.0, 5.0]]), math.nan)
+
+
+def run_child(code: str, limit_bytes: int = 0) -> "subprocess.CompletedProcess[str]":
+    """code in a child Python (a crash or a huge allocation must not take pytest down), address space limited."""
+    prefix = "import resource\n"
+    if limit_bytes:
+        prefix += f"resource.setrlimit(resource.RLIMIT_AS, ({limit_bytes}, {limit_bytes}))\n"
+    return subprocess.run([sys.executable, "-c", prefix + code], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+
+
+def test_adjacency_of_a_huge_index_allocates_by_the_triangles():
+    # 2^31 - 1 used to size an 8.4 GB table before anything failed; 1.5 GB of address space is plenty now.
+    out = run_child("import numpy as np\n"
+                    "from tmm_workbench.core.kernel import native\n"
+                    "F = np.array([[0, 1, 2**31 - 1], [1, 0, 7]], np.int64)\n"
+                    "print(native.triangle_adjacency(F).tolist())\n", limit_bytes=1_500_000_000)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[[1, -1, -1], [0, -1, -1]]"
+
+
+def test_lean_samples_near_1e307_are_refused_not_a_crash():
+    # Two triangles meeting between adjacent doubles near 1e307 made the refinement recurse until the stack
+    # overflowed (SIGSEGV).
+    out = run_child("import numpy as np\n"
+                    "from tmm_workbench.core.kernel import native\n"
+                    "X, D = 1e307, 1e300\n"
+                    "V = np.array([[X-D,0,0],[X,0,0],[X,10,0],[X-D,10,0],[X+D,0,5],[X+D,10,5]])\n"
+                    "F = np.array([[0,1,2],[0,2,3],[1,4,5],[1,5,2]], np.int32)\n"
+                    "idx = native.MeshIndex(np.array([[0,0,0],[10,0,0],[0,10,0]], float), F[:1])\n"
+                    "u = np.spacing(X)\n"
+                    "try:\n"
+                    "    idx = native.MeshIndex(V, F)\n"
+                    "except ValueError as e:\n"
+                    "    print(e)\n"
+                    "s = np.array([X - 4 * u, X + 4 * u])\n"
+                    "try:\n"
+                    "    native.lean_profiles(idx, native.Cutter(1.0, 1.0), np.array([[0.0, 5.0]]),\n"
+                    "        np.array([[1.0, 0.0]]), np.array([0, 2]), s, np.array([-1e6, -1e6]),\n"
+                    "        np.zeros(2, np.uint8), tol=0.01, max_step=1e300)\n"
+                    "except ValueError as e:\n"
+                    "    print(e)\n")
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert len(lines) == 2 and all("is outside the kernel's range" in line for line in lines), out.stdout
+    assert lines[1].startswith("lean runs: s of run 0, sample row 0 (1e+307)")

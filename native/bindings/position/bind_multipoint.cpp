@@ -160,6 +160,7 @@ void bind_multipoint(py::module_& m) {
       .def("position_batch",
            [](const tmm::MultipointPositioner& mp, const Arr& xy_in, int threads, const py::object& progress) {
              const Arr xy = check_points(xy_in, 2, "footprint points");
+             tmm_bindings::check_range(xy, "footprint points");
              const std::size_t n = static_cast<std::size_t>(xy.shape(0));
              std::vector<tmm::MultipointResult> res(n);
              tmm::BatchOptions options;
@@ -249,6 +250,9 @@ void bind_multipoint(py::module_& m) {
            [](const tmm::MultipointPositioner& mp, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis,
               const Arr& pts_in) {
              const Arr pts = check_points(pts_in, 3, "points");
+             tmm_bindings::check_range(pts, "points");
+             tmm::require_rows_in_range(tip.data(), 1, 3, "tip");
+             if (!(axis.allFinite() && axis.norm() > 0.0)) throw std::invalid_argument("axis must be a finite direction");
              const std::size_t n = static_cast<std::size_t>(pts.shape(0));
              py::array_t<double> d(static_cast<py::ssize_t>(n));
              const Eigen::Vector3d a = axis.normalized();
@@ -274,11 +278,13 @@ void bind_multipoint(py::module_& m) {
              for (std::size_t i = 0; i < n; ++i) {
                const Eigen::Vector3d ti(t[3 * i], t[3 * i + 1], t[3 * i + 2]), ai(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
                if (!ti.allFinite()) throw std::invalid_argument("tips: row " + std::to_string(i) + " is not finite");
+               tmm::require_rows_in_range(t + 3 * i, 1, 3, "tips: row " + std::to_string(i) + ", as");
                if (!(ai.allFinite() && ai.norm() > 0.0))
                  throw std::invalid_argument("axes: row " + std::to_string(i) + " is not a direction");
              }
              tmm::BatchOptions options;
              options.threads = threads;
+             options.progress = python_progress(py::none());  // Ctrl-C
              {
                py::gil_scoped_release release;
                tmm::parallel_chunks(n, 16, options, [&](std::size_t begin, std::size_t end) {

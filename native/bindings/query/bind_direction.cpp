@@ -100,6 +100,11 @@ void bind_direction(py::module_& m) {
   m.def("drop_along_triangle",
         [](const tmm::Cutter& cutter, const Array& start, const Array& axis, const Array& direction,
            const Eigen::Matrix3d& corners) {
+          tmm_bindings::check_range(start, "start");
+          tmm_bindings::check_range(axis, "axis");
+          tmm_bindings::check_range(direction, "direction");
+          const tmm::Vertices rows = corners;
+          tmm::require_rows_in_range(rows.data(), 3, 3, "corners");
           return tmm::drop_along(cutter, vec3(start, "start"), vec3(axis, "axis"), vec3(direction, "direction"),
                                  corners.row(0).transpose(), corners.row(1).transpose(), corners.row(2).transpose());
         },

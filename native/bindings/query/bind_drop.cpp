@@ -27,6 +27,7 @@ py::array_t<double> drop_cutter(const tmm::MeshIndex& index, const tmm::Cutter& 
     msg << "points must have shape (n, 2), got ndim " << xy.ndim();
     throw std::invalid_argument(msg.str());
   }
+  tmm_bindings::check_range(xy, "points");
   const std::size_t n = static_cast<std::size_t>(xy.shape(0));
   py::array_t<double> z(static_cast<py::ssize_t>(n));
   tmm::BatchOptions options;
@@ -116,7 +117,10 @@ void bind_drop(py::module_& m) {
 
   m.def("drop_on_triangle",
         [](const tmm::Cutter& cutter, double x, double y, const Eigen::Matrix3d& corners) {
+          tmm::require_in_range(x, "x");
+          tmm::require_in_range(y, "y");
           tmm::Vertices V = corners;
+          tmm::require_rows_in_range(V.data(), 3, 3, "corners");
           tmm::Triangles F(1, 3);
           F << 0, 1, 2;
           const tmm::MeshIndex index(V, F);

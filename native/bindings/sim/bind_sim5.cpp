@@ -12,6 +12,7 @@
 
 #include "tmm/sim/sweep5.hpp"
 #include "sim/sim_arrays.hpp"
+#include "util/arrays.hpp"
 #include "util/progress.hpp"
 
 namespace py = pybind11;
@@ -92,6 +93,9 @@ void bind_sim5(py::module_& m) {
   m.def("lowest_on_vertical",
         [](double Ro, double Ri, const std::string& shape, const Rows& tip, const Rows& axis, double x, double y) {
           const tmm::TorusTool tool = tool_from(Ro, Ri, shape);
+          tmm_bindings::check_range(tip, "tip");
+          tmm::require_in_range(x, "x");
+          tmm::require_in_range(y, "y");
           Eigen::Vector3d a = vec3(axis, "axis");
           const double len = a.norm();
           if (!(len > 0.0 && std::isfinite(len))) throw std::invalid_argument("axis must be a finite nonzero vector");

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "tmm/mesh/mesh.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm_bindings {
 
@@ -29,6 +30,15 @@ inline Arr check_points(const Arr& a, pybind11::ssize_t cols, const char* what) 
     throw std::invalid_argument(msg.str());
   }
   return a;
+}
+
+// Every value of a checked (n, cols) array within the kernel's range (tmm/util/range.hpp), refused naming
+// `what`, the row and its values.
+template <class A>
+void check_range(const A& a, const char* what) {
+  const auto cols = a.ndim() == 2 ? static_cast<std::size_t>(a.shape(1)) : std::size_t{1};
+  tmm::require_rows_in_range(a.data(), static_cast<std::size_t>(a.size()) / std::max<std::size_t>(cols, 1), cols,
+                             what);
 }
 
 // A new (n, 3) float64 array.

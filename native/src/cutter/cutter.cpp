@@ -4,6 +4,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 
 namespace {
@@ -20,6 +22,7 @@ Cutter::Cutter(double radius, double corner_radius) {
   if (!(std::isfinite(radius) && radius > 0.0)) fail("cutter radius must be positive and finite", radius);
   if (!(std::isfinite(corner_radius) && corner_radius >= 0.0))
     fail("cutter corner radius must be zero or positive", corner_radius);
+  require_length(radius, "cutter radius");
   if (corner_radius > radius * (1.0 + 1e-12)) {
     std::ostringstream msg;
     msg << "cutter corner radius " << corner_radius << " is larger than the cutter radius " << radius;
@@ -38,6 +41,8 @@ Cutter Cutter::apt(double radius, double corner_radius, double cutting_length, d
   if (!(std::isfinite(corner_radius) && corner_radius >= 0.0))
     fail("cutter corner radius must be zero or positive", corner_radius);
   if (!(cutting_length > 0.0)) fail("cutting-edge height must be positive", cutting_length);
+  require_length(radius, "cutter radius");
+  if (std::isfinite(cutting_length)) require_length(cutting_length, "cutting-edge height");
   if (!(std::isfinite(beta1) && beta1 >= 0.0 && beta1 < M_PI / 2))
     fail("bottom angle beta1 must be in [0, 90) degrees", beta1 * 180 / M_PI);
   if (!(std::isfinite(beta2) && std::fabs(beta2) < M_PI / 2))

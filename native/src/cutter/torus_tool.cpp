@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 
 using Eigen::Matrix3d;
@@ -59,6 +61,8 @@ void TorusTool::validate() const {
         "minor radius Ri must be > 0: a flat end mill (Ri = 0) has no pseudo-insert to tilt about, "
         "multipoint positioning needs a toroidal (or ball) cutter");
   }
+  require_length(Ro, "major radius Ro");
+  require_length(Ri, "minor radius Ri");
 }
 
 double TorusTool::profile(double rho) const {

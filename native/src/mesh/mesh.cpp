@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 namespace {
 
@@ -230,6 +232,12 @@ Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed) {
       throw std::invalid_argument("triangle " + std::to_string(t) + " has a non-finite coordinate");
     mag = std::max(mag, soup.row(t).cwiseAbs().maxCoeff());
   }
+  if (!in_range(mag)) {
+    for (Eigen::Index t = 0; t < m; ++t)
+      for (int k = 0; k < 9; ++k)
+        require_in_range(soup(t, k), "triangle " + std::to_string(t) + " corner " + std::to_string(k / 3) +
+                                         " coordinate " + "xyz"[k % 3]);
+  }
 
   // Cells 16*tol wide, so a tol-ball around a corner usually stays in one cell (a neighbour is looked
   // at along an axis only within tol of a cell face), and coarse enough that cell coordinates stay far
@@ -286,9 +294,16 @@ Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed) {
   return mesh;
 }
 
+void require_vertices_in_range(const VerticesRef& V) {
+  for (Eigen::Index v = 0; v < V.rows(); ++v)
+    for (int k = 0; k < 3; ++k)
+      if (!in_range(V(v, k))) require_in_range(V(v, k), "vertex " + std::to_string(v) + " coordinate " + "xyz"[k]);
+}
+
 void validate(const VerticesRef& V, const TrianglesRef& F) {
   for (Eigen::Index v = 0; v < V.rows(); ++v)
     if (!V.row(v).allFinite()) throw std::invalid_argument("vertex " + std::to_string(v) + " has a non-finite coordinate");
+  require_vertices_in_range(V);
   for (Eigen::Index t = 0; t < F.rows(); ++t)
     for (int i = 0; i < 3; ++i)
       if (F(t, i) < 0 || F(t, i) >= V.rows())
@@ -301,8 +316,27 @@ Normals face_normals(const VerticesRef& V, const TrianglesRef& F) {
   return unit_face_normals(V, F);
 }
 
+// The triangles with their vertices renumbered 0..k-1 in index order when the largest index exceeds the
+// number of corners (unused vertices, or a bad index): tables sized by the vertex count then follow the
+// triangles, not an index value (2^31 - 1 would ask for gigabytes). Adjacency depends only on equality.
+static Triangles compact_indices(const TrianglesRef& F) {
+  std::vector<int32_t> used;
+  used.reserve(static_cast<std::size_t>(F.rows()) * 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i) used.push_back(F(t, i));
+  std::sort(used.begin(), used.end());
+  used.erase(std::unique(used.begin(), used.end()), used.end());
+  Triangles C(F.rows(), 3);
+  for (Eigen::Index t = 0; t < F.rows(); ++t)
+    for (int i = 0; i < 3; ++i)
+      C(t, i) = static_cast<int32_t>(std::lower_bound(used.begin(), used.end(), F(t, i)) - used.begin());
+  return C;
+}
+
 Adjacency triangle_adjacency(const TrianglesRef& F) {
-  const VertexTriangles vt(F, vertex_count(F));
+  const Eigen::Index n = vertex_count(F);  // refuses negative indices
+  if (n > 3 * F.rows()) return triangle_adjacency(compact_indices(F));
+  const VertexTriangles vt(F, n);
   Adjacency A(F.rows(), 3);
   for (Eigen::Index t = 0; t < F.rows(); ++t)
     for (int i = 0; i < 3; ++i) {

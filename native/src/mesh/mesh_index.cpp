@@ -111,6 +111,7 @@ MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const
       throw std::invalid_argument(msg.str());
     }
   }
+  require_vertices_in_range(V);
   // Box centres for the order; indices checked once here.
   std::vector<double> cx(static_cast<std::size_t>(nt)), cy(cx.size());
   for (Eigen::Index t = 0; t < nt; ++t) {

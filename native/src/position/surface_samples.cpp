@@ -116,18 +116,22 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
   cell_ = cell;
   x0_ = box.lo.x();
   y0_ = box.lo.y();
-  nx_ = std::max(1, static_cast<int>(std::ceil((box.hi.x() - x0_) / cell_)) + 1);
-  ny_ = std::max(1, static_cast<int>(std::ceil((box.hi.y() - y0_) / cell_)) + 1);
-  if (static_cast<double>(nx_) * ny_ > 4e6) {  // huge face, tiny tool: coarser buckets
+  // Bucket counts in double first: a wide face over small buckets does not fit an int.
+  const double wx = std::ceil((box.hi.x() - x0_) / cell_) + 1.0, wy = std::ceil((box.hi.y() - y0_) / cell_) + 1.0;
+  if (wx * wy > 4e6) {  // huge face, tiny tool: coarser buckets (at most 1001 a side)
     cell_ = std::max(box.hi.x() - x0_, box.hi.y() - y0_) / 1000.0;
     nx_ = static_cast<int>(std::ceil((box.hi.x() - x0_) / cell_)) + 1;
     ny_ = static_cast<int>(std::ceil((box.hi.y() - y0_) / cell_)) + 1;
+  } else {
+    nx_ = std::max(1, static_cast<int>(wx));
+    ny_ = std::max(1, static_cast<int>(wy));
   }
   std::vector<int> bucket(pts_.size());
   start_.assign(static_cast<std::size_t>(nx_ * ny_ + 1), 0);
   for (std::size_t s = 0; s < pts_.size(); ++s) {
-    const int i = std::clamp(static_cast<int>((pts_[s].x() - x0_) / cell_), 0, nx_ - 1);
-    const int j = std::clamp(static_cast<int>((pts_[s].y() - y0_) / cell_), 0, ny_ - 1);
+    // Clamped in double before the cast (a zero-width face divides 0 by 0: bucket 0).
+    auto index = [&](double d, int n) { return d > 0.0 ? static_cast<int>(std::min(d / cell_, n - 1.0)) : 0; };
+    const int i = index(pts_[s].x() - x0_, nx_), j = index(pts_[s].y() - y0_, ny_);
     bucket[s] = j * nx_ + i;
     ++start_[static_cast<std::size_t>(bucket[s] + 1)];
   }

@@ -16,6 +16,7 @@
 
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/util/constants.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -435,6 +436,10 @@ void validate(const Cutter& cutter, const AdaptiveRasterOptions& o) {
   require(std::isfinite(o.sample_step) && o.sample_step > 0,
           "sample step must be > 0 mm, got " + num(o.sample_step));
   require(std::isfinite(o.floor_z), "floor must be finite, got " + num(o.floor_z));
+  const std::pair<const char*, double> lengths[] = {{"xmin", o.xmin}, {"ymin", o.ymin}, {"xmax", o.xmax},
+                                                    {"ymax", o.ymax}, {"floor_z", o.floor_z},
+                                                    {"stock_to_leave", o.stock_to_leave}};
+  for (const auto& [name, v] : lengths) require_in_range(v, std::string("adaptive raster ") + name);
   require(std::isfinite(o.stock_to_leave) && o.stock_to_leave >= 0,
           "stock to leave must be >= 0 mm, got " + num(o.stock_to_leave));
   require(std::isfinite(o.max_slope) && o.max_slope > 0 && o.max_slope < kPi / 2,

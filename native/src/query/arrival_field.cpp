@@ -10,13 +10,10 @@
 #include <string>
 #include <utility>
 
+#include "tmm/util/constants.hpp"
+#include "tmm/util/range.hpp"
+
 namespace tmm {
-
-namespace {
-
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-}  // namespace
 
 void check_arrival_inputs(const ArrivalGrid& g, const std::vector<double>& z, const StepRuleTable& r) {
   if (g.nx < 2 || g.ny < 2) throw std::invalid_argument("arrival field: the grid needs at least 2 x 2 nodes");
@@ -25,6 +22,12 @@ void check_arrival_inputs(const ArrivalGrid& g, const std::vector<double>& z, co
     throw std::invalid_argument("arrival field: z must have nx * ny heights");
   for (double v : z)
     if (!std::isfinite(v)) throw std::invalid_argument("arrival field: every CL height must be finite");
+  require_in_range(g.cell * std::max(g.nx, g.ny), "arrival field: the grid's extent cell * max(nx, ny)");
+  for (std::size_t k = 0; k < z.size(); ++k)
+    if (!in_range(z[k])) require_in_range(z[k], "arrival field: CL height " + std::to_string(k));
+  for (double s : r.steps) require_in_range(s, "arrival field: tabulated step");
+  require_in_range(r.radius, "arrival field: radius");
+  require_in_range(r.probe, "arrival field: probe");
   if (r.steps.empty()) throw std::invalid_argument("arrival field: the step table is empty");
   for (double s : r.steps)
     if (!(std::isfinite(s) && s > 0)) throw std::invalid_argument("arrival field: every tabulated step must be > 0");
@@ -79,7 +82,7 @@ double arrival_step(const ArrivalGrid& g, const std::vector<double>& z, const St
 
 std::vector<double> arrival_field(const ArrivalGrid& g, const std::vector<double>& z,
                                   const std::vector<std::uint8_t>& active, const std::vector<double>& start,
-                                  const StepRuleTable& r) {
+                                  const StepRuleTable& r, const BatchOptions& batch) {
   check_arrival_inputs(g, z, r);
   const std::size_t n = z.size();
   if (active.size() != n || start.size() != n)
@@ -143,12 +146,15 @@ std::vector<double> arrival_field(const ArrivalGrid& g, const std::vector<double
   };
   for (std::size_t k = 0; k < n; ++k)
     if (done[k]) neighbours(k);
+  SerialProgress progress(batch.progress);
+  std::size_t accepted = 0;
   while (!heap.empty()) {
     const auto [t, k] = heap.top();
     heap.pop();
     if (done[k] || t > T[k]) continue;  // a stale entry
     done[k] = 1;
     neighbours(k);
+    progress.tick(static_cast<double>(++accepted) / static_cast<double>(n));
   }
   for (std::size_t k = 0; k < n; ++k)
     if (!done[k]) T[k] = kInf;

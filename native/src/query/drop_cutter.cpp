@@ -13,6 +13,7 @@
 #endif
 
 #include "tmm/query/drop_contacts.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -449,11 +450,14 @@ void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const doubl
 
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {
+  require_in_range(floor_z, "floor_z");  // a NaN floor would come back as every height
   drop_batch_floors(index, cutter, xy, n, nullptr, floor_z, z_out, options, stats);
 }
 
 void drop_batch_capped(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                        double floor_z, double ceiling, double* z_out, const BatchOptions& options) {
+  require_in_range(floor_z, "floor_z");
+  if (std::isnan(ceiling)) throw std::invalid_argument("drop ceiling must not be NaN");
   drop_batch_floors(index, cutter, xy, n, nullptr, floor_z, z_out, options, nullptr, ceiling);
 }
 

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "tmm/query/drop_contacts.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -422,6 +423,7 @@ DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesR
                                    int threads)
     : V_(V) {
   require_unit(V, "drop direction");
+  validate(vertices, triangles);  // in the model's frame, before the rotation: messages name its values
   V_ = V.normalized();
   rot_ = rotation_to_minus_z(V_);
   index_ = rotated_index(vertices, triangles, rot_, threads);
@@ -489,6 +491,8 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
                       const double* axes, bool axes_per_point, std::size_t n, double max_travel,
                       double* travel_out, const BatchOptions& options, DropStats* stats) {
   // Validate up front: workers must not throw.
+  require_rows_in_range(starts, n, 3, "start points");
+  if (!(in_range(max_travel) || max_travel == kInfinity)) require_in_range(max_travel, "max_travel");
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}); ++i) {
     const Vector3d ax(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]);
     require_unit(ax, "cutter axis");

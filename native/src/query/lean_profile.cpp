@@ -13,6 +13,7 @@
 
 #include "lean_arcs.hpp"
 #include "tmm/query/drop_cutter.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -158,8 +159,8 @@ struct RunOut {
 class RunLean {
  public:
   RunLean(const MeshIndex& index, const Cutter& tool, const LeanOptions& o, double x0, double y0, double ux,
-          double uy, bool with_arcs)
-      : index_(index), tool_(tool), o_(o), x0_(x0), y0_(y0), ux_(ux), uy_(uy), with_arcs_(with_arcs) {}
+          double uy, bool with_arcs, const ChunkContext& ctx)
+      : index_(index), tool_(tool), o_(o), x0_(x0), y0_(y0), ux_(ux), uy_(uy), with_arcs_(with_arcs), ctx_(ctx) {}
 
   void run(const double* s, const double* z, const std::uint8_t* flags, std::size_t n, bool arcs, RunOut& out) {
     arcs_ = arcs;
@@ -191,31 +192,50 @@ class RunLean {
   }
 
   double exact(double t, int32_t* hint, bool* air) {
+    ctx_.throw_if_stopping();  // one run can be long: cancel between its drops
     ++drops_;
     return lean_exact(index_, tool_, o_.drop, x0_ + t * ux_, y0_ + t * uy_, hint, air);
   }
 
-  // Drops between (ta, za, wa) and (tb, zb, wb) appended in order up to b; false on air.
+  struct Drop {
+    double t, z;
+    int32_t w;
+  };
+
+  // Drops between (ta, za, wa) and (tb, zb, wb) appended in order up to b; false on air. Bisection in order
+  // with an explicit stack of pending right ends (the left end is the last drop pushed). Bounded: each
+  // pending end halves the interval, which stops at min_step (> 0) or when no double lies strictly between
+  // its ends, so the stack holds at most log2((tb - ta) / min_step) + 1 ends, and at most 2100 whatever the
+  // input (the doubles' exponent range) -- on the heap, never the call stack.
   bool refine(double ta, double za, int32_t wa, double tb, double zb, int32_t wb) {
-    const double len = tb - ta;
-    if (len <= o_.min_step) {
-      push(tb, zb, wb);
-      return true;
-    }
-    const double tm = 0.5 * (ta + tb);
-    int32_t wm = wa;
-    bool air = false;
-    const double zm = exact(tm, &wm, &air);
-    if (air) return false;
-    // every change of the triangle holding the cutter is located to min_step: cheaper rules (refining it only
-    // where the midpoint leaves the chord) let two turns hide each other and the fit leave the band by 4 %
-    const bool split = len > o_.max_step || std::fabs(zm - 0.5 * (za + zb)) > eps_ || wa != wb || wm != wa;
-    if (!split) {
+    Drop a{ta, za, wa};
+    std::vector<Drop> pending{{tb, zb, wb}};
+    while (!pending.empty()) {
+      const Drop b = pending.back();
+      const double len = b.t - a.t, tm = 0.5 * (a.t + b.t);
+      if (len <= o_.min_step || !(tm > a.t && tm < b.t)) {
+        push(b.t, b.z, b.w);
+        a = b;
+        pending.pop_back();
+        continue;
+      }
+      int32_t wm = a.w;
+      bool air = false;
+      const double zm = exact(tm, &wm, &air);
+      if (air) return false;
+      // every change of the triangle holding the cutter is located to min_step: cheaper rules (refining it
+      // only where the midpoint leaves the chord) let two turns hide each other and the fit leave the band by 4 %
+      const bool split = len > o_.max_step || std::fabs(zm - 0.5 * (a.z + b.z)) > eps_ || a.w != b.w || wm != a.w;
+      if (split) {
+        pending.push_back({tm, zm, wm});
+        continue;
+      }
       push(tm, zm, wm);
-      push(tb, zb, wb);
-      return true;
+      push(b.t, b.z, b.w);
+      a = b;
+      pending.pop_back();
     }
-    return refine(ta, za, wa, tm, zm, wm) && refine(tm, zm, wm, tb, zb, wb);
+    return true;
   }
 
   void push(double t, double e, int32_t w) {
@@ -340,6 +360,7 @@ class RunLean {
   const LeanOptions& o_;
   double x0_, y0_, ux_, uy_;
   bool with_arcs_;  // some run has arcs: every vertex gets a centre (NaN for lines)
+  const ChunkContext& ctx_;
   double eps_ = 0.0;
   bool arcs_ = false;  // this run fits arcs
   std::vector<double> t_, e_;
@@ -367,6 +388,11 @@ void validate(const LeanRuns& r, const LeanOptions& o) {
   require(o.fit_fraction > 0.5 && o.fit_fraction + 2 * o.rep_fraction < 1.0,
           value("lean fit_fraction", o.fit_fraction, "in (0.5, 1 - 2 rep_fraction)"));
   require(o.rounds >= 0 && o.rounds <= 100, value("lean rounds", o.rounds, "in [0, 100]"));
+  require_in_range(o.drop.drop_floor, "lean drop_floor");
+  require_in_range(o.drop.z_shift, "lean z_shift");
+  // -inf: no clamp, no air
+  if (o.drop.clamp_floor != -kInf) require_in_range(o.drop.clamp_floor, "lean clamp_floor");
+  if (o.drop.air_below != -kInf) require_in_range(o.drop.air_below, "lean air_below");
   require(!r.offsets.empty() && r.offsets.front() == 0 && r.offsets.back() == r.s.size(),
           "lean runs: offsets must start at 0 and end at the sample count");
   const std::size_t runs = r.offsets.size() - 1;
@@ -382,6 +408,9 @@ void validate(const LeanRuns& r, const LeanOptions& o) {
     require(b >= a + 2, "lean runs: every run needs 2 samples at least (run " + std::to_string(k) + ")");
     require(std::fabs(std::hypot(r.dir[2 * k], r.dir[2 * k + 1]) - 1.0) < 1e-9,
             "lean runs: dir must be a unit vector (run " + std::to_string(k) + ")");
+    require_rows_in_range(&r.origin[2 * k], 1, 2, "lean runs: origin of run " + std::to_string(k));
+    require_rows_in_range(&r.s[a], b - a, 1, "lean runs: s of run " + std::to_string(k) + ", sample");
+    require_rows_in_range(&r.z[a], b - a, 1, "lean runs: z of run " + std::to_string(k) + ", sample");
     for (std::size_t i = a; i < b; ++i)
       require(std::isfinite(r.s[i]) && std::isfinite(r.z[i]) && (i == a || r.s[i] >= r.s[i - 1] - kVertical),
               "lean runs: s must be finite and non-decreasing (run " + std::to_string(k) + ")");
@@ -405,11 +434,11 @@ LeanResult lean_profiles(const MeshIndex& index, const Cutter& tool, const LeanR
   validate(runs, options);
   const std::size_t n = runs.offsets.size() - 1;
   std::vector<RunOut> outs(n);
-  parallel_chunks(n, 4, batch, [&](std::size_t begin, std::size_t end) {
+  parallel_chunks(n, 4, batch, [&](std::size_t begin, std::size_t end, ChunkContext& ctx) {
     for (std::size_t k = begin; k < end; ++k) {
       const std::size_t a = runs.offsets[k];
       RunLean lean(index, tool, options, runs.origin[2 * k], runs.origin[2 * k + 1], runs.dir[2 * k],
-                   runs.dir[2 * k + 1], !runs.arcs.empty());
+                   runs.dir[2 * k + 1], !runs.arcs.empty(), ctx);
       lean.run(&runs.s[a], &runs.z[a], &runs.flags[a], runs.offsets[k + 1] - a, !runs.arcs.empty() && runs.arcs[k],
                outs[k]);
     }

@@ -13,6 +13,7 @@
 
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/util/bracket_1d.hpp"
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -39,6 +40,10 @@ void check_options(const WaterlineOptions& o) {
   };
   for (double v : {o.xmin, o.ymin, o.xmax, o.ymax})
     if (!std::isfinite(v)) fail("bounds", v, "finite");
+  require_in_range(o.xmin, "waterline bounds xmin");
+  require_in_range(o.ymin, "waterline bounds ymin");
+  require_in_range(o.xmax, "waterline bounds xmax");
+  require_in_range(o.ymax, "waterline bounds ymax");
   if (!(o.xmax > o.xmin)) fail("bounds xmax", o.xmax, "> xmin");
   if (!(o.ymax > o.ymin)) fail("bounds ymax", o.ymax, "> ymin");
   if (!(o.sample_step > 0 && std::isfinite(o.sample_step))) fail("sample step", o.sample_step, "> 0 (mm)");
@@ -822,6 +827,7 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
       msg << "waterline level z must be finite, got " << z;
       throw std::invalid_argument(msg.str());
     }
+    require_in_range(z, "waterline level z");
     zlow = std::min(zlow, z);
     zhigh = std::max(zhigh, z);
   }

@@ -21,6 +21,8 @@
 #define TMM_AVX2 __attribute__((target("avx2")))
 #endif
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 
 namespace {
@@ -637,6 +639,12 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
       msg << "tip " << k << " is not finite: (" << p[0] << ", " << p[1] << ", " << p[2] << ")";
       refuse(msg.str());
     }
+    if (!(in_range(p[0]) && in_range(p[1]) && in_range(p[2]))) {
+      std::ostringstream msg;
+      msg << "tip " << k << " (" << p[0] << ", " << p[1] << ", " << p[2]
+          << ") " << out_of_range_text();
+      refuse(msg.str());
+    }
   }
   for (std::size_t k = 0; k + 1 < n; ++k) {
     const auto v = static_cast<unsigned>(kinds[k]);
@@ -683,11 +691,15 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
   last_band = {};
 
   std::vector<BandResult> results(bands);
-  parallel_chunks(bands, 1, batch, [&](std::size_t b0, std::size_t b1) {
+  parallel_chunks(bands, 1, batch, [&](std::size_t b0, std::size_t b1, ChunkContext& ctx) {
     for (std::size_t bd = b0; bd < b1; ++bd) {
       BandCutter band(stock, bd * band_rows, std::min(ny, (bd + 1) * band_rows) - 1);
       auto run = [&](auto& profile) {
+        const double in_band = static_cast<double>(count[bd + 1] - count[bd]);
         for (std::size_t e = count[bd]; e < count[bd + 1]; ++e) {
+          // Progress and cancel between the moves of a band (a band can hold the whole path).
+          if (ctx.stopping()) return;
+          ctx.done_within(static_cast<double>(bd - b0) + static_cast<double>(e - count[bd]) / in_band);
           const std::size_t k = moves[e];
           band.set_move_index(k);
           band.cut(profile, make_move(tips + 3 * k, tips + 3 * k + 3, kinds[k] == MoveKind::Rapid), R,

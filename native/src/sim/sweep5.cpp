@@ -9,13 +9,14 @@
 #include <utility>
 #include <vector>
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 
 namespace {
 
 using Eigen::Vector3d;
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kTangentTol = 1e-7;  // mm: a line this close to the torus touches it (zmap.TANGENT_TOL)
 constexpr double kDoubtTol = 0.05;    // mm: candidates this close but not on it are re-solved (zmap.DOUBT_TOL)
 constexpr int kNewtonSteps = 3;       // polish of each quartic root (zmap.NEWTON_STEPS)
@@ -421,6 +422,8 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
     const double* t = tips + 3 * r;
     const double* a = axes_in + 3 * r;
     if (!(std::isfinite(t[0]) && std::isfinite(t[1]) && std::isfinite(t[2]))) refuse_row("tips", r, t, "is not finite");
+    if (!(in_range(t[0]) && in_range(t[1]) && in_range(t[2])))
+      refuse_row("tips", r, t, out_of_range_text().c_str());
     if (!(std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]))) refuse_row("axes", r, a, "is not finite");
     const Vector3d v(a[0], a[1], a[2]);
     const double len = v.norm();
@@ -444,9 +447,10 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
   std::vector<double>& z = stock.heights();
   double stock_top = -kInf;
   for (std::size_t c = 0; c < z.size(); ++c) {
-    if (!std::isfinite(z[c])) {
+    if (!in_range(z[c])) {
       std::ostringstream msg;
-      msg << "cut_5axis: stock cell (" << c % nx << ", " << c / nx << ") has a non-finite height " << z[c];
+      msg << "cut_5axis: stock cell (" << c % nx << ", " << c / nx << ") height " << z[c] << " "
+          << out_of_range_text();
       throw std::invalid_argument(msg.str());
     }
     stock_top = std::max(stock_top, z[c]);
@@ -489,12 +493,16 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
     return make_pose(tool, t, slerp(axis[m.k], axis[m.k + 1], m.theta, s), stock_top);
   };
   {
-    BatchOptions plain;
-    plain.threads = batch.threads;
-    parallel_chunks(moves.size(), 64, plain, [&](std::size_t b, std::size_t e) {
+    // Progress: this pass is cheap next to the stamping (a pose per instance against a footprint's cells).
+    const BatchOptions rows{batch.threads, progress_phase(batch.progress, 0.0, 0.02)};
+    parallel_chunks(moves.size(), 64, rows, [&](std::size_t b, std::size_t e, ChunkContext& ctx) {
       for (std::size_t i = b; i < e; ++i) {
         Move& m = moves[i];
         for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step) {
+          if ((step & 1023) == 0) {
+            if (ctx.stopping()) return;
+            ctx.done_within(static_cast<double>(i - b) + static_cast<double>(step) / static_cast<double>(m.steps));
+          }
           const Pose p = pose_at(m, step);
           m.ylo = std::min(m.ylo, p.ylo);
           m.yhi = std::max(m.yhi, p.yhi);
@@ -507,7 +515,8 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
   const std::size_t nbands = (ny + kRowsPerBand - 1) / kRowsPerBand;
   std::vector<BandResult> bands(nbands);
   const double x0 = stock.x0(), y0 = stock.y0(), cell = stock.cell();
-  parallel_chunks(nbands, 1, batch, [&](std::size_t b0, std::size_t b1) {
+  const BatchOptions cut{batch.threads, progress_phase(batch.progress, 0.02, 1.0)};
+  parallel_chunks(nbands, 1, cut, [&](std::size_t b0, std::size_t b1, ChunkContext& ctx) {
     std::vector<std::pair<std::size_t, double>> removed;  // (cell, height before) lowered by the current rapid
     for (std::size_t band = b0; band < b1; ++band) {
       BandResult& out = bands[band];
@@ -515,10 +524,15 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
       const double band_ylo = stock.cy(j0), band_yhi = stock.cy(j1);
       const std::vector<double> before(z.begin() + static_cast<std::ptrdiff_t>(j0 * nx),
                                        z.begin() + static_cast<std::ptrdiff_t>((j1 + 1) * nx));
+      // Progress and cancel between the instances of a move, not only between moves: one move can be long.
+      double band_steps = 0.0, steps_done = 0.0;
+      for (const Move& m : moves) band_steps += m.yhi < band_ylo || m.ylo > band_yhi ? 0.0 : m.steps + 1.0;
       for (const Move& m : moves) {
         if (m.yhi < band_ylo || m.ylo > band_yhi) continue;
         removed.clear();
-        for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step) {
+        for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step, ++steps_done) {
+          if (ctx.stopping()) return;
+          ctx.done_within(static_cast<double>(band - b0) + steps_done / band_steps);
           const Pose p = pose_at(m, step);
           if (p.yhi < band_ylo || p.ylo > band_yhi) continue;
           ++out.stats.instances;

@@ -5,6 +5,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tmm/util/range.hpp"
+
 namespace tmm {
 
 namespace {
@@ -25,6 +27,11 @@ ZMap::ZMap(double x0, double y0, double cell, std::size_t nx, std::size_t ny, do
   if (!std::isfinite(top)) refuse("stock top must be finite", top);
   if (nx == 0) refuse("nx must be at least 1", 0.0);
   if (ny == 0) refuse("ny must be at least 1", 0.0);
+  require_in_range(x0, "z-map x0");
+  require_in_range(y0, "z-map y0");
+  require_in_range(top, "z-map stock top");
+  require_in_range(x0 + static_cast<double>(nx) * cell, "z-map x0 + nx * cell");
+  require_in_range(y0 + static_cast<double>(ny) * cell, "z-map y0 + ny * cell");
   if (nx > max_cells / ny) {
     std::ostringstream msg;
     // In double: the byte count of a grid this large may not fit a size_t.

@@ -8,6 +8,9 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
+
+#include "tmm/util/range.hpp"
 
 namespace tmm {
 
@@ -128,8 +131,11 @@ BezierPatch::BezierPatch(int p, int q, std::vector<Vector3d> poles) : p_(p), q_(
         << poles_.size();
     throw std::invalid_argument(msg.str());
   }
-  for (const auto& c : poles_) {
+  for (std::size_t k = 0; k < poles_.size(); ++k) {
+    const Vector3d& c = poles_[k];
     if (!finite(c)) throw std::invalid_argument("Bezier patch has a non-finite pole");
+    for (int i = 0; i < 3; ++i)
+      if (!in_range(c[i])) require_in_range(c[i], "Bezier pole " + std::to_string(k) + " coordinate " + "xyz"[i]);
     box_.extend(c);
   }
 }
@@ -207,7 +213,7 @@ BezierPatch BezierPatch::transformed(const Eigen::Matrix3d& R, const Vector3d& t
 PatchSurface::PatchSurface(std::vector<BezierPatch> patches, int nu, int nv, std::vector<double> bu,
                            std::vector<double> bv)
     : patches_(std::move(patches)), nu_(nu), nv_(nv), bu_(std::move(bu)), bv_(std::move(bv)) {
-  if (nu < 1 || nv < 1 || patches_.size() != static_cast<std::size_t>(nu * nv)) {
+  if (nu < 1 || nv < 1 || patches_.size() != static_cast<std::size_t>(nu) * static_cast<std::size_t>(nv)) {
     std::ostringstream msg;
     msg << "surface of " << nu << " x " << nv << " patches given " << patches_.size() << " patches";
     throw std::invalid_argument(msg.str());
@@ -215,6 +221,8 @@ PatchSurface::PatchSurface(std::vector<BezierPatch> patches, int nu, int nv, std
   if (bu_.size() != static_cast<std::size_t>(nu + 1) || bv_.size() != static_cast<std::size_t>(nv + 1)) {
     throw std::invalid_argument("surface breakpoints: need nu + 1 values in u and nv + 1 in v");
   }
+  for (std::size_t k = 0; k < bu_.size(); ++k) require_in_range(bu_[k], "surface breakpoint u[" + std::to_string(k) + "]");
+  for (std::size_t k = 0; k < bv_.size(); ++k) require_in_range(bv_[k], "surface breakpoint v[" + std::to_string(k) + "]");
   for (std::size_t k = 1; k < bu_.size(); ++k)
     if (!(bu_[k] > bu_[k - 1])) throw std::invalid_argument("surface breakpoints in u must increase");
   for (std::size_t k = 1; k < bv_.size(); ++k)

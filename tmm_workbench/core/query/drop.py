@@ -1,6 +1,7 @@
 """Drop-cutter over a mesh: the kernel's spatial index and batch query, with core errors."""
 from __future__ import annotations
 
+import math
 from typing import Callable, Optional
 
 import numpy as np
@@ -35,7 +36,12 @@ class DropSurface:
         pts = np.ascontiguousarray(xy, dtype=np.float64).reshape(-1, 2)
         if not np.isfinite(pts).all():
             raise TmmError("drop points contain a non-finite coordinate")
+        floor = float(floor_z)
+        if math.isnan(floor):  # every height would come back NaN
+            raise TmmError("drop floor_z is NaN: it must be a finite height (mm)")
         try:
-            return native.drop_cutter(self._index, cutter.native, pts, float(floor_z), threads, progress)
+            return native.drop_cutter(self._index, cutter.native, pts, floor, threads, progress)
         except native.Cancelled as exc:
             raise Cancelled("tool path computation cancelled") from exc
+        except ValueError as exc:  # the kernel's range (points, floor) with its message
+            raise TmmError(f"{self.mesh.name}: {exc}") from exc

@@ -35,13 +35,18 @@ struct Mesh {
 // number is stored in `*degenerate_removed` when given. Triangle order is kept; vertices are numbered in
 // order of first use, and only vertices of kept triangles are returned (every vertex is referenced).
 // Throws std::invalid_argument for an empty soup, a non-finite coordinate (naming the triangle), a bad
-// tolerance, too many triangles for 32-bit indices (3m > 2^31-1), or when no non-degenerate triangle
-// remains.
+// tolerance, too many triangles for 32-bit indices (3m > 2^31-1), a coordinate outside the kernel's range
+// (tmm/util/range.hpp) or when no non-degenerate triangle remains.
 Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed = nullptr);
 
 // Throws std::invalid_argument naming the first triangle with an index outside [0, V.rows()) or the
-// first vertex with a non-finite coordinate. face_normals and vertex_normals validate with it.
+// first vertex with a non-finite coordinate or one outside the kernel's range. face_normals and
+// vertex_normals validate with it.
 void validate(const VerticesRef& V, const TrianglesRef& F);
+
+// Throws std::invalid_argument naming the first vertex with a coordinate outside the kernel's range
+// (|x| < kMaxCoordinate, tmm/util/range.hpp), its value and the range.
+void require_vertices_in_range(const VerticesRef& V);
 
 // Unit normal of each triangle, (p1 - p0) x (p2 - p0) normalised; (0, 0, 0) for a zero-area triangle.
 Normals face_normals(const VerticesRef& V, const TrianglesRef& F);

@@ -14,6 +14,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "tmm/util/parallel.hpp"
+
 namespace tmm {
 
 struct ArrivalGrid {
@@ -46,9 +48,11 @@ double arrival_step(const ArrivalGrid& grid, const std::vector<double>& z, const
 
 // T at every node (in steps: |grad T| = 1 / F). z: CL heights at the nodes (nx ny); active: nonzero where the
 // front may go; start: T of the start band's nodes (finite: fixed), NaN at the others. Nodes the front never
-// reaches (inactive or cut off) are +inf. Throws std::invalid_argument on inconsistent sizes or bad values.
+// reaches (inactive or cut off) are +inf. Throws std::invalid_argument on inconsistent sizes or bad values
+// (heights and lengths outside the kernel's range included), Cancelled when batch.progress (called from this
+// thread, on which it runs: batch.threads is not used) returns false.
 std::vector<double> arrival_field(const ArrivalGrid& grid, const std::vector<double>& z,
                                   const std::vector<std::uint8_t>& active, const std::vector<double>& start,
-                                  const StepRuleTable& rule);
+                                  const StepRuleTable& rule, const BatchOptions& batch = {});
 
 }  // namespace tmm

@@ -32,7 +32,8 @@ double drop_point(const MeshIndex& index, const Cutter& cutter, double x, double
 double drop_on_triangle(const Cutter& cutter, double x, double y, const IndexedTriangle& t,
                         double above = -std::numeric_limits<double>::infinity());
 
-// xy: n points (x0, y0, x1, y1, ...); z_out: n tip heights. Throws Cancelled if progress returns false.
+// xy: n points (x0, y0, x1, y1, ...); z_out: n tip heights. Throws Cancelled if progress returns false,
+// std::invalid_argument for a floor_z outside the kernel's range (NaN included; tmm/util/range.hpp).
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 double floor_z, double* z_out, const BatchOptions& options,
                 DropStats* stats = nullptr);

@@ -2,6 +2,8 @@
 // cancel: the one place that owns threads in the kernel.
 #pragma once
 
+#include <atomic>
+#include <chrono>
 #include <cstddef>
 #include <functional>
 #include <stdexcept>
@@ -16,17 +18,61 @@ class Cancelled : public std::runtime_error {
 
 struct BatchOptions {
   int threads = 0;  // 0: all hardware threads
-  // Called now and then from the calling thread with the fraction done; return false to cancel.
+  // Called now and then from the calling thread with the fraction done; return false to cancel. An
+  // exception thrown by it (a Python KeyboardInterrupt) stops the batch and propagates.
   std::function<bool(double)> progress;
+};
+
+// What a long chunk sees of its batch: whether to stop early, and how far it has come (so that one chunk
+// that is most of the work, a long move, still reports progress and can be cancelled within it).
+class ChunkContext {
+ public:
+  ChunkContext(const std::atomic<bool>& stop, std::atomic<double>& partial) : stop_(stop), partial_(partial) {}
+  // The batch is stopping (cancelled, or another chunk failed): return now, the results are thrown away.
+  bool stopping() const { return stop_.load(std::memory_order_relaxed); }
+  // For work deep in a call chain: leaves the chunk by throwing Cancelled (parallel_chunks then throws the
+  // caller's Cancelled or the failing chunk's error).
+  void throw_if_stopping() const {
+    if (stopping()) throw Cancelled();
+  }
+  // Items of the current chunk done so far, fractional (progress only; reset when the chunk ends).
+  void done_within(double items) { partial_.store(items, std::memory_order_relaxed); }
+
+ private:
+  const std::atomic<bool>& stop_;
+  std::atomic<double>& partial_;
 };
 
 // Calls work(begin, end) for the fixed chunks [k * chunk, min(n, (k + 1) * chunk)) of [0, n), each exactly
 // once, on options.threads threads. Chunks do not depend on the thread count, so work that depends only on
 // its chunk gives the same results whatever the thread count. With a progress callback the calling thread
-// only reports (a Python callback needs it) while workers compute; its false cancels (throws Cancelled
-// after the workers stop) and an exception from it stops the workers and propagates. The first exception
-// thrown by `work` stops the others and is rethrown.
+// only reports (a Python callback needs it) while workers compute, every 20 ms; its false cancels (throws
+// Cancelled after the workers stop) and an exception from it stops the workers and propagates. The first
+// exception thrown by `work` stops the others and is rethrown. Cancel is seen between chunks, and within a
+// chunk by work taking a ChunkContext (the overload below) that checks stopping() between its sub-steps.
 void parallel_chunks(std::size_t n, std::size_t chunk, const BatchOptions& options,
                      const std::function<void(std::size_t begin, std::size_t end)>& work);
+void parallel_chunks(std::size_t n, std::size_t chunk, const BatchOptions& options,
+                     const std::function<void(std::size_t begin, std::size_t end, ChunkContext& context)>& work);
+
+// Progress and cancel of a loop on the calling thread (no workers): tick is a counter, looking at the clock
+// every 256 calls and reporting at most every 20 ms; throws Cancelled when the callback says false.
+class SerialProgress {
+ public:
+  explicit SerialProgress(const std::function<bool(double)>& progress) : progress_(progress) {}
+  void tick(double fraction) {
+    if (progress_ && (++calls_ & 255u) == 0) report(fraction);
+  }
+
+ private:
+  void report(double fraction);
+  const std::function<bool(double)>& progress_;
+  unsigned calls_ = 0;
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// The progress of a phase [lo, hi] of a longer job reported through `outer` (empty if outer is). Refers to
+// outer, which must outlive the result (the caller's batch options).
+std::function<bool(double)> progress_phase(const std::function<bool(double)>& outer, double lo, double hi);
 
 }  // namespace tmm
