@@ -2,7 +2,8 @@
 # The Python binding tests against the UBSan-built module (build-ubsan, see TMM_SANITIZE in CMakeLists.txt):
 # the package and the tests copied to a temporary folder with the sanitized module in place of the normal
 # one, pytest run there (so neither the checkout's package nor its module is imported), the sanitizer
-# runtime preloaded, any report fatal. Run after `cmake --build build-ubsan`.
+# runtime preloaded, any report fatal; then the binding fuzz script (native/fuzz/fuzz_binding.py) the same way.
+# Run after `cmake --build build-ubsan`.
 set -euo pipefail
 BUILD="$(cd "${1:-$(dirname "${BASH_SOURCE[0]}")/../build-ubsan}" && pwd)"
 MODULE="$(ls "$BUILD"/_native*.so)"
@@ -21,3 +22,5 @@ export ASAN_OPTIONS="detect_leaks=0:abort_on_error=1"
 # The module found must be the sanitized copy: checked before the tests run.
 "$ROOT/.venv/bin/python" -c "import tmm_workbench._native as n, sys; assert n.__file__.startswith('$TMP'), n.__file__"
 "$ROOT/.venv/bin/python" -m pytest -q -p no:cacheprovider "${TESTS[@]/#/tests/core/}"
+# The binding fuzz script, bounded (TMM_FUZZ_CALLS calls, fixed seed), on the same sanitized module.
+PYTHONPATH="$TMP" "$ROOT/.venv/bin/python" "$ROOT/native/fuzz/fuzz_binding.py" --calls "${TMM_FUZZ_CALLS:-3000}"

@@ -11,7 +11,7 @@ cd "$ROOT"
 # (core.footprint.variable_step)
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib python3-pyclipper xvfb xauth cmake g++ make ninja-build libgtest-dev
-      python3-contourpy python3-scipy)
+      python3-contourpy python3-scipy clang-14 libclang-rt-14-dev)
 missing=()
 for p in "${DEBS[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then

@@ -80,6 +80,7 @@ void bind_surface(py::module_& m) {
       .def("evaluate",
            [](const PatchSurface& s, const Arr& uv_in) {
              const Arr uv = check_points(uv_in, 2, "uv");
+             tmm_bindings::check_range(uv, "uv");
              const std::size_t n = static_cast<std::size_t>(uv.shape(0));
              py::array_t<double> out[6] = {rows3(n), rows3(n), rows3(n), rows3(n), rows3(n), rows3(n)};
              double* d[6];
@@ -102,6 +103,8 @@ void bind_surface(py::module_& m) {
            py::arg("uv"), "S and its first and second derivatives at (n, 2) global parameters: dict of (n, 3).")
       .def("ray_hit",
            [](const PatchSurface& s, const Eigen::Vector3d& o, const Eigen::Vector3d& d) -> py::object {
+             tmm::require_rows_in_range(o.data(), 1, 3, "origin");
+             tmm::require_rows_in_range(d.data(), 1, 3, "direction");
              const auto hit = s.ray_hit(o, d);
              if (!hit) return py::none();
              return py::make_tuple(hit->s, hit->uv.x(), hit->uv.y());
