@@ -81,7 +81,7 @@ def test_bad_input_names_the_parameter():
     from tmm_workbench.core.errors import TmmError
 
     plane = grid_mesh(lambda x, y: 0 * x, 2, 2, (-5, -5, 5, 5))
-    with pytest.raises(TmmError, match=r"cusp height must be in \(0, 3\] mm"):
+    with pytest.raises(TmmError, match=r"cusp height must be in \[0.0001, 3\] mm"):
         section_stepover(plane, Cutter.ball(6), (-5, -5, 5, 5), 0.0, 4.0, -1.0)
     with pytest.raises(TmmError, match="cusp slope limit must be in"):
         section_stepover(plane, Cutter.ball(6), (-5, -5, 5, 5), 0.0, 0.01, -1.0, max_slope_deg=90.0)

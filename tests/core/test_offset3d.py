@@ -248,7 +248,7 @@ def test_a_smeared_corner_is_rebuilt_from_its_fitted_edges():
 
 def test_bad_inputs_are_refused_by_name_before_any_path():
     mesh = plate()
-    with pytest.raises(TmmError, match=r"cusp height must be in \(0, 3\] mm .* got 4"):
+    with pytest.raises(TmmError, match=r"cusp height must be in \[0.0001, 3\] mm .* got 4"):
         compute(mesh, BALL, SurfaceParams(boundary=(0, 0, 40, 30), stepover_mode=OFFSET3D, cusp=4.0))
     with pytest.raises(TmmError, match="cusp height"):
         compute(mesh, BALL, SurfaceParams(boundary=(0, 0, 40, 30), stepover_mode=OFFSET3D, cusp=0.0))

@@ -69,9 +69,9 @@ def test_adaptive_mode_keeps_the_cusp_in_the_simulated_stock():
 
 def test_bad_cusp_input_is_named():
     mesh = bump()
-    with pytest.raises(TmmError, match=r"cusp height must be in \(0, 3\] mm \(the tool radius\), got 4"):
+    with pytest.raises(TmmError, match=r"cusp height must be in \[0.0001, 3\] mm \(a machine's resolution to the tool radius\), got 4"):
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="cusp", cusp=4.0))
-    with pytest.raises(TmmError, match="cusp height must be a positive length, got 0"):
+    with pytest.raises(TmmError, match=r"cusp height must be >= 0.0001 mm, got 0"):
         compute(mesh, Cutter.ball(6), SurfaceParams(boundary=BOX, stepover_mode="adaptive", cusp=0.0))
     with pytest.raises(TmmError,
                        match="step-over mode must be 'stepover' or 'cusp' or 'adaptive' or 'offset3d', got 'x'"):

@@ -43,7 +43,7 @@ class Offset3D(FreeCADTestCase):
         op.CuspHeight = 50.0                                           # above the tool radius
         doc.recompute()
         self.assertFalse(op.isValid())
-        self.assertIn("cusp height must be in (0, 2] mm (the tool radius), got 50", op.getStatusString())
+        self.assertIn("cusp height must be in [0.0001, 2] mm (a machine's resolution to the tool radius), got 50", op.getStatusString())
         self.assertEqual(len(op.Path.Commands), 0)
         close_all()
 
@@ -67,7 +67,7 @@ class Offset3D(FreeCADTestCase):
         FreeCAD.closeDocument(r.doc.Name)
         with self.assertRaises(TmmError) as ctx:
             run_surface(bump_stl(), stepover_mode="offset3d", cusp=10.0, progress=False, doc_name="TmmApiBad3D")
-        self.assertIn("cusp height must be in (0, 3] mm", str(ctx.exception))
+        self.assertIn("cusp height must be in [0.0001, 3] mm", str(ctx.exception))
 
 
 def line_sketch(doc, a, b, name="Start"):

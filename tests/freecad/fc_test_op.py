@@ -208,7 +208,7 @@ class CuspSpacing(FreeCADTestCase):
         op.CuspHeight = 50.0                                           # above the tool radius
         doc.recompute()
         self.assertFalse(op.isValid())
-        self.assertIn("cusp height must be in (0, 2] mm (the tool radius), got 50", op.getStatusString())
+        self.assertIn("cusp height must be in [0.0001, 2] mm (a machine's resolution to the tool radius), got 50", op.getStatusString())
         self.assertEqual(len(op.Path.Commands), 0)
         close_all()
 

@@ -206,7 +206,7 @@ class Api(FreeCADTestCase):
                              ({"stepover": 0.0}, "must be a positive length"),
                              ({"stepover_mode": "scallop"},
                               "stepover_mode must be one of stepover, cusp, adaptive, offset3d, got 'scallop'"),
-                             ({"cusp": -1.0}, "cusp must be a positive length, got -1")):
+                             ({"cusp": -1.0}, "cusp must be >= 0.0001 mm, got -1")):
             with self.subTest(**kwargs):
                 with self.assertRaises(TmmError) as ctx:
                     run_surface(bump_stl(), progress=False, **kwargs)

@@ -76,7 +76,7 @@ class JobPost(FreeCADTestCase):
 
     def test_five_axis_first_op_posts_with_tarus(self) -> None:
         net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex")
-        r = run_multipoint(net, side_step=18.0, forward_step=4.0, progress=False, posts=())
+        r = run_multipoint(net, side_step=18.0, forward_step=4.0, progress=False, posts=(), pass_spacing="even")
         self.assertEqual(r.job.PostProcessor, "tarus")
         self.assertTrue(r.op.isValid(), r.op.getStatusString())
         self.assertGreater(cycle_seconds(r.op.CycleTime), 0)

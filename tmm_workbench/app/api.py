@@ -28,6 +28,7 @@ import FreeCAD
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app import geometry, posts, registry, tools
 from tmm_workbench.app import progress as progress_mod
+from tmm_workbench.app.api_args import CallbackProgress, plain_numbers
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import Spec, check, spec_of
@@ -58,6 +59,7 @@ class SurfaceResult:
     mesh: TriMesh        # the core mesh that was machined
 
 
+@plain_numbers
 def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter] = "ballend",
                 diameter: float = 6.0, corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
@@ -262,7 +264,7 @@ def _compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
     none); raises TmmError with the op's status when it fails or computes no tool path."""
     factory = None
     if callable(progress):
-        factory = lambda label: _CallbackProgress(progress)  # noqa: E731
+        factory = lambda label: CallbackProgress(progress)  # noqa: E731
     op.Proxy.progress_enabled = bool(progress)
     with progress_mod.using(factory):
         op.touch()
@@ -271,18 +273,11 @@ def _compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
         raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
 
 
-class _CallbackProgress(progress_mod.ProgressReporter):
-    def __init__(self, callback: Callable[[float], bool]) -> None:
-        self.callback = callback
-
-    def __call__(self, fraction: float) -> bool:
-        return bool(self.callback(fraction))
-
-
 # --- z-level roughing and waterline ----------------------------------------------------------------
 StockBox = tuple[float, float, float, float, float, float]
 
 
+@plain_numbers
 def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[str, Cutter] = "endmill",
                  diameter: float = 6.0, corner_radius: float = 0.0, step_down: float = 2.0,
                  stepover_percent: float = 40.0, stock_to_leave: float = 0.5,
@@ -343,6 +338,7 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
                    fcstd_path, doc_name, progress)
 
 
+@plain_numbers
 def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[str, Cutter] = "ballend",
                   diameter: float = 6.0, corner_radius: float = 0.0, step_down: float = 1.0,
                   stock_to_leave: float = 0.0, sample_step: Optional[float] = None,
@@ -510,6 +506,7 @@ class MultipointResult:
     files: dict               # post name -> written file (when out_dir is given), "fcstd" -> document
 
 
+@plain_numbers
 def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method: str = "vcrf",
                    side_step: float = 18.0, pass_spacing: Optional[str] = None, forward_step: float = 2.0,
                    feed_angle_deg: float = 90.0, margin: float = 0.0, zigzag: bool = True,
@@ -690,6 +687,7 @@ class SimulationReport:
     simulation: Any            # app.simulation.JobSimulation (grids, heights, deviation)
 
 
+@plain_numbers
 def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
              png_path: Optional[Union[str, os.PathLike]] = None, progress: Union[bool, Callable[[float], bool]] = True,
              fail_on_gouge: bool = False) -> SimulationReport:
@@ -707,7 +705,7 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
              tolerance=(tolerance, Spec(low=0.0, high=10.0, unit="mm", label="tolerance")),
              max_step=(max_step, Spec(low=1e-3, high=10.0, unit="mm", label="max_step", optional=True)))
     label = str(getattr(target, "Label", "simulation"))
-    factory = (lambda _: _CallbackProgress(progress)) if callable(progress) else None
+    factory = (lambda _: CallbackProgress(progress)) if callable(progress) else None
     with progress_mod.using(factory):
         with progress_mod.reporter(f"{label} simulation", bool(progress)) as cb:
             sim = simulation.simulate_job(target, cell, tolerance, max_step, cb)
@@ -736,6 +734,7 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     return report
 
 
+@plain_numbers
 def compare_cutters(model: Any, candidates: Sequence[Any], *, stepover: float, sample_step: float,
                     cell: float = 0.1, tolerance: float = 0.01, angle_deg: float = 0.0, margin: float = 0.0,
                     horiz_feed: float = 1000.0, vert_feed: float = 300.0) -> Any:

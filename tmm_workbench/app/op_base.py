@@ -11,6 +11,7 @@ from dataclasses import MISSING, fields
 from typing import Any, Callable, NamedTuple, Optional
 
 import FreeCAD
+import numpy as np
 import Path
 
 from tmm_workbench.app import hooks
@@ -21,6 +22,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError, WorkLimitError
 from tmm_workbench.core.tools.cutter import Cutter
 
 
+MAX_WORD = 1e9  # mm, mm/min, deg: any G-code word beyond it is a computation gone wrong, not a move
 PREFERENCES = "User parameter:BaseApp/Preferences/Mod/TMM"
 
 
@@ -126,6 +128,39 @@ class TmmOp(PathOp.ObjectOp):
                         setattr(obj, row.name, value)
         for name in self.READ_ONLY:
             obj.setEditorMode(name, 1)
+        self.ensure_path_version(obj, restoring)
+
+    # --- a saved path from an older version (what changed is said when it recomputes differently) -----
+    def ensure_path_version(self, obj: Any, restoring: bool) -> None:
+        """PathVersion: the TMM path version that computed the op's Path (0: before TMM recorded it);
+        PathNote: what the last recompute changed against a path an older version saved."""
+        from tmm_workbench.app import path_versions
+
+        now = path_versions.current(type(self).__name__)
+        if not hasattr(obj, "PathVersion"):
+            obj.addProperty("App::PropertyInteger", "PathVersion", "TMM",
+                            "The TMM tool-path version that computed this op's path (0: older than the record)")
+            obj.PathVersion = 0 if restoring else now
+        if not hasattr(obj, "PathNote"):
+            obj.addProperty("App::PropertyString", "PathNote", "TMM",
+                            "What changed when a path saved by an older TMM version was recomputed")
+        for name in ("PathVersion", "PathNote"):
+            obj.setEditorMode(name, 1)
+        self._saved_path = None
+        if restoring and obj.PathVersion < now and len(obj.Path.Commands):
+            self._saved_path = (int(obj.PathVersion), obj.Path.toGCode())
+
+    def note_path_change(self, obj: Any) -> None:
+        """After a good compute: the op's path version, and a note when it differs from an older version's."""
+        from tmm_workbench.app import path_versions
+
+        name = type(self).__name__
+        saved, self._saved_path = getattr(self, "_saved_path", None), None
+        obj.PathNote = ""
+        if saved is not None and obj.Path.toGCode() != saved[1]:
+            obj.PathNote = path_versions.note(name, saved[0])
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: {obj.PathNote}\n")
+        obj.PathVersion = path_versions.current(name)
 
     def opSetDefaultValues(self, obj: Any, job: Any) -> None:
         for name, value in self.defaults().items():
@@ -173,6 +208,7 @@ class TmmOp(PathOp.ObjectOp):
         if not self._computed:
             self.fail(obj, "FreeCAD did not compute the operation (its Job, model or stock is missing; "
                            "see the report view)")
+        self.note_path_change(obj)
         self.set_cycle_time(obj)
 
     def set_cycle_time(self, obj: Any) -> None:
@@ -242,6 +278,19 @@ class TmmOp(PathOp.ObjectOp):
         self._computed = True
         self.clear_results()
         self.guarded(obj, lambda: self.compute(obj))
+        self.check_finite(obj)
+
+    def check_finite(self, obj: Any) -> None:
+        """The last look before FreeCAD makes the Path: a NaN or infinite word would reach the G-code and the
+        machine (0.20 writes NaN as Z-922337203685.477581). Every cause is refused at its input; this
+        catches one not yet found."""
+        words = [(k, c.Name, w, v) for k, c in enumerate(self.commandlist) for w, v in c.Parameters.items()]
+        values = np.fromiter((v for *_, v in words), float, len(words))
+        bad = np.flatnonzero(~(np.abs(values) <= MAX_WORD))
+        if len(bad):
+            k, name, word, value = words[int(bad[0])]
+            self.fail(obj, f"the computed tool path has a word that is not a usable number ({name} {word}{value:g}"
+                           f" in command {k + 1}): nothing was written. Please report this with the document")
 
     def compute(self, obj: Any) -> None:
         raise NotImplementedError

@@ -67,6 +67,9 @@ def faces_region(links: list[tuple[Any, tuple[str, ...]]], models: list[Any], to
         for sub in subs or ():
             if not str(sub).startswith("Face"):
                 raise TmmError(f"Region 'Faces': {_label(obj)}.{sub} is not a face")
+            count = len(obj.Shape.Faces)
+            if not str(sub)[4:].isdigit() or not 1 <= int(str(sub)[4:]) <= count:
+                raise TmmError(f"Region 'Faces': {_label(obj)} has no {sub} (its faces: Face1 to Face{count})")
             face = obj.Shape.getElement(str(sub))
             points, triangles = face.tessellate(tolerance)
             if not triangles:

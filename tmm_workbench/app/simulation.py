@@ -140,15 +140,15 @@ def op_cycle_seconds(op: Any, decoded: Optional[tuple[Toolpath, list]] = None) -
     return three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).seconds
 
 
-def _stock_heights(job: Any, grid: Grid) -> np.ndarray:
+def _stock_heights(job: Any, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
     stock = getattr(job, "Stock", None)
     if stock is None or stock.Shape.isNull():
         raise TmmError(f"Job '{job.Label}' has no stock to simulate")
-    h = mesh_heights(geometry.mesh_from_shape(stock.Shape, 0.01, stock.Label), grid)
+    h = mesh_heights(geometry.mesh_from_shape(stock.Shape, 0.01, stock.Label), grid, progress=progress)
     return np.where(np.isfinite(h), h, float(stock.Shape.BoundBox.ZMin))  # outside the stock: none
 
 
-def _design_heights(job: Any, ops: list, grid: Grid) -> np.ndarray:
+def _design_heights(job: Any, ops: list, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
     """The design under each cell: the Job's models (TMM's stand-in boxes give the mesh or STL they stand for)
     and any model an op machines instead (its StlFile or Model), highest where they overlap."""
     from tmm_workbench.app.op_surface import mesh_of_model
@@ -161,7 +161,7 @@ def _design_heights(job: Any, ops: list, grid: Grid) -> np.ndarray:
             meshes.append(mesh_of_model(op.Model, DESIGN_DEFLECTION_MM))
     if not meshes:
         raise TmmError(f"Job '{job.Label}' has no model to compare with")
-    return mesh_heights(geometry.combine(meshes), grid)
+    return mesh_heights(geometry.combine(meshes), grid, progress=progress)
 
 
 def slope_regions(design: np.ndarray, cell: float) -> dict:
@@ -203,7 +203,13 @@ def simulation_grid(target: Any, cell: float) -> Grid:
     if getattr(job, "Stock", None) is None or job.Stock.Shape.isNull():
         raise TmmError(f"Job '{job.Label}' has no stock to simulate")
     bb = job.Stock.Shape.BoundBox
-    return Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, cell)
+    grid = Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, cell)
+    if min(grid.nx, grid.ny) < 2:  # one cell across compares nothing: no slope, no scallop between passes
+        largest = min(bb.XLength, bb.YLength) / 2
+        raise TmmError(f"simulation cell {cell:g} mm gives {grid.nx} x {grid.ny} cells over Job '{job.Label}''s "
+                       f"stock ({bb.XLength:g} x {bb.YLength:g} mm): at most {largest:g} mm gives the 2 x 2 a "
+                       f"comparison needs")
+    return grid
 
 
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
@@ -217,8 +223,11 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     if not ops:
         raise TmmError(f"Job '{job.Label}' has no active operation with a tool path")
     grid = simulation_grid(job, cell)
-    initial = _stock_heights(job, grid)
-    design = _design_heights(job, ops, grid)
+
+    def share(lo: float, hi: float) -> Optional[Callable[[float], bool]]:  # a phase's part of the whole
+        return (lambda f: progress(lo + (hi - lo) * f)) if progress else None
+    initial = _stock_heights(job, grid, share(0.0, 0.05))
+    design = _design_heights(job, ops, grid, share(0.05, 0.2))
     heights, done = initial, []
     result = None
     for k, op in enumerate(ops):
@@ -228,10 +237,9 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
         cutter = tools.cutter_from_tool(op.ToolController.Tool)
         five = tp.is_five_axis()
 
-        def part(f: float, k: int = k) -> bool:  # this op's share of the whole progress
-            return progress((k + f) / len(ops)) if progress else True
         r = simulate(tp, cutter, grid, heights, shape=_five_axis_shape(op) if five else "bull_nose",
-                     max_step=max_step, tolerance=tolerance, progress=part if progress else None)
+                     max_step=max_step, tolerance=tolerance,
+                     progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)))
         seconds = op_cycle_seconds(op, (tp, feeds))
         done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds))
         heights = r.heights

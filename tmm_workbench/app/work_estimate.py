@@ -208,9 +208,7 @@ def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
         return est
     from tmm_workbench.core.footprint import variable_step
 
-    cutter = _cutter(obj)
-    dense = variable_step.estimate_work(params.boundary, cutter, params.cusp,
-                                        variable_step.measure_cell(cutter, params.cusp))
+    dense = variable_step.estimate_params(_cutter(obj), params)
     return replace(est, count=est.count + dense,
                    note=f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial "
                         "passes where the simulated cusp is over, not counted)")

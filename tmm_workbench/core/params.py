@@ -12,8 +12,11 @@ parameter, its value and the allowed range, in the user's terms.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field, fields
 from typing import Any, Optional, Sequence
+
+import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 
@@ -65,8 +68,9 @@ def check(spec: Spec, value: Any) -> None:
         if value not in spec.choices:
             raise TmmError(f"{spec.label} must be {spec.range_text()}, got {value!r}")
         return
-    number = isinstance(value, (int, float)) and not isinstance(value, bool)
-    if spec.integer and not (isinstance(value, int) and not isinstance(value, bool)):
+    # numbers.Real and Integral also take numpy's scalars (np.float32(6) is a length as 6.0 is)
+    number = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if spec.integer and not (isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_))):
         raise TmmError(f"{spec.label} must be a whole number {spec.range_text()}, got {value!r}")
     ok = number and math.isfinite(value)
     if ok and spec.low is not None:
@@ -84,7 +88,8 @@ def check(spec: Spec, value: Any) -> None:
 
 def check_finite(label: str, values: Sequence[Any], unit: str = "mm") -> None:
     """Every entry of `values` a finite number (a box, a point)."""
-    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values):
+    if not all(isinstance(v, numbers.Real) and not isinstance(v, (bool, np.bool_)) and math.isfinite(v)
+               for v in values):
         raise TmmError(f"{label} must be finite numbers of {unit}, got {tuple(values)!r}")
 
 

@@ -50,6 +50,19 @@ def area(shape: Shape) -> float:
     return float(sum(signed_area(p) for p in shape))
 
 
+def crosses_itself(poly: np.ndarray) -> bool:
+    """True when the closed loop's edges cross (a figure eight, a bow tie): Clipper splits such a loop into
+    several, or its simple pieces' area differs from the loop's signed area."""
+    ints = _to_int([poly])
+    if not ints or len(ints[0]) < 4:
+        return False
+    pieces = _clipper().SimplifyPolygon(ints[0], _clipper().PFT_NONZERO)
+    if len(pieces) != 1:
+        return True
+    simple = abs(signed_area(np.asarray(pieces[0], dtype=float) / SCALE))
+    return abs(simple - abs(signed_area(poly))) > 1e-6 * max(simple, 1.0)
+
+
 def is_ccw(poly: np.ndarray) -> bool:
     return bool(_clipper().Orientation(_to_int([poly])[0]))
 

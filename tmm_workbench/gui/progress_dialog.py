@@ -28,7 +28,8 @@ class DialogProgress(ProgressReporter):
             if time.monotonic() - self.t0 < SHOW_AFTER_S:
                 return True
             self.dialog = self._open()
-        self.dialog.setValue(int(min(max(fraction, 0.0), 1.0) * STEPS))
+        # a phase that restarts its own count never moves the bar back
+        self.dialog.setValue(max(self.dialog.value(), int(min(max(fraction, 0.0), 1.0) * STEPS)))
         QtGui.QApplication.processEvents()
         return not self.dialog.wasCanceled()
 

@@ -23,11 +23,15 @@ import math
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.tools.cutter import Cutter
 
+# mm: the least cusp height asked for. A tenth of a micrometre is below any machine's resolution; finer
+# steps would only multiply passes (and a cusp of 1e-8 mm is lost in the profile's rounding)
+MIN_CUSP = 1e-4
 _SAMPLES = 2048          # profile samples across the tool, and cusp samples across one period
 _BISECTIONS = 48         # step-over bisection: far below a micrometre of step-over
 
@@ -77,9 +81,16 @@ def plane_cusp(cutter: Cutter, stepover: float, slope_deg: float = 0.0) -> float
     base = _golden_min(lambda v: float(profile_height(cutter, np.array([v]))[0] - v * t),
                        u[max(j - 1, 0)], u[min(j + 1, len(u) - 1)], float(rel[j]))
 
+    u_low = float(u[j])
+
     def left(y: np.ndarray, without: int | None = None) -> np.ndarray:
-        """The surface left above the plane at y (vertical): all instances that reach y (but `without`)."""
-        k = np.arange(math.floor((float(y.min()) - r_max) / stepover), math.ceil((float(y.max()) + r_max) / stepover) + 1)
+        """The surface left above the plane at y (vertical): the instances that may be lowest there (but
+        `without`). h(|u|) - u tan(slope) is convex in u (a convex profile, its wall infinite), so at any y
+        the lowest instance is one of the two whose u brackets its minimum u_low: a window of instances
+        around it is exact, and its size does not grow as the step-over shrinks (a tiny cusp would
+        otherwise ask for every instance within the tool's reach: 131074 of them at a cusp of 1e-8 mm)."""
+        k = np.arange(math.floor((float(y.min()) - u_low) / stepover) - 2,
+                      math.ceil((float(y.max()) - u_low) / stepover) + 3)
         if without is not None:
             k = k[k != without]
         du = y[:, None] - k[None, :] * stepover
@@ -100,18 +111,27 @@ def plane_cusp(cutter: Cutter, stepover: float, slope_deg: float = 0.0) -> float
     return best * math.cos(math.radians(slope_deg))
 
 
+def check_cusp(cutter: Cutter, cusp: float) -> None:
+    """TmmError naming the cusp height unless it lies in [MIN_CUSP, the tool radius]."""
+    if not (isinstance(cusp, (int, float)) and math.isfinite(cusp) and MIN_CUSP <= cusp <= cutter.radius):
+        shown = f"{cusp:g}" if isinstance(cusp, (int, float)) else repr(cusp)
+        raise TmmError(f"cusp height must be in [{MIN_CUSP:g}, {cutter.radius:g}] mm (a machine's resolution to the "
+                       f"tool radius), got {shown}")
+
+
 def stepover_for_cusp(cutter: Cutter, cusp: float, slope_deg: float = 0.0,
                       max_stepover: float | None = None) -> float:
     """The largest step-over (mm, at most `max_stepover`, default the diameter at the widest) whose cusp
     over a plane rising at `slope_deg` across the passes is at most `cusp` mm (along the normal)."""
     r_max = cutter.native.max_radius
-    if not (math.isfinite(cusp) and 0 < cusp <= cutter.radius):
+    if not (math.isfinite(cusp) and 0 < cusp <= cutter.radius):  # a derived cusp (a rule's margin) may be < MIN_CUSP
         raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {cusp!r}")
     hi = 2 * r_max if max_stepover is None else min(float(max_stepover), 2 * r_max)
     if plane_cusp(cutter, hi * (1 - 1e-12), slope_deg) <= cusp:
         return hi
     lo = 0.0
     for _ in range(_BISECTIONS):
+        cancel.poll()
         mid = (lo + hi) / 2
         if plane_cusp(cutter, mid, slope_deg) <= cusp:
             lo = mid

@@ -44,8 +44,9 @@ from typing import Optional
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.cusp import profile_height, stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import check_cusp, profile_height, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
@@ -93,8 +94,7 @@ def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: f
     """The constant step-over over `boundary` (passes at `angle_deg` from +X) that keeps the cusp at most `cusp`
     mm at every sampled crossing (see the module). `planar`: the planar rule's step at the steepest crossing,
     reported beside it."""
-    if not (math.isfinite(cusp) and 0 < cusp <= cutter.radius):
-        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {cusp!r}")
+    check_cusp(cutter, cusp)
     if not (math.isfinite(max_slope_deg) and 0 < max_slope_deg < 90):
         raise TmmError(f"cusp slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
     d, n = _section_frame(angle_deg)
@@ -273,6 +273,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
 
     def worst(s: float, rows: np.ndarray, ay: np.ndarray, ca: np.ndarray) -> np.ndarray:
         """The cusp (mm, 0 where not counted) of each pair (ay, ay + s) on its section."""
+        cancel.poll()
         by = ay + s
         ok = (ay >= y_lo - 1e-9) & (by <= y_hi + 1e-9) & (creases_between(rows, ay - s, by + s) == 0)
         cb, ca0, cb1 = tips(by, rows), tips(ay - s, rows), tips(by + s, rows)

@@ -31,7 +31,7 @@ from typing import Callable, Optional, Sequence
 
 import numpy as np
 
-from tmm_workbench.core import polygons
+from tmm_workbench.core import cancel, polygons
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.offset3d import Heights, Loop, OffsetLoops, StepRule, _closed, _spiked
 from tmm_workbench.core.limits import check_work
@@ -373,7 +373,7 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
     if band.any():
         f = native.arrival_steps(z, cell, np.column_stack([gx[band] - xs[0], gy[band] - ys[0]]), normal[band], **args)
         t0[band] = dist[band] / f
-    t = native.arrival_field(z, cell, active.astype(np.uint8), t0, **args)
+    t = cancel.native_call(native.arrival_field, z, cell, active.astype(np.uint8), t0, **args)
     origin = np.array([xs[0], ys[0]])
 
     def steps_at(xy: np.ndarray, u: np.ndarray, probe: float) -> np.ndarray:

@@ -47,6 +47,9 @@ def loops_region(loops: Sequence[np.ndarray], name: str = "region") -> Shape:
         p = np.asarray(loop, dtype=float).reshape(-1, 2)
         if len(p) >= 2 and np.hypot(*(p[-1] - p[0])) <= _LOOP_CLOSE_MM:
             p = p[:-1]
+        if len(p) >= 4 and polygons.crosses_itself(p):
+            raise TmmError(f"{name}: loop {k + 1} crosses itself seen from above (a figure eight?): a region's "
+                           f"loops must not cross; split it into loops that do not")
         if len(p) < 3 or abs(polygons.signed_area(p)) <= 1e-12:
             raise TmmError(f"{name}: loop {k + 1} encloses no area in XY (seen from above it is a line or a "
                            f"point: a vertical loop?)")
@@ -70,6 +73,8 @@ def triangles_region(triangles: np.ndarray, name: str = "faces") -> Shape:
     b = t[:, 2] - t[:, 0]
     cross = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     keep = np.abs(cross) > 1e-12
+    if not keep.any():
+        raise TmmError(f"{name}: seen from above the selected faces cover no area (vertical faces only?)")
     t = np.where((cross < 0)[:, None, None], t[:, ::-1], t)[keep]  # all counter-clockwise
     # in chunks of neighbours (Morton order of the centroids), then the chunks' outlines pairwise: one union
     # of many triangles costs more than linearly, compact patches have short outlines

@@ -26,7 +26,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import check_cusp, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
@@ -114,15 +114,18 @@ def _nanmax(a: np.ndarray) -> float:
 
 
 def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float) -> float:
-    """The dense raster's CL points (a cell apart both ways, over the boundary grown by the tool radius across),
-    refused above the limits before anything runs; the grid's cells are checked by Grid.covering."""
-    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT
+    """The measurement's CL points: the dense raster (a cell apart both ways, over the boundary grown by the tool
+    radius across: core.sim.cusp_field) and the design dropped on every cell, refused above the limits before
+    anything runs."""
+    from tmm_workbench.core.sim.cusp_field import dense_params, measure_grid_size
+    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT, raster_points
 
-    w, h = boundary[2] - boundary[0], boundary[3] - boundary[1] + 2 * cutter.radius
-    count = (w / cell + 2) * (h / cell + 2)
+    nx, ny = measure_grid_size(boundary, cutter, cell)
+    count = raster_points(dense_params(boundary, cutter, cell, cell)) + nx * ny
     check_work("CL points", count, _BYTES_PER_POINT,
                f"verify cusp: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
-               f"{_CELLS_PER_STEP}) over a {w:.6g} x {boundary[3] - boundary[1]:.6g} mm boundary")
+               f"{_CELLS_PER_STEP}, at least {_MIN_CELL:g} mm) over a {boundary[2] - boundary[0]:.6g} x "
+               f"{boundary[3] - boundary[1]:.6g} mm boundary")
     return count
 
 
@@ -470,13 +473,18 @@ def validate_params(params) -> None:
                        f"deg (got {params.slope_min_deg:g}..{params.slope_max_deg:g})")
 
 
+def estimate_params(cutter: Cutter, params) -> float:
+    """verify_params's measurement estimated (and refused above the limits) before the passes are placed."""
+    check_cusp(cutter, params.cusp)
+    return estimate_work(params.boundary, cutter, params.cusp, measure_cell(cutter, params.cusp))
+
+
 def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegment], drop: Drop,
                   surface: Optional[DropSurface], diagnostics: dict, progress: Optional[Progress] = None,
                   levels: Any = None) -> list[CutSegment]:
     """raster_drop's call: its pass set verified against `params.cusp` (diagnostics["verify"]; the report is
     appended to params.verify_notes when given); `levels` the 3D offset's arrival field (its loops')."""
-    if params.cusp > cutter.radius:
-        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
+    check_cusp(cutter, params.cusp)
     segments, report = verify_cusp(mesh, cutter, segments, params.boundary, params.angle_deg, params.cusp, drop,
                                    sample_step=params.sample_step, gouge_tol=params.gouge_tol,
                                    chord_tol=params.chord_tol, stock_to_leave=params.stock_to_leave,

@@ -76,5 +76,7 @@ def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
     the distance along the design's normal divided by cos of this slope."""
     finite = np.isfinite(design)
     filled = np.where(finite, design, design[finite].min() if finite.any() else 0.0)
-    gy, gx = np.gradient(filled, cell)
+    # a grid one cell wide has no slope across it (np.gradient needs two cells)
+    gy = np.gradient(filled, cell, axis=0) if filled.shape[0] > 1 else np.zeros_like(filled)
+    gx = np.gradient(filled, cell, axis=1) if filled.shape[1] > 1 else np.zeros_like(filled)
     return np.degrees(np.arctan(np.hypot(gx, gy)))

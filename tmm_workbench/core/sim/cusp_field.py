@@ -9,8 +9,9 @@ reach the model: a concave corner narrower than the tool; those cells are `unrea
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -94,6 +95,22 @@ class CuspField:
         return float(self.measured.mean())
 
 
+def measure_grid_size(boundary: Rect, cutter: Cutter, cell: float) -> tuple[int, int]:
+    """measure_grid's cells across and along, before any is allocated."""
+    r = cutter.radius
+    return (max(1, math.ceil((boundary[2] - boundary[0] - 2 * r) / cell - 1e-9)),
+            max(1, math.ceil((boundary[3] - boundary[1] - 2 * r) / cell - 1e-9)))
+
+
+def dense_params(boundary: Rect, cutter: Cutter, cell: float, sample_step: float, stock_to_leave: float = 0.0) -> Any:
+    """The dense raster's parameters: passes a cell apart over `boundary` grown by the tool radius across."""
+    from tmm_workbench.core.strategies.raster_drop import SurfaceParams  # the strategy uses this module
+
+    r = cutter.radius
+    return SurfaceParams(boundary=(boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=cell,
+                         sample_step=sample_step, stock_to_leave=stock_to_leave)
+
+
 def measure_grid(boundary: Rect, cutter: Cutter, cell: float) -> Grid:
     """The cells measured for a raster over `boundary`: inside it, clear of its edges by the tool radius (the
     passes' ends and the outermost passes' far sides are not the spacing's)."""
@@ -108,16 +125,14 @@ def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, 
     """The field for rasters over `boundary` (xmin, ymin, xmax, ymax) with `cutter`; `cell` is the simulation's
     cell and the dense raster's step-over. With `stock_to_leave` the dense raster leaves it too, and a cell is
     reachable when the envelope comes within tolerance + stock_to_leave of the design."""
-    from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # the strategy uses this module
+    from tmm_workbench.core.strategies.raster_drop import compute  # the strategy uses this module
 
     grid = grid or measure_grid(boundary, cutter, cell)
     surface = surface or DropSurface(mesh)
     design = mesh_heights(mesh, grid, surface)
-    r = cutter.radius
     top = float(mesh.bounds[1][2]) + stock_to_leave
-    dense = compute(mesh, cutter, SurfaceParams(boundary=(boundary[0], boundary[1] - r, boundary[2], boundary[3] + r),
-                                                stepover=grid.cell, sample_step=sample_step,
-                                                stock_to_leave=stock_to_leave), progress, surface)
+    dense = compute(mesh, cutter, dense_params(boundary, cutter, grid.cell, sample_step, stock_to_leave), progress,
+                    surface)
     stock_top = top + STOCK_ABOVE_MM
     path = link(dense.segments, LinkPolicy(stock_top, stock_top + 5))
     envelope = simulate(path, cutter, grid, box_heights(grid, stock_top)).heights

@@ -17,9 +17,10 @@ from typing import Optional
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
-from tmm_workbench.core.footprint.cusp import steepest_crossing_deg, stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import MIN_CUSP, check_cusp, steepest_crossing_deg, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, pass_count, raster_lines, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
@@ -73,7 +74,7 @@ class SurfaceParams(StrategyParams):
     # ADAPTIVE (each pass placed from the previous one's CL points so the cusp between them is the cusp height;
     # core.footprint.adaptive_raster)
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE, OFFSET3D))
-    cusp: float = param(0.01, "cusp height", "mm", low=0, low_open=True, kind="length")
+    cusp: float = param(0.01, "cusp height", "mm", low=MIN_CUSP)
     max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
     # --- machining region, spiral and slope range (issue 14 item 3: core.strategies.raster_region) ---
     # polygons with holes (core.polygons Shape) where the tool centre may go; None: the boundary rectangle.
@@ -108,9 +109,8 @@ class SurfaceParams(StrategyParams):
             validate_params(self)
 
 
-def estimate_work(params: SurfaceParams) -> float:
-    """CL points of the raster (passes and zig-zag links, an upper bound), refused above the limits before
-    any is made."""
+def raster_points(params: SurfaceParams) -> float:
+    """CL points of the raster (passes and zig-zag links, an upper bound), from the parameters alone."""
     b = params.boundary
     w, h = b[2] - b[0], b[3] - b[1]
     if not (w > 0 and h > 0):
@@ -125,9 +125,17 @@ def estimate_work(params: SurfaceParams) -> float:
         from tmm_workbench.core.strategies.raster_region import spiral_radius
 
         count = spiral_length(spiral_radius(params), params.stepover) / params.sample_step + 8 * passes
-    check_work("CL points", count, _BYTES_PER_POINT,
-               f"sample step {params.sample_step:g} mm and step-over {params.stepover:g} mm over a "
-               f"{w:.6g} x {h:.6g} mm boundary")
+    return count
+
+
+def estimate_work(params: SurfaceParams) -> float:
+    """raster_points, refused above the limits before any is made."""
+    count = raster_points(params)
+    b = params.boundary
+    spacing = (f"step-over {params.stepover:g} mm" if params.stepover_mode == STEPOVER else
+               f"cusp height {params.cusp:g} mm (a step-over down to {params.stepover:.3g} mm)")
+    check_work("CL points", count, _BYTES_PER_POINT, f"sample step {params.sample_step:g} mm and {spacing} over a "
+               f"{b[2] - b[0]:.6g} x {b[3] - b[1]:.6g} mm boundary")
     return count
 
 
@@ -135,7 +143,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
             surface: Optional[DropSurface] = None) -> StrategyResult:
     """Gouge-free raster finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments.
     diagnostics: "points" (CL points dropped), "passes", "top" (highest tip on the model), and the spacing's
-    (see _pass_lines)."""
+    (see _pass_lines). Its Python loops poll `progress` for cancel (core.cancel)."""
+    with cancel.watching(progress) as report:
+        return _compute(mesh, cutter, params, report, surface)
+
+
+def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Optional[Progress],
+             surface: Optional[DropSurface]) -> StrategyResult:
     params.validate()
     if cutter.kind not in SUPPORTED_TOOLS:
         raise TmmError(f"the {cutter.describe()} cutter is not supported by 3-axis raster finishing")
@@ -148,6 +162,10 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
     if b[2] <= lo[0] or b[0] >= hi[0] or b[3] <= lo[1] or b[1] >= hi[1]:
         raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
+    if params.verify_cusp:  # its measurement refused before minutes of placing passes, not after
+        from tmm_workbench.core.footprint.variable_step import estimate_params
+
+        estimate_params(cutter, params)
     floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
     diagnostics: dict = {}
     lines = [] if params.stepover_mode == OFFSET3D else _pass_lines(mesh, cutter, params, floor_z, diagnostics, progress)
@@ -187,7 +205,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opti
         aa = zz <= air_floor + 1.0 if skip else np.zeros(len(zz), dtype=bool)
         return np.maximum(zz, floor_z), aa
 
-    if progress is not None and params.stepover_mode in (ADAPTIVE, OFFSET3D):  # the placement reported the first half
+    if progress is not None and params.stepover_mode != STEPOVER:  # the placement reported the first half
         report = progress
         progress = lambda f: report(0.5 + 0.5 * f)  # noqa: E731
     z, air = drop(xy, progress)
@@ -240,8 +258,8 @@ def _pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: f
     section rule's worst cusp, core.footprint.cusp_section) or "cusps" / "cusp_limited" / "cusp_unreachable" (adaptive)."""
     b = params.boundary
     mode = params.stepover_mode
-    if mode != STEPOVER and params.cusp > cutter.radius:
-        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
+    if mode != STEPOVER:
+        check_cusp(cutter, params.cusp)
     if mode == STEPOVER:
         stepover = params.stepover
     elif mode == CUSP:

@@ -18,6 +18,7 @@ import numpy as np
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import offset3d, offset_field, region_order
+from tmm_workbench.core.footprint.cusp import check_cusp
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface, Progress
@@ -32,8 +33,7 @@ def check(params: Any, cutter: Cutter) -> None:
     if params.pattern == SPIRAL:
         raise TmmError("the 3D offset step-over mode makes its own loops from the region's boundary; with it use "
                        "the ZigZag (loops linked) or OneWay (a lift before each loop) pattern, not Spiral")
-    if not 0 < params.cusp <= cutter.radius:
-        raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {params.cusp:g}")
+    check_cusp(cutter, params.cusp)
     for k, curve in enumerate(params.offset_from or [], 1):
         c = np.asarray(curve, dtype=float)
         if c.ndim != 2 or c.shape[1] != 2 or len(c) < 2 or not np.isfinite(c).all():
