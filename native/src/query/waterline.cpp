@@ -518,7 +518,10 @@ void Level::refine_cells() {
   std::vector<std::vector<Square>> grown(cells.size());
   std::vector<std::unordered_map<uint64_t, double>> chunk_fine((cells.size() + chunk - 1) / chunk);
   std::atomic<std::size_t> drops{0}, sampled{0};
-  parallel_chunks(cells.size(), chunk, BatchOptions{batch_.threads, {}}, [&](std::size_t begin, std::size_t end) {
+  // Cancel (and Ctrl-C) within this phase too; its progress stays at the level's start.
+  BatchOptions refine{batch_.threads, {}, batch_.within};
+  if (batch_.progress) refine.progress = [&](double) { return batch_.progress(0.0); };
+  parallel_chunks(cells.size(), chunk, refine, [&](std::size_t begin, std::size_t end) {
     Probe pr;
     Nodes nd{pr, chunk_fine[begin / chunk], &sampled};
     for (std::size_t c = begin; c < end; ++c) {
@@ -734,7 +737,7 @@ std::vector<WaterlineLoop> Level::loops() {
   std::atomic<std::size_t> worker_drops{0};
   const std::size_t work_chunk = 8;
   // Progress: the crossings the first half of the level, the chords the second.
-  BatchOptions first_half{batch_.threads, {}}, second_half{batch_.threads, {}};
+  BatchOptions first_half{batch_.threads, {}, batch_.within}, second_half{batch_.threads, {}, batch_.within};
   if (batch_.progress) {
     first_half.progress = [&](double f) { return batch_.progress(0.5 * f); };
     second_half.progress = [&](double f) { return batch_.progress(0.5 + 0.5 * f); };
@@ -904,8 +907,8 @@ std::vector<std::vector<WaterlineLoop>> waterline(const MeshIndex& index, const 
       refined += level.refined_cells();
     }
   } else {
-    const BatchOptions one{1, {}};
-    parallel_chunks(zs.size(), 1, level_batch, [&](std::size_t begin, std::size_t end) {
+    parallel_chunks(zs.size(), 1, level_batch, [&](std::size_t begin, std::size_t end, ChunkContext& ctx) {
+      const BatchOptions one{1, {}, &ctx};  // a level stops within itself when the batch stops
       for (std::size_t k = begin; k < end; ++k) {
         Level level(index, cutter, g, o, zs[k], one);
         result[k] = level.loops();

@@ -16,20 +16,28 @@ class Cancelled : public std::runtime_error {
   Cancelled() : std::runtime_error("cancelled") {}
 };
 
+class ChunkContext;
+
 struct BatchOptions {
   int threads = 0;  // 0: all hardware threads
   // Called now and then from the calling thread with the fraction done; return false to cancel. An
   // exception thrown by it (a Python KeyboardInterrupt) stops the batch and propagates.
   std::function<bool(double)> progress;
+  // A batch run within a chunk of another (a waterline level among levels) stops when that one does:
+  // throws Cancelled then.
+  const ChunkContext* within = nullptr;
 };
 
 // What a long chunk sees of its batch: whether to stop early, and how far it has come (so that one chunk
 // that is most of the work, a long move, still reports progress and can be cancelled within it).
 class ChunkContext {
  public:
-  ChunkContext(const std::atomic<bool>& stop, std::atomic<double>& partial) : stop_(stop), partial_(partial) {}
+  ChunkContext(const std::atomic<bool>& stop, std::atomic<double>& partial, const ChunkContext* parent)
+      : stop_(stop), partial_(partial), parent_(parent) {}
   // The batch is stopping (cancelled, or another chunk failed): return now, the results are thrown away.
-  bool stopping() const { return stop_.load(std::memory_order_relaxed); }
+  bool stopping() const {
+    return stop_.load(std::memory_order_relaxed) || (parent_ != nullptr && parent_->stopping());
+  }
   // For work deep in a call chain: leaves the chunk by throwing Cancelled (parallel_chunks then throws the
   // caller's Cancelled or the failing chunk's error).
   void throw_if_stopping() const {
@@ -41,12 +49,14 @@ class ChunkContext {
  private:
   const std::atomic<bool>& stop_;
   std::atomic<double>& partial_;
+  const ChunkContext* parent_;
 };
 
 // Calls work(begin, end) for the fixed chunks [k * chunk, min(n, (k + 1) * chunk)) of [0, n), each exactly
 // once, on options.threads threads. Chunks do not depend on the thread count, so work that depends only on
 // its chunk gives the same results whatever the thread count. With a progress callback the calling thread
-// only reports (a Python callback needs it) while workers compute, every 20 ms; its false cancels (throws
+// only reports (a Python callback needs it) while workers compute, every 20 ms (a batch done sooner returns
+// at once); its false cancels (throws
 // Cancelled after the workers stop) and an exception from it stops the workers and propagates. The first
 // exception thrown by `work` stops the others and is rethrown. Cancel is seen between chunks, and within a
 // chunk by work taking a ChunkContext (the overload below) that checks stopping() between its sub-steps.
