@@ -39,10 +39,15 @@ class OpInJob(FreeCADTestCase):
         self.assertAlmostEqual(mv[-1][1]["Z"], clear, places=6)
         feeds = {round(p["F"] * 60, 6) for n, p in mv if n == "G1"}
         self.assertEqual(feeds, {H_FEED, V_FEED})
-        for n, p in mv:
+        # entries rapid straight down to 1 mm (LinkPolicy.entry_clearance) above the stock and feed from there
+        feed_from = min(safe, job.Stock.Shape.BoundBox.ZMax + 1.0)
+        for (n0, p0), (n, p) in zip([mv[0]] + mv, mv):
             if n == "G0":
                 self.assertNotIn("F", p)
-                self.assertGreaterEqual(p["Z"], safe - 1e-9)
+                self.assertGreaterEqual(p["Z"], feed_from - 1e-6)
+                if p["Z"] < safe - 1e-9:  # below the safe height only straight down
+                    self.assertAlmostEqual((p.get("X", p0.get("X")), p.get("Y", p0.get("Y"))),
+                                           (p0.get("X"), p0.get("Y")))
             else:
                 self.assertLess(p["Z"], safe)
         # the vertical feed for every plunge (straight down from the safe height) and for every cutting move
@@ -56,7 +61,7 @@ class OpInJob(FreeCADTestCase):
             slow = round(p1["F"] * 60, 6) == V_FEED
             if n0 == "G0":
                 self.assertTrue(slow)
-                self.assertAlmostEqual(p0["Z"], safe, places=6)
+                self.assertAlmostEqual(p0["Z"], feed_from, places=6)
                 self.assertAlmostEqual((p0["X"], p0["Y"]), (p1["X"], p1["Y"]))
                 continue
             down = p0["Z"] - p1["Z"] > math.hypot(p1["X"] - p0["X"], p1["Y"] - p0["Y"]) * tan

@@ -161,3 +161,13 @@ class OlderDocuments(FreeCADTestCase):
         op.touch()
         op.Document.recompute()
         self.assertEqual((op.PathVersion, op.PathNote), (path_versions.current("ObjectTmmSurface"), ""))
+
+
+class WithinTheStock(FreeCADTestCase):
+    def test_a_final_depth_below_the_stock_is_refused_by_name(self) -> None:
+        with self.assertRaises(TmmError) as ctx:
+            run_surface(bump_stl(), stepover=2.0, sample_step=1.0, final_depth=-200.0, progress=False)
+        self.assertIn("FinalDepth -200 mm is below the stock's bottom", str(ctx.exception))
+        r = run_surface(bump_stl(), stepover=2.0, sample_step=1.0, final_depth=1.0, progress=False,
+                        doc_name="TmmDepthOk")
+        self.assertGreaterEqual(float(r.toolpath.cutting_points()[:, 2].min()), 1.0 - 1e-9)

@@ -19,7 +19,7 @@ from typing import Any, Optional
 import FreeCAD
 import Path
 
-from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source, simulation
 from tmm_workbench.app import surface_passes
 from tmm_workbench.app import surface_verify
 from tmm_workbench.app import offset_start
@@ -170,11 +170,14 @@ class ObjectTmmSurface(op_base.TmmOp):
             FreeCAD.Console.PrintWarning(
                 f"{obj.Label}: ArcFitting off: the Job's post '{self.post_without_k(obj)}' writes no K, so arcs in "
                 "XZ/YZ would be wrong; lines within ChordTolerance instead\n")
-        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
+        finish = surface_passes.finish_params(obj)
+        check_final_depth(obj, finish.final_depth)
+        # entries rapid to just above what the Job's earlier ops left and feed from there
+        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value,
+                            material_top=simulation.material_left(obj, cutter))
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, surface_passes.finish_params(obj),
-                                                             policy, cb)
+            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy, cb)
         surface_verify.report(obj, notes)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
@@ -266,3 +269,16 @@ def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
 
 # Lets the Job's SetupSheet hold defaults for this op, headless too (the GUI's SetupOperation repeats it).
 PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)
+
+
+def check_final_depth(obj: Any, final_depth: Optional[float]) -> None:
+    """A final depth below the Job's stock would let the passes follow the model where no stock is: refused by
+    name, as roughing and waterline refuse levels below it."""
+    job = PathUtils.findParentJob(obj)
+    stock = getattr(job, "Stock", None) if job is not None else None
+    if final_depth is None or stock is None or stock.Shape.isNull():
+        return
+    bottom = float(stock.Shape.BoundBox.ZMin)
+    if final_depth < bottom - 1e-6:
+        raise TmmError(f"FinalDepth {final_depth:g} mm is below the stock's bottom {bottom:g} mm: set it within the "
+                       f"stock ({bottom:g} to {float(stock.Shape.BoundBox.ZMax):g} mm) or turn UseFinalDepth off")

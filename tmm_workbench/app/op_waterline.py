@@ -9,25 +9,24 @@ Levels: a step-down below the model's top, then `StepDown` apart down to its low
 there), or the same from TopZ down to BottomZ (UseZRange), within the Job's stock: a bottom below the stock's
 bottom is refused. Heights: FreeCAD's SafeHeight and ClearanceHeight (their SetupSheet defaults put them above
 the stock top); each loop is entered by a rapid down to 1 mm above what the earlier ops and the loops above left
-(`material_left`), then fed. The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight.
+(`app.simulation.material_left`), then fed. The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight.
 Feeds from the tool controller as the Surface op's (op_surface.commands). Errors never leave a partial path.
 """
 from __future__ import annotations
 
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, hooks, op_base, progress
+from tmm_workbench.app import geometry, hooks, op_base, progress, simulation
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
 from tmm_workbench.app.op_surface import ObjectTmmSurface
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import VERTICAL, LinkPolicy, StockHeights, link
+from tmm_workbench.core.linking import VERTICAL, LinkPolicy, link
 from tmm_workbench.core.strategies import waterline
 from tmm_workbench.core.strategies.waterline import WaterlineParams
 from tmm_workbench.core.toolpath import Toolpath
-from tmm_workbench.core.tools.cutter import Cutter
 
 OP_NAME = "TMM_Waterline"
 DIRECTIONS = {"Climb": "climb", "Conventional": "conventional"}
@@ -103,7 +102,7 @@ class ObjectTmmWaterline(op_base.TmmOp):
         params = self.params_from(obj, **extra)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
         policy.validate()
-        policy.material_top = material_left(obj, cutter)
+        policy.material_top = simulation.material_left(obj, cutter)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             result = waterline.compute(mesh, cutter, params, cb)
         top = result.diagnostics.get("top")
@@ -130,40 +129,6 @@ class ObjectTmmWaterline(op_base.TmmOp):
             x1, y1 = float(hi[0]) + radius, float(hi[1]) + radius
         m = obj.BoundaryMargin.Value
         return (x0 - m, y0 - m, x1 + m, y1 + m)
-
-
-KNOWN_CELL_MM = 0.5   # the stock heights the entries are placed over (a quarter of the tool radius if finer)
-
-
-def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
-    """What the active ops before `obj` in its Job left of the stock, as heights (app.simulation: the stock solid
-    cut by their Paths; the linker keeps them up to date as the loops cut, so each loop is entered by a rapid to
-    just above the level over it). The simulation, not a bound from the ops' stock to leave: a roughing's stair
-    steps on a slope stand higher than its stock to leave, and only the simulation sees them. None (every loop
-    entered from the safe height) without a stock, or while an earlier op waits for its recompute (its Path may
-    be stale: what it will leave is not known)."""
-    from tmm_workbench.app import simulation, tools
-    from tmm_workbench.core.sim.simulate import simulate
-
-    job = simulation.job_of(obj)
-    if job is None or getattr(job, "Stock", None) is None or job.Stock.Shape.isNull():
-        return None
-    earlier = []
-    for op in simulation.operations(job):
-        if op.Name == obj.Name:
-            break
-        earlier.append(op)
-    if any("Touched" in op.State or "Invalid" in op.State for op in earlier):
-        return None
-    grid = simulation.simulation_grid(job, min(KNOWN_CELL_MM, cutter.radius / 4))
-    heights = simulation._stock_heights(job, grid)
-    for op in earlier:
-        tp, _ = simulation._toolpath_and_feeds(op)
-        if len(tp) >= 2:
-            shape = simulation._five_axis_shape(op) if tp.is_five_axis() else "bull_nose"
-            heights = simulate(tp, tools.cutter_from_tool(op.ToolController.Tool), grid, heights,
-                               shape=shape).heights
-    return StockHeights(grid, heights, cutter)
 
 
 def SetupProperties() -> list[str]:

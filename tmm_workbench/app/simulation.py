@@ -16,12 +16,14 @@ from tmm_workbench.app import geometry, post_objects, tools
 from tmm_workbench.core import path5
 from tmm_workbench.core.arcs import arc_points
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.linking import StockHeights
 from tmm_workbench.core.sim import compare as compare_mod
 from tmm_workbench.core.sim.cycle_time import three_axis_time
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import SimResult, simulate
 from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
 
 DESIGN_DEFLECTION_MM = 0.001  # the model tessellated this close: well below the scallops compared
 ARC_TOLERANCE_MM = 1e-4       # chords of G2/G3 arcs within this of the arc (lean passes: 0.1 of their band)
@@ -253,3 +255,34 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     regions = {**slope_regions(design_here, grid.cell), **bucket_regions(grid, design_here)}
     comparison = compare_mod.compare(result, design_here, tolerance, regions)
     return JobSimulation(grid, result, comparison, done, design_here)
+
+
+KNOWN_CELL_MM = 0.5   # the stock heights the entries are placed over (a quarter of the tool radius if finer)
+
+
+def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
+    """What the active ops before `obj` in its Job left of the stock, as heights (the stock solid
+    cut by their Paths; the linker keeps them up to date as the loops cut, so each loop is entered by a rapid to
+    just above the level over it). The simulation, not a bound from the ops' stock to leave: a roughing's stair
+    steps on a slope stand higher than its stock to leave, and only the simulation sees them. None (every loop
+    entered from the safe height) without a stock, or while an earlier op waits for its recompute (its Path may
+    be stale: what it will leave is not known)."""
+    job = job_of(obj)
+    if job is None or getattr(job, "Stock", None) is None or job.Stock.Shape.isNull():
+        return None
+    earlier = []
+    for op in operations(job):
+        if op.Name == obj.Name:
+            break
+        earlier.append(op)
+    if any("Touched" in op.State or "Invalid" in op.State for op in earlier):
+        return None
+    grid = simulation_grid(job, min(KNOWN_CELL_MM, cutter.radius / 4))
+    heights = _stock_heights(job, grid)
+    for op in earlier:
+        tp, _ = _toolpath_and_feeds(op)
+        if len(tp) >= 2:
+            shape = _five_axis_shape(op) if tp.is_five_axis() else "bull_nose"
+            heights = simulate(tp, tools.cutter_from_tool(op.ToolController.Tool), grid, heights,
+                               shape=shape).heights
+    return StockHeights(grid, heights, cutter)
