@@ -100,7 +100,7 @@ def test_bad_input_is_refused_by_name():
     ball = Cutter.ball(4)
     for kwargs, message in [({"step_down": 0.0}, "step-down must be a positive length, got 0"),
                             ({"step_down": math.nan}, "step-down must be a positive length, got nan"),
-                            ({"chord_tol": 2.0}, r"chord tolerance must be in \(0, 1\] mm, got 2"),
+                            ({"chord_tol": 2.0}, r"chord tolerance must be in \[0.0001, 1\] mm, got 2"),
                             ({"direction": "up"}, "direction must be 'climb' or 'conventional', got 'up'"),
                             ({"sample_step": -1.0}, "sample step must be > 0 mm, got -1"),
                             ({"stock_to_leave": -0.1}, "stock to leave must be >= 0 mm, got -0.1"),

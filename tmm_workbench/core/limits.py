@@ -13,6 +13,10 @@ from dataclasses import dataclass, replace
 
 from tmm_workbench.core.errors import WorkLimitError
 
+# mm: the finest tolerance (cusp height, chord tolerance) an op takes. A tenth of a micrometre is below any
+# machine's resolution; finer values only multiply passes and points
+FINEST_MM = 1e-4
+
 
 def _env(name: str, default: float) -> float:
     try:

@@ -27,11 +27,10 @@ from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import FINEST_MM
 from tmm_workbench.core.tools.cutter import Cutter
 
-# mm: the least cusp height asked for. A tenth of a micrometre is below any machine's resolution; finer
-# steps would only multiply passes (and a cusp of 1e-8 mm is lost in the profile's rounding)
-MIN_CUSP = 1e-4
+MIN_CUSP = FINEST_MM  # the least cusp height asked for (a cusp of 1e-8 mm is lost in the profile's rounding)
 _SAMPLES = 2048          # profile samples across the tool, and cusp samples across one period
 _BISECTIONS = 48         # step-over bisection: far below a micrometre of step-over
 

@@ -28,6 +28,7 @@ from tmm_workbench.core import polygons as P
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.limits import FINEST_MM
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
@@ -52,7 +53,7 @@ class WaterlineParams(StrategyParams):
     bottom_z: Optional[float] = param(None, "bottom", "mm", optional=True)  # default: the model's lowest point
     stock_to_leave: float = param(0.0, "stock to leave", "mm", low=0)
     sample_step: Optional[float] = param(None, "sample step", "mm", optional=True, low=0, low_open=True)
-    chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
+    chord_tol: float = param(0.01, "chord tolerance", "mm", low=FINEST_MM, high=1.0)
     direction: str = param(CLIMB, "direction", choices=(CLIMB, CONVENTIONAL))
     stock_z: Optional[tuple[float, float]] = None  # the stock's bottom and top, mm: the levels stay within it
 

@@ -49,7 +49,7 @@ import numpy as np
 from tmm_workbench.core import polygons as P
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.limits import check_work
+from tmm_workbench.core.limits import FINEST_MM, check_work
 from tmm_workbench.core.linking import HELIX, PLUNGE, RAMP, RAMP_ANGLE, LinkPolicy, link
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
@@ -87,7 +87,7 @@ class RoughingParams(StrategyParams):
     ramp_angle_deg: float = param(3.0, "ramp angle", "deg", low=RAMP_ANGLE.low, high=RAMP_ANGLE.high)
     helix_diameter_percent: float = param(50.0, "helix diameter", "%", low=HELIX_MIN_PERCENT, high=100)
     final_z: Optional[float] = param(None, "final depth", "mm", optional=True)  # default: model's lowest + axial stock
-    chord_tol: float = param(0.01, "chord tolerance", "mm", low=0, low_open=True, high=1.0)
+    chord_tol: float = param(0.01, "chord tolerance", "mm", low=FINEST_MM, high=1.0)
     keep_tool_down: bool = param(True, "keep tool down", choices=(True, False))
     stock_heights: Optional[Any] = None   # optional (Grid, heights) of a stock that is not a box, or of what an
                                           # earlier op left (rest roughing): only where material lies is cut
