@@ -334,3 +334,14 @@ def test_lean_samples_near_1e307_are_refused_not_a_crash():
     lines = out.stdout.splitlines()
     assert len(lines) == 2 and all("is outside the kernel's range" in line for line in lines), out.stdout
     assert lines[1].startswith("lean runs: s of run 0, sample row 0 (1e+307)")
+
+
+@pytest.mark.parametrize("bad", [math.nan, 1e300])
+def test_a_stock_cell_outside_the_range_is_refused_by_both_simulations(bad):
+    stock = native.ZMap(0.0, 0.0, 1.0, 10, 10, 5.0)
+    stock.heights[3, 2] = bad
+    tips, kinds = np.array([[1.0, 1.0, 0.0], [8.0, 8.0, 0.0]]), np.array([0])
+    with pytest.raises(ValueError, match=rf"stock cell \(2, 3\) height {re.escape(f'{bad:g}')} {RANGE}"):
+        native.cut_3axis(stock, native.Cutter(1.0, 1.0), tips, kinds)
+    with pytest.raises(ValueError, match=rf"stock cell \(2, 3\) height {re.escape(f'{bad:g}')} {RANGE}"):
+        native.cut_5axis(stock, 1.0, 1.0, "round_insert", tips, np.array([[0.0, 0.0, 1.0]] * 2), kinds)

@@ -656,6 +656,15 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
   }
 
   const std::size_t ny = stock.ny();
+  // The heights are writable from Python: a NaN or huge cell would stay or spread as garbage.
+  const std::vector<double>& heights = stock.heights();
+  for (std::size_t c = 0; c < heights.size(); ++c) {
+    if (in_range(heights[c])) continue;
+    std::ostringstream msg;
+    msg << "stock cell (" << c % stock.nx() << ", " << c / stock.nx() << ") height " << heights[c] << " "
+        << out_of_range_text();
+    refuse(msg.str());
+  }
   const int threads = batch.threads > 0 ? batch.threads
                                         : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::size_t band_rows = options.band_rows;
