@@ -30,9 +30,9 @@ CASES = {
     "adaptive": ("run_surface", dict(stepover_mode="adaptive", cusp=0.002)),
     "offset3d": ("run_surface", dict(stepover_mode="offset3d", cusp=0.002)),
     "verify": ("run_surface", dict(stepover_mode="adaptive", cusp=0.005, verify_cusp=True)),
-    "roughing": ("run_roughing", dict(step_down=0.2, stepover_percent=5)),
+    "roughing": ("run_roughing", dict(step_down=0.5, stepover_percent=10)),
     "waterline": ("run_waterline", dict(step_down=0.02)),
-    "multipoint": ("run_multipoint", dict(scallop=0.001, forward_step=0.5)),
+    "multipoint": ("run_multipoint", dict(scallop=0.005, forward_step=1.0)),
     "sim3": ("simulate", dict(cell=0.02)),
 }
 
@@ -76,7 +76,7 @@ def run_case(name: str) -> None:
     else:
         call = lambda: getattr(api, function)(stl, progress=progress, **kwargs)  # noqa: E731
     threading.Thread(target=sampler, daemon=True).start()
-    threading.Thread(target=arm, daemon=True).start()
+    threading.Thread(target=arm, daemon=True).start()  # armed once the case's own input is made
     t0 = time.monotonic()
     try:
         call()

@@ -66,12 +66,18 @@ def _ask(_fraction: float) -> bool:
     return True
 
 
+def asker() -> Optional[Progress]:
+    """For a kernel batch call deep in a helper: a progress callback that asks the watched one whether to go on
+    (None when nothing is watched)."""
+    return _ask if _stack else None
+
+
 def native_call(function: Callable, *args, **kwargs):
     """A kernel batch call deep in a helper, cancelled through the watched callback (its `progress` keyword
     asks `poll`); the kernel's Cancelled arrives as the core's."""
     from tmm_workbench.core.kernel import native
 
     try:
-        return function(*args, progress=_ask if _stack else None, **kwargs)
+        return function(*args, progress=asker(), **kwargs)
     except native.Cancelled as exc:
         raise Cancelled("cancelled") from exc

@@ -252,6 +252,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
 
     def lower(tip: np.ndarray, axis: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The pass at `axis` (its tips `tip`, one row a layer) at y: the swept tool's lower surface."""
+        cancel.poll()
         u = np.broadcast_to(y - axis, tip[0].shape)
         out = tip[0] + profile_height(cutter, u)
         for delta, t, rise in zip(shifts[1:], tip[1:], rises[1:]):

@@ -7,6 +7,7 @@ from typing import Callable, Optional
 import numpy as np
 
 from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.geometry.mesh import TriMesh
@@ -39,6 +40,8 @@ class DropSurface:
         floor = float(floor_z)
         if math.isnan(floor):  # every height would come back NaN
             raise TmmError("drop floor_z is NaN: it must be a finite height (mm)")
+        if progress is None:  # a drop deep in a helper still honours the strategy's cancel (core.cancel)
+            progress = cancel.asker()
         try:
             return native.drop_cutter(self._index, cutter.native, pts, floor, threads, progress)
         except native.Cancelled as exc:

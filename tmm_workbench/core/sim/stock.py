@@ -36,12 +36,24 @@ def cylinder_heights(grid: Grid, centre: tuple[float, float], radius: float, top
     return np.where(inside, float(top), float(bottom))
 
 
+_BLOCK_CELLS = 250_000  # cells per needle batch (about 0.1-0.3 s)
+
+
 def mesh_heights(mesh: TriMesh, grid: Grid, surface: DropSurface | None = None, progress=None,
                  threads: int = 0) -> np.ndarray:
     """(ny, nx) highest point of the mesh on each cell centre's vertical line (a disc of NEEDLE_RADIUS
     dropped: higher by at most tan(slope) x NEEDLE_RADIUS); NaN where the line misses the mesh."""
     floor = float(mesh.vertices[:, 2].min()) - 1.0
     surface = surface or DropSurface(mesh)
-    z = surface.drop(Cutter.flat(2 * NEEDLE_RADIUS), grid.centres(), floor, progress, threads)
-    z = np.asarray(z).reshape(grid.ny, grid.nx)
+    needle = Cutter.flat(2 * NEEDLE_RADIUS)
+    # in blocks of rows: the needle's batch is one long kernel call otherwise, seconds before a cancel is seen
+    rows = max(1, _BLOCK_CELLS // grid.nx)
+    xs, ys = grid.xs(), grid.ys()
+    z = np.empty((grid.ny, grid.nx))
+    for j0 in range(0, grid.ny, rows):
+        block = ys[j0:j0 + rows]
+        X, Y = np.meshgrid(xs, block)
+        part = None if progress is None else (lambda f, j0=j0, k=len(block): progress((j0 + f * k) / grid.ny))
+        z[j0:j0 + len(block)] = surface.drop(needle, np.column_stack([X.ravel(), Y.ravel()]), floor, part,
+                                             threads).reshape(len(block), grid.nx)
     return np.where(z > floor + 0.5, z, np.nan)

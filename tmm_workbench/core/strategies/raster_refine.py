@@ -13,6 +13,8 @@ from typing import Callable
 
 import numpy as np
 
+from tmm_workbench.core import cancel
+
 Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy (n, 2) -> (z (n,), air (n,) bool)
 _FRACTIONS = np.array([0.2, 0.4, 0.5, 0.6, 0.8])
 _MID = 2  # the index of 0.5
@@ -44,11 +46,15 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
             for i in range(len(pts[r]) - (0 if chained and r < last and len(pts[r + 1]) else 1))]
     inserted, cliffs, deepest = 0, 0, 0.0
     for _ in range(rounds):
+        cancel.poll()
         todo = [(r, i) for r, i in todo if not (airs[r][i] or nxt(r, i)[1])]
         if not todo:
             break
+        cancel.poll()
         a = np.array([pts[r][i] for r, i in todo])
+        cancel.poll()
         b = np.array([nxt(r, i)[0] for r, i in todo])
+        cancel.poll()
         samples = a[:, None, :] + _FRACTIONS[None, :, None] * (b - a)[:, None, :]   # (m, 5, 3)
         zs, air_s = drop(samples[:, :, :2].reshape(-1, 2))
         zs, air_s = zs.reshape(len(todo), -1), air_s.reshape(len(todo), -1)
@@ -77,6 +83,7 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
                 cliffs += 1
         todo = []
         for r, adds in additions.items():
+            cancel.poll()
             adds.sort(key=lambda t: t[0])
             for rank, (i, p, is_air) in enumerate(adds):
                 at = i + 1 + rank  # earlier insertions of this round shift it by their count
