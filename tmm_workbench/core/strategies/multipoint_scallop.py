@@ -374,6 +374,7 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
     frame = meter.frame
     h = float(params.scallop)
     limit = estimate_passes(frame.a1 - frame.a0, Ri, h)
+    least = ball_step(Ri, h)  # no pass is placed nearer than this to the one before (but the last one)
     report = ScallopPlacement()
 
     def make(a: float) -> Optional[PassPositions]:
@@ -414,8 +415,13 @@ def place_passes(face: BezierFace, rect: Rect, params: Any, Ri: float, position:
             half = 0.5 * meter.row_spacing
             excluded += [(t - half, t + half) for t in bad]
             left.append((bad, rows))
+        if best is not None and best[0] < least - 1e-12 and room > least:
+            # a step below the estimate's (the ball's on a plane) holds only where a pass leaves no scallop of
+            # its own beside a strip it cannot reach: stepping on by it would creep (thousands of passes a
+            # micrometre apart); the strip is placed at the estimate's step and reported instead
+            best = None
         if best is None:  # the estimate's step, the strip measured as it is
-            s_fall = min(ball_step(Ri, h), room)
+            s_fall = min(least, room)
             trial = make(frame.a1 if s_fall >= room - 1e-9 else prev.a + s_fall)
             if trial is None:
                 raise TmmError(f"no pass fits the boundary after the pass at {prev.a - frame.a0:.4g} mm")
