@@ -291,12 +291,17 @@ def test_a_nan_floor_is_refused_by_name():
 
 
 def run_child(code: str, limit_bytes: int = 0) -> "subprocess.CompletedProcess[str]":
-    """code in a child Python (a crash or a huge allocation must not take pytest down), address space limited."""
+    """code in a child Python (a crash or a huge allocation must not take pytest down), allocations limited:
+    by the address space, or under AddressSanitizer (which reserves terabytes of it) by its allocator."""
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)}
     prefix = "import resource\n"
-    if limit_bytes:
+    if limit_bytes and "asan" in env.get("LD_PRELOAD", ""):
+        env["ASAN_OPTIONS"] = (env.get("ASAN_OPTIONS", "") + f":max_allocation_size_mb={limit_bytes >> 20}"
+                               ":allocator_may_return_null=1")
+    elif limit_bytes:
         prefix += f"resource.setrlimit(resource.RLIMIT_AS, ({limit_bytes}, {limit_bytes}))\n"
     return subprocess.run([sys.executable, "-c", prefix + code], capture_output=True, text=True, timeout=120,
-                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})
+                          env=env)
 
 
 def test_adjacency_of_a_huge_index_allocates_by_the_triangles():
