@@ -40,7 +40,7 @@ from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 HORIZ, VERT = 1000.0 / 60.0, 300.0 / 60.0   # mm/s
 SIM_CELL = 0.2                               # mm: the simulation that checks the rapids
-KNOWN_CELL = 0.5                             # mm: the stock heights the linker is given (coarser, as the App's)
+KNOWN_CELL = 0.25                            # mm: the stock heights the linker is given (as the App's)
 
 
 def grid_mesh(f: Callable[[np.ndarray, np.ndarray], np.ndarray], size: float, cells: int, name: str) -> TriMesh:

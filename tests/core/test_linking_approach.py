@@ -66,9 +66,10 @@ def test_heights_top_drops_the_tool_onto_the_cells():
     pad = math.sqrt(0.5)
     flat = heights_top(grid, h, 3.0)
     rounded = heights_top(grid, h, 3.0, ball.native.height)
-    at = np.array([[12.5, 10.5], [10.5, 10.5], [14.5, 10.5]])  # 2 mm, 4 mm and 0 mm from the spike
+    # 2 mm, 5.5 mm and 0 mm from the spike; between its centre and a neighbour's the stock may stand at 5 too
+    at = np.array([[12.5, 10.5], [9.0, 10.5], [14.5, 10.5]])
     assert flat(at).tolist() == [5.0, 0.0, 5.0]
-    assert rounded(at)[0] == pytest.approx(5.0 - ball.native.height(np.array([2.0 - pad]))[0])
+    assert rounded(at)[0] == pytest.approx(5.0 - ball.native.height(np.array([1.0 - pad]))[0])
     assert rounded(at)[2] == 5.0
     # near the edge: what lies off the grid
     assert heights_top(grid, h, 3.0, outside=math.inf)(np.array([[1.0, 10.0]]))[0] == math.inf
@@ -97,3 +98,19 @@ def test_no_rapid_into_a_stepped_stock_and_less_plunging():
     # the same rapids into the full 10 mm stock would cut: the heights are what makes them safe
     full = box_heights(grid, 10.0)
     assert len(simulate(known, tool, grid, full).collisions) == 3
+
+
+def test_a_wall_between_two_cell_centres_is_above_the_lower_one():
+    """A height is the stock's at its cell's centre: between a cut centre (0) and an uncut one (10) the stock may
+    rise to 10 anywhere short of the cut centre (a relief's wall). A tool whose reach ends just past the cut
+    centre, a cell short of the uncut one, must see 10 there (mount_rush: a rapid ended 11 mm inside the stock)."""
+    grid = Grid(0.0, 0.0, 1.0, 20, 5)
+    h = np.zeros((5, 20))
+    h[:, 10] = 10.0                       # the uncut column's centres at x = 10.5; cut centres at x = 11.5
+    radius = 2.0
+    pad = math.sqrt(0.5)
+    x = 11.5 + radius + pad - 0.05        # the cut centre just within reach, the uncut one a cell beyond it
+    top = heights_top(grid, h, radius)(np.array([[x, 2.5]]))[0]
+    assert top == 10.0
+    far = heights_top(grid, h, radius)(np.array([[x + 1.2, 2.5]]))[0]
+    assert far == 0.0                     # two cells away the wall cannot reach

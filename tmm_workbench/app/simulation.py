@@ -257,7 +257,8 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     return JobSimulation(grid, result, comparison, done, design_here)
 
 
-KNOWN_CELL_MM = 0.5   # the stock heights the entries are placed over (a quarter of the tool radius if finer)
+KNOWN_CELL_MM = 0.25  # the stock heights the entries are placed over (a quarter of the tool radius if finer)
+KNOWN_CELLS = 1e6     # at most (a larger stock gets larger cells: the entries then stay a little higher)
 
 
 def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
@@ -277,7 +278,9 @@ def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
         earlier.append(op)
     if any("Touched" in op.State or "Invalid" in op.State for op in earlier):
         return None
-    grid = simulation_grid(job, min(KNOWN_CELL_MM, cutter.radius / 4))
+    bb = job.Stock.Shape.BoundBox
+    cell = max(min(KNOWN_CELL_MM, cutter.radius / 4), math.sqrt(bb.XLength * bb.YLength / KNOWN_CELLS))
+    grid = simulation_grid(job, cell)
     heights = _stock_heights(job, grid)
     for op in earlier:
         tp, _ = _toolpath_and_feeds(op)
