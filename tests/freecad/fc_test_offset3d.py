@@ -69,6 +69,32 @@ class Offset3D(FreeCADTestCase):
             run_surface(bump_stl(), stepover_mode="offset3d", cusp=10.0, progress=False, doc_name="TmmApiBad3D")
         self.assertIn("cusp height must be in [0.0001, 3] mm", str(ctx.exception))
 
+    def test_the_op_reports_the_cells_above_the_cusp(self) -> None:
+        """CheckCusp (on by default): the op's read-only CuspReport says what the core's check measures on the same
+        passes (cells above CuspHeight and where, or held), and a warning suggests VerifyCusp; off, it is empty."""
+        from tmm_workbench.app.tools import cutter_from_tool
+        from tmm_workbench.core.strategies import raster_drop
+
+        r = run_surface(bump_stl(), sample_step=0.5, stepover_mode="offset3d", cusp=0.02, progress=False,
+                        doc_name="TmmCuspReport")
+        self.assertTrue(r.op.CheckCusp)
+        self.assertEqual(r.op.getEditorMode("CuspReport"), ["ReadOnly"])
+        from tmm_workbench.app.op_surface import FORWARD_STEPS
+
+        params = r.op.Proxy.params_from(r.op, boundary=r.op.Proxy.boundary(r.op, r.mesh),
+                                        forward_step=FORWARD_STEPS[r.op.ForwardStep])  # as the op computes it
+        result = raster_drop.compute(r.mesh, cutter_from_tool(r.op.ToolController.Tool), params)
+        said = result.diagnostics["cusp_check"]
+        self.assertGreater(said["exceeding"], 0)   # the coarse bump's slopes: the 3D offset overshoots here
+        self.assertIn(f"{said['exceeding']} of {said['measured']} measured cells above it", r.op.CuspReport)
+        self.assertIn("VerifyCusp adds partial passes there", r.op.CuspReport)
+        x, y, _, _ = said["places"][0]
+        self.assertIn(f"({x:.1f}, {y:.1f})", r.op.CuspReport)
+        r.op.CheckCusp = False
+        r.doc.recompute()
+        self.assertEqual(r.op.CuspReport, "")
+        FreeCAD.closeDocument(r.doc.Name)
+
 
 def line_sketch(doc, a, b, name="Start"):
     """An open sketch: one line from a to b (XY)."""
@@ -189,7 +215,12 @@ class Offset3DEstimate(FreeCADTestCase):
         params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
         result = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params)
         points = result.diagnostics["points"]
-        self.assertTrue(0.5 * points <= est.count <= 2.0 * points, (est.count, points))
+        # the count holds the cusp check's measurement too (CheckCusp, on by default: its dense raster at most)
+        from tmm_workbench.core.footprint import variable_step
+
+        check = variable_step.estimate_params(cutter_from_tool(tc.Tool), params)
+        self.assertIn("cusp check", est.note)
+        self.assertTrue(0.5 * points <= est.count - check <= 2.0 * points, (est.count, check, points))
         tp, feeds = _toolpath_and_feeds(op)
         cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
         self.assertTrue(0.5 * cutting < est.cutting_seconds < 2.0 * cutting, (est.cutting_seconds, cutting))

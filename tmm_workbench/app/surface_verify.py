@@ -2,6 +2,10 @@
 the pass set in the stock simulation and adds partial passes where its cusp exceeds CuspHeight. Off by default,
 and off in documents saved before it (a Bool property added on restore is False): their path is unchanged.
 
+`CheckCusp` (on by default; core.footprint.cusp_check): a cusp mode's pass set measured as the verification
+measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
+largest, where) and, when cells exceed it, a warning suggesting VerifyCusp. It never changes the path.
+
 Each pass set's report goes to the report view: a message with the cusp before and after, the passes added and
 the cells out of the tool's reach; a warning when cells stay above the tolerance after the round limit.
 """
@@ -18,19 +22,44 @@ PROPERTIES: list[Prop] = [
          "Cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds "
          "CuspHeight (any StepOverMode; ZigZag or OneWay over the Box region); cells out of the tool's reach are "
          "reported, not chased", "verify_cusp"),
+    Prop("App::PropertyBool", "CheckCusp", "Surface",
+         "Cusp modes (Cusp, Adaptive, Offset3D): measure the passes in the stock simulation as VerifyCusp does, "
+         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where",
+         "cusp_check"),
 ]
+REPORT = "CuspReport"
 
 
 def notes_for(params: Any) -> list:
-    """The list the strategy appends its reports to (empty when VerifyCusp is off)."""
+    """The list the strategy appends its reports to (empty when neither VerifyCusp nor CheckCusp runs)."""
+    from tmm_workbench.core.footprint import cusp_check
+
     notes: list = []
-    if params.verify_cusp:
+    if params.verify_cusp or cusp_check.applies(params):
         params.verify_notes = notes
     return notes
 
 
+def _report_property(obj: Any, text: str) -> None:
+    if not hasattr(obj, REPORT):
+        obj.addProperty("App::PropertyString", REPORT, "Surface",
+                        "What the cusp check measured on the last computed path (cells above CuspHeight, where)")
+    obj.setEditorMode(REPORT, 1)
+    setattr(obj, REPORT, text)
+
+
 def report(obj: Any, notes: list) -> None:
+    from tmm_workbench.core.footprint.cusp_check import CuspCheck
+
+    _report_property(obj, "")
     for note in notes:
+        if isinstance(note, CuspCheck):
+            _report_property(obj, note.summary())
+            if note.within:
+                FreeCAD.Console.PrintMessage(f"{obj.Label}: {note.summary()}\n")
+            else:
+                FreeCAD.Console.PrintWarning(f"{obj.Label}: {note.summary()}\n")
+            continue
         FreeCAD.Console.PrintMessage(f"{obj.Label}: {note.summary()}\n")
         if not note.within:
             FreeCAD.Console.PrintWarning(

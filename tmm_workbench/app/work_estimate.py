@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any, Mapping, Optional
 
-from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.errors import TmmError, WorkLimitError
 from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT
 
@@ -204,10 +204,16 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
 def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
     """With VerifyCusp (issue 14 item 4): the verification's dense raster added (known before it runs; its partial
     passes are not)."""
-    if not params.verify_cusp:
-        return est
-    from tmm_workbench.core.footprint import variable_step
+    from tmm_workbench.core.footprint import cusp_check, variable_step
 
+    if not params.verify_cusp:  # CheckCusp measures the cusp modes' passes (skipped above the limits)
+        if not cusp_check.applies(params):
+            return est
+        try:
+            dense = cusp_check.cost_points(params.boundary, _cutter(obj), params.cusp)
+        except WorkLimitError:
+            return replace(est, note="(the cusp check is skipped: its measurement is above the work limit)")
+        return replace(est, count=est.count + dense, note="(with the cusp check's dense raster, at most)")
     dense = variable_step.estimate_params(_cutter(obj), params)
     return replace(est, count=est.count + dense,
                    note=f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial "

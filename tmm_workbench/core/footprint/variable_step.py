@@ -82,6 +82,7 @@ class VerifyReport:
     length_added: float = 0.0     # mm of cutting along them
     buckets: list = field(default_factory=list)
     seconds: float = 0.0
+    check: Any = None             # cusp_check.CuspCheck of the final measurement (where cells stay above)
 
     @property
     def within(self) -> bool:
@@ -99,7 +100,7 @@ class VerifyReport:
         return head + tail
 
     def as_dict(self) -> dict:
-        out = {k: v for k, v in self.__dict__.items() if k != "buckets"}
+        out = {k: v for k, v in self.__dict__.items() if k not in ("buckets", "check")}
         out["buckets"] = len(self.buckets)
         return out
 
@@ -113,7 +114,7 @@ def _nanmax(a: np.ndarray) -> float:
     return float(np.nanmax(a)) if np.isfinite(a).any() else 0.0
 
 
-def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float) -> float:
+def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float, what: str = "verify cusp") -> float:
     """The measurement's CL points: the dense raster (a cell apart both ways, over the boundary grown by the tool
     radius across: core.sim.cusp_field) and the design dropped on every cell, refused above the limits before
     anything runs."""
@@ -123,7 +124,7 @@ def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float)
     nx, ny = measure_grid_size(boundary, cutter, cell)
     count = raster_points(dense_params(boundary, cutter, cell, cell)) + nx * ny
     check_work("CL points", count, _BYTES_PER_POINT,
-               f"verify cusp: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
+               f"{what}: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
                f"{_CELLS_PER_STEP}, at least {_MIN_CELL:g} mm) over a {boundary[2] - boundary[0]:.6g} x "
                f"{boundary[3] - boundary[1]:.6g} mm boundary")
     return count
@@ -436,6 +437,9 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     report.deepest = float(max(0.0, np.max(fld.design[on_model] + stock_to_leave - heights[on_model]))) \
         if on_model.any() else 0.0
     report.seconds = time.perf_counter() - t0
+    from tmm_workbench.core.footprint.cusp_check import from_field
+
+    report.check = from_field(fld, cusp, cutter.diameter)
     # the first extra segment follows the pass set after a lift; the others keep their own (joined: on the surface)
     return segments + [CutSegment(s.tips, s.kind, joined=s.joined and i > 0, pass_index=s.pass_index,
                                   entry_z=s.entry_z) for i, s in enumerate(extra)], report
@@ -491,6 +495,7 @@ def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegme
                                    slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress,
                                    levels=levels)
     diagnostics["verify"] = report.as_dict()
+    diagnostics["verify_check"] = report.check   # the cusp check's report without a second measurement
     if params.verify_notes is not None:
         params.verify_notes.append(report)
     return segments

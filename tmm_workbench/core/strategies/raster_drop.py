@@ -94,6 +94,9 @@ class SurfaceParams(StrategyParams):
     # extra partial passes where its cusp exceeds `cusp`; each pass set's VerifyReport is appended to verify_notes
     verify_cusp: bool = param(False, "verify cusp", choices=(True, False))
     verify_notes: Optional[list] = None
+    # the cusp modes' pass set measured as the verification measures it, no passes added: cells left above the
+    # cusp reported (diagnostics["cusp_check"], a CuspCheck appended to verify_notes; core.footprint.cusp_check)
+    cusp_check: bool = param(True, "cusp check", choices=(True, False))
 
     def validate(self) -> None:
         super().validate()
@@ -247,6 +250,10 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             diagnostics["arcs"].update(arcs)
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
+    from tmm_workbench.core.footprint import cusp_check
+
+    if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)
+        cusp_check.report_params(mesh, cutter, params, segments, surface, diagnostics)
     return StrategyResult(segments, diagnostics)
 
 

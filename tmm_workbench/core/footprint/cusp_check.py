@@ -1,0 +1,188 @@
+"""What a cusp mode left: its pass set measured as the verification pass measures it, no passes added.
+
+The cusp modes (constant cusp, adaptive, 3D offset) place their passes by rules that sample the surface (sections,
+a field's first-order marching, secants); where the sampling misses detail a few cells stay above the cusp height.
+The check cuts the pass set into the stock simulation on the verification's cells (core.footprint.variable_step:
+an eighth of the planar step, the dense raster sampled a cell apart) and reports how many measured cells exceed the
+cusp (with the crest between cells, CuspField.ridge_cusp, as the verification decides), the largest, and where:
+the bounding box and up to PLACES places (the worst cell of each group of exceeding cells within a tool diameter of
+each other), so that the op can say it and suggest VerifyCusp. With VerifyCusp on, the verification's own final
+measurement gives the same report (no second measurement).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.core import cancel
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.compare import slope_deg
+from tmm_workbench.core.sim.cusp_field import STOCK_ABOVE_MM, CuspField, field_of, grid_envelope, measure_grid
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.sim.stock import box_heights, mesh_heights
+from tmm_workbench.core.tools.cutter import Cutter
+
+PLACES = 5
+
+
+@dataclass
+class CuspCheck:
+    tolerance: float
+    cell: float
+    measured: int = 0                 # cells measured
+    exceeding: int = 0                # of them, with a cusp (crests included) above the tolerance
+    max_cusp: float = 0.0             # mm, the largest (crests included)
+    box: Optional[tuple] = None       # (xmin, ymin, xmax, ymax) of the exceeding cells
+    places: list = field(default_factory=list)   # [(x, y, cusp mm, cells)] the worst of each group, worst first
+    unreachable: int = 0
+    steep: int = 0
+    seconds: float = 0.0
+    verified: bool = False            # measured after the verification's partial passes
+    skipped: str = ""                 # why it did not run (its work above the limits)
+
+    @property
+    def within(self) -> bool:
+        return self.exceeding == 0 and not self.skipped
+
+    def summary(self) -> str:
+        if self.skipped:
+            return f"cusp check {self.tolerance:g} mm not run: {self.skipped}"
+        if self.within:
+            return (f"cusp check {self.tolerance:g} mm: held on all {self.measured} measured cells "
+                    f"(largest {self.max_cusp:.4f} mm, {self.cell:.3g} mm cells)")
+        where = "; ".join(f"({x:.1f}, {y:.1f}) {c:.4f} mm" for x, y, c, _ in self.places)
+        x0, y0, x1, y1 = self.box
+        return (f"cusp check {self.tolerance:g} mm: {self.exceeding} of {self.measured} measured cells above it, up "
+                f"to {self.max_cusp:.4f} mm, within x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} mm; worst at {where}"
+                + (" (after VerifyCusp's rounds)" if self.verified else ". VerifyCusp adds partial passes there"))
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+def from_field(fld: CuspField, cusp: np.ndarray, join: float, seconds: float = 0.0) -> CuspCheck:
+    """The check of the measured `cusp` (ridge_cusp of a cut) in `fld` (the verification's); exceeding cells closer
+    than `join` mm are one place."""
+    out = _report(fld.grid, cusp, fld.measured, fld.unreachable, fld.steep, fld.tolerance, join, seconds)
+    out.verified = True
+    return out
+
+
+def _places(xy: np.ndarray, v: np.ndarray, join: float) -> list:
+    """The worst cell of each group (cells closer than `join` joined), the worst groups first, PLACES at most."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    pairs = cKDTree(xy).query_pairs(join, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(xy), len(xy)))
+    _, label = connected_components(graph, directed=False)
+    order = np.argsort(-v)
+    first = np.unique(label[order], return_index=True)[1]   # each group's worst, by its rank in `order`
+    worst = order[np.sort(first)][:PLACES]
+    counts = np.bincount(label)
+    return [(float(xy[i, 0]), float(xy[i, 1]), float(v[i]), int(counts[label[i]])) for i in worst]
+
+
+_SCREEN = 0.9      # cells whose crest over the design is above this share of the tolerance get the envelope
+_AROUND = 2        # cells around those (a crest reads its neighbours' cusps, and their slopes theirs)
+
+
+def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], params: Any,
+                   surface: Optional[DropSurface] = None, progress: Optional[Progress] = None) -> CuspCheck:
+    """raster_drop's pass set (`params`: its SurfaceParams) measured against params.cusp (see the module).
+
+    The verification's measure, without its envelope everywhere: the envelope E lies between the design D (the
+    tool never enters it) and the path's heights H, within the dense raster's own cusp of D where the tool reaches
+    (cell^2 / 8R: 1.5 % of the tolerance for a ball); so the cusp (H - E) cos(slope) is at most H - D, and the
+    crest read on H - D (CuspField.ridge_cusp's rule) screens the cells: E is computed (cusp_field.grid_envelope)
+    only for those above _SCREEN x the tolerance and the _AROUND cells around them (their slopes and crests read
+    their neighbours), and the cusp read on the screened cells; the rest hold."""
+    from scipy.ndimage import binary_dilation
+
+    from tmm_workbench.core.footprint.variable_step import measure_cell
+
+    t0 = time.perf_counter()
+    surface = surface or DropSurface(mesh)
+    tol, s = params.cusp, params.stock_to_leave
+    grid = measure_grid(params.boundary, cutter, measure_cell(cutter, tol))
+    design = mesh_heights(mesh, grid, surface)
+    stock_top = float(mesh.bounds[1][2]) + s + STOCK_ABOVE_MM
+    cancel.poll()
+    path = link(segments, LinkPolicy(stock_top + 1.0, stock_top + 5.0))
+    heights = simulate(path, cutter, grid, box_heights(grid, stock_top), progress=cancel.asker()).heights
+    cancel.poll()
+    on_model = np.isfinite(design)
+    over = CuspField(grid, design, design + s, np.ones(design.shape), on_model, on_model & False, on_model & False,
+                     stock_top, tol, np.zeros(design.shape + (2,))).ridge_cusp(heights)
+    screen = np.nan_to_num(over, nan=0.0) > _SCREEN * tol
+    wanted = binary_dilation(screen, iterations=_AROUND) if screen.any() else screen
+    cusp = np.full(design.shape, np.nan)
+    flat = slope_deg(design, grid.cell)
+    measured, steep = on_model & (flat <= params.max_slope_deg), on_model & (flat > params.max_slope_deg)
+    unreachable = np.zeros(design.shape, dtype=bool)
+    if screen.any():
+        env = grid_envelope(mesh, cutter, params.boundary, grid, s, surface, stock_top, cells=wanted)
+        fld = field_of(grid, design, np.where(wanted, env, heights), tol, s, params.max_slope_deg, stock_top)
+        cusp[screen] = fld.ridge_cusp(heights)[screen]
+        for mine, theirs in ((measured, fld.measured), (steep, fld.steep), (unreachable, fld.unreachable)):
+            mine[screen] = theirs[screen]
+    return _report(grid, cusp, measured, unreachable, steep, tol, cutter.diameter, time.perf_counter() - t0)
+
+
+def _report(grid: Grid, cusp: np.ndarray, measured: np.ndarray, unreachable: np.ndarray, steep: np.ndarray,
+            tol: float, join: float, seconds: float) -> CuspCheck:
+    values = np.nan_to_num(cusp, nan=-np.inf)
+    bad = values > tol
+    out = CuspCheck(tol, grid.cell, int(measured.sum()), int(bad.sum()), max(0.0, float(values.max())),
+                    unreachable=int(unreachable.sum()), steep=int(steep.sum()), seconds=seconds)
+    if bad.any():
+        xy = grid.centres()[bad.ravel()]
+        out.box = (float(xy[:, 0].min()), float(xy[:, 1].min()), float(xy[:, 0].max()), float(xy[:, 1].max()))
+        out.places = _places(xy, values.ravel()[bad.ravel()], join)
+    return out
+
+
+def cost_points(boundary: Any, cutter: Cutter, cusp: float) -> float:
+    """The check's CL points at most (variable_step.estimate_work: the dense raster everywhere and the design),
+    refused above the limits (WorkLimitError)."""
+    from tmm_workbench.core.footprint.variable_step import estimate_work, measure_cell
+
+    return estimate_work(boundary, cutter, cusp, measure_cell(cutter, cusp), "cusp check")
+
+
+
+def applies(params: Any) -> bool:
+    """raster_drop's params: a cusp mode with the check on (STEPOVER asks for no cusp height)."""
+    from tmm_workbench.core.strategies.raster_drop import STEPOVER
+
+    return bool(params.cusp_check) and params.stepover_mode != STEPOVER
+
+
+def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
+                  surface: Optional[DropSurface], diagnostics: dict) -> CuspCheck:
+    """raster_drop's call: the check (the verification's own final measurement when it ran) in
+    diagnostics["cusp_check"], and appended to params.verify_notes when given (the op reports it)."""
+    from tmm_workbench.core.errors import WorkLimitError
+    from tmm_workbench.core.footprint.variable_step import measure_cell
+
+    check = diagnostics.pop("verify_check", None)
+    if check is None:
+        try:
+            cost_points(params.boundary, cutter, params.cusp)
+        except WorkLimitError as exc:   # the path stands; only the check is left out, and said
+            check = CuspCheck(params.cusp, measure_cell(cutter, params.cusp), skipped=str(exc))
+    if check is None:
+        check = check_segments(mesh, cutter, segments, params, surface)
+    diagnostics["cusp_check"] = check.as_dict()
+    if params.verify_notes is not None:
+        params.verify_notes.append(check)
+    return check
