@@ -110,12 +110,17 @@ SIM_CELL_MM = 0.1      # 3-axis simulation cells (the demo's step-overs are 0.3-
 SIM_CELL_5AXIS_MM = 0.25
 
 
+UNSAFE: list[str] = []  # simulated gouges and rapids into stock, any of which fails the main job
+
+
 def simulate_case(result: Any, png: Path, cell: float) -> dict[str, Any]:
     """The Job's stock cut by its op and compared with its model (api.simulate), with the heat map."""
     from tmm_workbench.app.api import simulate
 
     t0 = time.perf_counter()
     rep = simulate(result, cell=cell, tolerance=0.01, png_path=png, progress=False)
+    if rep.gouged or rep.collisions:  # a path a machine must not run: the main job fails (after its files)
+        UNSAFE.append(f"{png.stem}: {'gouged ' if rep.gouged else ''}{len(rep.collisions)} rapid collisions")
     return dict(max_left=rep.max_left, min_dev=rep.min_deviation, p95=rep.percentiles[95], gouged=rep.gouged,
                 collisions=len(rep.collisions), cycle=rep.cycle_seconds, seconds=time.perf_counter() - t0)
 
@@ -419,6 +424,8 @@ def print_table(rows: list[dict[str, Any]], total: float) -> None:
 def _entry() -> None:
     try:
         main()
+        if UNSAFE:
+            raise RuntimeError("the simulation found paths a machine must not run: " + "; ".join(UNSAFE))
     except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
         traceback.print_exc()
         sys.stdout.flush()
