@@ -32,7 +32,7 @@ CASES = {
     "verify": ("run_surface", dict(stepover_mode="adaptive", cusp=0.005, verify_cusp=True)),
     "roughing": ("run_roughing", dict(step_down=0.5, stepover_percent=10)),
     "waterline": ("run_waterline", dict(step_down=0.02)),
-    "multipoint": ("run_multipoint", dict(scallop=0.005, forward_step=1.0)),
+    "multipoint": ("run_multipoint", dict(scallop=0.02, forward_step=2.0)),
     "sim3": ("simulate", dict(cell=0.02)),
 }
 

@@ -24,6 +24,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.raster import EVEN, FIXED, Rect, pass_count, raster_lines, sample_segment
 from tmm_workbench.core.geometry.face import BezierFace
@@ -261,6 +262,12 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     "unreached_positions" ((k, 2) XY of the footprint points no position was found for: not cut), "between"
     (multipoint_refine), and with the scallop rule "scallop" (its ScallopPlacement: `unreached` lists the
     areas where the scallop is not held). What cannot be reached is reported, never a failure of the op."""
+    with cancel.watching(progress) as report:  # the scallop meter's Python loops poll it (core.cancel)
+        return _compute(surface, tool, params, report)
+
+
+def _compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
+             progress: Optional[Progress]) -> StrategyResult:
     if not isinstance(surface, BezierFace):
         raise TmmError(f"surface must be a BezierFace, got {type(surface).__name__}")
     Ro, Ri = _torus(tool)

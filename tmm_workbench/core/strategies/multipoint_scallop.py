@@ -29,6 +29,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.face import BezierFace
@@ -96,10 +97,12 @@ class DesignHeights:
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         uv = np.empty_like(xy)
         for k in range(0, len(xy), 2048):  # nearest sample, in chunks
+            cancel.poll()
             d = ((xy[k:k + 2048, None, :] - self.xy[None, :, :]) ** 2).sum(-1)
             uv[k:k + 2048] = self.uv[np.argmin(d, axis=1)]
         u0, u1, v0, v1 = self.domain
         for _ in range(iterations):
+            cancel.poll()
             ev = self.face.evaluate(uv)
             r = ev["S"][:, :2] - xy
             a, b, c, d = ev["Su"][:, 0], ev["Sv"][:, 0], ev["Su"][:, 1], ev["Sv"][:, 1]
@@ -316,6 +319,7 @@ class ScallopMeter:
         gap = 2.0 * self.row_spacing + 1e-9  # a row farther than this from a good position is not measured
         coarse = []
         for t_row in rows:
+            cancel.poll()
             if any(lo <= t_row <= hi for lo, hi in exclude):
                 continue
             near_p = gp & (np.abs(tp[:, 1] - t_row) <= gap)
