@@ -67,7 +67,7 @@ def test_the_constant_cusp_mode_reports_the_cells_it_leaves_above_the_cusp(field
 def test_the_screened_check_is_the_measurement_made_everywhere(field):
     mesh, surface = field
     for mode, boundary in (("offset3d", (5.0, 40.0, 19.0, 54.0)), ("cusp", WINDOW)):
-        params = _params(mode, boundary, cusp_check=False)
+        params = _params(mode, boundary, cusp_check="off")
         segments = compute(mesh, BALL, params, None, surface).segments
         assert "cusp_check" not in compute(mesh, BALL, params, None, surface).diagnostics
         screened = cusp_check.check_segments(mesh, BALL, segments, params, surface)
@@ -91,7 +91,7 @@ def test_a_path_that_holds_reports_none_and_the_stepover_mode_is_not_checked():
 
 def test_the_check_is_cancelled_through_the_watched_callback(field):
     mesh, surface = field
-    params = _params("cusp", cusp_check=False)
+    params = _params("cusp", cusp_check="off")
     segments = compute(mesh, BALL, params, None, surface).segments
     with pytest.raises(Cancelled):
         with cancel.watching(lambda f: False):
@@ -125,3 +125,14 @@ def test_a_check_above_the_work_limit_is_skipped_and_said_the_path_stands(field)
     said = result.diagnostics["cusp_check"]
     assert "cusp check: cusp height 0.01 mm measured on" in said["skipped"] and said["exceeding"] == 0
     assert result.segments and "not run" in cusp_check.CuspCheck(**said).summary()
+
+
+def test_auto_leaves_a_large_region_unchecked_and_says_so():
+    plate = grid_mesh(np.zeros((3, 3)), (80.0, 80.0), "plate")
+    params = _params("cusp", (0.0, 0.0, 80.0, 80.0))
+    assert cusp_check.cells(params.boundary, BALL, TOL) > cusp_check.AUTO_CELLS and not cusp_check.runs(params, BALL)
+    said = compute(plate, BALL, params).diagnostics["cusp_check"]
+    assert said["auto"] and "CheckCusp Auto" in said["skipped"] and said["measured"] == 0
+    small = _params("cusp", (0.0, 0.0, 30.0, 30.0))
+    assert cusp_check.runs(small, BALL) and not cusp_check.runs(_params("cusp", cusp_check="off"), BALL)
+    assert cusp_check.runs(_params("cusp", (0.0, 0.0, 80.0, 80.0), cusp_check="on"), BALL)

@@ -70,14 +70,15 @@ class Offset3D(FreeCADTestCase):
         self.assertIn("cusp height must be in [0.0001, 3] mm", str(ctx.exception))
 
     def test_the_op_reports_the_cells_above_the_cusp(self) -> None:
-        """CheckCusp (on by default): the op's read-only CuspReport says what the core's check measures on the same
-        passes (cells above CuspHeight and where, or held), and a warning suggests VerifyCusp; off, it is empty."""
+        """CheckCusp (Auto by default: on small regions): the op's read-only CuspReport says what the core's check
+        measures on the same passes (cells above CuspHeight and where, or held), and a warning suggests VerifyCusp;
+        off, it is empty."""
         from tmm_workbench.app.tools import cutter_from_tool
         from tmm_workbench.core.strategies import raster_drop
 
         r = run_surface(bump_stl(), sample_step=0.5, stepover_mode="offset3d", cusp=0.02, progress=False,
                         doc_name="TmmCuspReport")
-        self.assertTrue(r.op.CheckCusp)
+        self.assertEqual(r.op.CheckCusp, "Auto")   # on: the bump is a small region
         self.assertEqual(r.op.getEditorMode("CuspReport"), ["ReadOnly"])
         from tmm_workbench.app.op_surface import FORWARD_STEPS
 
@@ -90,7 +91,7 @@ class Offset3D(FreeCADTestCase):
         self.assertIn("VerifyCusp adds partial passes there", r.op.CuspReport)
         x, y, _, _ = said["places"][0]
         self.assertIn(f"({x:.1f}, {y:.1f})", r.op.CuspReport)
-        r.op.CheckCusp = False
+        r.op.CheckCusp = "Off"
         r.doc.recompute()
         self.assertEqual(r.op.CuspReport, "")
         FreeCAD.closeDocument(r.doc.Name)
@@ -215,7 +216,8 @@ class Offset3DEstimate(FreeCADTestCase):
         params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
         result = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params)
         points = result.diagnostics["points"]
-        # the count holds the cusp check's measurement too (CheckCusp, on by default: its dense raster at most)
+        # the count holds the cusp check's measurement too (CheckCusp Auto runs on this small region: its dense
+        # raster at most)
         from tmm_workbench.core.footprint import variable_step
 
         check = variable_step.estimate_params(cutter_from_tool(tc.Tool), params)

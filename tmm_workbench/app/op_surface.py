@@ -123,6 +123,7 @@ CHOICES.update(surface_passes.CHOICES)
 DEFAULTS.update(surface_passes.DEFAULTS)
 # the verification pass: partial passes where the simulated cusp exceeds CuspHeight (issue 14 item 4)
 PROPERTIES += surface_verify.PROPERTIES
+CHOICES.update(surface_verify.CHOICES)
 # the 3D offset's start: the region's boundary or a chosen curve (issue 14 item 1; app.offset_start)
 PROPERTIES += offset_start.PROPERTIES
 CHOICES.update(offset_start.CHOICES)

@@ -2,8 +2,8 @@
 the pass set in the stock simulation and adds partial passes where its cusp exceeds CuspHeight. Off by default,
 and off in documents saved before it (a Bool property added on restore is False): their path is unchanged.
 
-`CheckCusp` (on by default; core.footprint.cusp_check): a cusp mode's pass set measured as the verification
-measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
+`CheckCusp` (Auto by default: on small regions; core.footprint.cusp_check): a cusp mode's pass set measured as the
+verification measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
 largest, where) and, when cells exceed it, a warning suggesting VerifyCusp. It never changes the path.
 
 Each pass set's report goes to the report view: a message with the cusp before and after, the passes added and
@@ -22,11 +22,13 @@ PROPERTIES: list[Prop] = [
          "Cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds "
          "CuspHeight (any StepOverMode; ZigZag or OneWay over the Box region); cells out of the tool's reach are "
          "reported, not chased", "verify_cusp"),
-    Prop("App::PropertyBool", "CheckCusp", "Surface",
+    Prop("App::PropertyEnumeration", "CheckCusp", "Surface",
          "Cusp modes (Cusp, Adaptive, Offset3D): measure the passes in the stock simulation as VerifyCusp does, "
-         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where",
+         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where (Auto: on "
+         "small regions, where it takes a few seconds; On: always, about as long again as the passes)",
          "cusp_check"),
 ]
+CHOICES = {"CheckCusp": {"Auto": "auto", "On": "on", "Off": "off"}}
 REPORT = "CuspReport"
 
 
@@ -55,7 +57,7 @@ def report(obj: Any, notes: list) -> None:
     for note in notes:
         if isinstance(note, CuspCheck):
             _report_property(obj, note.summary())
-            if note.within:
+            if note.within or note.auto:
                 FreeCAD.Console.PrintMessage(f"{obj.Label}: {note.summary()}\n")
             else:
                 FreeCAD.Console.PrintWarning(f"{obj.Label}: {note.summary()}\n")

@@ -207,7 +207,7 @@ def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
     from tmm_workbench.core.footprint import cusp_check, variable_step
 
     if not params.verify_cusp:  # CheckCusp measures the cusp modes' passes (skipped above the limits)
-        if not cusp_check.applies(params):
+        if not cusp_check.runs(params, _cutter(obj)):
             return est
         try:
             dense = cusp_check.cost_points(params.boundary, _cutter(obj), params.cusp)

@@ -31,6 +31,8 @@ from tmm_workbench.core.sim.stock import box_heights, mesh_heights
 from tmm_workbench.core.tools.cutter import Cutter
 
 PLACES = 5
+AUTO_CELLS = 250_000   # the check runs by default (CheckCusp Auto) on at most this many cells (30 x 30 mm for a ball
+                       # D6 at 0.01 mm: a few seconds)
 
 
 @dataclass
@@ -46,7 +48,8 @@ class CuspCheck:
     steep: int = 0
     seconds: float = 0.0
     verified: bool = False            # measured after the verification's partial passes
-    skipped: str = ""                 # why it did not run (its work above the limits)
+    skipped: str = ""                 # why it did not run (its work above the limits, or above AUTO_CELLS)
+    auto: bool = False                # left out by CheckCusp Auto (not a warning)
 
     @property
     def within(self) -> bool:
@@ -161,10 +164,25 @@ def cost_points(boundary: Any, cutter: Cutter, cusp: float) -> float:
 
 
 def applies(params: Any) -> bool:
-    """raster_drop's params: a cusp mode with the check on (STEPOVER asks for no cusp height)."""
+    """raster_drop's params: a cusp mode with the check not off (STEPOVER asks for no cusp height)."""
     from tmm_workbench.core.strategies.raster_drop import STEPOVER
 
-    return bool(params.cusp_check) and params.stepover_mode != STEPOVER
+    return params.cusp_check != "off" and params.stepover_mode != STEPOVER
+
+
+def cells(boundary: Any, cutter: Cutter, cusp: float) -> int:
+    """The check's (and the verification's) measured cells over `boundary`, before any is allocated."""
+    from tmm_workbench.core.footprint.variable_step import measure_cell
+    from tmm_workbench.core.sim.cusp_field import measure_grid_size
+
+    nx, ny = measure_grid_size(boundary, cutter, measure_cell(cutter, cusp))
+    return nx * ny
+
+
+def runs(params: Any, cutter: Cutter) -> bool:
+    """Whether the check runs: on, or auto on at most AUTO_CELLS cells (where it costs a few seconds; on the
+    benchmark's 60 x 60 mm fields and larger it took 35-75 % of the pass placement's time)."""
+    return applies(params) and (params.cusp_check == "on" or cells(params.boundary, cutter, params.cusp) <= AUTO_CELLS)
 
 
 def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
@@ -175,6 +193,11 @@ def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[Cut
     from tmm_workbench.core.footprint.variable_step import measure_cell
 
     check = diagnostics.pop("verify_check", None)
+    if check is None and not runs(params, cutter):
+        n = cells(params.boundary, cutter, params.cusp)
+        check = CuspCheck(params.cusp, measure_cell(cutter, params.cusp), auto=True, skipped=(
+            f"{n} cells to measure, more than the {AUTO_CELLS} CheckCusp Auto measures (set it On: it takes about as "
+            "long again as the passes; or VerifyCusp)"))
     if check is None:
         try:
             cost_points(params.boundary, cutter, params.cusp)

@@ -22,7 +22,8 @@ same short spike out along the bisector as there).
 The rule aims under the cusp height (CUSP_AIM) for the field's first-order sampling. Where a corner's contour is
 too irregular to rebuild and spike (a bisector meeting a slope's foot) or a hilltop's last loop is a sliver, points
 on T's ridges may still lie more than half a step from both levels: those of the half level are checked against the
-passes as cut and the uncovered runs cut too (_uncovered; on flats, where the XY distance is the cusp rule).
+passes as cut and the uncovered runs cut too (_uncovered; on flats, where the XY distance is the cusp rule, and where
+fronts meet head on up to a 30 deg slope; the levels a quarter step either side of the half level too).
 """
 from __future__ import annotations
 
@@ -66,6 +67,12 @@ _COVER_SLACK = 1.04      # a ridge point is uncovered beyond this x half the aim
                          # 0.92 x 1.04^2 = 0.995 x the tolerance)
 _COVER_SLOPE = 10.0      # deg: ridge points checked on CL slopes up to this (corners on flats, hilltops); on a
                          # relief the check flagged a thousand short pieces that barely moved the simulated cusp
+_COVER_LEVELS = (0.5, 0.25, 0.75)   # the levels between two passes (k - these) whose ridge points are checked: the
+                         # point farthest from both passes where fronts meet lies anywhere between them (a random
+                         # field's 24 deg valley of T at T = k + 0.76: 0.0166 mm for 0.01 with the half level only)
+_MEET_SLOPE = 30.0       # deg: ridge points also checked on slopes up to this where fronts meet nearly head on (grad T
+_MEET_DEG = 120.0        # turns by more than this); at 90 deg or 60 deg of slope mount_rush got 250-600 more loops
+_MEET_SLACK = 1.04       # ... uncovered beyond this x half the aimed step there
 _COVER_RUN = 0.25        # flat steps added at either end of an uncovered run of the half level (_uncovered)
 _FIT_REACH = 4.0         # sharpened: each edge fitted over 2 to this many reaches from the corner
 _EDGE_TURN = 10.0        # deg: ... as long as it turns by no more than this (not round a short side's corner)
@@ -426,8 +433,8 @@ def _half_level(field: Field, k: int) -> list[np.ndarray]:
     return out
 
 
-def _ridge(field: Field, p: np.ndarray) -> np.ndarray:
-    """(n,) bool: the points where grad T turns by more than _RIDGE_DEG across _RIDGE_CELLS cells either side,
+def _ridge(field: Field, p: np.ndarray, turn_deg: float = _RIDGE_DEG) -> np.ndarray:
+    """(n,) bool: the points where grad T turns by more than `turn_deg` across _RIDGE_CELLS cells either side,
     along X or Y (two fronts meet there: a corner's bisector, a strip's middle, a hilltop)."""
     h = _RIDGE_CELLS * (field.xs[1] - field.xs[0])
     out = np.zeros(len(p), dtype=bool)
@@ -435,7 +442,7 @@ def _ridge(field: Field, p: np.ndarray) -> np.ndarray:
         ga, gb = field.gradient(p + d), field.gradient(p - d)
         with np.errstate(invalid="ignore", divide="ignore"):
             c = (ga * gb).sum(axis=1) / (np.hypot(*ga.T) * np.hypot(*gb.T))
-        out |= ~(c >= math.cos(math.radians(_RIDGE_DEG)))   # NaN (beside unreached nodes): a ridge too
+        out |= ~(c >= math.cos(math.radians(turn_deg)))   # NaN (beside unreached nodes): a ridge too
     return out
 
 
@@ -467,15 +474,19 @@ def _uncovered(field: Field, level: float, passes: list[np.ndarray], flat: float
     out = []
     for line in field.lines(level):
         ridge = _ridge(field, line)
+        slack = np.full(len(line), _COVER_SLACK)
         if field.slope is not None:   # (on steeper ground the XY distance misjudges the cusp: see _COVER_SLOPE)
             with np.errstate(invalid="ignore"):
-                ridge &= field.at(line, field.slope) <= _COVER_SLOPE
+                slope = field.at(line, field.slope)
+                meet = (slope > _COVER_SLOPE) & (slope <= _MEET_SLOPE) & _ridge(field, line, _MEET_DEG)
+            ridge &= (slope <= _COVER_SLOPE) | meet
+            slack[meet] = _MEET_SLACK
         if not ridge.any():
             continue
         idx = np.flatnonzero(ridge)
         gap, step = _step_across(field, line[idx], passes)
         bad = np.zeros(len(line), dtype=bool)
-        bad[idx] = gap > 0.5 * _COVER_SLACK * step
+        bad[idx] = gap > 0.5 * slack[idx] * step
         if not bad.any():
             continue
         closed = len(line) > 3 and np.allclose(line[0], line[-1])
@@ -566,7 +577,7 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         caps = [c for c in keep(_half_level(field, k - 1)) if float(np.hypot(*np.diff(c, axis=0).T).sum()) > _MIN_HALF * flat]
         cut = [c for c in (add(line, k, previous) for line in current + caps) if c is not None]
         # the half level's points on a ridge of T still farther than half a local step from both levels as cut
-        for line in keep(_uncovered(field, k - 0.5, cut_before + cut, flat)):
+        for line in (ln for d in _COVER_LEVELS for ln in keep(_uncovered(field, k - d, cut_before + cut, flat))):
             c = add(line, k, [])
             if c is not None:
                 cut.append(c)

@@ -95,8 +95,9 @@ class SurfaceParams(StrategyParams):
     verify_cusp: bool = param(False, "verify cusp", choices=(True, False))
     verify_notes: Optional[list] = None
     # the cusp modes' pass set measured as the verification measures it, no passes added: cells left above the
-    # cusp reported (diagnostics["cusp_check"], a CuspCheck appended to verify_notes; core.footprint.cusp_check)
-    cusp_check: bool = param(True, "cusp check", choices=(True, False))
+    # cusp reported (diagnostics["cusp_check"], a CuspCheck appended to verify_notes; core.footprint.cusp_check);
+    # "auto": where it is cheap (a small region), "on": always, "off"
+    cusp_check: str = param("auto", "cusp check", choices=("auto", "on", "off"))
 
     def validate(self) -> None:
         super().validate()
