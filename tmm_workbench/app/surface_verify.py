@@ -57,7 +57,7 @@ def report(obj: Any, notes: list) -> None:
     for note in notes:
         if isinstance(note, CuspCheck):
             _report_property(obj, note.summary())
-            if note.within or note.auto:
+            if note.within or note.auto or note.verified:   # (VerifyCusp warns itself)
                 FreeCAD.Console.PrintMessage(f"{obj.Label}: {note.summary()}\n")
             else:
                 FreeCAD.Console.PrintWarning(f"{obj.Label}: {note.summary()}\n")

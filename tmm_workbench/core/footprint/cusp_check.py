@@ -186,14 +186,16 @@ def runs(params: Any, cutter: Cutter) -> bool:
 
 
 def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
-                  surface: Optional[DropSurface], diagnostics: dict) -> CuspCheck:
-    """raster_drop's call: the check (the verification's own final measurement when it ran) in
-    diagnostics["cusp_check"], and appended to params.verify_notes when given (the op reports it)."""
+                  surface: Optional[DropSurface], diagnostics: dict) -> Optional[CuspCheck]:
+    """raster_drop's call: the check in diagnostics["cusp_check"], and appended to params.verify_notes when given
+    (the op reports it); None when the verification ran (its final measurement is the report: variable_step)."""
     from tmm_workbench.core.errors import WorkLimitError
     from tmm_workbench.core.footprint.variable_step import measure_cell
 
-    check = diagnostics.pop("verify_check", None)
-    if check is None and not runs(params, cutter):
+    if "cusp_check" in diagnostics:
+        return None
+    check = None
+    if not runs(params, cutter):
         n = cells(params.boundary, cutter, params.cusp)
         check = CuspCheck(params.cusp, measure_cell(cutter, params.cusp), auto=True, skipped=(
             f"{n} cells to measure, more than the {AUTO_CELLS} CheckCusp Auto measures (set it On: it takes about as "

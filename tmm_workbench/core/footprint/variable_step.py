@@ -495,7 +495,7 @@ def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegme
                                    slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress,
                                    levels=levels)
     diagnostics["verify"] = report.as_dict()
-    diagnostics["verify_check"] = report.check   # the cusp check's report without a second measurement
+    diagnostics["cusp_check"] = report.check.as_dict()   # the final measurement: no second one by the check
     if params.verify_notes is not None:
-        params.verify_notes.append(report)
+        params.verify_notes += [report, report.check]
     return segments
