@@ -53,7 +53,7 @@ class WorkEstimate(FreeCADTestCase):
         params = op.Proxy.params_from(op, boundary=op.Proxy.boundary(op, mesh))
         points = raster_drop.compute(mesh, cutter_from_tool(tc.Tool), params).diagnostics["points"]
         self.assertGreaterEqual(est.count, points)
-        self.assertEqual(est.note, "")
+        self.assertIn("cusp check", est.note)  # CheckCusp's measurement, on by default, is counted and said
         checked = work_estimate.estimate(op, {"VerifyCusp": True})
         self.assertGreater(checked.count, est.count)
         self.assertIn("up to 4 rounds of partial passes", checked.text())

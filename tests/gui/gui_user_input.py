@@ -308,7 +308,7 @@ def waterline_panel(info: dict) -> None:
     open_panel(op)
     info["wl_ranges"] = {name: [field(name).property("minimum"), field(name).property("maximum")]
                          for name in ("stepDown", "sampleStep", "chordTolerance", "topZ")}
-    assert info["wl_ranges"]["chordTolerance"] == [0.0, 1.0], info["wl_ranges"]  # the params' (0, 1] mm
+    assert info["wl_ranges"]["chordTolerance"] == [0.0001, 1.0], info["wl_ranges"]  # the params' [0.0001, 1] mm
     assert info["wl_ranges"]["stepDown"][0] == 0.0 and info["wl_ranges"]["topZ"] == [-10000.0, 10000.0], info
     commands = len(op.Path.Commands)
     type_into("sampleStep", "0.00001")
