@@ -22,7 +22,7 @@ same short spike out along the bisector as there).
 The rule aims under the cusp height (CUSP_AIM) for the field's first-order sampling. Where a corner's contour is
 too irregular to rebuild and spike (a bisector meeting a slope's foot) or a hilltop's last loop is a sliver, points
 on T's ridges may still lie more than half a step from both levels: those of the half level are checked against the
-passes as cut and the uncovered runs cut too (_uncovered; on flats, where the XY distance is the cusp rule, and where
+passes as cut and the uncovered runs cut too (offset_cover.uncovered; on flats, where the XY distance is the cusp rule, and where
 fronts meet head on up to a 30 deg slope; the levels a quarter step either side of the half level too).
 """
 from __future__ import annotations
@@ -35,6 +35,7 @@ import numpy as np
 from tmm_workbench.core import cancel, polygons
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.offset3d import Heights, Loop, OffsetLoops, StepRule, _closed, _spiked
+from tmm_workbench.core.footprint.offset_cover import COVER_LEVELS, meet_nodes, uncovered
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.polygons import Shape
 from tmm_workbench.core.tools.cutter import Cutter
@@ -60,20 +61,6 @@ CUSP_AIM = 0.92          # the rule's cusp: this share of the tolerance (the ste
                          # what the field samples only to first order: the marching in its cell, the 0.25 mm
                          # chords along the passes, the slope and curvature as secants over _PROBE of a step
                          # (measured: benchmarks/offset3d_where.py, results.md "### 3D offset")
-_RIDGE_DEG = 45.0        # a half-level point lies on a ridge of T where grad T turns by more than this across
-                         # _RIDGE_CELLS either side (a corner's bisector, fronts meeting, a hilltop)
-_RIDGE_CELLS = 1.5
-_COVER_SLACK = 1.04      # a ridge point is uncovered beyond this x half the aimed step (on a plane: a cusp of
-                         # 0.92 x 1.04^2 = 0.995 x the tolerance)
-_COVER_SLOPE = 10.0      # deg: ridge points checked on CL slopes up to this (corners on flats, hilltops); on a
-                         # relief the check flagged a thousand short pieces that barely moved the simulated cusp
-_COVER_LEVELS = (0.5, 0.25, 0.75)   # the levels between two passes (k - these) whose ridge points are checked: the
-                         # point farthest from both passes where fronts meet lies anywhere between them (a random
-                         # field's 24 deg valley of T at T = k + 0.76: 0.0166 mm for 0.01 with the half level only)
-_MEET_SLOPE = 30.0       # deg: ridge points also checked on slopes up to this where fronts meet nearly head on (grad T
-_MEET_DEG = 120.0        # turns by more than this); at 90 deg or 60 deg of slope mount_rush got 250-600 more loops
-_MEET_SLACK = 1.04       # ... uncovered beyond this x half the aimed step there
-_COVER_RUN = 0.25        # flat steps added at either end of an uncovered run of the half level (_uncovered)
 _FIT_REACH = 4.0         # sharpened: each edge fitted over 2 to this many reaches from the corner
 _EDGE_TURN = 10.0        # deg: ... as long as it turns by no more than this (not round a short side's corner)
 
@@ -433,89 +420,6 @@ def _half_level(field: Field, k: int) -> list[np.ndarray]:
     return out
 
 
-def _ridge(field: Field, p: np.ndarray, turn_deg: float = _RIDGE_DEG) -> np.ndarray:
-    """(n,) bool: the points where grad T turns by more than `turn_deg` across _RIDGE_CELLS cells either side,
-    along X or Y (two fronts meet there: a corner's bisector, a strip's middle, a hilltop)."""
-    h = _RIDGE_CELLS * (field.xs[1] - field.xs[0])
-    out = np.zeros(len(p), dtype=bool)
-    for d in (np.array([h, 0.0]), np.array([0.0, h])):
-        ga, gb = field.gradient(p + d), field.gradient(p - d)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            c = (ga * gb).sum(axis=1) / (np.hypot(*ga.T) * np.hypot(*gb.T))
-        out |= ~(c >= math.cos(math.radians(turn_deg)))   # NaN (beside unreached nodes): a ridge too
-    return out
-
-
-def _step_across(field: Field, p: np.ndarray, passes: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """(n,) each point's XY distance to the nearest pass, and the speed's step (mm) there for a front crossing
-    along that distance's direction (the gap the point lies in; on a ridge grad T itself is smeared, along the
-    bisector), the slope and curvature over that distance (the CL surface between the point and the pass, not
-    half a flat step that may reach a slope's foot beyond it)."""
-    from tmm_workbench.core.footprint.offset3d import _gaps
-
-    gap, seg = _gaps(p, passes)
-    a = np.vstack([q[:-1] for q in passes])[seg]
-    ab = np.vstack([q[1:] for q in passes])[seg] - a
-    t = np.clip(((p - a) * ab).sum(axis=1) / np.maximum((ab * ab).sum(axis=1), 1e-300), 0.0, 1.0)
-    u = a + t[:, None] * ab - p
-    u[np.hypot(*u.T) <= 1e-12] = (1.0, 0.0)
-    probe = max(float(np.median(gap)) if len(gap) else 0.0, 2 * (field.xs[1] - field.xs[0]))
-    return gap, np.maximum(field.steps(p, u, probe), field.steps(p, u, field.probe))
-
-
-def _uncovered(field: Field, level: float, passes: list[np.ndarray], flat: float) -> list[np.ndarray]:
-    """The pieces of the half level {T = level} whose points on a ridge of T lie farther than half the local step
-    from every pass in `passes` (the two levels either side as cut: spikes and caps included): a corner whose
-    contour was too irregular to rebuild and spike (a bisector meeting a slope's foot), the corners of a
-    hilltop's last small loop, a short cap left out. Each uncovered run, _COVER_RUN flat steps longer at either
-    end, is cut too: every point there then lies within half a step of a pass, which is the cusp rule itself."""
-    if field.steps is None or not passes:
-        return []
-    out = []
-    for line in field.lines(level):
-        ridge = _ridge(field, line)
-        slack = np.full(len(line), _COVER_SLACK)
-        if field.slope is not None:   # (on steeper ground the XY distance misjudges the cusp: see _COVER_SLOPE)
-            with np.errstate(invalid="ignore"):
-                slope = field.at(line, field.slope)
-                meet = (slope > _COVER_SLOPE) & (slope <= _MEET_SLOPE) & _ridge(field, line, _MEET_DEG)
-            ridge &= (slope <= _COVER_SLOPE) | meet
-            slack[meet] = _MEET_SLACK
-        if not ridge.any():
-            continue
-        idx = np.flatnonzero(ridge)
-        gap, step = _step_across(field, line[idx], passes)
-        bad = np.zeros(len(line), dtype=bool)
-        bad[idx] = gap > 0.5 * slack[idx] * step
-        if not bad.any():
-            continue
-        closed = len(line) > 3 and np.allclose(line[0], line[-1])
-        s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(line, axis=0).T))])
-        reach = _COVER_RUN * flat
-        if closed:   # arc length around the loop: runs may wrap
-            total = s[-1]
-            grow = np.zeros(len(line), dtype=bool)
-            for i in np.flatnonzero(bad):
-                d = np.abs(s - s[i])
-                grow |= np.minimum(d, total - d) <= reach
-            if grow.all():
-                out.append(line)
-                continue
-            first = int(np.flatnonzero(~grow)[0])
-            body, flag = np.roll(line[:-1], -first, axis=0), np.roll(grow[:-1], -first)
-        else:
-            grow = np.zeros(len(line), dtype=bool)
-            for i in np.flatnonzero(bad):
-                grow |= np.abs(s - s[i]) <= reach
-            body, flag = line, grow
-        edges = np.flatnonzero(np.diff(np.concatenate([[0], flag.astype(int), [0]])))
-        for a, b in zip(edges[::2], edges[1::2]):
-            lo, hi = max(a - 1, 0), min(b + 1, len(body))
-            if hi - lo >= 2:
-                out.append(body[lo:hi])
-    return out
-
-
 def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sample_step: float,
                 max_slope_deg: float = 75.0, start: Optional[Sequence[np.ndarray]] = None,
                 progress: Optional[Progress] = None) -> OffsetLoops:
@@ -568,6 +472,7 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         if not previous:
             raise TmmError("3D offset start curve: it lies outside the machining region")
         cut_before = [c for c in (add(p, 0, []) for p in previous) if c is not None]
+    meets = meet_nodes(field)
     for k in range(1, levels + 2):
         if progress is not None and progress(min(k / max(levels, 1), 1.0)) is False:
             raise Cancelled("tool path computation cancelled")
@@ -577,7 +482,9 @@ def field_loops(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, sam
         caps = [c for c in keep(_half_level(field, k - 1)) if float(np.hypot(*np.diff(c, axis=0).T).sum()) > _MIN_HALF * flat]
         cut = [c for c in (add(line, k, previous) for line in current + caps) if c is not None]
         # the half level's points on a ridge of T still farther than half a local step from both levels as cut
-        for line in (ln for d in _COVER_LEVELS for ln in keep(_uncovered(field, k - d, cut_before + cut, flat))):
+        quarter = bool(np.any(meets & (field.t > k - 1) & (field.t < k)))   # (contouring costs: only where needed)
+        for line in (ln for d in COVER_LEVELS if d == 0.5 or quarter
+                     for ln in keep(uncovered(field, k - d, cut_before + cut, flat, meet_only=d != 0.5))):
             c = add(line, k, [])
             if c is not None:
                 cut.append(c)
