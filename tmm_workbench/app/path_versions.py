@@ -10,8 +10,9 @@ from __future__ import annotations
 # op proxy class name -> [(version, what changed in that version)], oldest first
 CHANGES: dict[str, list[tuple[int, str]]] = {
     "ObjectTmmSurface": [
-        (1, "a cusp height below 0.0001 mm is refused; VerifyCusp's partial passes rapid to 1 mm above the "
-            "simulated surface and feed from there"),
+        (1, "a cusp height below 0.0001 mm is refused; entries rapid to 1 mm above what the Job's earlier ops "
+            "left (VerifyCusp's partial passes: above its simulated surface) and feed from there; the 3D offset "
+            "adds loops where fronts meet head on across a slope"),
     ],
     "ObjectTmmRoughing": [
         (1, "entries rapid to 1 mm above the material where it is known and feed from there; ramp and helix "
