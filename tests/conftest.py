@@ -76,3 +76,13 @@ def _point_triangle_sq(p, a, b, c):
 @pytest.fixture
 def wavy_mesh() -> TriMesh:
     return grid_mesh(lambda x, y: 3 * np.sin(x / 6) * np.cos(y / 5) + 0.05 * x, 40, 30, (0, 0, 40, 30), "wavy")
+
+
+def random_net(seed: int) -> np.ndarray:
+    """A random bicubic control net: 4 x 4 poles 50 mm apart, z uniform in 70-100 mm (the 5-axis tests' faces)."""
+    rng = np.random.default_rng(seed)
+    net = np.zeros((4, 4, 3))
+    net[..., 0] = 50.0 * np.arange(4)[:, None]
+    net[..., 1] = 50.0 * np.arange(4)[None, :]
+    net[..., 2] = rng.uniform(70.0, 100.0, (4, 4))
+    return net

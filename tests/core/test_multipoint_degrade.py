@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from tests.conftest import SEED_JSON
+from tests.conftest import SEED_JSON, random_net
 from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.strategies import multipoint
@@ -19,15 +19,6 @@ from tmm_workbench.core.strategies.multipoint_scallop import NOT_REACHED, LeftAr
 from tmm_workbench.core.tools.cutter import Cutter
 
 TORUS = Cutter.torus(6.7, 6.0)
-
-
-def random_net(seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    net = np.zeros((4, 4, 3))
-    net[..., 0] = 50.0 * np.arange(4)[:, None]
-    net[..., 1] = 50.0 * np.arange(4)[None, :]
-    net[..., 2] = rng.uniform(70.0, 100.0, (4, 4))
-    return net
 
 
 # (net, boundary): strips along an edge where rows stay above 0.01 mm at any side step

@@ -11,6 +11,7 @@ import math
 import numpy as np
 import pytest
 
+from tests.conftest import random_net
 from tmm_workbench.core import path5
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.machine import rotary
@@ -31,15 +32,6 @@ TIP_TOL, AXIS_TOL = 0.005, math.radians(0.05)
 # 12 and 57 pass it within 0.001 deg, 4 within 0.002 deg
 NET_SEEDS = (45, 47, 12, 57, 4)
 DEPTH_CHECKED = (45, 47)  # the face gouge along every line (about 7 s a net)
-
-
-def random_net(seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    net = np.zeros((4, 4, 3))
-    net[..., 0] = 50.0 * np.arange(4)[:, None]
-    net[..., 1] = 50.0 * np.arange(4)[None, :]
-    net[..., 2] = rng.uniform(70.0, 100.0, (4, 4))
-    return net
 
 
 def axis_at(tilt: float, azimuth: float) -> tuple[float, float, float]:
