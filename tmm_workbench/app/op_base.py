@@ -284,13 +284,15 @@ class TmmOp(PathOp.ObjectOp):
         """The last look before FreeCAD makes the Path: a NaN or infinite word would reach the G-code and the
         machine (0.20 writes NaN as Z-922337203685.477581). Every cause is refused at its input; this
         catches one not yet found."""
-        words = [(k, c.Name, w, v) for k, c in enumerate(self.commandlist) for w, v in c.Parameters.items()]
-        values = np.fromiter((v for *_, v in words), float, len(words))
-        bad = np.flatnonzero(~(np.abs(values) <= MAX_WORD))
-        if len(bad):
-            k, name, word, value = words[int(bad[0])]
-            self.fail(obj, f"the computed tool path has a word that is not a usable number ({name} {word}{value:g}"
-                           f" in command {k + 1}): nothing was written. Please report this with the document")
+        values = np.fromiter((v for c in self.commandlist for v in c.Parameters.values()), float)
+        if (np.abs(values) <= MAX_WORD).all():
+            return
+        for k, c in enumerate(self.commandlist):  # only on failure: name the first bad word
+            bad = [(w, v) for w, v in c.Parameters.items() if not abs(v) <= MAX_WORD]
+            if bad:
+                self.fail(obj, f"the computed tool path has a word that is not a usable number ({c.Name} "
+                               f"{bad[0][0]}{bad[0][1]:g} in command {k + 1}): nothing was written. Please report "
+                               "this with the document")
 
     def compute(self, obj: Any) -> None:
         raise NotImplementedError
