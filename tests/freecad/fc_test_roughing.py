@@ -88,6 +88,17 @@ def levels(mv: list) -> list[float]:
     return sorted(zs, reverse=True)
 
 
+def feed_length(op: Any) -> float:
+    """mm of the op's G1 moves."""
+    here, total = None, 0.0
+    for n, p in moves(op):
+        nxt = dict(here or {}, **{k: p[k] for k in ("X", "Y", "Z") if k in p})
+        if n == "G1" and here is not None and len(here) == 3:
+            total += math.dist([here[k] for k in "XYZ"], [nxt[k] for k in "XYZ"])
+        here = nxt
+    return total
+
+
 def cells_inside(sim: Any, box: tuple[float, float, float, float], inset: float) -> np.ndarray:
     """The simulated heights of the cells whose centres lie `inset` inside the XY box."""
     g = sim.grid
@@ -276,6 +287,34 @@ class RoughingApi(FreeCADTestCase):
         self.assertGreater(both.min_deviation, -GOUGE_MM)
         self.assertEqual(both.collisions, [])
         self.assertLess(both.remaining_volume, rough.remaining_volume)
+
+    def test_a_second_roughing_cuts_only_what_the_first_left(self) -> None:
+        """The pocket block roughed with a 10 mm end mill, then with a 4 mm one in the same Job: the second cuts
+        the corners the first could not reach (its stock is what the first left, app.simulation.rest_stock), a
+        fraction of what the 4 mm tool cuts from the full stock; the Job simulated: no gouge, no rapid into
+        stock, less left than after the first."""
+        from tmm_workbench.app.api import _add_tool
+
+        doc = new_doc("TmmRestRough")
+        values = {"StepDown": 2.5, "StockToLeave": 0.3}
+        job, tc, first = job_with(doc, pocket_block(doc), "TMM_Roughing", diameter=10.0, values=values)
+        self.assertTrue(first.isValid(), first.getStatusString())
+        alone = simulate(job, cell=0.1, tolerance=GOUGE_MM, progress=False)
+        tc2 = _add_tool(job, tools.make_tool_bit(doc, "endmill", 4.0), H_FEED / 60, V_FEED / 60, 12000)
+        rest = registry.create("TMM_Roughing", job, {"Model": first.Model, "ToolController": tc2, **values})
+        rest.Proxy.progress_enabled = False
+        doc.recompute()
+        self.assertTrue(rest.isValid(), rest.getStatusString())
+        both = simulate(job, cell=0.1, tolerance=GOUGE_MM, progress=False)
+        self.assertGreater(both.min_deviation, -GOUGE_MM, (both.min_deviation, both.gouge_cells))
+        self.assertEqual(both.collisions, [])
+        self.assertLess(both.remaining_volume, alone.remaining_volume - 1.0)  # the pocket's corners
+
+        doc2 = new_doc("TmmFullRough")
+        _, _, full = job_with(doc2, pocket_block(doc2), "TMM_Roughing", diameter=4.0, values=values)
+        self.assertTrue(full.isValid(), full.getStatusString())
+        cut_rest, cut_full = feed_length(rest), feed_length(full)
+        self.assertLess(cut_rest, 0.25 * cut_full, (cut_rest, cut_full))
 
     def test_cancel(self) -> None:
         """A progress callback returning False cancels: the op's message, no document left behind."""

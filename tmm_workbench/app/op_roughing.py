@@ -5,7 +5,9 @@ offset or zig-zag passes at a step-over in % of the diameter, entered by helix, 
 What is machined: as the Surface op (op_surface: `StlFile`, then `Model`, then the Job's model; STL files,
 Mesh and Part objects). What is cut: the Job's stock solid. Its bounding box is the strategy's `stock_box`;
 a stock that is not a box (a cylinder, a solid of any shape) also gives its top as heights on a grid
-(`stock_heights`, from app.simulation's stock-as-heights helper), so no air above it is cut.
+(`stock_heights`, from app.simulation's stock-as-heights helper), so no air above it is cut. After earlier ops
+in the Job, the stock is what they left (app.simulation.rest_stock: the stock solid cut by their Paths), so a
+second roughing cuts only the material the first could not reach and enters just above it.
 
 Heights: FreeCAD's SafeHeight and ClearanceHeight (their SetupSheet defaults put them above the stock top).
 The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight (the core's plain cutters
@@ -17,7 +19,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, hooks, op_base, progress
+from tmm_workbench.app import geometry, hooks, op_base, progress, simulation
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_surface import ObjectTmmSurface
@@ -152,12 +154,17 @@ class ObjectTmmRoughing(op_base.TmmOp):
         check_step_down(self.tool, obj.StepDown.Value)
         job = PathUtils.findParentJob(obj)
         final_z = obj.FinalZ.Value if obj.UseFinalZ else None
-        params = self.params_from(obj, final_z=final_z, **stock_of(job, self.stock))
+        stock = stock_of(job, self.stock)
+        rest = simulation.rest_stock(obj, cutter)   # earlier ops in the Job: cut only what they left
+        if rest is not None:
+            stock["stock_heights"] = rest
+        params = self.params_from(obj, final_z=final_z, **stock)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy, cb)
         if not len(toolpath):
-            raise TmmError("no material to remove: the stock lies within the model plus stock to leave")
+            left = "what the Job's earlier ops left" if rest is not None else "the stock"
+            raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
         self.commandlist.extend(ObjectTmmSurface.commands(self, toolpath, STEEP_DESCENT_DEG,
                                                           obj.ClearanceHeight.Value))

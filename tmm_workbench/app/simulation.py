@@ -16,7 +16,7 @@ from tmm_workbench.app import geometry, post_objects, tools
 from tmm_workbench.core import path5
 from tmm_workbench.core.arcs import arc_points
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.linking import StockHeights
+from tmm_workbench.core.linking import StockHeights, cell_tops
 from tmm_workbench.core.sim import compare as compare_mod
 from tmm_workbench.core.sim.cycle_time import three_axis_time
 from tmm_workbench.core.sim.grid import Grid
@@ -261,13 +261,9 @@ KNOWN_CELL_MM = 0.25  # the stock heights the entries are placed over (a quarter
 KNOWN_CELLS = 1e6     # at most (a larger stock gets larger cells: the entries then stay a little higher)
 
 
-def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
-    """What the active ops before `obj` in its Job left of the stock, as heights (the stock solid
-    cut by their Paths; the linker keeps them up to date as the loops cut, so each loop is entered by a rapid to
-    just above the level over it). The simulation, not a bound from the ops' stock to leave: a roughing's stair
-    steps on a slope stand higher than its stock to leave, and only the simulation sees them. None (every loop
-    entered from the safe height) without a stock, or while an earlier op waits for its recompute (its Path may
-    be stale: what it will leave is not known)."""
+def earlier_ops(obj: Any) -> Optional[list]:
+    """The active ops before `obj` in its Job; None without a stock or while one of them waits for its
+    recompute (its Path may be stale: what it will leave is not known)."""
     job = job_of(obj)
     if job is None or getattr(job, "Stock", None) is None or job.Stock.Shape.isNull():
         return None
@@ -277,6 +273,34 @@ def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
             break
         earlier.append(op)
     if any("Touched" in op.State or "Invalid" in op.State for op in earlier):
+        return None
+    return earlier
+
+
+def rest_stock(obj: Any, cutter: Cutter) -> Optional[tuple[Grid, np.ndarray]]:
+    """What the Job's earlier ops left, as (grid, heights) for a roughing to cut only where material lies, each
+    cell the highest of its neighbours (a height is the stock's at a cell's centre only; a wall between two
+    centres rises to the higher). None when no earlier op has a path (the stock solid itself is then exact) or
+    one waits for its recompute."""
+    earlier = earlier_ops(obj)
+    if not earlier or not any(len(_toolpath_and_feeds(op)[0]) >= 2 for op in earlier):
+        return None
+    left = material_left(obj, cutter)
+    if left is None:
+        return None
+    return left.grid, cell_tops(left.heights)
+
+
+def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
+    """What the active ops before `obj` in its Job left of the stock, as heights (the stock solid
+    cut by their Paths; the linker keeps them up to date as the loops cut, so each loop is entered by a rapid to
+    just above the level over it). The simulation, not a bound from the ops' stock to leave: a roughing's stair
+    steps on a slope stand higher than its stock to leave, and only the simulation sees them. None (every loop
+    entered from the safe height) without a stock, or while an earlier op waits for its recompute (its Path may
+    be stale: what it will leave is not known)."""
+    job = job_of(obj)
+    earlier = earlier_ops(obj)
+    if earlier is None:
         return None
     bb = job.Stock.Shape.BoundBox
     cell = max(min(KNOWN_CELL_MM, cutter.radius / 4), math.sqrt(bb.XLength * bb.YLength / KNOWN_CELLS))

@@ -250,12 +250,18 @@ def heights_top(grid: Any, heights: np.ndarray, radius: float,
             near = rho <= radius
             if near.any():
                 lift = profile(rho[near]) if profile is not None else 0.0
-                out[k] = max(out[k], float(np.max(_cell_tops(h, j0, j1, i0, i1)[near] - lift)))
+                out[k] = max(out[k], float(np.max(_window_tops(h, j0, j1, i0, i1)[near] - lift)))
         return out
     return top
 
 
-def _cell_tops(h: np.ndarray, j0: int, j1: int, i0: int, i1: int) -> np.ndarray:
+def cell_tops(heights: np.ndarray) -> np.ndarray:
+    """Each cell's height raised to the highest of its 8 neighbours' (see _window_tops)."""
+    h = np.asarray(heights, dtype=float)
+    return _window_tops(h, 0, h.shape[0], 0, h.shape[1])
+
+
+def _window_tops(h: np.ndarray, j0: int, j1: int, i0: int, i1: int) -> np.ndarray:
     """The heights of rows j0:j1, columns i0:i1, each the highest of its cell and its 8 neighbours: a height is
     the stock's at the cell's centre only, and between a cut centre and an uncut one the stock rises to the
     uncut one (a wall of a relief between two samples: a rapid 11 mm into mount_rush's stock without this)."""

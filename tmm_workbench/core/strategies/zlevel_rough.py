@@ -63,6 +63,7 @@ from tmm_workbench.core.tools.cutter import Cutter
 SUPPORTED_TOOLS = ("flat", "bull", "ball")
 _AIR_MARGIN = 1.0           # mm: the tool-centre box reaches this far past the tool touching the stock
 _ENTRY_CLEARANCE = 0.5      # mm: helices and ramps start this far above the material
+_FLOOR_NOISE = 1e-4        # mm: stock heights this close above a layer are the floor an earlier layer cut
 _MIN_REGION_AREA = 1e-6     # mm^2: tool-centre regions smaller than this are rounding, not room
 _SLIVER = 0.02              # mm: unreachable material thinner than this is the offsets' rounding
 _MIN_RAMP = 0.25            # a ramp follows a pass at least this many tool diameters long; a region whose
@@ -284,7 +285,7 @@ class _Context:
         rects = []
         xs0 = grid.x0 + np.arange(grid.nx) * grid.cell
         for j in range(grid.ny):
-            above = np.concatenate([[False], heights[j] > z, [False]]).astype(np.int8)
+            above = np.concatenate([[False], heights[j] > z + _FLOOR_NOISE, [False]]).astype(np.int8)
             edges = np.flatnonzero(np.diff(above))
             y0 = grid.y0 + j * grid.cell
             for a, e in zip(edges[::2], edges[1::2]):
@@ -380,7 +381,7 @@ def _length(pas: clearing.Pass) -> float:
     return float(np.hypot(*np.diff(xy, axis=0).T).sum())
 
 
-def _air_approach(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, air_free: P.Shape
+def _air_approach(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, material_reach: P.Shape
                   ) -> Optional[tuple[np.ndarray, int]]:
     """(a point beside the stock where the tool stands in air, the index of the outer loop's vertex it is
     fed to) if the region is open to the outside; the straight move between them lies in the tool-centre
@@ -397,15 +398,15 @@ def _air_approach(ctx: _Context, z: float, region: P.Region, tool_centres: P.Sha
             continue
         normal = np.array([t[1], -t[0]]) / tl   # outward of a counter-clockwise loop
         p = outer[k] + d * normal
-        if not P.contains_point(air_free, p) and P.segment_inside(p, outer[k], tool_centres):
+        if not P.contains_point(material_reach, p) and P.segment_inside(p, outer[k], tool_centres):
             return p, k
     return None
 
 
-def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, air_free: P.Shape,
+def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Shape, material_reach: P.Shape,
                   steps: _Steps) -> list[CutSegment]:
     p = ctx.params
-    approach = _air_approach(ctx, z, region, tool_centres, air_free)
+    approach = _air_approach(ctx, z, region, tool_centres, material_reach)
     open_region = approach is not None
     if p.pattern == "offset":
         passes = clearing.offset_passes(region, ctx.s, climb=ctx.climb, outside_in=open_region,
@@ -430,7 +431,7 @@ def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Sha
             joined = float(np.hypot(*(q - prev_end))) <= ctx.D and P.segment_inside(prev_end, q, region.shape)
         if i == 0 and open_region:
             tips = np.vstack([[[air[0], air[1], z]], _tips(pas.xy, z, pas.closed)])
-            # down through air beside the stock: no material at any height over the tool there (air_free)
+            # down through air beside the material: none at or above z under the tool there (material_reach)
             seg = CutSegment(tips, entry=PLUNGE, entry_z=z, closed=False)
         else:
             try:
@@ -482,7 +483,6 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     slices = wl.waterline_loops(surface, needle, levels, bounds, sample_step=sample, chord_tol=params.chord_tol,
                                 progress=steps.part(0.45, 0.6))
     ctx = _Context(cutter, params, top)
-    air_free = P.offset(ctx.material_xy(final), ctx.R + 1e-3, ctx.arc_tol)
     segments: list[CutSegment] = []
     unreachable = 0.0
     region_count = 0
@@ -494,13 +494,16 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
         material = ctx.material_xy(float(z))
         if not material or not tool_centres:
             continue
+        # where the tool standing touches material at or above z: a descent outside it is through air (the
+        # stock is a height field; what earlier layers or ops cleared below the top is air too)
+        material_reach = P.offset(material, ctx.R + 1e-3, ctx.arc_tol)
         # the first loop round the material takes a step-over of it (or the tool's radius, for step-overs
         # past half the diameter: an erosion by s - R would cut the stock's corners off)
         touching = P.offset(material, max(ctx.R - ctx.s, 0.0), ctx.arc_tol)
         cut_shape = P.intersection(tool_centres, touching)
         regions = [r for r in P.regions(cut_shape) if r.area > _MIN_REGION_AREA]
         for region in regions:
-            segments += _clear_region(ctx, float(z), region, tool_centres, air_free, steps)
+            segments += _clear_region(ctx, float(z), region, tool_centres, material_reach, steps)
         region_count += len(regions)
         swept = P.offset(cut_shape, ctx.reach, ctx.arc_tol) if cut_shape else []
         ctx.swept.append((float(z), swept))
