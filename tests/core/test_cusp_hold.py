@@ -127,12 +127,35 @@ def test_a_check_above_the_work_limit_is_skipped_and_said_the_path_stands(field)
     assert result.segments and "not run" in cusp_check.CuspCheck(**said).summary()
 
 
-def test_auto_leaves_a_large_region_unchecked_and_says_so():
+def test_auto_measures_a_large_region_on_coarser_cells_and_says_how_far_a_crest_may_read_low():
     plate = grid_mesh(np.zeros((3, 3)), (80.0, 80.0), "plate")
     params = _params("cusp", (0.0, 0.0, 80.0, 80.0))
-    assert cusp_check.cells(params.boundary, BALL, TOL) > cusp_check.AUTO_CELLS and not cusp_check.runs(params, BALL)
+    fine = measure_cell(BALL, TOL)
+    assert cusp_check.cells(params.boundary, BALL, TOL) > cusp_check.AUTO_CELLS
+    cell = cusp_check.check_cell(params, BALL)
+    assert cell > fine and cusp_check.cells(params.boundary, BALL, TOL, cell) <= cusp_check.AUTO_CELLS
     said = compute(plate, BALL, params).diagnostics["cusp_check"]
-    assert said["auto"] and "CheckCusp Auto" in said["skipped"] and said["measured"] == 0
-    small = _params("cusp", (0.0, 0.0, 30.0, 30.0))
-    assert cusp_check.runs(small, BALL) and not cusp_check.runs(_params("cusp", cusp_check="off"), BALL)
-    assert cusp_check.runs(_params("cusp", (0.0, 0.0, 80.0, 80.0), cusp_check="on"), BALL)
+    assert not said["skipped"] and said["cell"] == cell
+    assert said["measured"] == cusp_check.cells(params.boundary, BALL, TOL, cell)   # every cell of the plate
+    assert said["reads_low"] == pytest.approx(cell * cell / BALL.diameter) and "read up to" in \
+        cusp_check.CuspCheck(**said).summary()
+    assert cusp_check.check_cell(_params("cusp", (0.0, 0.0, 80.0, 80.0), cusp_check="on"), BALL) == fine
+    assert cusp_check.check_cell(_params("cusp", (0.0, 0.0, 30.0, 30.0)), BALL) == fine
+    assert not cusp_check.applies(_params("cusp", cusp_check="off"))
+
+
+def test_auto_on_coarser_cells_finds_what_the_verification_cells_find_within_its_bound(field, monkeypatch):
+    """The window forced onto coarser cells (Auto's limit lowered): the same places above the cusp, the largest
+    within reads_low / cos^2 of the window's steepest measured slope (55 deg) of the fine cells' reading."""
+    mesh, surface = field
+    result = compute(mesh, BALL, _params("adaptive", cusp_check="off"), None, surface)
+    fine = cusp_check.check_segments(mesh, BALL, result.segments, _params("adaptive", cusp_check="on"), surface)
+    monkeypatch.setattr(cusp_check, "AUTO_CELLS", fine.measured // 3)
+    coarse = cusp_check.check_segments(mesh, BALL, result.segments, _params("adaptive"), surface)
+    assert coarse.cell > 1.5 * fine.cell and coarse.measured <= fine.measured // 3 and coarse.reads_low > 0
+    assert fine.exceeding > 0 and coarse.exceeding > 0
+    bound = coarse.reads_low / np.cos(np.radians(55.0)) ** 2
+    assert coarse.max_cusp >= fine.max_cusp - bound
+    near = [min(np.hypot(x - cx, y - cy) for cx, cy, _, _ in coarse.places) for x, y, _, _ in fine.places[:1]]
+    assert near[0] < BALL.diameter
+

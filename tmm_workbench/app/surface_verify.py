@@ -2,7 +2,7 @@
 the pass set in the stock simulation and adds partial passes where its cusp exceeds CuspHeight. Off by default,
 and off in documents saved before it (a Bool property added on restore is False): their path is unchanged.
 
-`CheckCusp` (Auto by default: on small regions; core.footprint.cusp_check): a cusp mode's pass set measured as the
+`CheckCusp` (Auto by default: a large region on coarser cells; core.footprint.cusp_check): a cusp mode's pass set measured as the
 verification measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
 largest, where) and, when cells exceed it, a warning suggesting VerifyCusp. It never changes the path.
 
@@ -24,8 +24,9 @@ PROPERTIES: list[Prop] = [
          "reported, not chased", "verify_cusp"),
     Prop("App::PropertyEnumeration", "CheckCusp", "Surface",
          "Cusp modes (Cusp, Adaptive, Offset3D): measure the passes in the stock simulation as VerifyCusp does, "
-         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where (Auto: on "
-         "small regions, where it takes a few seconds; On: always, about as long again as the passes)",
+         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where (Auto: a "
+         "few seconds, a large region on coarser cells, saying how far a crest may read low; On: always on the "
+         "verification's cells, about as long again as the passes)",
          "cusp_check"),
 ]
 CHOICES = {"CheckCusp": {"Auto": "auto", "On": "on", "Off": "off"}}
@@ -57,7 +58,7 @@ def report(obj: Any, notes: list) -> None:
     for note in notes:
         if isinstance(note, CuspCheck):
             _report_property(obj, note.summary())
-            if note.within or note.auto or note.verified:   # (VerifyCusp warns itself)
+            if note.within or note.verified:   # (VerifyCusp warns itself)
                 FreeCAD.Console.PrintMessage(f"{obj.Label}: {note.summary()}\n")
             else:
                 FreeCAD.Console.PrintWarning(f"{obj.Label}: {note.summary()}\n")

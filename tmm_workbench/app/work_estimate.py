@@ -207,10 +207,11 @@ def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
     from tmm_workbench.core.footprint import cusp_check, variable_step
 
     if not params.verify_cusp:  # CheckCusp measures the cusp modes' passes (skipped above the limits)
-        if not cusp_check.runs(params, _cutter(obj)):
+        if not cusp_check.applies(params):
             return est
         try:
-            dense = cusp_check.cost_points(params.boundary, _cutter(obj), params.cusp)
+            dense = cusp_check.cost_points(params.boundary, _cutter(obj), params.cusp,
+                                           cusp_check.check_cell(params, _cutter(obj)))
         except WorkLimitError:
             return replace(est, note="(the cusp check is skipped: its measurement is above the work limit)")
         return replace(est, count=est.count + dense, note="(with the cusp check's dense raster, at most)")

@@ -7,7 +7,9 @@ an eighth of the planar step, the dense raster sampled a cell apart) and reports
 cusp (with the crest between cells, CuspField.ridge_cusp, as the verification decides), the largest, and where:
 the bounding box and up to PLACES places (the worst cell of each group of exceeding cells within a tool diameter of
 each other), so that the op can say it and suggest VerifyCusp. With VerifyCusp on, the verification's own final
-measurement gives the same report (no second measurement).
+measurement gives the same report (no second measurement). CheckCusp Auto measures every region at a bounded cost:
+one with more than AUTO_CELLS of the verification's cells on coarser cells (check_cell), saying how far a crest
+may read low there (reads_low).
 """
 from __future__ import annotations
 
@@ -31,8 +33,8 @@ from tmm_workbench.core.sim.stock import box_heights, mesh_heights
 from tmm_workbench.core.tools.cutter import Cutter
 
 PLACES = 5
-AUTO_CELLS = 250_000   # the check runs by default (CheckCusp Auto) on at most this many cells (30 x 30 mm for a ball
-                       # D6 at 0.01 mm: a few seconds)
+AUTO_CELLS = 250_000   # CheckCusp Auto measures at most this many cells (30 x 30 mm of the verification's cells for a
+                       # ball D6 at 0.01 mm: a few seconds); a larger region on coarser cells (check_cell)
 
 
 @dataclass
@@ -48,8 +50,9 @@ class CuspCheck:
     steep: int = 0
     seconds: float = 0.0
     verified: bool = False            # measured after the verification's partial passes
-    skipped: str = ""                 # why it did not run (its work above the limits, or above AUTO_CELLS)
-    auto: bool = False                # left out by CheckCusp Auto (not a warning)
+    skipped: str = ""                 # why it did not run (its work above the limits)
+    reads_low: float = 0.0            # mm a cusp may read under its crest on level ground (reads_low), on cells
+                                      # coarser than the verification's (0 on those)
 
     @property
     def within(self) -> bool:
@@ -58,14 +61,17 @@ class CuspCheck:
     def summary(self) -> str:
         if self.skipped:
             return f"cusp check {self.tolerance:g} mm not run: {self.skipped}"
+        coarse = (f"; CheckCusp Auto on this large region: a crest may read up to {self.reads_low:.4f} mm low "
+                  "(level ground; / cos^2 of a slope)" if self.reads_low else "")
         if self.within:
             return (f"cusp check {self.tolerance:g} mm: held on all {self.measured} measured cells "
-                    f"(largest {self.max_cusp:.4f} mm, {self.cell:.3g} mm cells)")
+                    f"(largest {self.max_cusp:.4f} mm, {self.cell:.3g} mm cells{coarse})")
         where = "; ".join(f"({x:.1f}, {y:.1f}) {c:.4f} mm" for x, y, c, _ in self.places)
         x0, y0, x1, y1 = self.box
-        return (f"cusp check {self.tolerance:g} mm: {self.exceeding} of {self.measured} measured cells above it, up "
-                f"to {self.max_cusp:.4f} mm, within x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} mm; worst at {where}"
-                + (" (after VerifyCusp's rounds)" if self.verified else ". VerifyCusp adds partial passes there"))
+        return (f"cusp check {self.tolerance:g} mm: {self.exceeding} of {self.measured} measured {self.cell:.3g} mm "
+                f"cells above it, up to {self.max_cusp:.4f} mm, within x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} mm; "
+                f"worst at {where}" + (" (after VerifyCusp's rounds)" if self.verified else
+                                       f". VerifyCusp adds partial passes there{coarse}"))
 
     def as_dict(self) -> dict:
         return dict(self.__dict__)
@@ -116,7 +122,7 @@ def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], pa
     t0 = time.perf_counter()
     surface = surface or DropSurface(mesh)
     tol, s = params.cusp, params.stock_to_leave
-    grid = measure_grid(params.boundary, cutter, measure_cell(cutter, tol))
+    grid = measure_grid(params.boundary, cutter, check_cell(params, cutter))
     design = mesh_heights(mesh, grid, surface)
     stock_top = float(mesh.bounds[1][2]) + s + STOCK_ABOVE_MM
     cancel.poll()
@@ -138,7 +144,10 @@ def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], pa
         cusp[screen] = fld.ridge_cusp(heights)[screen]
         for mine, theirs in ((measured, fld.measured), (steep, fld.steep), (unreachable, fld.unreachable)):
             mine[screen] = theirs[screen]
-    return _report(grid, cusp, measured, unreachable, steep, tol, cutter.diameter, time.perf_counter() - t0)
+    out = _report(grid, cusp, measured, unreachable, steep, tol, cutter.diameter, time.perf_counter() - t0)
+    if grid.cell > measure_cell(cutter, tol) * (1 + 1e-9):   # CheckCusp Auto's coarser cells: say what they miss
+        out.reads_low = reads_low(cutter, grid.cell)
+    return out
 
 
 def _report(grid: Grid, cusp: np.ndarray, measured: np.ndarray, unreachable: np.ndarray, steep: np.ndarray,
@@ -154,13 +163,12 @@ def _report(grid: Grid, cusp: np.ndarray, measured: np.ndarray, unreachable: np.
     return out
 
 
-def cost_points(boundary: Any, cutter: Cutter, cusp: float) -> float:
-    """The check's CL points at most (variable_step.estimate_work: the dense raster everywhere and the design),
-    refused above the limits (WorkLimitError)."""
+def cost_points(boundary: Any, cutter: Cutter, cusp: float, cell: Optional[float] = None) -> float:
+    """The check's CL points at most on `cell` mm cells (the verification's by default; variable_step.estimate_work:
+    the dense raster everywhere and the design), refused above the limits (WorkLimitError)."""
     from tmm_workbench.core.footprint.variable_step import estimate_work, measure_cell
 
-    return estimate_work(boundary, cutter, cusp, measure_cell(cutter, cusp), "cusp check")
-
+    return estimate_work(boundary, cutter, cusp, cell or measure_cell(cutter, cusp), "cusp check")
 
 
 def applies(params: Any) -> bool:
@@ -170,19 +178,40 @@ def applies(params: Any) -> bool:
     return params.cusp_check != "off" and params.stepover_mode != STEPOVER
 
 
-def cells(boundary: Any, cutter: Cutter, cusp: float) -> int:
-    """The check's (and the verification's) measured cells over `boundary`, before any is allocated."""
+def cells(boundary: Any, cutter: Cutter, cusp: float, cell: Optional[float] = None) -> int:
+    """The cells measured over `boundary` on `cell` mm cells (the verification's by default), before any is
+    allocated."""
     from tmm_workbench.core.footprint.variable_step import measure_cell
     from tmm_workbench.core.sim.cusp_field import measure_grid_size
 
-    nx, ny = measure_grid_size(boundary, cutter, measure_cell(cutter, cusp))
+    nx, ny = measure_grid_size(boundary, cutter, cell or measure_cell(cutter, cusp))
     return nx * ny
 
 
-def runs(params: Any, cutter: Cutter) -> bool:
-    """Whether the check runs: on, or auto on at most AUTO_CELLS cells (where it costs a few seconds; on the
-    benchmark's 60 x 60 mm fields and larger it took 35-75 % of the pass placement's time)."""
-    return applies(params) and (params.cusp_check == "on" or cells(params.boundary, cutter, params.cusp) <= AUTO_CELLS)
+def check_cell(params: Any, cutter: Cutter) -> float:
+    """The check's cell: the verification's (variable_step.measure_cell); with CheckCusp Auto, on a region of more
+    than AUTO_CELLS of them, one about sqrt(their count / AUTO_CELLS) times coarser, with at most AUTO_CELLS (the
+    check's work then about that of a 30 x 30 mm region at the verification's cells, whatever the region's size:
+    the cells, the path's cut into them and the dense raster's points all scale with their count)."""
+    from tmm_workbench.core.footprint.variable_step import measure_cell
+
+    cell = measure_cell(cutter, params.cusp)
+    if params.cusp_check == "on":
+        return cell
+    scale = math.sqrt(max(1.0, cells(params.boundary, cutter, params.cusp) / AUTO_CELLS))
+    while cells(params.boundary, cutter, params.cusp, cell * scale) > AUTO_CELLS:
+        scale *= 1.01
+    return cell * scale
+
+
+def reads_low(cutter: Cutter, cell: float) -> float:
+    """How far under its crest a cusp may read on level ground on `cell` mm cells: a crest between two tool surfaces
+    of curvature 1 / rho across it (rho the ball's or the corner's radius; the radius for a flat end) read as the V
+    through three cells (CuspField.ridge_cusp) is at most 3 c^2 / (8 rho) low, and the dense raster a cell apart
+    stands up to c^2 / (8 rho) above the envelope it stands for: c^2 / (2 rho) in all. On a slope t across the
+    crest the tool's surface bends 1 / cos^3 t more and the cusp is read along the normal: / cos^2 t."""
+    rho = cutter.corner_radius or cutter.radius
+    return cell * cell / (2 * rho)
 
 
 def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
@@ -190,23 +219,15 @@ def report_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[Cut
     """raster_drop's call: the check in diagnostics["cusp_check"], and appended to params.verify_notes when given
     (the op reports it); None when the verification ran (its final measurement is the report: variable_step)."""
     from tmm_workbench.core.errors import WorkLimitError
-    from tmm_workbench.core.footprint.variable_step import measure_cell
 
     if "cusp_check" in diagnostics:
         return None
-    check = None
-    if not runs(params, cutter):
-        n = cells(params.boundary, cutter, params.cusp)
-        check = CuspCheck(params.cusp, measure_cell(cutter, params.cusp), auto=True, skipped=(
-            f"{n} cells to measure, more than the {AUTO_CELLS} CheckCusp Auto measures (set it On: it takes about as "
-            "long again as the passes; or VerifyCusp)"))
-    if check is None:
-        try:
-            cost_points(params.boundary, cutter, params.cusp)
-        except WorkLimitError as exc:   # the path stands; only the check is left out, and said
-            check = CuspCheck(params.cusp, measure_cell(cutter, params.cusp), skipped=str(exc))
-    if check is None:
+    cell = check_cell(params, cutter)
+    try:
+        cost_points(params.boundary, cutter, params.cusp, cell)
         check = check_segments(mesh, cutter, segments, params, surface)
+    except WorkLimitError as exc:   # the path stands; only the check is left out, and said
+        check = CuspCheck(params.cusp, cell, skipped=str(exc))
     diagnostics["cusp_check"] = check.as_dict()
     if params.verify_notes is not None:
         params.verify_notes.append(check)
