@@ -11,7 +11,7 @@ import pytest
 
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.machine import JointLimitError, Joints, TarusMachine
+from tmm_workbench.core.machine import JointLimitError, Joints, TarusMachine, rotary
 from tmm_workbench.app import post_objects as objects
 from tmm_workbench.core.post import Operation, ToolInfo, apt_writer, tarus_writer
 from tmm_workbench.core.post.apt_writer import AptOptions, write_apt
@@ -215,7 +215,7 @@ def test_cycle_time_estimate():
     m = TarusMachine()
     tp = tilted_path(50)
     res = write_tarus(program(tp), m, TarusOptions(precision=10, angle_precision=12, **WHOLE))
-    joints = m.solve_path(tp.points(), tp.axes(), rapid=[mv.kind is MoveKind.RAPID for mv in tp])
+    joints = rotary.solve_path(m, tp.points(), tp.axes(), rapid=[mv.kind is MoveKind.RAPID for mv in tp])
     feeds = [None if mv.kind is MoveKind.RAPID else (VERT if mv.kind is MoveKind.PLUNGE else HORIZ) for mv in tp]
     assert res.cycle_time == pytest.approx(m.cycle_time(joints, tp.points(), feeds), rel=1e-9)
 

@@ -9,6 +9,7 @@ import pytest
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine import JointLimitError, Joints, JointSpeeds, TarusMachine, ThreeAxisMachine
+from tmm_workbench.core.machine import rotary
 from tmm_workbench.core.machine.rotary import RotaryPlanError
 
 RNG = np.random.default_rng(20261123)
@@ -54,7 +55,7 @@ def test_ik_fk_vectorised_and_with_negative_tilts():
     n = 3000
     tips = RNG.uniform(-300, 300, (n, 3))
     axes = random_axes(n, math.radians(60.0))
-    joints = m.solve_path(tips, axes)
+    joints = rotary.solve_path(m, tips, axes)
     ft, fa = m.forward_path(joints)
     assert np.abs(ft - tips).max() < 1e-9
     assert np.abs(fa - axes).max() < 1e-12
@@ -91,7 +92,7 @@ def sweep_through_vertical(n: int = 41, tilt: float = math.radians(30)) -> tuple
 def test_sweep_through_vertical_with_negative_tilts_stays_on_one_branch():
     m = TarusMachine(c_limits=(-math.radians(45), math.radians(45)))
     tips, axes = sweep_through_vertical()
-    j = m.solve_path(tips, axes)
+    j = rotary.solve_path(m, tips, axes)
     assert np.all(j[:, 3] == 0.0)  # A never moves
     np.testing.assert_allclose(j[:, 4], np.linspace(math.radians(30), -math.radians(30), len(tips)), atol=1e-12)
     ft, fa = m.forward_path(j)
@@ -101,7 +102,7 @@ def test_sweep_through_vertical_with_negative_tilts_stays_on_one_branch():
 def test_sweep_through_vertical_with_positive_tilts_turns_a_once_at_the_pole():
     m = TarusMachine()  # C in 0..45 deg: the head must turn A by 180 deg where the tool is vertical
     tips, axes = sweep_through_vertical()
-    j = m.solve_path(tips, axes)
+    j = rotary.solve_path(m, tips, axes)
     assert np.all(j[:, 4] >= 0)
     da = np.diff(j[:, 3])
     assert np.count_nonzero(np.abs(da) > 1e-12) == 1
@@ -132,11 +133,11 @@ def test_a_unwrapping_on_a_spiral_has_no_jumps():
     m = TarusMachine(a_limits=None)  # a continuous A
     tips, axes = spiral(3, 721)      # three full turns of the axis azimuth, 1.5 deg per step
     c = math.radians(20)
-    j = m.solve_path(tips, axes)
+    j = rotary.solve_path(m, tips, axes)
     assert np.abs(np.diff(j[:, 3])).max() < math.radians(1.5) + 1e-9
     assert j[-1, 3] == pytest.approx(6 * math.pi, abs=1e-9)
     # the other way round too, starting next to -180 deg
-    j2 = m.solve_path(tips[::-1], axes[::-1], start=Joints(0, 0, 0, 6 * math.pi, c))
+    j2 = rotary.solve_path(m, tips[::-1], axes[::-1], start=Joints(0, 0, 0, 6 * math.pi, c))
     assert np.abs(np.diff(j2[:, 3])).max() < math.radians(1.5) + 1e-9
     assert j2[-1, 3] == pytest.approx(0.0, abs=1e-9)
 
@@ -145,18 +146,18 @@ def test_a_limits_never_unwind_inside_a_cut():
     """The old planner put a whole turn of A into a cutting move to stay inside the limits; now a cut that
     cannot fit is refused, naming its moves, and one that fits gets the turn that keeps it inside."""
     with pytest.raises(RotaryPlanError) as err:
-        TarusMachine().solve_path(*spiral(3, 721))   # 1080 deg of A, limits +-360
+        rotary.solve_path(TarusMachine(), *spiral(3, 721))   # 1080 deg of A, limits +-360
     assert "moves 0..720" in str(err.value) and "1080 deg" in str(err.value)
     narrow = TarusMachine(a_limits=(-math.pi, math.pi))
     with pytest.raises(RotaryPlanError):
-        narrow.solve_path(*spiral(0.75, 400))          # 270 deg of A do not fit 360 deg that start at -180
+        rotary.solve_path(narrow, *spiral(0.75, 400))          # 270 deg of A do not fit 360 deg that start at -180
     start = Joints(0, 0, 0, math.radians(170), 0.2)
     tips, axes = spiral(0.4, 200)                    # 144 deg, starting at azimuth 0
-    j = narrow.solve_path(tips, axes, start=start)
+    j = rotary.solve_path(narrow, tips, axes, start=start)
     assert np.abs(np.diff(j[:, 3])).max() < math.radians(1.0)  # continuous: no wrap inside
     assert j[:, 3].min() >= -math.pi - 1e-12 and j[:, 3].max() <= math.pi + 1e-12
     fitted = TarusMachine(a_limits=(math.radians(300), math.radians(520)))
-    j = fitted.solve_path(tips, axes)                # moved up one whole turn to fit
+    j = rotary.solve_path(fitted, tips, axes)                # moved up one whole turn to fit
     assert j[0, 3] == pytest.approx(2 * math.pi)
 
 
@@ -170,7 +171,7 @@ def test_a_unwinds_at_the_rapid_between_cuts():
     tips = np.vstack([t1, up, t2])
     axes = np.vstack([a1, [[0.0, 0.0, 1.0]], a2])
     rapid = [False] * len(t1) + [True] + [True] + [False] * (len(t2) - 1)
-    j = m.solve_path(tips, axes, rapid=rapid)
+    j = rotary.solve_path(m, tips, axes, rapid=rapid)
     assert j[:, 3].max() <= 2 * math.pi + 1e-12 and j[:, 3].min() >= -2 * math.pi - 1e-12
     cut1, cut2 = j[:len(t1), 3], j[len(t1) + 1:, 3]
     assert np.abs(np.diff(cut1)).max() < math.radians(1.5) and np.abs(np.diff(cut2)).max() < math.radians(1.5)
@@ -183,7 +184,7 @@ def test_limit_violation_names_move_joint_and_value():
     tips = np.zeros((3, 3))
     axes = np.array([[0, 0, 1.0], [math.sin(0.5), 0, math.cos(0.5)], [math.sin(1.0), 0, math.cos(1.0)]])
     with pytest.raises(JointLimitError) as err:
-        m.solve_path(tips, axes)
+        rotary.solve_path(m, tips, axes)
     e = err.value
     assert isinstance(e, TmmError)
     assert (e.index, e.joint) == (2, "C")
@@ -265,6 +266,6 @@ def test_a_continuous_does_not_unwind_between_cuts():
     tips = np.vstack([t1, [[0.0, 0.0, 80.0]], t1])
     axes = np.vstack([a1, [[0.0, 0.0, 1.0]], a1])
     rapid = [False] * len(t1) + [True] + [True] + [False] * (len(t1) - 1)
-    j = m.solve_path(tips, axes, rapid=rapid)
+    j = rotary.solve_path(m, tips, axes, rapid=rapid)
     assert np.abs(np.diff(j[:, 3])).max() < math.radians(61)
     assert j[-1, 3] == pytest.approx(math.radians(660))

@@ -40,7 +40,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.axes import slerp
-from tmm_workbench.core.machine.tarus import _LIMIT_SLACK, JointLimitError, Joints, TarusMachine
+from tmm_workbench.core.machine.tarus import _LIMIT_SLACK, JointLimitError, Joints, TarusMachine, unit_axis
 
 TWO_PI = 2.0 * math.pi
 _SAME_AXIS = 1e-12   # 1 - cos(angle) under which two axes are the same orientation
@@ -231,6 +231,22 @@ def plan(machine: TarusMachine, moves: list[Move], a_start: Optional[float] = No
             _check_linear(machine, row, i)
         joints[first:last + 1] = block
     return joints
+
+
+def solve_path(machine: TarusMachine, tips: np.ndarray, axes: np.ndarray, start: Optional[Joints] = None,
+               rapid: Optional[list[bool]] = None) -> np.ndarray:
+    """(n, 5) joints for a path of tips (n, 3) and axes (n, 3), planned as a post plans it (`plan`): A
+    continuous through each cut (branch, unwrapping, held through vertical axes), the whole turns that keep each
+    cut inside the A limits, unwinding only at rapids that turn the tool (`rapid`: per move; default none, the
+    whole path one cut). JointLimitError names the first move (0-based index) out of the X/Y/Z/C limits;
+    RotaryPlanError a cut A cannot follow."""
+    tips = np.asarray(tips, dtype=float).reshape(-1, 3)
+    axes = np.asarray(axes, dtype=float).reshape(-1, 3)
+    if len(tips) != len(axes):
+        raise TmmError(f"solve_path: {len(tips)} tips but {len(axes)} axes")
+    flags = [False] * len(tips) if rapid is None else [bool(r) for r in rapid]
+    moves = [Move(tuple(t), tuple(unit_axis(u)), r) for t, u, r in zip(tips, axes, flags)]
+    return plan(machine, moves, start.a if start is not None else None)
 
 
 def _turns(machine: TarusMachine, a: np.ndarray) -> list[int]:

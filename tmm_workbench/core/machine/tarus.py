@@ -240,23 +240,6 @@ class TarusMachine:
                 f"{u[2]:.6f}; {self.name})", joint, value, lim, index)
         return best
 
-    def solve_path(self, tips: np.ndarray, axes: np.ndarray, start: Optional[Joints] = None,
-                   rapid: Optional[Sequence[bool]] = None) -> np.ndarray:
-        """(n, 5) joints for a path of tips (n, 3) and axes (n, 3), planned as a post plans it
-        (core.machine.rotary): A continuous through each cut (branch, unwrapping, held through vertical
-        axes), the whole turns that keep each cut inside the A limits, unwinding only at rapids that turn
-        the tool (`rapid`: per move; default none, the whole path one cut). JointLimitError names the first
-        move (0-based index) out of the X/Y/Z/C limits; RotaryPlanError a cut A cannot follow."""
-        from tmm_workbench.core.machine import rotary
-
-        tips = np.asarray(tips, dtype=float).reshape(-1, 3)
-        axes = np.asarray(axes, dtype=float).reshape(-1, 3)
-        if len(tips) != len(axes):
-            raise TmmError(f"solve_path: {len(tips)} tips but {len(axes)} axes")
-        flags = [False] * len(tips) if rapid is None else [bool(r) for r in rapid]
-        moves = [rotary.Move(tuple(t), tuple(unit_axis(u)), r) for t, u, r in zip(tips, axes, flags)]
-        return rotary.plan(self, moves, start.a if start is not None else None)
-
     # --- time ----------------------------------------------------------------------------------
     def motion_time(self, j0: Joints | Sequence[float], j1: Joints | Sequence[float]) -> float:
         """Seconds from j0 to j1 with all joints moving at once at their constant speeds (seed 000 eq.
