@@ -122,6 +122,21 @@ def test_cancel_and_work_limit():
 OFFSET_TOL = 1e-6
 
 
+def test_a_pass_is_cancelled_within_it():
+    """The kernel reports within a pass too (the fraction of the width placed at its start), so that a long
+    pass can be cancelled before its end: stopped at the report after the first with some width placed, the
+    last report is that same fraction (before, the next report was the next pass's start)."""
+    seen: list[float] = []
+
+    def progress(f: float) -> bool:
+        seen.append(f)
+        return not (len(seen) >= 2 and seen[-2] > 0)
+
+    with pytest.raises(Cancelled):
+        adaptive_pass_offsets(bump(), Cutter.ball(6), BOX, 0.0, 0.01, 0.25, -30.0, progress=progress)
+    assert seen[-1] > 0 and seen[-1] == seen[-2]
+
+
 def _same(kernel, reference):
     assert len(kernel.offsets) == len(reference.offsets)
     assert np.abs(kernel.offsets - reference.offsets).max() <= OFFSET_TOL

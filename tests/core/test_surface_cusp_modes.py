@@ -14,7 +14,9 @@ from tests.core.test_adaptive_raster import BOX, bump
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.linking import LinkPolicy
+from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.sim.compare import slope_deg
+from tmm_workbench.core.sim.cusp_field import grid_envelope
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import box_heights
@@ -55,16 +57,45 @@ def test_adaptive_mode_keeps_the_cusp_in_the_simulated_stock():
     assert fractions and all(b >= a - 1e-12 for a, b in zip(fractions, fractions[1:]))  # never backwards
     grid = Grid.covering(4, 3.5, 16, 8.5, 0.02)
     cut = simulate(path, ball, grid, box_heights(grid, 5)).heights
-    dense = compute_surface_toolpath(mesh, ball, SurfaceParams(boundary=(0, -4, 20, 16), stepover=0.02,
-                                                               sample_step=0.25),
-                                     LinkPolicy(safe_height=10, clearance_height=12))
-    envelope = simulate(dense, ball, grid, box_heights(grid, 5)).heights
+    # the envelope of a dense raster dropped at points 0.02 mm apart both ways (no move across a valley's chord
+    # leaves material of its own: the cusp modes split theirs)
+    envelope = grid_envelope(mesh, ball, BOX, grid, 0.0, DropSurface(mesh), 5.0)
     cusp = (cut - envelope) * np.cos(np.radians(slope_deg(envelope, grid.cell)))
-    assert cusp.max() <= 1.05 * 0.01 and cusp.min() >= -2e-3
+    # (on the convex top the path's moves may pass below the exact drop height by the gouge tolerance, the
+    # envelope's points a cell apart do not)
+    assert cusp.max() <= 1.05 * 0.01 and cusp.min() >= -params.gouge_tol
     r = compute(mesh, ball, params)
     gaps = np.diff(pass_offsets(r))
     assert len(gaps) + 1 < 0.95 * (12.0 / gaps[:-1].min() + 1)
     assert r.diagnostics["cusp_limited"] == 0 and r.diagnostics["cusps"].max() <= 0.01
+
+
+def _highest_move_over_the_drop(mesh, cutter, result) -> float:
+    """How far the path's cutting moves pass above the exact drop height at 5 points between their ends."""
+    tips = [s.tips for s in result.segments if s.kind.value == "pass"]
+    a = np.vstack([t[:-1] for t in tips])
+    b = np.vstack([t[1:] for t in tips])
+    f = np.array([0.2, 0.4, 0.5, 0.6, 0.8])[None, :, None]
+    samples = (a[:, None, :] + f * (b - a)[:, None, :]).reshape(-1, 3)
+    exact = DropSurface(mesh).drop(cutter, samples[:, :2], -10.0)
+    return float((samples[:, 2] - exact).max())
+
+
+@pytest.mark.parametrize("mode", ["cusp", "adaptive"])
+def test_cusp_modes_split_the_moves_that_leave_material_across_a_valley(mode):
+    """A V valley crossing the passes at an angle: the ball's CL path kinks at its crease, and a move across the
+    kink passes above the exact CL path, leaving material the spacing (computed on the CL points) does not count.
+    The cusp modes split such moves until they pass at most a tenth of the cusp above it (plus the chord
+    tolerance of the thinning); the step-over mode keeps them."""
+    valley = grid_mesh(lambda x, y: 0.5 * np.abs(x - 10.0 - 0.3 * y), 200, 100, (-5, -5, 25, 15))
+    ball = Cutter.ball(6)
+    params = SurfaceParams(boundary=(0, 0, 20, 10), stepover_mode=mode, cusp=0.01, sample_step=0.25,
+                           cusp_check="off")
+    held = compute(valley, ball, params)
+    assert _highest_move_over_the_drop(valley, ball, held) <= 0.1 * 0.01 + params.chord_tol + 1e-6
+    assert held.diagnostics["between"]["inserted"] > 0
+    plain = compute(valley, ball, SurfaceParams(boundary=(0, 0, 20, 10), stepover=0.5, sample_step=0.25))
+    assert _highest_move_over_the_drop(valley, ball, plain) > 0.3 * 0.01
 
 
 def test_bad_cusp_input_is_named():

@@ -149,10 +149,15 @@ class Placer {
          const BatchOptions& batch, AdaptiveRasterResult& out)
       : index_(index), tool_(tool), o_(o), h_{cutter, cutter.max_radius()}, out_(out),
         needle_(o.stock_to_leave == 0 ? Cutter(1e-4, 0.0) : Cutter(o.stock_to_leave, o.stock_to_leave)) {
-    threads_.threads = batch.threads;  // the inner batches only compute; the caller reports progress
+    threads_.threads = batch.threads;
+    // a pass's batches report the pass's start (how many evaluations it takes is not known before), so that a
+    // long pass can be cancelled within it
+    if (batch.progress) threads_.progress = [&outer = batch.progress, this](double) { return outer(at_); };
     frame_ = {std::cos(o.angle), std::sin(o.angle), -std::sin(o.angle), std::cos(o.angle)};
     reach_ = static_cast<long>(std::ceil(h_.r_max / o.sample_step - 1e-9));
   }
+  Placer(const Placer&) = delete;  // its batches' progress refers to it
+  Placer& operator=(const Placer&) = delete;
 
   // The pass at `offset` in the turned frame: CL points (x, y, z) rows, or nothing outside the boundary.
   std::optional<std::vector<double>> line(double offset) const {
@@ -407,6 +412,8 @@ class Placer {
   }
 
   bool unreachable() const { return unreachable_; }
+  // The fraction of the width placed, reported while the next pass is placed.
+  void at(double fraction) { at_ = fraction; }
 
  private:
   const MeshIndex& index_;
@@ -418,6 +425,7 @@ class Placer {
   BatchOptions threads_;
   Frame frame_{};
   long reach_ = 0;
+  double at_ = 0.0;
   // the strip of pass a
   std::vector<double> x_, za_, ys_, design_, dx2_, hdx_, pa_;
   std::vector<std::size_t> sections_, near_;
@@ -492,7 +500,9 @@ AdaptiveRasterResult adaptive_raster(const MeshIndex& index, const Cutter& tool,
   std::optional<std::vector<double>> prev = placer.line(lo);
   double step = s_max;
   while (out.offsets.back() < hi - 1e-9) {
-    if (batch.progress && !batch.progress((out.offsets.back() - lo) / (hi - lo))) throw Cancelled();
+    const double placed = (out.offsets.back() - lo) / (hi - lo);
+    if (batch.progress && !batch.progress(placed)) throw Cancelled();
+    placer.at(placed);
     const double base = out.offsets.back();
     if (!prev) {  // the boundary's corner: nothing to measure against
       const double next = std::min(hi, base + s_min);

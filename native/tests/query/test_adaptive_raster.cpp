@@ -3,11 +3,13 @@
 //  - a convex cylinder along the passes: the cusp between two ball passes is where the two balls' circles
 //    cross, nearer the axis: D cos(d/2) - sqrt(R^2 - D^2 sin^2(d/2)) - Rc (D = Rc + R, d the angle between
 //    the centres); every gap's exact cusp within the tolerance and not much under it;
-//  - the same offsets for any thread count; progress sees the width placed, cancel throws Cancelled;
+//  - the same offsets for any thread count; progress sees the width placed, also within a pass, where cancel
+//    throws Cancelled too;
 //  - bad options and a too large section grid refused by name.
 // The numpy reference (core/footprint/adaptive_raster.py) is compared in tests/core/test_adaptive_raster.py.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -118,14 +120,26 @@ TEST(AdaptiveRaster, SameForAnyThreadCountProgressAndCancel) {
   const auto b = tmm::adaptive_raster(bump, bull, bull, o, two);
   EXPECT_EQ(a.offsets, b.offsets);
   EXPECT_EQ(a.cusps, b.cusps);
-  ASSERT_EQ(seen.size(), a.offsets.size() - 1);  // once before each pass after the first
-  for (std::size_t k = 1; k < seen.size(); ++k) EXPECT_GT(seen[k], seen[k - 1]);
+  // before each pass after the first the width placed, then within the pass that same fraction: never back,
+  // and as many values as passes placed
+  for (std::size_t k = 1; k < seen.size(); ++k) EXPECT_GE(seen[k], seen[k - 1]);
   EXPECT_EQ(seen.front(), 0.0);
+  std::vector<double> starts = seen;
+  starts.erase(std::unique(starts.begin(), starts.end()), starts.end());
+  EXPECT_EQ(starts.size(), a.offsets.size() - 1);
+  EXPECT_GT(seen.size(), starts.size());  // reports within the passes
+  // cancelled within a pass: stopped at the report after the first with some width placed, which comes from
+  // within that pass (the same fraction), not from the next pass's start
   tmm::BatchOptions stop;
-  int calls = 0;
-  stop.progress = [&](double) { return ++calls < 3; };
+  std::vector<double> asked;
+  stop.progress = [&](double f) {
+    asked.push_back(f);
+    return !(asked.size() >= 2 && asked[asked.size() - 2] > 0.0);
+  };
   EXPECT_THROW(tmm::adaptive_raster(bump, bull, bull, o, stop), tmm::Cancelled);
-  EXPECT_EQ(calls, 3);
+  ASSERT_GE(asked.size(), 2u);
+  EXPECT_GT(asked.back(), 0.0);
+  EXPECT_EQ(asked.back(), asked[asked.size() - 2]);
 }
 
 TEST(AdaptiveRaster, BadOptionsAreRefusedByName) {

@@ -50,6 +50,8 @@ _AIR_DEPTH_MM = 1e6  # SKIP drops onto a floor this far below the model: only ai
 _COLLINEAR_MM = 1e-7  # points this close to the chord of their neighbours add nothing to the path
 # Per CL point: the xy, z and segment arrays, the kernel's copies and the tool path's moves after thinning.
 _BYTES_PER_POINT = 400
+_LEAVE_SHARE = 0.1   # the cusp modes' moves pass at most this share of the cusp above the exact drop height (their
+                     # spacing counts the tool at the CL points: material a move leaves above them is not in it)
 
 
 @dataclass
@@ -216,11 +218,13 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
     diagnostics.update(points=len(xy), passes=len(lines) if chains is None else diagnostics["passes"])
-    if params.gouge_tol > 0:
+    leave = _LEAVE_SHARE * params.cusp if params.stepover_mode in (CUSP, ADAPTIVE) else math.inf
+    if params.gouge_tol > 0 or math.isfinite(leave):
         from tmm_workbench.core.strategies import raster_refine
 
-        runs, z, air, diagnostics["between"] = raster_refine.refine(runs, z, air, drop, params.gouge_tol,
-                                                                    chained=params.pattern in (ZIGZAG, SPIRAL))
+        runs, z, air, diagnostics["between"] = raster_refine.refine(
+            runs, z, air, drop, params.gouge_tol or math.inf, chained=params.pattern in (ZIGZAG, SPIRAL),
+            leave_tol=leave)
     if params.slope_min_deg > 0 or params.slope_max_deg < 90:
         from tmm_workbench.core.strategies import raster_region
 

@@ -9,6 +9,7 @@ go down an edge. Deeper moves than `tol` left after `rounds` are counted in the 
 """
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -21,12 +22,14 @@ _MID = 2  # the index of 0.5
 
 
 def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, drop: Drop, tol: float,
-           chained: bool, rounds: int = 12, min_step: float = 1e-3
+           chained: bool, rounds: int = 12, min_step: float = 1e-3, leave_tol: float = math.inf
            ) -> tuple[list[tuple[bool, np.ndarray]], np.ndarray, np.ndarray, dict]:
     """The runs (is_link, xy) with points inserted, their heights and air flags (flattened as the input).
     chained: consecutive runs are cut one after the other with the tool down (zig-zag: a pass, its link,
     the next pass), so the move from a run's last point to the next run's first is checked too (points
-    found there are added to the end of the first run)."""
+    found there are added to the end of the first run). leave_tol: a move passing more than this above the exact
+    drop height is split too (the cusp modes: in a concave valley or corner a move across the crease of the CL
+    surface leaves material above the cusp their spacing was computed for, which places it on the CL points)."""
     pts: list[np.ndarray] = []   # per run: (k, 3) points
     airs: list[np.ndarray] = []
     k = 0
@@ -61,11 +64,12 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
         cut = zs - samples[:, :, 2]
         cut[air_s] = -np.inf
         worst = cut.max(axis=1)
+        left = np.where(air_s, -np.inf, -cut).max(axis=1)
         # a jump of the drop height (an edge the tool falls off or climbs onto) can hide between the samples:
         # a steep move whose middle is far from its chord, above or below, is split until the jump is found
         steep = np.abs(b[:, 2] - a[:, 2]) > 10 * tol
         jump = steep & (np.abs(cut[:, _MID]) > tol) & np.isfinite(cut[:, _MID])
-        bad = np.flatnonzero((worst > tol) | jump)
+        bad = np.flatnonzero((worst > tol) | jump | (left > leave_tol))
         if not len(bad):
             todo = []
             break

@@ -63,7 +63,8 @@ AdaptiveRasterWork adaptive_raster_work(const Cutter& cutter, const AdaptiveRast
 // The passes (see the head). `tool` is dropped (the cutter grown by the stock to leave: its tip raised by
 // the stock gives the drop on the offset design); `cutter`'s profile shapes the surface the instances leave.
 // Threads and progress as batch queries do: batch.threads for the drops and the sections, batch.progress
-// (from the calling thread, once per pass, the fraction of the width placed; false cancels: throws
+// (from the calling thread: before each pass the fraction of the width placed, then within the pass's
+// batches every 20 ms that same fraction, so that a long pass can be cancelled too; false cancels: throws
 // Cancelled). Throws std::invalid_argument on bad options (adaptive_raster_work).
 AdaptiveRasterResult adaptive_raster(const MeshIndex& index, const Cutter& tool, const Cutter& cutter,
                                      const AdaptiveRasterOptions& options, const BatchOptions& batch);
