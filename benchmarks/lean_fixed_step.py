@@ -107,7 +107,7 @@ def main() -> None:
         sampled = compute(mesh, cutter, replace(params, chord_tol=0.0), surface=surface).segments
         exact = ExactDrop(surface.index, cutter, floor - 1e6 if skip else floor, 0.0, floor,
                           floor - 1e6 + 1.0 if skip else -math.inf)
-        lean, _, st = lean_segments_kernel(sampled, exact, TOL, p["sample_step"] / 2, lower_bound=True)  # as raster_drop
+        lean, st = lean_segments_kernel(sampled, exact, TOL, p["sample_step"] / 2, lower_bound=True)  # as raster_drop
         dt = time.perf_counter() - t0
         below, above = deviation(lean, surface, cutter, floor, skip)
         rows.append(dict(case=case.name, label="lean (kernel)", moves=moves(lean), below=below, above=above, s=dt,

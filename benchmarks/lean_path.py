@@ -39,7 +39,6 @@ import FreeCAD  # noqa: E402
 from tmm_workbench.app import posts  # noqa: E402
 from tmm_workbench.app.api import run_surface, simulate  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
-from tmm_workbench.core.strategies.raster_lean import chorded  # noqa: E402
 from tmm_workbench.core.toolpath import MoveKind  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
@@ -50,7 +49,7 @@ CLIFF = 2e-3  # mm: moves shorter in XY go down or up a cliff (raster_refine's c
 
 def deviation(toolpath, mesh, cutter: Cutter) -> tuple[float, float]:
     """(most below, most above) the exact CL path over the FEED moves, mm (air points left out)."""
-    tp = chorded(toolpath, 1e-5)
+    tp = toolpath.chorded(1e-5)
     p = tp.points()
     feed = np.array([m.kind is MoveKind.FEED for m in tp.moves])
     pts = []

@@ -36,19 +36,18 @@ from tmm_workbench.core.geometry import bezier  # noqa: E402
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
-from tmm_workbench.core.strategies.raster_lean import arc_chords  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 
-def with_arcs_chorded(segments, arc_map) -> list:
+def with_arcs_chorded(segments) -> list:
     """The segments' tips with each arc move replaced by its 1e-5 mm chords (only .tips, for deviation)."""
     out = []
     for seg in segments:
         t = seg.tips
         pts = [t[:1]]
-        for a, b in zip(t[:-1], t[1:]):
-            arc = arc_map.get((tuple(map(float, a)), tuple(map(float, b))))
-            pts.append(b[None] if arc is None else arc_chords(a, b, arc, 1e-5))
+        for k, (a, b) in enumerate(zip(t[:-1], t[1:])):
+            arc = seg.arc(k + 1)
+            pts.append(b[None] if arc is None else arc.chords(a, b, 1e-5))
         out.append(SimpleNamespace(tips=np.vstack(pts)))
     return out
 
@@ -86,14 +85,15 @@ def main() -> None:
             t0 = time.perf_counter()
             res = compute(mesh, cutter, replace(params, **extra), surface=surface)
             dt = time.perf_counter() - t0
-            segs, arc_map = res.segments, res.diagnostics.get("arcs") or {}
+            segs = res.segments
+            n_arcs = sum(a is not None for s in segs for a in (s.arcs or ()))
             n = moves(segs)
             base = base or n
-            row = dict(tol=tol_mesh, tris=len(mesh.triangles), label=label, moves=n, arcs=len(arc_map),
+            row = dict(tol=tol_mesh, tris=len(mesh.triangles), label=label, moves=n, arcs=n_arcs,
                        ratio=base / n, s=dt, below=float("nan"), above=float("nan"), dev_s=0.0)
             if not args.no_dev and label != "before":
                 t1 = time.perf_counter()
-                row["below"], row["above"] = deviation(with_arcs_chorded(segs, arc_map), surface, cutter, floor,
+                row["below"], row["above"] = deviation(with_arcs_chorded(segs), surface, cutter, floor,
                                                        False)
                 row["dev_s"] = time.perf_counter() - t1
             rows.append(row)

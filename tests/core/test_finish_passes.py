@@ -96,20 +96,20 @@ def test_arcs_kept_when_the_pass_set_runs_backwards(corner):
     """ArcFitting with two pass sets and a start point (the sets begun at the corner nearest it, run backwards
     for the far corner): every arc the raster fitted reaches the path, in the sense of the way it is run, and the
     finishing set's moves, arcs as circles, stay within the chord tolerance of the exact CL path."""
+    from tests.core.test_raster_lean import arcs_of
     from tmm_workbench.core.query.drop import DropSurface
-    from tmm_workbench.core.strategies.raster_lean import chorded
 
     mesh, tol = bump(), 0.001
     params = SurfaceParams(boundary=BOX, stepover=2.0, sample_step=0.5, forward_step="tolerance", chord_tol=tol,
                            arcs=True)
     finish = FinishParams(passes=2, step_down=0.5, start_xy=corner)
     path = compute_finish_toolpath(mesh, BALL, params, finish, POLICY)
-    fitted = sum(len(compute(mesh, BALL, params if k else replace(params, stock_to_leave=0.5)).diagnostics["arcs"])
+    fitted = sum(len(arcs_of(compute(mesh, BALL, params if k else replace(params, stock_to_leave=0.5)).segments))
                  for k in (0, 1))
     assert len(path.arcs) == fitted > 20
     assert {a.clockwise for a in path.arcs.values()} == {True, False}
     # the finishing set: the moves after the last retract
-    tp = chorded(path, 1e-6)
+    tp = path.chorded(1e-6)
     p = tp.points()
     last_rapid = max(i for i, m in enumerate(tp.moves) if m.kind is MoveKind.RAPID and i < len(tp.moves) - 3)
     feed = [i for i in range(last_rapid + 1, len(p)) if tp.moves[i].kind is MoveKind.FEED and i > 0]
@@ -143,3 +143,21 @@ def test_bad_input_is_named():
     with pytest.raises(TmmError, match="CL points"):  # all the pass sets counted before any is dropped
         compute_finish_toolpath(mesh, BALL, SurfaceParams(boundary=BOX, stepover=1e-3, sample_step=1e-3),
                                 FinishParams(passes=50, step_down=0.1), POLICY)
+
+
+def test_reverse_path_reverses_the_arcs():
+    """Each move of the reversed path is the same circle run the other way: the arc into tip i of a segment ends,
+    reversed, at its tip i - 1, and the arc into a joined segment's first tip moves to the segment before."""
+    from tmm_workbench.core.arcs import Arc
+    from tmm_workbench.core.segments import CutSegment
+
+    def arc(x: float) -> Arc:
+        return Arc((x, 0.0, -5.0), True, "XZ")
+
+    a = CutSegment(np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0]]), arcs=(None, arc(0.5), None))
+    b = CutSegment(np.array([[3.0, 0, 0], [4, 0, 0]]), joined=True, arcs=(arc(2.5), arc(3.5)))
+    back = reverse_path([a, b])
+    assert back[0].tips[:, 0].tolist() == [4, 3] and back[0].arcs == (None, arc(3.5).reversed())
+    assert back[1].joined and back[1].tips[:, 0].tolist() == [2, 1, 0]
+    assert back[1].arcs == (arc(2.5).reversed(), None, arc(0.5).reversed())
+    assert arc(0.5).reversed().clockwise is False

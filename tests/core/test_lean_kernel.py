@@ -1,7 +1,7 @@
-"""Lean passes fitted in the kernel (core.strategies.lean_kernel over native.lean_profiles, issue 14 item 2),
+"""Lean passes fitted in the kernel (core.strategies.lean_kernel over native.lean_profiles),
 against independent references with the real kernel: every move of the lean path sampled every 0.005 mm lies
 within +-tol of the exact drop height there (dense drops: the reference), the kernel's fit uses no more moves
-than the Python fit (raster_lean.lean_segments, the slow reference kept for this) on the same samples, at least
+than the Python fit (tests/core/lean_reference.py, the slow reference) on the same samples, at least
 the lower bound it reports, and the off-model (skip) moves stay as sampled; with arcs, the same band with fewer
 moves. The simulated stock against the
 design is checked in tests/core/test_raster_lean.py (lines: the kernel path)."""
@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 
 from tests.conftest import grid_mesh
-from tests.core.test_raster_lean import TOL, bump, move_points
+from tests.core import lean_reference
+from tests.core.test_raster_lean import TOL, arcs_of, bump, move_points
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import load_stl
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.shared_data import shared_dir
-from tmm_workbench.core.strategies import raster_lean
 from tmm_workbench.core.strategies.lean_kernel import ExactDrop, lean_segments_kernel
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
 from tmm_workbench.core.toolpath import MoveKind
@@ -38,7 +38,7 @@ def sphere_on_plate():
 
 
 def worst(mesh, cutter, segments) -> float:
-    pts = move_points(segments, {})
+    pts = move_points(segments)
     exact = DropSurface(mesh).drop(cutter, pts[:, :2], float(mesh.bounds[0][2]))
     return float(np.abs(pts[:, 2] - exact).max())
 
@@ -48,13 +48,13 @@ def both_fits(mesh, cutter, params):
     sampled = compute(mesh, cutter, replace(params, forward_step="sample", chord_tol=0.0)).segments
     surface = DropSurface(mesh)
     floor = float(mesh.bounds[0][2])
-    kern, _, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
-                                           params.sample_step / 2, lower_bound=True)  # as raster_drop
+    kern, kstats = lean_segments_kernel(sampled, ExactDrop(surface.index, cutter, floor, 0.0, floor), TOL,
+                                        params.sample_step / 2, lower_bound=True)  # as raster_drop
 
     def drop(p):
         return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
 
-    py, _, pstats = raster_lean.lean_segments(sampled, drop, TOL, False, min(params.sample_step / 4, 0.05))
+    py, pstats = lean_reference.lean_segments(sampled, drop, TOL, False, min(params.sample_step / 4, 0.05))
     return kern, kstats, py, pstats
 
 
@@ -98,27 +98,28 @@ def test_kernel_arcs_within_tolerance_and_fewer_moves(sphere_on_plate, angle):
     surface = DropSurface(sphere_on_plate)
     floor = float(sphere_on_plate.bounds[0][2])
     exact = ExactDrop(surface.index, cutter, floor, 0.0, floor)
-    segs, arcs, stats = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2, arcs=True)
-    lines, no_arcs, _ = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2)
+    segs, stats = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2, arcs=True)
+    lines, _ = lean_segments_kernel(sampled, exact, TOL, params.sample_step / 2)
+    arcs = arcs_of(segs)
 
     def drop(p):
         return np.maximum(surface.drop(cutter, p, floor), floor), np.zeros(len(p), dtype=bool)
 
-    py, py_arcs, _ = raster_lean.lean_segments(sampled, drop, TOL, True, min(params.sample_step / 4, 0.05))
-    pts = move_points(segs, arcs)
+    py, _ = lean_reference.lean_segments(sampled, drop, TOL, True, min(params.sample_step / 4, 0.05))
+    pts = move_points(segs)
     assert np.abs(pts[:, 2] - np.maximum(surface.drop(cutter, pts[:, :2], floor), floor)).max() <= TOL + 1e-6
-    assert stats["arcs"] == len(arcs) > 20 and not no_arcs and py_arcs
-    assert ("XZ" if angle == 0.0 else "YZ") in {a.plane for a in arcs.values()}  # (links run across: the other)
+    assert stats["arcs"] == len(arcs) > 20 and not arcs_of(lines) and arcs_of(py)
+    assert ("XZ" if angle == 0.0 else "YZ") in {a.plane for a in arcs}  # (links run across: the other)
     n_a, n_l, n_p = (sum(len(s) for s in x) for x in (segs, lines, py))
     assert n_a < n_l and n_a <= n_p, (n_a, n_l, n_p)
     res = compute(sphere_on_plate, cutter, params)  # the op's path is the kernel's, arcs included
-    assert sum(len(s) for s in res.segments) == n_a and len(res.diagnostics["arcs"]) == len(arcs)
+    assert sum(len(s) for s in res.segments) == n_a and arcs_of(res.segments) == arcs
 
 
 def feed_points(tp, step=0.005) -> np.ndarray:
     """Points every `step` mm along every FEED move of the linked path `tp` (arcs as 1e-6 mm chords): also the
     moves the linker makes between segments it joins, which no segment holds."""
-    tp = raster_lean.chorded(tp, 1e-6)
+    tp = tp.chorded(1e-6)
     p, out = tp.points(), []
     for i in range(1, len(p)):
         if tp.moves[i].kind is MoveKind.FEED:
@@ -131,15 +132,16 @@ def feed_points(tp, step=0.005) -> np.ndarray:
 def test_moves_between_joined_segments_within_tolerance(bump_mesh, arcs):
     """The zig-zag links cross the dome's slopes (the boundary's edges at x 10 and 30) with one sample between
     two passes: the moves into and out of a link are fitted and checked like the passes' (they were not, and
-    left the band: -0.0047 mm on mount_rush). The kernel's fit and the Python one (arcs); every arc reaches the
-    path (the linker finds it by its ends: a run's last point off by an ulp lost it, a chord instead)."""
+    left the band: -0.0047 mm on mount_rush). Every arc of the segments, the one into a joined segment's first
+    tip included, is an arc move of the linked path."""
     cutter = Cutter.ball(4.0)
     params = SurfaceParams(boundary=(10, 2, 30, 18), stepover=0.6, sample_step=0.5, forward_step="tolerance",
                            chord_tol=TOL, arcs=arcs)
     res = compute(bump_mesh, cutter, params)
     assert sum(s.kind.name == "LINK" for s in res.segments) > 20
-    tp = raster_lean.attach_arcs(link(res.segments, LinkPolicy(50.0, 55.0)), res.diagnostics["arcs"])
-    assert len(tp.arcs) == len(res.diagnostics["arcs"]) and (len(tp.arcs) > 100 or not arcs)  # each arc found
+    tp = link(res.segments, LinkPolicy(50.0, 55.0))
+    assert list(tp.arcs.values()) == arcs_of(res.segments) and (len(tp.arcs) > 100 or not arcs)
+    assert not arcs or any(s.joined and s.arc(0) is not None for s in res.segments)
     pts = feed_points(tp)
     floor = float(bump_mesh.bounds[0][2])
     exact = np.maximum(DropSurface(bump_mesh).drop(cutter, pts[:, :2], floor), floor)
@@ -148,8 +150,7 @@ def test_moves_between_joined_segments_within_tolerance(bump_mesh, arcs):
 
 def test_segment_ends_are_the_samples_bit_for_bit(bump_mesh):
     """A lean segment ends (and unless joined, starts) exactly where its samples did (both fits, a raster at 30
-    deg): the linker joins segments and finds arcs by these points (a last point rebuilt as origin + s u, an ulp
-    off, lost an arc on mount_rush: a chord 0.0117 mm below the path)."""
+    deg): the linker joins segments at these points (a last point rebuilt as origin + s u is an ulp off)."""
     cutter = Cutter.ball(4.0)
     params = SurfaceParams(boundary=(2, 2, 38, 18), stepover=1.0, sample_step=0.25, angle_deg=30.0,
                            forward_step="tolerance", chord_tol=TOL)
@@ -168,7 +169,7 @@ def test_stock_to_leave_and_air_are_the_raster_s(bump_mesh):
     params = SurfaceParams(boundary=(-6, 2, 46, 18), stepover=2.0, sample_step=0.25, forward_step="tolerance",
                            chord_tol=TOL, stock_to_leave=0.3, off_model="skip")
     res = compute(bump_mesh, cutter, params)
-    pts = move_points(res.segments, {})
+    pts = move_points(res.segments)
     grown = cutter.offset(0.3)
     floor = float(bump_mesh.bounds[0][2])
     exact = DropSurface(bump_mesh).drop(grown, pts[:, :2], floor - 1e6) + 0.3

@@ -45,6 +45,22 @@ def test_joined_segments_keep_the_tool_down():
     np.testing.assert_array_equal(cut, np.vstack([a.tips, link_.tips, b.tips]))
 
 
+def test_arcs_of_the_segments_are_the_feed_moves_arcs():
+    """The linker makes a segment's arcs arc moves (Move.arc): the move into a joined segment's first tip too,
+    never the entry into a segment it enters from above."""
+    from tmm_workbench.core.arcs import Arc
+
+    up, down = Arc((5.0, 0.0, -4.0), False, "XZ"), Arc((5.0, 5.0, -4.0), True, "XZ")
+    a = CutSegment(np.array([(0, 0, 1), (10, 0, 1)], dtype=float), arcs=(down, up))
+    b = CutSegment(np.array([(10, 5, 1), (0, 5, 1)], dtype=float), joined=True, arcs=(up, None))
+    c = CutSegment(np.array([(0, 10, 1), (10, 10, 1)], dtype=float), arcs=(down, up))
+    tp = link([a, b, c], LinkPolicy(8.0, 12.0))
+    feeds = [m for m in tp if m.kind is MoveKind.FEED]
+    assert [m.arc for m in feeds] == [up, up, None, up]  # a's and c's first tips are plunged onto
+    assert all(m.arc is None for m in tp if m.kind is not MoveKind.FEED)
+    assert tp.arcs == {i: m.arc for i, m in enumerate(tp.moves) if m.arc is not None} and len(tp.arcs) == 3
+
+
 def test_along_axis_retract_and_transit_height():
     tool = Cutter.torus(6.7, 6.0)
     t = math.radians(20)

@@ -1,4 +1,4 @@
-"""Lean passes (core.strategies.raster_lean, issue 14 item 2): the forward step chosen by the chord tolerance.
+"""Lean passes (core.strategies.raster_lean): the forward step chosen by the chord tolerance.
 Checked against independent references with the real kernel: every move (line or arc) of the lean path
 sampled every 0.005 mm lies within the tolerance of the exact drop height there (a dense-sampling
 reference), the simulated stock (core.sim) differs from the one a dense sampled path leaves by at most the
@@ -13,6 +13,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import grid_mesh
+from tests.core.lean_reference import fit_profile
+from tmm_workbench.core.arcs import Arc
 from tmm_workbench.core.geometry.mesh import load_stl
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.query.drop import DropSurface
@@ -21,7 +23,6 @@ from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import box_heights, mesh_heights
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute, compute_surface_toolpath
-from tmm_workbench.core.strategies.raster_lean import Arc, arc_chords, chorded, fit_profile
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.001
@@ -39,15 +40,21 @@ def bump_mesh():
     return grid_mesh(bump, 160, 80, (0, 0, 40, 20))
 
 
-def move_points(segments, arcs, step=0.005):
-    """Points every `step` mm along every cutting move of `segments` (arcs as 1e-6 mm chords)."""
+def arcs_of(segments):
+    """The arcs of the segments' moves (CutSegment.arcs), in order."""
+    return [a for seg in segments for a in (seg.arcs or ()) if a is not None]
+
+
+def move_points(segments, step=0.005):
+    """Points every `step` mm along every cutting move between the tips of each of `segments` (arcs as 1e-6 mm
+    chords)."""
     out = []
     for seg in segments:
         t = seg.tips
-        for a, b in zip(t[:-1], t[1:]):
-            arc = arcs.get((tuple(map(float, a)), tuple(map(float, b))))
+        for k, (a, b) in enumerate(zip(t[:-1], t[1:])):
+            arc = seg.arc(k + 1)
             if arc is not None:
-                pts = np.vstack([a, arc_chords(a, b, arc, 1e-6)])
+                pts = np.vstack([a, arc.chords(a, b, 1e-6)])
             else:
                 pts = np.vstack([a, b])
             for p, q in zip(pts[:-1], pts[1:]):
@@ -63,7 +70,7 @@ def test_within_tolerance_of_the_exact_path(bump_mesh, angle, arcs):
     params = SurfaceParams(boundary=(2, 2, 38, 18), stepover=1.0, sample_step=0.25, angle_deg=angle,
                            forward_step="tolerance", chord_tol=TOL, arcs=arcs)
     res = compute(bump_mesh, cutter, params)
-    pts = move_points(res.segments, res.diagnostics["arcs"])
+    pts = move_points(res.segments)
     exact = DropSurface(bump_mesh).drop(cutter, pts[:, :2], float(bump_mesh.bounds[0][2]))
     dev = pts[:, 2] - exact
     assert np.abs(dev).max() <= TOL + 1e-6, (dev.min(), dev.max())
@@ -73,10 +80,10 @@ def test_within_tolerance_of_the_exact_path(bump_mesh, angle, arcs):
     assert n_lean < n_sampled
     if arcs and angle in (0.0, 90.0):
         assert res.diagnostics["lean"]["arcs"] > 0
-        planes = {a.plane for a in res.diagnostics["arcs"].values()}  # zig-zag links run across the passes
+        planes = {a.plane for a in arcs_of(res.segments)}  # zig-zag links run across the passes
         assert ("XZ" if angle == 0.0 else "YZ") in planes and planes <= {"XZ", "YZ"}
     if angle == 30.0:
-        assert not res.diagnostics["arcs"]  # not in a principal plane: lines only
+        assert not arcs_of(res.segments)  # not in a principal plane: lines only
 
 
 def test_simulated_stock_within_tolerance_of_a_dense_reference(bump_mesh):
@@ -92,7 +99,7 @@ def test_simulated_stock_within_tolerance_of_a_dense_reference(bump_mesh):
     for arcs in (False, True):
         lean = compute_surface_toolpath(bump_mesh, cutter, replace(base, forward_step="tolerance", arcs=arcs), policy)
         assert bool(lean.arcs) == arcs
-        got = simulate(chorded(lean, 1e-5), cutter, grid, stock).heights
+        got = simulate(lean.chorded(1e-5), cutter, grid, stock).heights
         # the band: the surface cut at most TOL below the design (a tool at most TOL below the exact path) ...
         assert (got - design).min() >= -TOL - 1e-4, (got - design).min()
         # ... and no more left than TOL above what the dense path leaves (at a valley the dense path's 0.01 mm
@@ -112,8 +119,8 @@ def test_real_model_fewer_moves_within_tolerance():
     surface = DropSurface(mesh)
     outside = 0
     for seg in res.segments:
-        for a, b in zip(seg.tips[:-1], seg.tips[1:]):
-            pts = move_points([type(seg)(np.vstack([a, b]))], res.diagnostics["arcs"])
+        for k, (a, b) in enumerate(zip(seg.tips[:-1], seg.tips[1:])):
+            pts = move_points([type(seg)(np.vstack([a, b]), arcs=(None, seg.arc(k + 1)))])
             dev = np.abs(pts[:, 2] - surface.drop(cutter, pts[:, :2], float(mesh.bounds[0][2])))
             outside += dev.max() > TOL + 1e-6
     assert outside == 0 and res.diagnostics["lean"]["arcs"] > 20
@@ -150,12 +157,10 @@ def test_arc_sense_over_a_hump(plane, expected_g3):
     start[ax] -= r * math.sin(half)
     end[ax] += r * math.sin(half)
     start[2] = end[2] = r * math.cos(half)
-    from tmm_workbench.core.strategies.raster_lean import arc_entry
-
-    key, arc = arc_entry(start, end, c, plane)
-    assert key == (tuple(start), tuple(end))
+    arc = Arc.through(start, end, c, plane)
     assert arc.clockwise == (not expected_g3)
-    pts = arc_chords(start, end, arc, 1e-6)
+    assert arc.command(start, end)[0] == ("G3" if expected_g3 else "G2")
+    pts = arc.chords(start, end, 1e-6)
     assert np.allclose(np.linalg.norm(pts - c, axis=1), r)
     assert pts[:, 2].max() == pytest.approx(r, abs=1e-5)      # over the top, not the long way round below
     assert np.allclose(pts[:, 1 - ax], c[1 - ax])             # in the plane
@@ -167,10 +172,11 @@ def test_chorded_toolpath_keeps_lines_and_expands_arcs():
 
     tp = Toolpath()
     tp.add(MoveKind.FEED, 0, 0, 0)
-    tp.add(MoveKind.FEED, 10, 0, 0)
-    tp.arcs[1] = Arc((5.0, 0.0, -5.0), False, "XZ")  # G3 over the top from x 0 to 10, radius 5 * sqrt(2)
-    out = chorded(tp, 1e-4)
-    pts = out.points()
-    assert len(out) > 10 and np.allclose(pts[-1], (10, 0, 0))
+    tp.add(MoveKind.FEED, 10, 0, 0, arc=Arc((5.0, 0.0, -5.0), False, "XZ"))  # G3 over the top, radius 5 sqrt 2
+    tp.add(MoveKind.FEED, 12, 0, 0)
+    out = tp.chorded(1e-4)
+    assert tp.arcs == {1: tp.moves[1].arc} and not out.arcs
+    pts = out.points()[:-1]
+    assert len(out) > 10 and np.allclose(pts[-1], (10, 0, 0)) and out.moves[-1] == tp.moves[-1]
     assert np.allclose(np.hypot(pts[:, 0] - 5, pts[:, 2] + 5), math.sqrt(50))
     assert pts[:, 2].max() > 2.0

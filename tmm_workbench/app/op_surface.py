@@ -26,6 +26,7 @@ from tmm_workbench.app import offset_start
 from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
+from tmm_workbench.core.arcs import PLANE_CODES
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
@@ -35,7 +36,6 @@ from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL
 from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
 from tmm_workbench.core.strategies.raster_drop import SAMPLED, TOLERANCE
 from tmm_workbench.core.strategies.raster_drop import OFFSET3D  # the 3D offset spacing
-from tmm_workbench.core.strategies.raster_lean import arc_offsets
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
@@ -116,7 +116,6 @@ DEFAULTS["ForwardStep"] = "Tolerance"
 # FreeCAD posts whose parameter list has no K: an arc in XZ or YZ would lose its centre's Z (0.20-1.1)
 POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
                    "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
-_PLANE_CODES = {"XZ": "G18", "YZ": "G19"}
 # % step-over, Depths (final depth, finishing passes) and start point (issue 15 item 6): app.surface_passes
 PROPERTIES += surface_passes.PROPERTIES
 CHOICES.update(surface_passes.CHOICES)
@@ -226,15 +225,13 @@ class ObjectTmmSurface(op_base.TmmOp):
             out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
         plane = "XY"
         for i, (m, down) in enumerate(zip(toolpath, steep)):
-            arc = toolpath.arcs.get(i)
-            if arc is not None:  # lean passes: G2/G3 in the pass's vertical plane, the plane selected first
-                if arc.plane != plane:
-                    out.append(Path.Command(_PLANE_CODES[arc.plane], {}))
-                    plane = arc.plane
+            if m.arc is not None and i > 0:  # lean passes: G2/G3 in the pass's vertical plane, selected first
+                if m.arc.plane != plane:
+                    out.append(Path.Command(PLANE_CODES[m.arc.plane], {}))
+                    plane = m.arc.plane
                 prev = toolpath.moves[i - 1]
-                words = {"X": m.x, "Y": m.y, "Z": m.z, "F": self.horizFeed}
-                words.update(arc_offsets((prev.x, prev.y, prev.z), arc))
-                out.append(Path.Command("G2" if arc.clockwise else "G3", words))
+                name, words = m.arc.command((prev.x, prev.y, prev.z), (m.x, m.y, m.z))
+                out.append(Path.Command(name, {**words, "F": self.horizFeed}))
                 continue
             if m.kind is MoveKind.RAPID:
                 out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
@@ -242,7 +239,7 @@ class ObjectTmmSurface(op_base.TmmOp):
                 feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
                 out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
         if plane != "XY":
-            out.append(Path.Command("G17", {}))
+            out.append(Path.Command(PLANE_CODES["XY"], {}))
         return out
 
 

@@ -25,6 +25,8 @@ Helix and ramp are only as gouge-free as the XY they pass over: the strategy giv
 lies where the tool centre may go at the first tip's height and above (the linker does not see the model).
 The path starts at the clearance height over the first entry (5-axis: upright, then turned there) and
 ends at the clearance height (5-axis: upright again, so any later op starts untilted).
+The FEED moves through a segment's tips keep its arcs (CutSegment.arcs -> Move.arc): the move into its first
+tip only when the segment is joined (otherwise the entry reaches that tip).
 """
 from __future__ import annotations
 
@@ -346,7 +348,7 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
                     tp.add(MoveKind.FEED, *p, seg.axis(0))
             first = 1
         for i in range(first, len(pts)):
-            tp.add(MoveKind.FEED, *pts[i], seg.axis(i))
+            tp.add(MoveKind.FEED, *pts[i], seg.axis(i), seg.arc(i))
         if hasattr(policy.material_top, "cut"):   # a StockHeights: what this segment cut, for the later entries
             policy.material_top.cut(Toolpath(tp.moves[start:]))
     last = tp.moves[-1]
@@ -382,7 +384,7 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
             tp.add(MoveKind.PLUNGE, *seg.tips[0], a)                         # along the axis onto the face
             start = 1
         for i in range(start, len(seg)):
-            tp.add(MoveKind.FEED, *seg.tips[i], seg.axis(i))
+            tp.add(MoveKind.FEED, *seg.tips[i], seg.axis(i), seg.arc(i))
         if k + 1 < len(segments) and segments[k + 1].joined:
             continue
         a1 = seg.axis(len(seg) - 1)

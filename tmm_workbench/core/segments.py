@@ -11,6 +11,8 @@ Optional entry facts a strategy may give (core.linking's HELIX and RAMP use them
 tip: the helix or ramp begins there, the tool fed down to it through air; None: at the safe height),
 `helix_centre` and `helix_ccw` (the helix circle through the first tip and its sense), `closed` (the tips
 are a loop: a ramp follows it backwards from the first tip, around it as often as needed).
+`arcs` (3-axis): per tip, the arc (core.arcs.Arc) of the move that ends at it, None for a line; the move to the
+first tip comes from the previous segment's last one (used when `joined`). The linker makes them arc moves.
 """
 from __future__ import annotations
 
@@ -19,6 +21,10 @@ from dataclasses import dataclass, field
 from typing import Any, Optional
 
 import numpy as np
+
+from tmm_workbench.core.arcs import Arc
+
+ArcsAt = tuple[Optional[Arc], ...]  # per tip: the arc of the move ending there, None: a line
 
 
 class SegmentKind(enum.Enum):
@@ -38,6 +44,7 @@ class CutSegment:
     helix_centre: Optional[tuple[float, float]] = None
     helix_ccw: bool = True
     closed: bool = False                  # the tips are a closed loop
+    arcs: Optional[ArcsAt] = None         # per tip, the arc ending there; None: lines only
 
     def __post_init__(self) -> None:
         self.tips = np.asarray(self.tips, dtype=float).reshape(-1, 3)
@@ -45,6 +52,12 @@ class CutSegment:
             self.axes = np.asarray(self.axes, dtype=float).reshape(-1, 3)
             if len(self.axes) != len(self.tips):
                 raise ValueError(f"{len(self.axes)} tool axes for {len(self.tips)} tips")
+        if self.arcs is not None:
+            self.arcs = tuple(self.arcs)
+            if len(self.arcs) != len(self.tips):
+                raise ValueError(f"{len(self.arcs)} arcs for {len(self.tips)} tips")
+            if self.axes is not None and any(self.arcs):
+                raise ValueError("arcs are 3-axis moves: a segment with tool axes has none")
 
     def __len__(self) -> int:
         return len(self.tips)
@@ -54,6 +67,19 @@ class CutSegment:
             return (0.0, 0.0, 1.0)
         a = self.axes[i]
         return (float(a[0]), float(a[1]), float(a[2]))
+
+    def arc(self, i: int) -> Optional[Arc]:
+        """The arc of the move that ends at tip i (None: a line)."""
+        return None if self.arcs is None else self.arcs[i]
+
+    def reversed_arcs(self, into_first: Optional[Arc] = None) -> Optional[ArcsAt]:
+        """The arcs of this segment run backwards (its tips reversed): the arc ending at tip i then ends at
+        tip i - 1 and turns the other way; `into_first` is the arc of the move that now ends at the first tip."""
+        if (self.arcs is None and into_first is None) or not len(self):
+            return None
+        old = self.arcs or (None,) * len(self)
+        back = tuple(None if a is None else a.reversed() for a in old[:0:-1])
+        return (into_first,) + back
 
 
 @dataclass

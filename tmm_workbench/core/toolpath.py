@@ -1,15 +1,19 @@
 """The toolpath model: ordered moves of the tool tip and tool axis, before any FreeCAD or G-code concern.
 
 A move's position is the tool tip (the CL point of seed 000) in work coordinates, mm; its axis is the unit
-vector from the tip towards the spindle, (0, 0, 1) for 3-axis work.
+vector from the tip towards the spindle, (0, 0, 1) for 3-axis work. A FEED move may be an arc (`Move.arc`,
+core.arcs.Arc: G2/G3 from the previous move's point about its centre; 3-axis lean passes): readers that take
+moves as lines read its chord, or `Toolpath.chorded` for the arc within a tolerance.
 """
 from __future__ import annotations
 
 import enum
 from dataclasses import dataclass, field
-from typing import Iterator
+from typing import Iterator, Optional
 
 import numpy as np
+
+from tmm_workbench.core.arcs import Arc
 
 
 class MoveKind(enum.Enum):
@@ -28,14 +32,12 @@ class Move:
     y: float
     z: float
     axis: tuple[float, float, float] = Z_AXIS
+    arc: Optional[Arc] = None  # a FEED move along this circle from the previous move's point; None: a line
 
 
 @dataclass
 class Toolpath:
     moves: list[Move] = field(default_factory=list)
-    # move index -> core.strategies.raster_lean.Arc: that FEED move is an arc to its point (G2/G3 in a
-    # vertical plane; lean passes with arcs only). Readers that take moves as lines: raster_lean.chorded.
-    arcs: dict = field(default_factory=dict)
 
     def __iter__(self) -> Iterator[Move]:
         return iter(self.moves)
@@ -44,9 +46,28 @@ class Toolpath:
         return len(self.moves)
 
     def add(self, kind: MoveKind, x: float, y: float, z: float,
-            axis: tuple[float, float, float] = Z_AXIS) -> None:
+            axis: tuple[float, float, float] = Z_AXIS, arc: Optional[Arc] = None) -> None:
         self.moves.append(Move(kind, float(x), float(y), float(z),
-                               (float(axis[0]), float(axis[1]), float(axis[2]))))
+                               (float(axis[0]), float(axis[1]), float(axis[2])), arc))
+
+    @property
+    def arcs(self) -> dict[int, Arc]:
+        """The arc moves: move index -> its Arc."""
+        return {i: m.arc for i, m in enumerate(self.moves) if m.arc is not None}
+
+    def chorded(self, tolerance: float = 1e-4) -> "Toolpath":
+        """The tool path with its arc moves as chords within `tolerance` (the same kind and axis): what a
+        simulation of the moves as lines reads. Without arcs: this path."""
+        if not any(m.arc is not None for m in self.moves[1:]):
+            return self
+        out = Toolpath(self.moves[:1])
+        for p, m in zip(self.moves, self.moves[1:]):
+            if m.arc is None:
+                out.moves.append(m)
+                continue
+            for q in m.arc.chords((p.x, p.y, p.z), (m.x, m.y, m.z), tolerance):
+                out.add(m.kind, *q, m.axis)
+        return out
 
     def points(self) -> np.ndarray:
         """Tip positions as an (n, 3) array."""

@@ -15,6 +15,7 @@ from typing import Optional
 
 import numpy as np
 
+from tmm_workbench.core.arcs import Arc
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, link
@@ -23,7 +24,6 @@ from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, StrategyResult
 from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import STEPOVER, SurfaceParams
-from tmm_workbench.core.strategies.raster_lean import attach_arcs, both_ways
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
@@ -87,15 +87,24 @@ def start_key(tips: np.ndarray, start_xy: tuple[float, float]) -> tuple[float, f
 
 
 def reverse_path(segments: list[CutSegment]) -> list[CutSegment]:
-    """The same cuts run backwards: segments in reverse order, each reversed; a segment is joined when the
-    one that followed it was joined to it."""
+    """The same cuts run backwards: segments in reverse order, each reversed (arcs too); a segment is joined
+    when the one that followed it was joined to it, and the move into its first tip is then that one's first
+    move backwards (the arc into that one's first tip, turned)."""
     n = len(segments)
-    return [_flipped(segments[n - 1 - i], segments[n - i].joined if i > 0 else False) for i in range(n)]
+    out = []
+    for i in range(n):
+        after = segments[n - i] if i > 0 else None  # the segment that followed this one
+        joined = after is not None and after.joined
+        into = after.arc(0) if joined and len(after) else None
+        out.append(_flipped(segments[n - 1 - i], joined, None if into is None else into.reversed()))
+    return out
 
 
-def _flipped(seg: CutSegment, joined: bool) -> CutSegment:
+def _flipped(seg: CutSegment, joined: bool, into_first: Optional[Arc] = None) -> CutSegment:
+    """`seg` run backwards; `into_first`: the arc of the move that now ends at its first tip (joined)."""
     axes = None if seg.axes is None else seg.axes[::-1].copy()
-    return replace(seg, tips=seg.tips[::-1].copy(), axes=axes, joined=joined, entry_z=None, helix_centre=None)
+    return replace(seg, tips=seg.tips[::-1].copy(), axes=axes, arcs=seg.reversed_arcs(into_first), joined=joined,
+                   entry_z=None, helix_centre=None)
 
 
 def estimate_work(params: SurfaceParams, finish: FinishParams) -> float:
@@ -126,7 +135,6 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
     levels = finish.stock_levels(params.stock_to_leave)
     surface = surface or DropSurface(mesh)
     segments: list[CutSegment] = []
-    arcs: dict = {}  # the pass sets' arcs, by their moves' ends either way (a set may run backwards)
     top = -np.inf
     for i, stock in enumerate(levels):
         report = None
@@ -134,7 +142,6 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
             report = lambda f, i=i: progress((i + f) / len(levels))  # noqa: E731
         result, pass_set = _pass_set(mesh, cutter, replace(params, stock_to_leave=stock), finish.start_xy, report,
                                      surface)
-        arcs.update(both_ways(result.diagnostics.get("arcs") or {}))
         top = max(top, result.diagnostics["top"])
         if pass_set:
             pass_set[0] = replace(pass_set[0], joined=False)  # a retract between the sets
@@ -142,7 +149,7 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    return attach_arcs(link(segments, policy), arcs)
+    return link(segments, policy)
 
 
 def _pass_set(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, start_xy: Optional[tuple[float, float]],

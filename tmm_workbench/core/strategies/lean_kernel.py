@@ -1,4 +1,4 @@
-"""Lean passes fitted in the kernel (issue 14 item 2): native.lean_profiles (native/src/query/lean_profile.cpp).
+"""Lean passes fitted in the kernel: native.lean_profiles (native/src/query/lean_profile.cpp).
 
 The straight runs of the segments (raster_lean's: passes and zig-zag links, split where the XY direction
 turns) go to the kernel with their samples; it rebuilds each run's exact CL profile by adaptive exact drops
@@ -7,7 +7,7 @@ by min-link windows and checks them at the drop intervals' midpoints near the ba
 With `arcs`, in runs that lie in a principal vertical plane (XZ or YZ) the kernel then merges consecutive moves
 into one arc (G2/G3) or one longer line where that holds the same band and checks (native/src/query/lean_arcs.cpp).
 The ends of a run, both ends of a vertical move and the moves beside air stay as sampled, as in the Python fit
-(raster_lean.lean_segments, the slow reference).
+(tests/core/lean_reference.py, the slow reference). The arcs ride in the segments (CutSegment.arcs).
 """
 from __future__ import annotations
 
@@ -17,9 +17,11 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from tmm_workbench.core.arcs import Arc
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
-from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.segments import ArcsAt, CutSegment
+from tmm_workbench.core.strategies.raster_lean import Run, RunKey, plane_of, run_xy, straight_runs, with_runs_replaced
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
@@ -41,13 +43,11 @@ class ExactDrop:
 
 def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: float, max_step: float = 0.05,
                          lower_bound: bool = False, progress: Optional[Progress] = None, threads: int = 0,
-                         arcs: bool = False) -> tuple[list[CutSegment], dict, dict]:
-    """The segments with each straight run's points replaced by the kernel's lean vertices, the arcs
-    ({(start xyz, end xyz): Arc} for raster_lean.attach_arcs; empty without `arcs`) and the counts (points_in,
-    points_out, arcs, checked: the kernel's exact drops, breakpoints, refits, kept_dense, and with `lower_bound`
-    the least lines any fit within +-tol can use on these runs)."""
-    from tmm_workbench.core.strategies.raster_lean import arc_entry, plane_of, run_xy, straight_runs, with_runs_replaced
-
+                         arcs: bool = False) -> tuple[list[CutSegment], dict]:
+    """The segments with each straight run's points replaced by the kernel's lean vertices (with `arcs`, the
+    moves that are arcs in CutSegment.arcs) and the counts (points_in, points_out, arcs, checked: the kernel's
+    exact drops, breakpoints, refits, kept_dense, and with `lower_bound` the least lines any fit within +-tol can
+    use on these runs)."""
     if not tol > 0:
         raise TmmError(f"chord tolerance must be > 0 mm for lean passes, got {tol:g}")
     parts, by_key = straight_runs(segments)
@@ -56,7 +56,7 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
                  kept_dense=0, lower_bound=0)
     if not runs:
         stats["points_out"] = stats["points_in"]
-        return list(segments), {}, stats
+        return list(segments), stats
     planes = [plane_of(r.u) if arcs else None for r in runs]
     flags = [np.where(r.fixed, native.LEAN_FIXED, 0) | np.where(r.settled, native.LEAN_KEEP, 0) for r in runs]
     offsets = np.concatenate([[0], np.cumsum([len(r.s) for r in runs])]).astype(np.int64)
@@ -75,17 +75,30 @@ def lean_segments_kernel(segments: list[CutSegment], exact: ExactDrop, tol: floa
         raise TmmError(f"lean passes: {exc} (max_step {max_step:g} mm)") from exc
     verts = {key: np.column_stack([run_xy(r, s[off[n]:off[n + 1]]), z[off[n]:off[n + 1]]])
              for n, (key, r) in enumerate(zip(keys, runs))}
-    arc_map: dict = {}
-    for n, (key, r) in enumerate(zip(keys, runs)):
-        if planes[n] is None:
-            continue
-        v, cs, cz = verts[key], info["arc_s"][off[n]:off[n + 1]], info["arc_z"][off[n]:off[n + 1]]
-        for i in np.flatnonzero(np.isfinite(cs)):
-            centre = np.array([*(r.origin + cs[i] * r.u), cz[i]])
-            move, arc = arc_entry(v[i - 1], v[i], centre, planes[n])
-            arc_map[move] = arc
-    out = with_runs_replaced(segments, parts, verts, verts.__getitem__)
+    out = with_runs_replaced(segments, parts, verts, verts.__getitem__,
+                             _run_arcs(keys, runs, planes, verts, info.get("arc_s"), info.get("arc_z"), off))
     stats.update(points_out=sum(len(seg) for seg in out), checked=int(info["drops"]),
                  breakpoints=int(info["breakpoints"]), refits=int(info["refits"]),
                  kept_dense=int(info["kept_dense"]), lower_bound=int(info["lower_bound"]), arcs=int(info["arcs"]))
-    return out, arc_map, stats
+    return out, stats
+
+
+def _run_arcs(keys: list[RunKey], runs: list[Run], planes: list[Optional[str]], verts: dict[RunKey, np.ndarray],
+              centre_s: Optional[np.ndarray], centre_z: Optional[np.ndarray], off: np.ndarray
+              ) -> dict[RunKey, ArcsAt]:
+    """Per run with arcs, per vertex the arc of the move ending there (None: a line), from the kernel's centres
+    (distance along the run and height at each vertex, NaN for a line; run n's vertices at off[n]:off[n + 1])."""
+    out: dict[RunKey, ArcsAt] = {}
+    for n, (key, r) in enumerate(zip(keys, runs)):
+        if planes[n] is None:  # fitted with lines only
+            continue
+        cs, cz = centre_s[off[n]:off[n + 1]], centre_z[off[n]:off[n + 1]]
+        found = np.flatnonzero(np.isfinite(cs))
+        if not len(found):
+            continue
+        v = verts[key]
+        at: list[Optional[Arc]] = [None] * len(v)
+        for i in found:
+            at[i] = Arc.through(v[i - 1], v[i], (*(r.origin + cs[i] * r.u), cz[i]), planes[n])
+        out[key] = tuple(at)
+    return out

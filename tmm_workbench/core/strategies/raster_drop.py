@@ -241,7 +241,7 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
 
         exact = ExactDrop(surface.index, cutter.offset(s), (air_floor if skip else floor_z) - s, s, floor_z,
                           air_floor + 1.0 if skip else -math.inf)
-        segments, diagnostics["arcs"], diagnostics["lean"] = lean_segments_kernel(
+        segments, diagnostics["lean"] = lean_segments_kernel(
             segments, exact, params.chord_tol, params.sample_step / 2, progress=progress, arcs=params.arcs)
     if params.verify_cusp:  # issue 14 item 4
         from tmm_workbench.core.footprint.variable_step import verify_params
@@ -249,10 +249,9 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
         n = len(segments)
         segments = verify_params(mesh, cutter, params, segments, drop, surface, diagnostics, progress, levels)
         if lean and len(segments) > n:  # its partial passes (cut into its simulation as sampled) fitted as well
-            extra, arcs, stats = lean_segments_kernel(segments[n:], exact, params.chord_tol, params.sample_step / 2,
-                                                      progress=progress, arcs=params.arcs)
+            extra, stats = lean_segments_kernel(segments[n:], exact, params.chord_tol, params.sample_step / 2,
+                                                progress=progress, arcs=params.arcs)
             segments = segments[:n] + extra
-            diagnostics["arcs"].update(arcs)
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
     from tmm_workbench.core.footprint import cusp_check
@@ -311,11 +310,6 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    arcs = result.diagnostics.pop("arcs", None)
-    if arcs:
-        from tmm_workbench.core.strategies.raster_lean import attach_arcs
-
-        return attach_arcs(link(result.segments, policy), arcs)
     return link(result.segments, policy)
 
 
