@@ -15,8 +15,9 @@ from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, MultipointParams
-from tmm_workbench.core.strategies.multipoint_scallop import NOT_REACHED, LeftArea
+from tmm_workbench.core.strategies.multipoint_scallop import NOT_REACHED, OVER_SCALLOP, LeftArea
 from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.verify.zmap import ZTool, simulate
 
 TORUS = Cutter.torus(6.7, 6.0)
 
@@ -82,3 +83,55 @@ def test_a_position_the_kernel_gives_as_nan_is_not_cut(monkeypatch):
                                MultipointParams())
     assert list(res.status[1:]) == [STATUS_FAILED, STATUS_FAILED] and res.status[0] != STATUS_FAILED
     assert res.reason_texts()[1] == multipoint.NOT_FINITE
+
+
+# A 12 mm net (random 2 scaled by 12/150, z 5.6-8 mm) under a small torus: the tilted tool touches the face
+# millimetres before and behind the row it cuts, so the strips between passes were read between the wrong
+# contacts; the placement fell back to the estimate's step (OVER_SCALLOP strips) and reported rows the tool
+# reaches. Now every strip holds the scallop and only what dense passes cannot remove either is reported.
+SMALL_TORUS = Cutter.torus(2.0, 1.0)
+SMALL_H = 0.01
+
+
+@pytest.fixture(scope="module")
+def small_net():
+    net = random_net(2) * (12.0 / 150.0)
+    face = BezierFace.from_net(net)
+    params = MultipointParams(pass_spacing="scallop", scallop=SMALL_H, side_step=1.0, forward_step=0.5,
+                              between_tol=0.0)
+    return face, params, multipoint.compute(face, SMALL_TORUS, params)
+
+
+def test_small_net_holds_the_scallop_on_every_strip(small_net):
+    _, _, result = small_net
+    rep = result.diagnostics["scallop"]
+    assert rep.offsets[0] == pytest.approx(0.0) and rep.offsets[-1] == pytest.approx(12.0)
+    assert all(b > a for a, b in zip(rep.offsets, rep.offsets[1:]))
+    assert not [a for a in rep.unreached if a.reason == OVER_SCALLOP]  # no strip at the estimate's step
+    assert all(0.0 <= v <= SMALL_H for v in rep.scallops), rep.scallops
+
+
+def test_small_net_reports_only_what_dense_passes_leave_too(small_net):
+    """Each area reported: passes every 0.05 mm (the kernel's positions, cut by the independent Python
+    z-map) still leave more than the scallop there, so no side step of this tool could hold it."""
+    face, params, result = small_net
+    rep = result.diagnostics["scallop"]
+    across = np.arange(0.0, 12.0 + 1e-9, 0.05)
+    along = np.arange(0.0, 12.0 + 1e-9, params.forward_step)
+    xy = np.array([(x, y) for x in across for y in along])
+    res = multipoint.position_points(face, 2.0, 1.0, xy, params)
+    tool = ZTool(2.0, 1.0, params.shape)
+    for area in rep.unreached:
+        (x0, y0), (x1, y1) = area.outline.min(0), area.outline.max(0)
+        near = np.abs(xy[:, 0] - 0.5 * (x0 + x1)) <= 0.5 * (x1 - x0) + 3.0 + 1e-9  # within the tool's reach
+        paths = []
+        for x in np.unique(xy[near, 0]):
+            idx = np.flatnonzero((xy[:, 0] == x) & (res.status != STATUS_FAILED))
+            paths.append((res["tip"][idx], res["axis"][idx]))
+        worst = 0.0
+        for y in np.arange(math.ceil(y0), y1 + 1e-9, 1.0):
+            xs = np.arange(x0, x1 + 1e-9, 0.02)
+            sim = simulate(tool, np.column_stack([xs, np.full_like(xs, y)]), 50.0, paths, 0.25, "slerp", 2e-3)
+            design = face.evaluate(np.column_stack([xs / 12.0, np.full_like(xs, y / 12.0)]))["S"][:, 2]
+            worst = max(worst, float(np.nanmax(sim.z - design)))
+        assert worst > SMALL_H, area.describe()

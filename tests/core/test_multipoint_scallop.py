@@ -14,7 +14,8 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, BezierFace, MultipointParams
-from tmm_workbench.core.strategies.multipoint_scallop import DesignHeights, Frame, estimate_passes
+from tmm_workbench.core.strategies.multipoint_meter import DesignHeights, Frame
+from tmm_workbench.core.strategies.multipoint_scallop import estimate_passes
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.verify.zmap import ZTool, simulate
 
