@@ -14,7 +14,7 @@ import Part
 
 from fc_helpers import OUT, BadInputCase, SPHERE_ON_PLATE, FreeCADTestCase, close_all, moves, new_doc
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import op_base, op_roughing, registry, tools
+from tmm_workbench.app import op_roughing, registry, tools, work_estimate
 from tmm_workbench.app.api import run_roughing, simulate
 from tmm_workbench.core.errors import TmmError
 
@@ -242,7 +242,7 @@ class RoughingBadInput(BadInputCase):
         self.assertFails("lies outside the stock", "x 100..140")
 
     def test_work_above_the_limit_is_refused(self) -> None:
-        group = FreeCAD.ParamGet(op_base.PREFERENCES)
+        group = FreeCAD.ParamGet(work_estimate.PREFERENCES)
         group.SetInt("MaxPoints", 1000)
         try:
             self.op.StepDown = 0.01

@@ -13,7 +13,7 @@ import numpy as np
 
 from fc_helpers import OUT, SPHERE_ON_PLATE, BadInputCase, FreeCADTestCase, moves, new_doc, reopened
 from fc_test_roughing import BLOCK, GOUGE_MM, POCKET, check_feeds_and_heights, job_with, levels, pocket_block
-from tmm_workbench.app import op_base, op_waterline, registry
+from tmm_workbench.app import op_waterline, registry, work_estimate
 from tmm_workbench.app.api import run_waterline, simulate
 from tmm_workbench.core.errors import TmmError
 
@@ -158,7 +158,7 @@ class WaterlineBadInput(BadInputCase):
         self.assertFails("safe height")
 
     def test_work_above_the_limit_is_refused(self) -> None:
-        group = FreeCAD.ParamGet(op_base.PREFERENCES)
+        group = FreeCAD.ParamGet(work_estimate.PREFERENCES)
         group.SetInt("MaxPoints", 1000)
         try:
             self.op.SampleStep = 0.01

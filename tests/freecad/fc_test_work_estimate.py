@@ -88,6 +88,29 @@ class WorkEstimate(FreeCADTestCase):
         self.assertIsNone(work_estimate.estimate(op).cutting_seconds)
         self.assertNotIn("cutting", work_estimate.estimate(op).text())
 
+    def test_estimate_tells_the_compute_time(self) -> None:
+        """The count at the strategy's measured pace (benchmarks/compute_estimate.py compares it with real runs):
+        a quick op says nothing of it; values that would compute for minutes say so in the status line, and the
+        op announces it before it starts (est.long)."""
+        doc = new_doc("TmmEstimateCompute")
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"BoundaryShape": "Model", "StepOver": 1.5,
+                                                              "SampleStep": 0.4})
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        self.assertAlmostEqual(est.compute_seconds, est.count * work_estimate.PACE["surface"])
+        self.assertFalse(est.long)
+        self.assertNotIn("computing", est.text())
+        fine = work_estimate.estimate(op, {"StepOver": 0.02, "SampleStep": 0.01})
+        self.assertGreater(fine.compute_seconds, work_estimate.LONG_COMPUTE_S, fine.text())
+        self.assertTrue(fine.long)
+        self.assertIn("computing about 00:", fine.text())
+        # the cusp check's (or the verification's) dense raster adds its time at its own pace
+        plain = work_estimate.estimate(op, {"StepOverMode": "cusp", "CuspHeight": 0.01, "CheckCusp": "off"})
+        checked = work_estimate.estimate(op, {"StepOverMode": "cusp", "CuspHeight": 0.01, "CheckCusp": "on"})
+        self.assertGreater(checked.compute_seconds, plain.compute_seconds)
+        self.assertAlmostEqual(checked.compute_seconds - plain.compute_seconds,
+                               (checked.count - plain.count) * work_estimate.PACE["verify"])
+
     def test_part_model_refused_before_tessellation(self) -> None:
         """A Part model with a tessellation tolerance below the range, or a raster above the limit: the op fails
         at once, from the bounding boxes, without tessellating the sphere."""

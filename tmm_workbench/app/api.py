@@ -26,12 +26,12 @@ from typing import Any, Callable, Iterator, Optional, Sequence, Union
 import FreeCAD
 
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import geometry, posts, registry, tools
+from tmm_workbench.app import geometry, model_proxy, posts, registry, tools
 from tmm_workbench.app import progress as progress_mod
-from tmm_workbench.app.api_args import CallbackProgress, plain_numbers
+from tmm_workbench.app.api_args import CallbackProgress, by_core_name, numbers, option, plain_numbers
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.params import Spec, check, spec_of
+from tmm_workbench.core.params import Spec, spec_of
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -119,7 +119,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     from tmm_workbench.app import surface_passes
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
-    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
              stepover=(stepover, spec_of(SurfaceParams, "stepover")),
              sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
              angle_deg=(angle_deg, spec_of(SurfaceParams, "angle_deg")),
@@ -128,7 +128,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
              cusp=(cusp, spec_of(SurfaceParams, "cusp")),
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
-    extra: dict[str, Any] = {"StepOverMode": _option("stepover_mode", stepover_mode, STEPOVER_MODE_NAMES)}
+    extra: dict[str, Any] = {"StepOverMode": option("stepover_mode", stepover_mode, STEPOVER_MODE_NAMES)}
     if chord_tolerance is not None:
         extra["ChordTolerance"] = chord_tolerance
     if cusp is not None:
@@ -142,7 +142,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
         if stepover_mode != "offset3d":
             raise TmmError(f"offset_from needs stepover_mode 'offset3d', got {stepover_mode!r}")
         extra.update(offset_start.api_values(offset_from, model))
-    extra["ForwardStep"] = _option("forward_step", forward_step, FORWARD_STEP_NAMES)
+    extra["ForwardStep"] = option("forward_step", forward_step, FORWARD_STEP_NAMES)
     if not isinstance(arcs, bool):
         raise TmmError(f"arcs must be True or False, got {arcs!r}")
     extra["ArcFitting"] = arcs
@@ -151,11 +151,11 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     if not isinstance(verify_cusp, bool):
         raise TmmError(f"verify_cusp must be True or False, got {verify_cusp!r}")
     extra["VerifyCusp"] = verify_cusp
-    shape = tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES,
+    shape = tool if isinstance(tool, Cutter) else option("tool", tool, TOOL_ALIASES,
                                                           sorted(set(TOOL_ALIASES.values())))
-    pattern_name = _option("pattern", pattern, PATTERN_NAMES)
-    boundary_name = _option("boundary", boundary, BOUNDARY_NAMES)
-    off_model_name = _option("off_model", off_model, OFF_MODEL_NAMES)
+    pattern_name = option("pattern", pattern, PATTERN_NAMES)
+    boundary_name = option("boundary", boundary, BOUNDARY_NAMES)
+    off_model_name = option("off_model", off_model, OFF_MODEL_NAMES)
 
     own_doc = isinstance(model, (str, os.PathLike))
     if own_doc and not Path(model).expanduser().is_file():
@@ -180,31 +180,6 @@ def _api_document(own: bool, name: str, existing: Any, fcstd_path: Any) -> Itera
     if fcstd_path:
         Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
         doc.saveAs(str(fcstd_path))
-
-
-def _option(label: str, value: Any, names: dict[str, str], shown: Optional[Sequence[str]] = None) -> str:
-    """The op's property value for an API option (`names`: lower-case API name -> property value); a TmmError
-    listing the choices (`shown`, default the API names) for anything else."""
-    prop = names.get(str(value).lower())
-    if prop is None:
-        choices = list(shown or names)
-        listed = f"'{choices[0]}' or '{choices[1]}'" if len(choices) == 2 else "one of " + ", ".join(choices)
-        raise TmmError(f"{label} must be {listed}, got {value!r}")
-    return prop
-
-
-def _numbers(**values: tuple[Any, Spec]) -> None:
-    """Each API argument checked against its range by its own name (None: the op's default is used)."""
-    from dataclasses import replace
-
-    for name, (value, spec) in values.items():
-        if value is not None:
-            check(replace(spec, label=name), value)
-
-
-def _by_core_name(props: dict[str, str]) -> dict[str, str]:
-    """An op's enumeration table (property value -> core name) turned round: core name -> property value."""
-    return {core: prop for prop, core in props.items()}
 
 
 def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float,
@@ -308,7 +283,7 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
     from tmm_workbench.app import op_roughing
     from tmm_workbench.core.strategies.zlevel_rough import RoughingParams
 
-    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
              **_specs(RoughingParams, step_down=step_down, stepover_percent=stepover_percent,
                       stock_to_leave=stock_to_leave, stock_to_leave_axial=stock_to_leave_axial,
                       remaining_height=remaining_height, ramp_angle_deg=ramp_angle_deg,
@@ -320,11 +295,11 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
         _stock_box_checked(stock)
     values: dict[str, Any] = {
         "StepDown": step_down, "StepOver": stepover_percent, "StockToLeave": stock_to_leave,
-        "LayerMode": _option("layer_mode", layer_mode, _by_core_name(op_roughing.LAYER_MODES)),
+        "LayerMode": option("layer_mode", layer_mode, by_core_name(op_roughing.LAYER_MODES)),
         "FlatLayers": bool(flat_layers), "KeepToolDown": bool(keep_tool_down),
-        "Pattern": _option("pattern", pattern, _by_core_name(op_roughing.PATTERNS)),
-        "Direction": _option("direction", direction, _by_core_name(op_roughing.DIRECTIONS)),
-        "Entry": _option("entry", entry, _by_core_name(op_roughing.ENTRIES))}
+        "Pattern": option("pattern", pattern, by_core_name(op_roughing.PATTERNS)),
+        "Direction": option("direction", direction, by_core_name(op_roughing.DIRECTIONS)),
+        "Entry": option("entry", entry, by_core_name(op_roughing.ENTRIES))}
     for prop, value in (("AxialStockToLeave", stock_to_leave_axial), ("RemainingHeight", remaining_height),
                         ("RampAngle", ramp_angle_deg), ("HelixDiameter", helix_diameter_percent),
                         ("ChordTolerance", chord_tolerance)):
@@ -362,7 +337,7 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     from tmm_workbench.app import op_waterline
     from tmm_workbench.core.strategies.waterline import WaterlineParams
 
-    _numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
+    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
              **_specs(WaterlineParams, step_down=step_down, stock_to_leave=stock_to_leave, sample_step=sample_step),
              chord_tolerance=(chord_tolerance, spec_of(WaterlineParams, "chord_tol")), margin=(margin, _LENGTH),
              top_z=(top_z, _LENGTH), bottom_z=(bottom_z, _LENGTH), stock_margin=(stock_margin, _LENGTH),
@@ -375,8 +350,8 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
         _stock_box_checked(stock)
     values: dict[str, Any] = {
         "StepDown": step_down, "StockToLeave": stock_to_leave, "BoundaryMargin": margin,
-        "BoundaryShape": _option("boundary", boundary, BOUNDARY_NAMES),
-        "Direction": _option("direction", direction, _by_core_name(op_waterline.DIRECTIONS))}
+        "BoundaryShape": option("boundary", boundary, BOUNDARY_NAMES),
+        "Direction": option("direction", direction, by_core_name(op_waterline.DIRECTIONS))}
     if sample_step is not None:
         values["SampleStep"] = sample_step
     if chord_tolerance is not None:
@@ -400,7 +375,7 @@ def _common_numbers(safe_height: Any, clearance_height: Any, horiz_feed: Any, ve
 
 
 def _tool_shape(tool: Union[str, Cutter]) -> Union[str, Cutter]:
-    return tool if isinstance(tool, Cutter) else _option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
+    return tool if isinstance(tool, Cutter) else option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
 
 
 def _stock_box_checked(stock: Any) -> StockBox:
@@ -550,13 +525,13 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     from tmm_workbench.app import posts as posts_mod
     from tmm_workbench.core.strategies.multipoint import MultipointParams, face_top
 
-    method_name = _option("method", method, _by_core_name(op_multipoint.METHODS))
-    shape_name = _option("tool_shape", tool_shape, _by_core_name(op_multipoint.TOOL_SHAPES))
-    anchor_name = _option("footprint_anchor", footprint_anchor, _by_core_name(op_multipoint.ANCHORS))
+    method_name = option("method", method, by_core_name(op_multipoint.METHODS))
+    shape_name = option("tool_shape", tool_shape, by_core_name(op_multipoint.TOOL_SHAPES))
+    anchor_name = option("footprint_anchor", footprint_anchor, by_core_name(op_multipoint.ANCHORS))
     if pass_spacing is None:  # the README's and the new op's default: the side step from the scallop
         pass_spacing = "scallop"
-    spacing_name = _option("pass_spacing", pass_spacing, _by_core_name(op_multipoint.PASS_SPACINGS))
-    _numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
+    spacing_name = option("pass_spacing", pass_spacing, by_core_name(op_multipoint.PASS_SPACINGS))
+    numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
              side_step=(side_step, spec_of(MultipointParams, "side_step")),
              forward_step=(forward_step, spec_of(MultipointParams, "forward_step")),
              scallop=(scallop, spec_of(MultipointParams, "scallop")),
@@ -701,7 +676,7 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     from tmm_workbench.core.preview.deviation_png import render_deviation_png
 
     target = getattr(target, "job", None) or target
-    _numbers(cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
+    numbers(cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
              tolerance=(tolerance, Spec(low=0.0, high=10.0, unit="mm", label="tolerance")),
              max_step=(max_step, Spec(low=1e-3, high=10.0, unit="mm", label="max_step", optional=True)))
     label = str(getattr(target, "Label", "simulation"))
@@ -743,20 +718,19 @@ def compare_cutters(model: Any, candidates: Sequence[Any], *, stepover: float, s
     or a Job (its model); `candidates`: ToolBits, tool controllers (their tool) or core Cutters. Feeds in
     mm/min, the same for all (the cycle times compare the paths)."""
     from tmm_workbench.app import geometry, simulation
-    from tmm_workbench.app.op_surface import mesh_of_model
     from tmm_workbench.core.sim.optimal_cutter import compare_cutters as core_compare
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
-    _numbers(stepover=(stepover, spec_of(SurfaceParams, "stepover")),
+    numbers(stepover=(stepover, spec_of(SurfaceParams, "stepover")),
              sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
              cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED))
     if isinstance(model, (str, os.PathLike)):
         mesh = geometry.mesh_from_stl(model)
     elif simulation.job_of(model) is model:
-        mesh = geometry.combine([mesh_of_model(m, 0.001) for m in model.Model.Group])
+        mesh = geometry.combine([model_proxy.mesh_of_model(m, 0.001) for m in model.Model.Group])
     else:
-        mesh = mesh_of_model(model, 0.001)
+        mesh = model_proxy.mesh_of_model(model, 0.001)
     cutters = []
     for c in candidates:
         if isinstance(c, Cutter):

@@ -4,12 +4,14 @@ and a progress callback's answer must be a bool (a string such as "stop" is trut
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable
+from dataclasses import replace
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.app import progress as progress_mod
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.params import Spec, check
 
 
 def _plain(value: Any) -> Any:
@@ -40,3 +42,26 @@ class CallbackProgress(progress_mod.ProgressReporter):
         if not isinstance(answer, (bool, np.bool_)):
             raise TmmError(f"progress callback must return True (go on) or False (cancel), got {answer!r}")
         return bool(answer)
+
+
+def option(label: str, value: Any, names: dict[str, str], shown: Optional[Sequence[str]] = None) -> str:
+    """The op's property value for an API option (`names`: lower-case API name -> property value); a TmmError
+    listing the choices (`shown`, default the API names) for anything else."""
+    prop = names.get(str(value).lower())
+    if prop is None:
+        choices = list(shown or names)
+        listed = f"'{choices[0]}' or '{choices[1]}'" if len(choices) == 2 else "one of " + ", ".join(choices)
+        raise TmmError(f"{label} must be {listed}, got {value!r}")
+    return prop
+
+
+def numbers(**values: tuple[Any, Spec]) -> None:
+    """Each API argument checked against its range by its own name (None: the op's default is used)."""
+    for name, (value, spec) in values.items():
+        if value is not None:
+            check(replace(spec, label=name), value)
+
+
+def by_core_name(props: dict[str, str]) -> dict[str, str]:
+    """An op's enumeration table (property value -> core name) turned round: core name -> property value."""
+    return {core: prop for prop, core in props.items()}

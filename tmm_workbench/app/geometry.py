@@ -110,3 +110,15 @@ def bezier_face(surface: Any, name: str = "face") -> BezierFace:
     if weights is not None and np.max(np.abs(weights - 1.0)) > 1e-12:
         raise TmmError(f"{name}: rational Bézier surface (weights not all 1) is not supported")
     return BezierFace.from_net(poles, name=name)
+
+
+def stock_box_of(stock: Any) -> tuple[float, float, float, float, float, float]:
+    bb = stock.Shape.BoundBox
+    return (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
+
+
+def is_box(shape: Any) -> bool:
+    """The solid fills its bounding box (FreeCAD's box stocks, a box from the base)."""
+    bb = shape.BoundBox
+    full = bb.XLength * bb.YLength * bb.ZLength
+    return full > 0 and abs(shape.Volume - full) <= 1e-6 * full

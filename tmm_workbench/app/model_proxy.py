@@ -16,6 +16,7 @@ import FreeCAD
 import Part
 
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.app import geometry, hooks
 
 MIN_THICKNESS_MM = 0.01  # a flat mesh still needs a solid box (grown downwards, the top stays)
@@ -93,3 +94,13 @@ def source_of(obj: Any) -> Optional[Any]:
     if is_bounds(target):
         return target.Source if target.Source is not None else target.StlFile
     return None
+
+
+def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
+    """The mesh to machine for a model object; TMM's stand-in boxes give what they stand for."""
+    source = source_of(obj)
+    if source is None:
+        return geometry.mesh_from_object(obj, deflection)
+    if isinstance(source, str):
+        return geometry.mesh_from_stl(source)
+    return geometry.mesh_from_object(source, deflection)

@@ -14,30 +14,15 @@ import FreeCAD
 import numpy as np
 import Path
 
-from tmm_workbench.app import hooks
+from tmm_workbench.app import hooks, work_estimate
 from tmm_workbench.app.compat import PathOp
 from tmm_workbench.app.tools import TOOLBIT_SHAPES, cutter_from_tool, label_of, shape_name
-from tmm_workbench.core import kernel, limits
+from tmm_workbench.core import kernel
 from tmm_workbench.core.errors import Cancelled, TmmError, WorkLimitError
 from tmm_workbench.core.tools.cutter import Cutter
 
 
 MAX_WORD = 1e9  # mm, mm/min, deg: any G-code word beyond it is a computation gone wrong, not a move
-PREFERENCES = "User parameter:BaseApp/Preferences/Mod/TMM"
-
-
-def apply_work_limits() -> None:
-    """The user's work limits (FreeCAD preferences MaxPoints, MaxPositions, MaxMemoryGB under
-    Preferences/Mod/TMM; 0 or absent: the core's defaults) for the next computation."""
-    group = FreeCAD.ParamGet(PREFERENCES)
-    points, positions = group.GetInt("MaxPoints", 0), group.GetInt("MaxPositions", 0)
-    memory = group.GetFloat("MaxMemoryGB", 0.0)
-    defaults = limits.WorkLimits()
-    limits.set_limits(points if points > 0 else defaults.max_points,
-                      memory if memory > 0 else defaults.max_memory_bytes / 1e9,
-                      positions if positions > 0 else defaults.max_positions)
-
-
 class Prop(NamedTuple):
     """One row of an op's property table. `field`: the params dataclass field it sets ("" for none)."""
     type: str
@@ -198,7 +183,7 @@ class TmmOp(PathOp.ObjectOp):
         if not obj.Active:
             super().execute(obj)
             return
-        apply_work_limits()
+        work_estimate.apply_work_limits()
         problem = self.input_problem(obj)
         if problem:
             self.fail(obj, problem)
@@ -255,21 +240,23 @@ class TmmOp(PathOp.ObjectOp):
         return ""
 
     def check_work(self, obj: Any) -> None:
-        """The work estimated from the properties and bounding boxes before anything is loaded, tessellated
-        or allocated (app.work_estimate; an STL file is estimated right after reading, in the strategy);
-        the chosen post's need of a spindle speed reported."""
-        from tmm_workbench.app import work_estimate
-
+        """The work estimated from the properties and bounding boxes before anything is tessellated or allocated
+        (app.work_estimate; an STL file is read for its bounds, once: the op then computes from the same read),
+        a computation of more than LONG_COMPUTE_S announced; the chosen post's need of a spindle speed
+        reported."""
         try:
             work_estimate.check_ranges(obj)
         except TmmError as exc:
             self.fail(obj, str(exc))
         try:
-            work_estimate.estimate(obj, load_stl=False)
+            est = work_estimate.estimate(obj)
         except WorkLimitError as exc:
             self.fail(obj, str(exc))
         except TmmError:  # other bad input: the computation names it with what it reads
-            pass
+            est = None
+        if est is not None and est.long:  # minutes of computing are announced, not a surprise
+            FreeCAD.Console.PrintMessage(f"{obj.Label}: {est.text()}; Cancel (the progress dialog, Esc) stops "
+                                         "it\n")
         spindle = spindle_problem(obj)
         if spindle:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {spindle}\n")

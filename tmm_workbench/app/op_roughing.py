@@ -79,31 +79,18 @@ DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, 
 AXIAL_EXPRESSION = "StockToLeave"  # the axial stock to leave follows the radial one unless given
 
 
-def stock_box_of(stock: Any) -> tuple[float, float, float, float, float, float]:
-    bb = stock.Shape.BoundBox
-    return (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
-
-
-def is_box(shape: Any) -> bool:
-    """The solid fills its bounding box (FreeCAD's box stocks, a box from the base)."""
-    bb = shape.BoundBox
-    full = bb.XLength * bb.YLength * bb.ZLength
-    return full > 0 and abs(shape.Volume - full) <= 1e-6 * full
-
-
 def stock_of(job: Any, stock: Any) -> dict[str, Any]:
     """The strategy's stock fields for the Job's stock solid: `stock_box`, and `stock_heights` (grid,
     heights) when the solid is not a box."""
     if stock is None or stock.Shape.isNull() or not stock.Shape.Solids:
         raise TmmError("the Job has no stock solid to rough from")
-    out: dict[str, Any] = {"stock_box": stock_box_of(stock)}
-    if not is_box(stock.Shape):
-        from tmm_workbench.app.simulation import _stock_heights
+    out: dict[str, Any] = {"stock_box": geometry.stock_box_of(stock)}
+    if not geometry.is_box(stock.Shape):
         from tmm_workbench.core.sim.grid import Grid
 
         bb = stock.Shape.BoundBox
         grid = Grid.covering(bb.XMin, bb.YMin, bb.XMax, bb.YMax, STOCK_CELL_MM)
-        out["stock_heights"] = (grid, _stock_heights(job, grid))
+        out["stock_heights"] = (grid, simulation.stock_heights(job, grid))
     return out
 
 

@@ -31,11 +31,8 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import finish_passes
-from tmm_workbench.core.strategies.raster_drop import (ADAPTIVE, CUSP, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, ONEWAY,
-                                                       STEPOVER, ZIGZAG, SurfaceParams)
-from tmm_workbench.core.strategies.raster_drop import INWARD, OUTWARD, SPIRAL  # the region block
-from tmm_workbench.core.strategies.raster_drop import SAMPLED, TOLERANCE
-from tmm_workbench.core.strategies.raster_drop import OFFSET3D  # the 3D offset spacing
+from tmm_workbench.core.strategies.raster_drop import (INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY,
+                                                       OUTWARD, SAMPLED, SPIRAL, TOLERANCE, ZIGZAG, SurfaceParams)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
@@ -98,13 +95,9 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyAngle", "SlopeMax", "Surface",
          "Cut only where the surface slope is at most this (steeper walls left to waterline)", "slope_max_deg"),
 ]
-SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE}
-# 3D offset (issue 14 item 1): closed loops from the region's edge inward, CuspHeight apart across the surface
-# (core.strategies.raster_offset3d); a document saved before it gets the choice on restore (op_base)
-SPACINGS["Offset3D"] = OFFSET3D
 FORWARD_STEPS = {"Tolerance": TOLERANCE, "SampleStep": SAMPLED}
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
-           "StepOverMode": SPACINGS, "ForwardStep": FORWARD_STEPS}
+           "StepOverMode": surface_passes.SPACINGS, "ForwardStep": FORWARD_STEPS}
 DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
                             "BoundaryMargin": 0.0, "PlungeAngle": 45.0, "ForwardStep": "SampleStep"}
 CHOICES.update({"Region": {r: r for r in region_source.REGIONS},
@@ -193,11 +186,11 @@ class ObjectTmmSurface(op_base.TmmOp):
         if obj.StlFile:
             return geometry.mesh_from_stl(obj.StlFile)
         if obj.Model is not None:
-            return mesh_of_model(obj.Model, deflection)
+            return model_proxy.mesh_of_model(obj.Model, deflection)
         models = list(self.model or [])
         if not models:
             raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
-        return geometry.combine([mesh_of_model(m, deflection) for m in models])
+        return geometry.combine([model_proxy.mesh_of_model(m, deflection) for m in models])
 
     def boundary(self, obj: Any, mesh: TriMesh) -> tuple[float, float, float, float]:
         if obj.BoundaryShape == "Stock":
@@ -241,16 +234,6 @@ class ObjectTmmSurface(op_base.TmmOp):
         if plane != "XY":
             out.append(Path.Command(PLANE_CODES["XY"], {}))
         return out
-
-
-def mesh_of_model(obj: Any, deflection: float) -> TriMesh:
-    """The mesh to machine for a model object; TMM's stand-in boxes give what they stand for."""
-    source = model_proxy.source_of(obj)
-    if source is None:
-        return geometry.mesh_from_object(obj, deflection)
-    if isinstance(source, str):
-        return geometry.mesh_from_stl(source)
-    return geometry.mesh_from_object(source, deflection)
 
 
 def SetupProperties() -> list[str]:

@@ -16,9 +16,11 @@ from typing import Any, Optional
 
 import numpy as np
 
+from tmm_workbench.app.api_args import numbers, option
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import region
+from tmm_workbench.core.params import Spec, spec_of
 from tmm_workbench.core.polygons import Shape
 
 BOX, FACES, SKETCH = "Box", "Faces", "Sketch"
@@ -135,21 +137,19 @@ def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
     """The Surface op's region, spiral and slope properties for run_surface's arguments:
     region None (the box), an object with closed edges (a sketch), or faces: names of the model's faces
     ("Face3", ["Face3", "Face5"]) or (object, names) pairs; slope_range (min, max) deg or None."""
-    from tmm_workbench.app.api import _numbers, _option
-    from tmm_workbench.core.params import Spec, spec_of
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
-    values: dict[str, Any] = {"SpiralDirection": _option("spiral_direction", spiral_direction,
+    values: dict[str, Any] = {"SpiralDirection": option("spiral_direction", spiral_direction,
                                                          {"outward": "Outward", "inward": "Inward"})}
     if tolerance is not None:
-        _numbers(region_tolerance=(tolerance, Spec("", "mm", low=TOLERANCE_RANGE[0], high=TOLERANCE_RANGE[1])))
+        numbers(region_tolerance=(tolerance, Spec("", "mm", low=TOLERANCE_RANGE[0], high=TOLERANCE_RANGE[1])))
         values["RegionTolerance"] = tolerance
     if slope_range is not None:
         try:
             low, high = (float(v) for v in slope_range)
         except (TypeError, ValueError):
             raise TmmError(f"slope_range must be (min, max) in deg, got {slope_range!r}") from None
-        _numbers(slope_min=(low, spec_of(SurfaceParams, "slope_min_deg")),
+        numbers(slope_min=(low, spec_of(SurfaceParams, "slope_min_deg")),
                  slope_max=(high, spec_of(SurfaceParams, "slope_max_deg")))
         values.update(SlopeMin=low, SlopeMax=high)
     if region is None:

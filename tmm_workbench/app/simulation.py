@@ -12,7 +12,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from tmm_workbench.app import geometry, post_objects, tools
+from tmm_workbench.app import geometry, model_proxy, post_objects, tools
 from tmm_workbench.core import path5
 from tmm_workbench.core.arcs import arc_points
 from tmm_workbench.core.errors import TmmError
@@ -142,7 +142,7 @@ def op_cycle_seconds(op: Any, decoded: Optional[tuple[Toolpath, list]] = None) -
     return three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).seconds
 
 
-def _stock_heights(job: Any, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
+def stock_heights(job: Any, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
     stock = getattr(job, "Stock", None)
     if stock is None or stock.Shape.isNull():
         raise TmmError(f"Job '{job.Label}' has no stock to simulate")
@@ -153,14 +153,13 @@ def _stock_heights(job: Any, grid: Grid, progress: Optional[Callable[[float], bo
 def _design_heights(job: Any, ops: list, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
     """The design under each cell: the Job's models (TMM's stand-in boxes give the mesh or STL they stand for)
     and any model an op machines instead (its StlFile or Model), highest where they overlap."""
-    from tmm_workbench.app.op_surface import mesh_of_model
 
-    meshes = [mesh_of_model(m, DESIGN_DEFLECTION_MM) for m in list(getattr(job.Model, "Group", []) or [])]
+    meshes = [model_proxy.mesh_of_model(m, DESIGN_DEFLECTION_MM) for m in list(getattr(job.Model, "Group", []) or [])]
     for op in ops:
         if getattr(op, "StlFile", ""):
             meshes.append(geometry.mesh_from_stl(op.StlFile))
         elif getattr(op, "Model", None) is not None:
-            meshes.append(mesh_of_model(op.Model, DESIGN_DEFLECTION_MM))
+            meshes.append(model_proxy.mesh_of_model(op.Model, DESIGN_DEFLECTION_MM))
     if not meshes:
         raise TmmError(f"Job '{job.Label}' has no model to compare with")
     return mesh_heights(geometry.combine(meshes), grid, progress=progress)
@@ -228,7 +227,7 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
 
     def share(lo: float, hi: float) -> Optional[Callable[[float], bool]]:  # a phase's part of the whole
         return (lambda f: progress(lo + (hi - lo) * f)) if progress else None
-    initial = _stock_heights(job, grid, share(0.0, 0.05))
+    initial = stock_heights(job, grid, share(0.0, 0.05))
     design = _design_heights(job, ops, grid, share(0.05, 0.2))
     heights, done = initial, []
     result = None
@@ -305,7 +304,7 @@ def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
     bb = job.Stock.Shape.BoundBox
     cell = max(min(KNOWN_CELL_MM, cutter.radius / 4), math.sqrt(bb.XLength * bb.YLength / KNOWN_CELLS))
     grid = simulation_grid(job, cell)
-    heights = _stock_heights(job, grid)
+    heights = stock_heights(job, grid)
     for op in earlier:
         tp, _ = _toolpath_and_feeds(op)
         if len(tp) >= 2:

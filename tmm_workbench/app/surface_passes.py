@@ -13,8 +13,12 @@ import FreeCAD
 
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT, FinishParams, stepover_of_percent
-from tmm_workbench.core.strategies.raster_drop import STEPOVER
+from tmm_workbench.core.strategies.raster_drop import ADAPTIVE, CUSP, OFFSET3D, STEPOVER
 from tmm_workbench.core.tools.cutter import Cutter
+
+# the Surface's step-over modes, op property value -> core name; 3D offset: closed loops from the region's edge
+# inward, CuspHeight apart across the surface (a document saved before it gets the choice on restore, op_base)
+SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE, "Offset3D": OFFSET3D}
 
 MM, PERCENT = "mm", "%"
 
@@ -90,6 +94,4 @@ def finish_params(obj: Any) -> FinishParams:
 
 
 def _spacing_name(core: str) -> str:
-    from tmm_workbench.app.op_surface import SPACINGS
-
     return {c: p for p, c in SPACINGS.items()}[core]

@@ -12,6 +12,10 @@ import math
 from dataclasses import dataclass, replace
 from typing import Any, Mapping, Optional
 
+import FreeCAD
+
+from tmm_workbench.app import geometry
+from tmm_workbench.core import limits
 from tmm_workbench.core.errors import TmmError, WorkLimitError
 from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT
@@ -31,8 +35,30 @@ EXTRA_SPECS: dict[str, Spec] = {
     "StepDown": Spec("finishing step-down", "mm", low=0.0, high=1000.0, low_open=True),
     "FinalDepth": Spec("final depth", "mm", low=-10_000.0, high=10_000.0),
 }
+# compute seconds per counted unit on this project's reference machine (2 cores; benchmarks/compute_estimate.py
+# measures them against the real runs: an estimate, within about 2x either way)
+PACE = {"surface": 1.5e-5, "adaptive": 5e-5, "surface_flat_cusp": 2.5e-5, "offset3d": 3.3e-4, "verify": 2e-6,
+        "waterline": 1e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025}
+PACE_TOOL_MM = 6.0      # the surface paces are a 6 mm tool's; a larger one covers more triangles per drop
+TELL_COMPUTE_S = 5.0    # the panel's estimate names the compute time from here
+LONG_COMPUTE_S = 30.0   # the op says so before it starts (console), with how to cancel
 # a side of a range the params leave open, for the panel's minimum / maximum
 OPEN_HIGH = {"mm": 10_000.0, "deg": 360.0, "%": 100.0}
+
+
+PREFERENCES = "User parameter:BaseApp/Preferences/Mod/TMM"
+
+
+def apply_work_limits() -> None:
+    """The user's work limits (FreeCAD preferences MaxPoints, MaxPositions, MaxMemoryGB under
+    Preferences/Mod/TMM; 0 or absent: the core's defaults) for the next computation."""
+    group = FreeCAD.ParamGet(PREFERENCES)
+    points, positions = group.GetInt("MaxPoints", 0), group.GetInt("MaxPositions", 0)
+    memory = group.GetFloat("MaxMemoryGB", 0.0)
+    defaults = limits.WorkLimits()
+    limits.set_limits(points if points > 0 else defaults.max_points,
+                      memory if memory > 0 else defaults.max_memory_bytes / 1e9,
+                      positions if positions > 0 else defaults.max_positions)
 
 
 @dataclass(frozen=True)
@@ -43,6 +69,7 @@ class Estimate:
     cut_length: Optional[float] = None   # mm of cutting moves, from the boxes and the spacing (not a path)
     feed: Optional[float] = None         # mm/s, the tool controller's horizontal feed
     note: str = ""                       # what the count leaves out (VerifyCusp's partial passes)
+    compute_seconds: Optional[float] = None   # the count at the strategy's measured pace (PACE)
 
     @property
     def cutting_seconds(self) -> Optional[float]:
@@ -58,7 +85,14 @@ class Estimate:
         t = self.cutting_seconds
         time = f", cutting about {hms(t)} at {self.feed * 60:.4g} mm/min" if t is not None else ""
         note = f" {self.note}" if self.note else ""
-        return f"about {self.count:.3g} {self.what}{passes}{time}{note}"
+        c = self.compute_seconds
+        compute = f"; computing about {hms(c)}" if c is not None and c >= TELL_COMPUTE_S else ""
+        return f"about {self.count:.3g} {self.what}{passes}{time}{note}{compute}"
+
+    @property
+    def long(self) -> bool:
+        """The computation will take longer than a user waits without being told (LONG_COMPUTE_S)."""
+        return (self.compute_seconds or 0.0) > LONG_COMPUTE_S
 
 
 def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
@@ -133,8 +167,6 @@ def _stl_bounds(path: str) -> tuple[float, ...]:
     """An STL file's bounds, read once per file version (the panel asks on every value entered)."""
     import os
 
-    from tmm_workbench.app import geometry
-
     try:
         st = os.stat(path)
         key = (path, st.st_mtime, st.st_size)
@@ -198,7 +230,22 @@ def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> O
     w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
     # passes cover the boundary at the step-over: their length is its area over the spacing
     return _verified(Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover,
-                              _feed(obj)), obj, params)
+                              _feed(obj), compute_seconds=count * _surface_pace(obj, params)), obj, params)
+
+
+def _surface_kind(obj: Any, params: Any) -> str:
+    """The PACE row of a raster: a flat or bull-nose cutter's cusp spacing costs more per point than a ball's."""
+    from tmm_workbench.core.strategies import raster_drop
+
+    cutter = _cutter(obj)
+    ball = cutter.corner_radius >= cutter.radius
+    if params.stepover_mode == raster_drop.ADAPTIVE:
+        return "adaptive"
+    return "surface" if ball or params.stepover_mode == raster_drop.STEPOVER else "surface_flat_cusp"
+
+
+def _surface_pace(obj: Any, params: Any) -> float:
+    return PACE[_surface_kind(obj, params)] * max(1.0, (_cutter(obj).diameter / PACE_TOOL_MM) ** 2)
 
 
 def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
@@ -214,11 +261,16 @@ def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
                                            cusp_check.check_cell(params, _cutter(obj)))
         except WorkLimitError:
             return replace(est, note="(the cusp check is skipped: its measurement is above the work limit)")
-        return replace(est, count=est.count + dense, note="(with the cusp check's dense raster, at most)")
+        return replace(est, count=est.count + dense, note="(with the cusp check's dense raster, at most)",
+                       compute_seconds=_plus(est.compute_seconds, dense * PACE["verify"]))
     dense = variable_step.estimate_params(_cutter(obj), params)
-    return replace(est, count=est.count + dense,
+    return replace(est, count=est.count + dense, compute_seconds=_plus(est.compute_seconds, dense * PACE["verify"]),
                    note=f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial "
                         "passes where the simulated cusp is over, not counted)")
+
+
+def _plus(seconds: Optional[float], more: float) -> Optional[float]:
+    return None if seconds is None else seconds + more
 
 
 def _offset3d(obj: Any, params: Any) -> Estimate:
@@ -233,7 +285,8 @@ def _offset3d(obj: Any, params: Any) -> Estimate:
     length = raster_offset3d.loop_length(shape, cutter, params)
     x0, y0, x1, y1 = params.boundary
     flat = offset_field.step_rule(cutter, params.cusp, params.max_slope_deg).flat
-    return Estimate(count, "CL points", math.ceil(0.5 * min(x1 - x0, y1 - y0) / flat) + 1, length, _feed(obj))
+    return Estimate(count, "CL points", math.ceil(0.5 * min(x1 - x0, y1 - y0) / flat) + 1, length, _feed(obj),
+                    compute_seconds=count * PACE["offset3d"])
 
 
 def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
@@ -262,11 +315,11 @@ def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
     n = len(waterline.levels(top, bottom, params.step_down))
     # a level's loops run round the model: its box's outline offset by the tool radius, per level
     outline = 2 * (b[3] - b[0] + b[4] - b[1]) + 2 * math.pi * cutter.radius
-    return Estimate(count, "waterline drops and points", n, n * outline, _feed(obj))
+    return Estimate(count, "waterline drops and points", n, n * outline, _feed(obj),
+                    compute_seconds=count * PACE["waterline"])
 
 
 def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
-    from tmm_workbench.app.op_roughing import stock_box_of
     from tmm_workbench.app.compat import PathUtils
     from tmm_workbench.core.strategies import zlevel_rough
 
@@ -275,15 +328,15 @@ def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> 
     if stock is None or stock.Shape.isNull() or not stock.Shape.Solids:
         raise TmmError("the Job has no stock solid to rough from")
     final_z = _value(obj, "FinalZ", ov) if obj.UseFinalZ else None
-    params = _params(proxy, obj, ov, final_z=final_z, stock_box=stock_box_of(stock))
+    params = _params(proxy, obj, ov, final_z=final_z, stock_box=geometry.stock_box_of(stock))
     params.validate()
     cutter = _cutter(obj)
     layers = zlevel_rough.layer_count(params, cutter)
     b = params.stock_box
     # an upper bound: every layer clears the whole stock outline at the step-over
     length = layers * (b[3] - b[0]) * (b[4] - b[1]) / params.stepover(cutter)
-    return Estimate(zlevel_rough.estimate_work(params, cutter, layers), "roughing loop points", None, length,
-                    _feed(obj))
+    count = zlevel_rough.estimate_work(params, cutter, layers)
+    return Estimate(count, "roughing loop points", None, length, _feed(obj), compute_seconds=count * PACE["roughing"])
 
 
 def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
@@ -302,7 +355,9 @@ def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -
     area = (rect[2] - rect[0]) * (rect[3] - rect[1])
     return Estimate(count, "tool positions",
                     pass_count(math.hypot(rect[2] - rect[0], rect[3] - rect[1]), params.side_step),
-                    area / params.side_step, _feed(obj))
+                    area / params.side_step, _feed(obj),
+                    compute_seconds=count * PACE["multipoint_scallop" if params.pass_spacing == multipoint.SCALLOP
+                                                 else "multipoint"])
 
 
 _BY_CLASS = {"ObjectTmmSurface": _surface, "ObjectTmmWaterline": _waterline, "ObjectTmmRoughing": _roughing,
@@ -313,8 +368,6 @@ def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl
     """The op's work with its properties (and `overrides`: property -> value in mm / deg / %), refused by a
     TmmError above the work limits (the user's preferences) or for a value out of its range; None when it
     cannot be told without reading the model (an STL file and not `load_stl`, no face yet)."""
-    from tmm_workbench.app.op_base import apply_work_limits
-
     proxy = obj.Proxy
     ov = dict(overrides or {})
     for prop, value in ov.items():

@@ -204,7 +204,7 @@ class SimulatePanel:
     def check_cell(self) -> None:
         """The grid the entered cell size makes, told before any simulation: its cells, or the refusal (a
         grid above the work limits) with Simulate disabled."""
-        from tmm_workbench.app.op_base import apply_work_limits
+        from tmm_workbench.app.work_estimate import apply_work_limits
         from tmm_workbench.app.simulation import simulation_grid
 
         try:
