@@ -124,18 +124,19 @@ class Fuzz:
 
 def fuzz_mesh(z: Fuzz, tmp: str) -> None:
     V, F = z.mesh()
-    z.call("face_normals", lambda: native.face_normals(V, F))
-    z.call("vertex_normals", lambda: native.vertex_normals(V, F, str(z.rng.choice(["angle", "area", "meyer", "x"]))))
-    z.call("triangle_adjacency", lambda: native.triangle_adjacency(F))
+    z.call("face_normals", lambda: native.face_normals(V, F, z.progress()))
+    z.call("vertex_normals", lambda: native.vertex_normals(V, F, str(z.rng.choice(["angle", "area", "meyer", "x"])),
+                                                           z.progress()))
+    z.call("triangle_adjacency", lambda: native.triangle_adjacency(F, z.progress()))
     soup = z.points(int(z.rng.integers(0, 20)), 9)
-    z.call("weld", lambda: native.weld(soup, z.real(1e-3)))
+    z.call("weld", lambda: native.weld(soup, z.real(1e-3), z.progress()))
     data = z.rng.integers(0, 256, int(z.rng.integers(0, 300)), dtype=np.uint8).tobytes()
     if z.rng.random() < 0.5:
         data = b"solid f\nfacet normal 0 0 1\nouter loop\n" + b"".join(
             b"vertex %r %r %r\n" % (z.real(), z.real(), z.real()) for _ in range(3)) + b"endloop\nendfacet\nendsolid f\n"
     with open(tmp, "wb") as f:
         f.write(data)
-    z.call("read_stl", lambda: native.read_stl(tmp))
+    z.call("read_stl", lambda: native.read_stl(tmp, z.progress()))
 
 
 def cutter(z: Fuzz) -> Any:
@@ -148,7 +149,8 @@ def cutter(z: Fuzz) -> Any:
 
 def fuzz_drop(z: Fuzz) -> None:
     V, F = z.mesh()
-    index = z.call("MeshIndex", lambda: native.MeshIndex(V, F, threads=int(z.rng.integers(-1, 3))))
+    index = z.call("MeshIndex", lambda: native.MeshIndex(V, F, threads=int(z.rng.integers(-1, 3)),
+                                                         progress=z.progress()))
     c = cutter(z)
     if c is not None:
         z.call("Cutter.height", lambda: c.height(np.abs(z.points(5, 1, c.max_radius, odd=False).reshape(-1))))
@@ -214,7 +216,7 @@ def fuzz_multipoint(z: Fuzz) -> None:
         extend=z.positive(1.0) if z.rng.random() < 0.3 else 0.0))
     if s is None or opts is None:
         return
-    mp = z.call("MultipointPositioner", lambda: native.MultipointPositioner(s, opts))
+    mp = z.call("MultipointPositioner", lambda: native.MultipointPositioner(s, opts, z.progress()))
     if mp is None:
         return
     xy = z.points(int(z.rng.integers(0, 6)), 2, 50.0)

@@ -72,12 +72,12 @@ def asker() -> Optional[Progress]:
     return _ask if _stack else None
 
 
-def native_call(function: Callable, *args, **kwargs):
-    """A kernel batch call deep in a helper, cancelled through the watched callback (its `progress` keyword
-    asks `poll`); the kernel's Cancelled arrives as the core's."""
+def native_call(function: Callable, *args, progress: Optional[Progress] = None, **kwargs):
+    """A kernel call taking a `progress` keyword (a batch, a mesh phase): given the caller's `progress`, else
+    cancelled through the watched callback (`poll`); the kernel's Cancelled arrives as the core's."""
     from tmm_workbench.core.kernel import native
 
     try:
-        return function(*args, progress=asker(), **kwargs)
+        return function(*args, progress=asker() if progress is None else progress, **kwargs)
     except native.Cancelled as exc:
         raise Cancelled("cancelled") from exc

@@ -150,12 +150,14 @@ void bind_multipoint(py::module_& m) {
 
   py::class_<tmm::MultipointPositioner, std::shared_ptr<tmm::MultipointPositioner>>(m, "MultipointPositioner",
       "Multipoint positioning of a toroidal cutter on a PatchSurface (seed 001: VCRF or DRD).")
-      .def(py::init([](std::shared_ptr<tmm::PatchSurface> surface, const Options& o) {
+      .def(py::init([](std::shared_ptr<tmm::PatchSurface> surface, const Options& o, const py::object& progress) {
+             const auto report = python_progress(progress);
              py::gil_scoped_release release;
-             return std::make_shared<tmm::MultipointPositioner>(std::move(surface), o.tool, o.kernel);
+             return std::make_shared<tmm::MultipointPositioner>(std::move(surface), o.tool, o.kernel, report);
            }),
-           py::arg("surface"), py::arg("options"),
-           "ValueError naming the option for an invalid tool or option (NaN and infinities included).")
+           py::arg("surface"), py::arg("options"), py::arg("progress") = py::none(),
+           "ValueError naming the option for an invalid tool or option (NaN and infinities included). "
+           "progress(fraction) -> bool while the surface samples are built; False cancels (raises Cancelled).")
       .def_property_readonly("options", [](const tmm::MultipointPositioner& mp) { return Options{mp.tool(), mp.options()}; })
       .def("position_batch",
            [](const tmm::MultipointPositioner& mp, const Arr& xy_in, int threads, const py::object& progress) {

@@ -49,13 +49,17 @@ void bind_drop(py::module_& m) {
 
   py::class_<tmm::MeshIndex, std::shared_ptr<tmm::MeshIndex>>(m, "MeshIndex",
       "Spatial index (XY bounding volume hierarchy with heights) over a triangle mesh for drop-cutter.")
-      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const py::object& F, int threads) {
+      .def(py::init([](const Eigen::Ref<const tmm::Vertices>& V, const py::object& F, int threads,
+                       const py::object& progress) {
              const tmm::Triangles T = tmm_bindings::triangles_from(F);
+             const auto report = python_progress(progress);
              py::gil_scoped_release release;
-             return std::make_shared<tmm::MeshIndex>(V, T, threads);
+             return std::make_shared<tmm::MeshIndex>(V, T, threads, report);
            }),
            py::arg("vertices"), py::arg("triangles"), py::kw_only(), py::arg("threads") = 0,
-           "threads: build threads (0: all cores; small meshes build on one).")
+           py::arg("progress") = py::none(),
+           "threads: build threads (0: all cores; small meshes build on one). progress(fraction) -> bool, "
+           "called now and then; False cancels (raises Cancelled).")
       .def_property_readonly("build_threads", &tmm::MeshIndex::build_threads)
       .def_property_readonly("triangle_count", &tmm::MeshIndex::triangle_count)
       .def_property_readonly("node_count", [](const tmm::MeshIndex& i) { return i.nodes().size(); })

@@ -65,6 +65,12 @@ inline tmm::Triangles triangles_from(const pybind11::handle& obj) {
     throw std::invalid_argument(msg.str());
   }
   tmm::Triangles F(a.shape(0), 3);
+  if (kind == 'i' && a.itemsize() == sizeof(std::int32_t)) {  // every value fits: one copy, no checks (the
+    // widening copy below takes a noticeable pause before a big mesh's kernel call can report progress)
+    const py::array_t<std::int32_t, py::array::c_style | py::array::forcecast> typed(a);
+    std::copy_n(typed.data(), F.size(), F.data());
+    return F;
+  }
   auto fill = [&](auto typed) {
     using T = typename decltype(typed)::value_type;
     constexpr T lo = std::numeric_limits<T>::min() < 0 ? static_cast<T>(std::numeric_limits<std::int32_t>::min()) : T{0};

@@ -14,6 +14,8 @@
 #include <system_error>
 #include <vector>
 
+#include "tmm/util/parallel.hpp"
+
 namespace tmm {
 namespace {
 
@@ -22,6 +24,9 @@ namespace fs = std::filesystem;
 constexpr std::size_t kHeaderBytes = 84;   // 80-byte header + uint32 triangle count
 constexpr std::size_t kRecordBytes = 50;   // normal, 3 corners (12 float32), uint16 attribute
 constexpr std::size_t kSniffBytes = 1024;  // prefix inspected to tell text from binary
+// The shortest ASCII facet: "facet normal 0 0 0 outer loop", three "vertex 0 0 0", "endloop endfacet",
+// single separators.
+constexpr std::size_t kMinFacetBytes = 85;
 
 struct FileCloser {
   void operator()(std::FILE* f) const { std::fclose(f); }
@@ -92,7 +97,8 @@ std::string quoted(std::string_view tok) {
 // ---------------------------------------------------------------------------------------------------
 // Binary
 
-Soup read_binary(std::FILE* f, const std::string& path, uint64_t size, const unsigned char* head) {
+Soup read_binary(std::FILE* f, const std::string& path, uint64_t size, const unsigned char* head,
+                 SerialProgress& progress) {
   if (size < kHeaderBytes)
     throw StlError(path, "file too short for an STL (" + std::to_string(size) +
                              " bytes; a binary STL needs an 84-byte header)");
@@ -114,6 +120,7 @@ Soup read_binary(std::FILE* f, const std::string& path, uint64_t size, const uns
   if (std::fseek(f, long(kHeaderBytes), SEEK_SET) != 0)
     throw StlError(path, "cannot seek: " + std::string(std::strerror(errno)));
   for (std::size_t first = 0; first < declared; first += kChunk) {
+    progress.step(first, declared);
     const std::size_t count = std::min<std::size_t>(kChunk, declared - first);
     read_exactly(f, buf.data(), count * kRecordBytes, path);
     for (std::size_t i = 0; i < count; ++i) {
@@ -141,18 +148,25 @@ Soup read_binary(std::FILE* f, const std::string& path, uint64_t size, const uns
 
 class AsciiParser {
  public:
-  AsciiParser(std::string_view text, const std::string& path) : p_(text.data()), end_(p_ + text.size()), path_(path) {}
+  // Reports the share of the text parsed in progress's current part.
+  AsciiParser(std::string_view text, const std::string& path, SerialProgress& progress)
+      : begin_(text.data()), p_(begin_), end_(p_ + text.size()), path_(path), progress_(progress) {}
 
   Soup parse() {
-    std::vector<double> corners;
-    corners.reserve(std::size_t(end_ - p_) / 256 * 9 + 9);  // ~260 bytes per facet in typical files
+    // Rows for as many facets as the text can hold, written in place and trimmed at the end (a shrinking
+    // realloc; untouched rows cost address space only): a growing vector copies itself, and a gigabyte
+    // file's triangles took seconds to copy without a report.
+    Soup soup(Eigen::Index((end_ - p_) / kMinFacetBytes + 1), 9);
+    Eigen::Index rows = 0;
     skip_space();
     if (end_ - p_ >= 3 && std::string_view(p_, 3) == "\xEF\xBB\xBF") p_ += 3;
     expect_solid(next());
     for (;;) {
       const std::string_view tok = next();
       if (iequals(tok, "facet")) {
-        parse_facet(corners);
+        if (rows == soup.rows()) throw std::logic_error("ASCII STL: more facets than kMinFacetBytes allows");
+        parse_facet(soup.row(rows++).data());
+        progress_.tick(static_cast<std::size_t>(p_ - begin_), static_cast<std::size_t>(end_ - begin_));
       } else if (iequals(tok, "endsolid")) {
         skip_rest_of_line();  // the solid's name
         const std::string_view after = next();
@@ -162,8 +176,9 @@ class AsciiParser {
         fail_expected("'facet' or 'endsolid'", tok);
       }
     }
-    if (corners.empty()) throw StlError(path_, "ASCII STL holds no triangles");
-    return Eigen::Map<const Soup>(corners.data(), Eigen::Index(corners.size() / 9), 9);
+    if (rows == 0) throw StlError(path_, "ASCII STL holds no triangles");
+    soup.conservativeResize(rows, 9);
+    return soup;
   }
 
  private:
@@ -221,7 +236,8 @@ class AsciiParser {
     return x;
   }
 
-  void parse_facet(std::vector<double>& corners) {
+  // Fills the 9 corner coordinates of `row`.
+  void parse_facet(double* row) {
     expect("normal");
     for (int k = 0; k < 3; ++k) number("facet normal");  // not used: often zero or wrong, may be nan
     expect("outer");
@@ -231,16 +247,18 @@ class AsciiParser {
       for (int k = 0; k < 3; ++k) {
         const double x = number("vertex coordinate");
         if (!std::isfinite(x)) fail("non-finite vertex coordinate " + quoted(tok_));
-        corners.push_back(x);
+        row[3 * v + k] = x;
       }
     }
     expect("endloop");
     expect("endfacet");
   }
 
+  const char* begin_;
   const char* p_;
   const char* end_;
   const std::string& path_;
+  SerialProgress& progress_;
   std::size_t line_ = 1;
   std::string_view tok_;      // the last token read
   std::size_t tok_line_ = 1;  // and its line
@@ -249,6 +267,20 @@ class AsciiParser {
 }  // namespace
 
 namespace {
+
+// Share of an ASCII read spent loading the text (the parse is the rest: tens of times slower).
+constexpr double kTextLoadShare = 0.05;
+
+// Reads the rest of the file into text[from, size) in blocks of a few tens of MB, so that a slow disk or
+// a file of gigabytes reports progress and can be cancelled while it loads.
+void read_text(std::FILE* f, char* text, std::size_t size, std::size_t from, const std::string& path,
+               SerialProgress& progress) {
+  constexpr std::size_t kBlock = std::size_t(8) << 20;
+  for (std::size_t at = from; at < size; at += kBlock) {
+    progress.step(at, size);
+    read_exactly(f, text + at, std::min(kBlock, size - at), path);
+  }
+}
 
 std::string file_kind(fs::file_type t) {
   switch (t) {
@@ -262,7 +294,7 @@ std::string file_kind(fs::file_type t) {
 
 }  // namespace
 
-Soup read_stl(const std::string& path) {
+Soup read_stl(const std::string& path, const std::function<bool(double)>& progress) {
   std::error_code ec;
   const fs::file_status st = fs::status(path, ec);
   if (st.type() == fs::file_type::not_found) throw StlError(path, "file not found");
@@ -285,15 +317,26 @@ Soup read_stl(const std::string& path) {
   // Binary when the size matches the declared count (binary headers often start with "solid" too).
   const bool size_fits_binary = size >= kHeaderBytes && size == kHeaderBytes + kRecordBytes * uint64_t(load_u32le(head + 80));
   const bool starts_solid = istarts_with(skip_bom_and_space(prefix), "solid");
-  if (size_fits_binary || has_control_bytes(prefix)) return read_binary(f.get(), path, size, head);
+  SerialProgress reporter(progress);
+  if (size_fits_binary || has_control_bytes(prefix)) {
+    Soup soup = read_binary(f.get(), path, size, head, reporter);
+    reporter.finish();
+    return soup;
+  }
   if (!starts_solid)
     throw StlError(path, "not an STL file: text that does not start with 'solid' (starts with " +
                              quoted(skip_bom_and_space(prefix).substr(0, 20)) + ")");
 
-  std::string text(std::size_t(size), '\0');
-  std::memcpy(text.data(), head, sniffed);
-  read_exactly(f.get(), text.data() + sniffed, text.size() - sniffed, path);
-  return AsciiParser(text, path).parse();
+  // Not zero-filled first: the blocks read fill it (a gigabyte memset would be a pause of its own).
+  const auto length = static_cast<std::size_t>(size);
+  const std::unique_ptr<char[]> text(new char[length]);
+  std::memcpy(text.get(), head, sniffed);
+  reporter.part(0.0, kTextLoadShare);
+  read_text(f.get(), text.get(), length, sniffed, path, reporter);
+  reporter.part(kTextLoadShare, 1.0);
+  Soup soup = AsciiParser({text.get(), length}, path, reporter).parse();
+  reporter.finish();
+  return soup;
 }
 
 }  // namespace tmm

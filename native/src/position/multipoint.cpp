@@ -68,14 +68,18 @@ double checked_spacing(const PatchSurface& s, const MultipointOptions& options, 
 
 }  // namespace
 
+// The samples are most of the construction: with an extended face, two sets of about the same size.
 MultipointPositioner::MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool,
-                                           MultipointOptions options)
+                                           MultipointOptions options, const std::function<bool(double)>& progress)
     : tool_(tool),
       opt_(checked(options, tool_)),
       real_(std::move(surface)),
       surface_(extended_or_same(real_, opt_.extend)),
-      samples_(*surface_, checked_spacing(*surface_, opt_, tool_), bucket_size(tool_)) {
-  if (opt_.extend > 0.0) real_samples_ = std::make_unique<const SurfaceSamples>(*real_, samples_.spacing(), bucket_size(tool_));
+      samples_(*surface_, checked_spacing(*surface_, opt_, tool_), bucket_size(tool_),
+               progress_phase(progress, 0.0, opt_.extend > 0.0 ? 0.5 : 1.0)) {
+  if (opt_.extend > 0.0)
+    real_samples_ = std::make_unique<const SurfaceSamples>(*real_, samples_.spacing(), bucket_size(tool_),
+                                                           progress_phase(progress, 0.5, 1.0));
 }
 
 MultipointPositioner::Drop MultipointPositioner::drop_vcrf(double x, double y, int* evals) const {

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "tmm/util/parallel.hpp"
+
 namespace tmm {
 
 namespace {
@@ -84,13 +86,22 @@ double SurfaceSamples::finest_spacing(const PatchSurface& surface, double spacin
   return plan_for(lengths, std::max(spacing, longest / (kMaxSide - 1))).spacing;
 }
 
-SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, double cell) {
+SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, double cell,
+                               const std::function<bool(double)>& progress) {
   if (!(spacing > 0.0) || !std::isfinite(spacing) || !(cell > 0.0) || !std::isfinite(cell))
     throw std::invalid_argument("sample spacing and bucket size must be finite and > 0");
   const Plan plan = plan_for(polygon_lengths(surface), spacing);
   const std::vector<std::pair<int, int>>& counts = plan.counts;
   spacing = plan.spacing;
   spacing_ = spacing;
+  std::size_t total = 0;
+  for (const auto& [mu, mv] : counts) total += static_cast<std::size_t>(mu + 1) * static_cast<std::size_t>(mv + 1);
+  pts_.reserve(total);
+  uv_.reserve(total);
+  patch_.reserve(total);
+  // Parts by their measured share of the time: evaluating the patches is most of it.
+  SerialProgress reporter(progress);
+  reporter.part(0.0, 0.85);
   Box3 box;
   int k = 0;
   for (int i = 0; i < surface.nu(); ++i) {
@@ -104,6 +115,7 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
       const BezierPatch& p = surface.patch(i, j);
       for (int a = 0; a <= mu; ++a) {
         for (int b = 0; b <= mv; ++b) {
+          reporter.tick(pts_.size(), total);
           const double u = static_cast<double>(a) / mu, v = static_cast<double>(b) / mv;
           pts_.push_back(p.point(u, v));
           uv_.emplace_back(U0 + u * (U1 - U0), V0 + v * (V1 - V0));
@@ -113,6 +125,13 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
       }
     }
   }
+  reporter.part(0.85, 1.0);
+  build_buckets(box, cell, reporter);
+  reporter.finish();
+}
+
+// The XY bucket grid over the samples of `box`: buckets `cell` wide, coarser for a huge face.
+void SurfaceSamples::build_buckets(const Box3& box, double cell, SerialProgress& progress) {
   cell_ = cell;
   x0_ = box.lo.x();
   y0_ = box.lo.y();
@@ -129,6 +148,7 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
   std::vector<int> bucket(pts_.size());
   start_.assign(static_cast<std::size_t>(nx_ * ny_ + 1), 0);
   for (std::size_t s = 0; s < pts_.size(); ++s) {
+    progress.tick(s, 2 * pts_.size());
     // Clamped in double before the cast (a zero-width face divides 0 by 0: bucket 0).
     auto index = [&](double d, int n) { return d > 0.0 ? static_cast<int>(std::min(d / cell_, n - 1.0)) : 0; };
     const int i = index(pts_[s].x() - x0_, nx_), j = index(pts_[s].y() - y0_, ny_);
@@ -138,7 +158,10 @@ SurfaceSamples::SurfaceSamples(const PatchSurface& surface, double spacing, doub
   for (std::size_t b = 1; b < start_.size(); ++b) start_[b] += start_[b - 1];
   order_.resize(pts_.size());
   std::vector<int> fill(start_.begin(), start_.end() - 1);
-  for (std::size_t s = 0; s < pts_.size(); ++s) order_[static_cast<std::size_t>(fill[bucket[s]]++)] = static_cast<int>(s);
+  for (std::size_t s = 0; s < pts_.size(); ++s) {
+    progress.tick(pts_.size() + s, 2 * pts_.size());
+    order_[static_cast<std::size_t>(fill[bucket[s]]++)] = static_cast<int>(s);
+  }
 }
 
 }  // namespace tmm

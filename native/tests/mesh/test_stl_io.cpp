@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "support/progress_checks.hpp"
+
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -367,3 +369,18 @@ TEST(StlRead, NotARegularFileIsRefusedAtOnce) {
 }
 
 }  // namespace
+
+// Reading reports progress (ASCII: by the text parsed; binary: by blocks of triangles), a cancel at the
+// first report stops it, and a callback that goes on changes nothing.
+TEST(StlRead, ReportsProgressAndCancels) {
+  TempDir tmp;
+  std::vector<Tri> tris;
+  for (int i = 0; i < 3000; ++i)  // enough facets for an ASCII report before the last
+    tris.push_back(Tri{float(i), 0, 0, float(i) + 1, 0, 0, float(i), 1, float(i % 7)});
+  for (const std::string& path : {tmp.file("a.stl", ascii_stl(tris)), tmp.file("b.stl", binary_stl(tris))}) {
+    const tmm::Soup soup =
+        tmm_test::run_reported([&](const tmm_test::ProgressFn& p) { return tmm::read_stl(path, p); });
+    EXPECT_EQ(soup, tmm::read_stl(path)) << path;
+    expect_soup(soup, tris);
+  }
+}

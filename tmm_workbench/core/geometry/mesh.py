@@ -2,11 +2,17 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Callable, Optional
 
 import numpy as np
 
+from tmm_workbench.core.cancel import native_call
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.kernel import native
+
+# Each kernel phase below takes seconds on a mesh of millions of triangles: it reports to `progress` and stops
+# when it answers False (Cancelled), or without one asks the strategy's watched callback (core.cancel).
+Progress = Callable[[float], bool]
 
 WELD_TOLERANCE_MM = 1e-6
 NORMAL_WEIGHTINGS = ("angle", "area", "meyer")
@@ -43,8 +49,8 @@ class TriMesh:
         self.degenerate_removed = 0
 
     @classmethod
-    def from_corners(cls, corners: np.ndarray, name: str = "mesh",
-                     weld_tolerance: float = WELD_TOLERANCE_MM) -> "TriMesh":
+    def from_corners(cls, corners: np.ndarray, name: str = "mesh", weld_tolerance: float = WELD_TOLERANCE_MM,
+                     progress: Optional[Progress] = None) -> "TriMesh":
         """From a triangle soup (m, 3, 3): corners welded within `weld_tolerance` mm; triangles that become
         degenerate (a repeated vertex or zero area) are dropped and counted in `degenerate_removed`."""
         c = np.ascontiguousarray(corners, dtype=np.float64)
@@ -53,28 +59,28 @@ class TriMesh:
         if len(c) == 0:
             raise TmmError(f"{name}: the mesh has no triangles")
         try:  # the kernel also rejects non-finite corners, naming the triangle
-            v, f, removed = native.weld(c.reshape(-1, 9), float(weld_tolerance))
+            v, f, removed = native_call(native.weld, c.reshape(-1, 9), float(weld_tolerance), progress=progress)
         except ValueError as exc:
             raise TmmError(f"{name}: {exc}") from exc
         mesh = cls(v, f, name)
         mesh.degenerate_removed = int(removed)
         return mesh
 
-    def face_normals(self) -> np.ndarray:
+    def face_normals(self, progress: Optional[Progress] = None) -> np.ndarray:
         """Unit normal (m, 3) of each triangle, from its winding; zero for a zero-area triangle."""
-        return native.face_normals(self.vertices, self.triangles)
+        return native_call(native.face_normals, self.vertices, self.triangles, progress=progress)
 
-    def vertex_normals(self, weighting: str = "angle") -> np.ndarray:
+    def vertex_normals(self, weighting: str = "angle", progress: Optional[Progress] = None) -> np.ndarray:
         """Unit normal (n, 3) of each vertex; `weighting` is one of NORMAL_WEIGHTINGS (seed 000, 3.2)."""
         if weighting not in NORMAL_WEIGHTINGS:
             raise TmmError(f"{self.name}: unknown vertex normal weighting {weighting!r} "
                            f"(allowed: {', '.join(NORMAL_WEIGHTINGS)})")
-        return native.vertex_normals(self.vertices, self.triangles, weighting)
+        return native_call(native.vertex_normals, self.vertices, self.triangles, weighting, progress=progress)
 
-    def adjacency(self) -> np.ndarray:
+    def adjacency(self, progress: Optional[Progress] = None) -> np.ndarray:
         """(m, 3) int32: the triangle across edge i = (t[i], t[(i + 1) % 3]) of each triangle t, or -1 for a
         boundary or non-manifold edge."""
-        return native.triangle_adjacency(self.triangles)
+        return native_call(native.triangle_adjacency, self.triangles, progress=progress)
 
     @property
     def bounds(self) -> tuple[np.ndarray, np.ndarray]:
@@ -87,14 +93,20 @@ class TriMesh:
         return f"TriMesh({self.name!r}, {len(self.vertices)} vertices, {len(self.triangles)} triangles)"
 
 
-def load_stl(path: str | Path, weld_tolerance: float = WELD_TOLERANCE_MM) -> TriMesh:
-    """Read an ASCII or binary STL file (detected by content) into a welded mesh.
+def load_stl(path: str | Path, weld_tolerance: float = WELD_TOLERANCE_MM,
+             progress: Optional[Progress] = None) -> TriMesh:
+    """Read an ASCII or binary STL file (detected by content) into a welded mesh; `progress` sees the reading
+    as its first half, the welding as the second.
 
     A missing, empty, truncated or garbled file raises TmmError naming the file and the line (ASCII) or
     triangle (binary) where it is wrong."""
     p = Path(path)
+    reading = welding = None
+    if progress is not None:
+        reading, welding = (lambda f: progress(0.5 * f)), (lambda f: progress(0.5 + 0.5 * f))
     try:
-        soup = native.read_stl(str(p))
+        soup = native_call(native.read_stl, str(p), progress=reading)
     except (ValueError, RuntimeError) as exc:  # native.StlError is a ValueError
         raise TmmError(str(exc)) from exc
-    return TriMesh.from_corners(soup.reshape(-1, 3, 3), name=p.name, weld_tolerance=weld_tolerance)
+    return TriMesh.from_corners(soup.reshape(-1, 3, 3), name=p.name, weld_tolerance=weld_tolerance,
+                                progress=welding)

@@ -18,10 +18,12 @@ Progress = Callable[[float], bool]
 class DropSurface:
     """A mesh indexed for drop-cutter queries along -Z. Build once, drop many cutters and points."""
 
-    def __init__(self, mesh: TriMesh) -> None:
+    def __init__(self, mesh: TriMesh, progress: Optional[Progress] = None) -> None:
+        """Indexes `mesh` (seconds for millions of triangles): reports to `progress`, or without one asks the
+        strategy's watched callback (core.cancel); Cancelled when either says stop."""
         self.mesh = mesh
         try:
-            self._index = native.MeshIndex(mesh.vertices, mesh.triangles)
+            self._index = cancel.native_call(native.MeshIndex, mesh.vertices, mesh.triangles, progress=progress)
         except ValueError as exc:
             raise TmmError(f"{mesh.name}: {exc}") from exc
 

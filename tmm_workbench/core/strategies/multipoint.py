@@ -203,8 +203,9 @@ def _torus(tool: Cutter) -> tuple[float, float]:
 
 
 def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[MultipointParams] = None,
-                    method: Optional[str] = None):
-    """The kernel's positioner for the torus (Ro, Ri) (surface samples built once per face and tool)."""
+                    method: Optional[str] = None, progress: Optional[Progress] = None):
+    """The kernel's positioner for the torus (Ro, Ri) (surface samples built once per face and tool: a second
+    at a fine sample spacing, reported to `progress` or, without one, cancelled through core.cancel)."""
     params = params or MultipointParams()
     Cutter.torus(Ro, Ri)  # the one place that checks a torus' radii
     params.validate()
@@ -219,7 +220,7 @@ def make_positioner(face: BezierFace, Ro: float, Ri: float, params: Optional[Mul
         drd_refinements=int(params.drd_refinements), drd_bisections=int(params.drd_bisections),
         extend=float(params.extend), anchor=params.anchor, anchor_iterations=int(params.anchor_iterations))
     try:
-        return native.MultipointPositioner(face.native, options)
+        return cancel.native_call(native.MultipointPositioner, face.native, options, progress=progress)
     except ValueError as exc:
         raise TmmError(str(exc)) from exc
 
@@ -230,7 +231,8 @@ def position_points(face: BezierFace, Ro: float, Ri: float, xy: np.ndarray,
     """Multipoint positions of the torus (Ro, Ri) at the (n, 2) footprint points (method: params.method
     unless given)."""
     params = params or MultipointParams()
-    return _position(make_positioner(face, Ro, Ri, params, method), xy, params, progress)
+    with cancel.watching(progress) as report:  # the samples are built before any position: they ask it
+        return _position(make_positioner(face, Ro, Ri, params, method), xy, params, report)
 
 
 def _position(mp, xy: np.ndarray, params: MultipointParams, progress: Optional[Progress] = None

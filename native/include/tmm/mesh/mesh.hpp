@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string_view>
 
 namespace tmm {
@@ -37,7 +38,11 @@ struct Mesh {
 // Throws std::invalid_argument for an empty soup, a non-finite coordinate (naming the triangle), a bad
 // tolerance, too many triangles for 32-bit indices (3m > 2^31-1), a coordinate outside the kernel's range
 // (tmm/util/range.hpp) or when no non-degenerate triangle remains.
-Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed = nullptr);
+// Here and below, progress(fraction) is called now and then from the calling thread (tmm::SerialProgress:
+// every 20 ms, and 1.0 at the end); false cancels: throws tmm::Cancelled. Meshes of millions of triangles
+// take seconds.
+Mesh weld(const SoupRef& soup, double tol, std::size_t* degenerate_removed = nullptr,
+          const std::function<bool(double)>& progress = {});
 
 // Throws std::invalid_argument naming the first triangle with an index outside [0, V.rows()) or the
 // first vertex with a non-finite coordinate or one outside the kernel's range. face_normals and
@@ -49,14 +54,14 @@ void validate(const VerticesRef& V, const TrianglesRef& F);
 void require_vertices_in_range(const VerticesRef& V);
 
 // Unit normal of each triangle, (p1 - p0) x (p2 - p0) normalised; (0, 0, 0) for a zero-area triangle.
-Normals face_normals(const VerticesRef& V, const TrianglesRef& F);
+Normals face_normals(const VerticesRef& V, const TrianglesRef& F, const std::function<bool(double)>& progress = {});
 inline Normals face_normals(const Mesh& m) { return face_normals(m.V, m.F); }
 
 // For triangle t and edge i = (F(t,i), F(t,(i+1)%3)): the other triangle sharing that edge (orientation
 // is not required to agree), or -1 when the edge is a boundary edge or is non-manifold (shared by more
 // than two triangles: no single neighbour exists, so it is reported like a boundary).
 // Expected O(m) for bounded vertex valence. Indices must be >= 0 (std::invalid_argument otherwise).
-Adjacency triangle_adjacency(const TrianglesRef& F);
+Adjacency triangle_adjacency(const TrianglesRef& F, const std::function<bool(double)>& progress = {});
 inline Adjacency triangle_adjacency(const Mesh& m) { return triangle_adjacency(m.F); }
 
 // Vertex normal weightings of seed 000 section 3.2.
@@ -72,7 +77,8 @@ const char* weighting_name(NormalWeighting w);
 
 // Unit normal per vertex, oriented like the incident face normals (which follow the triangle winding).
 // A vertex used by no triangle of non-zero area gets (0, 0, 0).
-Normals vertex_normals(const VerticesRef& V, const TrianglesRef& F, NormalWeighting w);
+Normals vertex_normals(const VerticesRef& V, const TrianglesRef& F, NormalWeighting w,
+                       const std::function<bool(double)>& progress = {});
 inline Normals vertex_normals(const Mesh& m, NormalWeighting w) { return vertex_normals(m.V, m.F, w); }
 
 }  // namespace tmm

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -42,8 +43,11 @@ class MeshIndex {
   // threads: at most this many threads build the tree (0: all hardware threads; subtrees of more than
   // kParallelBuild triangles are split between threads, so small meshes build on one). The tree does not
   // depend on it. Throws std::invalid_argument on out-of-range indices, non-finite coordinates, an empty
-  // mesh or threads < 0.
-  MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F, int threads = 0);
+  // mesh or threads < 0. progress(fraction) is called now and then from the calling thread
+  // (tmm::SerialProgress: every 20 ms, and 1.0 at the end); false cancels: throws tmm::Cancelled (a mesh of
+  // ten million triangles takes seconds).
+  MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F, int threads = 0,
+            const std::function<bool(double)>& progress = {});
   static constexpr int32_t kParallelBuild = 100000;
   // The number of threads the build ran on.
   int build_threads() const { return build_threads_; }
@@ -72,7 +76,8 @@ class MeshIndex {
   void near_rect(double x0, double y0, double x1, double y1, double radius, double floor, Visit&& visit) const;
 
  private:
-  void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads, std::atomic<int>& used);
+  struct BuildState;  // what the build's threads share (mesh_index.cpp)
+  void build(int32_t self, int32_t below, int32_t begin, int32_t end, int threads, BuildState& state, bool reports);
   static int32_t descendants(int32_t triangles);
 
   std::vector<IndexedTriangle> tris_;

@@ -3,6 +3,7 @@
 
 #include "tmm/mesh/mesh.hpp"
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 
@@ -31,6 +32,8 @@ class StlError : public std::runtime_error {
 // Throws StlError for a missing/unreadable file, a directory or anything else that is not a regular file
 // (FIFO, device, socket: refused before opening), an empty file, no triangles, a truncated or garbled
 // file, or a non-finite vertex coordinate.
-Soup read_stl(const std::string& path);
+// progress(fraction) is called now and then (tmm::SerialProgress: every 20 ms, and 1.0 at the end) from the
+// calling thread; false cancels: throws tmm::Cancelled (a gigabyte ASCII file takes seconds to parse).
+Soup read_stl(const std::string& path, const std::function<bool(double)>& progress = {});
 
 }  // namespace tmm

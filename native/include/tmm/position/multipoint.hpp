@@ -43,7 +43,10 @@ class MultipointPositioner {
  public:
   // Throws std::invalid_argument naming the first invalid tool radius or option (NaN and infinities
   // included; a sample_spacing finer than the face can be sampled at, with the finest it can).
-  MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool, MultipointOptions options);
+  // progress(fraction) is called now and then from the calling thread while the surface samples are built
+  // (a second for a fine spacing); false cancels: throws Cancelled.
+  MultipointPositioner(std::shared_ptr<const PatchSurface> surface, TorusTool tool, MultipointOptions options,
+                       const std::function<bool(double)>& progress = {});
 
   // Position the tool at footprint point (x, y): Axis anchor, the tool whose axis before tilting is the
   // vertical through (x, y); Tip anchor, the tool whose tilted tip lies at (x, y) (see FootprintAnchor).

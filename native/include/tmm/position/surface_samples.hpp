@@ -7,18 +7,24 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 #include "tmm/surface/bezier.hpp"
 
 namespace tmm {
 
+class SerialProgress;
+
 // Dense-enough samples of a surface and an XY bucket grid over them: the "rays from the surface" of VCRF
 // and the candidates of the gouge check. Built once per surface and tool.
 class SurfaceSamples {
  public:
-  // spacing: target distance between samples (mm); cell: XY bucket size (mm).
-  SurfaceSamples(const PatchSurface& surface, double spacing, double cell);
+  // spacing: target distance between samples (mm); cell: XY bucket size (mm). progress(fraction) is
+  // called now and then (tmm::SerialProgress); false cancels: throws tmm::Cancelled (millions of samples
+  // take a second).
+  SurfaceSamples(const PatchSurface& surface, double spacing, double cell,
+                 const std::function<bool(double)>& progress = {});
   // The largest number of samples kept: beyond it the spacing is widened (spacing() tells by how much);
   // at most kMaxSide intervals along a patch side (beyond it the side is sampled coarser).
   static constexpr std::size_t kMaxSamples = 4000000;
@@ -47,6 +53,7 @@ class SurfaceSamples {
   void boundary_neighbours(std::size_t k, F&& f) const;
 
  private:
+  void build_buckets(const Box3& box, double cell, SerialProgress& progress);
   std::vector<Vector3d> pts_;
   std::vector<Vector2d> uv_;
   std::vector<int> patch_;

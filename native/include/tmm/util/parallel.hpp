@@ -66,19 +66,44 @@ void parallel_chunks(std::size_t n, std::size_t chunk, const BatchOptions& optio
                      const std::function<void(std::size_t begin, std::size_t end, ChunkContext& context)>& work);
 
 // Progress and cancel of a loop on the calling thread (no workers): tick is a counter, looking at the clock
-// every 256 calls and reporting at most every 20 ms; throws Cancelled when the callback says false.
+// every 256 calls and reporting at most every 20 ms; throws Cancelled when the callback says false. A job of
+// several loops shares one: each loop runs in its part [lo, hi] of the job (part()) and reports its items
+// done within it, so the fraction never goes back. A part's first look at the clock reports at once (a
+// short loop reports too, and a cancel can be tested in each part without waiting for the clock).
 class SerialProgress {
  public:
   explicit SerialProgress(const std::function<bool(double)>& progress) : progress_(progress) {}
   void tick(double fraction) {
     if (progress_ && (++calls_ & 255u) == 0) report(fraction);
   }
+  // The loops that follow are the part [lo, hi] of the job.
+  void part(double lo, double hi) {
+    lo_ = lo;
+    hi_ = hi;
+    last_ = {};
+  }
+  // Item `done` of `total` of the current part (the fraction is only computed when reported).
+  void tick(std::size_t done, std::size_t total) {
+    if (progress_ && (++calls_ & 255u) == 0) report(within(done, total));
+  }
+  // For coarse steps (a millisecond or more each, a block read from a file): looks at the clock every call.
+  void step(std::size_t done, std::size_t total) {
+    if (progress_) report(within(done, total));
+  }
+  // The last report (1.0), the caller's last chance to cancel, as parallel_chunks gives it.
+  void finish() {
+    if (progress_ && !progress_(1.0)) throw Cancelled();
+  }
 
  private:
+  double within(std::size_t done, std::size_t total) const {
+    return lo_ + (hi_ - lo_) * static_cast<double>(done) / static_cast<double>(total > 0 ? total : 1);
+  }
   void report(double fraction);
   const std::function<bool(double)>& progress_;
   unsigned calls_ = 0;
-  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+  double lo_ = 0.0, hi_ = 1.0;
+  std::chrono::steady_clock::time_point last_{};  // long ago: the first report is not held back
 };
 
 // The progress of a phase [lo, hi] of a longer job reported through `outer` (empty if outer is). Refers to
