@@ -15,7 +15,8 @@ from tmm_workbench.core.geometry import bezier
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, MultipointParams
-from tmm_workbench.core.strategies.multipoint_scallop import NOT_REACHED, OVER_SCALLOP, LeftArea
+from tmm_workbench.core.strategies.multipoint_scallop import (MAX_TRIALS, NOT_REACHED, OVER_SCALLOP, LeftArea,
+                                                               estimate_passes)
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.verify.zmap import ZTool, simulate
 
@@ -109,6 +110,7 @@ def test_small_net_holds_the_scallop_on_every_strip(small_net):
     assert all(b > a for a, b in zip(rep.offsets, rep.offsets[1:]))
     assert not [a for a in rep.unreached if a.reason == OVER_SCALLOP]  # no strip at the estimate's step
     assert all(0.0 <= v <= SMALL_H for v in rep.scallops), rep.scallops
+    assert rep.trials <= estimate_passes(12.0, 1.0, SMALL_H) * MAX_TRIALS  # within the work estimate's
 
 
 def test_small_net_reports_only_what_dense_passes_leave_too(small_net):
