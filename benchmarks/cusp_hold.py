@@ -8,7 +8,8 @@ of the same tool cut into the stock simulation (core.sim.cusp_field, 0.1 mm cell
 apart sampled every 0.25 mm), the cusp along the normal on slopes up to 75 deg where the tool reaches the model.
 Printed per row: the largest cusp, its 99.5th percentile, the cells above 1.05 x the cusp, the cycle (1000 mm/min)
 and the compute seconds (the op's own check included), and what the op itself reports (CheckCusp On: diagnostics
-"cusp_check": cells above the cusp on the verification's finer cells, crests included, the largest, its seconds).
+"cusp_check": cells above the cusp on the verification's finer cells, crests included, the largest, its seconds;
+--check auto: on CheckCusp Auto's cells, coarser on regions of more than 250,000 of those).
 
     .venv/bin/python benchmarks/cusp_hold.py                       # every case and mode (about 10 min loaded)
     .venv/bin/python benchmarks/cusp_hold.py --only bumps1,cavity --modes offset3d
@@ -39,8 +40,8 @@ TOL = 0.01
 CELL = 0.1
 OVER = 1.05           # cells above this x the cusp are counted
 MODES = ("cusp", "adaptive", "offset3d")
-CHECK = "on"          # the op's own check (CheckCusp) on every case: its report and what it costs (Auto would
-                      # leave these regions out)
+CHECK = "on"          # the op's own check (CheckCusp) by default On on every case: its report and what it costs
+                      # on the verification's cells (--check auto: these regions on Auto's coarser cells)
 
 
 def grid_mesh(z: np.ndarray, size: tuple[float, float], name: str) -> TriMesh:
@@ -85,12 +86,12 @@ def cases(only: set[str]) -> list[tuple[str, TriMesh]]:
     return [(name, make()) for name, make in makers.items() if not only or name in only]
 
 
-def row(name: str, mesh: TriMesh, cutter: Cutter, mode: str, field) -> str:
+def row(name: str, mesh: TriMesh, cutter: Cutter, mode: str, field, check: str = CHECK) -> str:
     lo, hi = mesh.bounds
     boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
     t0 = time.perf_counter()
     result = compute(mesh, cutter, SurfaceParams(boundary=boundary, sample_step=0.25, stepover_mode=mode, cusp=TOL,
-                                                 max_slope_deg=SLOPE_LIMIT, cusp_check=CHECK))
+                                                 max_slope_deg=SLOPE_LIMIT, cusp_check=check))
     top = float(hi[2])
     path = link(result.segments, LinkPolicy(top + 5, top + 10))
     secs = time.perf_counter() - t0
@@ -99,7 +100,7 @@ def row(name: str, mesh: TriMesh, cutter: Cutter, mode: str, field) -> str:
     above = int(np.sum(m > OVER * TOL))
     check = result.diagnostics.get("cusp_check")
     said = ("-" if check is None else "skipped" if check["skipped"] else
-            f"{check['exceeding']} / {check['max_cusp']:.4f} ({check['seconds']:.1f} s)")
+            f"{check['exceeding']} / {check['max_cusp']:.4f} ({check['seconds']:.1f} s, {check['cell']:.3f} mm cells)")
     return (f"| {name} | {mode} | {result.diagnostics['passes']} | {m.max():.4f} | {np.percentile(m, 99.5):.4f} | "
             f"{above} | {len(m)} | {cycle(path) / 60:.1f} | {secs:.1f} | {said} |")
 
@@ -108,6 +109,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--only", default="", help="comma-separated: bumps1, bumps2, cavity, sphere_on_plate, mount_rush")
     ap.add_argument("--modes", default=",".join(MODES), help="comma-separated: " + ", ".join(MODES))
+    ap.add_argument("--check", default=CHECK, choices=("on", "auto"), help="the op's CheckCusp")
     args = ap.parse_args()
     cutter = Cutter.ball(6.0)
     print(f"| case | mode | passes | max cusp mm | p99.5 mm | cells > {OVER:g} x | measured | cycle min | compute s "
@@ -118,7 +120,7 @@ def main() -> None:
         boundary = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         field = cusp_field(mesh, cutter, boundary, TOL, CELL, SLOPE_LIMIT, sample_step=0.25)
         for mode in filter(None, args.modes.split(",")):
-            print(row(name, mesh, cutter, mode, field), flush=True)
+            print(row(name, mesh, cutter, mode, field, args.check), flush=True)
     print(f"# {time.perf_counter() - t0:.0f} s")
 
 

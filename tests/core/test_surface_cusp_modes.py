@@ -81,7 +81,7 @@ def _highest_move_over_the_drop(mesh, cutter, result) -> float:
     return float((samples[:, 2] - exact).max())
 
 
-@pytest.mark.parametrize("mode", ["cusp", "adaptive"])
+@pytest.mark.parametrize("mode", ["cusp", "adaptive", "offset3d"])
 def test_cusp_modes_split_the_moves_that_leave_material_across_a_valley(mode):
     """A V valley crossing the passes at an angle: the ball's CL path kinks at its crease, and a move across the
     kink passes above the exact CL path, leaving material the spacing (computed on the CL points) does not count.

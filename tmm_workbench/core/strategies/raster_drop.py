@@ -218,7 +218,7 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
     if air.all():
         raise TmmError("the cutter is over no part of the model anywhere in the boundary (off-model: skip)")
     diagnostics.update(points=len(xy), passes=len(lines) if chains is None else diagnostics["passes"])
-    leave = _LEAVE_SHARE * params.cusp if params.stepover_mode in (CUSP, ADAPTIVE) else math.inf
+    leave = _LEAVE_SHARE * params.cusp if params.stepover_mode != STEPOVER else math.inf
     if params.gouge_tol > 0 or math.isfinite(leave):
         from tmm_workbench.core.strategies import raster_refine
 
