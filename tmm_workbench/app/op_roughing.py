@@ -19,17 +19,14 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, hooks, op_base, progress, simulation
-from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
+from tmm_workbench.app import geometry, op_base, op_mesh, progress, simulation
+from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
-from tmm_workbench.app.op_surface import ObjectTmmSurface
 from tmm_workbench.app.tools import label_of
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import zlevel_rough
 from tmm_workbench.core.strategies.zlevel_rough import RoughingParams
-from tmm_workbench.core.toolpath import Toolpath
 
 OP_NAME = "TMM_Roughing"
 LAYER_MODES = {"Fixed": "fixed", "Tolerance": "tolerance"}
@@ -39,10 +36,7 @@ ENTRIES = {"Helix": "helix", "Ramp": "ramp", "Plunge": "plunge"}
 STEEP_DESCENT_DEG = 45.0   # cutting moves down more steeply than this run at the vertical feed
 STOCK_CELL_MM = 0.5        # grid of a stock that is not a box (its top as heights)
 
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
-    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
-    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyDistance", "StepDown", "Layers", "Depth of each z-level (at most the tool's cutting edge "
          "height)", "step_down"),
     Prop("App::PropertyEnumeration", "LayerMode", "Layers",
@@ -75,7 +69,7 @@ PROPERTIES: list[Prop] = [
          "helix_diameter_percent"),
 ]
 CHOICES = {"LayerMode": LAYER_MODES, "Pattern": PATTERNS, "Direction": DIRECTIONS, "Entry": ENTRIES}
-DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "UseFinalZ": False, "FinalZ": 0.0}
+DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "UseFinalZ": False, "FinalZ": 0.0}
 AXIAL_EXPRESSION = "StockToLeave"  # the axial stock to leave follows the radial one unless given
 
 
@@ -105,38 +99,27 @@ def check_step_down(tool: Any, step_down: float) -> None:
                        f"'{label_of(tool)}' (allowed: up to {edge:g} mm)")
 
 
-class ObjectTmmRoughing(op_base.TmmOp):
+class ObjectTmmRoughing(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed)."""
 
+    VIEW_KIND = "roughing_op"
     PARAMS = RoughingParams
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
-    toolpath: Optional[Toolpath] = None
-    mesh: Optional[TriMesh] = None
     params: Optional[RoughingParams] = None
-
-    def opFeatures(self, obj: Any) -> int:
-        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
 
     def opSetDefaultValues(self, obj: Any, job: Any) -> None:
         obj.setExpression("AxialStockToLeave", AXIAL_EXPRESSION)  # a given value replaces it
         super().opSetDefaultValues(obj, job)
-
-    def opOnDocumentRestored(self, obj: Any) -> None:
-        self.ensure_properties(obj, restoring=True)
-        hooks.attach_view("roughing_op", obj)  # a document saved headless has no view providers
-        job = PathUtils.findParentJob(obj)
-        if job is not None:
-            hooks.attach_view("job", job)
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:
         self.mesh = self.toolpath = self.params = None
 
     def compute(self, obj: Any) -> None:
-        mesh = ObjectTmmSurface.model_mesh(self, obj)  # the Surface op's model rules, one place
+        mesh = self.model_mesh(obj)
         cutter = self.cutter()
         check_step_down(self.tool, obj.StepDown.Value)
         job = PathUtils.findParentJob(obj)
@@ -153,8 +136,7 @@ class ObjectTmmRoughing(op_base.TmmOp):
             left = "what the Job's earlier ops left" if rest is not None else "the stock"
             raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
-        self.commandlist.extend(ObjectTmmSurface.commands(self, toolpath, STEEP_DESCENT_DEG,
-                                                          obj.ClearanceHeight.Value))
+        self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 
 def SetupProperties() -> list[str]:

@@ -17,33 +17,26 @@ from __future__ import annotations
 from typing import Any, Optional
 
 import FreeCAD
-import Path
 
-from tmm_workbench.app import geometry, hooks, model_proxy, op_base, progress, region_source, simulation
+from tmm_workbench.app import op_base, op_mesh, progress, region_source, simulation
 from tmm_workbench.app import surface_passes
 from tmm_workbench.app import surface_verify
 from tmm_workbench.app import offset_start
-from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
+from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
-from tmm_workbench.core.arcs import PLANE_CODES
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import finish_passes
 from tmm_workbench.core.strategies.raster_drop import (INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY,
                                                        OUTWARD, SAMPLED, SPIRAL, TOLERANCE, ZIGZAG, SurfaceParams)
-from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
 OP_NAME = "TMM_Surface"
 PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL}
 OFF_MODEL = {"Floor": OFF_MODEL_FLOOR, "Skip": OFF_MODEL_SKIP}
 BOUNDARIES = ("Stock", "Model")
 
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
-    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
-    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyEnumeration", "BoundaryShape", "Boundary",
          "Area covered by the tool tip: the Stock's or the Model's XY bounding box"),
     Prop("App::PropertyDistance", "BoundaryMargin", "Boundary",
@@ -67,7 +60,7 @@ PROPERTIES: list[Prop] = [
          "The tolerance of the moves: with ForwardStep Tolerance, how far above or below the exact tool path a "
          "move may pass; with SampleStep, how far above the CL points a longer straight move may pass where it "
          "replaces them (never below one; 0: keep every point off a straight line)", "chord_tol"),
-    # lean passes (issue 14 item 2): the forward step by ChordTolerance, arcs in the pass's plane
+    # lean passes: the forward step by ChordTolerance, arcs in the pass's plane
     Prop("App::PropertyEnumeration", "ForwardStep", "Surface",
          "Tolerance: the fewest moves within ChordTolerance of the exact tool path, above or below it (points "
          "added where a move would leave it, removed where a longer move stays in it); SampleStep: a point "
@@ -80,7 +73,7 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "OffModel", "Surface",
          "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
          "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model"),
-    # --- machining region, spiral, slope range (issue 14 item 3; app.region_source) ---
+    # --- machining region, spiral, slope range (app.region_source) ---
     Prop("App::PropertyEnumeration", "Region", "Region",
          "Where the tool centre may go: Box (BoundaryShape with BoundaryMargin), Faces (RegionFaces seen from "
          "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes)"),
@@ -98,31 +91,31 @@ PROPERTIES: list[Prop] = [
 FORWARD_STEPS = {"Tolerance": TOLERANCE, "SampleStep": SAMPLED}
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Pattern": PATTERNS, "OffModel": OFF_MODEL,
            "StepOverMode": surface_passes.SPACINGS, "ForwardStep": FORWARD_STEPS}
-DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Stock",
+DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "BoundaryShape": "Stock",
                             "BoundaryMargin": 0.0, "PlungeAngle": 45.0, "ForwardStep": "SampleStep"}
 CHOICES.update({"Region": {r: r for r in region_source.REGIONS},
                 "SpiralDirection": {"Outward": OUTWARD, "Inward": INWARD}})
 DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
-# lean passes by default for new ops since the fit is in the kernel (issue 14 item 2); documents saved without
-# the property restore with SampleStep (RESTORED_DEFAULTS)
+# lean passes by default for new ops since the fit is in the kernel; documents saved without the property
+# restore with SampleStep (RESTORED_DEFAULTS)
 DEFAULTS["ForwardStep"] = "Tolerance"
 # FreeCAD posts whose parameter list has no K: an arc in XZ or YZ would lose its centre's Z (0.20-1.1)
 POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
                    "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
-# % step-over, Depths (final depth, finishing passes) and start point (issue 15 item 6): app.surface_passes
+# % step-over, Depths (final depth, finishing passes) and start point: app.surface_passes
 PROPERTIES += surface_passes.PROPERTIES
 CHOICES.update(surface_passes.CHOICES)
 DEFAULTS.update(surface_passes.DEFAULTS)
-# the verification pass: partial passes where the simulated cusp exceeds CuspHeight (issue 14 item 4)
+# the verification pass: partial passes where the simulated cusp exceeds CuspHeight
 PROPERTIES += surface_verify.PROPERTIES
 CHOICES.update(surface_verify.CHOICES)
-# the 3D offset's start: the region's boundary or a chosen curve (issue 14 item 1; app.offset_start)
+# the 3D offset's start: the region's boundary or a chosen curve (app.offset_start)
 PROPERTIES += offset_start.PROPERTIES
 CHOICES.update(offset_start.CHOICES)
 DEFAULTS.update(offset_start.DEFAULTS)
 
 
-class ObjectTmmSurface(op_base.TmmOp):
+class ObjectTmmSurface(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
 
     PARAMS = SurfaceParams
@@ -131,19 +124,6 @@ class ObjectTmmSurface(op_base.TmmOp):
     DEFAULTS = DEFAULTS
     # documents from before them kept every point, on the samples
     RESTORED_DEFAULTS = {"ChordTolerance": 0.0, "ForwardStep": "SampleStep"}
-    toolpath: Optional[Toolpath] = None
-    mesh: Optional[TriMesh] = None
-
-    def opFeatures(self, obj: Any) -> int:
-        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
-
-    def opOnDocumentRestored(self, obj: Any) -> None:
-        self.ensure_properties(obj, restoring=True)
-        # a document saved headless has no view providers for the op and its Job
-        hooks.attach_view("op", obj)
-        job = PathUtils.findParentJob(obj)
-        if job is not None:
-            hooks.attach_view("job", job)
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:
@@ -181,59 +161,6 @@ class ObjectTmmSurface(op_base.TmmOp):
         name = str(getattr(job, "PostProcessor", "") or "")
         return name if name in POSTS_WITHOUT_K else ""
 
-    def model_mesh(self, obj: Any) -> TriMesh:
-        deflection = obj.LinearDeflection.Value
-        if obj.StlFile:
-            return geometry.mesh_from_stl(obj.StlFile)
-        if obj.Model is not None:
-            return model_proxy.mesh_of_model(obj.Model, deflection)
-        models = list(self.model or [])
-        if not models:
-            raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
-        return geometry.combine([model_proxy.mesh_of_model(m, deflection) for m in models])
-
-    def boundary(self, obj: Any, mesh: TriMesh) -> tuple[float, float, float, float]:
-        if obj.BoundaryShape == "Stock":
-            if self.stock is None or self.stock.Shape.isNull():
-                raise TmmError("boundary 'Stock': the Job has no stock")
-            bb = self.stock.Shape.BoundBox
-            x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
-        else:
-            lo, hi = mesh.bounds
-            x0, y0, x1, y1 = float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
-        m = obj.BoundaryMargin.Value
-        return (x0 - m, y0 - m, x1 + m, y1 + m)
-
-    def commands(self, toolpath: Toolpath, plunge_angle_deg: float = 45.0,
-                 clearance: Optional[float] = None) -> list[Any]:
-        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and for cutting moves
-        going down more steeply than `plunge_angle_deg`, the horizontal feed for the other cutting moves.
-        With `clearance`, the path starts with a Z-only rapid to it: after a tool change the tool goes up
-        before it moves in X and Y."""
-        if not (0.0 <= plunge_angle_deg <= 90.0):
-            raise TmmError(f"plunge angle must be in [0, 90] deg, got {plunge_angle_deg:g}")
-        steep = toolpath.steep_descents(plunge_angle_deg)
-        out = []
-        if clearance is not None and len(toolpath):
-            out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
-        plane = "XY"
-        for i, (m, down) in enumerate(zip(toolpath, steep)):
-            if m.arc is not None and i > 0:  # lean passes: G2/G3 in the pass's vertical plane, selected first
-                if m.arc.plane != plane:
-                    out.append(Path.Command(PLANE_CODES[m.arc.plane], {}))
-                    plane = m.arc.plane
-                prev = toolpath.moves[i - 1]
-                name, words = m.arc.command((prev.x, prev.y, prev.z), (m.x, m.y, m.z))
-                out.append(Path.Command(name, {**words, "F": self.horizFeed}))
-                continue
-            if m.kind is MoveKind.RAPID:
-                out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
-            else:
-                feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
-                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
-        if plane != "XY":
-            out.append(Path.Command(PLANE_CODES["XY"], {}))
-        return out
 
 
 def SetupProperties() -> list[str]:

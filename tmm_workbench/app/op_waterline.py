@@ -16,26 +16,20 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, hooks, op_base, progress, simulation
-from tmm_workbench.app.compat import PathOp, PathSetupSheet, PathUtils
+from tmm_workbench.app import op_base, op_mesh, progress, simulation
+from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
-from tmm_workbench.app.op_surface import ObjectTmmSurface
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import VERTICAL, LinkPolicy, link
 from tmm_workbench.core.strategies import waterline
 from tmm_workbench.core.strategies.waterline import WaterlineParams
-from tmm_workbench.core.toolpath import Toolpath
 
 OP_NAME = "TMM_Waterline"
 DIRECTIONS = {"Climb": "climb", "Conventional": "conventional"}
 BOUNDARIES = ("Model", "Stock")
 
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
-    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
-    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyEnumeration", "BoundaryShape", "Boundary",
          "Area the tool tip may reach: the Model's XY box grown by the tool radius, or the Stock's XY box"),
     Prop("App::PropertyDistance", "BoundaryMargin", "Boundary",
@@ -55,40 +49,29 @@ PROPERTIES: list[Prop] = [
     Prop("App::PropertyDistance", "BottomZ", "Levels", "Lowest level when UseZRange is set"),
 ]
 CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Direction": DIRECTIONS}
-DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM, "BoundaryShape": "Model",
+DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "BoundaryShape": "Model",
                             "BoundaryMargin": 0.0, "SampleStep": 0.0, "UseZRange": False, "TopZ": 0.0,
                             "BottomZ": 0.0}
 
 
-class ObjectTmmWaterline(op_base.TmmOp):
+class ObjectTmmWaterline(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed), `diagnostics` (the strategy's: levels, loops, points, top)."""
 
+    VIEW_KIND = "waterline_op"
     PARAMS = WaterlineParams
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
-    toolpath: Optional[Toolpath] = None
-    mesh: Optional[TriMesh] = None
     params: Optional[WaterlineParams] = None
     diagnostics: Optional[dict] = None
-
-    def opFeatures(self, obj: Any) -> int:
-        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
-
-    def opOnDocumentRestored(self, obj: Any) -> None:
-        self.ensure_properties(obj, restoring=True)
-        hooks.attach_view("waterline_op", obj)  # a document saved headless has no view providers
-        job = PathUtils.findParentJob(obj)
-        if job is not None:
-            hooks.attach_view("job", job)
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:
         self.mesh = self.toolpath = self.params = self.diagnostics = None
 
     def compute(self, obj: Any) -> None:
-        mesh = ObjectTmmSurface.model_mesh(self, obj)  # the Surface op's model rules, one place
+        mesh = self.model_mesh(obj)
         cutter = self.cutter()
         check_step_down(self.tool, obj.StepDown.Value)
         sample = obj.SampleStep.Value
@@ -114,21 +97,7 @@ class ObjectTmmWaterline(op_base.TmmOp):
         toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
         self.diagnostics = dict(result.diagnostics)
-        self.commandlist.extend(ObjectTmmSurface.commands(self, toolpath, STEEP_DESCENT_DEG,
-                                                          obj.ClearanceHeight.Value))
-
-    def boundary(self, obj: Any, mesh: TriMesh, radius: float) -> tuple[float, float, float, float]:
-        if obj.BoundaryShape == "Stock":
-            if self.stock is None or self.stock.Shape.isNull():
-                raise TmmError("boundary 'Stock': the Job has no stock")
-            bb = self.stock.Shape.BoundBox
-            x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
-        else:  # the tool reaches round the model's outside walls
-            lo, hi = mesh.bounds
-            x0, y0 = float(lo[0]) - radius, float(lo[1]) - radius
-            x1, y1 = float(hi[0]) + radius, float(hi[1]) + radius
-        m = obj.BoundaryMargin.Value
-        return (x0 - m, y0 - m, x1 + m, y1 + m)
+        self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 
 def SetupProperties() -> list[str]:

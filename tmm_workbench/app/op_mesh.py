@@ -1,0 +1,101 @@
+"""What the ops that machine a model as a mesh share (Surface, Waterline, Roughing): the model's properties and
+the mesh they give (`StlFile`, then `Model`, then the Job's model: Part solids tessellated within
+`LinearDeflection`, TMM's stand-in boxes replaced by the meshes they stand for), the XY boundary from the stock
+or the model, and the Path commands of a tool path (feeds from the tool controller).
+"""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import Path
+
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base
+from tmm_workbench.app.compat import PathOp, PathUtils
+from tmm_workbench.app.op_base import Prop
+from tmm_workbench.core.arcs import PLANE_CODES
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.toolpath import MoveKind, Toolpath
+
+MODEL_PROPERTIES: list[Prop] = [
+    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
+    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
+    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
+]
+MODEL_DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM}
+
+
+class MeshOp(op_base.TmmOp):
+    """An op computed on the model's mesh. `VIEW_KIND`: the view provider hooks attach on restore. Transient
+    results of the last run (not saved): `toolpath`, `mesh`."""
+
+    VIEW_KIND = "op"
+    toolpath: Optional[Toolpath] = None
+    mesh: Optional[TriMesh] = None
+
+    def opFeatures(self, obj: Any) -> int:
+        return PathOp.FeatureTool | PathOp.FeatureHeights | PathOp.FeatureCoolant
+
+    def opOnDocumentRestored(self, obj: Any) -> None:
+        self.ensure_properties(obj, restoring=True)
+        hooks.attach_view(self.VIEW_KIND, obj)  # a document saved headless has no view providers
+        job = PathUtils.findParentJob(obj)
+        if job is not None:
+            hooks.attach_view("job", job)
+
+    def model_mesh(self, obj: Any) -> TriMesh:
+        deflection = obj.LinearDeflection.Value
+        if obj.StlFile:
+            return geometry.mesh_from_stl(obj.StlFile)
+        if obj.Model is not None:
+            return model_proxy.mesh_of_model(obj.Model, deflection)
+        models = list(self.model or [])
+        if not models:
+            raise TmmError("nothing to machine: set StlFile or Model, or give the Job a model")
+        return geometry.combine([model_proxy.mesh_of_model(m, deflection) for m in models])
+
+    def boundary(self, obj: Any, mesh: TriMesh, reach: float = 0.0) -> tuple[float, float, float, float]:
+        """The Stock's or the model's XY box (the latter grown by `reach`: a waterline's tool goes round the
+        model's outside walls), grown by BoundaryMargin."""
+        if obj.BoundaryShape == "Stock":
+            if self.stock is None or self.stock.Shape.isNull():
+                raise TmmError("boundary 'Stock': the Job has no stock")
+            bb = self.stock.Shape.BoundBox
+            x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
+        else:
+            lo, hi = mesh.bounds
+            x0, y0 = float(lo[0]) - reach, float(lo[1]) - reach
+            x1, y1 = float(hi[0]) + reach, float(hi[1]) + reach
+        m = obj.BoundaryMargin.Value
+        return (x0 - m, y0 - m, x1 + m, y1 + m)
+
+    def commands(self, toolpath: Toolpath, plunge_angle_deg: float = 45.0,
+                 clearance: Optional[float] = None) -> list[Any]:
+        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and for cutting moves
+        going down more steeply than `plunge_angle_deg`, the horizontal feed for the other cutting moves; an
+        arc move as G2/G3 in its plane, the plane selected before it. With `clearance`, the path starts with a
+        Z-only rapid to it: after a tool change the tool goes up before it moves in X and Y."""
+        if not (0.0 <= plunge_angle_deg <= 90.0):
+            raise TmmError(f"plunge angle must be in [0, 90] deg, got {plunge_angle_deg:g}")
+        steep = toolpath.steep_descents(plunge_angle_deg)
+        out = []
+        if clearance is not None and len(toolpath):
+            out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
+        plane = "XY"
+        for i, (m, down) in enumerate(zip(toolpath, steep)):
+            if m.arc is not None and i > 0:
+                if m.arc.plane != plane:
+                    out.append(Path.Command(PLANE_CODES[m.arc.plane], {}))
+                    plane = m.arc.plane
+                prev = toolpath.moves[i - 1]
+                name, words = m.arc.command((prev.x, prev.y, prev.z), (m.x, m.y, m.z))
+                out.append(Path.Command(name, {**words, "F": self.horizFeed}))
+                continue
+            if m.kind is MoveKind.RAPID:
+                out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
+            else:
+                feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
+                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
+        if plane != "XY":
+            out.append(Path.Command(PLANE_CODES["XY"], {}))
+        return out
