@@ -34,7 +34,7 @@ import numpy as np
 import FreeCAD
 import Path
 
-from tmm_workbench.app import geometry, hooks, op_base, progress
+from tmm_workbench.app import geometry, hooks, op_base, progress, work_estimate
 from tmm_workbench.app.compat import PathOp, PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import path5
@@ -206,6 +206,8 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath` (the op's tool
     path, linked once by core.linking), `segments` (the strategy's cut segments), `results` (per footprint
     point), `face`, `radii` (Ro, Ri), `placement` (the scallop rule's report, None for other spacings)."""
+
+    ESTIMATE = staticmethod(work_estimate.multipoint)  # the work from the properties (app.work_estimate)
 
     PARAMS = MultipointParams
     PROPERTIES = PROPERTIES

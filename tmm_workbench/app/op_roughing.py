@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, op_base, op_mesh, progress, simulation
+from tmm_workbench.app import geometry, op_base, op_mesh, progress, simulation, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.tools import label_of
@@ -102,6 +102,8 @@ def check_step_down(tool: Any, step_down: float) -> None:
 class ObjectTmmRoughing(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed)."""
+
+    ESTIMATE = staticmethod(work_estimate.roughing)  # the work from the properties (app.work_estimate)
 
     VIEW_KIND = "roughing_op"
     PARAMS = RoughingParams

@@ -18,7 +18,7 @@ from typing import Any, Optional
 
 import FreeCAD
 
-from tmm_workbench.app import op_base, op_mesh, progress, region_source, simulation
+from tmm_workbench.app import op_base, op_mesh, progress, region_source, simulation, work_estimate
 from tmm_workbench.app import surface_passes
 from tmm_workbench.app import surface_verify
 from tmm_workbench.app import offset_start
@@ -117,6 +117,8 @@ DEFAULTS.update(offset_start.DEFAULTS)
 
 class ObjectTmmSurface(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
+
+    ESTIMATE = staticmethod(work_estimate.surface)  # the work from the properties (app.work_estimate)
 
     PARAMS = SurfaceParams
     PROPERTIES = PROPERTIES

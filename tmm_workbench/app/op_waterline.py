@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from tmm_workbench.app import op_base, op_mesh, progress, simulation
+from tmm_workbench.app import op_base, op_mesh, progress, simulation, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
@@ -57,6 +57,8 @@ DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "BoundaryShape": "Model",
 class ObjectTmmWaterline(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed), `diagnostics` (the strategy's: levels, loops, points, top)."""
+
+    ESTIMATE = staticmethod(work_estimate.waterline)  # the work from the properties (app.work_estimate)
 
     VIEW_KIND = "waterline_op"
     PARAMS = WaterlineParams

@@ -203,7 +203,7 @@ def _feed(obj: Any) -> Optional[float]:
     return value if value > 0 else None
 
 
-def _surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
     from tmm_workbench.core.footprint.cusp import stepover_for_cusp
     from tmm_workbench.core.footprint.raster import pass_count
     from tmm_workbench.core.strategies import raster_drop
@@ -289,7 +289,7 @@ def _offset3d(obj: Any, params: Any) -> Estimate:
                     compute_seconds=count * PACE["offset3d"])
 
 
-def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
     from tmm_workbench.core.strategies import waterline
 
     cutter = _cutter(obj)
@@ -319,7 +319,7 @@ def _waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
                     compute_seconds=count * PACE["waterline"])
 
 
-def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+def roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
     from tmm_workbench.app.compat import PathUtils
     from tmm_workbench.core.strategies import zlevel_rough
 
@@ -339,7 +339,7 @@ def _roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> 
     return Estimate(count, "roughing loop points", None, length, _feed(obj), compute_seconds=count * PACE["roughing"])
 
 
-def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
     from tmm_workbench.core.footprint.raster import pass_count
     from tmm_workbench.core.strategies import multipoint
 
@@ -360,9 +360,6 @@ def _multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -
                                                  else "multipoint"])
 
 
-_BY_CLASS = {"ObjectTmmSurface": _surface, "ObjectTmmWaterline": _waterline, "ObjectTmmRoughing": _roughing,
-             "ObjectTmmMultipoint": _multipoint}
-
 
 def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl: bool = True) -> Optional[Estimate]:
     """The op's work with its properties (and `overrides`: property -> value in mm / deg / %), refused by a
@@ -373,7 +370,7 @@ def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl
     for prop, value in ov.items():
         check_value(proxy, prop, value)
     check_ranges(obj, ov)
-    run = _BY_CLASS.get(type(proxy).__name__)
+    run = getattr(type(proxy), "ESTIMATE", None)  # each op names its estimator
     if run is None:
         return None
     apply_work_limits()
