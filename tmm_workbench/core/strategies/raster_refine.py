@@ -19,7 +19,8 @@ from tmm_workbench.core import cancel
 Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy (n, 2) -> (z (n,), air (n,) bool)
 _FRACTIONS = np.array([0.2, 0.4, 0.5, 0.6, 0.8])
 _MID = 2  # the index of 0.5
-_BLOCK = 100_000  # moves checked per drop: a block's arrays take a fraction of a second, cancel is asked between
+_BLOCK = 50_000  # moves checked per drop: a block's arrays take a fraction of a second, cancel is asked between
+_NONE = np.zeros(0, dtype=np.int64)
 
 
 def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, drop: Drop, tol: float,
@@ -32,9 +33,9 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
     drop height is split too (the cusp modes: in a concave valley or corner a move across the crease of the CL
     surface leaves material above the cusp their spacing was computed for, which places it on the CL points).
 
-    A move is named by its run r and its first point i; with the runs laid end to end (`_cut_moves`) its
-    points are the flat indices start[r] + i and the one after (in the next run when i is the last): array
-    work only, so that a fine step-over's millions of moves do not hold a cancel (core.cancel) for a second."""
+    The moves to check are kept per run (the index of their first point) and checked as arrays, a block of
+    runs at a time, so that a fine step-over's millions of moves neither hold a cancel (core.cancel) for a
+    second nor ask for arrays of hundreds of MB."""
     pts: list[np.ndarray] = []   # per run: (k, 3) points
     airs: list[np.ndarray] = []
     k = 0
@@ -42,24 +43,21 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
         pts.append(np.column_stack([xy, z[k:k + len(xy)]]))
         airs.append(air[k:k + len(xy)].copy())
         k += len(xy)
-    todo_r, todo_i = _all_moves([len(p) for p in pts], chained)
+    lengths = [len(p) for p in pts]
+    todo = [np.arange(max(n - 1 + (chained and r + 1 < len(pts) and lengths[r + 1] > 0), 0))
+            for r, n in enumerate(lengths)]
     inserted, cliffs, deepest = 0, 0, 0.0
     for _ in range(rounds):
-        cancel.poll()
-        todo_r, todo_i, g, flat = _cut_moves(pts, airs, todo_r, todo_i)
-        if not len(g):
+        todo = _cutting(airs, todo)
+        if not any(len(t) for t in todo):
             break
-        bad, new, new_air, cliff, worst = _check(flat, g, drop, tol, leave_tol, min_step)
-        if not len(bad):
-            todo_r = todo_i = np.zeros(0, dtype=np.int64)
+        todo, found, found_cliffs, worst = _split_round(pts, airs, todo, drop, tol, leave_tol, min_step)
+        if not found:
             break
-        deepest = float(max(worst.max(), 0.0))
-        cliffs += int(cliff.sum())
-        inserted += len(bad)
-        todo_r, todo_i = _insert(pts, airs, todo_r[bad], todo_i[bad], new, new_air)
+        inserted, cliffs, deepest = inserted + found, cliffs + found_cliffs, float(max(worst, 0.0))
     else:
-        todo_r, todo_i, _, _ = _cut_moves(pts, airs, todo_r, todo_i)
-    remaining = len(todo_r)
+        todo = _cutting(airs, todo)
+    remaining = sum(len(t) for t in todo)
     out_runs = [(is_link, p[:, :2]) for (is_link, _), p in zip(runs, pts)]
     z_out = np.concatenate([p[:, 2] for p in pts]) if pts else z
     air_out = np.concatenate(airs) if airs else air
@@ -67,24 +65,64 @@ def refine(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray, 
                                       "deepest_refined": deepest}
 
 
-def _check(flat: np.ndarray, g: np.ndarray, drop: Drop, tol: float, leave_tol: float, min_step: float
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The moves g (flat indices of their first points) to split, checked in blocks: their positions in g, the
-    points to insert, whether each is in the air, which are cliffs, and how far each cuts in."""
-    starts = range(0, len(g), _BLOCK)
-    blocks = [_check_block(flat, g[lo:lo + _BLOCK], drop, tol, leave_tol, min_step) for lo in starts]
-    bad = np.concatenate([lo + block[0] for lo, block in zip(starts, blocks)])
-    return (bad, *(np.concatenate([block[k] for block in blocks]) for k in range(1, 5)))
+def _cutting(airs: list[np.ndarray], todo: list[np.ndarray]) -> list[np.ndarray]:
+    """The moves of todo that cut: neither end in the air."""
+    out = []
+    for r, t in enumerate(todo):
+        if len(t):
+            cancel.poll()
+            after = np.concatenate([airs[r][1:], airs[r + 1][:1]]) if r + 1 < len(airs) else airs[r][1:]
+            t = t[~(airs[r][t] | after[t])]
+        out.append(t)
+    return out
 
 
-def _check_block(flat: np.ndarray, g: np.ndarray, drop: Drop, tol: float, leave_tol: float, min_step: float
+def _split_round(pts: list[np.ndarray], airs: list[np.ndarray], todo: list[np.ndarray], drop: Drop, tol: float,
+                 leave_tol: float, min_step: float) -> tuple[list[np.ndarray], int, int, float]:
+    """One round: the moves of todo checked a block of runs at a time, points inserted where they cut in (or
+    leave too much); returns the moves to check next, the points inserted, the cliffs among them and the
+    deepest cut found (-inf if none)."""
+    following = [_NONE] * len(pts)
+    found, found_cliffs, worst = 0, 0, -math.inf
+    r0 = 0
+    while r0 < len(pts):
+        r1, count = r0, 0
+        while r1 < len(pts) and (count == 0 or count + len(todo[r1]) <= _BLOCK):
+            count, r1 = count + len(todo[r1]), r1 + 1
+        group = [r for r in range(r0, r1) if len(todo[r])]
+        r0 = r1
+        if not group:
+            continue
+        cancel.poll()
+        ends = [_ends(pts, r, todo[r]) for r in group]
+        rs = np.repeat(group, [len(todo[r]) for r in group])
+        bad, new, new_air, cliff, cuts = _check_block(np.concatenate([e[0] for e in ends]),
+                                                      np.concatenate([e[1] for e in ends]),
+                                                      drop, tol, leave_tol, min_step)
+        if len(bad):
+            found, found_cliffs, worst = found + len(bad), found_cliffs + int(cliff.sum()), max(worst, cuts.max())
+            _insert(pts, airs, rs[bad], np.concatenate([todo[r] for r in group])[bad], new, new_air, following)
+    return following, found, found_cliffs, worst
+
+
+def _ends(pts: list[np.ndarray], r: int, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The first and last points of the moves t of run r (the last point of a run moves to the next run's
+    first)."""
+    p = pts[r]
+    b = p[np.minimum(t + 1, len(p) - 1)]
+    last = t + 1 == len(p)
+    if last.any():
+        b[last] = pts[r + 1][0]
+    return p[t], b
+
+
+def _check_block(a: np.ndarray, b: np.ndarray, drop: Drop, tol: float, leave_tol: float, min_step: float
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """_check for one block of moves."""
-    cancel.poll()
-    a, b = flat[g], flat[g + 1]
+    """The moves a -> b to split: their positions, the points to insert, whether each is in the air, which
+    are cliffs, and how far each cuts in."""
     samples = a[:, None, :] + _FRACTIONS[None, :, None] * (b - a)[:, None, :]   # (m, 5, 3)
     zs, air_s = drop(samples[:, :, :2].reshape(-1, 2))
-    zs, air_s = zs.reshape(len(g), -1), air_s.reshape(len(g), -1)
+    zs, air_s = zs.reshape(len(a), -1), air_s.reshape(len(a), -1)
     cut = zs - samples[:, :, 2]
     cut[air_s] = -np.inf
     worst = cut.max(axis=1)
@@ -106,39 +144,13 @@ def _check_block(flat: np.ndarray, g: np.ndarray, drop: Drop, tol: float, leave_
     return bad, new, air_s[bad, _MID] & ~cliff, cliff, worst[bad]
 
 
-def _all_moves(lengths: list[int], chained: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Every move (r, i) of the runs, in order: within a run, and with `chained` from a run's last point to
-    the next run's first when that run has points."""
-    n = np.asarray(lengths, dtype=np.int64)
-    following = np.append(n[1:], 0)
-    count = np.maximum(n - 1 + (chained & (following > 0)), 0)
-    r = np.repeat(np.arange(len(n)), count)
-    return r, np.arange(len(r)) - np.repeat(np.cumsum(count) - count, count)
-
-
-def _cut_moves(pts: list[np.ndarray], airs: list[np.ndarray], todo_r: np.ndarray, todo_i: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """The moves (r, i) of todo that cut (neither end in the air), their first points' flat indices and the
-    runs' points laid end to end."""
-    if not len(todo_r):
-        return todo_r, todo_i, todo_r, np.zeros((0, 3))
-    flat, flat_air = np.concatenate(pts), np.concatenate(airs)
-    start = np.cumsum([0] + [len(p) for p in pts[:-1]])
-    g = start[todo_r] + todo_i
-    cuts = ~(flat_air[g] | flat_air[g + 1])
-    return todo_r[cuts], todo_i[cuts], g[cuts], flat
-
-
 def _insert(pts: list[np.ndarray], airs: list[np.ndarray], rs: np.ndarray, is_: np.ndarray, new: np.ndarray,
-            new_air: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Inserts new[k] after point is_[k] of run rs[k] (the moves in order), one insert per run; returns the
-    moves to check next: both halves of each move split at a new point (a cliff's corner, in line with an
-    end, is not checked again)."""
-    todo_r: list[np.ndarray] = []
-    todo_i: list[np.ndarray] = []
+            new_air: np.ndarray, following: list[np.ndarray]) -> None:
+    """Inserts new[k] after point is_[k] of run rs[k] (the moves in order), one insert per run, and sets the
+    run's moves to check next: both halves of each move split at a new point (a cliff's corner, in line with
+    an end, is not checked again)."""
     bounds = np.flatnonzero(np.diff(rs)) + 1
     for lo, hi in zip(np.concatenate([[0], bounds]), np.concatenate([bounds, [len(rs)]])):
-        cancel.poll()
         r = int(rs[lo])
         pts[r] = np.insert(pts[r], is_[lo:hi] + 1, new[lo:hi], axis=0)
         airs[r] = np.insert(airs[r], is_[lo:hi] + 1, new_air[lo:hi])
@@ -146,7 +158,4 @@ def _insert(pts: list[np.ndarray], airs: list[np.ndarray], rs: np.ndarray, is_: 
         p = pts[r]
         after = np.vstack([p[1:], pts[r + 1][:1]]) if r + 1 < len(pts) else p[1:]
         split = (p[at, :2] != after[at, :2]).any(axis=1) & (p[at, :2] != p[at - 1, :2]).any(axis=1)
-        at = at[split]
-        todo_r.append(np.full(2 * len(at), r))
-        todo_i.append(np.column_stack([at - 1, at]).ravel())
-    return np.concatenate(todo_r), np.concatenate(todo_i)
+        following[r] = np.column_stack([at[split] - 1, at[split]]).ravel()
