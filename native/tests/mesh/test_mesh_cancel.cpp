@@ -80,7 +80,7 @@ TEST(MeshCancel, MeshIndex) {
   }
 }
 
-// A cancel while the tree is built on two threads (its part of the job, [0.85, 1], reports at once): the
+// A cancel while the tree is built on two threads (its part of the job, [0.87, 1], reports at once): the
 // other thread leaves its half, the build unwinds.
 TEST(MeshCancel, MeshIndexStopsWhileTheTreeIsBuiltOnTwoThreads) {
   const Grid g = grid(225);  // 101250 triangles: halves built on two threads (above kParallelBuild)
@@ -89,10 +89,10 @@ TEST(MeshCancel, MeshIndexStopsWhileTheTreeIsBuiltOnTwoThreads) {
   EXPECT_THROW(tmm::MeshIndex(g.V, g.F, 2,
                               [&last](double f) {
                                 last = f;
-                                return f < 0.85;
+                                return f < 0.87;
                               }),
                tmm::Cancelled);
-  EXPECT_GE(last, 0.85);
+  EXPECT_GE(last, 0.87);  // the nodes are zeroed below 0.87: a report from 0.87 on is a leaf's
   EXPECT_LT(last, 1.0);
 }
 
