@@ -81,8 +81,8 @@ def measure(name: str, call: Callable[[Callable[[float], bool]], object]) -> Non
         latency = "finished"
     except native.Cancelled:
         latency = f"{time.perf_counter() - at:.3f}"
-    print(f"{name:<26} {total:8.2f} {len(stamps):8d} {gaps.max():8.3f} {latency:>10} {'' if monotone else ' (went back)'}",
-          flush=True)
+    back = "" if monotone else " (went back)"
+    print(f"{name:<26} {total:8.2f} {len(stamps):8d} {gaps.max():8.3f} {latency:>10}{back}", flush=True)
 
 
 def finest_positioner_options(surface) -> "native.MultipointOptions":
