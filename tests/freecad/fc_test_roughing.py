@@ -293,7 +293,7 @@ class RoughingApi(FreeCADTestCase):
         the corners the first could not reach (its stock is what the first left, app.simulation.rest_stock), a
         fraction of what the 4 mm tool cuts from the full stock; the Job simulated: no gouge, no rapid into
         stock, less left than after the first."""
-        from tmm_workbench.app.api import _add_tool
+        from tmm_workbench.app.api_run import add_tool as _add_tool
 
         doc = new_doc("TmmRestRough")
         values = {"StepDown": 2.5, "StockToLeave": 0.3}

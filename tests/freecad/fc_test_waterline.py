@@ -95,7 +95,7 @@ class WaterlineInJob(FreeCADTestCase):
         first = simulate(job, cell=0.1, tolerance=GOUGE_MM, progress=False)
         self.assertGreater(first.min_deviation, -GOUGE_MM)
         from tmm_workbench.app import tools
-        from tmm_workbench.app.api import _add_tool
+        from tmm_workbench.app.api_run import add_tool as _add_tool
 
         tc2 = _add_tool(job, tools.make_tool_bit(doc, "endmill", 4.0), 600 / 60, 200 / 60, 12000)
         water = registry.create("TMM_Waterline", job, {"Model": rough.Model, "StepDown": 0.5,

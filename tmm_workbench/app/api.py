@@ -16,21 +16,20 @@ by the call is closed first).
 """
 from __future__ import annotations
 
-import math
 import os
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator, Optional, Sequence, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import FreeCAD
 
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import geometry, model_proxy, posts, registry, tools
+from tmm_workbench.app import model_proxy, registry, tools
 from tmm_workbench.app import progress as progress_mod
+from tmm_workbench.app import api_run
 from tmm_workbench.app.api_args import CallbackProgress, by_core_name, numbers, option, plain_numbers
+from tmm_workbench.app.api_run import StockBox, SurfaceResult, run  # noqa: F401 - the API's names
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import Spec, spec_of
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
@@ -47,16 +46,6 @@ OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
 FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes (issue 14 item 2)
 STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region's edge inward (issue 14 item 1)
-
-
-@dataclass
-class SurfaceResult:
-    doc: Any             # App.Document holding everything
-    job: Any             # the Path Job
-    op: Any              # the TMM op (Surface; also what run_roughing and run_waterline return)
-    gcode: str           # post-processed G-code
-    toolpath: Toolpath   # the core tool path the op's Path was made from
-    mesh: TriMesh        # the core mesh that was machined
 
 
 @plain_numbers
@@ -151,105 +140,17 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     if not isinstance(verify_cusp, bool):
         raise TmmError(f"verify_cusp must be True or False, got {verify_cusp!r}")
     extra["VerifyCusp"] = verify_cusp
-    shape = tool if isinstance(tool, Cutter) else option("tool", tool, TOOL_ALIASES,
-                                                          sorted(set(TOOL_ALIASES.values())))
-    pattern_name = option("pattern", pattern, PATTERN_NAMES)
-    boundary_name = option("boundary", boundary, BOUNDARY_NAMES)
-    off_model_name = option("off_model", off_model, OFF_MODEL_NAMES)
-
-    own_doc = isinstance(model, (str, os.PathLike))
-    if own_doc and not Path(model).expanduser().is_file():
-        raise TmmError(f"STL file not found: {model}")
-    with _api_document(own_doc, doc_name, None if own_doc else model.Document, fcstd_path) as doc:
-        return _build(doc, model, shape, diameter, corner_radius, stepover, sample_step, angle_deg,
-                      pattern_name, stock_to_leave, boundary_name, margin, off_model_name, safe_height,
-                      clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, progress, extra)
-
-
-@contextmanager
-def _api_document(own: bool, name: str, existing: Any, fcstd_path: Any) -> Iterator[Any]:
-    """The document an API call works in: a new one named `name` (`own`; closed again when the call fails, so
-    no half-made document is left) or `existing`; saved to `fcstd_path` (when given) once the call succeeded."""
-    doc = FreeCAD.newDocument(name) if own else existing
-    try:
-        yield doc
-    except BaseException:
-        if own:
-            FreeCAD.closeDocument(doc.Name)
-        raise
-    if fcstd_path:
-        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
-        doc.saveAs(str(fcstd_path))
-
-
-def _build(doc: Any, model: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float,
-           stepover: float, sample_step: float, angle_deg: float, pattern: str, stock_to_leave: float, boundary: str,
-           margin: float, off_model: str, safe_height: Optional[float], clearance_height: Optional[float],
-           horiz_feed: float, vert_feed: float, spindle_speed: float, post: str,
-           gcode_path: Any, progress: Any, extra: dict) -> SurfaceResult:
-    jm = jobs.prepare_model(doc, model)
-    doc.recompute()
-    job = jobs.create_job(doc, jm.job_base)
-    values = _heights(job, jm.job_base.Shape.BoundBox.ZMax, safe_height, clearance_height)
-    bit = _bit(doc, shape, diameter, corner_radius)
-    tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
-    values.update({"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
-                   "Pattern": pattern, "StockToLeave": stock_to_leave, "BoundaryShape": boundary,
-                   "BoundaryMargin": margin, "OffModel": off_model})
-    values.update(extra)
-    values.update(_model_values(jm))
-    op = registry.create("TMM_Surface", job, values)
-    return _post_op(doc, job, tc, op, post, gcode_path, progress)
-
-
-def _heights(job: Any, model_top: float, safe_height: Optional[float], clearance_height: Optional[float]) -> dict:
-    """SafeHeight and ClearanceHeight: given, or the top of the model or of the Job's stock, whichever is
-    higher, + 5 mm and + 10 mm."""
-    top = max(model_top, _stock_top(job))
-    safe = top + 5.0 if safe_height is None else float(safe_height)
-    clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
-    return {"SafeHeight": safe, "ClearanceHeight": clearance}
-
-
-def _bit(doc: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float) -> Any:
-    return (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
-            else tools.make_tool_bit(doc, shape, diameter, corner_radius))
-
-
-def _model_values(jm: jobs.JobModel) -> dict:
-    """The op's model properties for a prepared model: its STL file or its object."""
-    return {"StlFile": jm.stl_file} if jm.stl_file else {"Model": jm.link}
-
-
-def _post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, progress: Any) -> SurfaceResult:
-    """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller)."""
-    jobs.choose_post(job, post)  # when the Job offers it
-    _compute(op, progress)
-    gcode = posts.export(post, [tc, op], gcode_path)
-    return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
-
-
-def _stock_top(job: Any) -> float:
-    stock = getattr(job, "Stock", None)
-    return float(stock.Shape.BoundBox.ZMax) if stock is not None and not stock.Shape.isNull() else -math.inf
-
-
-def _compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
-    """Recomputes the op with the caller's progress (a callback, True for the default reporter, False for
-    none); raises TmmError with the op's status when it fails or computes no tool path."""
-    factory = None
-    if callable(progress):
-        factory = lambda label: CallbackProgress(progress)  # noqa: E731
-    op.Proxy.progress_enabled = bool(progress)
-    with progress_mod.using(factory):
-        op.touch()
-        op.Document.recompute()
-    if not op.isValid() or op.Proxy.toolpath is None:
-        raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
+    values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
+              "Pattern": option("pattern", pattern, PATTERN_NAMES), "StockToLeave": stock_to_leave,
+              "BoundaryShape": option("boundary", boundary, BOUNDARY_NAMES), "BoundaryMargin": margin,
+              "OffModel": option("off_model", off_model, OFF_MODEL_NAMES), **extra}
+    return run("TMM_Surface", model, tool=tool, diameter=diameter, corner_radius=corner_radius,
+               safe_height=safe_height, clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
+               spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
+               doc_name=doc_name, progress=progress, **values)
 
 
 # --- z-level roughing and waterline ----------------------------------------------------------------
-StockBox = tuple[float, float, float, float, float, float]
 
 
 @plain_numbers
@@ -291,8 +192,6 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
              chord_tolerance=(chord_tolerance, spec_of(RoughingParams, "chord_tol")),
              final_z=(final_z, _LENGTH), stock_margin=(stock_margin, _LENGTH), stock_above=(stock_above, _LENGTH),
              **_common_numbers(safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed))
-    if stock is not None:
-        _stock_box_checked(stock)
     values: dict[str, Any] = {
         "StepDown": step_down, "StepOver": stepover_percent, "StockToLeave": stock_to_leave,
         "LayerMode": option("layer_mode", layer_mode, by_core_name(op_roughing.LAYER_MODES)),
@@ -307,10 +206,11 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
             values[prop] = value
     if final_z is not None:
         values.update(UseFinalZ=True, FinalZ=final_z)
-    stock_ext = (stock, stock_margin, stock_above)
-    return _run_op(op_roughing.OP_NAME, model, job, values, stock_ext, _tool_shape(tool), diameter, corner_radius,
-                   safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path,
-                   fcstd_path, doc_name, progress)
+    return run(op_roughing.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
+               stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
+               clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
+               spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
+               doc_name=doc_name, progress=progress, **values)
 
 
 @plain_numbers
@@ -346,8 +246,6 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     if (top_z is None) != (bottom_z is None):
         raise TmmError(f"top_z and bottom_z are given together or not at all, got top_z={top_z!r}, "
                        f"bottom_z={bottom_z!r}")
-    if stock is not None:
-        _stock_box_checked(stock)
     values: dict[str, Any] = {
         "StepDown": step_down, "StockToLeave": stock_to_leave, "BoundaryMargin": margin,
         "BoundaryShape": option("boundary", boundary, BOUNDARY_NAMES),
@@ -358,9 +256,11 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
         values["ChordTolerance"] = chord_tolerance
     if top_z is not None:
         values.update(UseZRange=True, TopZ=top_z, BottomZ=bottom_z)
-    return _run_op(op_waterline.OP_NAME, model, job, values, (stock, stock_margin, stock_above), _tool_shape(tool),
-                   diameter, corner_radius, safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed,
-                   post, gcode_path, fcstd_path, doc_name, progress)
+    return run(op_waterline.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
+               stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
+               clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
+               spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
+               doc_name=doc_name, progress=progress, **values)
 
 
 def _specs(params_class: type, **values: Any) -> dict[str, tuple[Any, Spec]]:
@@ -373,95 +273,6 @@ def _common_numbers(safe_height: Any, clearance_height: Any, horiz_feed: Any, ve
     return dict(safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
                 horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
 
-
-def _tool_shape(tool: Union[str, Cutter]) -> Union[str, Cutter]:
-    return tool if isinstance(tool, Cutter) else option("tool", tool, TOOL_ALIASES, sorted(set(TOOL_ALIASES.values())))
-
-
-def _stock_box_checked(stock: Any) -> StockBox:
-    from tmm_workbench.core.params import check_finite
-
-    try:
-        box = tuple(float(v) for v in stock)
-    except (TypeError, ValueError):
-        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}") from None
-    if len(box) != 6:
-        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}")
-    check_finite("stock", box)
-    if not (box[3] > box[0] and box[4] > box[1] and box[5] > box[2]):
-        raise TmmError(f"stock box is empty: x {box[0]:g}..{box[3]:g}, y {box[1]:g}..{box[4]:g}, "
-                       f"z {box[2]:g}..{box[5]:g} mm")
-    return box  # type: ignore[return-value]
-
-
-def _set_stock(job: Any, stock: Optional[StockBox], margin: float, above: float) -> None:
-    """The Job's box stock (FreeCAD's stock from the base, its extents set): `stock` exactly, or the model's box
-    grown by `margin` on the sides and `above` on top."""
-    s = job.Stock
-    bb = s.Base.Shape.BoundBox if getattr(s, "Base", None) is not None else None
-    if bb is None or not hasattr(s, "ExtXneg"):
-        raise TmmError(f"Job '{job.Label}': its stock is not FreeCAD's stock from the base; set it in the Job")
-    if stock is None:
-        ext = (margin, margin, 1.0, margin, margin, above)
-    else:
-        ext = (bb.XMin - stock[0], bb.YMin - stock[1], bb.ZMin - stock[2],
-               stock[3] - bb.XMax, stock[4] - bb.YMax, stock[5] - bb.ZMax)
-    for name, v in zip(("ExtXneg", "ExtYneg", "ExtZneg", "ExtXpos", "ExtYpos", "ExtZpos"), ext):
-        setattr(s, name, v)
-    job.Document.recompute()
-
-
-def _add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, spindle_speed: float) -> Any:
-    """A further tool controller in `job` for `bit` (the next tool number)."""
-    from tmm_workbench.app.compat import PathToolController
-
-    FreeCAD.setActiveDocument(job.Document.Name)
-    number = max([int(t.ToolNumber) for t in job.Tools.Group] + [0]) + 1
-    tc = PathToolController.Create(f"TC: {bit.Label}", bit, number)
-    job.Proxy.addToolController(tc)
-    tc.HorizFeed = horiz_feed_mm_s
-    tc.VertFeed = vert_feed_mm_s
-    tc.SpindleSpeed = float(spindle_speed)
-    return tc
-
-
-def _run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
-            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
-            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str, gcode_path: Any, fcstd_path: Any,
-            doc_name: str, progress: Any) -> SurfaceResult:
-    """A roughing or waterline op (property `values`) in a new Job for `model` with a box stock, or in `job`
-    with a further tool controller; computed, posted, saved. A document opened here is closed on failure."""
-    job = getattr(job, "job", None) or job
-    if job is None and model is None:
-        raise TmmError("model: give an STL path, a Mesh or a Part object (or a job to add the op to)")
-    own_doc = job is None and isinstance(model, (str, os.PathLike))
-    if own_doc and not Path(model).expanduser().is_file():
-        raise TmmError(f"STL file not found: {model}")
-    existing = None if own_doc else (job.Document if job is not None else model.Document)
-    with _api_document(own_doc, doc_name, existing, fcstd_path) as doc:
-        values = dict(values)
-        if job is None:
-            jm = jobs.prepare_model(doc, model)
-            doc.recompute()
-            job = jobs.create_job(doc, jm.job_base)
-            _set_stock(job, *stock_ext)
-            values.update(_model_values(jm))
-            tc = jobs.set_tool(job, _bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0,
-                               vert_feed / 60.0, spindle_speed)
-        else:  # the Job's stock and model stay; the op machines `model` when one is given
-            if isinstance(model, (str, os.PathLike)):
-                geometry.mesh_from_stl(model)  # a clear error for a missing or bad file
-                values["StlFile"] = str(Path(model).expanduser().resolve())
-            elif model is not None:
-                values["Model"] = model
-            tc = _add_tool(job, _bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0, vert_feed / 60.0,
-                           spindle_speed)
-        top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
-        values.update(_heights(job, top, safe_height, clearance_height))
-        values["ToolController"] = tc
-        op = registry.create(op_name, job, values)
-        result = _post_op(doc, job, tc, op, post, gcode_path, progress)
-    return result
 
 
 # --- 5-axis multipoint ---------------------------------------------------------------------------
@@ -549,7 +360,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
 
     source_obj, sub = _face_pair(face_source)
     own_doc = source_obj is None
-    with _api_document(own_doc, doc_name, None if own_doc else source_obj.Document, fcstd_path) as doc:
+    with api_run.api_document(own_doc, doc_name, None if own_doc else source_obj.Document, fcstd_path) as doc:
         if own_doc:
             source_obj, sub = _surface_feature(doc, face_source), "Face1"
         doc.recompute()
@@ -559,7 +370,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         except TmmError:  # the op reports it (and keeps its message as its status)
             top = source_obj.Shape.BoundBox.ZMax
         job = jobs.create_job(doc, source_obj, name="Job")
-        top = max(top, _stock_top(job))  # rapids at the safe height must clear the stock, not only the face
+        top = max(top, api_run.stock_top(job))  # rapids at the safe height must clear the stock, not only the face
         safe = top + 5.0 if safe_height is None else float(safe_height)
         clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
         clone = job.Model.Group[-1]
@@ -582,7 +393,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
         if posts:
             jobs.choose_post(job, posts[0])  # when the Job offers it
 
-        _compute(op, progress)
+        api_run.compute(op, progress)
 
         gcode: dict[str, str] = {}
         files: dict[str, Path] = {}

@@ -1,0 +1,57 @@
+"""The one run API (app.api_run.run): a mesh op by its registry name with its properties as the op declares them,
+the same path as the named wrappers (run_surface, run_roughing), and every name, choice and number it is given
+checked against the op's declarations before a document is made."""
+from __future__ import annotations
+
+import FreeCAD
+
+from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase
+from tmm_workbench.app.api import run_roughing, run_surface
+from tmm_workbench.app.api_run import run
+from tmm_workbench.core.errors import TmmError
+
+
+def _words(gcode: str) -> list[str]:
+    """The motion lines of a G-code text (the post's date and comments left out)."""
+    return [ln for ln in gcode.splitlines() if ln.startswith(("G0", "G1", "G2", "G3"))]
+
+
+class RunByName(FreeCADTestCase):
+    def test_the_surface_by_its_properties_is_run_surface(self) -> None:
+        named = run_surface(str(SPHERE_ON_PLATE), stepover=2.0, sample_step=1.0, pattern="oneway", progress=False,
+                            doc_name="TmmRunNamed")
+        generic = run("TMM_Surface", str(SPHERE_ON_PLATE), StepOver=2.0, SampleStep=1.0, Pattern="OneWay",
+                      BoundaryShape="Model",
+                      progress=False, doc_name="TmmRunGeneric", gcode_path=OUT / "run_generic.ngc")
+        self.assertGreater(len(_words(generic.gcode)), 100)
+        self.assertEqual(_words(generic.gcode), _words(named.gcode))
+        self.assertEqual(generic.op.Pattern, "OneWay")
+        self.assertTrue((OUT / "run_generic.ngc").is_file())
+
+    def test_roughing_by_its_properties_with_a_stock_margin(self) -> None:
+        named = run_roughing(str(SPHERE_ON_PLATE), diameter=10.0, step_down=6.0, stock_margin=2.0, progress=False,
+                             doc_name="TmmRunRoughNamed")
+        generic = run("TMM_Roughing", str(SPHERE_ON_PLATE), tool="endmill", diameter=10.0, StepDown=6.0,
+                      stock_margin=2.0, progress=False, doc_name="TmmRunRough")
+        self.assertAlmostEqual(generic.job.Stock.Shape.BoundBox.XMin, named.job.Stock.Shape.BoundBox.XMin)
+        self.assertEqual(_words(generic.gcode), _words(named.gcode))
+
+    def test_every_name_choice_and_number_is_checked_before_a_document_is_made(self) -> None:
+        before = set(FreeCAD.listDocuments())
+        cases = [
+            (dict(Stepover=1.0), "TMM_Surface has no property 'Stepover' (did you mean StepOver?)"),
+            (dict(StepOverMode="Spiral"), "StepOverMode must be one of"),
+            (dict(SampleStep=-0.5), "sample step must be"),
+            (dict(StepOver=-1.0), "step-over must be a positive length, got -1"),
+        ]
+        for props, said in cases:
+            with self.subTest(props=props), self.assertRaises(TmmError) as ctx:
+                run("TMM_Surface", str(SPHERE_ON_PLATE), progress=False, **props)
+            self.assertIn(said, str(ctx.exception))
+        with self.assertRaises(TmmError) as ctx:
+            run("TMM_Multipoint", str(SPHERE_ON_PLATE))
+        self.assertIn("use run_multipoint", str(ctx.exception))
+        with self.assertRaises(TmmError) as ctx:
+            run("TMM_Drill", str(SPHERE_ON_PLATE))
+        self.assertIn("TMM_Surface, TMM_Roughing, TMM_Waterline", str(ctx.exception))
+        self.assertEqual(set(FreeCAD.listDocuments()), before)

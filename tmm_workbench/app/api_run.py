@@ -1,0 +1,251 @@
+"""The engine of the headless API (app.api): one TMM op on a model in a Path Job, computed, posted and saved, and
+`run`, the one entry for every mesh op by its registry name with its properties as the op's property editor names
+them (checked against the op's own declarations: the names, their ranges, their choices).
+
+    from tmm_workbench.app.api_run import run
+    r = run("TMM_Surface", "part.stl", tool="ballend", diameter=6, StepOverMode="Cusp", CuspHeight=0.01,
+            gcode_path="part.ngc")
+
+`run_surface`, `run_roughing` and `run_waterline` (app.api) are the same with the API's argument names.
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import os
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Iterator, Optional, Union
+
+import FreeCAD
+
+from tmm_workbench.app import geometry, op_base, posts, registry, tools, work_estimate
+from tmm_workbench.app import job as jobs
+from tmm_workbench.app import progress as progress_mod
+from tmm_workbench.app.api_args import CallbackProgress, option
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.toolpath import Toolpath
+from tmm_workbench.core.tools.cutter import Cutter
+
+MESH_OPS = ("TMM_Surface", "TMM_Roughing", "TMM_Waterline")   # run_multipoint machines a face, not a mesh
+
+
+StockBox = tuple[float, float, float, float, float, float]
+
+
+@dataclass
+class SurfaceResult:
+    doc: Any             # App.Document holding everything
+    job: Any             # the Path Job
+    op: Any              # the TMM op (Surface; also what run_roughing and run_waterline return)
+    gcode: str           # post-processed G-code
+    toolpath: Toolpath   # the core tool path the op's Path was made from
+    mesh: TriMesh        # the core mesh that was machined
+
+
+@contextmanager
+def api_document(own: bool, name: str, existing: Any, fcstd_path: Any) -> Iterator[Any]:
+    """The document an API call works in: a new one named `name` (`own`; closed again when the call fails, so
+    no half-made document is left) or `existing`; saved to `fcstd_path` (when given) once the call succeeded."""
+    doc = FreeCAD.newDocument(name) if own else existing
+    try:
+        yield doc
+    except BaseException:
+        if own:
+            FreeCAD.closeDocument(doc.Name)
+        raise
+    if fcstd_path:
+        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
+        doc.saveAs(str(fcstd_path))
+
+
+def heights(job: Any, model_top: float, safe_height: Optional[float], clearance_height: Optional[float]) -> dict:
+    """SafeHeight and ClearanceHeight: given, or the top of the model or of the Job's stock, whichever is
+    higher, + 5 mm and + 10 mm."""
+    top = max(model_top, stock_top(job))
+    safe = top + 5.0 if safe_height is None else float(safe_height)
+    clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
+    return {"SafeHeight": safe, "ClearanceHeight": clearance}
+
+
+def bit(doc: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float) -> Any:
+    return (tools.bit_for_cutter(doc, shape) if isinstance(shape, Cutter)
+            else tools.make_tool_bit(doc, shape, diameter, corner_radius))
+
+
+def model_values(jm: jobs.JobModel) -> dict:
+    """The op's model properties for a prepared model: its STL file or its object."""
+    return {"StlFile": jm.stl_file} if jm.stl_file else {"Model": jm.link}
+
+
+def post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, progress: Any) -> SurfaceResult:
+    """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller)."""
+    jobs.choose_post(job, post)  # when the Job offers it
+    compute(op, progress)
+    gcode = posts.export(post, [tc, op], gcode_path)
+    return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
+
+
+def stock_top(job: Any) -> float:
+    stock = getattr(job, "Stock", None)
+    return float(stock.Shape.BoundBox.ZMax) if stock is not None and not stock.Shape.isNull() else -math.inf
+
+
+def compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
+    """Recomputes the op with the caller's progress (a callback, True for the default reporter, False for
+    none); raises TmmError with the op's status when it fails or computes no tool path."""
+    factory = None
+    if callable(progress):
+        factory = lambda label: CallbackProgress(progress)  # noqa: E731
+    op.Proxy.progress_enabled = bool(progress)
+    with progress_mod.using(factory):
+        op.touch()
+        op.Document.recompute()
+    if not op.isValid() or op.Proxy.toolpath is None:
+        raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
+
+
+
+
+def stock_box_checked(stock: Any) -> StockBox:
+    from tmm_workbench.core.params import check_finite
+
+    try:
+        box = tuple(float(v) for v in stock)
+    except (TypeError, ValueError):
+        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}") from None
+    if len(box) != 6:
+        raise TmmError(f"stock must be (xmin, ymin, zmin, xmax, ymax, zmax) in mm, got {stock!r}")
+    check_finite("stock", box)
+    if not (box[3] > box[0] and box[4] > box[1] and box[5] > box[2]):
+        raise TmmError(f"stock box is empty: x {box[0]:g}..{box[3]:g}, y {box[1]:g}..{box[4]:g}, "
+                       f"z {box[2]:g}..{box[5]:g} mm")
+    return box  # type: ignore[return-value]
+
+
+def set_stock(job: Any, stock: Optional[StockBox], margin: float, above: float) -> None:
+    """The Job's box stock (FreeCAD's stock from the base, its extents set): `stock` exactly, or the model's box
+    grown by `margin` on the sides and `above` on top."""
+    s = job.Stock
+    bb = s.Base.Shape.BoundBox if getattr(s, "Base", None) is not None else None
+    if bb is None or not hasattr(s, "ExtXneg"):
+        raise TmmError(f"Job '{job.Label}': its stock is not FreeCAD's stock from the base; set it in the Job")
+    if stock is None:
+        ext = (margin, margin, 1.0, margin, margin, above)
+    else:
+        ext = (bb.XMin - stock[0], bb.YMin - stock[1], bb.ZMin - stock[2],
+               stock[3] - bb.XMax, stock[4] - bb.YMax, stock[5] - bb.ZMax)
+    for name, v in zip(("ExtXneg", "ExtYneg", "ExtZneg", "ExtXpos", "ExtYpos", "ExtZpos"), ext):
+        setattr(s, name, v)
+    job.Document.recompute()
+
+
+def add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, spindle_speed: float) -> Any:
+    """A further tool controller in `job` for `bit` (the next tool number)."""
+    from tmm_workbench.app.compat import PathToolController
+
+    FreeCAD.setActiveDocument(job.Document.Name)
+    number = max([int(t.ToolNumber) for t in job.Tools.Group] + [0]) + 1
+    tc = PathToolController.Create(f"TC: {bit.Label}", bit, number)
+    job.Proxy.addToolController(tc)
+    tc.HorizFeed = horiz_feed_mm_s
+    tc.VertFeed = vert_feed_mm_s
+    tc.SpindleSpeed = float(spindle_speed)
+    return tc
+
+
+def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
+            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
+            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str, gcode_path: Any, fcstd_path: Any,
+            doc_name: str, progress: Any) -> SurfaceResult:
+    """A roughing or waterline op (property `values`) in a new Job for `model` with a box stock, or in `job`
+    with a further tool controller; computed, posted, saved. A document opened here is closed on failure."""
+    job = getattr(job, "job", None) or job
+    if job is None and model is None:
+        raise TmmError("model: give an STL path, a Mesh or a Part object (or a job to add the op to)")
+    own_doc = job is None and isinstance(model, (str, os.PathLike))
+    if own_doc and not Path(model).expanduser().is_file():
+        raise TmmError(f"STL file not found: {model}")
+    existing = None if own_doc else (job.Document if job is not None else model.Document)
+    with api_document(own_doc, doc_name, existing, fcstd_path) as doc:
+        values = dict(values)
+        if job is None:
+            jm = jobs.prepare_model(doc, model)
+            doc.recompute()
+            job = jobs.create_job(doc, jm.job_base)
+            if stock_ext is not None:
+                set_stock(job, *stock_ext)
+            values.update(model_values(jm))
+            tc = jobs.set_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0,
+                               vert_feed / 60.0, spindle_speed)
+        else:  # the Job's stock and model stay; the op machines `model` when one is given
+            if isinstance(model, (str, os.PathLike)):
+                geometry.mesh_from_stl(model)  # a clear error for a missing or bad file
+                values["StlFile"] = str(Path(model).expanduser().resolve())
+            elif model is not None:
+                values["Model"] = model
+            tc = add_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0, vert_feed / 60.0,
+                           spindle_speed)
+        top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
+        values.update(heights(job, top, safe_height, clearance_height))
+        values["ToolController"] = tc
+        op = registry.create(op_name, job, values)
+        result = post_op(doc, job, tc, op, post, gcode_path, progress)
+    return result
+
+
+def proxy_class(op: str) -> type:
+    """The proxy class of the op registered as `op` (its declarations: PROPERTIES, CHOICES, PARAMS)."""
+    try:
+        module = registry.entry(op).app()
+    except KeyError as exc:
+        raise TmmError(str(exc.args[0])) from None
+    return next(v for v in vars(module).values() if isinstance(v, type) and issubclass(v, op_base.TmmOp)
+                and v.__module__ == module.__name__)
+
+
+def check_properties(op: str, properties: dict[str, Any]) -> None:
+    """Each property named as the op declares it, a choice among its choices, a number within its range."""
+    cls = proxy_class(op)
+    rows = {row.name for row in cls.PROPERTIES}
+    for name, value in properties.items():
+        if name not in rows:
+            close = difflib.get_close_matches(name, rows, 1)
+            hint = f" (did you mean {close[0]}?)" if close else ""
+            raise TmmError(f"{op} has no property {name!r}{hint}; its properties: {', '.join(sorted(rows))}")
+        choices = cls.CHOICES.get(name)
+        if choices is not None and isinstance(value, str):
+            option(name, value, {c.lower(): c for c in choices})
+        elif isinstance(value, (int, float)) and not isinstance(value, bool):
+            work_estimate.check_value(cls, name, float(value))
+
+
+def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter] = "ballend", diameter: float = 6.0,
+        corner_radius: float = 0.0, stock: Optional[StockBox] = None, stock_margin: Optional[float] = None,
+        stock_above: Optional[float] = None, safe_height: Optional[float] = None,
+        clearance_height: Optional[float] = None, horiz_feed: float = 1000.0, vert_feed: float = 300.0,
+        spindle_speed: float = 10000.0, post: str = "linuxcnc", gcode_path: Any = None, fcstd_path: Any = None,
+        doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
+        **properties: Any) -> SurfaceResult:
+    """The op registered as `op` (MESH_OPS) on `model` (STL path, Mesh or Part object; None with `job`: the Job's
+    model) with `properties` (the op's property names and values: StepOver=0.5, Pattern="OneWay"), in a new Job
+    or added to `job` with its own tool controller; computed, posted, saved (as app.api.run_surface). The Job's
+    stock: FreeCAD's default for a new Job unless `stock` (a box) or `stock_margin` / `stock_above` (mm around
+    the model) is given. TmmError names a property the op does not have, a choice it does not offer, a number
+    out of its range."""
+    if op not in MESH_OPS:
+        hint = " (a face: use run_multipoint)" if op == "TMM_Multipoint" else ""
+        raise TmmError(f"run: op must be one of {', '.join(MESH_OPS)}, got {op!r}{hint}")
+    check_properties(op, properties)
+    shape = tool if isinstance(tool, Cutter) else option("tool", tool, tools.SHAPE_ALIASES,
+                                                          sorted(set(tools.SHAPE_ALIASES.values())))
+    if stock is not None:
+        stock_box_checked(stock)
+    given = stock is not None or stock_margin is not None or stock_above is not None
+    stock_ext = (stock, 1.0 if stock_margin is None else stock_margin,
+                 1.0 if stock_above is None else stock_above) if given else None
+    return run_op(op, model, job, properties, stock_ext, shape, diameter, corner_radius, safe_height,
+                  clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, fcstd_path, doc_name,
+                  progress)
