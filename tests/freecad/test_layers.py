@@ -127,12 +127,10 @@ def _short(names: frozenset[str]) -> frozenset[str]:
 
 
 # Circles that stand today, to be taken apart (the surface verification and the cusp measurement call the raster
-# strategy; the multipoint refinement reads the strategy's status codes). The list may only shrink: a new circle,
-# or a listed one grown, fails.
+# strategy). The list may only shrink: a new circle, or a listed one grown, fails.
 KNOWN_CIRCLES = [
     frozenset({"core.footprint.cusp_check", "core.footprint.variable_step", "core.sim.cusp_field",
                "core.strategies.raster_drop", "core.strategies.raster_offset3d", "core.strategies.raster_region"}),
-    frozenset({"core.strategies.multipoint", "core.strategies.multipoint_refine"}),
 ]
 
 

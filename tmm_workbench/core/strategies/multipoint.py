@@ -33,13 +33,14 @@ from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import ALONG_AXIS, LinkPolicy, link
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.segments import CutSegment, StrategyResult
+# the positioner's status codes, also read from here by the op, the pictures and the tests
+from tmm_workbench.core.strategies.multipoint_status import (STATUS_FAILED, STATUS_NAMES, STATUS_ONE,  # noqa: F401
+                                                             STATUS_TWO)
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
 
-STATUS_TWO, STATUS_ONE, STATUS_FAILED = 0, 1, 2
-STATUS_NAMES = ("two", "one", "failed")
 METHODS = ("vcrf", "drd")
 SHAPES = ("round_insert", "bull_nose")
 ROTATIONS = ("pseudo_insert", "global_x")

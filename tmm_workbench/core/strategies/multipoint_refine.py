@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from tmm_workbench.core.geometry.axes import slerp
-from tmm_workbench.core.strategies.multipoint import STATUS_FAILED
+from tmm_workbench.core.strategies.multipoint_status import STATUS_FAILED
 
 CHECK_SPACING_MM = 0.25  # between checked instances of a move: a torus of minor radius Ri dips at most
 #                          (0.125)^2 / (2 Ri) between them (0.0013 mm for Ri = 6)
