@@ -87,7 +87,8 @@ class Offset3D(FreeCADTestCase):
         result = raster_drop.compute(r.mesh, cutter_from_tool(r.op.ToolController.Tool), params)
         said = result.diagnostics["cusp_check"]
         self.assertGreater(said["exceeding"], 0)   # the coarse bump's slopes: the 3D offset overshoots here
-        self.assertIn(f"{said['exceeding']} of {said['measured']} measured cells above it", r.op.CuspReport)
+        self.assertIn(f"{said['exceeding']} of {said['measured']} measured {said['cell']:.3g} mm cells above it",
+                      r.op.CuspReport)
         self.assertIn("VerifyCusp adds partial passes there", r.op.CuspReport)
         x, y, _, _ = said["places"][0]
         self.assertIn(f"({x:.1f}, {y:.1f})", r.op.CuspReport)
