@@ -7,7 +7,7 @@
 #include <chrono>
 #include <vector>
 
-#include "tmm/query/arrival_field.hpp"
+#include "tmm/algo/arrival_field.hpp"
 #include "tmm/sim/sweep5.hpp"
 #include "tmm/util/parallel.hpp"
 

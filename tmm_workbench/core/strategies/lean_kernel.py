@@ -1,11 +1,11 @@
-"""Lean passes fitted in the kernel: native.lean_profiles (native/src/query/lean_profile.cpp).
+"""Lean passes fitted in the kernel: native.lean_profiles (native/src/algo/lean_profile.cpp).
 
 The straight runs of the segments (raster_lean's: passes and zig-zag links, split where the XY direction
 turns) go to the kernel with their samples; it rebuilds each run's exact CL profile by adaptive exact drops
 (breakpoints located where the triangle holding the cutter changes), fits the fewest lines within +-tol of it
 by min-link windows and checks them at the drop intervals' midpoints near the band's edge (see the header).
 With `arcs`, in runs that lie in a principal vertical plane (XZ or YZ) the kernel then merges consecutive moves
-into one arc (G2/G3) or one longer line where that holds the same band and checks (native/src/query/lean_arcs.cpp).
+into one arc (G2/G3) or one longer line where that holds the same band and checks (native/src/algo/lean_arcs.cpp).
 The ends of a run, both ends of a vertical move and the moves beside air stay as sampled, as in the Python fit
 (tests/core/lean_reference.py, the slow reference). The arcs ride in the segments (CutSegment.arcs).
 """

@@ -14,7 +14,7 @@
 // comes within (1 - fit_fraction) x tol of the band's edge; a move that leaves +-tol there gets the point
 // as a drop and its stretch is fitted again (up to `rounds`), else the stretch keeps every drop (a polyline
 // within rep_fraction x tol). (4) In runs marked for arcs: consecutive moves merged into one arc (G2/G3 in the
-// run's vertical plane) or one longer line where that holds the same band and checks (src/query/lean_arcs.hpp).
+// run's vertical plane) or one longer line where that holds the same band and checks (src/algo/lean_arcs.hpp).
 #pragma once
 
 #include <cstddef>

@@ -1,5 +1,5 @@
-// Fast marching of the 3D offset's arrival-time field: see tmm/query/arrival_field.hpp.
-#include "tmm/query/arrival_field.hpp"
+// Fast marching of the 3D offset's arrival-time field: see tmm/algo/arrival_field.hpp.
+#include "tmm/algo/arrival_field.hpp"
 
 #include <algorithm>
 #include <cmath>

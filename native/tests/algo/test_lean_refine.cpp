@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "tmm/query/drop_cutter.hpp"
-#include "tmm/query/lean_profile.hpp"
+#include "tmm/algo/lean_profile.hpp"
 
 namespace {
 

@@ -5,7 +5,7 @@
 
 #include <algorithm>
 
-#include "tmm/query/adaptive_raster.hpp"
+#include "tmm/algo/adaptive_raster.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
 

@@ -1,7 +1,7 @@
 // Adaptive raster: see the header and core/footprint/adaptive_raster.py (the reference, step for step: the
 // same samples, the same bracketing, the same search; only the least over a pass's instances is pruned, which
 // does not change it).
-#include "tmm/query/adaptive_raster.hpp"
+#include "tmm/algo/adaptive_raster.hpp"
 
 #include <algorithm>
 #include <array>

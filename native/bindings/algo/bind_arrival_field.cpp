@@ -8,7 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "tmm/query/arrival_field.hpp"
+#include "tmm/algo/arrival_field.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
 

@@ -1,4 +1,4 @@
-// Adaptive raster pass placement (query/adaptive_raster.hpp) against closed forms:
+// Adaptive raster pass placement (algo/adaptive_raster.hpp) against closed forms:
 //  - a level plane: every gap is the ball's planar step for 0.95 x the tolerance, R - sqrt(R^2 - (s/2)^2);
 //  - a convex cylinder along the passes: the cusp between two ball passes is where the two balls' circles
 //    cross, nearer the axis: D cos(d/2) - sqrt(R^2 - D^2 sin^2(d/2)) - Rc (D = Rc + R, d the angle between
@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "support/test_meshes.hpp"
-#include "tmm/query/adaptive_raster.hpp"
+#include "tmm/algo/adaptive_raster.hpp"
 
 namespace {
 

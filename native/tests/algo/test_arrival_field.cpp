@@ -1,4 +1,4 @@
-// The 3D offset's arrival-time field (query/arrival_field.hpp) against closed forms:
+// The 3D offset's arrival-time field (algo/arrival_field.hpp) against closed forms:
 //  - a level plane, a straight start line at any angle: T is the distance over the flat step (exact to
 //    rounding: first-order fast marching is exact for a plane wave);
 //  - a level plane, a point start: T within the first-order error of the distance;
@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "tmm/query/arrival_field.hpp"
+#include "tmm/algo/arrival_field.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Lean passes' kernel fit (query/lean_profile.hpp) against independent references:
+// Lean passes' kernel fit (algo/lean_profile.hpp) against independent references:
 //  - a run over a tilted plane is one line: 2 vertices, the ends exact;
 //  - a ball over a faceted sphere cap (2.5 mm facets, as sphere_on_plate.stl) and over a faceted cylinder across
 //    its axis: every move within +-tol of the exact drop height sampled every 0.002 mm (drop_point), far fewer
@@ -17,7 +17,7 @@
 
 #include "support/test_meshes.hpp"
 #include "tmm/query/drop_cutter.hpp"
-#include "tmm/query/lean_profile.hpp"
+#include "tmm/algo/lean_profile.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Python binding of the lean passes' kernel fit (query/lean_profile.hpp): runs as flat numpy arrays in, the
+// Python binding of the lean passes' kernel fit (algo/lean_profile.hpp): runs as flat numpy arrays in, the
 // vertices as numpy arrays out, the GIL released (progress takes it back for its call).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "tmm/query/lean_profile.hpp"
+#include "tmm/algo/lean_profile.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
 

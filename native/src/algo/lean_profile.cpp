@@ -1,6 +1,6 @@
 // Lean passes: the exact profile along a run by adaptive drops, the min-link fit in its band, the checks.
-// See tmm/query/lean_profile.hpp for the method.
-#include "tmm/query/lean_profile.hpp"
+// See tmm/algo/lean_profile.hpp for the method.
+#include "tmm/algo/lean_profile.hpp"
 
 #include <algorithm>
 #include <array>
