@@ -180,7 +180,7 @@ TEST(LeanProfile, ArcsOverAFinelyFacetedCylinder) {
 }
 
 TEST(LeanProfile, ArcsOverAFacetedSphereStayInTheBand) {
-  // 2.5 mm facets: an arc takes a roll over an edge, no more (results.md, "the least number of moves")
+  // 2.5 mm facets: an arc takes a roll over an edge, no more (docs/history/results-log.md, "The least number of moves")
   const MeshIndex cap = grid_mesh(sphere_cap, -25, -25, 25, 25, 20, 20);
   expect_arcs_within_band(cap, Cutter(3.0, 3.0), 0.001, 1.0);
 }
