@@ -32,7 +32,7 @@ from cusp_spacing import SLOPE_LIMIT, cycle  # noqa: E402
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl  # noqa: E402
 from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
 from tmm_workbench.core.shared_data import benchmark_file  # noqa: E402
-from tmm_workbench.core.sim.cusp_field import cusp_field  # noqa: E402
+from tmm_workbench.core.strategies.surface.reference import cusp_field  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 

@@ -41,7 +41,8 @@ from cusp_spacing import (FEED, PLUNGE, SLOPE_LIMIT, Bisection, cycle, equal_cus
 from tmm_workbench.core.errors import TmmError  # noqa: E402
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.sim.cusp_field import cusp_field, measure  # noqa: E402
+from tmm_workbench.core.sim.cusp_field import measure  # noqa: E402
+from tmm_workbench.core.strategies.surface.reference import cusp_field  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 BASE = "constant step-over"

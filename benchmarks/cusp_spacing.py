@@ -7,7 +7,7 @@ dense raster (0.1 mm apart) are cut into the stock simulation (core.sim, 0.1 mm 
 largest difference along the normal where the slope is at most the cusp slope limit and the dense raster comes
 within the tolerance of the model (elsewhere the tool cannot reach: not a cusp): core.sim.cusp_field. The rows
 "+ verify" are the constant cusp mode and the adaptive raster with the verification pass (issue 14 item 4,
-core.footprint.variable_step: partial passes added where the simulated cusp exceeds the tolerance).
+core.strategies.surface.variable_step: partial passes added where the simulated cusp exceeds the tolerance).
 
     .venv/bin/python benchmarks/cusp_spacing.py            # sphere_on_plate and mount_rush, ball D6, 0.01 mm
     .venv/bin/python benchmarks/cusp_spacing.py --quick    # sphere_on_plate only
@@ -37,7 +37,8 @@ sys.path.insert(0, str(ROOT))
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.sim.cusp_field import cusp_field, measure  # noqa: E402
+from tmm_workbench.core.sim.cusp_field import measure  # noqa: E402
+from tmm_workbench.core.strategies.surface.reference import cusp_field  # noqa: E402
 from tmm_workbench.core.sim.cycle_time import three_axis_time, toolpath_feeds  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
@@ -144,7 +145,7 @@ def run(name: str, mesh, cutter: Cutter, tol: float, cell: float = CELL, boundar
     if best is not None:
         rows.append(best)
 
-    # --- the verification pass (issue 14 item 4, core.footprint.variable_step): partial passes where the
+    # --- the verification pass (issue 14 item 4, core.strategies.surface.variable_step): partial passes where the
     # simulated cusp exceeds the tolerance; passes shown as the set's + the partial ones
     for label, mode in (("constant cusp mode + verify", "cusp"), ("adaptive + verify", "adaptive")):
         row, _ = verified(mesh, cutter, boundary, field, mode, tol, label)

@@ -37,7 +37,7 @@ from tmm_workbench.core.footprint.region import box_region  # noqa: E402
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.query.drop import DropSurface  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.sim.cusp_field import cusp_field  # noqa: E402
+from tmm_workbench.core.strategies.surface.reference import cusp_field  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 CAUSES = ("border", "ridge of T", "concave", "slope", "other")

@@ -18,7 +18,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from tmm_workbench.core.geometry.mesh import TriMesh  # noqa: E402
-from tmm_workbench.core.sim.optimal_cutter import SLOPE_BANDS, compare_cutters  # noqa: E402
+from tmm_workbench.core.plan.optimal_cutter import SLOPE_BANDS, compare_cutters  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 D = 6.0

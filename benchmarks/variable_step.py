@@ -1,5 +1,5 @@
 """Seed 003's variable side-step experiment (section 4.1), reproduced on a relief of our own (mount_rush.stl),
-and the verification pass of issue 14 item 4 (core.footprint.variable_step) beside it.
+and the verification pass of issue 14 item 4 (core.strategies.surface.variable_step) beside it.
 
 The seed: a ball of radius 1/8 in, a zig-zag raster at a side step of 1/40 in, the surface divided into 20 x 20 mm
 buckets; the buckets whose scallop is above the work piece's average are machined again with a side step of
@@ -27,11 +27,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from tmm_workbench.core.footprint.cusp import plane_cusp  # noqa: E402
-from tmm_workbench.core.footprint.variable_step import measure_cell  # noqa: E402
+from tmm_workbench.core.strategies.surface.variable_step import measure_cell  # noqa: E402
 from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
 from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.sim.cusp_field import cusp_field  # noqa: E402
+from tmm_workbench.core.strategies.surface.reference import cusp_field  # noqa: E402
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 

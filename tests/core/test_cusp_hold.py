@@ -1,5 +1,5 @@
-"""The cusp modes report the cells they leave above the cusp height (core.footprint.cusp_check): the check is the
-verification's measurement (its cells, the envelope of a dense raster a cell apart), computed only where the path
+"""The cusp modes report the cells they leave above the cusp height (core.strategies.surface.cusp_check): the check is
+the verification's measurement (its cells, the envelope of a dense raster a cell apart), computed only where the path
 comes near the height, and it agrees with that measurement made everywhere."""
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ import pytest
 
 from tmm_workbench.core import cancel
 from tmm_workbench.core.errors import Cancelled
-from tmm_workbench.core.footprint import cusp_check
-from tmm_workbench.core.footprint.variable_step import measure_cell
+from tmm_workbench.core.strategies.surface import cusp_check
+from tmm_workbench.core.strategies.surface.variable_step import measure_cell
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.sim.cusp_field import cusp_field
+from tmm_workbench.core.strategies.surface.reference import cusp_field
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
 from tmm_workbench.core.tools.cutter import Cutter
 

@@ -143,7 +143,7 @@ def test_section_rule_holds_the_cusp_at_a_low_free_border(across_deg):
     cells along the border (core.sim.cusp_field: the path against a dense raster, where the tool reaches).
     At 30 deg the 2D section's tools missed the swept tool's reach beyond the border (0.0158 mm simulated): the
     rule drops them along the pass there too."""
-    from tmm_workbench.core.sim.cusp_field import cusp_field
+    from tmm_workbench.core.strategies.surface.reference import cusp_field
 
     slope = math.tan(math.radians(across_deg))
     mesh, cutter = sheet(slope), Cutter.ball(6)

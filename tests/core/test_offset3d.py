@@ -349,7 +349,7 @@ def test_relief_patch_holds_the_cusp_with_long_loops_and_no_gouge():
     along the normal where the slope is at most 75 deg and the tool reaches the model)."""
     from tmm_workbench.core.geometry.mesh import load_stl
     from tmm_workbench.core.shared_data import shared_dir
-    from tmm_workbench.core.sim.cusp_field import cusp_field
+    from tmm_workbench.core.strategies.surface.reference import cusp_field
 
     mesh = load_stl(shared_dir() / "benchmarks" / "stl" / "mount_rush.stl")
     tol, box = 0.01, (-8.0, 0.0, 4.0, 12.0)

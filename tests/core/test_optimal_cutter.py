@@ -1,4 +1,4 @@
-"""The optimal cutter (core.sim.optimal_cutter, seed 003 section 4.2): on a plane, a bull-nose whose flat
+"""The optimal cutter (core.plan.optimal_cutter, seed 003 section 4.2): on a plane, a bull-nose whose flat
 bottom is wider than the step-over leaves nothing while a ball leaves its cusp everywhere, so the bull ranks
 first; on a steep ramp (45 deg) the ball leaves less than the bull (seed 003: ball better above about 40 deg)."""
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pytest
 
 from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.sim.optimal_cutter import compare_cutters
+from tmm_workbench.core.plan.optimal_cutter import compare_cutters
 from tmm_workbench.core.tools.cutter import Cutter
 
 CANDIDATES = [("ball D6", Cutter.ball(6.0)), ("bull D6 r1", Cutter.bull(6.0, 1.0))]

@@ -12,7 +12,8 @@ import pytest
 
 from tmm_workbench.core import cancel, limits, polygons
 from tmm_workbench.core.errors import Cancelled, TmmError, WorkLimitError
-from tmm_workbench.core.footprint import cusp, region, variable_step
+from tmm_workbench.core.footprint import cusp, region
+from tmm_workbench.core.strategies.surface import variable_step
 from tmm_workbench.core.params import Spec, check
 from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.strategies.raster_drop import ADAPTIVE, SurfaceParams

@@ -1,4 +1,4 @@
-"""Variable side step (core.footprint.variable_step, issue 14 item 4): the raster's pass set cut into the stock
+"""Variable side step (core.strategies.surface.variable_step, issue 14 item 4): the raster's pass set cut into the stock
 simulation, extra partial passes where its cusp exceeds the tolerance. Checked independently: the final path
 and a dense raster cut again into a grid of finer cells than the verification used (core.sim.cusp_field's
 measure), the design compared with the simulated stock for gouges, the extra passes counted and located."""
@@ -11,10 +11,10 @@ from benchmarks.seed000_surfaces import INCH, seed000_mesh
 from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
-from tmm_workbench.core.footprint.variable_step import VerifyReport, measure_cell
+from tmm_workbench.core.strategies.surface.variable_step import VerifyReport, measure_cell
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import SegmentKind
-from tmm_workbench.core.sim.cusp_field import cusp_field
+from tmm_workbench.core.strategies.surface.reference import cusp_field
 from tmm_workbench.core.strategies.raster_drop import SurfaceParams, compute
 from tmm_workbench.core.tools.cutter import Cutter
 

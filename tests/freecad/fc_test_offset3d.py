@@ -219,7 +219,7 @@ class Offset3DEstimate(FreeCADTestCase):
         points = result.diagnostics["points"]
         # the count holds the cusp check's measurement too (CheckCusp Auto runs on this small region: its dense
         # raster at most)
-        from tmm_workbench.core.footprint import variable_step
+        from tmm_workbench.core.strategies.surface import variable_step
 
         check = variable_step.estimate_params(cutter_from_tool(tc.Tool), params)
         self.assertIn("cusp check", est.note)

@@ -9,7 +9,7 @@ import unittest
 from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.sim.cusp_field import cusp_field
+from tmm_workbench.core.strategies.surface.reference import cusp_field
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.01

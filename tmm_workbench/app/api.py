@@ -524,12 +524,12 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
 def compare_cutters(model: Any, candidates: Sequence[Any], *, stepover: float, sample_step: float,
                     cell: float = 0.1, tolerance: float = 0.01, angle_deg: float = 0.0, margin: float = 0.0,
                     horiz_feed: float = 1000.0, vert_feed: float = 300.0) -> Any:
-    """Seed 003's optimal cutter (core.sim.optimal_cutter): the same 3-axis raster with each candidate, each
+    """Seed 003's optimal cutter (core.plan.optimal_cutter): the same 3-axis raster with each candidate, each
     simulated and compared with the model, ranked with the reason. `model`: an STL path, a Mesh/Part object
     or a Job (its model); `candidates`: ToolBits, tool controllers (their tool) or core Cutters. Feeds in
     mm/min, the same for all (the cycle times compare the paths)."""
     from tmm_workbench.app import geometry, simulation
-    from tmm_workbench.core.sim.optimal_cutter import compare_cutters as core_compare
+    from tmm_workbench.core.plan.optimal_cutter import compare_cutters as core_compare
     from tmm_workbench.core.strategies.raster_drop import SurfaceParams
 
     numbers(stepover=(stepover, spec_of(SurfaceParams, "stepover")),

@@ -166,9 +166,9 @@ def _design_heights(job: Any, ops: list, grid: Grid, progress: Optional[Callable
 
 
 def slope_regions(design: np.ndarray, cell: float) -> dict:
-    """Masks of the design's cells by slope band (core.sim.optimal_cutter.SLOPE_BANDS): where seed 003
+    """Masks of the design's cells by slope band (core.plan.optimal_cutter.SLOPE_BANDS): where seed 003
     found the cutters differ."""
-    from tmm_workbench.core.sim.optimal_cutter import SLOPE_BANDS
+    from tmm_workbench.core.plan.optimal_cutter import SLOPE_BANDS
 
     slope = compare_mod.slope_deg(design, cell)
     return {f"slope {lo:g}-{hi:g} deg": np.isfinite(design) & (slope >= lo) & (slope < hi) for lo, hi in SLOPE_BANDS}

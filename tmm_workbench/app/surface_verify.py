@@ -1,9 +1,9 @@
-"""The 3-axis Surface op's verification pass (issue 14 item 4; core.footprint.variable_step): `VerifyCusp` cuts
+"""The 3-axis Surface op's verification pass (core.strategies.surface.variable_step): `VerifyCusp` cuts
 the pass set in the stock simulation and adds partial passes where its cusp exceeds CuspHeight. Off by default,
 and off in documents saved before it (a Bool property added on restore is False): their path is unchanged.
 
-`CheckCusp` (Auto by default: a large region on coarser cells; core.footprint.cusp_check): a cusp mode's pass set measured as the
-verification measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
+`CheckCusp` (Auto by default: a large region on coarser cells; core.strategies.surface.cusp_check): a cusp mode's
+pass set measured as the verification measures it, no passes added. What it finds goes to the read-only `CuspReport` (cells above CuspHeight, the
 largest, where) and, when cells exceed it, a warning suggesting VerifyCusp. It never changes the path.
 
 Each pass set's report goes to the report view: a message with the cusp before and after, the passes added and
@@ -35,7 +35,7 @@ REPORT = "CuspReport"
 
 def notes_for(params: Any) -> list:
     """The list the strategy appends its reports to (empty when neither VerifyCusp nor CheckCusp runs)."""
-    from tmm_workbench.core.footprint import cusp_check
+    from tmm_workbench.core.strategies.surface import cusp_check
 
     notes: list = []
     if params.verify_cusp or cusp_check.applies(params):
@@ -52,7 +52,7 @@ def _report_property(obj: Any, text: str) -> None:
 
 
 def report(obj: Any, notes: list) -> None:
-    from tmm_workbench.core.footprint.cusp_check import CuspCheck
+    from tmm_workbench.core.strategies.surface.cusp_check import CuspCheck
 
     _report_property(obj, "")
     for note in notes:

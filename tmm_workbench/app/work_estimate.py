@@ -251,7 +251,7 @@ def _surface_pace(obj: Any, params: Any) -> float:
 def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
     """With VerifyCusp (issue 14 item 4): the verification's dense raster added (known before it runs; its partial
     passes are not)."""
-    from tmm_workbench.core.footprint import cusp_check, variable_step
+    from tmm_workbench.core.strategies.surface import cusp_check, variable_step
 
     if not params.verify_cusp:  # CheckCusp measures the cusp modes' passes (skipped above the limits)
         if not cusp_check.applies(params):

@@ -6,8 +6,7 @@ import math
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
-
-Rect = tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
+from tmm_workbench.core.geometry.rect import Rect  # noqa: F401 - the footprints' rectangle
 
 
 EVEN, FIXED = "even", "fixed"

@@ -7,8 +7,8 @@ from typing import Optional, Sequence
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.raster import Rect
 from tmm_workbench.core.geometry.bspline import BezierPieces, bspline_to_bezier
+from tmm_workbench.core.geometry.rect import Rect
 from tmm_workbench.core.kernel import native
 
 

@@ -11,14 +11,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Optional
+from typing import Callable, Optional
 
 import numpy as np
 
 from tmm_workbench.core import cancel
-from tmm_workbench.core.footprint.raster import Rect
+from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.geometry.rect import Rect
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.sim.grid import Grid
@@ -29,6 +29,9 @@ from tmm_workbench.core.tools.cutter import Cutter
 
 SLOPE_LIMIT_DEG = 75.0
 STOCK_ABOVE_MM = 5.0  # the box stock's top above the model: every cut starts in material
+# The dense raster's envelope, made by its caller (the strategy: core.strategies.surface.measure.dense_raster):
+# (grid, surface, stock top, progress) -> the (ny, nx) heights the raster leaves in a box stock at the stock top
+DenseRaster = Callable[[Grid, DropSurface, float, Optional[Progress]], np.ndarray]
 
 
 @dataclass
@@ -103,15 +106,6 @@ def measure_grid_size(boundary: Rect, cutter: Cutter, cell: float) -> tuple[int,
             max(1, math.ceil((boundary[3] - boundary[1] - 2 * r) / cell - 1e-9)))
 
 
-def dense_params(boundary: Rect, cutter: Cutter, cell: float, sample_step: float, stock_to_leave: float = 0.0) -> Any:
-    """The dense raster's parameters: passes a cell apart over `boundary` grown by the tool radius across."""
-    from tmm_workbench.core.strategies.raster_drop import SurfaceParams  # the strategy uses this module
-
-    r = cutter.radius
-    return SurfaceParams(boundary=(boundary[0], boundary[1] - r, boundary[2], boundary[3] + r), stepover=cell,
-                         sample_step=sample_step, stock_to_leave=stock_to_leave)
-
-
 def measure_grid(boundary: Rect, cutter: Cutter, cell: float) -> Grid:
     """The cells measured for a raster over `boundary`: inside it, clear of its edges by the tool radius (the
     passes' ends and the outermost passes' far sides are not the spacing's)."""
@@ -120,16 +114,18 @@ def measure_grid(boundary: Rect, cutter: Cutter, cell: float) -> Grid:
 
 
 def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, cell: float,
-               slope_limit_deg: float = SLOPE_LIMIT_DEG, sample_step: float = 0.25, stock_to_leave: float = 0.0,
+               slope_limit_deg: float = SLOPE_LIMIT_DEG, stock_to_leave: float = 0.0,
                surface: Optional[DropSurface] = None, grid: Optional[Grid] = None,
-               progress: Optional[Progress] = None, fast_envelope: bool = False) -> CuspField:
+               progress: Optional[Progress] = None, fast_envelope: bool = False,
+               dense: Optional[DenseRaster] = None) -> CuspField:
     """The field for rasters over `boundary` (xmin, ymin, xmax, ymax) with `cutter`; `cell` is the simulation's
-    cell and the dense raster's step-over. With `stock_to_leave` the dense raster leaves it too, and a cell is
-    reachable when the envelope comes within tolerance + stock_to_leave of the design. `fast_envelope`: the dense
-    raster as one batch drop on its grid of points (sampled `cell` apart, no chord thinning or refinement) cut
-    by the kernel from arrays (grid_envelope: several times faster than through the strategy and the linker)."""
-    from tmm_workbench.core.strategies.raster_drop import compute  # the strategy uses this module
-
+    cell and the dense raster's step-over. The envelope is `dense`'s (the strategy's dense raster, made by the
+    caller: core.strategies.surface.measure.dense_raster) or, with `fast_envelope`, grid_envelope's (the dense
+    raster as one batch drop on its grid of points, sampled `cell` apart, no chord thinning or refinement, cut by
+    the kernel from arrays: several times faster). With `stock_to_leave` the dense raster leaves it too, and a
+    cell is reachable when the envelope comes within tolerance + stock_to_leave of the design."""
+    if not fast_envelope and dense is None:
+        raise TmmError("the cusp field needs the dense raster's envelope (dense) or fast_envelope")
     grid = grid or measure_grid(boundary, cutter, cell)
     surface = surface or DropSurface(mesh)
     design = mesh_heights(mesh, grid, surface)
@@ -138,10 +134,7 @@ def cusp_field(mesh: TriMesh, cutter: Cutter, boundary: Rect, tolerance: float, 
     if fast_envelope:
         envelope = grid_envelope(mesh, cutter, boundary, grid, stock_to_leave, surface, stock_top, progress)
     else:
-        dense = compute(mesh, cutter, dense_params(boundary, cutter, grid.cell, sample_step, stock_to_leave),
-                        progress, surface)
-        path = link(dense.segments, LinkPolicy(stock_top, stock_top + 5))
-        envelope = simulate(path, cutter, grid, box_heights(grid, stock_top)).heights
+        envelope = dense(grid, surface, stock_top, progress)
     return field_of(grid, design, envelope, tolerance, stock_to_leave, slope_limit_deg, stock_top)
 
 
@@ -164,10 +157,10 @@ def grid_envelope(mesh: TriMesh, cutter: Cutter, boundary: Rect, grid: Grid, sto
                   surface: DropSurface, stock_top: float, progress: Optional[Progress] = None,
                   cells: Optional[np.ndarray] = None) -> np.ndarray:
     """The dense raster's envelope without the strategy: its passes (along X, a cell apart over `boundary` grown
-    by the tool radius across, as dense_params) dropped in one batch on points a cell apart, on the model's floor
-    at least, and cut in serpentine order from arrays. The straight moves between points a cell apart pass below
-    the exact CL path by its sag on convex ground (cell^2 / 8 rho: about a micrometre): the envelope is, if
-    anything, lower, and the cusp over it larger. `cells` ((ny, nx) bool): only these cells' envelope is wanted;
+    by the tool radius across, as the strategy's dense_params) dropped in one batch on points a cell apart, on the
+    model's floor at least, and cut in serpentine order from arrays. The straight moves between points a cell apart
+    pass below the exact CL path by its sag on convex ground (cell^2 / 8 rho: about a micrometre): the envelope is,
+    if anything, lower, and the cusp over it larger. `cells` ((ny, nx) bool): only these cells' envelope is wanted;
     only the points within the tool's reach of them are dropped and cut (runs of a pass, the tool lifted above
     the stock between runs); elsewhere the result is the stock top."""
     from tmm_workbench.core.kernel import native

@@ -22,14 +22,13 @@ from tmm_workbench.core.footprint.cusp import check_cusp
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.strategies.surface.params import _BYTES_PER_POINT, ONEWAY, SPIRAL
 from tmm_workbench.core.tools.cutter import Cutter
 
 
 
 def check(params: Any, cutter: Cutter) -> None:
     """The inputs the mode adds, by name, before any work."""
-    from tmm_workbench.core.strategies.raster_drop import SPIRAL
-
     if params.pattern == SPIRAL:
         raise TmmError("the 3D offset step-over mode makes its own loops from the region's boundary; with it use "
                        "the ZigZag (loops linked) or OneWay (a lift before each loop) pattern, not Spiral")
@@ -61,8 +60,6 @@ def estimate_work(shape: list, cutter: Cutter, params: Any) -> float:
     """The CL points of the passes (loop_length over the sample step), after refusing above the limits, before
     any height is dropped: the field's grid nodes (each dropped) and the passes at the smallest step (every
     place at the slope limit: an upper bound)."""
-    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT
-
     rule = offset_field.step_rule(cutter, params.cusp, params.max_slope_deg)
     least, flat = float(rule.step(np.array([params.max_slope_deg]))[0]), rule.flat
     start = None if params.offset_from is None else [np.asarray(c, dtype=float) for c in params.offset_from]
@@ -81,7 +78,6 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: Any, flo
     places its extra passes between them by it). diagnostics: "passes" (loops), "jumps", "levels", "stepover" (the flat
     step, mm), "least_step" (mm), "region_area" (mm^2)."""
     from tmm_workbench.core.footprint import region as region_mod
-    from tmm_workbench.core.strategies.raster_drop import ONEWAY
     from tmm_workbench.core.strategies.raster_region import max_link
 
     check(params, cutter)

@@ -5,8 +5,9 @@ The region bounds the tool centre (core.footprint.region). The raster's passes (
 the step-over mode as in the box) are clipped to it exactly; the spiral (core.footprint.spiral) is clipped
 the same way. The pieces are put in chains (core.footprint.region_order): within a chain the tool stays
 down over straight links inside the region, dropped on the surface like every CL point; between chains
-it jumps (the linker lifts to the safe height). Each chain is cut like today's zig-zag (raster_drop's
-_segments), so the box with neither region nor spiral gives exactly the path it always gave.
+it jumps (the linker lifts to the safe height). Each chain is cut like today's zig-zag (core.strategies.surface.
+segments), so the box with neither region nor spiral gives exactly the path it always gave. The region's and the
+slope range's checks are SurfaceParams's (core.strategies.surface.params.validate_region).
 """
 from __future__ import annotations
 
@@ -19,43 +20,13 @@ from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import region as region_mod
 from tmm_workbench.core.footprint import region_order, spiral
-from tmm_workbench.core.polygons import Shape
 from tmm_workbench.core.strategies import slope_filter
+from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - shape_of, spiral_radius: the region's
+    INWARD, ONEWAY, SPIRAL, ZIGZAG, shape_of, spiral_radius)
 from tmm_workbench.core.tools.cutter import Cutter
 
 Run = region_order.Run
 _BARRIER: Run = (True, np.zeros((0, 2)))  # between chains: raster_refine does not check across it
-
-
-def validate(params: Any) -> None:
-    """The region's polygons and the slope range, by name."""
-    from tmm_workbench.core.strategies.raster_drop import ADAPTIVE, SPIRAL
-
-    if params.region is not None:
-        if not isinstance(params.region, (list, tuple)) or not params.region:
-            raise TmmError(f"region must be a list of polygons ((n, 2) arrays, mm), got {params.region!r}")
-        for k, p in enumerate(params.region):
-            a = np.asarray(p, dtype=float)
-            if a.ndim != 2 or a.shape[1] != 2 or len(a) < 3:
-                raise TmmError(f"region polygon {k + 1} must be 3 or more XY points, got shape {a.shape}")
-            if not np.isfinite(a).all():
-                raise TmmError(f"region polygon {k + 1} has a point that is not finite")
-    if params.slope_min_deg > params.slope_max_deg:
-        raise TmmError(f"slope range: minimum {params.slope_min_deg:g} deg is above the maximum "
-                       f"{params.slope_max_deg:g} deg (allowed: 0 <= minimum <= maximum <= 90)")
-    if params.pattern == SPIRAL and params.stepover_mode == ADAPTIVE:
-        raise TmmError("the adaptive step-over mode places raster passes; with the spiral pattern use the "
-                       "step-over or cusp mode")
-
-
-def shape_of(params: Any) -> Shape:
-    return params.region if params.region is not None else region_mod.box_region(params.boundary)
-
-
-def spiral_radius(params: Any) -> float:
-    """How far the spiral goes from its centre: to the region's farthest vertex (for the work estimate)."""
-    shape = shape_of(params)
-    return float(np.hypot(*(np.vstack(shape) - spiral.centre_of(shape)).T).max())
 
 
 def max_link(stepover: float, cutter: Cutter) -> float:
@@ -67,8 +38,6 @@ def max_link(stepover: float, cutter: Cutter) -> float:
 def chains(lines: list[np.ndarray], cutter: Cutter, params: Any, diagnostics: dict) -> list[list[Run]]:
     """The runs of each chain (see the module doc). diagnostics: "passes" (pieces), "jumps" (lifts between
     chains), "region_area" (mm^2)."""
-    from tmm_workbench.core.strategies.raster_drop import SPIRAL, ZIGZAG, INWARD
-
     shape = shape_of(params)
     stepover = float(diagnostics["stepover"])
     longest = max_link(stepover, cutter)
@@ -104,10 +73,8 @@ def flatten(chain_list: list[list[Run]]) -> list[Run]:
 
 def segments(runs: list[Run], z: np.ndarray, air: np.ndarray, params: Any, chain_list: list[list[Run]],
              cut: Callable[..., list]) -> list:
-    """raster_drop's segments, chain by chain (`cut`: raster_drop._segments): each chain starts with a
-    jump. `runs` as flattened (raster_refine may have added points; the run count is the same)."""
-    from tmm_workbench.core.strategies.raster_drop import ONEWAY, ZIGZAG
-
+    """raster_drop's segments, chain by chain (`cut`: core.strategies.surface.segments.segments): each chain starts
+    with a jump. `runs` as flattened (raster_refine may have added points; the run count is the same)."""
     pattern = ONEWAY if params.pattern == ONEWAY else ZIGZAG
     out = []
     r, k = 0, 0

@@ -1,4 +1,4 @@
-"""Variable side step (issue 14 item 4; seed 003 section 4.1): a verification pass over a raster's pass set.
+"""Variable side step (seed 003 section 4.1): the Surface's verification stage over a raster's pass set.
 
 The pass set is cut into the stock simulation and its cusp measured as core.sim.cusp_field defines it (along the
 normal, slopes up to the slope limit, reachable cells only). Cells whose cusp exceeds the tolerance are grouped
@@ -26,16 +26,21 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.footprint.cusp import check_cusp, stepover_for_cusp
+from tmm_workbench.core.footprint.cusp import check_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import LinkPolicy, heights_top, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.sim.cusp_field import CuspField, cusp_field
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.strategies import raster_refine
+from tmm_workbench.core.strategies.surface.cusp_check import from_field
+from tmm_workbench.core.strategies.surface.measure import (  # noqa: F401 - measure_cell: the measurement's
+    Compute, dense_raster, estimate_work, measure_cell)
+from tmm_workbench.core.strategies.surface.params import ONEWAY, validate_verify
+from tmm_workbench.core.strategies.surface.segments import segments as cut_segments
 from tmm_workbench.core.tools.cutter import Cutter
 
 Drop = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]  # xy -> (tip z, air flags): raster_drop's drop
@@ -44,8 +49,6 @@ ROUNDS = 4
 # little higher), and the extra passes aim at TARGET of it.
 _EXCEED = 0.95
 _TARGET = 0.8
-_CELLS_PER_STEP = 8     # the measuring cell: the planar step-over for the tolerance / 8 (0.06 mm for D6, 0.01)
-_MIN_CELL, _MAX_CELL = 0.02, 1.0
 
 
 @dataclass
@@ -105,29 +108,8 @@ class VerifyReport:
         return out
 
 
-def measure_cell(cutter: Cutter, tolerance: float) -> float:
-    """The simulation cell for `tolerance`: an eighth of the planar step-over (0.06 mm for a ball D6 at 0.01 mm)."""
-    return float(np.clip(stepover_for_cusp(cutter, tolerance, 0.0) / _CELLS_PER_STEP, _MIN_CELL, _MAX_CELL))
-
-
 def _nanmax(a: np.ndarray) -> float:
     return float(np.nanmax(a)) if np.isfinite(a).any() else 0.0
-
-
-def estimate_work(boundary: Rect, cutter: Cutter, tolerance: float, cell: float, what: str = "verify cusp") -> float:
-    """The measurement's CL points: the dense raster (a cell apart both ways, over the boundary grown by the tool
-    radius across: core.sim.cusp_field) and the design dropped on every cell, refused above the limits before
-    anything runs."""
-    from tmm_workbench.core.sim.cusp_field import dense_params, measure_grid_size
-    from tmm_workbench.core.strategies.raster_drop import _BYTES_PER_POINT, raster_points
-
-    nx, ny = measure_grid_size(boundary, cutter, cell)
-    count = raster_points(dense_params(boundary, cutter, cell, cell)) + nx * ny
-    check_work("CL points", count, _BYTES_PER_POINT,
-               f"{what}: cusp height {tolerance:g} mm measured on {cell:.3g} mm cells (the planar step-over / "
-               f"{_CELLS_PER_STEP}, at least {_MIN_CELL:g} mm) over a {boundary[2] - boundary[0]:.6g} x "
-               f"{boundary[3] - boundary[1]:.6g} mm boundary")
-    return count
 
 
 class _Passes:
@@ -296,13 +278,11 @@ def _strip(grid: Grid, tips: np.ndarray, reach: float) -> Optional[tuple[Grid, s
 def _extra_segments(xy: np.ndarray, drop: Drop, gouge_tol: float, chord_tol: float) -> list[CutSegment]:
     """One partial pass (XY points at the sample step), dropped and checked as raster_drop drops its own (split
     where it crosses air)."""
-    from tmm_workbench.core.strategies import raster_drop, raster_refine
-
     z, air = drop(xy)
     runs = [(False, xy)]
     if gouge_tol > 0:
         runs, z, air, _ = raster_refine.refine(runs, z, air, drop, gouge_tol, chained=False)
-    return raster_drop._segments(runs, z, air, raster_drop.ONEWAY, chord_tol)
+    return cut_segments(runs, z, air, ONEWAY, chord_tol)
 
 
 def _nearest_first(lines: list[np.ndarray], start: np.ndarray) -> list[np.ndarray]:
@@ -326,8 +306,6 @@ def _surface_link(a: np.ndarray, b: np.ndarray, drop: Drop, sample_step: float,
                   gouge_tol: float) -> Optional[CutSegment]:
     """A LINK from tip a to tip b on the surface (dropped points, gouge-checked between them as raster_drop's
     zig-zag links; the tool stays down), or None where it crosses air."""
-    from tmm_workbench.core.strategies import raster_refine
-
     xy = sample_segment(a[:2], b[:2], sample_step)
     z, air = drop(xy)
     if air.any():
@@ -346,15 +324,19 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
                 tolerance: float, drop: Drop, *, sample_step: float = 0.5, gouge_tol: float = 0.005,
                 chord_tol: float = 0.001, stock_to_leave: float = 0.0, slope_limit_deg: float = 75.0,
                 cell: Optional[float] = None, rounds: int = ROUNDS, surface: Optional[DropSurface] = None,
-                progress: Optional[Progress] = None, levels: Any = None) -> tuple[list[CutSegment], VerifyReport]:
+                progress: Optional[Progress] = None, levels: Any = None,
+                compute: Optional[Compute] = None) -> tuple[list[CutSegment], VerifyReport]:
     """`segments` (a raster's pass set over `boundary`, passes along `angle_deg`; or the 3D offset's loops, the
     level sets of the arrival field `levels`, an offset_field.Field) with extra partial passes appended where the
     simulated cusp exceeds `tolerance`, and the report (see the module). `drop` drops the tool at XY points as the
-    raster did (stock to leave, floor, air). `progress` (fraction -> False to cancel) follows the dense raster,
+    raster did (stock to leave, floor, air); `compute` makes the dense raster the cusp is measured against (the
+    raster strategy's, core.strategies.raster_drop.compute). `progress` (fraction -> False to cancel) follows the dense raster,
     the bulk of the work, and is asked again before each round."""
     t0 = time.perf_counter()
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"verify cusp tolerance must be a length > 0 mm, got {tolerance!r}")
+    if compute is None:
+        raise TmmError("verify cusp needs the raster strategy that makes its dense raster (compute)")
     cell = measure_cell(cutter, tolerance) if cell is None else float(cell)
     estimate_work(boundary, cutter, tolerance, cell)
     surface = surface or DropSurface(mesh)
@@ -366,8 +348,9 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         if not passes.rows:
             raise TmmError("verify cusp needs straight raster passes (ZigZag or OneWay), found none")
     # the envelope sampled a cell apart along its passes too: the path's own chords count as cusp
-    fld: CuspField = cusp_field(mesh, cutter, boundary, tolerance, cell, slope_limit_deg, cell, stock_to_leave,
-                                surface, progress=progress)
+    fld: CuspField = cusp_field(mesh, cutter, boundary, tolerance, cell, slope_limit_deg, stock_to_leave, surface,
+                                progress=progress,
+                                dense=dense_raster(compute, mesh, cutter, boundary, cell, stock_to_leave))
     policy = LinkPolicy(fld.stock_top + 1.0, fld.stock_top + 5.0)
     heights = fld.cut(link(segments, policy), cutter)
     before = fld.ridge_cusp(heights)
@@ -437,8 +420,6 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     report.deepest = float(max(0.0, np.max(fld.design[on_model] + stock_to_leave - heights[on_model]))) \
         if on_model.any() else 0.0
     report.seconds = time.perf_counter() - t0
-    from tmm_workbench.core.footprint.cusp_check import from_field
-
     report.check = from_field(fld, cusp, cutter.diameter)
     # the first extra segment follows the pass set after a lift; the others keep their own (joined: on the surface)
     return segments + [CutSegment(s.tips, s.kind, joined=s.joined and i > 0, pass_index=s.pass_index,
@@ -462,38 +443,27 @@ def _entry_top(fld: CuspField, heights: np.ndarray, cutter: Cutter, tip: np.ndar
     return top if math.isfinite(top) else None
 
 
-def validate_params(params) -> None:
-    """What the verification pass needs of raster_drop's SurfaceParams (refused before any work)."""
-    from tmm_workbench.core.strategies.raster_drop import SPIRAL
-
-    if params.pattern == SPIRAL:
-        raise TmmError("verify cusp works on straight raster passes or the 3D offset's loops (pattern zigzag or "
-                       "oneway), not spiral")
-    if params.region is not None:
-        raise TmmError("verify cusp works on the boundary box only for now (region Box), not on a face or sketch "
-                       "region")
-    if params.slope_min_deg > 0 or params.slope_max_deg < 90:
-        raise TmmError(f"verify cusp measures every slope up to the cusp slope limit: set the slope range to 0..90 "
-                       f"deg (got {params.slope_min_deg:g}..{params.slope_max_deg:g})")
+validate_params = validate_verify  # what the verification needs of SurfaceParams (core.strategies.surface.params)
 
 
-def estimate_params(cutter: Cutter, params) -> float:
+def estimate_params(cutter: Cutter, params: Any) -> float:
     """verify_params's measurement estimated (and refused above the limits) before the passes are placed."""
     check_cusp(cutter, params.cusp)
     return estimate_work(params.boundary, cutter, params.cusp, measure_cell(cutter, params.cusp))
 
 
-def verify_params(mesh: TriMesh, cutter: Cutter, params, segments: list[CutSegment], drop: Drop,
+def verify_params(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment], drop: Drop,
                   surface: Optional[DropSurface], diagnostics: dict, progress: Optional[Progress] = None,
-                  levels: Any = None) -> list[CutSegment]:
+                  levels: Any = None, compute: Optional[Compute] = None) -> list[CutSegment]:
     """raster_drop's call: its pass set verified against `params.cusp` (diagnostics["verify"]; the report is
-    appended to params.verify_notes when given); `levels` the 3D offset's arrival field (its loops')."""
+    appended to params.verify_notes when given); `levels` the 3D offset's arrival field (its loops'), `compute` the
+    raster strategy (its dense raster is the measurement's reference)."""
     check_cusp(cutter, params.cusp)
     segments, report = verify_cusp(mesh, cutter, segments, params.boundary, params.angle_deg, params.cusp, drop,
                                    sample_step=params.sample_step, gouge_tol=params.gouge_tol,
                                    chord_tol=params.chord_tol, stock_to_leave=params.stock_to_leave,
                                    slope_limit_deg=params.max_slope_deg, surface=surface, progress=progress,
-                                   levels=levels)
+                                   levels=levels, compute=compute)
     diagnostics["verify"] = report.as_dict()
     diagnostics["cusp_check"] = report.check.as_dict()   # the final measurement: no second one by the check
     if params.verify_notes is not None:

@@ -5,7 +5,8 @@ leave less on gentle slopes, ball cutters on steep ones), the volume left and re
 ranked with the reason, and a map of which cutter leaves the least in each cell (seed 003, Figure 4.10's
 "best scallop height").
 
-Deviations are vertical (core.sim.compare); the slope bands use the design's slope from its heights."""
+Deviations are vertical (core.sim.compare); the slope bands use the design's slope from its heights. A plan above
+the strategies: it runs the raster strategy for each candidate and measures what each leaves in the simulation."""
 from __future__ import annotations
 
 import math

@@ -2,7 +2,7 @@
 
 The cusp modes (constant cusp, adaptive, 3D offset) place their passes by rules that sample the surface (sections,
 a field's first-order marching, secants); where the sampling misses detail a few cells stay above the cusp height.
-The check cuts the pass set into the stock simulation on the verification's cells (core.footprint.variable_step:
+The check cuts the pass set into the stock simulation on the verification's cells (core.strategies.surface.measure:
 an eighth of the planar step, the dense raster sampled a cell apart) and reports how many measured cells exceed the
 cusp (with the crest between cells, CuspField.ridge_cusp, as the verification decides), the largest, and where:
 the bounding box and up to PLACES places (the worst cell of each group of exceeding cells within a tool diameter of
@@ -26,10 +26,13 @@ from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.compare import slope_deg
-from tmm_workbench.core.sim.cusp_field import STOCK_ABOVE_MM, CuspField, field_of, grid_envelope, measure_grid
+from tmm_workbench.core.sim.cusp_field import (STOCK_ABOVE_MM, CuspField, field_of, grid_envelope, measure_grid,
+                                               measure_grid_size)
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import box_heights, mesh_heights
+from tmm_workbench.core.strategies.surface.measure import estimate_work, measure_cell
+from tmm_workbench.core.strategies.surface.params import STEPOVER
 from tmm_workbench.core.tools.cutter import Cutter
 
 PLACES = 5
@@ -117,8 +120,6 @@ def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], pa
     their neighbours), and the cusp read on the screened cells; the rest hold."""
     from scipy.ndimage import binary_dilation
 
-    from tmm_workbench.core.footprint.variable_step import measure_cell
-
     t0 = time.perf_counter()
     surface = surface or DropSurface(mesh)
     tol, s = params.cusp, params.stock_to_leave
@@ -164,37 +165,28 @@ def _report(grid: Grid, cusp: np.ndarray, measured: np.ndarray, unreachable: np.
 
 
 def cost_points(boundary: Any, cutter: Cutter, cusp: float, cell: Optional[float] = None) -> float:
-    """The check's CL points at most on `cell` mm cells (the verification's by default; variable_step.estimate_work:
+    """The check's CL points at most on `cell` mm cells (the verification's by default; measure.estimate_work:
     the dense raster everywhere and the design), refused above the limits (WorkLimitError)."""
-    from tmm_workbench.core.footprint.variable_step import estimate_work, measure_cell
-
     return estimate_work(boundary, cutter, cusp, cell or measure_cell(cutter, cusp), "cusp check")
 
 
 def applies(params: Any) -> bool:
     """raster_drop's params: a cusp mode with the check not off (STEPOVER asks for no cusp height)."""
-    from tmm_workbench.core.strategies.raster_drop import STEPOVER
-
     return params.cusp_check != "off" and params.stepover_mode != STEPOVER
 
 
 def cells(boundary: Any, cutter: Cutter, cusp: float, cell: Optional[float] = None) -> int:
     """The cells measured over `boundary` on `cell` mm cells (the verification's by default), before any is
     allocated."""
-    from tmm_workbench.core.footprint.variable_step import measure_cell
-    from tmm_workbench.core.sim.cusp_field import measure_grid_size
-
     nx, ny = measure_grid_size(boundary, cutter, cell or measure_cell(cutter, cusp))
     return nx * ny
 
 
 def check_cell(params: Any, cutter: Cutter) -> float:
-    """The check's cell: the verification's (variable_step.measure_cell); with CheckCusp Auto, on a region of more
+    """The check's cell: the verification's (measure.measure_cell); with CheckCusp Auto, on a region of more
     than AUTO_CELLS of them, one about sqrt(their count / AUTO_CELLS) times coarser, with at most AUTO_CELLS (the
     check's work then about that of a 30 x 30 mm region at the verification's cells, whatever the region's size:
     the cells, the path's cut into them and the dense raster's points all scale with their count)."""
-    from tmm_workbench.core.footprint.variable_step import measure_cell
-
     cell = measure_cell(cutter, params.cusp)
     if params.cusp_check == "on":
         return cell
