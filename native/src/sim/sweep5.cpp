@@ -127,9 +127,11 @@ double lowest_on_vertical(const TorusTool& tool, const Vector3d& tip, const Vect
   return solid_lowest(tool, l) + C.z();
 }
 
-SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, const double* axes_in,
-                    const MoveKind* kinds, std::size_t n, const Sweep5Options& options, const BatchOptions& batch,
-                    Sweep5Stats* stats_out) {
+namespace {
+
+// The options and the path (tips, axes normalised, kinds), refused by name when not usable.
+void read_path(const TorusTool& tool, const double* tips, const double* axes_in, const MoveKind* kinds,
+               std::size_t n, const Sweep5Options& options, std::vector<Vector3d>& tip, std::vector<Vector3d>& axis) {
   tool.validate();
   if (!(std::isfinite(options.max_step) && options.max_step > 0.0)) {
     std::ostringstream msg;
@@ -143,7 +145,8 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
   }
   if (n > 0 && (!tips || !axes_in)) throw std::invalid_argument("cut_5axis: tips and axes must not be null");
   if (n > 1 && !kinds) throw std::invalid_argument("cut_5axis: kinds must not be null for 2 or more points");
-  std::vector<Vector3d> tip(n), axis(n);
+  tip.assign(n, Vector3d::Zero());
+  axis.assign(n, Vector3d::Zero());
   for (std::size_t r = 0; r < n; ++r) {
     const double* t = tips + 3 * r;
     const double* a = axes_in + 3 * r;
@@ -169,8 +172,12 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
       throw std::invalid_argument(msg.str());
     }
   }
-  const std::size_t nx = stock.nx(), ny = stock.ny();
-  std::vector<double>& z = stock.heights();
+}
+
+// The stock's highest cell; every cell refused by name when out of range (the heights are writable from Python).
+double stock_top_of(const ZMap& stock) {
+  const std::size_t nx = stock.nx();
+  const std::vector<double>& z = stock.heights();
   double stock_top = -kInf;
   for (std::size_t c = 0; c < z.size(); ++c) {
     if (!in_range(z[c])) {
@@ -181,20 +188,13 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
     }
     stock_top = std::max(stock_top, z[c]);
   }
+  return stock_top;
+}
 
-  const double Ro = tool.Ro, Ri = tool.Ri, Rt = tool.radius();
-  const double reach = std::hypot(Rt, 2.0 * Ri);
-  const bool core = tool.shape == ToolShape::BullNose && Ro > 0.0;
-  const bool ball = Ro == 0.0;
-  // Squared radii and margins of the pruning tests: a line within the tangent tolerance counts as touching.
-  const double Rt2_hit = (Rt + kTangentTol + kPruneMargin) * (Rt + kTangentTol + kPruneMargin);
-  const double Ro2_hit = (Ro + kPruneMargin) * (Ro + kPruneMargin);
-  const double Ro2mRi2 = Ro * Ro - Ri * Ri;
-  const double g_margin = 2.0 * Ri * (kTangentTol + kPruneMargin) + 1e-12;
-
-  // The simulated moves, their sub-steps and the rows their instances reach.
+// The simulated moves and their sub-steps: no torus point moves more than max_step between instances.
+std::vector<Move> plan_moves(const std::vector<Vector3d>& tip, const std::vector<Vector3d>& axis,
+                             const MoveKind* kinds, std::size_t n, double reach, double max_step) {
   std::vector<Move> moves;
-  SimReport report;
   for (std::size_t k = 0; k + 1 < n; ++k) {
     if (kinds[k] == MoveKind::Jump) continue;
     Move m;
@@ -202,26 +202,42 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
     m.rapid = kinds[k] == MoveKind::Rapid;
     m.first = k == 0 || kinds[k - 1] == MoveKind::Jump;
     m.theta = std::acos(std::clamp(axis[k].dot(axis[k + 1]), -1.0, 1.0));
-    const double steps = std::ceil(((tip[k + 1] - tip[k]).norm() + m.theta * reach) / options.max_step - 1e-12);
+    const double steps = std::ceil(((tip[k + 1] - tip[k]).norm() + m.theta * reach) / max_step - 1e-12);
     if (!(steps <= kMaxSteps)) {
       std::ostringstream msg;
-      msg << "cut_5axis: move " << k << " needs " << steps << " sub-steps of max_step = " << options.max_step
+      msg << "cut_5axis: move " << k << " needs " << steps << " sub-steps of max_step = " << max_step
           << " mm (more than " << kMaxSteps << "): max_step is too small";
       throw std::invalid_argument(msg.str());
     }
     m.steps = std::max<std::size_t>(1, static_cast<std::size_t>(steps));
     moves.push_back(m);
   }
-  report.moves_cut = moves.size();
-  auto pose_at = [&](const Move& m, std::size_t step) {
+  return moves;
+}
+
+// The path's instances and the tool's per-cell tests: what every band shares (read only).
+class Stamper {
+ public:
+  Stamper(ZMap& stock, const TorusTool& tool, const std::vector<Vector3d>& tip, const std::vector<Vector3d>& axis,
+          double stock_top)
+      : stock_(stock), tool_(tool), tip_(tip), axis_(axis), stock_top_(stock_top), Ro_(tool.Ro), Ri_(tool.Ri),
+        Rt_(tool.radius()), core_(tool.shape == ToolShape::BullNose && Ro_ > 0.0), ball_(Ro_ == 0.0),
+        // Squared radii and margins of the pruning tests: a line within the tangent tolerance counts as
+        // touching.
+        Rt2_hit_((Rt_ + kTangentTol + kPruneMargin) * (Rt_ + kTangentTol + kPruneMargin)),
+        Ro2_hit_((Ro_ + kPruneMargin) * (Ro_ + kPruneMargin)), Ro2mRi2_(Ro_ * Ro_ - Ri_ * Ri_),
+        g_margin_(2.0 * Ri_ * (kTangentTol + kPruneMargin) + 1e-12) {}
+
+  // The instance at sub-step `step` of move m: tip linear, axis by slerp.
+  Pose pose_at(const Move& m, std::size_t step) const {
     const double s = static_cast<double>(step) / static_cast<double>(m.steps);
-    const Vector3d t = (1.0 - s) * tip[m.k] + s * tip[m.k + 1];
-    return make_pose(tool, t, slerp(axis[m.k], axis[m.k + 1], m.theta, s), stock_top);
-  };
-  {
-    // Progress: this pass is cheap next to the stamping (a pose per instance against a footprint's cells).
-    const BatchOptions rows{batch.threads, progress_phase(batch.progress, 0.0, 0.02)};
-    parallel_chunks(moves.size(), 64, rows, [&](std::size_t b, std::size_t e, ChunkContext& ctx) {
+    const Vector3d t = (1.0 - s) * tip_[m.k] + s * tip_[m.k + 1];
+    return make_pose(tool_, t, slerp(axis_[m.k], axis_[m.k + 1], m.theta, s), stock_top_);
+  }
+
+  // The rows each move's instances reach (progress: this pass is cheap next to the stamping).
+  void move_rows(std::vector<Move>& moves, const BatchOptions& batch) const {
+    parallel_chunks(moves.size(), 64, batch, [&](std::size_t b, std::size_t e, ChunkContext& ctx) {
       for (std::size_t i = b; i < e; ++i) {
         Move& m = moves[i];
         for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step) {
@@ -237,121 +253,145 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
     });
   }
 
-  // Bands of rows, each cutting every instance that reaches it, in path order.
-  const std::size_t nbands = (ny + kRowsPerBand - 1) / kRowsPerBand;
-  std::vector<BandResult> bands(nbands);
-  const double x0 = stock.x0(), y0 = stock.y0(), cell = stock.cell();
-  const BatchOptions cut{batch.threads, progress_phase(batch.progress, 0.02, 1.0)};
-  parallel_chunks(nbands, 1, cut, [&](std::size_t b0, std::size_t b1, ChunkContext& ctx) {
-    std::vector<std::pair<std::size_t, double>> removed;  // (cell, height before) lowered by the current rapid
-    for (std::size_t band = b0; band < b1; ++band) {
-      BandResult& out = bands[band];
-      const std::size_t j0 = band * kRowsPerBand, j1 = std::min(ny, j0 + kRowsPerBand) - 1;
-      const double band_ylo = stock.cy(j0), band_yhi = stock.cy(j1);
-      const std::vector<double> before(z.begin() + static_cast<std::ptrdiff_t>(j0 * nx),
-                                       z.begin() + static_cast<std::ptrdiff_t>((j1 + 1) * nx));
-      // Progress and cancel between the instances of a move, not only between moves: one move can be long.
-      double band_steps = 0.0, steps_done = 0.0;
-      for (const Move& m : moves) band_steps += m.yhi < band_ylo || m.ylo > band_yhi ? 0.0 : m.steps + 1.0;
-      for (const Move& m : moves) {
-        if (m.yhi < band_ylo || m.ylo > band_yhi) continue;
-        removed.clear();
-        for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step, ++steps_done) {
-          if (ctx.stopping()) return;
-          ctx.done_within(static_cast<double>(band - b0) + steps_done / band_steps);
-          const Pose p = pose_at(m, step);
-          if (p.yhi < band_ylo || p.ylo > band_yhi) continue;
-          ++out.stats.instances;
-          const double ax = p.a.x(), ay = p.a.y(), az = p.a.z();
-          const double cx = p.C.x(), cy = p.C.y(), cz = p.C.z();
-          const double sb2 = p.sin_b * p.sin_b;
-          const double jlo = std::max(static_cast<double>(j0), std::ceil((p.ylo - y0) / cell - 0.5));
-          const double jhi = std::min(static_cast<double>(j1), std::floor((p.yhi - y0) / cell - 0.5));
-          for (double jd = jlo; jd <= jhi; ++jd) {
-            const auto j = static_cast<std::size_t>(jd);
-            const double y = stock.cy(j), qy = y - cy;
-            const auto [xlo, xhi] = stadium_row(p, Rt, y);
-            if (!(xlo <= xhi)) continue;
-            const double ilo = std::max(0.0, std::ceil((xlo - x0) / cell - 0.5));
-            const double ihi = std::min(static_cast<double>(nx) - 1.0, std::floor((xhi - x0) / cell - 0.5));
-            if (ilo > ihi) continue;
-            double* row = z.data() + j * nx;
-            const auto i0 = static_cast<std::size_t>(ilo), i1 = static_cast<std::size_t>(ihi);
-            out.stats.cells_tested += i1 - i0 + 1;
-            for (std::size_t i = i0; i <= i1; ++i) {
-              const double zc = row[i];
-              if (zc <= p.zmin) continue;  // already below everything of this instance
-              const double qx = stock.cx(i) - cx, dz = zc - cz;
-              const double qa = qx * ax + qy * ay;
-              const double hp = qa + dz * az;  // the cell top's height above the centre plane
-              if (hp < -Ri - kPruneMargin) continue;  // the solid has h >= -Ri, and h falls down the line
-              // Going down the line from the cell top by s, h = h_p - a_z s and rho^2(s) = rho_p^2 - 2 m s +
-              // sin^2(b) s^2 (m = r_p . e_perp = dz - a_z h_p): rho is convex in s. Each part is tested on the
-              // stretch of the line where it can be (the torus: |h| <= Ri inside the ball |x - C| <= Ro + Ri).
-              const double qq = qx * qx + qy * qy;
-              const double dd = qq + dz * dz;  // |p - C|^2
-              const double rho2 = dd - hp * hp, mm = dz - az * hp;
-              auto rho2_at = [&](double sv) { return std::max(rho2 - 2.0 * mm * sv + sb2 * sv * sv, 0.0); };
-              auto rho2_min = [&](double lo, double hi) {  // min of rho^2 over s in [lo, hi]
-                return rho2_at(sb2 > 0.0 ? std::clamp(mm / sb2, lo, hi) : lo);
-              };
-              // The shank {rho <= Rt, h >= 0} and the flat core {rho <= Ro, h >= -Ri}: exact tests.
-              const bool shank = hp >= 0.0 && rho2_min(0.0, hp / az) <= Rt2_hit;
-              const bool flat = core && rho2_min(0.0, (hp + Ri) / az) <= Ro2_hit;
-              // The quartic decides most lines at the price of one evaluation; the bounds decide the rest.
-              const Line l{qa, qq, az};
-              const Quartic quartic = ball ? Quartic{} : torus_quartic(l, Ro, Ri);
-              const Verdict verdict = ball ? Verdict::Unknown : torus_below(quartic, dz);
-              bool torus = verdict == Verdict::Yes;
-              if (verdict == Verdict::Unknown && qq <= Rt2_hit) {
-                const double w = std::sqrt(Rt2_hit - qq);
-                const double lo = std::max({0.0, (hp - Ri) / az, dz - w}), hi = std::min((hp + Ri) / az, dz + w);
-                // Inside the torus: |x - C|^2 + Ro^2 - Ri^2 <= 2 Ro rho, and rho lies under its chord on each
-                // half of [lo, hi]: the quadratic G(s) = |x - C|^2 + Ro^2 - Ri^2 - 2 Ro chord(s) <= 0 somewhere.
-                if (lo <= hi) {
-                  const double mid = 0.5 * (lo + hi);
-                  const double r_lo = std::sqrt(rho2_at(lo)), r_mid = std::sqrt(rho2_at(mid));
-                  const double r_hi = std::sqrt(rho2_at(hi));
-                  auto may_enter = [&](double u, double v, double ru, double rv) {
-                    const double k = v - u > 1e-12 ? (rv - ru) / (v - u) : 0.0;
-                    const double sv = std::clamp(dz + Ro * k, u, v);
-                    const double G = sv * sv - 2.0 * (dz + Ro * k) * sv + dd + Ro2mRi2 - 2.0 * Ro * (ru - k * u);
-                    return G <= g_margin;
-                  };
-                  torus = may_enter(lo, mid, r_lo, r_mid) || may_enter(mid, hi, r_mid, r_hi);
-                }
-              }
-              if (!(torus || shank || flat)) continue;
-              double t = kInf;
-              if (torus) {
-                ++out.stats.exact_solves;
-                std::size_t* fallback = &out.stats.fallback_solves;
-                t = ball ? torus_lowest(l, Ro, Ri, fallback) : torus_lowest(quartic, l, Ro, Ri, fallback, dz);
-              }
-              if (shank) t = std::min(t, half_cylinder_lowest(l, Rt, 0.0));
-              if (flat) t = std::min(t, half_cylinder_lowest(l, Ro, -Ri));
-              const double zl = t + cz;
-              if (zl < zc) {
-                ++out.stats.lowerings;
-                if (m.rapid) removed.emplace_back(j * nx + i, zc);
-                row[i] = zl;
-              }
-            }
-          }
-        }
-        if (m.rapid && !removed.empty()) {
-          double depth = 0.0;
-          for (const auto& [c, zb] : removed) depth = std::max(depth, zb - z[c]);
-          out.removals.push_back({m.k, depth});
+  // Band `band` (rows j0..j1): every instance that reaches it, in path order. Progress and cancel between the
+  // instances of a move, not only between moves: one move can be long. False when the batch stopped it.
+  bool cut_band(const std::vector<Move>& moves, std::size_t band, double done_before, ChunkContext& ctx,
+                std::vector<std::pair<std::size_t, double>>& removed, BandResult& out) {
+    const std::size_t nx = stock_.nx(), ny = stock_.ny();
+    std::vector<double>& z = stock_.heights();
+    const std::size_t j0 = band * kRowsPerBand, j1 = std::min(ny, j0 + kRowsPerBand) - 1;
+    const double band_ylo = stock_.cy(j0), band_yhi = stock_.cy(j1);
+    const std::vector<double> before(z.begin() + static_cast<std::ptrdiff_t>(j0 * nx),
+                                     z.begin() + static_cast<std::ptrdiff_t>((j1 + 1) * nx));
+    double band_steps = 0.0, steps_done = 0.0;
+    for (const Move& m : moves) band_steps += m.yhi < band_ylo || m.ylo > band_yhi ? 0.0 : m.steps + 1.0;
+    for (const Move& m : moves) {
+      if (m.yhi < band_ylo || m.ylo > band_yhi) continue;
+      removed.clear();  // (cell, height before) lowered by this move when it is a rapid
+      for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step, ++steps_done) {
+        if (ctx.stopping()) return false;
+        ctx.done_within(done_before + steps_done / band_steps);
+        const Pose p = pose_at(m, step);
+        if (p.yhi < band_ylo || p.ylo > band_yhi) continue;
+        ++out.stats.instances;
+        stamp(p, j0, j1, m.rapid, removed, out.stats);
+      }
+      if (m.rapid && !removed.empty()) {
+        double depth = 0.0;
+        for (const auto& [c, zb] : removed) depth = std::max(depth, zb - z[c]);
+        out.removals.push_back({m.k, depth});
+      }
+    }
+    for (std::size_t c = 0; c < before.size(); ++c) out.lowered += z[j0 * nx + c] < before[c];
+    return true;
+  }
+
+ private:
+  // One instance on rows j0..j1: each cell of its footprint lowered to the tool's lowest point on its line.
+  void stamp(const Pose& p, std::size_t j0, std::size_t j1, bool rapid,
+             std::vector<std::pair<std::size_t, double>>& removed, Sweep5Stats& stats) {
+    const std::size_t nx = stock_.nx();
+    double* z = stock_.heights().data();
+    const double x0 = stock_.x0(), y0 = stock_.y0(), cell = stock_.cell();
+    const double cx = p.C.x(), cy = p.C.y(), cz = p.C.z();
+    const double jlo = std::max(static_cast<double>(j0), std::ceil((p.ylo - y0) / cell - 0.5));
+    const double jhi = std::min(static_cast<double>(j1), std::floor((p.yhi - y0) / cell - 0.5));
+    for (double jd = jlo; jd <= jhi; ++jd) {
+      const auto j = static_cast<std::size_t>(jd);
+      const double y = stock_.cy(j), qy = y - cy;
+      const auto [xlo, xhi] = stadium_row(p, Rt_, y);
+      if (!(xlo <= xhi)) continue;
+      const double ilo = std::max(0.0, std::ceil((xlo - x0) / cell - 0.5));
+      const double ihi = std::min(static_cast<double>(nx) - 1.0, std::floor((xhi - x0) / cell - 0.5));
+      if (ilo > ihi) continue;
+      double* row = z + j * nx;
+      const auto i0 = static_cast<std::size_t>(ilo), i1 = static_cast<std::size_t>(ihi);
+      stats.cells_tested += i1 - i0 + 1;
+      for (std::size_t i = i0; i <= i1; ++i) {
+        const double zc = row[i];
+        if (zc <= p.zmin) continue;  // already below everything of this instance
+        const double zl = lowest_below(p, stock_.cx(i) - cx, qy, zc - cz, stats) + cz;
+        if (zl < zc) {
+          ++stats.lowerings;
+          if (rapid) removed.emplace_back(j * nx + i, zc);
+          row[i] = zl;
         }
       }
-      for (std::size_t c = 0; c < before.size(); ++c) out.lowered += z[j0 * nx + c] < before[c];
     }
-  });
+  }
 
-  // Merge the bands: deepest removal per rapid over all bands (max: independent of the order).
+  // The lowest point (above the centre C) of the instance's solid on the vertical line at (qx, qy) from C,
+  // whose cell top lies dz above C; inf when the line misses every part below the top.
+  double lowest_below(const Pose& p, double qx, double qy, double dz, Sweep5Stats& stats) const {
+    const double ax = p.a.x(), ay = p.a.y(), az = p.a.z();
+    const double sb2 = p.sin_b * p.sin_b;
+    const double Ro = Ro_, Ri = Ri_;
+    const double qa = qx * ax + qy * ay;
+    const double hp = qa + dz * az;  // the cell top's height above the centre plane
+    if (hp < -Ri - kPruneMargin) return kInf;  // the solid has h >= -Ri, and h falls down the line
+    // Going down the line from the cell top by s, h = h_p - a_z s and rho^2(s) = rho_p^2 - 2 m s +
+    // sin^2(b) s^2 (m = r_p . e_perp = dz - a_z h_p): rho is convex in s. Each part is tested on the
+    // stretch of the line where it can be (the torus: |h| <= Ri inside the ball |x - C| <= Ro + Ri).
+    const double qq = qx * qx + qy * qy;
+    const double dd = qq + dz * dz;  // |p - C|^2
+    const double rho2 = dd - hp * hp, mm = dz - az * hp;
+    auto rho2_at = [&](double sv) { return std::max(rho2 - 2.0 * mm * sv + sb2 * sv * sv, 0.0); };
+    auto rho2_min = [&](double lo, double hi) {  // min of rho^2 over s in [lo, hi]
+      return rho2_at(sb2 > 0.0 ? std::clamp(mm / sb2, lo, hi) : lo);
+    };
+    // The shank {rho <= Rt, h >= 0} and the flat core {rho <= Ro, h >= -Ri}: exact tests.
+    const bool shank = hp >= 0.0 && rho2_min(0.0, hp / az) <= Rt2_hit_;
+    const bool flat = core_ && rho2_min(0.0, (hp + Ri) / az) <= Ro2_hit_;
+    // The quartic decides most lines at the price of one evaluation; the bounds decide the rest.
+    const Line l{qa, qq, az};
+    const Quartic quartic = ball_ ? Quartic{} : torus_quartic(l, Ro, Ri);
+    const Verdict verdict = ball_ ? Verdict::Unknown : torus_below(quartic, dz);
+    bool torus = verdict == Verdict::Yes;
+    if (verdict == Verdict::Unknown && qq <= Rt2_hit_) {
+      const double w = std::sqrt(Rt2_hit_ - qq);
+      const double lo = std::max({0.0, (hp - Ri) / az, dz - w}), hi = std::min((hp + Ri) / az, dz + w);
+      // Inside the torus: |x - C|^2 + Ro^2 - Ri^2 <= 2 Ro rho, and rho lies under its chord on each
+      // half of [lo, hi]: the quadratic G(s) = |x - C|^2 + Ro^2 - Ri^2 - 2 Ro chord(s) <= 0 somewhere.
+      if (lo <= hi) {
+        const double mid = 0.5 * (lo + hi);
+        const double r_lo = std::sqrt(rho2_at(lo)), r_mid = std::sqrt(rho2_at(mid));
+        const double r_hi = std::sqrt(rho2_at(hi));
+        auto may_enter = [&](double u, double v, double ru, double rv) {
+          const double k = v - u > 1e-12 ? (rv - ru) / (v - u) : 0.0;
+          const double sv = std::clamp(dz + Ro * k, u, v);
+          const double G = sv * sv - 2.0 * (dz + Ro * k) * sv + dd + Ro2mRi2_ - 2.0 * Ro * (ru - k * u);
+          return G <= g_margin_;
+        };
+        torus = may_enter(lo, mid, r_lo, r_mid) || may_enter(mid, hi, r_mid, r_hi);
+      }
+    }
+    if (!(torus || shank || flat)) return kInf;
+    double t = kInf;
+    if (torus) {
+      ++stats.exact_solves;
+      std::size_t* fallback = &stats.fallback_solves;
+      t = ball_ ? torus_lowest(l, Ro, Ri, fallback) : torus_lowest(quartic, l, Ro, Ri, fallback, dz);
+    }
+    if (shank) t = std::min(t, half_cylinder_lowest(l, Rt_, 0.0));
+    if (flat) t = std::min(t, half_cylinder_lowest(l, Ro, -Ri));
+    return t;
+  }
+
+  ZMap& stock_;
+  const TorusTool& tool_;
+  const std::vector<Vector3d>& tip_;
+  const std::vector<Vector3d>& axis_;
+  const double stock_top_;
+  const double Ro_, Ri_, Rt_;
+  const bool core_, ball_;
+  const double Rt2_hit_, Ro2_hit_, Ro2mRi2_, g_margin_;
+};
+
+// Merges the bands: cells lowered and counters summed, the deepest removal per rapid over all bands (max:
+// independent of the order) reported when deeper than the tolerance.
+void merge_bands(const std::vector<BandResult>& bands, const std::vector<Move>& moves, double collision_tol,
+                 SimReport& report, Sweep5Stats& stats) {
   std::vector<RapidCollision> all;
-  Sweep5Stats stats;
   for (const BandResult& b : bands) {
     report.cells_lowered += b.lowered;
     all.insert(all.end(), b.removals.begin(), b.removals.end());
@@ -365,9 +405,39 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
   });
   for (const RapidCollision& c : all) {
     if (!report.collisions.empty() && report.collisions.back().move == c.move) continue;  // the deepest came first
-    if (c.depth > options.collision_tol) report.collisions.push_back(c);
+    if (c.depth > collision_tol) report.collisions.push_back(c);
   }
   for (const Move& m : moves) stats.instances += m.steps + (m.first ? 1 : 0);
+}
+
+}  // namespace
+
+SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, const double* axes_in,
+                    const MoveKind* kinds, std::size_t n, const Sweep5Options& options, const BatchOptions& batch,
+                    Sweep5Stats* stats_out) {
+  std::vector<Vector3d> tip, axis;
+  read_path(tool, tips, axes_in, kinds, n, options, tip, axis);
+  const double stock_top = stock_top_of(stock);
+  const double reach = std::hypot(tool.radius(), 2.0 * tool.Ri);
+  std::vector<Move> moves = plan_moves(tip, axis, kinds, n, reach, options.max_step);
+  SimReport report;
+  report.moves_cut = moves.size();
+  Stamper stamper(stock, tool, tip, axis, stock_top);
+  stamper.move_rows(moves, BatchOptions{batch.threads, progress_phase(batch.progress, 0.0, 0.02)});
+
+  // Bands of rows, each cutting every instance that reaches it, in path order; the bands in parallel (the
+  // heights do not depend on the thread count).
+  const std::size_t nbands = (stock.ny() + kRowsPerBand - 1) / kRowsPerBand;
+  std::vector<BandResult> bands(nbands);
+  const BatchOptions cut{batch.threads, progress_phase(batch.progress, 0.02, 1.0)};
+  parallel_chunks(nbands, 1, cut, [&](std::size_t b0, std::size_t b1, ChunkContext& ctx) {
+    std::vector<std::pair<std::size_t, double>> removed;
+    for (std::size_t band = b0; band < b1; ++band)
+      if (!stamper.cut_band(moves, band, static_cast<double>(band - b0), ctx, removed, bands[band])) return;
+  });
+
+  Sweep5Stats stats;
+  merge_bands(bands, moves, options.collision_tol, report, stats);
   if (stats_out) *stats_out = stats;
   return report;
 }
