@@ -15,7 +15,7 @@ from tmm_workbench.core.errors import TmmError
 POST_DIR = str(Path(__file__).resolve().parent / "posts")
 # 4 decimals of mm for the stock posts: at their default 3, the rounding alone puts 3-axis surface finishing
 # up to 0.024 mm into steep CL profiles (tests/core/test_linear_moves.py)
-DEFAULT_ARGS = {"linuxcnc": "--no-show-editor --precision 4", "grbl": "--no-show-editor --precision 4"}
+DEFAULT_ARGS = {name: "--no-show-editor --precision 4" for name in ("linuxcnc", "grbl", "tmm_linuxcnc", "tmm_grbl")}
 
 
 def install_post_dir() -> None:
