@@ -63,7 +63,7 @@ def main() -> None:
     for name in names:
         count, estimated, measured = run_case(name)
         told = "yes" if measured <= 30 or estimated > 30 else "NO"
-        print(f"{name:<15} {count:>10.3g} {estimated:>12.1f} {measured:>11.1f} {measured / max(estimated, 1e-9):>6.2f}"
+        print(f"\n{name:<15} {count:>10.3g} {estimated:>12.1f} {measured:>11.1f} {measured / max(estimated, 1e-9):>6.2f}"
               f"  {told}", flush=True)
         for doc in list(FreeCAD.listDocuments()):
             FreeCAD.closeDocument(doc)

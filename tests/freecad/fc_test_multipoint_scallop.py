@@ -101,6 +101,14 @@ class ScallopOp(FreeCADTestCase):
         self.assertEqual(op_multipoint.tool_shape(op.ToolShape, op.ToolController.Tool), "bull_nose")
         self.assertTrue(op.isValid(), op.getStatusString())
         self.assertIn("largest scallop", op.ContactSummary)
+        # the simulation and the panel's checks read the tool as the op computes it
+        self.assertEqual(op.Proxy.params_from(op).shape, "bull_nose")
+        from tmm_workbench.app.api import simulate
+        from tmm_workbench.app.work_estimate import estimate
+
+        self.assertIsNotNone(estimate(op))
+        sim = simulate(op, cell=2.0, progress=False)
+        self.assertTrue(sim.simulation.result.five_axis)
 
     def test_fixed_step_wider_than_the_tool_is_warned(self) -> None:
         r = run_multipoint(seed_net(), Ro=2.0, Ri=1.0, side_step=18.0, pass_spacing="fixed", doc_name="MpWide",

@@ -58,7 +58,7 @@ class Offset3D(FreeCADTestCase):
         close_all()
 
     def test_run_surface(self) -> None:
-        r = run_surface(bump_stl(), stepover=2.0, sample_step=0.5, stepover_mode="offset3d", cusp=0.02,
+        r = run_surface(bump_stl(), sample_step=0.5, stepover_mode="offset3d", cusp=0.02,
                         progress=False, doc_name="TmmApiOffset3D")
         self.assertEqual(r.op.StepOverMode, "Offset3D")
         pts = r.toolpath.cutting_points()

@@ -75,7 +75,7 @@ class Posts(FreeCADTestCase):
         try:
             self.assertIn("tmmselftest", PathPreferences.allAvailablePostProcessors())
             doc = new_doc()
-            job, tc, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 5.0})
+            job, tc, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 4.0})
             self.assertIn("tmmselftest", job.getEnumerationsOfProperty("PostProcessor"))
             text = posts.export("tmmselftest", [tc, op])
             self.assertEqual(text.count("\n"), len([c for c in op.Path.Commands if c.Name in ("G0", "G1")]))
@@ -108,7 +108,7 @@ class Posts(FreeCADTestCase):
 
     def test_unknown_post(self) -> None:
         doc = new_doc()
-        _, tc, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 5.0})
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"StepOver": 4.0})
         with self.assertRaises(TmmError) as ctx:
             posts.export("no_such_machine", [tc, op])
         self.assertIn("no_such_machine", str(ctx.exception))
@@ -189,7 +189,7 @@ class Api(FreeCADTestCase):
         self.assertEqual(set(FreeCAD.listDocuments()), docs)  # the call's own document is closed again
 
     def test_cusp_spacing(self) -> None:
-        r = run_surface(bump_stl(), stepover=2.0, sample_step=1.0, stepover_mode="adaptive", cusp=0.02,
+        r = run_surface(bump_stl(), sample_step=1.0, stepover_mode="adaptive", cusp=0.02,
                         progress=False, doc_name="TmmApiCusp")
         self.assertEqual((r.op.StepOverMode, round(r.op.CuspHeight.Value, 9)), ("Adaptive", 0.02))
         ys = sorted({round(float(y), 6) for y in r.toolpath.cutting_points()[:, 1]})
@@ -206,11 +206,32 @@ class Api(FreeCADTestCase):
                              ({"stepover": 0.0}, "must be a positive length"),
                              ({"stepover_mode": "scallop"},
                               "stepover_mode must be one of stepover, cusp, adaptive, offset3d, got 'scallop'"),
-                             ({"cusp": -1.0}, "cusp must be >= 0.0001 mm, got -1")):
+                             ({"cusp": -1.0}, "cusp must be >= 0.0001 mm, got -1"),
+                             # an argument the chosen mode would ignore, and a step-over no tool covers
+                             ({"cusp": 0.01}, "cusp 0.01 is not used with stepover_mode 'stepover'"),
+                             ({"stepover": 0.5, "stepover_mode": "cusp"},
+                              "stepover is not used with stepover_mode 'cusp'"),
+                             ({"spiral_direction": "inward"}, "spiral_direction is used with pattern 'spiral' only"),
+                             ({"arcs": True, "forward_step": "sample"}, "arcs need forward_step 'tolerance'"),
+                             ({"stepover": 0.5, "stepover_percent": 10.0}, "not both"),
+                             ({"stepover": 500.0}, "StepOver 500 mm is wider than the tool (diameter 6 mm)")):
             with self.subTest(**kwargs):
                 with self.assertRaises(TmmError) as ctx:
                     run_surface(bump_stl(), progress=False, **kwargs)
                 self.assertIn(text, str(ctx.exception))
+
+    def test_a_flat_end_mill_in_a_cusp_mode_is_warned(self) -> None:
+        from tmm_workbench.app.op_surface import check_tool_fit
+        from tmm_workbench.core.strategies.raster_drop import SurfaceParams
+        from tmm_workbench.core.tools.cutter import Cutter
+
+        params = SurfaceParams(stepover_mode="cusp", cusp=0.01)
+        self.assertIn("a ball or bull-nose end mill", check_tool_fit(params, Cutter.flat(6.0)))
+        self.assertEqual(check_tool_fit(params, Cutter.ball(6.0)), "")
+        self.assertEqual(check_tool_fit(SurfaceParams(stepover=6.0), Cutter.flat(6.0)), "")
+        # a cusp with the verification is read in the step-over mode too
+        r = run_surface(bump_stl(), cusp=0.05, verify_cusp=True, progress=False, doc_name="TmmVerifyStep")
+        self.assertAlmostEqual(r.op.CuspHeight.Value, 0.05)
 
 
 if __name__ == "__main__":

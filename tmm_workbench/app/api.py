@@ -35,6 +35,7 @@ from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOOL_ALIASES = tools.SHAPE_ALIASES
+DEFAULT_STEPOVER = 1.0  # mm, stepover_mode 'stepover' without a step-over given
 _LENGTH = Spec("", "mm")
 _POSITIVE = Spec("", "mm", low=0, low_open=True, kind="length")
 _NON_NEGATIVE = Spec("", "mm", low=0, kind="length")
@@ -50,13 +51,14 @@ STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region
 
 @plain_numbers
 def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter] = "ballend",
-                diameter: float = 6.0, corner_radius: float = 0.0, stepover: float = 1.0, sample_step: float = 0.5,
+                diameter: float = 6.0, corner_radius: float = 0.0, stepover: Optional[float] = None,
+                sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
                 boundary: str = "model", margin: float = 0.0, off_model: str = "floor",
                 chord_tolerance: Optional[float] = None, stepover_mode: str = "stepover",
                 cusp: Optional[float] = None,
                 region: Any = None, slope_range: Optional[tuple[float, float]] = None,
-                spiral_direction: str = "outward", region_tolerance: Optional[float] = None,
+                spiral_direction: Optional[str] = None, region_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                 forward_step: str = "tolerance", arcs: bool = False,
@@ -78,7 +80,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     (lift over such places, cut only over the model).
     chord_tolerance: how far above the CL points a longer straight move may pass where it replaces them
     (mm; default the op's, 0.001; 0 keeps every point off a straight line).
-    stepover_mode: 'stepover' (passes `stepover` apart) | 'cusp' (the step-over that keeps the cusp height
+    An argument the chosen mode would ignore is refused by name (stepover with a cusp mode, cusp without one or
+    verify_cusp, spiral_direction without pattern 'spiral', arcs with forward_step 'sample').
+    stepover_mode: 'stepover' (passes `stepover` apart, default 1 mm) | 'cusp' (the step-over that keeps the cusp height
     `cusp` on the boundary's worst crossing, slope and curvature) | 'adaptive' (each pass placed from the previous one's tool
     positions so the cusp between them is `cusp`); cusp: mm, default the op's (0.01).
     stepover_mode 'offset3d': closed loops from the region's boundary inward, spaced so the cusp between
@@ -118,13 +122,18 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
              safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
              horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
     extra: dict[str, Any] = {"StepOverMode": option("stepover_mode", stepover_mode, STEPOVER_MODE_NAMES)}
+    _refuse_ignored(stepover_mode, stepover, stepover_percent, cusp, verify_cusp, pattern, spiral_direction,
+                    forward_step, arcs)
+    if stepover is None and str(stepover_mode).lower() == "stepover" and stepover_percent is None:
+        stepover = DEFAULT_STEPOVER
     if chord_tolerance is not None:
         extra["ChordTolerance"] = chord_tolerance
     if cusp is not None:
         extra["CuspHeight"] = cusp
     from tmm_workbench.app import region_source
 
-    extra.update(region_source.api_values(region, model, spiral_direction, slope_range, region_tolerance))
+    extra.update(region_source.api_values(region, model, spiral_direction or "outward", slope_range,
+                                          region_tolerance))
     if offset_from is not None:  # the 3D offset from a chosen curve (issue 14 item 1; app.offset_start)
         from tmm_workbench.app import offset_start
 
@@ -140,14 +149,35 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     if not isinstance(verify_cusp, bool):
         raise TmmError(f"verify_cusp must be True or False, got {verify_cusp!r}")
     extra["VerifyCusp"] = verify_cusp
-    values = {"StepOver": stepover, "SampleStep": sample_step, "RasterAngle": angle_deg,
+    values = {"SampleStep": sample_step, "RasterAngle": angle_deg,
               "Pattern": option("pattern", pattern, PATTERN_NAMES), "StockToLeave": stock_to_leave,
               "BoundaryShape": option("boundary", boundary, BOUNDARY_NAMES), "BoundaryMargin": margin,
               "OffModel": option("off_model", off_model, OFF_MODEL_NAMES), **extra}
+    if stepover is not None:
+        values["StepOver"] = stepover
     return run("TMM_Surface", model, tool=tool, diameter=diameter, corner_radius=corner_radius,
                safe_height=safe_height, clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
                doc_name=doc_name, progress=progress, **values)
+
+
+def _refuse_ignored(stepover_mode: Any, stepover: Any, stepover_percent: Any, cusp: Any, verify_cusp: Any,
+                    pattern: Any, spiral_direction: Any, forward_step: Any, arcs: Any) -> None:
+    """An argument the chosen mode would ignore is refused by name, not dropped."""
+    mode = str(stepover_mode).lower()
+    if mode != "stepover" and (stepover is not None or stepover_percent is not None):
+        name = "stepover" if stepover is not None else "stepover_percent"
+        raise TmmError(f"{name} is not used with stepover_mode {stepover_mode!r}: the spacing comes from the cusp "
+                       "height (cusp); leave it out, or use stepover_mode 'stepover'")
+    if stepover is not None and stepover_percent is not None:
+        raise TmmError("give stepover (mm) or stepover_percent (of the tool diameter), not both")
+    if mode == "stepover" and cusp is not None and verify_cusp is not True:
+        raise TmmError(f"cusp {cusp!r} is not used with stepover_mode 'stepover' (passes `stepover` apart): give "
+                       "stepover_mode 'cusp', 'adaptive' or 'offset3d' to space the passes by it, or verify_cusp=True")
+    if spiral_direction is not None and str(pattern).lower() != "spiral":
+        raise TmmError(f"spiral_direction is used with pattern 'spiral' only, got pattern {pattern!r}")
+    if arcs is True and str(forward_step).lower() == "sample":
+        raise TmmError("arcs need forward_step 'tolerance' (arcs are fitted to the exact tool path), got 'sample'")
 
 
 # --- z-level roughing and waterline ----------------------------------------------------------------

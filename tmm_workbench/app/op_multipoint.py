@@ -248,12 +248,18 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     def clear_results(self) -> None:
         self.toolpath = self.segments = self.results = self.face = self.radii = self.placement = None
 
+    def params_from(self, obj: Any, **extra: Any) -> Any:
+        """As every op's, with the tool solid the op computes with (FromToolBit read as the ToolBit's solid): the
+        simulation and the panel's checks read the same."""
+        extra.setdefault("shape", tool_shape(obj.ToolShape, None))
+        return super().params_from(obj, **extra)
+
     def compute(self, obj: Any) -> None:
         base, sub = self.base_face(obj)
         surf = face_surface(base, sub)
         face = geometry.bezier_face(surf, name=f"{base.Label}.{sub}")
         cutter = self.cutter()
-        params = self.params_from(obj, shape=tool_shape(obj.ToolShape, self.tool))
+        params = self.params_from(obj)
         safe, clearance = obj.SafeHeight.Value, obj.ClearanceHeight.Value
         top = face_top(face)
         if safe <= top:

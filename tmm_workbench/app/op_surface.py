@@ -29,7 +29,8 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.strategies import finish_passes
 from tmm_workbench.core.strategies.raster_drop import (INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY,
-                                                       OUTWARD, SAMPLED, SPIRAL, TOLERANCE, ZIGZAG, SurfaceParams)
+                                                       OUTWARD, SAMPLED, SPIRAL, STEPOVER, TOLERANCE, ZIGZAG,
+                                                       SurfaceParams)
 
 OP_NAME = "TMM_Surface"
 PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL}
@@ -100,8 +101,8 @@ DEFAULTS.update({"Region": region_source.BOX, "RegionTolerance": 0.01})
 # restore with SampleStep (RESTORED_DEFAULTS)
 DEFAULTS["ForwardStep"] = "Tolerance"
 # FreeCAD posts whose parameter list has no K: an arc in XZ or YZ would lose its centre's Z (0.20-1.1)
-POSTS_WITHOUT_K = ("linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf", "fablin", "jtech",
-                   "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
+POSTS_WITHOUT_K = ("linuxcnc", "tmm_linuxcnc", "mach3_mach4", "fanuc", "KineticNCBeamicon2", "comparams", "dxf",
+                   "fablin", "jtech", "nccad", "opensbp", "rml", "estlcam", "fangling", "generic", "wedm")
 # % step-over, Depths (final depth, finishing passes) and start point: app.surface_passes
 PROPERTIES += surface_passes.PROPERTIES
 CHOICES.update(surface_passes.CHOICES)
@@ -140,6 +141,9 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                                   forward_step=FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""), SAMPLED),
                                   **surface_passes.params_extra(obj, cutter))
         params.offset_from = offset_start.curves_of(obj, params.stepover_mode == OFFSET3D)
+        flat_cusp = check_tool_fit(params, cutter)
+        if flat_cusp:
+            FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")
         if params.arcs and self.post_without_k(obj):
             params.arcs = False
             FreeCAD.Console.PrintWarning(
@@ -179,6 +183,20 @@ def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
 
 # Lets the Job's SetupSheet hold defaults for this op, headless too (the GUI's SetupOperation repeats it).
 PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)
+
+
+def check_tool_fit(params: SurfaceParams, cutter: Any) -> str:
+    """A step-over wider than the tool leaves strips no pass touches: refused by name. A cusp spacing with a flat
+    end mill (its cusps come from the bottom's edge on every slope, so the passes crowd): the warning to show."""
+    if params.stepover_mode == STEPOVER and params.stepover > cutter.diameter:
+        raise TmmError(f"StepOver {params.stepover:g} mm is wider than the tool (diameter {cutter.diameter:g} mm): "
+                       f"strips between the passes would stay uncut; set it to at most {cutter.diameter:g} mm")
+    if params.stepover_mode != STEPOVER and cutter.corner_radius <= 0:
+        return (f"{params.stepover_mode} spacing with a flat end mill: its cusps come from the edge of its flat "
+                "bottom on every slope, so the passes fall very close together (many more than with a rounded "
+                f"tool); a ball or bull-nose end mill of the same diameter holds CuspHeight {params.cusp:g} mm "
+                "with far fewer passes")
+    return ""
 
 
 def check_final_depth(obj: Any, final_depth: Optional[float]) -> None:

@@ -37,7 +37,7 @@ EXTRA_SPECS: dict[str, Spec] = {
 }
 # compute seconds per counted unit on this project's reference machine (2 cores, loaded by other work: the upper
 # of the runs that benchmarks/compute_estimate.py measured; a machine to itself computes up to ~2x faster)
-PACE = {"surface": 2e-5, "adaptive": 7e-5, "surface_flat_cusp": 4e-5, "offset3d": 5e-4, "verify": 3e-6,
+PACE = {"surface": 2e-5, "adaptive": 7e-5, "surface_flat_cusp": 4e-5, "offset3d": 5e-4, "verify": 4e-6,
         "waterline": 2e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025}
 PACE_TOOL_MM = 6.0      # the surface paces are a 6 mm tool's; a larger one covers more triangles per drop
 TELL_COMPUTE_S = 5.0    # the panel's estimate names the compute time from here
