@@ -6,7 +6,9 @@ positions by multipoint_meter's ScallopMeter, is at most `MultipointParams.scall
 
 The search per pass brackets the step (the scallop grows about with the square of the step, so the next trial
 interpolates in sqrt(scallop)), keeps the largest step found within the tolerance and stops when the scallop is
-within SCALLOP_REL of it or the bracket is narrower than STEP_TOL. Rows where one of the two passes has no
+within SCALLOP_REL of it or the bracket is narrower than STEP_TOL. The step found is then searched again
+down to one that also holds the rows near the passes' ends (ScallopMeter.end_rows, where the cusp rises past
+the last position) if a smaller step can (_Placer._hold_ends). Rows where one of the two passes has no
 good position near them (failed positions, the ends of the passes) are not measured and are counted. All the
 trial passes of the placement stay within the work estimate's: MAX_TRIALS per pass of its pass limit.
 
@@ -40,6 +42,8 @@ SCALLOP_REL = 0.02      # a pass is accepted once its scallop is within 2 % belo
 STEP_TOL = 0.005        # mm: or once the bracket on the step is this narrow
 MAX_TRIALS = 14         # trial passes per pass of the pass limit, on average (one search: at most this many)
 FILL_TRIES = 4          # offsets tried for each pass added where the scallop is not held
+END_RISE = 1.25         # the end rows' scallop up to this x the tolerance is held by a smaller step (_hold_ends)
+END_TRIALS = 4          # trial passes searching that step
 
 
 NOT_REACHED = "not reached"    # rows no side step holds: left out of the strip's measure
@@ -175,11 +179,8 @@ class _Placer:
                            "estimate the work was checked against); use a larger scallop")
         prev, before = placed[-1], placed[-3:-1]
         room = frame.a1 - prev.a
-        # one trial is kept for each pass that may still follow (its fallback): the trials stay within the
-        # estimate's
-        spare = self.budget - report.trials - (self.limit - len(placed))
         best, excluded = _hold(self.make, self.meter, before, prev, h, min(self.step, room), room,
-                               min(self.least, room), spare)
+                               min(self.least, room), self._spare())
         if excluded and len(placed) > 1 and len(placed) - 1 not in self.redone:
             return self._redo(excluded)
         self.far = frozenset()
@@ -189,6 +190,8 @@ class _Placer:
             if trial is None:
                 raise TmmError(f"no pass fits the boundary after the pass at {prev.a - frame.a0:.4g} mm")
             best = (self.step, self.meter.scallop(before, prev, trial, _intervals(excluded, self.meter)), trial)
+        elif not excluded:
+            best = self._hold_ends(best, before, prev)
         s_ok, value, trial = best
         if excluded or value > h:
             self.left_out[id(trial)] = {row_key(t) for t in excluded}
@@ -197,6 +200,47 @@ class _Placer:
         report.scallops.append(value)
         self.step = s_ok
         return trial.a
+
+    def _spare(self) -> int:
+        """The trials left for this pass: one is kept for each pass that may still follow (its fallback), so
+        the trials stay within the estimate's."""
+        return self.budget - self.report.trials - (self.limit - len(self.placed))
+
+    def _hold_ends(self, best: tuple, before: list[PassPositions], prev: PassPositions) -> tuple:
+        """The step found on the rows, searched again (at most END_TRIALS trial passes) for the largest one
+        that also holds the end rows (ScallopMeter.end_rows) when they are above the tolerance by at most
+        END_RISE: a smaller step holds the cusp that rises where the passes end. More than that is the tool
+        not reaching the face near its edge, which no step holds (the ends are not the placement's rows:
+        never reported). Unchanged if no step tried holds them."""
+        s, _, trial = best
+        ends = self._ends(before, prev, trial)
+        if not self.h < ends <= END_RISE * self.h:
+            return best
+        held: Optional[tuple] = None
+        over = (s, ends)
+        s_try = max(self.least, s * math.sqrt(self.h / ends))
+        for _ in range(END_TRIALS):
+            again = self.make(prev.a + s_try) if self._spare() > 0 and s_try < over[0] - STEP_TOL else None
+            if again is None:
+                break
+            value = self.meter.scallop(before, prev, again)
+            worst = max(value, self._ends(before, prev, again))
+            if worst <= self.h:
+                held = (s_try, worst, again, value)
+                if self.h - worst <= SCALLOP_REL * self.h:
+                    break
+            else:
+                over = (s_try, worst)
+                if s_try <= self.least + 1e-12:
+                    break
+            if held is not None and over[0] - held[0] < STEP_TOL:
+                break
+            s_try = max(self.least, _next_step(s_try, worst, self.h, held and held[:3], over, over[0]))
+        return best if held is None else (held[0], held[3], held[2])
+
+    def _ends(self, before: list[PassPositions], prev: PassPositions, new: PassPositions) -> float:
+        rows = self.meter.end_rows(prev, new)
+        return self.meter.scallop(before, prev, new, at=rows) if len(rows) else 0.0
 
     def _redo(self, excluded: list[float]) -> float:
         """Rows no step holds lie where the previous pass cuts the row between its two contacts (its strip
