@@ -45,8 +45,8 @@ PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
 STEPOVER_MODE_NAMES = {"stepover": "StepOver", "cusp": "Cusp", "adaptive": "Adaptive"}
-FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes (issue 14 item 2)
-STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region's edge inward (issue 14 item 1)
+FORWARD_STEP_NAMES = {"tolerance": "Tolerance", "sample": "SampleStep"}  # lean passes
+STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region's edge inward
 
 
 @plain_numbers
@@ -100,7 +100,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     G2/G3 in the pass's plane (XZ/YZ, rasters at 0/90 deg) with 'tolerance', where the post writes K (not
     linuxcnc: lines there, with a warning).
     verify_cusp: cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds
-    `cusp` (the op's VerifyCusp; issue 14 item 4), any stepover_mode (offset3d: the extra passes are level sets
+    `cusp` (the op's VerifyCusp), any stepover_mode (offset3d: the extra passes are level sets
     of its field between two loops), zigzag or oneway over the box.
     Feeds in mm/min. progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
@@ -134,7 +134,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
 
     extra.update(region_source.api_values(region, model, spiral_direction or "outward", slope_range,
                                           region_tolerance))
-    if offset_from is not None:  # the 3D offset from a chosen curve (issue 14 item 1; app.offset_start)
+    if offset_from is not None:  # the 3D offset from a chosen curve (app.offset_start)
         from tmm_workbench.app import offset_start
 
         if stepover_mode != "offset3d":

@@ -1,4 +1,4 @@
-"""Where the 3-axis Surface op's 3D offset passes start (issue 14 item 1): `OffsetStart` Boundary (the region's
+"""Where the 3-axis Surface op's 3D offset passes start: `OffsetStart` Boundary (the region's
 boundary, inward: what the op always did, and what a document saved before the choice restores with) or Curve
 (`OffsetCurve`: a sketch or any object with edges, open or closed, discretised within RegionTolerance and
 projected along Z; the passes are offset from it to both sides across the region, core SurfaceParams.offset_from).

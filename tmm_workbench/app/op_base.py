@@ -156,7 +156,7 @@ class TmmOp(PathOp.ObjectOp):
         self._initial_values = {}
         self.new_op_state(obj, job)
 
-    # --- a new op tells the truth before its first compute (issue 15 item 5) ----------------------
+    # --- a new op tells the truth before its first compute ----------------------
     def new_op_state(self, obj: Any, job: Any) -> None:
         """The heights' expressions (OpStockZMax + the SetupSheet's offsets) are evaluated when ObjectOp
         creates the op, before a compute sets OpStockZMax: a new op showed 3 / 5 mm. The stock's top goes in

@@ -1,4 +1,4 @@
-"""The 3-axis Surface op's machining region from FreeCAD objects (issue 14 item 3), as the core's polygons
+"""The 3-axis Surface op's machining region from FreeCAD objects, as the core's polygons
 (core.footprint.region): it bounds the tool centre (the CL point's XY), as FreeCAD's 3D Surface boundary.
 
   Box     no region: the op's BoundaryShape box with its margin (what the op always did);

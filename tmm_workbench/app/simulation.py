@@ -1,4 +1,4 @@
-"""A Job's (or one op's) tool paths cut into its stock and compared with its model (issue 12): the App side
+"""A Job's (or one op's) tool paths cut into its stock and compared with its model: the App side
 of core.sim. The stock is the Job's stock solid as a height field (box, cylinder or any solid: its top on
 each cell's vertical line), the design the Job's model objects tessellated finely; each active op in order
 cuts the same z-map with its own tool (app.tools, the one ToolBit map) from its Path (G0/G1, 5-axis axes

@@ -1,4 +1,4 @@
-"""The 3-axis Surface op's properties for what FreeCAD's 3D Surface users expect (issue 15 item 6): the
+"""The 3-axis Surface op's properties for what FreeCAD's 3D Surface users expect: the
 step-over in % of the tool diameter, a Depths group (final depth, finishing passes over a semi-finish stock
 to leave, their step-down) and a start point; the core is core.strategies.finish_passes.
 

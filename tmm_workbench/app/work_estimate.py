@@ -219,7 +219,7 @@ def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Op
     m = _value(obj, "BoundaryMargin", ov)
     params = _params(proxy, obj, ov, boundary=(x0 - m, y0 - m, x1 + m, y1 + m))
     params.validate()
-    if params.stepover_mode == raster_drop.OFFSET3D:  # the 3D offset's passes (issue 14 item 1)
+    if params.stepover_mode == raster_drop.OFFSET3D:  # the 3D offset's passes
         return _verified(_offset3d(obj, params), obj, params)
     stepover = params.stepover
     if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
@@ -249,7 +249,7 @@ def _surface_pace(obj: Any, params: Any) -> float:
 
 
 def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
-    """With VerifyCusp (issue 14 item 4): the verification's dense raster added (known before it runs; its partial
+    """With VerifyCusp: the verification's dense raster added (known before it runs; its partial
     passes are not)."""
     from tmm_workbench.core.strategies.surface import cusp_check, variable_step
 

@@ -1,4 +1,4 @@
-"""The Surface op panel's rows for where the 3D offset's passes start (issue 14 item 1, app.offset_start): the
+"""The Surface op panel's rows for where the 3D offset's passes start (app.offset_start): the
 OffsetStart combo (bound like the page's own) and the OffsetCurve chooser (sketches and objects with edges, open
 or closed)."""
 from __future__ import annotations

@@ -5,7 +5,7 @@ command creates the op with our view provider (icon from the add-on's file). The
 (`Base`: one Bézier or B-spline face), so PathOpGui's TaskPanel adds its stock Base Geometry page; a face
 selected before the command is taken as the op's Base.
 
-The view provider also draws the tool axes (issue 15 item 4): every `AxisEvery`-th cutting position as a
+The view provider also draws the tool axes: every `AxisEvery`-th cutting position as a
 line `AxisLength` long from the tip up the axis, coloured by contact status or tilt (`AxisColouring`),
 shown while `ShowToolAxes` is on. They come from the last computation's per-position results, or, after a
 document is reopened (the results are not saved), from the Path's G1 moves (tilt colours then).
@@ -46,7 +46,7 @@ class TaskPanelOpPage(op_page.OpPage):
         self.form.contacts.setText(obj.ContactSummary)
         super().show_status(obj)
 
-    # the side step warned about as it is typed, before any compute (issue 15 item 4)
+    # the side step warned about as it is typed, before any compute
     def init_extra(self, obj: Any) -> None:
         self.obj = obj
         self.form.passSpacing.currentIndexChanged.connect(self.warn_side_step)

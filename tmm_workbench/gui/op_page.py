@@ -176,7 +176,7 @@ class OpViewProvider(PathOpGui.ViewProvider):
     def setupTaskPanel(self, panel: Any) -> None:
         from tmm_workbench.gui import panel_state
 
-        panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply (issue 15 item 5)
+        panel_state.commit_on_apply(panel)  # Cancel keeps the last good Apply
         panel_state.drop_fields_on_cancel(panel)  # a field left focused writes nothing after Cancel's abort
         panel_state.forget_widgets_on_close(panel)  # no stale Qt wrappers left (a crash on 1.1)
         field_limits.guard_panel(panel)  # outermost: OK / Apply compute nothing while a value is refused

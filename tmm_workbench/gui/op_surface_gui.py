@@ -21,18 +21,18 @@ SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampl
               "cuspSlopeLimit": "CuspSlopeLimit"}
 COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
           "stepOverMode": "StepOverMode"}
-SPIN_BOXES.update(region_panel.SPIN_BOXES)  # the region group box (issue 14 item 3)
+SPIN_BOXES.update(region_panel.SPIN_BOXES)  # the region group box
 COMBOS.update(region_panel.COMBOS)
-# lean passes (issue 14 item 2)
+# lean passes
 SPIN_BOXES["chordTolerance"] = "ChordTolerance"
 COMBOS["forwardStep"] = "ForwardStep"
 CHECKS = {"arcFitting": "ArcFitting"}
-CHECKS["verifyCusp"] = "VerifyCusp"  # the verification pass (issue 14 item 4)
-# the group 'Depths, passes and start point' (issue 15 item 6)
+CHECKS["verifyCusp"] = "VerifyCusp"  # the verification pass
+# the group 'Depths, passes and start point'
 SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
 COMBOS.update(surface_depths_gui.COMBOS)
 CHECKS.update(surface_depths_gui.CHECKS)
-COMBOS.update(offset_start_panel.COMBOS)  # the 3D offset's start (issue 14 item 1)
+COMBOS.update(offset_start_panel.COMBOS)  # the 3D offset's start
 
 
 class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):

@@ -1,4 +1,4 @@
-"""What the op panels' Apply and Cancel keep (issue 15 item 5). FreeCAD's op panel (PathOpGui.TaskPanel) keeps
+"""What the op panels' Apply and Cancel keep. FreeCAD's op panel (PathOpGui.TaskPanel) keeps
 one undo transaction open from the panel's opening to OK or Cancel, and Cancel aborts it: after a good Apply,
 Cancel threw that path away (and in the panel of a new op, the op itself). Here a good Apply (the op computed
 and valid) commits what it did and opens a new transaction: Cancel goes back to the last good Apply, the new op

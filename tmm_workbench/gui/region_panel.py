@@ -1,5 +1,5 @@
-"""The Surface op panel's group box for the machining region, the spiral and the slope range (issue 14
-item 3): widget -> property tables the op page binds like its own, the sketch chooser, and "Use selected
+"""The Surface op panel's group box for the machining region, the spiral and the slope range: widget -> property
+tables the op page binds like its own, the sketch chooser, and "Use selected
 faces" (the faces selected in the 3D view become RegionFaces, Region becomes Faces)."""
 from __future__ import annotations
 

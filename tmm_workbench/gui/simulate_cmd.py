@@ -1,4 +1,4 @@
-"""Command 'TMM Simulate' (issue 12): the selected Job's stock (or one op's) cut by its tool paths and
+"""Command 'TMM Simulate': the selected Job's stock (or one op's) cut by its tool paths and
 compared with the design, in a task panel (the numbers of api.simulate, a colour legend) and in the 3D view
 (the simulated stock as a mesh coloured by its deviation, RdBu_r as the heat map PNG, grey where there is no
 design). The mesh is a Coin node of the view's scene graph, not a document object: closing the panel

@@ -1,4 +1,4 @@
-"""The 3-axis Surface panel's group 'Depths, passes and start point' (issue 15 item 6; properties in
+"""The 3-axis Surface panel's group 'Depths, passes and start point' (properties in
 app.surface_passes): the step-over unit (mm or % of the tool diameter), final depth, finishing passes and
 their step-down, start point. Bound through OpPage's tables where FreeCAD has a widget for the property
 (quantity spin boxes, the unit combo box, check boxes); the % step-over, the pass count and the start point's

@@ -32,7 +32,7 @@ double clearance(const PatchSurface& s, const SurfaceSamples& samples, const Tor
   // The candidates Newton polishes: every discrete local minimum of the tool distance over the samples,
   // in its patch's grid (no lower grid neighbour) and along the face's boundary (no lower neighbour on the
   // edge: a minimum on an edge curve need not be one in 2D). Minima are not thinned by distance: a second
-  // contact 2 mm from P has its own basin, however close (issue 11: a thinning radius of two sample
+  // contact 2 mm from P has its own basin, however close (a thinning radius of two sample
   // spacings kept only P's sample and missed a 1.8 um gouge on the edge beside it).
   std::vector<std::pair<double, std::size_t>> cand;
   double nearest = kInf;

@@ -45,7 +45,7 @@ TiltSearch::TiltSearch(const PatchSurface& s, const SurfaceSamples& samples, con
 
 bool TiltSearch::near_P(const Vector2d& uv, double beta) const {
   if ((s_.point(uv.x(), uv.y()) - P_).norm() >= near_) return false;
-  // Close to P, but in a basin of its own? (issue 11: a second contact on the face's edge 2.6 mm from P,
+  // Close to P, but in a basin of its own? (found on a face: a second contact on the face's edge 2.6 mm from P,
   // inside near_, was taken for P.) Along the parameter segment P -> uv the tool distance at this tilt
   // rises above both ends by more than the osculation allowance: a ridge parts them, uv is not P.
   const ToolPose pose = frame_.tilted(beta);

@@ -1,4 +1,4 @@
-"""Adaptive raster (issue 14; seed 000 section 3.5.2.2): each pass placed from the real cutter positions of
+"""Adaptive raster (seed 000 section 3.5.2.2): each pass placed from the real cutter positions of
 the previous one, so that the largest cusp between the two is the tolerance.
 
 The seed intersects the cutter's section with the surface's section at each CC point (eq. 3.54-3.58) and takes

@@ -1,4 +1,4 @@
-"""Step-over from a cusp height (issue 14, constant mode), for any APT cutter of revolution.
+"""Step-over from a cusp height (constant mode), for any APT cutter of revolution.
 
 Parallel passes `s` apart (horizontally) over a plane that rises at `slope` across them leave ridges (cusps)
 between neighbouring tool instances. Along a pass the tool moves horizontally and the plane does not change,

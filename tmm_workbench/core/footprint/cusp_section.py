@@ -1,4 +1,4 @@
-"""Constant cusp mode that holds the tolerance on curved surfaces (issue 14 item 1, first bullet).
+"""Constant cusp mode that holds the tolerance on curved surfaces.
 
 The planar rule (core.footprint.cusp) keeps the cusp on a plane at the region's steepest crossing; on a surface
 that bends across the passes it does not: a concave section of radius rho lifts a ball's cusp by about

@@ -1,4 +1,4 @@
-"""The constant-scallop "3D offset" pattern (issue 14 item 1, third bullet): what its passes are made of and how
+"""The constant-scallop "3D offset" pattern: what its passes are made of and how
 they are cut. The passes themselves are the level sets of one arrival-time field (core.footprint.offset_field);
 here: the cusp rule's step for a slope across the passes (StepRule), the passes (Loop, OffsetLoops), the spike a
 sharp convex corner gets (_spiked) and the cutting order (loop_chains).

@@ -1,4 +1,4 @@
-"""The 3D offset's passes as level sets of one arrival-time field (issue 14 item 1, third bullet).
+"""The 3D offset's passes as level sets of one arrival-time field.
 
 A front leaves the start set (the machining region's boundary, holes included, or a chosen curve, open or
 closed) and moves across the CL surface at the speed F(p, u) = the XY step the cusp rule allows at p for passes

@@ -1,4 +1,4 @@
-"""The tool axes a 5-axis op's 3D view draws (issue 15 item 4), numpy only: every n-th cutting position as
+"""The tool axes a 5-axis op's 3D view draws, numpy only: every n-th cutting position as
 a line from the tip up its axis, coloured by contact status (two contacts green, one contact orange) or by
 tilt (blue vertical -> red at the tilt limit)."""
 from __future__ import annotations

@@ -1,2 +1,2 @@
-"""Stock simulation (issue 12): the z-map the kernel cuts (grid, stock), what a tool path leaves
+"""Stock simulation: the z-map the kernel cuts (grid, stock), what a tool path leaves
 (simulate), compared with the design (compare), and how long it takes (cycle_time)."""

@@ -1,4 +1,4 @@
-"""The simulated cusp of a 3-axis raster, measured the same way whatever placed its passes (issue 14 items 1, 4, 7).
+"""The simulated cusp of a 3-axis raster, measured the same way whatever placed its passes.
 
 The path and a dense raster of the same tool (passes one cell apart: its own cusp, cell^2 / 8R for a ball, is
 negligible against the tolerance) are cut into the stock simulation. The dense raster leaves the reachable

@@ -1,4 +1,4 @@
-"""No gouge and no chord error between multipoint positions (issue 11 item 3): the tool moving from one
+"""No gouge and no chord error between multipoint positions: the tool moving from one
 position to the next (the tip on its straight line, the axis by slerp, as a control with tool-centre-point
 mode moves it) is checked against the real face at instances at most 0.25 mm apart by the kernel's signed
 clearance (the smallest signed distance from the face to the tool solid, exact by Newton: negative a gouge,

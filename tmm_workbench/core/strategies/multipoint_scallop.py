@@ -1,4 +1,4 @@
-"""Side step from a scallop height for multipoint 5-axis finishing (issue 14 item 5).
+"""Side step from a scallop height for multipoint 5-axis finishing.
 
 Passes are placed one after the other across the boundary: the first on the start edge, each next one at the
 largest side step for which the scallop left between it and the passes before it, measured on the real tool

@@ -1,4 +1,4 @@
-"""3-axis finishing by the "3D offset" (constant scallop) step-over mode (issue 14 item 1): what raster_drop
+"""3-axis finishing by the "3D offset" (constant scallop) step-over mode: what raster_drop
 does when SurfaceParams.stepover_mode is OFFSET3D.
 
 The passes (core.footprint.offset_field: the level sets of one arrival-time field) follow the machining region

@@ -1,4 +1,4 @@
-"""No gouge between 3-axis CL points (issue 11 item 3, the 3-axis side): the straight move between two
+"""No gouge between 3-axis CL points (the 3-axis side): the straight move between two
 dropped points passes below the exact drop height where a ridge or an edge lies between them. Each move is
 checked at 5 interior points (dropped in one batch for all moves); where it passes more than `tol` below,
 or where a steep move's middle lies far from its chord (a jump of the drop height between samples), the

@@ -1,4 +1,4 @@
-"""3-axis finishing in a machining region, the spiral pattern and the slope range (issue 14 item 3): what
+"""3-axis finishing in a machining region, the spiral pattern and the slope range: what
 raster_drop does when SurfaceParams has a `region`, the pattern SPIRAL or a slope range.
 
 The region bounds the tool centre (core.footprint.region). The raster's passes (at any angle, spaced by

@@ -1,4 +1,4 @@
-"""Slope range filter for 3-axis finishing (issue 14 item 3): keep only the CL points where the surface's
+"""Slope range filter for 3-axis finishing: keep only the CL points where the surface's
 slope lies in [low, high] deg, so steep areas can be left to waterline and shallow ones to the raster.
 
 The slope is that of the drop height z(x, y) (the CL surface), by central differences of the cutter

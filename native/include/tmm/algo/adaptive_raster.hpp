@@ -1,4 +1,4 @@
-// Adaptive raster (issue 14; seed 000 section 3.5.2.2): the across-offsets of parallel passes such that the
+// Adaptive raster (seed 000 section 3.5.2.2): the across-offsets of parallel passes such that the
 // largest cusp between neighbours is the tolerance, each pass placed from the real CL points of the previous
 // one. The kernel's port of core/footprint/adaptive_raster.py, which stays the slow reference and explains
 // the method; the two must agree (tests/core/test_adaptive_raster.py).

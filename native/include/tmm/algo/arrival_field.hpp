@@ -1,4 +1,4 @@
-// Arrival-time field of the "3D offset" passes (issue 14 item 1): a front leaves a start set (the machining
+// Arrival-time field of the "3D offset" passes: a front leaves a start set (the machining
 // region's boundary, or a chosen curve) and moves across the CL surface at the speed F = the XY step the cusp
 // rule allows there, so that the passes, the level sets {T = k}, lie one local step apart everywhere and stay
 // long and smooth (a distance field has no pieces of its own: its level sets split only where the region does).

@@ -1,4 +1,4 @@
-// Lean passes (issue 14 item 2): along each straight run of a 3-axis raster, the fewest straight moves that stay
+// Lean passes: along each straight run of a 3-axis raster, the fewest straight moves that stay
 // within +-tol of the exact CL path (the drop height profile z(s) along the run).
 //
 // Per run: (1) the exact profile between the given samples, by adaptive exact drops: an interval is halved while

@@ -57,18 +57,18 @@ class SurfaceParams(StrategyParams):
     stepover_mode: str = param(STEPOVER, "step-over mode", choices=(STEPOVER, CUSP, ADAPTIVE, OFFSET3D))
     cusp: float = param(0.01, "cusp height", "mm", low=MIN_CUSP)
     max_slope_deg: float = param(75.0, "cusp slope limit", "deg", low=0, high=90, low_open=True, high_open=True)
-    # --- machining region, spiral and slope range (issue 14 item 3: core.strategies.raster_region) ---
+    # --- machining region, spiral and slope range (core.strategies.raster_region) ---
     # polygons with holes (core.polygons Shape) where the tool centre may go; None: the boundary rectangle.
     # `boundary` is then the region's box.
     region: Optional[list] = None
-    # 3D offset from a chosen curve (issue 14 item 1): XY polylines (open or closed, (n, 2) each) the passes are
+    # 3D offset from a chosen curve: XY polylines (open or closed, (n, 2) each) the passes are
     # offset from, to both sides across the region; None: from the region's boundary inward
     offset_from: Optional[list] = None
     spiral_direction: str = param(OUTWARD, "spiral direction", choices=(OUTWARD, INWARD))
     # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
     slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
     slope_max_deg: float = param(90.0, "slope maximum", "deg", low=0, high=90)
-    # lean passes (issue 14 item 2, core.strategies.raster_lean): the forward step by the chord tolerance
+    # lean passes (core.strategies.raster_lean): the forward step by the chord tolerance
     forward_step: str = param(SAMPLED, "forward step", choices=(SAMPLED, TOLERANCE))
     arcs: bool = param(False, "arc fitting", choices=(True, False))  # G2/G3 in XZ/YZ (TOLERANCE only)
     # --- verification pass (core.strategies.surface.variable_step): the pass set cut in the simulation,

@@ -365,7 +365,7 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
     run_on = 2.0 * math.sqrt(2.0 * cutter.radius * tolerance) + cell
     extra: list[CutSegment] = []
     # consecutive partial passes (serpentine, mostly a gap's few passes over one stretch) closer than this are
-    # joined on the surface instead of a lift (issue 14 item 4: 432 lifts on mount_rush)
+    # joined on the surface instead of a lift (432 lifts on mount_rush)
     join_max = passes.join * cutter.diameter
     cusp = before
     for k in range(rounds):
