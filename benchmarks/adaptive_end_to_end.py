@@ -24,13 +24,13 @@ from benchmarks.user_wait import user_wait  # noqa: E402
 from tmm_workbench.app.api import run_surface  # noqa: E402
 from tmm_workbench.core.footprint import adaptive_raster  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
-from tmm_workbench.core.strategies import raster_drop  # noqa: E402
+from tmm_workbench.core.strategies.surface import pattern  # noqa: E402
 
 
 def run(label: str, out: Path, reference: bool) -> dict:
     placed = adaptive_raster.adaptive_pass_offsets
     if reference:  # the strategy imported the function by name: swap it there for the run
-        raster_drop.adaptive_pass_offsets = functools.partial(placed, reference=True)
+        pattern.adaptive_pass_offsets = functools.partial(placed, reference=True)
     try:
         t0 = time.perf_counter()
         r = run_surface(str(shared_dir() / "benchmarks" / "stl" / "sphere_on_plate.stl"), doc_name=f"e2e_{label}",
@@ -38,7 +38,7 @@ def run(label: str, out: Path, reference: bool) -> dict:
                         gcode_path=str(out / f"{label}.ngc"))
         total = time.perf_counter() - t0
     finally:
-        raster_drop.adaptive_pass_offsets = placed
+        pattern.adaptive_pass_offsets = placed
     return user_wait(r, total, out / f"{label}_again.ngc")
 
 

@@ -182,8 +182,8 @@ def main() -> None:
         import functools
 
         from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
-        from tmm_workbench.core.strategies import raster_drop
-        raster_drop.adaptive_pass_offsets = functools.partial(adaptive_pass_offsets, reference=True)
+        from tmm_workbench.core.strategies.surface import pattern
+        pattern.adaptive_pass_offsets = functools.partial(adaptive_pass_offsets, reference=True)
     if args.seed000:
         from seed000_surfaces import INCH, seed000_mesh
         for name in ("convex", "concave"):
