@@ -14,6 +14,7 @@
 #include <string>
 #include <utility>
 
+#include "adaptive_envelope.hpp"
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/util/constants.hpp"
 #include "tmm/util/range.hpp"
@@ -22,13 +23,14 @@ namespace tmm {
 
 namespace {
 
+using namespace adaptive_detail;  // NOLINT: the envelope split off from this file
+
 constexpr double kSafety = 0.95;       // aim a little under the tolerance (the reference's _SAFETY)
 constexpr int kRounds = 6;             // step evaluations per pass
 constexpr double kSpacing = 0.05;      // mm between samples across a section
 constexpr int kRidgeHalvings = 12;     // the ridge within a sample spacing / 4096
 constexpr int kDense = 8;              // envelope passes between two passes: kDense - 1 of them, then b
 constexpr std::size_t kSectionChunk = 8;
-constexpr double kMargin = 1e-9;        // mm: a pruning bound this far under the value cannot cut a rounding
 
 void require(bool ok, const std::string& what) {
   if (!ok) throw std::invalid_argument(what);
@@ -38,85 +40,6 @@ std::string num(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
-}
-
-// The cutter's profile h(rho), inf beyond its widest radius (its side wall).
-struct Profile {
-  const Cutter& cutter;
-  double r_max;
-  double operator()(double rho) const { return rho <= r_max ? cutter.height(rho) : kInf; }
-};
-
-// One pass's instance that may reach a section: its lower surface there is z + h(sqrt(dx2 + dy^2)), never
-// below `bound` = z + h(|dx|) nor below z + h(|dy|).
-struct Instance {
-  double bound, z, dx2;
-};
-
-// The instances of a pass (tip heights z along a's x) near one section (listed nearest first) that can be
-// the least somewhere across it, lowest first. An instance no lower than a nearer one (dx2 no larger) never
-// is: h rises with rho, so the nearer one's z + h(sqrt(dx2 + dy^2)) is no higher at any dy. Those kept
-// therefore get lower as they get farther; those whose bound is inf (farther along the pass than the tool's
-// radius) never reach the section. dx2 and hdx = h(|dx|) are the same for every pass.
-void gather(const double* z, const std::vector<std::size_t>& near, const std::vector<double>& dx2,
-            const std::vector<double>& hdx, std::size_t first, std::size_t count, std::vector<Instance>& out) {
-  out.clear();
-  double lowest_z = kInf;
-  for (std::size_t k = first; k < first + count; ++k) {
-    const double zk = z[near[k]], bound = zk + hdx[k];
-    if (zk < lowest_z && bound < kInf) {
-      out.push_back({bound, zk, dx2[k]});
-      lowest_z = zk;
-    }
-  }
-  std::reverse(out.begin(), out.end());
-}
-
-// What lowest() needs of one dy across the section, the same for every section: dy^2, h(|dy|) and the
-// bound's bend h'(|dy|) / (r_max + |dy|) (h convex and rising: h(sqrt(dx2 + dy2)) - h(|dy|) >=
-// h'(|dy|) dx2 / (sqrt(dx2 + dy2) + |dy|), the root at most r_max where an instance reaches).
-struct Across {
-  double dy2, lift, bend;
-};
-
-Across across(double dy, const Profile& h) {
-  const double dy2 = dy * dy, ady = std::sqrt(dy2), lift = h(ady);
-  const double slope = lift < kInf ? h.cutter.slope(ady) : 0.0;
-  return {dy2, lift, std::isfinite(slope) ? slope / (h.r_max + ady) : 0.0};
-}
-
-// The least over `in` of z + h(rho) at dy across the section (inf where none reaches): exactly the
-// reference's min over all instances, skipping those whose bound (kMargin under it, so that no rounding can
-// matter) shows they cannot go lower, and stopping where none of the rest can (they stand higher, and
-// h(sqrt(dx2 + dy^2)) >= h(|dy|) in floating point too). `hint`, if given, is an
-// instance tried first (the previous sample's least: its value prunes the rest); on return, this one's.
-double lowest(const std::vector<Instance>& in, const Across& a, const Profile& h, std::size_t* hint = nullptr) {
-  if (!(a.lift < kInf)) return kInf;  // beyond the tool's reach across: no instance reaches
-  double best = kInf;
-  std::size_t first = in.size(), won = in.size();
-  if (hint && *hint < in.size()) {
-    first = won = *hint;
-    best = in[first].z + h(std::sqrt(in[first].dx2 + a.dy2));
-  }
-  for (std::size_t k = 0; k < in.size(); ++k) {
-    const Instance& i = in[k];
-    if (i.z + a.lift >= best) break;
-    if (k == first || i.bound >= best || i.z + a.lift + a.bend * i.dx2 - kMargin >= best) continue;
-    const double v = i.z + h(std::sqrt(i.dx2 + a.dy2));
-    if (v < best) {
-      best = v;
-      won = k;
-    }
-  }
-  if (hint) *hint = won;
-  return best;
-}
-
-double lowest(const std::vector<Instance>& in, double dy, const Profile& h) { return lowest(in, across(dy, h), h); }
-
-// A lower bound of lowest(in, a, h): no instance of the pass comes lower there.
-double floor_of(const std::vector<Instance>& in, const Across& a) {
-  return in.empty() ? kInf : in.front().z + a.lift;
 }
 
 struct Frame {
@@ -295,115 +218,34 @@ class Placer {
 
   // The largest cusp between pass a and a candidate pass at y1 (the reference's Strip.cusp).
   double cusp(double y1) {
-    const std::size_t S = sections_.size(), n = x_.size(), K = static_cast<std::size_t>(2 * reach_ + 1);
+    const std::size_t S = sections_.size(), n = x_.size();
     if (!S) return 0.0;
-    std::size_t N = 0;
-    while (N < ys_.size() && ys_[N] <= y1 + h_.r_max + kSpacing) ++N;
-    std::array<double, kDense> yp;  // the dense passes' y, then b's
-    for (int k = 1; k < kDense; ++k) yp[k - 1] = y0_ + (y1 - y0_) * (static_cast<double>(k) / kDense);
-    yp[kDense - 1] = y1;
-    std::vector<double> xy(2 * kDense * n), z(kDense * n);
+    Candidate c;
+    c.y1 = y1;
+    while (c.N < ys_.size() && ys_[c.N] <= y1 + h_.r_max + kSpacing) ++c.N;
+    const std::size_t N = c.N;
+    for (int k = 1; k < kDense; ++k) c.yp[k - 1] = y0_ + (y1 - y0_) * (static_cast<double>(k) / kDense);
+    c.yp[kDense - 1] = y1;
+    std::vector<double> xy(2 * kDense * n);
+    c.z.resize(kDense * n);
     for (int p = 0; p < kDense; ++p)
       for (std::size_t i = 0; i < n; ++i) {
         xy[2 * (p * n + i)] = x_[i];
-        xy[2 * (p * n + i) + 1] = yp[p];
+        xy[2 * (p * n + i) + 1] = c.yp[p];
       }
-    drop(xy, z);
-    const double cos_limit = std::cos(o_.max_slope), floor_z = o_.floor_z, tol = o_.cusp, y0 = y0_;
-    const std::size_t ny = ys_.size();
-    std::vector<Across> at(kDense * N);  // b's and the dense passes' dy terms at the samples, for all sections
+    drop(xy, c.z);
+    c.at.resize(kDense * N);  // b's and the dense passes' dy terms at the samples, for all sections
     for (int p = 0; p < kDense; ++p)
-      for (std::size_t j = 0; j < N; ++j) at[p * N + j] = across(ys_[j] - yp[p], h_);
+      for (std::size_t j = 0; j < N; ++j) c.at[p * N + j] = across(ys_[j] - c.yp[p], h_);
     std::vector<double> best(S, 0.0);
     std::vector<char> unreach(S, 0);
     parallel_chunks(S, kSectionChunk, threads_, [&](std::size_t begin, std::size_t end) {
-      std::array<std::vector<Instance>, kDense> pass;  // the dense passes, then b
-      std::vector<double> pa(N), pb(N), env(N), cosv(N);
-      std::vector<char> ok(N);
+      SectionScratch w(N);
       for (std::size_t s = begin; s < end; ++s) {
-        for (int p = 0; p < kDense; ++p) gather(z.data() + p * n, near_, dx2_, hdx_, s * K, K, pass[p]);
-        const std::vector<Instance>& A = a_[s];
-        const std::vector<Instance>& B = pass[kDense - 1];
-        std::array<std::size_t, kDense> hint{};  // each pass's least at the previous sample
-        for (std::size_t j = 0; j < N; ++j) {
-          pa[j] = pa_[s * ny + j];
-          pb[j] = lowest(B, at[(kDense - 1) * N + j], h_, &hint[kDense - 1]);
-          double e = std::min(pa[j], pb[j]);
-          // the dense passes nearest first (the least is the same in any order); one that cannot come lower
-          // is skipped
-          const double f = (ys_[j] - y0) / (y1 - y0) * kDense - 1;
-          const int near = f <= 0 ? 0 : f >= kDense - 2 ? kDense - 2 : static_cast<int>(std::lround(f));
-          for (int d = 0; d < kDense - 1; ++d)
-            for (int side = 0; side < (d ? 2 : 1); ++side) {
-              const int p = side ? near + d : near - d;
-              if (p < 0 || p > kDense - 2) continue;
-              const Across& ap = at[p * N + j];
-              if (floor_of(pass[p], ap) < e) e = std::min(e, lowest(pass[p], ap, h_, &hint[p]));
-            }
-          env[j] = e;
-        }
-        // out of reach only between the two passes' contacts (each one's least height above the design, the
-        // first such sample: numpy's argmin): before a's contact the material is the previous pass's
-        double ya = ys_[0], yb = ys_[0];
-        {
-          double ga = kInf, gb = kInf;
-          for (std::size_t j = 0; j < N; ++j) {
-            const double d = design_[s * ny + j];
-            if (!std::isfinite(d)) continue;
-            if (std::isfinite(pa[j]) && pa[j] - d < ga) {
-              ga = pa[j] - d;
-              ya = ys_[j];
-            }
-            if (std::isfinite(pb[j]) && pb[j] - d < gb) {
-              gb = pb[j] - d;
-              yb = ys_[j];
-            }
-          }
-        }
-        // the slope across (numpy's gradient over the envelope, the floor where nothing reaches)
-        auto g = [&](std::size_t j) { return std::isfinite(env[j]) ? env[j] : floor_z; };
-        double b = 0.0;
+        envelope(c, s, w);
         bool un = false;
-        for (std::size_t j = 0; j < N; ++j) {
-          double grad = 0.0;
-          if (N >= 2)
-            grad = j == 0 ? (g(1) - g(0)) / kSpacing
-                   : j == N - 1 ? (g(N - 1) - g(N - 2)) / kSpacing
-                                : (g(j + 1) - g(j - 1)) / (2.0 * kSpacing);
-          cosv[j] = 1.0 / std::sqrt(1.0 + grad * grad);
-          bool good = std::isfinite(env[j]) && env[j] > floor_z + 1e-6 && cosv[j] >= cos_limit;
-          const bool reached = (env[j] - design_[s * ny + j]) * cosv[j] <= tol;
-          if (good && !reached && ys_[j] >= ya && ys_[j] <= yb) un = true;
-          good = good && reached;
-          ok[j] = good;
-          if (good) b = std::max(b, (std::min(pa[j], pb[j]) - env[j]) * cosv[j]);
-        }
-        // the ridge, where a's and b's surfaces cross: bracketed on the samples (the last where a's is the
-        // lower), then halved
-        std::size_t last = 0;
-        for (std::size_t j = N; j-- > 0;)
-          if (pa[j] <= pb[j] && std::isfinite(pa[j])) {
-            last = j;
-            break;
-          }
-        double lo_y = ys_[last], hi_y = ys_[std::min(last + 1, N - 1)];
-        for (int it = 0; it < kRidgeHalvings; ++it) {
-          const double mid = 0.5 * (lo_y + hi_y);
-          if (lowest(A, mid - y0, h_) >= lowest(B, mid - y1, h_)) hi_y = mid;
-          else lo_y = mid;
-        }
-        const double ridge = 0.5 * (lo_y + hi_y);
-        const double h_ridge = std::min(lowest(A, ridge - y0, h_), lowest(B, ridge - y1, h_));
-        double e_ridge = h_ridge;
-        for (int p = 0; p + 1 < kDense; ++p) {
-          const Across ap = across(ridge - yp[p], h_);
-          if (floor_of(pass[p], ap) < e_ridge) e_ridge = std::min(e_ridge, lowest(pass[p], ap, h_));
-        }
-        const double c = std::nearbyint((ridge - ys_[0]) / kSpacing);  // numpy's round: half to even
-        const std::size_t col = c <= 0 ? 0 : std::min(static_cast<std::size_t>(c), N - 1);
-        if (ok[col] && std::isfinite(h_ridge) && std::isfinite(e_ridge))
-          b = std::max(b, (h_ridge - e_ridge) * cosv[col]);
-        best[s] = b;
+        const double b = sample_cusp(c, s, w, un);
+        best[s] = ridge_cusp(c, s, w, b);
         unreach[s] = un;
       }
     });
@@ -416,6 +258,130 @@ class Placer {
   void at(double fraction) { at_ = fraction; }
 
  private:
+  // One candidate pass b at y1: the samples across that matter (N), the dense passes' y (then b's), their
+  // CL heights (kDense passes of x_.size() points) and their dy terms at the samples.
+  struct Candidate {
+    double y1 = 0;
+    std::size_t N = 0;
+    std::array<double, kDense> yp{};
+    std::vector<double> z;
+    std::vector<Across> at;
+  };
+  // One thread's work space over a section: the dense passes (then b) and the profiles across.
+  struct SectionScratch {
+    explicit SectionScratch(std::size_t N) : pa(N), pb(N), env(N), cosv(N), ok(N) {}
+    std::array<std::vector<Instance>, kDense> pass;
+    std::vector<double> pa, pb, env, cosv;
+    std::vector<char> ok;
+  };
+
+  // Section s: a's and b's surfaces across (pa, pb) and the envelope of every pass between (env).
+  void envelope(const Candidate& c, std::size_t s, SectionScratch& w) const {
+    const std::size_t n = x_.size(), K = static_cast<std::size_t>(2 * reach_ + 1), N = c.N, ny = ys_.size();
+    const double y0 = y0_, y1 = c.y1;
+    auto& pass = w.pass;
+    for (int p = 0; p < kDense; ++p) gather(c.z.data() + p * n, near_, dx2_, hdx_, s * K, K, pass[p]);
+    const std::vector<Instance>& B = pass[kDense - 1];
+    std::array<std::size_t, kDense> hint{};  // each pass's least at the previous sample
+    for (std::size_t j = 0; j < N; ++j) {
+      w.pa[j] = pa_[s * ny + j];
+      w.pb[j] = lowest(B, c.at[(kDense - 1) * N + j], h_, &hint[kDense - 1]);
+      double e = std::min(w.pa[j], w.pb[j]);
+      // the dense passes nearest first (the least is the same in any order); one that cannot come lower
+      // is skipped
+      const double f = (ys_[j] - y0) / (y1 - y0) * kDense - 1;
+      const int near = f <= 0 ? 0 : f >= kDense - 2 ? kDense - 2 : static_cast<int>(std::lround(f));
+      for (int d = 0; d < kDense - 1; ++d)
+        for (int side = 0; side < (d ? 2 : 1); ++side) {
+          const int p = side ? near + d : near - d;
+          if (p < 0 || p > kDense - 2) continue;
+          const Across& ap = c.at[p * N + j];
+          if (floor_of(pass[p], ap) < e) e = std::min(e, lowest(pass[p], ap, h_, &hint[p]));
+        }
+      w.env[j] = e;
+    }
+  }
+
+  // The cusp on section s's samples (the slope's cosine and which samples count kept in w); un: material
+  // out of reach between the two passes' contacts.
+  double sample_cusp(const Candidate& c, std::size_t s, SectionScratch& w, bool& un) const {
+    const std::size_t N = c.N, ny = ys_.size();
+    const double cos_limit = std::cos(o_.max_slope), floor_z = o_.floor_z, tol = o_.cusp;
+    const std::vector<double>& pa = w.pa;
+    const std::vector<double>& pb = w.pb;
+    const std::vector<double>& env = w.env;
+    // out of reach only between the two passes' contacts (each one's least height above the design, the
+    // first such sample: numpy's argmin): before a's contact the material is the previous pass's
+    double ya = ys_[0], yb = ys_[0];
+    {
+      double ga = kInf, gb = kInf;
+      for (std::size_t j = 0; j < N; ++j) {
+        const double d = design_[s * ny + j];
+        if (!std::isfinite(d)) continue;
+        if (std::isfinite(pa[j]) && pa[j] - d < ga) {
+          ga = pa[j] - d;
+          ya = ys_[j];
+        }
+        if (std::isfinite(pb[j]) && pb[j] - d < gb) {
+          gb = pb[j] - d;
+          yb = ys_[j];
+        }
+      }
+    }
+    // the slope across (numpy's gradient over the envelope, the floor where nothing reaches)
+    auto g = [&](std::size_t j) { return std::isfinite(env[j]) ? env[j] : floor_z; };
+    double b = 0.0;
+    un = false;
+    for (std::size_t j = 0; j < N; ++j) {
+      double grad = 0.0;
+      if (N >= 2)
+        grad = j == 0 ? (g(1) - g(0)) / kSpacing
+               : j == N - 1 ? (g(N - 1) - g(N - 2)) / kSpacing
+                            : (g(j + 1) - g(j - 1)) / (2.0 * kSpacing);
+      w.cosv[j] = 1.0 / std::sqrt(1.0 + grad * grad);
+      bool good = std::isfinite(env[j]) && env[j] > floor_z + 1e-6 && w.cosv[j] >= cos_limit;
+      const bool reached = (env[j] - design_[s * ny + j]) * w.cosv[j] <= tol;
+      if (good && !reached && ys_[j] >= ya && ys_[j] <= yb) un = true;
+      good = good && reached;
+      w.ok[j] = good;
+      if (good) b = std::max(b, (std::min(pa[j], pb[j]) - env[j]) * w.cosv[j]);
+    }
+    return b;
+  }
+
+  // The cusp b on the samples raised by the one at the ridge, where a's and b's surfaces cross: bracketed on
+  // the samples (the last where a's is the lower), then halved.
+  double ridge_cusp(const Candidate& c, std::size_t s, const SectionScratch& w, double b) const {
+    const std::size_t N = c.N;
+    const double y0 = y0_, y1 = c.y1;
+    const std::vector<Instance>& A = a_[s];
+    const std::vector<Instance>& B = w.pass[kDense - 1];
+    std::size_t last = 0;
+    for (std::size_t j = N; j-- > 0;)
+      if (w.pa[j] <= w.pb[j] && std::isfinite(w.pa[j])) {
+        last = j;
+        break;
+      }
+    double lo_y = ys_[last], hi_y = ys_[std::min(last + 1, N - 1)];
+    for (int it = 0; it < kRidgeHalvings; ++it) {
+      const double mid = 0.5 * (lo_y + hi_y);
+      if (lowest(A, mid - y0, h_) >= lowest(B, mid - y1, h_)) hi_y = mid;
+      else lo_y = mid;
+    }
+    const double ridge = 0.5 * (lo_y + hi_y);
+    const double h_ridge = std::min(lowest(A, ridge - y0, h_), lowest(B, ridge - y1, h_));
+    double e_ridge = h_ridge;
+    for (int p = 0; p + 1 < kDense; ++p) {
+      const Across ap = across(ridge - c.yp[p], h_);
+      if (floor_of(w.pass[p], ap) < e_ridge) e_ridge = std::min(e_ridge, lowest(w.pass[p], ap, h_));
+    }
+    const double cr = std::nearbyint((ridge - ys_[0]) / kSpacing);  // numpy's round: half to even
+    const std::size_t col = cr <= 0 ? 0 : std::min(static_cast<std::size_t>(cr), N - 1);
+    if (w.ok[col] && std::isfinite(h_ridge) && std::isfinite(e_ridge))
+      b = std::max(b, (h_ridge - e_ridge) * w.cosv[col]);
+    return b;
+  }
+
   const MeshIndex& index_;
   const Cutter& tool_;
   const AdaptiveRasterOptions& o_;

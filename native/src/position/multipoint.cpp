@@ -107,82 +107,39 @@ double MultipointPositioner::clearance_real(const Vector3d& tip, const Vector3d&
   return tmm::clearance(*real_, real_samples_ ? *real_samples_ : samples_, tool_, {tip, axis}, where, evals);
 }
 
-MultipointResult MultipointPositioner::position_core(double x, double y) const {
-  MultipointResult res;
-  const PatchSurface& s = *surface_;
-  int evals = 0;
-  const Vector3d Z = Vector3d::UnitZ();
-  const double Ro = tool_.Ro, Ri = tool_.Ri;
+MultipointResult MultipointPositioner::finish_single(MultipointResult& res, ContactReason reason,
+                                                     const ToolPose& pose, double beta, double known_penetration,
+                                                     int& evals) const {
   const bool drd = opt_.method == MultipointMethod::DRD;
-
-  const Drop drop = drd ? drop_drd(s, x, y, &evals) : drop_vcrf(x, y, &evals);
-  if (!drop.ok) {
+  res.status = ContactStatus::OneContact;
+  res.reason = reason;
+  res.tip = pose.tip;
+  res.axis = pose.axis;
+  res.beta = beta;
+  res.centre = pose.tip + tool_.Ri * pose.axis;
+  res.Q = res.P;
+  res.nQ = res.nP;
+  res.uvQ = res.uvP;
+  res.gap_P = res.gap_Q = tool_distance(tool_, pose.tip, pose.axis, res.P);
+  // The full check, unless the search ran it (DRD): VCRF's own check is partial (its earliest circular
+  // rays and beside P), its finding is kept if deeper.
+  res.penetration = (drd && known_penetration >= 0.0)
+                        ? known_penetration
+                        : std::max(known_penetration, penetration(pose.tip, pose.axis, nullptr, &evals));
+  if (res.penetration > opt_.tol) {
     res.status = ContactStatus::Failed;
-    res.reason = ContactReason::NoSurface;
-    res.tip = Vector3d(x, y, s.bounds().hi.z());
-    res.centre = res.tip + Ri * Z;
-    res.evaluations = evals;
-    return res;
+    res.reason = ContactReason::Gouge;
   }
-  const Vector3d tip0(x, y, drop.tip_z);
-  const Vector3d C0 = tip0 + Ri * Z;
-  res.drop_z = drop.tip_z;
-  res.uvP = drop.uv;
-  {
-    const SurfacePoint sp = s.eval(drop.uv.x(), drop.uv.y(), 1);
-    res.P = sp.S;
-    res.nP = sp.normal();
-    if (res.nP.z() < 0.0) res.nP = -res.nP;
-  }
-  // One contact, at P. known_penetration >= 0: what the search's check found at the pose.
-  auto finish_single = [&](ContactReason reason, const ToolPose& pose, double beta, double known_penetration) {
-    res.status = ContactStatus::OneContact;
-    res.reason = reason;
-    res.tip = pose.tip;
-    res.axis = pose.axis;
-    res.beta = beta;
-    res.centre = pose.tip + Ri * pose.axis;
-    res.Q = res.P;
-    res.nQ = res.nP;
-    res.uvQ = res.uvP;
-    res.gap_P = res.gap_Q = tool_distance(tool_, pose.tip, pose.axis, res.P);
-    // The full check, unless the search ran it (DRD): VCRF's own check is partial (its earliest circular
-    // rays and beside P; issue 11), its finding is kept if deeper.
-    res.penetration = (drd && known_penetration >= 0.0)
-                          ? known_penetration
-                          : std::max(known_penetration, penetration(pose.tip, pose.axis, nullptr, &evals));
-    if (res.penetration > opt_.tol) {
-      res.status = ContactStatus::Failed;
-      res.reason = ContactReason::Gouge;
-    }
-    res.evaluations = evals;
-    return res;
-  };
+  res.evaluations = evals;
+  return res;
+}
 
-  const Vector3d dP = res.P - C0;
-  const Vector3d q = dP - dP.dot(Z) * Z;
-  const double rhoP = q.norm();
-  const ToolPose vertical{tip0, Z};
-  if (Ro == 0.0) return finish_single(ContactReason::Ball, vertical, 0.0, -1.0);
-  const double eps = 1e-9 * (1.0 + Ro + Ri);
-  if (tool_.shape == ToolShape::BullNose && rhoP <= Ro + eps)
-    return finish_single(ContactReason::FlatBottom, vertical, 0.0, -1.0);
-  if (tool_.shape == ToolShape::RoundInsert && rhoP < Ro - Ri + eps)
-    return finish_single(ContactReason::Hollow, vertical, 0.0, -1.0);
-
-  // Pseudo-insert frame (seed eqs. 24-27): e from the axis to P.
-  const PseudoInsert frame(tip0, q / rhoP, tool_);
-  const TiltGuess guess =
-      drd ? drd_tilt_guess(s, tool_, opt_, 2.0 * samples_.spacing(), frame, res.uvP, drop.tip_z, x, y, &evals)
-          : vcrf_tilt_guess(s, samples_, tool_, opt_, frame, res.uvP, x, y, &evals);
-  if (!(guess.beta <= opt_.beta_max))
-    return finish_single(ContactReason::TiltLimit, frame.tilted(opt_.beta_max), opt_.beta_max, -1.0);
-
-  TiltSearch search(s, samples_, tool_, opt_, frame, res.uvP, res.P, guess, &evals);
-  const TiltOutcome t = search.run(guess.beta, guess.uvQ);
-  if (!t.two) return finish_single(t.reason, t.pose, t.beta, t.penetration);
-
-  // --- Two contacts.
+MultipointResult MultipointPositioner::finish_two(MultipointResult& res, const TiltOutcome& t,
+                                                  const PseudoInsert& frame, const Vector3d& tip0,
+                                                  int& evals) const {
+  const PatchSurface& s = *surface_;
+  const Vector3d Z = Vector3d::UnitZ();
+  const bool drd = opt_.method == MultipointMethod::DRD;
   const double beta = t.beta;
   Vector3d tip = t.pose.tip, axis = t.pose.axis;
   res.penetration = t.penetration;
@@ -213,7 +170,7 @@ MultipointResult MultipointPositioner::position_core(double x, double y) const {
     res.penetration = std::max(res.penetration, penetration(tip, axis, nullptr, &evals));
   res.tip = tip;
   res.axis = axis;
-  res.centre = tip + Ri * axis;
+  res.centre = tip + tool_.Ri * axis;
   res.gap_P = tool_distance(tool_, tip, axis, res.P);
   res.gap_Q = tool_distance(tool_, tip, axis, res.Q);
   if (opt_.rotation == TiltRotation::PseudoInsert &&
@@ -224,6 +181,59 @@ MultipointResult MultipointPositioner::position_core(double x, double y) const {
   if (opt_.rotation == TiltRotation::GlobalX && res.penetration > opt_.tol) res.status = ContactStatus::Failed;
   res.evaluations = evals;
   return res;
+}
+
+MultipointResult MultipointPositioner::position_core(double x, double y) const {
+  MultipointResult res;
+  const PatchSurface& s = *surface_;
+  int evals = 0;
+  const Vector3d Z = Vector3d::UnitZ();
+  const double Ro = tool_.Ro, Ri = tool_.Ri;
+  const bool drd = opt_.method == MultipointMethod::DRD;
+
+  const Drop drop = drd ? drop_drd(s, x, y, &evals) : drop_vcrf(x, y, &evals);
+  if (!drop.ok) {
+    res.status = ContactStatus::Failed;
+    res.reason = ContactReason::NoSurface;
+    res.tip = Vector3d(x, y, s.bounds().hi.z());
+    res.centre = res.tip + Ri * Z;
+    res.evaluations = evals;
+    return res;
+  }
+  const Vector3d tip0(x, y, drop.tip_z);
+  const Vector3d C0 = tip0 + Ri * Z;
+  res.drop_z = drop.tip_z;
+  res.uvP = drop.uv;
+  {
+    const SurfacePoint sp = s.eval(drop.uv.x(), drop.uv.y(), 1);
+    res.P = sp.S;
+    res.nP = sp.normal();
+    if (res.nP.z() < 0.0) res.nP = -res.nP;
+  }
+
+  const Vector3d dP = res.P - C0;
+  const Vector3d q = dP - dP.dot(Z) * Z;
+  const double rhoP = q.norm();
+  const ToolPose vertical{tip0, Z};
+  if (Ro == 0.0) return finish_single(res, ContactReason::Ball, vertical, 0.0, -1.0, evals);
+  const double eps = 1e-9 * (1.0 + Ro + Ri);
+  if (tool_.shape == ToolShape::BullNose && rhoP <= Ro + eps)
+    return finish_single(res, ContactReason::FlatBottom, vertical, 0.0, -1.0, evals);
+  if (tool_.shape == ToolShape::RoundInsert && rhoP < Ro - Ri + eps)
+    return finish_single(res, ContactReason::Hollow, vertical, 0.0, -1.0, evals);
+
+  // Pseudo-insert frame (seed eqs. 24-27): e from the axis to P.
+  const PseudoInsert frame(tip0, q / rhoP, tool_);
+  const TiltGuess guess =
+      drd ? drd_tilt_guess(s, tool_, opt_, 2.0 * samples_.spacing(), frame, res.uvP, drop.tip_z, x, y, &evals)
+          : vcrf_tilt_guess(s, samples_, tool_, opt_, frame, res.uvP, x, y, &evals);
+  if (!(guess.beta <= opt_.beta_max))
+    return finish_single(res, ContactReason::TiltLimit, frame.tilted(opt_.beta_max), opt_.beta_max, -1.0, evals);
+
+  TiltSearch search(s, samples_, tool_, opt_, frame, res.uvP, res.P, guess, &evals);
+  const TiltOutcome t = search.run(guess.beta, guess.uvQ);
+  if (!t.two) return finish_single(res, t.reason, t.pose, t.beta, t.penetration, evals);
+  return finish_two(res, t, frame, tip0, evals);
 }
 
 MultipointResult MultipointPositioner::position_axis(double x, double y) const {

@@ -39,6 +39,10 @@
 
 namespace tmm {
 
+struct ToolPose;      // position/pose.hpp
+struct PseudoInsert;  // position/pose.hpp
+struct TiltOutcome;   // position/tilt_search.hpp
+
 class MultipointPositioner {
  public:
   // Throws std::invalid_argument naming the first invalid tool radius or option (NaN and infinities
@@ -78,6 +82,13 @@ class MultipointPositioner {
 
  private:
   MultipointResult position_core(double x, double y) const;
+  // The endings of position_core: one contact at P (known_penetration >= 0: what the search's check found at
+  // the pose), or two (the search's pose, turned about global X instead for the seed's rotation); each
+  // checks the pose and fills res.
+  MultipointResult finish_single(MultipointResult& res, ContactReason reason, const ToolPose& pose, double beta,
+                                 double known_penetration, int& evals) const;
+  MultipointResult finish_two(MultipointResult& res, const TiltOutcome& t, const PseudoInsert& frame,
+                              const Vector3d& tip0, int& evals) const;
   TorusTool tool_;
   MultipointOptions opt_;
   std::shared_ptr<const PatchSurface> real_;
