@@ -66,7 +66,8 @@ class VerifyCusp(FreeCADTestCase):
 
     def test_run_surface_verify_cusp(self) -> None:
         kw = dict(diameter=4.0, stepover=0.4, sample_step=0.5, cusp=TOL, progress=False)
-        plain = run_surface(str(bump_stl()), doc_name="TmmApiPlain", **kw)
+        plain = run_surface(str(bump_stl()), doc_name="TmmApiPlain", diameter=4.0, stepover=0.4, sample_step=0.5,
+                            progress=False)  # a cusp without the verification would be refused: it is not read
         checked = run_surface(str(bump_stl()), doc_name="TmmApiVerify", verify_cusp=True, **kw)
         self.assertIs(checked.op.VerifyCusp, True)
         self.assertGreater(len(checked.toolpath), len(plain.toolpath))

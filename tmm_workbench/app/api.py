@@ -171,7 +171,7 @@ def _refuse_ignored(stepover_mode: Any, stepover: Any, stepover_percent: Any, cu
                        "height (cusp); leave it out, or use stepover_mode 'stepover'")
     if stepover is not None and stepover_percent is not None:
         raise TmmError("give stepover (mm) or stepover_percent (of the tool diameter), not both")
-    if mode == "stepover" and cusp is not None and verify_cusp is not True:
+    if mode == "stepover" and cusp is not None and verify_cusp is False:  # a non-bool is refused below
         raise TmmError(f"cusp {cusp!r} is not used with stepover_mode 'stepover' (passes `stepover` apart): give "
                        "stepover_mode 'cusp', 'adaptive' or 'offset3d' to space the passes by it, or verify_cusp=True")
     if spiral_direction is not None and str(pattern).lower() != "spiral":

@@ -21,7 +21,7 @@ constant-mode step at `max_slope_deg` (core.footprint.cusp); gaps that still exc
 as `limited`. Passes run along `angle_deg` from +X; the work is done in a frame turned so that they run along +X'
 (the cutter is a solid of revolution: its drop does not change when the mesh turns about Z).
 
-The kernel's port (native.adaptive_raster, native/src/query/adaptive_raster.cpp) does the work when the kernel
+The kernel's port (native.adaptive_raster, native/src/algo/adaptive_raster.cpp) does the work when the kernel
 has it: the same samples, bracket and search, tens of times faster. This module's numpy code stays as the slow
 reference it is tested against (`reference=True`; tests/core/test_adaptive_raster.py).
 """
@@ -279,7 +279,7 @@ def adaptive_pass_offsets(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_d
 def _kernel_offsets(surface: DropSurface, cutter: Cutter, boundary: Rect, angle_deg: float, cusp: float,
                     sample_step: float, floor_z: float, stock_to_leave: float, max_slope_deg: float, s_min: float,
                     s_max: float, progress: Optional[Progress]) -> AdaptivePasses:
-    """The same placement in the kernel (native/src/query/adaptive_raster.cpp): `surface` holds the turned mesh."""
+    """The same placement in the kernel (native/src/algo/adaptive_raster.cpp): `surface` holds the turned mesh."""
     o = native.AdaptiveRasterOptions()
     o.xmin, o.ymin, o.xmax, o.ymax = (float(v) for v in boundary)
     o.angle, o.max_slope = math.radians(angle_deg), math.radians(max_slope_deg)
