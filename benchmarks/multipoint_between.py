@@ -1,7 +1,7 @@
 """Between multipoint positions on seed 001's three patches (core.strategies.multipoint_refine): for the
 seed footprint (side step 18 mm Fixed) at forward steps 2 and 8 mm, without the check (between_tol 0) and
 with it (0.005 mm): positions, inserted, still out of tolerance, the whole compute's time, and the deepest
-cut and widest chord gap along the moves measured independently (core.verify.swept.worst_between: face
+cut and widest chord gap along the moves measured independently (tests/core/swept.py: worst_between, face
 samples 0.25 mm apart, instances 0.5 mm apart).
 
     .venv/bin/python benchmarks/multipoint_between.py
@@ -21,7 +21,7 @@ from tmm_workbench.core.shared_data import benchmark_file  # noqa: E402
 from tmm_workbench.core.strategies import multipoint  # noqa: E402
 from tmm_workbench.core.strategies.multipoint import MultipointParams, make_positioner  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
-from tmm_workbench.core.verify import swept  # noqa: E402
+from tests.core import swept  # noqa: E402
 
 RO, RI = 6.7, 6.0
 

@@ -1,5 +1,5 @@
 """5-axis z-map simulation: the kernel's cut_5axis on a seed-001-size job, against the Python reference
-(core.verify.zmap) on a subset. Prints a markdown table.
+(tests/core/zmap_reference.py) on a subset. Prints a markdown table.
 
     .venv/bin/python benchmarks/sim5_bench.py             # the kernel in the package (tmm_workbench._native)
     TMM_SIM5_BUILD=build-sim5 .venv/bin/python benchmarks/sim5_bench.py   # a side build's module
@@ -34,7 +34,7 @@ from tmm_workbench.core.strategies.multipoint import (BezierFace, MultipointPara
                                                       compute_multipoint_toolpath, face_top, link_policy)
 from tmm_workbench.core.toolpath import MoveKind  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
-from tmm_workbench.core.verify import zmap  # noqa: E402
+from tests.core import zmap_reference as zmap  # noqa: E402
 
 RO, RI = 6.7, 6.0
 CELL = 0.1

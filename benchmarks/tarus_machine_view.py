@@ -1,4 +1,4 @@
-"""Tarus G-code of seed 001's three patches seen by the machine (core.verify.machine_view): A range and travel,
+"""Tarus G-code of seed 001's three patches seen by the machine (tests/core/machine_view.py): A range and travel,
 the largest A step, the tip's deviation from the straight line under linear joint interpolation, lines the
 joints cannot do in their programmed time, cycle time; joint mode and TCP mode.
 
@@ -30,7 +30,7 @@ from tmm_workbench.core.strategies.multipoint import (BezierFace, MultipointPara
                                                       compute_multipoint_toolpath, face_top, link_policy,
                                                       make_positioner)
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
-from tmm_workbench.core.verify import machine_view, swept  # noqa: E402
+from tests.core import machine_view, swept  # noqa: E402
 
 TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter=25.4, corner_radius=6.0,
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")

@@ -10,8 +10,9 @@ simulated section). `multipoint_footprint` (core.multipoint) spreads its passes 
 150 / 9 = 16.7 mm apart), so the positions are computed here at this explicit footprint with
 `position_points`.
 
-The swept tool is simulated by core.zmap on a line of needles at y = section_y (exact line-tool solves,
-sub-steps halved until the section changes by less than verify_tol), 0.25 mm apart, then refined around the
+The swept tool is simulated by the Python z-map (tests/core/zmap_reference.py) on a line of needles at
+y = section_y (exact line-tool solves, sub-steps halved until the section changes by less than verify_tol),
+0.25 mm apart, then refined around the
 local maxima above 0.05 mm (the scallop peaks are cusps) and the lowest local minima: needles 0.025 mm apart over
 +-0.25 mm, then 0.001 mm apart over +-0.025 mm. Deviation = simulated height minus
 the design height at the same (x, y); the seed patches have control points at x = 50 i, y = 50 j, evenly
@@ -31,7 +32,6 @@ from tmm_workbench.core.geometry.bezier import evaluate, load_seed_patch
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, BezierFace, MultipointParams, MultipointResults, position_points
 from tmm_workbench.core.shared_data import benchmark_file
-from tmm_workbench.core.verify.zmap import ZTool, simulate
 
 
 RO, RI = 6.7, 6.0
@@ -175,6 +175,9 @@ def run_experiment(which: str = "convex", method: str = "vcrf", section_y: float
         res, passes = positions
         xy, t_pos = res.xy, float("nan")
     counts = res.counts()
+    # imported here, not at the top: the z-map is test code, and the wheel and sanitizer runs copy only part of
+    # tests/ while a test of theirs imports seed_footprint from this module
+    from tests.core.zmap_reference import ZTool, simulate
 
     tool = ZTool(RO, RI, params.shape)
     paths = tool_paths(res, passes)

@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 from benchmarks.seed import experiment as se  # noqa: E402
 from tmm_workbench.core.geometry.bezier import load_seed_patch  # noqa: E402
 from tmm_workbench.core.strategies.multipoint import MultipointParams  # noqa: E402
-from tmm_workbench.core.verify.zmap import ZTool, lowest_z, simulate  # noqa: E402
+from tests.core.zmap_reference import ZTool, lowest_z, simulate  # noqa: E402
 
 GRID = 0.12          # mm, design-surface samples under the tool
 NEAR_P = 1.5         # mm: a second contact must lie farther than this from P

@@ -12,7 +12,7 @@ from tmm_workbench.core.linking import ALONG_AXIS, ENTRIES, LinkPolicy, link
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.toolpath import MoveKind, Z_AXIS
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify.zmap import ZTool
+from tests.core.zmap_reference import ZTool
 
 
 def seg(points, joined=False, kind=SegmentKind.PASS, axes=None):

@@ -2,7 +2,7 @@
 step the straight moves cut into seed 001's convex patch and, on the concave one, stand off the face (the
 chord error: material left) by far more than the tolerance; with the check on, neither exceeds it, or the
 moves still out of it are reported. Measured independently of the kernel's clearance: the face sampled
-every 0.25 mm (core.verify.swept.FaceSamples) against the tool solid, every 0.5 mm along each move (the
+every 0.25 mm (tests/core/swept.py: FaceSamples) against the tool solid, every 0.5 mm along each move (the
 samples are within 0.0013 mm of the face's true distance for this torus)."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import MultipointParams, make_positioner
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify import swept
+from tests.core import swept
 
 RO, RI, TOL, SAMPLING = 6.7, 6.0, 0.005, 0.0015
 

@@ -18,7 +18,7 @@ from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, MultipointPa
 from tmm_workbench.core.strategies.multipoint_scallop import (MAX_TRIALS, NOT_REACHED, OVER_SCALLOP, LeftArea,
                                                                estimate_passes)
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify.zmap import ZTool, simulate
+from tests.core.zmap_reference import ZTool, simulate
 
 TORUS = Cutter.torus(6.7, 6.0)
 

@@ -1,5 +1,5 @@
 """Side step from a scallop height (core.strategies.multipoint_scallop, issue 14 item 5): the placed passes'
-scallop read again by the independent Python z-map (core.verify.zmap, its own line-torus solves) on needle
+scallop read again by the independent Python z-map (tests/core/zmap_reference.py, its own line-torus solves) on needle
 lines the placement did not use, no gouge, the design heights, the frame, bad input and the work estimate."""
 from __future__ import annotations
 
@@ -17,7 +17,7 @@ from tmm_workbench.core.strategies.multipoint import STATUS_FAILED, BezierFace, 
 from tmm_workbench.core.strategies.multipoint_meter import END_INSET, DesignHeights, Frame
 from tmm_workbench.core.strategies.multipoint_scallop import estimate_passes
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify.zmap import ZTool, simulate
+from tests.core.zmap_reference import ZTool, simulate
 
 TORUS = Cutter.torus(6.7, 6.0)
 BOX = (30.0, 40.0, 85.0, 70.0)  # a part of the seed patch: 4-5 passes, a few seconds

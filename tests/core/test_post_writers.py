@@ -17,7 +17,7 @@ from tmm_workbench.core.post import Operation, ToolInfo, apt_writer, tarus_write
 from tmm_workbench.core.post.apt_writer import AptOptions, write_apt
 from tmm_workbench.core.post.tarus_writer import TarusOptions, write_tarus
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
-from tmm_workbench.core.verify import machine_view
+from tests.core import machine_view
 
 TOOL = ToolInfo(number=3, label="6 mm ball", shape="ballend", diameter=6.0, corner_radius=3.0, cutting_height=20.0,
                 spindle_rpm=12000, spindle_dir="CW")

@@ -1,5 +1,5 @@
 """The kernel's 5-axis z-map simulation (native cut_5axis, lowest_on_vertical) against the Python reference
-tmm_workbench/core/verify/zmap.py on the same needles, and seed 001's section figure (docs/seed_experiment.md:
+tests/core/zmap_reference.py on the same needles, and seed 001's section figure (docs/seed_experiment.md:
 convex patch, seed options, VCRF, the whole section y = 27: max deviation 0.556 mm at x = 10.27).
 
 With TMM_SIM5_BUILD=<build folder> the module is loaded from that folder (and stands in for the package's, so
@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tmm_workbench.core.verify import zmap
+from tests.core import zmap_reference as zmap
 
 ROOT = Path(__file__).resolve().parents[2]
 

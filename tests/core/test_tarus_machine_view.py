@@ -1,4 +1,4 @@
-"""Seed 001's three patches through the Tarus post, seen by the machine (core.verify.machine_view): in joint
+"""Seed 001's three patches through the Tarus post, seen by the machine (tests/core/machine_view.py): in joint
 and TCP mode, A stays inside its +-360 deg limits and never turns 180 deg in one line, every line is doable
 at the joint speeds, the tool cuts no deeper than 0.01 mm into the face anywhere along the motion (as the
 control moves it), and in joint mode the tip stays within 0.005 mm of the straight line between programmed
@@ -21,7 +21,7 @@ from tmm_workbench.core.post.tarus_writer import TarusOptions, write_tarus
 from tmm_workbench.core.strategies.multipoint import (MultipointParams, compute_multipoint_toolpath, face_top,
                                                       link_policy, make_positioner)
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify import machine_view, swept
+from tests.core import machine_view, swept
 
 TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter=25.4, corner_radius=6.0,
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")

@@ -1,7 +1,7 @@
 """The Tarus post through the vertical (C = 0, the head-head machine's singularity): an axis passing the
 vertical on a free-form face is planned through it (C down to 0, A turned there, on at the new A; the way
-round chosen for the A limits) within the tolerances, and checked as the machine moves (core.verify.
-machine_view: joints interpolated linearly, the tip on its line, A never a whole turn inside a cut, no gouge
+round chosen for the A limits) within the tolerances, and checked as the machine moves (tests/core/
+machine_view.py: joints interpolated linearly, the tip on its line, A never a whole turn inside a cut, no gouge
 deeper than 0.01 mm). Before: 'cannot follow its straight line ... even in 4096 pieces' on a move passing
 the vertical closely, RotaryPlanError on a cut whose axis circles the vertical (random nets 45 and 47)."""
 from __future__ import annotations
@@ -22,7 +22,7 @@ from tmm_workbench.core.strategies.multipoint import (MultipointParams, compute_
                                                       link_policy, make_positioner)
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.verify import machine_view, swept
+from tests.core import machine_view, swept
 
 TOOL = ToolInfo(number=1, label="bull-nose D25.4 r6", shape="bullnose", diameter=25.4, corner_radius=6.0,
                 cutting_height=30.0, spindle_rpm=10000, spindle_dir="CW")

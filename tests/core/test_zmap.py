@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.verify import zmap
-from tmm_workbench.core.verify.zmap import (ZTool, _torus_lowest, cut, interpolate_axis, lowest_z, move_instances,
+from tests.core import zmap_reference as zmap
+from tests.core.zmap_reference import (ZTool, _torus_lowest, cut, interpolate_axis, lowest_z, move_instances,
                                     simulate, substeps)
 
 Z = np.array([0.0, 0.0, 1.0])

@@ -77,7 +77,7 @@ class MachineView:
 def view(machine: TarusMachine, text: str, tcp: bool = False, depth=None, samples: int = 8) -> MachineView:
     """The checks of the module doc on Tarus G-code written for `machine` (joint mode, or TCP mode where the
     control keeps the tip on its line: no deviation is measured there). With `depth` (tips, axes -> mm
-    inside the part, e.g. core.verify.swept.FaceGouge), the tool is also checked at `samples` instances
+    inside the part, e.g. tests/core/swept.py: FaceGouge), the tool is also checked at `samples` instances
     along every line (cuts, and the approach, retract and transit rapids), moved as the control moves it
     (joints linear, or in TCP mode the tip linear and A, C linear), and at its end."""
     lines = read_tarus(text)

@@ -1,4 +1,6 @@
-"""Z-map (height-map) simulation of a 5-axis toroidal tool: vertical needles cut down by the swept tool.
+"""Z-map (height-map) simulation of a 5-axis toroidal tool: vertical needles cut down by the swept tool. The
+slow, independent reference the kernel's sweep (core.sim, the product's stock simulation) and the multipoint
+scallop are checked against; test code, not part of the add-on.
 
 Each needle is a vertical line at (x, y) holding a height; the tool, moved linearly between consecutive
 positions, lowers every needle to the lowest point of the tool solid on that vertical line. Needles may be
