@@ -1,7 +1,7 @@
 """The time a user waits for the 3-axis Surface op with the adaptive step-over (issue 14 items 1 and 7): from OK
 to the path (the op's recompute through `run_surface`: strategy, linker, Path) and FreeCAD's post, with the pass
-placement in the kernel (native.adaptive_raster) and in the numpy reference (core.footprint.adaptive_raster, as
-before the port), side by side. sphere_on_plate.stl, ball D6, cusp 0.01 mm, 0.25 mm sampling, as
+placement in the kernel (native.adaptive_raster) and in the numpy reference (tests/core/adaptive_raster_reference.py,
+as before the port), side by side. sphere_on_plate.stl, ball D6, cusp 0.01 mm, 0.25 mm sampling, as
 benchmarks/cusp_spacing.py.
 
 Run with FreeCAD's Python:
@@ -10,7 +10,6 @@ Run with FreeCAD's Python:
 """
 from __future__ import annotations
 
-import functools
 import os
 import sys
 import tempfile
@@ -21,16 +20,16 @@ ROOT = Path(__file__).resolve().parents[1] if "__file__" in globals() else Path.
 sys.path.insert(0, str(ROOT))
 
 from benchmarks.user_wait import user_wait  # noqa: E402
+from tests.core import adaptive_raster_reference  # noqa: E402
 from tmm_workbench.app.api import run_surface  # noqa: E402
-from tmm_workbench.core.footprint import adaptive_raster  # noqa: E402
 from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
 from tmm_workbench.core.strategies.surface import pattern  # noqa: E402
 
 
 def run(label: str, out: Path, reference: bool) -> dict:
-    placed = adaptive_raster.adaptive_pass_offsets
+    placed = pattern.adaptive_pass_offsets
     if reference:  # the strategy imported the function by name: swap it there for the run
-        pattern.adaptive_pass_offsets = functools.partial(placed, reference=True)
+        pattern.adaptive_pass_offsets = adaptive_raster_reference.adaptive_pass_offsets
     try:
         t0 = time.perf_counter()
         r = run_surface(str(shared_dir() / "benchmarks" / "stl" / "sphere_on_plate.stl"), doc_name=f"e2e_{label}",

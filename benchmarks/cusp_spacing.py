@@ -179,11 +179,9 @@ def main() -> None:
                     help="place the adaptive passes with the numpy reference instead of the kernel")
     args = ap.parse_args()
     if args.reference:  # the strategy imported the function by name: swap it there
-        import functools
-
-        from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
+        from tests.core import adaptive_raster_reference
         from tmm_workbench.core.strategies.surface import pattern
-        pattern.adaptive_pass_offsets = functools.partial(adaptive_pass_offsets, reference=True)
+        pattern.adaptive_pass_offsets = adaptive_raster_reference.adaptive_pass_offsets
     if args.seed000:
         from seed000_surfaces import INCH, seed000_mesh
         for name in ("convex", "concave"):

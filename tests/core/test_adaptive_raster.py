@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import grid_mesh
+from tests.core import adaptive_raster_reference
 from tmm_workbench.core import limits
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
@@ -114,7 +115,7 @@ def test_cancel_and_work_limit():
         adaptive_pass_offsets(mesh, Cutter.ball(6), BOX, 0.0, 0.01, 0.25, -30.0, max_slope_deg=90.0)
 
 
-# --- the kernel's port (native.adaptive_raster) against this numpy reference ------------------------------------
+# --- the kernel's port (native.adaptive_raster) against the numpy reference (adaptive_raster_reference.py) -----
 # The kernel computes the same samples, bracket and search (only the least over a pass's instances is pruned,
 # which does not change it): the offsets agree to floating-point rounding. A rounding difference could flip one
 # step's comparison with the target and shift the rest of the set by up to the 2 % bracket, so the stated
@@ -154,7 +155,7 @@ def test_the_kernel_matches_the_reference_on_the_bump(cutter, angle, stock):
     floor_z = float(mesh.bounds[0][2])
     args = (mesh, cutter, BOX, angle, 0.01, 0.25, floor_z, stock)
     kernel = adaptive_pass_offsets(*args)
-    reference = adaptive_pass_offsets(*args, reference=True)
+    reference = adaptive_raster_reference.adaptive_pass_offsets(*args)
     _same(kernel, reference)
     assert len(kernel.offsets) > 20 and kernel.cusps.max() > 0.005  # a real curved case, not a plane
 
@@ -170,6 +171,6 @@ def test_the_kernel_matches_the_reference_on_sphere_on_plate():
     window = (26.0, 4.0, 50.0, 20.0)
     args = (mesh, Cutter.ball(6), window, 0.0, 0.01, 0.25, float(mesh.bounds[0][2]))
     kernel = adaptive_pass_offsets(*args)
-    reference = adaptive_pass_offsets(*args, reference=True)
+    reference = adaptive_raster_reference.adaptive_pass_offsets(*args)
     _same(kernel, reference)
     assert kernel.unreachable > 0 and np.ptp(np.diff(kernel.offsets)[:-1]) > 0.05  # the corner, varied gaps
