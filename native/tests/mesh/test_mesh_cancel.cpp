@@ -3,7 +3,6 @@
 // gives the same result with a callback that goes on as without one.
 #include <gtest/gtest.h>
 
-#include <cstddef>
 #include <cstring>
 #include <memory>
 #include <random>
@@ -43,15 +42,6 @@ bool same_bytes(const std::vector<A>& a, const std::vector<B>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(A)) == 0;
 }
 
-// Field by field: an IndexedTriangle's padding after its edge bits holds whatever the stack held.
-bool same_triangles(const std::vector<tmm::IndexedTriangle>& a, const std::vector<tmm::IndexedTriangle>& b) {
-  if (a.size() != b.size()) return false;
-  constexpr std::size_t kValues = offsetof(tmm::IndexedTriangle, owned_edges);  // the doubles before the bits
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if (std::memcmp(&a[i], &b[i], kValues) != 0 || a[i].owned_edges != b[i].owned_edges) return false;
-  }
-  return true;
-}
 
 TEST(MeshCancel, Weld) {
   const tmm::Soup soup = soup_of(grid(60));
@@ -86,7 +76,7 @@ TEST(MeshCancel, MeshIndex) {
   for (const int threads : {1, 2}) {
     const auto index = run_reported([&](const ProgressFn& p) { return tmm::MeshIndex(g.V, g.F, threads, p); });
     const tmm::MeshIndex plain(g.V, g.F, threads);
-    EXPECT_TRUE(same_triangles(index.triangles(), plain.triangles()));
+    EXPECT_TRUE(tmm_test::same_triangles(index.triangles(), plain.triangles()));
     EXPECT_TRUE(same_bytes(index.nodes(), plain.nodes()));
   }
 }

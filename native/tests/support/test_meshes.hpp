@@ -4,12 +4,25 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <random>
 #include <utility>
+#include <vector>
 
 #include "tmm/mesh/mesh_index.hpp"
 
 namespace tmm_test {
+
+// Field by field: an IndexedTriangle's padding after its edge bits is never written, so bytes may differ.
+inline bool same_triangles(const std::vector<tmm::IndexedTriangle>& a, const std::vector<tmm::IndexedTriangle>& b) {
+  if (a.size() != b.size()) return false;
+  constexpr std::size_t kValues = offsetof(tmm::IndexedTriangle, owned_edges);  // the doubles before the bits
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::memcmp(&a[i], &b[i], kValues) != 0 || a[i].owned_edges != b[i].owned_edges) return false;
+  }
+  return true;
+}
 
 // The index over the single triangle a b c.
 inline tmm::MeshIndex one_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
