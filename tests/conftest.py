@@ -1,7 +1,6 @@
 """Shared test helpers: small analytic meshes built from arrays (no file I/O)."""
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -9,14 +8,14 @@ import pytest
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.shared_data import shared_dir
+from tmm_workbench.core.shared_data import SIBLING, shared_dir
 
 # The shared benchmark files (seed surfaces, STL files), wherever core.shared_data finds them. Absent, only
 # the tests that read them fail (each names the missing path), not the collection of every test.
 try:
     SHARED = shared_dir()
 except TmmError:
-    SHARED = Path("/work/shared")
+    SHARED = SIBLING
 SHARED_STL = SHARED / "benchmarks" / "stl"
 SEED_JSON = SHARED / "benchmarks" / "seed_surfaces.json"
 

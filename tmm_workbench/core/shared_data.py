@@ -1,6 +1,7 @@
 """Where the project's shared benchmark files are (seed surfaces, real STL files). They are not part of the
-add-on: benchmarks, the demo, the seed experiment and the tests read them from the folder `shared/` beside
-the checkout, or from /work/shared, or from $TMM_SHARED_DIR when set (checked first)."""
+add-on: benchmarks, the demo, the seed experiment and the tests read them from $TMM_SHARED_DIR when set, else
+from the folder `shared/` beside the checkout (the checkout found through this file, links resolved, so the
+FreeCAD Mod link to it counts)."""
 from __future__ import annotations
 
 import os
@@ -9,13 +10,13 @@ from pathlib import Path
 from tmm_workbench.core.errors import TmmError
 
 REPO = Path(__file__).resolve().parents[2]
-_CANDIDATES = (REPO.parent / "shared", Path("/work/shared"))
+SIBLING = REPO.parent / "shared"
 
 
 def shared_dir() -> Path:
     """The shared folder (the one holding benchmarks/); TmmError naming the places tried if none does."""
     env = os.environ.get("TMM_SHARED_DIR")
-    tried = ([Path(env)] if env else []) + list(_CANDIDATES)
+    tried = ([Path(env)] if env else []) + [SIBLING]
     for d in tried:
         if (d / "benchmarks").is_dir():
             return d
