@@ -11,7 +11,7 @@ import pytest
 
 from tests.conftest import SEED_JSON
 from tmm_workbench.core.geometry import bezier
-from tmm_workbench.core.geometry.bspline import bspline_point, bspline_to_bezier, flat_knots
+from tmm_workbench.core.geometry.bspline import bspline_to_bezier, flat_knots
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, STATUS_ONE, STATUS_TWO, BezierFace, MultipointParams,
@@ -20,6 +20,29 @@ from tmm_workbench.core.toolpath import MoveKind
 
 SEEDS = SEED_JSON
 RO, RI = 6.7, 6.0
+
+
+def bspline_point(poles, degree_u: int, degree_v: int, U: np.ndarray, V: np.ndarray, u: float, v: float) -> np.ndarray:
+    """S(u, v) of a non-rational B-spline by de Boor's algorithm: independent of the knot insertion that
+    core.geometry.bspline converts with, which is what it checks."""
+    P = np.asarray(poles, dtype=float)
+
+    def de_boor(ctrl, knots, p, t):
+        n = len(ctrl)
+        k = p
+        while k < n - 1 and knots[k + 1] <= t:
+            k += 1
+        d = [np.array(ctrl[j + k - p], dtype=float) for j in range(p + 1)]
+        for r in range(1, p + 1):
+            for j in range(p, r - 1, -1):
+                i = j + k - p
+                den = knots[i + p - r + 1] - knots[i]
+                a = 0.0 if den == 0 else (t - knots[i]) / den
+                d[j] = (1 - a) * d[j - 1] + a * d[j]
+        return d[p]
+
+    rows = np.array([de_boor(P[i], V, degree_v, v) for i in range(P.shape[0])])
+    return de_boor(rows, U, degree_u, u)
 
 
 def seed_net(kind: str) -> np.ndarray:

@@ -114,25 +114,3 @@ def bspline_to_bezier(poles, degree_u: int, degree_v: int, knots_u: Sequence[flo
     Puv = np.swapaxes(Puv, 0, 1)
     nets = [np.ascontiguousarray(Puv[i0:i0 + p + 1, j0:j0 + q + 1]) for i0 in su for j0 in sv]
     return BezierPieces(nets, len(su), len(sv), bu, bv)
-
-
-def bspline_point(poles, degree_u: int, degree_v: int, U: np.ndarray, V: np.ndarray, u: float, v: float) -> np.ndarray:
-    """S(u, v) of a non-rational B-spline by de Boor's algorithm (independent reference for tests)."""
-    P = np.asarray(poles, dtype=float)
-
-    def de_boor(ctrl, knots, p, t):
-        n = len(ctrl)
-        k = p
-        while k < n - 1 and knots[k + 1] <= t:
-            k += 1
-        d = [np.array(ctrl[j + k - p], dtype=float) for j in range(p + 1)]
-        for r in range(1, p + 1):
-            for j in range(p, r - 1, -1):
-                i = j + k - p
-                den = knots[i + p - r + 1] - knots[i]
-                a = 0.0 if den == 0 else (t - knots[i]) / den
-                d[j] = (1 - a) * d[j - 1] + a * d[j]
-        return d[p]
-
-    rows = np.array([de_boor(P[i], V, degree_v, v) for i in range(P.shape[0])])
-    return de_boor(rows, U, degree_u, u)

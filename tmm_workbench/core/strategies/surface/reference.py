@@ -1,6 +1,6 @@
 """The simulated cusp of a 3-axis pass set against the raster strategy's own dense raster: core.sim.cusp_field's
-measurement with its reference made here, above the strategy (core.strategies.raster_drop), for the tests, the
-benchmarks and the op's report."""
+measurement with its reference made here, above the strategy (core.strategies.raster_drop), for the tests and
+the benchmarks (the op's own check, core.strategies.surface.variable_step, puts the same pieces together)."""
 from __future__ import annotations
 
 from typing import Optional
