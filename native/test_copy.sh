@@ -12,4 +12,4 @@ cp "$ROOT/tests/core/__init__.py" "$TMP/tests/core/"
 TESTS=(test_drop_binding.py test_kernel_cancel.py test_mesh_io.py test_multipoint.py test_native_hardening.py
        test_waterline.py)
 for t in "${TESTS[@]}"; do cp "$ROOT/tests/core/$t" "$TMP/tests/core/"; done
-export TMM_SHARED_DIR="${TMM_SHARED_DIR:-$(cd "$ROOT" && python3 -c 'from tmm_workbench.core.shared_data import shared_dir; print(shared_dir())' 2>/dev/null || echo /work/shared)}"
+export TMM_SHARED_DIR="${TMM_SHARED_DIR:-$(cd "$ROOT" && python3 -c 'from tmm_workbench.core.shared_data import shared_dir; print(shared_dir())' 2>/dev/null || echo "$ROOT/../shared")}"

@@ -1,4 +1,4 @@
-// Adaptive raster: see the header and core/footprint/adaptive_raster.py (the reference, step for step: the
+// Adaptive raster: see the header and tests/core/adaptive_raster_reference.py (the numpy reference, step for step: the
 // same samples, the same bracketing, the same search; only the least over a pass's instances is pruned, which
 // does not change it).
 #include "tmm/algo/adaptive_raster.hpp"

@@ -34,7 +34,7 @@ angle to them): there the simulated cusp exceeded the rule's by up to 1.6x on a 
 that cross such a border get the swept tool: drops at 0.05, 0.2 and 0.5 R either side along the passes too (H
 and E from every offset's instance at its 3D distance), and E there also from instances between the samples,
 dropped where the CL section turns (the foot of the roll onto the floor, a corner the samples cut off)
-(docs/results.md, "Constant cusp mode by the section rule", 2026-12-02 cusp4 and cusp5).
+(docs/history/results-log.md, "Constant cusp mode by the section rule", 2026-12-02 cusp4 and cusp5).
 """
 from __future__ import annotations
 
@@ -419,7 +419,7 @@ def _swept_layers(surface: DropSurface, tool: Cutter, cutter: Cutter, world: np.
     region (a sample on the model, its neighbour off it, the design there within the tool's reach of the floor:
     the passes beyond it roll over the edge onto the floor, and as the edge runs at an angle to them, differently
     along the pass; the section's instances alone missed the swept tool's reach there by 0.0046 mm on a 30 deg
-    sheet, docs/results.md). A whole section or none, so that H and E of a pair come from the same tool."""
+    sheet, docs/history/results-log.md). A whole section or none, so that H and E of a pair come from the same tool."""
     r_max = cutter.native.max_radius
     on = np.isfinite(design)
     edge = np.zeros(c.shape, dtype=bool)

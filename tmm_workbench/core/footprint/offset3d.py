@@ -14,7 +14,7 @@ short spike out along the bisector there (_spiked), which brings it to d / 2.
 
 (Until 2026-12-02 the passes were a variable offset by discs, by Clipper: each next loop the boundary of what was
 left once every point within d(p) of the current loops was taken away. On a relief it fell apart into many short
-loops: see docs/results.md "### 3D offset" and this file's history.)
+loops: see docs/history/results-log.md "### 3D offset" and this file's history.)
 """
 from __future__ import annotations
 

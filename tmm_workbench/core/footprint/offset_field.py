@@ -60,7 +60,7 @@ _BYTES_PER_NODE = 64     # heights, T, masks, the node coordinates and the drop'
 CUSP_AIM = 0.92          # the rule's cusp: this share of the tolerance (the step 4 % narrower for a ball), for
                          # what the field samples only to first order: the marching in its cell, the 0.25 mm
                          # chords along the passes, the slope and curvature as secants over _PROBE of a step
-                         # (measured: benchmarks/offset3d_where.py, results.md "### 3D offset")
+                         # (measured: benchmarks/offset3d_where.py, history/results-log.md "3D offset")
 _FIT_REACH = 4.0         # sharpened: each edge fitted over 2 to this many reaches from the corner
 _EDGE_TURN = 10.0        # deg: ... as long as it turns by no more than this (not round a short side's corner)
 

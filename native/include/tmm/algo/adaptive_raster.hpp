@@ -1,7 +1,7 @@
 // Adaptive raster (seed 000 section 3.5.2.2): the across-offsets of parallel passes such that the
 // largest cusp between neighbours is the tolerance, each pass placed from the real CL points of the previous
-// one. The kernel's port of core/footprint/adaptive_raster.py, which stays the slow reference and explains
-// the method; the two must agree (tests/core/test_adaptive_raster.py).
+// one. The kernel's port of the numpy placement in tests/core/adaptive_raster_reference.py, the slow
+// reference that explains the method; the two must agree (tests/core/test_adaptive_raster.py).
 //
 // In short: the work happens in a frame where the passes run along +X' (`index` is the mesh turned so:
 // the cutter is a solid of revolution, so its drop does not change when the mesh turns about Z). For a pass
