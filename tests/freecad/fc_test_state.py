@@ -148,7 +148,7 @@ class SurfaceExpectations(FreeCADTestCase):
         from tmm_workbench.core.errors import TmmError
 
         lo_x, lo_y = -30.0, -30.0
-        r = run_surface(str(bump_stl()), diameter=4.0, stepover=9.0, stepover_percent=50.0, sample_step=0.5,
+        r = run_surface(str(bump_stl()), diameter=4.0, stepover_percent=50.0, sample_step=0.5,
                         boundary="model", pattern="oneway", stock_to_leave=0.2, final_depth=0.5, finish_passes=2,
                         finish_step_down=0.3, start_point=(lo_x, lo_y), doc_name="TmmApiDepths", progress=False)
         op = r.op
