@@ -207,3 +207,81 @@ def bit_for_cutter(doc: Any, cutter: Cutter, label: str = "") -> Any:
     if shape is None:
         return make_apt_bit(doc, cutter, label)
     return make_tool_bit(doc, shape, cutter.diameter, cutter.corner_radius, label)
+
+
+# --- the tool assembly: shank, neck and holder above the cutter (core.tools.assembly) ---
+
+GRIP_SHANK_DIAMETERS = 3.0  # default grip: 3 shank diameters in the holder (about 2/3 of an ER collet's bore)
+
+
+def user_holders_file() -> Optional[Path]:
+    """The user's holder file extending TMM's library: holders.json in TMM's folder of the FreeCAD user data
+    folder (docs/holders.md); None outside FreeCAD."""
+    try:
+        import FreeCAD
+    except ImportError:
+        return None
+    from tmm_workbench.core.tools import holders
+
+    return holders.user_file_in(FreeCAD.getUserAppDataDir())
+
+
+def _optional_mm(tool: Any, *props: str) -> Optional[float]:
+    """The first of `props` the tool carries, in mm; None when it has none of them."""
+    for prop in props:
+        if hasattr(tool, prop):
+            return _mm(getattr(tool, prop))
+    return None
+
+
+def _default_stick_out(probe: Any, length: float, label: str) -> float:
+    """The bit's Length minus a grip of GRIP_SHANK_DIAMETERS shank diameters, shortened so the flutes, neck
+    and cone stay out of the holder; refused when less than one shank diameter would be held."""
+    shank = probe.shank_diameter
+    stick_out = max(length - GRIP_SHANK_DIAMETERS * shank, probe.minimum_stick_out)
+    if length - stick_out < shank - 1e-9:
+        raise TmmError(f"tool '{label}': its length {length:g} mm leaves {length - stick_out:g} mm to clamp "
+                       f"once the {probe.minimum_stick_out:g} mm of flutes, neck and cone stand out, less than "
+                       f"the shank diameter {shank:g} mm: give the stick-out")
+    return stick_out
+
+
+def assembly_from_tool(tool: Any, holder: Any = None, stick_out: Optional[float] = None, *,
+                       cutter_clearance: float = 0.0, shank_clearance: float = 1.0, holder_clearance: float = 1.0,
+                       shank_cone_deg: float = 90.0, holders_file: Any = "user") -> Any:
+    """The core ToolAssembly of a ToolBit (0.20, 1.0, 1.1 alike): its cutter (cutter_from_tool), ShankDiameter
+    (the cutter diameter when the bit has none: 0.20's legacy tools), CuttingEdgeHeight as the flute length
+    (at least a cone's height), Length as the overall length, NeckDiameter with NeckLength or NeckHeight when
+    the shape has a neck. `holder`: a core Holder, a name in the library (shipped + `holders_file`, by default
+    user_holders_file()) or None. `stick_out`: the gauge length from the holder face to the tip; None takes
+    Length minus 3 shank diameters (_default_stick_out). TmmError naming the tool and the value."""
+    from tmm_workbench.core.tools import holders
+    from tmm_workbench.core.tools.assembly import ToolAssembly
+
+    cutter = cutter_from_tool(tool)
+    label = label_of(tool)
+    shank = _optional_mm(tool, "ShankDiameter")
+    edge = _optional_mm(tool, "CuttingEdgeHeight")
+    if edge is None and not math.isfinite(cutter.cutting_length):
+        raise TmmError(f"tool '{label}' has no CuttingEdgeHeight: its flute length is unknown")
+    flute = max(v for v in (edge, cutter.cutting_length) if v is not None and math.isfinite(v))
+    length = _optional_mm(tool, "Length")
+    neck_d = _optional_mm(tool, "NeckDiameter")
+    neck_l = _optional_mm(tool, "NeckLength", "NeckHeight") if neck_d is not None else None
+    if isinstance(holder, str):
+        path = user_holders_file() if holders_file == "user" else holders_file
+        holder = holders.holder(holder, path)
+    try:
+        def assemble(out: float, held: Any) -> Any:
+            return ToolAssembly(cutter, cutter.diameter if shank is None else shank, out, flute_length=flute,
+                                holder=held, neck_diameter=neck_d, neck_length=neck_l or 0.0,
+                                shank_cone_deg=shank_cone_deg, overall_length=length,
+                                cutter_clearance=cutter_clearance, shank_clearance=shank_clearance,
+                                holder_clearance=holder_clearance)
+        if stick_out is None:
+            if length is None:
+                raise TmmError("it has no Length: give the stick-out")
+            stick_out = _default_stick_out(assemble(length, None), length, label)
+        return assemble(stick_out, holder)
+    except TmmError as exc:
+        raise TmmError(str(exc) if str(exc).startswith(f"tool '{label}'") else f"tool '{label}': {exc}") from exc
