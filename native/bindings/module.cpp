@@ -7,6 +7,7 @@ void bind_mesh(py::module_& m);   // mesh/bind_mesh.cpp: STL reading, indexed me
 void bind_cutter(py::module_& m);  // cutter/bind_cutter.cpp: the cutter of revolution and its profile
 void bind_drop(py::module_& m);   // query/bind_drop.cpp: spatial index, batch drop-cutter
 void bind_direction(py::module_& m);  // query/bind_direction.cpp: drop along any direction, any axis
+void bind_drop_assembly(py::module_& m);  // query/bind_drop_assembly.cpp: drop of cutter + shank + holder
 void bind_surface(py::module_& m);    // surface/bind_surface.cpp: Bezier/B-spline faces
 void bind_multipoint(py::module_& m);  // position/bind_multipoint.cpp: multipoint positioning of a torus
 void bind_waterline(py::module_& m);  // query/bind_waterline.cpp: exact waterline loops
@@ -22,6 +23,7 @@ PYBIND11_MODULE(_native, m) {
   bind_cutter(m);
   bind_drop(m);
   bind_direction(m);
+  bind_drop_assembly(m);
   bind_waterline(m);
   bind_surface(m);
   bind_multipoint(m);
