@@ -3,6 +3,7 @@
 #include "tmm/query/drop_assembly.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -43,6 +44,10 @@ void check_bodies(const std::vector<ToolBody>& bodies) {
 }
 
 constexpr std::size_t kNoBody = ~std::size_t{0};
+// Fewer points walk without the height cells (building them costs about a walk per cell row).
+constexpr std::size_t kCellsFromPoints = 256;
+// Pieces reaching at most this many times the cutter's radius are dropped with tile lists, wider ones by walks.
+constexpr double kTilesUpTo = 2.0;
 
 // Does a body other than `skip`, grown by its clearance, hold the disc of radius `radius` at height `z` grown
 // by `clearance`? Then that disc's piece (a top rim) can never set the height and is left out.
@@ -99,6 +104,154 @@ void add_body(std::vector<AssemblyPiece>& out, std::size_t i, const std::vector<
     out.push_back({Cutter(b.r1 + c, c), b.z1 - c, owner});
 }
 
+// Upper bounds of the mesh's height near a batch's points: square cells over the points' box grown by the
+// largest reach, each holding the highest top of the index nodes overlapping it. A piece can lift the tool at a
+// point only if a triangle within its reach rises above the point's floor; the cells' maxima over the squares
+// around them reaching that far bound this, so most points skip a piece (a holder high above the part) with
+// one lookup instead of a walk down the index.
+class HeightCells {
+ public:
+  static constexpr double kCellsPerSide = 256;
+
+  HeightCells(const MeshIndex& index, const double* xy, std::size_t n, double reach) {
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = xy[2 * i], y = xy[2 * i + 1];
+      if (!std::isfinite(x) || !std::isfinite(y)) continue;
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+    if (!(x0 <= x1) || index.nodes().empty()) return;  // no finite point: every point walks
+    x0_ = x0 - reach;
+    y0_ = y0 - reach;
+    side_ = std::max(std::max(x1 - x0, y1 - y0) + 2.0 * reach, 1e-9) / kCellsPerSide;
+    nx_ = static_cast<std::size_t>((x1 + reach - x0_) / side_) + 1;
+    ny_ = static_cast<std::size_t>((y1 + reach - y0_) / side_) + 1;
+    top_.assign(nx_ * ny_, -INFINITY);
+    fill(index);
+  }
+
+  bool empty() const { return top_.empty(); }
+
+  // The maxima over squares of cells reaching `reach` around each cell (any triangle whose box comes within
+  // `reach` of a point lies in the square around the point's cell).
+  std::vector<double> dilated(double reach) const {
+    const auto k = static_cast<std::size_t>(std::ceil(reach / side_)) + 1;
+    std::vector<double> rows(top_.size()), out(top_.size());
+    for (std::size_t j = 0; j < ny_; ++j) window_max(&top_[j * nx_], &rows[j * nx_], nx_, 1, k);
+    for (std::size_t i = 0; i < nx_; ++i) window_max(&rows[i], &out[i], ny_, nx_, k);
+    return out;
+  }
+
+  // The cell holding (x, y), or the nearest one (a node's corner outside the grid); clamped before the cast.
+  std::size_t cell(double x, double y) const {
+    const double i = std::clamp((x - x0_) / side_, 0.0, static_cast<double>(nx_ - 1));
+    const double j = std::clamp((y - y0_) / side_, 0.0, static_cast<double>(ny_ - 1));
+    return static_cast<std::size_t>(j) * nx_ + static_cast<std::size_t>(i);
+  }
+
+ private:
+  // Every node no wider than two cells raises the cells under its box to its top; a wider leaf's triangles
+  // raise theirs each to the triangle's plane's highest point over the cell, if below its top (a big sloping
+  // facet spans many cells, mostly far below its top). Each triangle lies under a small node or a wide leaf.
+  // One pass in the nodes' order (no walk down the tree): the small nodes' descendants write again, cheaply.
+  void fill(const MeshIndex& index) {
+    const double x1 = x0_ + side_ * static_cast<double>(nx_), y1 = y0_ + side_ * static_cast<double>(ny_);
+    for (const BvhNode& node : index.nodes()) {
+      if (node.xmax < x0_ || node.ymax < y0_ || node.xmin > x1 || node.ymin > y1) continue;
+      if (node.xmax - node.xmin <= 2.0 * side_ && node.ymax - node.ymin <= 2.0 * side_) {
+        const std::size_t a = cell(node.xmin, node.ymin), b = cell(node.xmax, node.ymax);
+        for (std::size_t j = a / nx_; j <= b / nx_; ++j)
+          for (std::size_t i = a % nx_; i <= b % nx_; ++i) top_[j * nx_ + i] = std::max(top_[j * nx_ + i], node.zmax);
+      } else if (node.count > 0) {
+        for (int32_t t = node.first; t < node.first + node.count; ++t) raise(index.triangles()[static_cast<std::size_t>(t)]);
+      }
+    }
+  }
+
+  void raise(const IndexedTriangle& t) {
+    const std::size_t a = cell(t.xmin, t.ymin), b = cell(t.xmax, t.ymax);
+    const bool sloped = std::fabs(t.n[2]) > 1e-6;  // else only its top bounds it
+    const double gx = sloped ? -t.n[0] / t.n[2] : 0.0, gy = sloped ? -t.n[1] / t.n[2] : 0.0;
+    const double margin = 1e-9 * (1.0 + std::fabs(t.zmax));  // the plane's rounding
+    for (std::size_t j = a / nx_; j <= b / nx_; ++j) {
+      const double cy = y0_ + side_ * static_cast<double>(gy > 0 ? j + 1 : j);
+      for (std::size_t i = a % nx_; i <= b % nx_; ++i) {
+        double z = t.zmax;
+        if (sloped) {
+          const double cx = x0_ + side_ * static_cast<double>(gx > 0 ? i + 1 : i);
+          z = std::min(z, t.p[0][2] + gx * (cx - t.p[0][0]) + gy * (cy - t.p[0][1]) + margin);
+        }
+        top_[j * nx_ + i] = std::max(top_[j * nx_ + i], z);
+      }
+    }
+  }
+
+  // out[i] = max(in[i - k .. i + k]) over the m values at `stride` (van Herk / Gil-Werman: blocks of 2k + 1,
+  // a running max from each block's start and from its end, two reads per value whatever k).
+  static void window_max(const double* in, double* out, std::size_t m, std::size_t stride, std::size_t k) {
+    const std::size_t w = 2 * k + 1, len = m + 2 * k;
+    std::vector<double> pad(len, -INFINITY), from_start(len), to_end(len);
+    for (std::size_t i = 0; i < m; ++i) pad[i + k] = in[i * stride];
+    for (std::size_t j = 0; j < len; ++j) from_start[j] = j % w == 0 ? pad[j] : std::max(from_start[j - 1], pad[j]);
+    for (std::size_t j = len; j-- > 0;)
+      to_end[j] = (j + 1 == len || (j + 1) % w == 0) ? pad[j] : std::max(to_end[j + 1], pad[j]);
+    for (std::size_t i = 0; i < m; ++i) out[i * stride] = std::max(to_end[i], from_start[i + 2 * k]);
+  }
+
+  double x0_ = 0, y0_ = 0, side_ = 1;
+  std::size_t nx_ = 0, ny_ = 0;
+  std::vector<double> top_;
+};
+
+// One body's piece over the batch, each point from its own floor `base` (the height so far + the lift). Points
+// whose cells' bound is not above the floor keep it (top = base). The others are dropped with `tiles` as a
+// batch (drop_batch's tile lists: a shank or neck about the cutter's size), else each by the index walk warm-
+// started with the previous point's winner (a holder: its reach spans so many triangles that gathering them
+// per tile costs more than the walks; measured, benchmarks/drop_assembly.py).
+void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy, std::size_t n, const double* base,
+                double* top, const HeightCells& cells, bool tiles, const BatchOptions& options, DropStats* stats) {
+  std::vector<double> bound;
+  if (!cells.empty()) bound = cells.dilated(profile.max_radius());
+  auto clears = [&](std::size_t i) {
+    const double x = xy[2 * i], y = xy[2 * i + 1];
+    return !bound.empty() && std::isfinite(x) && std::isfinite(y) && bound[cells.cell(x, y)] <= base[i];
+  };
+  if (tiles) {
+    std::vector<std::size_t> kept;
+    std::vector<double> kxy, kbase;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (clears(i)) {
+        top[i] = base[i];
+        continue;
+      }
+      kept.push_back(i);
+      kxy.insert(kxy.end(), {xy[2 * i], xy[2 * i + 1]});
+      kbase.push_back(base[i]);
+    }
+    std::vector<double> ktop(kept.size());
+    drop_batch(index, profile, kxy.data(), kept.size(), kbase.data(), ktop.data(), options, stats);
+    for (std::size_t k = 0; k < kept.size(); ++k) top[kept[k]] = ktop[k];
+    return;
+  }
+  std::atomic<std::size_t> tested{0};
+  parallel_chunks(n, 512, options, [&](std::size_t begin, std::size_t end) {
+    DropStats local;
+    int32_t hint = -1;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (clears(i)) {
+        top[i] = base[i];
+        continue;
+      }
+      top[i] = drop_point(index, profile, xy[2 * i], xy[2 * i + 1], base[i], &local, &hint);
+    }
+    tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+  });
+  if (stats) stats->triangles_tested += tested.load();
+}
+
 }  // namespace
 
 ToolAssembly::ToolAssembly(const Cutter& cutter, const std::vector<ToolBody>& bodies, double cutter_clearance)
@@ -143,6 +296,9 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
   const std::vector<AssemblyPiece>& pieces = tool.pieces();
   const double passes = static_cast<double>(pieces.size());
   std::vector<double> base(n), top(n);
+  double reach = 0.0;  // of the bodies' pieces
+  for (std::size_t k = 1; k < pieces.size(); ++k) reach = std::max(reach, pieces[k].profile.max_radius());
+  const HeightCells cells(index, xy, pieces.size() > 1 && n >= kCellsFromPoints ? n : 0, reach);
   std::fill(z_out, z_out + n, floor_z);
   if (set_by) std::fill(set_by, set_by + n, kSetByFloor);
   for (std::size_t k = 0; k < pieces.size(); ++k) {
@@ -154,7 +310,8 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
     if (k == 0)  // one floor: the plain batch (with no clearance, the very heights of drop_batch)
       drop_batch(index, p.profile, xy, n, floor_z + p.lift, top.data(), pass, stats);
     else
-      drop_batch(index, p.profile, xy, n, base.data(), top.data(), pass, stats);
+      drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells,
+                 p.profile.max_radius() <= kTilesUpTo * pieces[0].profile.max_radius(), pass, stats);
     for (std::size_t i = 0; i < n; ++i) {
       if (top[i] > base[i] && top[i] - p.lift > z_out[i]) {
         z_out[i] = top[i] - p.lift;

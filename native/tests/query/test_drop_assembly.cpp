@@ -311,7 +311,7 @@ TEST(DropAssembly, NoBodiesIsTheCutterDropExactly) {
   }
 }
 
-TEST(DropAssembly, ThreadsAgree) {
+TEST(DropAssembly, ThreadsAgreeAndBatchEqualsPoints) {
   const auto index = bumpy(30, 15);
   const tmm::ToolAssembly tool(Cutter(1.0, 1.0), short_assembly());
   std::vector<double> xy;
@@ -327,8 +327,14 @@ TEST(DropAssembly, ThreadsAgree) {
   tmm::drop_assembly_batch(index, tool, xy.data(), n, -10.0, z2.data(), b2.data(), two);
   EXPECT_EQ(z1, z2);
   EXPECT_EQ(b1, b2);
-  for (std::size_t i = 0; i < n; i += 97)
-    EXPECT_NEAR(tmm::drop_assembly_point(index, tool, xy[2 * i], xy[2 * i + 1], -10.0), z1[i], 1e-9);
+  // The batch skips pieces by its height cells and drops them by tiles or walks; the point query walks each.
+  int lifted = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    int32_t by = 0;
+    ASSERT_NEAR(tmm::drop_assembly_point(index, tool, xy[2 * i], xy[2 * i + 1], -10.0, &by), z1[i], 1e-9) << i;
+    lifted += b1[i] >= 0;
+  }
+  EXPECT_GT(lifted, 500);
 }
 
 // A pocket 6 x 6 mm, 10 deep, in a plate: a ball on a 3 mm stick-out cannot reach its floor, the holder
@@ -350,6 +356,21 @@ TEST(DropAssembly, HolderSetsTheHeightInADeepPocket) {
   EXPECT_NEAR(tmm::drop_assembly_point(index, tool, 15.0, 15.0, -5.0, &by), 10.0, 1e-12);
   EXPECT_EQ(by, tmm::kSetByCutter);
   check_against_reference(index, Cutter(1.0, 1.0), bodies, 0.0, -6.0, 6.0, 12, 10);
+  // A raster over the pocket and its rim: the batch (height cells, tiles, walks) equals the point query.
+  std::vector<double> xy;
+  for (double y = -14; y <= 14; y += 0.4)
+    for (double x = -14; x <= 14; x += 0.4) xy.insert(xy.end(), {x, y});
+  const std::size_t n = xy.size() / 2;
+  std::vector<double> z(n);
+  std::vector<int32_t> set(n);
+  tmm::drop_assembly_batch(index, tool, xy.data(), n, -5.0, z.data(), set.data(), tmm::BatchOptions{});
+  int held = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    ASSERT_NEAR(tmm::drop_assembly_point(index, tool, xy[2 * i], xy[2 * i + 1], -5.0, &by), z[i], 1e-9) << i;
+    EXPECT_EQ(by, set[i]) << i;
+    held += set[i] == 1;
+  }
+  EXPECT_GT(held, 50);
 }
 
 // A needle 10 high on a plate: tool positions whose axis passes a top rim's width from it.

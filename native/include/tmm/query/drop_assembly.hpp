@@ -72,9 +72,11 @@ double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, dou
 
 // xy: n points (x0, y0, x1, y1, ...); z_out: n tip heights; set_by (may be null): n codes as above. The cutter
 // is dropped first (drop_batch), then each body's pieces from the lowest up, each starting from the height so
-// far (a per-point floor): the index skips every subtree whose top is below the tip height so far + the
-// piece's lift, so a holder high above the part costs a few node tests. With no bodies and no clearance the
-// heights are exactly drop_batch's. Throws as drop_batch (Cancelled, a floor out of range).
+// far (a per-point floor): a point skips a piece when a grid of the mesh's heights near the points, dilated by
+// the piece's reach, stays below the tip height so far + the piece's lift (a holder high above the part: one
+// lookup), and the drops that remain skip every index subtree whose top is below that floor. With no bodies
+// and no clearance the heights are exactly drop_batch's. Throws as drop_batch (Cancelled, a floor out of
+// range).
 void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
                          double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
                          DropStats* stats = nullptr);
