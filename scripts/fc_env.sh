@@ -21,10 +21,11 @@ deb http://deb.debian.org/debian-security trixie-security main" ;;
   forky) SCRIPT="/usr/share/debootstrap/scripts/sid"; SOURCES="deb $MIRROR forky main" ;;
   *) echo "fc_env.sh: unknown suite '$SUITE' (trixie or forky)" >&2; exit 2 ;;
 esac
-# What the tests need inside: FreeCAD, the kernel's build tools, the test runners, Xvfb for the GUI test.
+# What the tests need inside: FreeCAD, the kernel's build tools (ccache: its cache in the chroot's
+# /var/cache/ccache, kept with it), the test runners (pytest-xdist: two at a time), Xvfb for the GUI test.
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib xvfb xauth cmake g++ ninja-build libgtest-dev ca-certificates
-      python3-opencamlib python3-pyclipper python3-contourpy python3-scipy)
+      python3-opencamlib python3-pyclipper python3-contourpy python3-scipy python3-pytest-xdist ccache)
 
 MOUNTS=()
 cleanup() {

@@ -8,10 +8,11 @@ ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
 
 # contourpy: the 3D offset's passes (core.footprint.offset_field); scipy: the verification's buckets on them
-# (core.footprint.variable_step)
+# (core.footprint.variable_step); pytest-xdist: the tests two at a time (scripts/test.sh); ccache: the compiled
+# objects kept between test runs (scripts/test.sh sets CCACHE_DIR)
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib python3-pyclipper xvfb xauth cmake g++ make ninja-build libgtest-dev
-      python3-contourpy python3-scipy clang-14 libclang-rt-14-dev)
+      python3-contourpy python3-scipy clang-14 libclang-rt-14-dev python3-pytest-xdist ccache)
 missing=()
 for p in "${DEBS[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then
@@ -30,7 +31,9 @@ if ! .venv/bin/python -c "import opencamlib" >/dev/null 2>&1; then
   .venv/bin/python -m pip install -q opencamlib
 fi
 
-# Native kernel for /usr/bin/python3 (FreeCAD's interpreter).
+# Native kernel for /usr/bin/python3 (FreeCAD's interpreter). Through ccache when CCACHE_DIR names its cache
+# (scripts/test.sh; taken when the folder is first configured).
+[ -n "${CCACHE_DIR:-}" ] && command -v ccache >/dev/null && export CMAKE_CXX_COMPILER_LAUNCHER=ccache
 cmake -S native -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython_EXECUTABLE=/usr/bin/python3 >/dev/null
 cmake --build build -j"$(nproc)"
 
