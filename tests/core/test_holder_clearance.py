@@ -197,7 +197,9 @@ def test_cutter_only_raster_collides_and_assembly_raster_is_clear(cavity, surfac
     at_cl = np.all(bad.tip[:, :2] == raster[bad.move], axis=1)   # the samples at CL points (move ends)
     np.testing.assert_allclose(bad.intrusion[at_cl], (za - zc)[bad.move[at_cl]], atol=1e-9)
     assert bad.deepest == pytest.approx(21.0, abs=1e-6)   # holder face 1 mm above the plate, tip on the floor
-    assert np.isfinite(bad.contact).all()
+    located = np.isfinite(bad.contact).all(axis=1)       # the deepest max_contacts (1000) are located
+    assert located.sum() == min(bad.count, 1000)
+    assert bad.intrusion[located].min() >= bad.intrusion[~located].max()
     assert "holder collision" in bad.summary() and "holder 21.000 mm too low" in bad.summary()
 
     rows = np.isin(raster[:, 1], BRUTE_ROWS) & (np.arange(len(raster)) % 2 == 0)

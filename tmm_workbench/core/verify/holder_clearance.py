@@ -167,7 +167,7 @@ def _reach(bodies: list) -> float:
 
 def check_holder_clearance(mesh: TriMesh, assembly: ToolAssembly, toolpath: Toolpath,
                            surface: Optional[DropSurface] = None, *, sample_step: float = 0.5,
-                           tolerance: float = 1e-3, surface_step: float = 0.25, max_contacts: int = 10_000,
+                           tolerance: float = 1e-3, surface_step: float = 0.25, max_contacts: int = 1_000,
                            progress: Optional[Progress] = None, threads: int = 0) -> HolderClearance:
     """Where along `toolpath` the neck, shank or holder of `assembly` comes closer to `mesh` than its clearance
     by more than `tolerance` (mm). Moves sampled at most `sample_step` apart (module doc); the model's surface
