@@ -48,7 +48,7 @@ def main() -> None:
         box = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         for step in steps:
             params = SurfaceParams(stepover=1.0, sample_step=step, boundary=box)
-            t_est, est = seconds(lambda: raster_drop.estimate_work(params))
+            t_est, est = seconds(lambda: raster_drop.count_points(params))
             t_run, res = seconds(lambda: raster_drop.compute(mesh, cutter, replace(params)))
             real = res.diagnostics["points"]
             print(f"{name:18} {step:9g} {est:11.4g} {real:11d} {est / real:6.2f} {t_est:11.2e} {t_run:10.2f}")

@@ -123,12 +123,16 @@ def test_work_is_refused_before_anything_is_computed():
     old = limits.set_limits(max_points=10_000_000)
     try:
         with pytest.raises(TmmError, match=r"sample step 0.002 mm over a 40 x 30 mm boundary and 80 waterline"):
-            estimate_work(p, Cutter.ball(4), 8.0, 0.0)
+            estimate_work(p, Cutter.ball(4), (0.0, 0.0, 0.0, 40.0, 30.0, 8.0))   # the model's box: levels 8..0
         with pytest.raises(TmmError, match="sample step 0.002 mm"):
             compute(mesh, Cutter.ball(4), p)
     finally:
         limits.set_limits(max_points=old.max_points)
-    assert estimate_work(WaterlineParams(boundary=(0, 0, 40, 30)), Cutter.ball(4), 8.0, 0.0) > 0
+    work = estimate_work(WaterlineParams(boundary=(0, 0, 40, 30)), Cutter.ball(4), (0.0, 0.0, 0.0, 40.0, 30.0, 8.0))
+    assert work.count > 0 and work.passes == len(levels(8.0, 0.0, 1.0))
+    ranged = estimate_work(WaterlineParams(boundary=(0, 0, 40, 30), top_z=4.0, bottom_z=2.0), Cutter.ball(4),
+                           (0.0, 0.0, 0.0, 40.0, 30.0, 8.0))
+    assert ranged.passes == len(levels(4.0, 2.0, 1.0)) < work.passes   # the Z range, not the box, when given
 
 
 def test_a_tiny_step_down_is_refused_at_once_by_name():

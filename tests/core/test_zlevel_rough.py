@@ -351,5 +351,6 @@ def test_work_above_the_limit_refused_before_any_work(pocket):
         limits.set_limits(max_points=old.max_points)
     assert calls == []                                                   # nothing computed
     with pytest.raises(TmmError, match=r"2200 layers \(step-down 0.01 mm\), step-over 1 % of D6"):
-        zr.estimate_work(RoughingParams(stock_box=BOX, step_down=0.01, stepover_percent=1.0), Cutter.flat(6))
-    assert zr.estimate_work(RoughingParams(stock_box=BOX), Cutter.flat(6)) < 1e7
+        zr.estimate_work(RoughingParams(stock_box=BOX, step_down=0.01, stepover_percent=1.0), Cutter.flat(6), BOX)
+    work = zr.estimate_work(RoughingParams(stock_box=BOX), Cutter.flat(6), BOX)
+    assert 0 < work.count < 1e7 and work.paces == (("roughing", work.count),)

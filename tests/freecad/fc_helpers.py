@@ -170,3 +170,11 @@ class BadInputCase(FreeCADTestCase):
         self.assertEqual(len(self.op.Path.Commands), 0, "no partial or stale path")
         self.assertIsNone(self.op.Proxy.toolpath)
         return status
+
+
+def seed_net():
+    """Seed 001's convex Bézier control net (the 5-axis tests' face)."""
+    from tmm_workbench.core.geometry import bezier
+    from tmm_workbench.core.shared_data import benchmark_file
+
+    return bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import FreeCAD
 
-from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase
+from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase, seed_net
 from tmm_workbench.app.api import run_roughing, run_surface
 from tmm_workbench.app.api_run import run
 from tmm_workbench.core.errors import TmmError
@@ -50,8 +50,27 @@ class RunByName(FreeCADTestCase):
             self.assertIn(said, str(ctx.exception))
         with self.assertRaises(TmmError) as ctx:
             run("TMM_Multipoint", str(SPHERE_ON_PLATE))
-        self.assertIn("use run_multipoint", str(ctx.exception))
+        self.assertIn("face_source must be a control net", str(ctx.exception))
+        with self.assertRaises(TmmError) as ctx:
+            run("TMM_Multipoint", seed_net(), stock_margin=2.0)
+        self.assertIn("stock_margin is not used by TMM_Multipoint", str(ctx.exception))
         with self.assertRaises(TmmError) as ctx:
             run("TMM_Drill", str(SPHERE_ON_PLATE))
-        self.assertIn("TMM_Surface, TMM_Roughing, TMM_Waterline", str(ctx.exception))
+        self.assertIn("TMM_Surface, TMM_Roughing, TMM_Waterline, TMM_Multipoint", str(ctx.exception))
         self.assertEqual(set(FreeCAD.listDocuments()), before)
+
+
+class FaceOpByName(FreeCADTestCase):
+    def test_multipoint_by_its_properties_is_run_multipoint(self) -> None:
+        from tmm_workbench.app.api import run_multipoint
+        from tmm_workbench.core.tools.cutter import Cutter
+
+        named = run_multipoint(seed_net(), side_step=18.0, forward_step=4.0, pass_spacing="even", posts=("tarus",),
+                               progress=False, doc_name="TmmRunMpNamed")
+        generic = run("TMM_Multipoint", seed_net(), tool=Cutter.torus(6.7, 6.0), SideStep=18.0, ForwardStep=4.0,
+                      PassSpacing="Even", ToolShape="RoundInsert", post="tarus", progress=False,
+                      doc_name="TmmRunMpGeneric")
+        self.assertGreater(len(_words(generic.gcode)), 20)
+        self.assertEqual(_words(generic.gcode), _words(named.gcode["tarus"]))
+        self.assertEqual(named.face[1], "Face1")
+        self.assertAlmostEqual(generic.op.SafeHeight.Value, named.op.SafeHeight.Value)

@@ -11,7 +11,7 @@ import FreeCAD
 import Part
 import numpy as np
 
-from fc_helpers import OUT, FreeCADTestCase, close_all, new_doc
+from fc_helpers import OUT, FreeCADTestCase, close_all, new_doc, seed_net
 from tmm_workbench.app.api import run_multipoint
 from tmm_workbench.app import tools
 from tmm_workbench.app.compat import load_post
@@ -27,9 +27,6 @@ SEED = benchmark_file("seed_surfaces.json")
 FAST = dict(side_step=18.0, forward_step=4.0, progress=False, pass_spacing="even")
 DRD = dict(side_step=37.5, forward_step=10.0, progress=False, method="drd", pass_spacing="even")  # DRD is ~20x slower than VCRF
 
-
-def seed_net() -> np.ndarray:
-    return bezier.load_seed_patch(SEED, "convex")
 
 
 def bezier_surface(net: np.ndarray) -> Part.BezierSurface:

@@ -9,21 +9,16 @@ import unittest
 import FreeCAD
 import numpy as np
 
-from fc_helpers import OUT, FreeCADTestCase, close_all
+from fc_helpers import OUT, FreeCADTestCase, close_all, seed_net
 from tmm_workbench.app import op_multipoint
 from tmm_workbench.app.api import run_multipoint
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry import bezier
-from tmm_workbench.core.shared_data import benchmark_file
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import BezierFace, MultipointParams
 from tmm_workbench.core.tools.cutter import Cutter
 
 QUICK = dict(forward_step=10.0, progress=False, posts=())
 
-
-def seed_net() -> np.ndarray:
-    return bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex")
 
 
 def commands(op) -> list[tuple[str, dict]]:

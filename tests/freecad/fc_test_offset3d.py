@@ -80,7 +80,7 @@ class Offset3D(FreeCADTestCase):
                         doc_name="TmmCuspReport")
         self.assertEqual(r.op.CheckCusp, "Auto")   # on: the bump is a small region
         self.assertEqual(r.op.getEditorMode("CuspReport"), ["ReadOnly"])
-        from tmm_workbench.app.op_surface import FORWARD_STEPS
+        from tmm_workbench.core.strategies.surface.forward_step import FORWARD_STEPS
 
         params = r.op.Proxy.params_from(r.op, boundary=r.op.Proxy.boundary(r.op, r.mesh),
                                         forward_step=FORWARD_STEPS[r.op.ForwardStep])  # as the op computes it

@@ -183,7 +183,7 @@ class RegionFromSketch(FreeCADTestCase):
         op.RegionTolerance = 0.0
         op.SlopeMin = 0.0
         doc.recompute()
-        self.assertIn("RegionTolerance must be in [0.001, 10] mm, got 0 mm", op.getStatusString())
+        self.assertIn("region tolerance must be in [0.001, 10] mm, got 0", op.getStatusString())
         op.RegionTolerance = 0.01
         op.RegionSketch = None
         op.SlopeMin = 0.0

@@ -26,6 +26,8 @@ class Registry(FreeCADTestCase):
                              if c.__module__ == app.__name__ and getattr(c, "PARAMS", None) is not None)
                 params = proxy.PARAMS
                 self.assertTrue(issubclass(params, StrategyParams))
+                self.assertIs(proxy.STRATEGY, core)  # the estimate's strategy is the registry's
+                self.assertTrue(callable(proxy.ESTIMATE))
                 self.assertTrue(callable(core.compute))
                 self.assertTrue(set(core.SUPPORTED_TOOLS) <= {"ball", "flat", "bull", "general"})
                 by_name = {f.name: f for f in fields(params)}
@@ -76,3 +78,37 @@ class Registry(FreeCADTestCase):
 
 if __name__ == "__main__":
     unittest.main()
+
+
+class SurfaceStages(FreeCADTestCase):
+    """The Surface op, its panel and run_surface are derived from its stages' declarations (app.stages)."""
+
+    def test_every_declared_widget_is_in_the_panel(self) -> None:
+        import xml.etree.ElementTree as ET
+        from pathlib import Path
+
+        from tmm_workbench.app import op_surface, stages
+
+        ui = Path(__file__).resolve().parents[2] / "resources" / "panels" / "surface_op.ui"
+        names = {w.get("name") for w in ET.parse(ui).iter("widget")}
+        for table in stages.widgets(op_surface.STAGES):
+            for widget, prop in table.items():
+                self.assertIn(widget, names, f"{prop}: widget {widget} is not in {ui.name}")
+
+    def test_every_run_surface_argument_is_declared(self) -> None:
+        from tmm_workbench.app import api, api_run, op_surface
+        from tmm_workbench.core.stage import api_names
+
+        declared = api_names(op_surface.STAGES)
+        own = set(inspect.signature(api_run.run).parameters) - {"op", "properties"}
+        for name in inspect.signature(api.run_surface).parameters:
+            self.assertTrue(name in declared or name in own, f"run_surface({name}=) is declared by no stage")
+        self.assertFalse(declared - set(inspect.signature(api.run_surface).parameters),
+                         "a stage declares an argument run_surface does not take")
+
+    def test_a_property_declared_twice_is_refused(self) -> None:
+        from tmm_workbench.app import op_surface, stages
+        from tmm_workbench.core.strategies.surface import pattern
+
+        with self.assertRaisesRegex(ValueError, "StepOver is declared by two stages"):
+            stages.properties(op_surface.STAGES + (pattern.STAGE,))

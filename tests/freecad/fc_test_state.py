@@ -13,7 +13,7 @@ import FreeCAD
 
 from fc_helpers import OUT, FreeCADTestCase, bump_stl, job_with_op, moves, new_doc
 from tmm_workbench.app import job as jobs
-from tmm_workbench.app import registry, surface_passes, tools
+from tmm_workbench.app import registry, stages, surface_passes, tools
 from tmm_workbench.app.api import run_multipoint, run_roughing, run_waterline, simulate
 from tmm_workbench.app.compat import PathPreferences
 from tmm_workbench.core.geometry import bezier
@@ -194,14 +194,14 @@ class OldDocument(FreeCADTestCase):
         doc = new_doc("TmmOld")
         _, _, op = job_with_op(doc, str(bump_stl()), values=FAST)
         before, name = moves(op), op.Name
-        for row in surface_passes.PROPERTIES:
-            op.removeProperty(row.name)
+        for field in surface_passes.STAGE.fields:
+            op.removeProperty(field.prop)
         path = OUT / "old_surface.FCStd"
         doc.saveAs(str(path))
         FreeCAD.closeDocument(doc.Name)
         doc = FreeCAD.openDocument(str(path))
         op = doc.getObject(name)
-        for prop, value in surface_passes.DEFAULTS.items():
+        for prop, value in stages.defaults((surface_passes.STAGE,)).items():
             self.assertEqual(getattr(op, prop), value, prop)
         op.Proxy.progress_enabled = False
         op.touch()

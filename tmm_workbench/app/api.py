@@ -23,11 +23,10 @@ from typing import Any, Callable, Optional, Sequence, Union
 
 import FreeCAD
 
-from tmm_workbench.app import job as jobs
-from tmm_workbench.app import model_proxy, registry, tools
+from tmm_workbench.app import model_proxy, tools
 from tmm_workbench.app import progress as progress_mod
-from tmm_workbench.app import api_run
-from tmm_workbench.app.api_args import CallbackProgress, by_core_name, numbers, option, plain_numbers
+from tmm_workbench.app.api_args import (FEED, LENGTH, NON_NEGATIVE, CallbackProgress, by_core_name, numbers, option,
+                                        plain_numbers)
 from tmm_workbench.app.api_run import StockBox, SurfaceResult, run  # noqa: F401 - the API's names
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, spec_of
@@ -36,11 +35,6 @@ from tmm_workbench.core.tools.cutter import Cutter
 
 TOOL_ALIASES = tools.SHAPE_ALIASES
 DEFAULT_STEPOVER = 1.0  # mm, stepover_mode 'stepover' without a step-over given
-_LENGTH = Spec("", "mm")
-_POSITIVE = Spec("", "mm", low=0, low_open=True, kind="length")
-_NON_NEGATIVE = Spec("", "mm", low=0, kind="length")
-_FEED = Spec("", "mm/min", low=0, low_open=True)
-_SPEED = Spec("", "rpm", low=0)
 PATTERN_NAMES = {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral"}
 BOUNDARY_NAMES = {"model": "Model", "stock": "Stock"}
 OFF_MODEL_NAMES = {"floor": "Floor", "skip": "Skip"}
@@ -109,75 +103,17 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     stock_to_leave + k x finish_step_down, the last stock_to_leave); start_point (x, y): each pass set begins at
     the raster's end nearest it.
     """
-    from tmm_workbench.app import surface_passes
-    from tmm_workbench.core.strategies.raster_drop import SurfaceParams
+    args = dict(locals())  # the call's arguments by name, as the op's stages declare them
+    from tmm_workbench.app import op_surface, stages
+    from tmm_workbench.core.strategies.surface.params import SurfaceParams
 
-    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
-             stepover=(stepover, spec_of(SurfaceParams, "stepover")),
-             sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
-             angle_deg=(angle_deg, spec_of(SurfaceParams, "angle_deg")),
-             stock_to_leave=(stock_to_leave, spec_of(SurfaceParams, "stock_to_leave")), margin=(margin, _LENGTH),
-             chord_tolerance=(chord_tolerance, spec_of(SurfaceParams, "chord_tol")),
-             cusp=(cusp, spec_of(SurfaceParams, "cusp")),
-             safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
-             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
-    extra: dict[str, Any] = {"StepOverMode": option("stepover_mode", stepover_mode, STEPOVER_MODE_NAMES)}
-    _refuse_ignored(stepover_mode, stepover, stepover_percent, cusp, verify_cusp, pattern, spiral_direction,
-                    forward_step, arcs)
     if stepover is None and str(stepover_mode).lower() == "stepover" and stepover_percent is None:
-        stepover = DEFAULT_STEPOVER
-    if chord_tolerance is not None:
-        extra["ChordTolerance"] = chord_tolerance
-    if cusp is not None:
-        extra["CuspHeight"] = cusp
-    from tmm_workbench.app import region_source
-
-    extra.update(region_source.api_values(region, model, spiral_direction or "outward", slope_range,
-                                          region_tolerance))
-    if offset_from is not None:  # the 3D offset from a chosen curve (app.offset_start)
-        from tmm_workbench.app import offset_start
-
-        if stepover_mode != "offset3d":
-            raise TmmError(f"offset_from needs stepover_mode 'offset3d', got {stepover_mode!r}")
-        extra.update(offset_start.api_values(offset_from, model))
-    extra["ForwardStep"] = option("forward_step", forward_step, FORWARD_STEP_NAMES)
-    if not isinstance(arcs, bool):
-        raise TmmError(f"arcs must be True or False, got {arcs!r}")
-    extra["ArcFitting"] = arcs
-    extra.update(surface_passes.api_values(stepover_percent, final_depth, finish_passes, finish_step_down,
-                                           start_point))
-    if not isinstance(verify_cusp, bool):
-        raise TmmError(f"verify_cusp must be True or False, got {verify_cusp!r}")
-    extra["VerifyCusp"] = verify_cusp
-    values = {"SampleStep": sample_step, "RasterAngle": angle_deg,
-              "Pattern": option("pattern", pattern, PATTERN_NAMES), "StockToLeave": stock_to_leave,
-              "BoundaryShape": option("boundary", boundary, BOUNDARY_NAMES), "BoundaryMargin": margin,
-              "OffModel": option("off_model", off_model, OFF_MODEL_NAMES), **extra}
-    if stepover is not None:
-        values["StepOver"] = stepover
+        args["stepover"] = DEFAULT_STEPOVER
+    values = stages.api_values(op_surface.STAGES, SurfaceParams, args, model)
     return run("TMM_Surface", model, tool=tool, diameter=diameter, corner_radius=corner_radius,
                safe_height=safe_height, clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
                doc_name=doc_name, progress=progress, **values)
-
-
-def _refuse_ignored(stepover_mode: Any, stepover: Any, stepover_percent: Any, cusp: Any, verify_cusp: Any,
-                    pattern: Any, spiral_direction: Any, forward_step: Any, arcs: Any) -> None:
-    """An argument the chosen mode would ignore is refused by name, not dropped."""
-    mode = str(stepover_mode).lower()
-    if mode != "stepover" and (stepover is not None or stepover_percent is not None):
-        name = "stepover" if stepover is not None else "stepover_percent"
-        raise TmmError(f"{name} is not used with stepover_mode {stepover_mode!r}: the spacing comes from the cusp "
-                       "height (cusp); leave it out, or use stepover_mode 'stepover'")
-    if stepover is not None and stepover_percent is not None:
-        raise TmmError("give stepover (mm) or stepover_percent (of the tool diameter), not both")
-    if mode == "stepover" and cusp is not None and verify_cusp is False:  # a non-bool is refused below
-        raise TmmError(f"cusp {cusp!r} is not used with stepover_mode 'stepover' (passes `stepover` apart): give "
-                       "stepover_mode 'cusp', 'adaptive' or 'offset3d' to space the passes by it, or verify_cusp=True")
-    if spiral_direction is not None and str(pattern).lower() != "spiral":
-        raise TmmError(f"spiral_direction is used with pattern 'spiral' only, got pattern {pattern!r}")
-    if arcs is True and str(forward_step).lower() == "sample":
-        raise TmmError("arcs need forward_step 'tolerance' (arcs are fitted to the exact tool path), got 'sample'")
 
 
 # --- z-level roughing and waterline ----------------------------------------------------------------
@@ -214,14 +150,12 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
     from tmm_workbench.app import op_roughing
     from tmm_workbench.core.strategies.zlevel_rough import RoughingParams
 
-    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
-             **_specs(RoughingParams, step_down=step_down, stepover_percent=stepover_percent,
+    numbers(**_specs(RoughingParams, step_down=step_down, stepover_percent=stepover_percent,
                       stock_to_leave=stock_to_leave, stock_to_leave_axial=stock_to_leave_axial,
                       remaining_height=remaining_height, ramp_angle_deg=ramp_angle_deg,
                       helix_diameter_percent=helix_diameter_percent),
              chord_tolerance=(chord_tolerance, spec_of(RoughingParams, "chord_tol")),
-             final_z=(final_z, _LENGTH), stock_margin=(stock_margin, _LENGTH), stock_above=(stock_above, _LENGTH),
-             **_common_numbers(safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed))
+             final_z=(final_z, LENGTH))  # the tool, stock, heights and feeds: run's
     values: dict[str, Any] = {
         "StepDown": step_down, "StepOver": stepover_percent, "StockToLeave": stock_to_leave,
         "LayerMode": option("layer_mode", layer_mode, by_core_name(op_roughing.LAYER_MODES)),
@@ -267,12 +201,9 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     from tmm_workbench.app import op_waterline
     from tmm_workbench.core.strategies.waterline import WaterlineParams
 
-    numbers(diameter=(diameter, _POSITIVE), corner_radius=(corner_radius, _NON_NEGATIVE),
-             **_specs(WaterlineParams, step_down=step_down, stock_to_leave=stock_to_leave, sample_step=sample_step),
-             chord_tolerance=(chord_tolerance, spec_of(WaterlineParams, "chord_tol")), margin=(margin, _LENGTH),
-             top_z=(top_z, _LENGTH), bottom_z=(bottom_z, _LENGTH), stock_margin=(stock_margin, _LENGTH),
-             stock_above=(stock_above, _LENGTH),
-             **_common_numbers(safe_height, clearance_height, horiz_feed, vert_feed, spindle_speed))
+    numbers(**_specs(WaterlineParams, step_down=step_down, stock_to_leave=stock_to_leave, sample_step=sample_step),
+             chord_tolerance=(chord_tolerance, spec_of(WaterlineParams, "chord_tol")), margin=(margin, LENGTH),
+             top_z=(top_z, LENGTH), bottom_z=(bottom_z, LENGTH))  # the tool, stock, heights and feeds: run's
     if (top_z is None) != (bottom_z is None):
         raise TmmError(f"top_z and bottom_z are given together or not at all, got top_z={top_z!r}, "
                        f"bottom_z={bottom_z!r}")
@@ -297,11 +228,6 @@ def _specs(params_class: type, **values: Any) -> dict[str, tuple[Any, Spec]]:
     """API arguments named as the params fields, each with its field's spec."""
     return {name: (value, spec_of(params_class, name)) for name, value in values.items()}
 
-
-def _common_numbers(safe_height: Any, clearance_height: Any, horiz_feed: Any, vert_feed: Any,
-                    spindle_speed: Any) -> dict[str, tuple[Any, Spec]]:
-    return dict(safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
-                horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
 
 
 
@@ -362,9 +288,9 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
     document opened by the call is closed first).
     """
-    from tmm_workbench.app import geometry, op_multipoint
+    from tmm_workbench.app import op_multipoint
     from tmm_workbench.app import posts as posts_mod
-    from tmm_workbench.core.strategies.multipoint import MultipointParams, face_top
+    from tmm_workbench.core.strategies.multipoint import MultipointParams
 
     method_name = option("method", method, by_core_name(op_multipoint.METHODS))
     shape_name = option("tool_shape", tool_shape, by_core_name(op_multipoint.TOOL_SHAPES))
@@ -372,115 +298,45 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     if pass_spacing is None:  # the README's and the new op's default: the side step from the scallop
         pass_spacing = "scallop"
     spacing_name = option("pass_spacing", pass_spacing, by_core_name(op_multipoint.PASS_SPACINGS))
-    numbers(Ro=(Ro, _NON_NEGATIVE), Ri=(Ri, _NON_NEGATIVE),
+    numbers(Ro=(Ro, NON_NEGATIVE), Ri=(Ri, NON_NEGATIVE),
              side_step=(side_step, spec_of(MultipointParams, "side_step")),
              forward_step=(forward_step, spec_of(MultipointParams, "forward_step")),
              scallop=(scallop, spec_of(MultipointParams, "scallop")),
-             feed_angle_deg=(feed_angle_deg, spec_of(MultipointParams, "feed_angle_deg")), margin=(margin, _LENGTH),
+             feed_angle_deg=(feed_angle_deg, spec_of(MultipointParams, "feed_angle_deg")), margin=(margin, LENGTH),
              tilt_limit_deg=(tilt_limit_deg, spec_of(MultipointParams, "beta_max_deg")),
              tolerance=(tolerance, spec_of(MultipointParams, "tol")),
-             axis_retract=(axis_retract, _NON_NEGATIVE),
+             axis_retract=(axis_retract, NON_NEGATIVE),
              surface_extension=(surface_extension, spec_of(MultipointParams, "extend")),
-             gouge_tolerance=(gouge_tolerance, spec_of(MultipointParams, "between_tol")),
-             safe_height=(safe_height, _LENGTH), clearance_height=(clearance_height, _LENGTH),
-             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED), spindle_speed=(spindle_speed, _SPEED))
+             gouge_tolerance=(gouge_tolerance, spec_of(MultipointParams, "between_tol")))  # heights, feeds: run's
     if Ro + Ri <= 0:
         raise TmmError("the tool has no size: Ro + Ri must be > 0")
     cutter = Cutter.flat(2 * Ro) if Ri == 0 else Cutter.torus(Ro, Ri)  # a flat one is refused by the op
-
-    source_obj, sub = _face_pair(face_source)
-    own_doc = source_obj is None
-    with api_run.api_document(own_doc, doc_name, None if own_doc else source_obj.Document, fcstd_path) as doc:
-        if own_doc:
-            source_obj, sub = _surface_feature(doc, face_source), "Face1"
-        doc.recompute()
-        try:
-            surf = op_multipoint.face_surface(source_obj, sub)
-            top = face_top(geometry.bezier_face(surf))
-        except TmmError:  # the op reports it (and keeps its message as its status)
-            top = source_obj.Shape.BoundBox.ZMax
-        job = jobs.create_job(doc, source_obj, name="Job")
-        top = max(top, api_run.stock_top(job))  # rapids at the safe height must clear the stock, not only the face
-        safe = top + 5.0 if safe_height is None else float(safe_height)
-        clearance = max(top + 10.0, safe) if clearance_height is None else float(clearance_height)
-        clone = job.Model.Group[-1]
-        bit = tools.bit_for_cutter(doc, cutter)
-        tc = jobs.set_tool(job, bit, horiz_feed / 60.0, vert_feed / 60.0, spindle_speed)
-        values: dict[str, Any] = {
-            "Base": [(clone, (sub,))], "Method": method_name, "ToolShape": shape_name, "SideStep": side_step,
-            "ForwardStep": forward_step, "FeedAngle": feed_angle_deg, "BoundaryMargin": margin,
-            "ZigZag": bool(zigzag), "AxisRetract": axis_retract, "SafeHeight": safe, "ClearanceHeight": clearance,
-            "SurfaceExtension": surface_extension, "FootprintAnchor": anchor_name, "PassSpacing": spacing_name}
-        if tilt_limit_deg is not None:
-            values["TiltLimit"] = tilt_limit_deg
-        if tolerance is not None:
-            values["Tolerance"] = tolerance
-        if gouge_tolerance is not None:
-            values["GougeTolerance"] = gouge_tolerance
-        if scallop is not None:
-            values["Scallop"] = scallop
-        op = registry.create(op_multipoint.OP_NAME, job, values)
-        if posts:
-            jobs.choose_post(job, posts[0])  # when the Job offers it
-
-        api_run.compute(op, progress)
-
-        gcode: dict[str, str] = {}
-        files: dict[str, Path] = {}
-        out = Path(out_dir) if out_dir else None
-        if out is not None:
-            out.mkdir(parents=True, exist_ok=True)
-        for post in posts:
-            target = out / f"{name}{POST_SUFFIXES.get(post, f'.{post}.ngc')}" if out is not None else None
-            gcode[post] = posts_mod.export(post, [tc, op], target)
-            if target is not None:
-                files[post] = target
+    values: dict[str, Any] = {
+        "Method": method_name, "ToolShape": shape_name, "SideStep": side_step, "ForwardStep": forward_step,
+        "FeedAngle": feed_angle_deg, "BoundaryMargin": margin, "ZigZag": bool(zigzag), "AxisRetract": axis_retract,
+        "SurfaceExtension": surface_extension, "FootprintAnchor": anchor_name, "PassSpacing": spacing_name}
+    for prop, value in (("TiltLimit", tilt_limit_deg), ("Tolerance", tolerance), ("GougeTolerance", gouge_tolerance),
+                        ("Scallop", scallop)):
+        if value is not None:
+            values[prop] = value
+    out = Path(out_dir) if out_dir else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    targets = {post: out / f"{name}{POST_SUFFIXES.get(post, f'.{post}.ngc')}" if out is not None else None
+               for post in posts}
+    first = posts[0] if posts else None
+    r = run("TMM_Multipoint", face_source, tool=cutter, safe_height=safe_height, clearance_height=clearance_height,
+            horiz_feed=horiz_feed, vert_feed=vert_feed, spindle_speed=spindle_speed, post=first,
+            gcode_path=targets.get(first), fcstd_path=fcstd_path, doc_name=doc_name, progress=progress, **values)
+    gcode = {first: r.gcode} if first else {}
+    for post in posts[1:]:
+        gcode[post] = posts_mod.export(post, [r.op.ToolController, r.op], targets[post])
+    files: dict[str, Path] = {post: target for post, target in targets.items() if target is not None}
     if fcstd_path:
         files["fcstd"] = Path(fcstd_path)
-    p = op.Proxy
-    return MultipointResult(doc, job, op, (clone, sub), p.toolpath, p.segments, p.results, gcode, files)
-
-
-def _face_pair(source: Any) -> tuple[Any, str]:
-    """(object, "FaceN") for a pair input, (None, "") for a net or a surface."""
-    if isinstance(source, (tuple, list)) and len(source) == 2 and hasattr(source[0], "TypeId"):
-        obj, sub = source
-        if not isinstance(sub, str) or not sub.startswith("Face"):
-            raise TmmError(f"face_source: the element of {obj.Label} must be named 'FaceN', got {sub!r}")
-        return obj, sub
-    return None, ""
-
-
-def _surface_feature(doc: Any, source: Any) -> Any:
-    """A Part::Feature holding the face of a surface or of a Bézier control net."""
-    import Part
-
-    kind = type(source).__name__
-    if kind in ("BezierSurface", "BSplineSurface"):
-        surf = source
-    else:
-        import numpy as np
-
-        try:
-            net = np.asarray(source, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise TmmError(f"face_source must be a control net, a Part surface or (object, 'FaceN'); "
-                           f"got {type(source).__name__}") from exc
-        if net.ndim != 3 or net.shape[2] != 3 or net.shape[0] < 2 or net.shape[1] < 2:
-            raise TmmError(f"a Bézier control net must have shape (m+1, n+1, 3), m, n >= 1; got {net.shape}")
-        if not np.isfinite(net).all():
-            raise TmmError("the Bézier control net has a non-finite coordinate")
-        if max(net.shape[:2]) > 26:
-            raise TmmError(f"a Bézier net of shape {net.shape} exceeds FreeCAD's degree limit (25)")
-        surf = Part.BezierSurface()
-        surf.increase(net.shape[0] - 1, net.shape[1] - 1)
-        for i in range(net.shape[0]):
-            for j in range(net.shape[1]):
-                surf.setPole(i + 1, j + 1, FreeCAD.Vector(*map(float, net[i, j])))
-    obj = doc.addObject("Part::Feature", "Surface")
-    obj.Shape = surf.toShape()
-    obj.Label = "Bezier surface" if type(surf).__name__ == "BezierSurface" else "B-spline surface"
-    return obj
+    p = r.op.Proxy
+    clone, subs = r.op.Base[0]
+    return MultipointResult(r.doc, r.job, r.op, (clone, subs[0]), p.toolpath, p.segments, p.results, gcode, files)
 
 
 # --- stock simulation ----------------------------------------------------------------------------
@@ -565,7 +421,7 @@ def compare_cutters(model: Any, candidates: Sequence[Any], *, stepover: float, s
     numbers(stepover=(stepover, spec_of(SurfaceParams, "stepover")),
              sample_step=(sample_step, spec_of(SurfaceParams, "sample_step")),
              cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
-             horiz_feed=(horiz_feed, _FEED), vert_feed=(vert_feed, _FEED))
+             horiz_feed=(horiz_feed, FEED), vert_feed=(vert_feed, FEED))
     if isinstance(model, (str, os.PathLike)):
         mesh = geometry.mesh_from_stl(model)
     elif simulation.job_of(model) is model:

@@ -14,6 +14,13 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, check
 
 
+LENGTH = Spec("", "mm")
+POSITIVE = Spec("", "mm", low=0, low_open=True, kind="length")
+NON_NEGATIVE = Spec("", "mm", low=0, kind="length")
+FEED = Spec("", "mm/min", low=0, low_open=True)
+SPEED = Spec("", "rpm", low=0)
+
+
 def _plain(value: Any) -> Any:
     if isinstance(value, np.generic) and np.ndim(value) == 0:
         return value.item()  # np.float32(6) -> 6.0, np.int64(3) -> 3, np.bool_ -> bool

@@ -20,16 +20,18 @@ from typing import Any, Callable, Iterator, Optional, Union
 
 import FreeCAD
 
-from tmm_workbench.app import geometry, op_base, posts, registry, tools, work_estimate
+from tmm_workbench.app import face_source, geometry, op_base, posts, registry, tools, work_estimate
 from tmm_workbench.app import job as jobs
 from tmm_workbench.app import progress as progress_mod
-from tmm_workbench.app.api_args import CallbackProgress, option
+from tmm_workbench.app.api_args import (FEED, LENGTH, NON_NEGATIVE, POSITIVE, SPEED, CallbackProgress,
+                                        numbers, option)
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
-MESH_OPS = ("TMM_Surface", "TMM_Roughing", "TMM_Waterline")   # run_multipoint machines a face, not a mesh
+MESH_OPS = ("TMM_Surface", "TMM_Roughing", "TMM_Waterline")
+FACE_OPS = ("TMM_Multipoint",)   # a Bézier / B-spline face (app.face_source), a new document and Job for it
 
 
 StockBox = tuple[float, float, float, float, float, float]
@@ -80,12 +82,15 @@ def model_values(jm: jobs.JobModel) -> dict:
     return {"StlFile": jm.stl_file} if jm.stl_file else {"Model": jm.link}
 
 
-def post_op(doc: Any, job: Any, tc: Any, op: Any, post: str, gcode_path: Any, progress: Any) -> SurfaceResult:
-    """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller)."""
-    jobs.choose_post(job, post)  # when the Job offers it
+def post_op(doc: Any, job: Any, tc: Any, op: Any, post: Optional[str], gcode_path: Any,
+            progress: Any) -> SurfaceResult:
+    """The Job's post set to `post` (when it offers it), the op computed, its G-code (with its tool controller;
+    none without a post)."""
+    if post:
+        jobs.choose_post(job, post)  # when the Job offers it
     compute(op, progress)
-    gcode = posts.export(post, [tc, op], gcode_path)
-    return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, op.Proxy.mesh)
+    gcode = posts.export(post, [tc, op], gcode_path) if post else ""
+    return SurfaceResult(doc, job, op, gcode, op.Proxy.toolpath, getattr(op.Proxy, "mesh", None))
 
 
 def stock_top(job: Any) -> float:
@@ -157,43 +162,57 @@ def add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, 
 
 
 def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
-            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
-            horiz_feed: float, vert_feed: float, spindle_speed: float, post: str, gcode_path: Any, fcstd_path: Any,
-            doc_name: str, progress: Any) -> SurfaceResult:
-    """A roughing or waterline op (property `values`) in a new Job for `model` with a box stock, or in `job`
+           diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
+           horiz_feed: float, vert_feed: float, spindle_speed: float, post: Optional[str], gcode_path: Any,
+           fcstd_path: Any, doc_name: str, progress: Any) -> SurfaceResult:
+    """The op (property `values`) in a new Job for `model` (a mesh op's box stock; a face op's face) or in `job`
     with a further tool controller; computed, posted, saved. A document opened here is closed on failure."""
     job = getattr(job, "job", None) or job
     if job is None and model is None:
         raise TmmError("model: give an STL path, a Mesh or a Part object (or a job to add the op to)")
-    own_doc = job is None and isinstance(model, (str, os.PathLike))
-    if own_doc and not Path(model).expanduser().is_file():
+    face = op_name in FACE_OPS
+    own_doc = job is None and (face_source.owns_document(model) if face else isinstance(model, (str, os.PathLike)))
+    if own_doc and not face and not Path(model).expanduser().is_file():
         raise TmmError(f"STL file not found: {model}")
-    existing = None if own_doc else (job.Document if job is not None else model.Document)
+    existing = None if own_doc else (job.Document if job is not None else
+                                     (face_source.face_pair(model)[0] if face else model).Document)
     with api_document(own_doc, doc_name, existing, fcstd_path) as doc:
         values = dict(values)
         if job is None:
-            jm = jobs.prepare_model(doc, model)
-            doc.recompute()
-            job = jobs.create_job(doc, jm.job_base)
-            if stock_ext is not None:
-                set_stock(job, *stock_ext)
-            values.update(model_values(jm))
+            job, model_props, top = (face_source.face_job(doc, model) if face else
+                                     new_mesh_job(doc, model, stock_ext))
+            values.update(model_props)
             tc = jobs.set_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0,
                                vert_feed / 60.0, spindle_speed)
         else:  # the Job's stock and model stay; the op machines `model` when one is given
-            if isinstance(model, (str, os.PathLike)):
-                geometry.mesh_from_stl(model)  # a clear error for a missing or bad file
-                values["StlFile"] = str(Path(model).expanduser().resolve())
-            elif model is not None:
-                values["Model"] = model
+            values.update(mesh_values(model))
+            top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
             tc = add_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0, vert_feed / 60.0,
-                           spindle_speed)
-        top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
+                          spindle_speed)
         values.update(heights(job, top, safe_height, clearance_height))
         values["ToolController"] = tc
         op = registry.create(op_name, job, values)
         result = post_op(doc, job, tc, op, post, gcode_path, progress)
     return result
+
+
+def new_mesh_job(doc: Any, model: Any, stock_ext: Optional[tuple]) -> tuple[Any, dict, float]:
+    """A Job around the mesh model (its stand-in box for a mesh), its stock set when asked, the op's model
+    properties and the model's top."""
+    jm = jobs.prepare_model(doc, model)
+    doc.recompute()
+    job = jobs.create_job(doc, jm.job_base)
+    if stock_ext is not None:
+        set_stock(job, *stock_ext)
+    return job, model_values(jm), max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
+
+
+def mesh_values(model: Any) -> dict:
+    """The op's model properties for `model` in an existing Job (None: the Job's model)."""
+    if isinstance(model, (str, os.PathLike)):
+        geometry.mesh_from_stl(model)  # a clear error for a missing or bad file
+        return {"StlFile": str(Path(model).expanduser().resolve())}
+    return {} if model is None else {"Model": model}
 
 
 def proxy_class(op: str) -> type:
@@ -226,18 +245,28 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
         corner_radius: float = 0.0, stock: Optional[StockBox] = None, stock_margin: Optional[float] = None,
         stock_above: Optional[float] = None, safe_height: Optional[float] = None,
         clearance_height: Optional[float] = None, horiz_feed: float = 1000.0, vert_feed: float = 300.0,
-        spindle_speed: float = 10000.0, post: str = "linuxcnc", gcode_path: Any = None, fcstd_path: Any = None,
-        doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
+        spindle_speed: float = 10000.0, post: Optional[str] = "linuxcnc", gcode_path: Any = None,
+        fcstd_path: Any = None, doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
         **properties: Any) -> SurfaceResult:
-    """The op registered as `op` (MESH_OPS) on `model` (STL path, Mesh or Part object; None with `job`: the Job's
-    model) with `properties` (the op's property names and values: StepOver=0.5, Pattern="OneWay"), in a new Job
-    or added to `job` with its own tool controller; computed, posted, saved (as app.api.run_surface). The Job's
-    stock: FreeCAD's default for a new Job unless `stock` (a box) or `stock_margin` / `stock_above` (mm around
-    the model) is given. TmmError names a property the op does not have, a choice it does not offer, a number
-    out of its range."""
-    if op not in MESH_OPS:
-        hint = " (a face: use run_multipoint)" if op == "TMM_Multipoint" else ""
-        raise TmmError(f"run: op must be one of {', '.join(MESH_OPS)}, got {op!r}{hint}")
+    """The op registered as `op` on `model` with `properties` (the op's property names and values: StepOver=0.5,
+    Pattern="OneWay"), computed, posted (`post` None: not posted), saved (as app.api.run_surface).
+    A mesh op (MESH_OPS): `model` an STL path, a Mesh or a Part object (None with `job`: the Job's model), in a new
+    Job or added to `job` with its own tool controller; the Job's stock: FreeCAD's default for a new Job unless
+    `stock` (a box) or `stock_margin` / `stock_above` (mm around the model) is given.
+    A face op (FACE_OPS): `model` a face source (app.face_source), in a new Job around it.
+    TmmError names a property the op does not have, a choice it does not offer, a number out of its range, an
+    argument the op would ignore."""
+    if op not in MESH_OPS + FACE_OPS:
+        raise TmmError(f"run: op must be one of {', '.join(MESH_OPS + FACE_OPS)}, got {op!r}")
+    if op in FACE_OPS:  # a face op's Job is made around its face, with FreeCAD's default stock
+        for name, value in (("job", job), ("stock", stock), ("stock_margin", stock_margin),
+                            ("stock_above", stock_above)):
+            if value is not None:
+                raise TmmError(f"{name} is not used by {op}: it machines one face in a new Job around it")
+    numbers(diameter=(diameter, POSITIVE), corner_radius=(corner_radius, NON_NEGATIVE),
+            stock_margin=(stock_margin, LENGTH), stock_above=(stock_above, LENGTH),
+            safe_height=(safe_height, LENGTH), clearance_height=(clearance_height, LENGTH),
+            horiz_feed=(horiz_feed, FEED), vert_feed=(vert_feed, FEED), spindle_speed=(spindle_speed, SPEED))
     check_properties(op, properties)
     shape = tool if isinstance(tool, Cutter) else option("tool", tool, tools.SHAPE_ALIASES,
                                                           sorted(set(tools.SHAPE_ALIASES.values())))

@@ -9,20 +9,11 @@ from typing import Any, Optional
 
 import numpy as np
 
-from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.stage import Args, Field, Stage
 
 BOUNDARY, CURVE = "Boundary", "Curve"
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyEnumeration", "OffsetStart", "Surface",
-         "StepOverMode Offset3D: the passes start from the region's Boundary (inward) or from OffsetCurve (to both "
-         "sides of it, across the region)"),
-    Prop("App::PropertyLink", "OffsetCurve", "Surface",
-         "OffsetStart Curve: a sketch or an object's edges (open or closed), seen from above"),
-]
-CHOICES = {"OffsetStart": {BOUNDARY: BOUNDARY, CURVE: CURVE}}
-DEFAULTS = {"OffsetStart": BOUNDARY}
-
+_CHOICES = {BOUNDARY: BOUNDARY, CURVE: CURVE}
 
 def _label(obj: Any) -> str:
     return f"'{getattr(obj, 'Label', obj)}'"
@@ -62,8 +53,9 @@ def curves_of(op: Any, offset3d: bool) -> Optional[list[np.ndarray]]:
     return curves_of_object(op.OffsetCurve, float(op.RegionTolerance.Value))
 
 
-def api_values(offset_from: Any, model: Any) -> dict[str, Any]:
+def api_values(args: Args, model: Any) -> dict[str, Any]:
     """run_surface's offset_from: None (the boundary) or an object with edges of the model's document."""
+    offset_from = args.get("offset_from")
     if offset_from is None:
         return {"OffsetStart": BOUNDARY}
     if not hasattr(offset_from, "TypeId"):
@@ -73,3 +65,19 @@ def api_values(offset_from: Any, model: Any) -> dict[str, Any]:
         raise TmmError(f"offset_from {_label(offset_from)} must be in the model's document (an STL path makes a "
                        f"new one: pass a Mesh or Part object of the curve's document as the model)")
     return {"OffsetStart": CURVE, "OffsetCurve": offset_from}
+
+
+def ignored(args: Args) -> Optional[str]:
+    mode = args.get("stepover_mode")
+    if args.get("offset_from") is not None and str(mode).lower() != "offset3d":
+        return f"offset_from needs stepover_mode 'offset3d', got {mode!r}"
+    return None
+
+
+STAGE = Stage("offset start", (
+    Field("OffsetStart", "choice", "Surface",
+          "StepOverMode Offset3D: the passes start from the region's Boundary (inward) or from OffsetCurve (to both "
+          "sides of it, across the region)", choices=_CHOICES, default=BOUNDARY, widget="offsetStart"),
+    Field("OffsetCurve", "link", "Surface",
+          "OffsetStart Curve: a sketch or an object's edges (open or closed), seen from above"),
+), ignored=ignored, composite=("offset_from",), composite_values=api_values)

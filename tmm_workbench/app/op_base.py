@@ -52,6 +52,9 @@ class TmmOp(PathOp.ObjectOp):
     DEFAULTS: dict[str, Any] = {}
     READ_ONLY: tuple[str, ...] = ()
     RESTORED_DEFAULTS: dict[str, Any] = {}
+    SPECS: dict[str, Any] = {}   # the ranges of properties that name no params field (app.stages), by property
+    ESTIMATE: Optional[Callable[..., Any]] = None   # the strategy's inputs from the properties (app.work_estimate)
+    STRATEGY: Any = None         # the core strategy module: its estimate_work(params, cutter, bounds) (core.work)
     progress_enabled: bool = True
 
     def __init__(self, obj: Any, name: str, parentJob: Any = None,

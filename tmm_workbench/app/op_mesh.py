@@ -9,20 +9,23 @@ from typing import Any, Optional
 
 import Path
 
-from tmm_workbench.app import geometry, hooks, model_proxy, op_base
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base, stages
 from tmm_workbench.app.compat import PathOp, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core.arcs import PLANE_CODES
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.stage import Field, Stage
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 
-MODEL_PROPERTIES: list[Prop] = [
-    Prop("App::PropertyFile", "StlFile", "Model", "STL file to machine (takes precedence over Model)"),
-    Prop("App::PropertyLink", "Model", "Model", "Mesh or Part object to machine; empty: the Job's model"),
-    Prop("App::PropertyDistance", "LinearDeflection", "Model", "Tessellation tolerance for Part models"),
-]
-MODEL_DEFAULTS: dict[str, Any] = {"LinearDeflection": geometry.DEFAULT_DEFLECTION_MM}
+MODEL_STAGE = Stage("model", (
+    Field("StlFile", "file", "Model", "STL file to machine (takes precedence over Model)"),
+    Field("Model", "link", "Model", "Mesh or Part object to machine; empty: the Job's model"),
+    Field("LinearDeflection", "length", "Model", "Tessellation tolerance for Part models",
+          default=geometry.DEFAULT_DEFLECTION_MM, widget="linearDeflection"),
+))
+MODEL_PROPERTIES: list[Prop] = stages.properties((MODEL_STAGE,))
+MODEL_DEFAULTS: dict[str, Any] = stages.defaults((MODEL_STAGE,))
 
 
 class MeshOp(op_base.TmmOp):

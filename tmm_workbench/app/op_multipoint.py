@@ -207,7 +207,8 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     path, linked once by core.linking), `segments` (the strategy's cut segments), `results` (per footprint
     point), `face`, `radii` (Ro, Ri), `placement` (the scallop rule's report, None for other spacings)."""
 
-    ESTIMATE = staticmethod(work_estimate.multipoint)  # the work from the properties (app.work_estimate)
+    ESTIMATE = staticmethod(work_estimate.multipoint)  # its strategy's inputs from the properties
+    STRATEGY = multipoint  # its estimate_work (core.work)
 
     PARAMS = MultipointParams
     PROPERTIES = PROPERTIES

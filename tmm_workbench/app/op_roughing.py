@@ -103,7 +103,8 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed)."""
 
-    ESTIMATE = staticmethod(work_estimate.roughing)  # the work from the properties (app.work_estimate)
+    ESTIMATE = staticmethod(work_estimate.roughing)  # its strategy's inputs from the properties
+    STRATEGY = zlevel_rough  # its estimate_work (core.work)
 
     VIEW_KIND = "roughing_op"
     PARAMS = RoughingParams

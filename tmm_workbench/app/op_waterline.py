@@ -58,7 +58,8 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
     """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `params`
     (the strategy's, as computed), `diagnostics` (the strategy's: levels, loops, points, top)."""
 
-    ESTIMATE = staticmethod(work_estimate.waterline)  # the work from the properties (app.work_estimate)
+    ESTIMATE = staticmethod(work_estimate.waterline)  # its strategy's inputs from the properties
+    STRATEGY = waterline  # its estimate_work (core.work)
 
     VIEW_KIND = "waterline_op"
     PARAMS = WaterlineParams

@@ -16,16 +16,17 @@ from typing import Any, Optional
 
 import numpy as np
 
-from tmm_workbench.app.api_args import numbers, option
+from tmm_workbench.app.api_args import numbers
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import region
-from tmm_workbench.core.params import Spec, spec_of
+from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.polygons import Shape
+from tmm_workbench.core.stage import Args, Field, Stage
 
 BOX, FACES, SKETCH = "Box", "Faces", "Sketch"
 REGIONS = (BOX, FACES, SKETCH)
-TOLERANCE_RANGE = (0.001, 10.0)  # mm
+TOLERANCE_SPEC = Spec("region tolerance", "mm", low=0.001, high=10.0)
 MAX_TRIANGLES = 500_000          # of the selected faces' tessellation: refused above, before the union (~20 s)
 
 
@@ -117,9 +118,7 @@ def region_of(op: Any, job: Any) -> Optional[Shape]:
     if kind == BOX:
         return None
     tolerance = float(op.RegionTolerance.Value)
-    if not TOLERANCE_RANGE[0] <= tolerance <= TOLERANCE_RANGE[1]:  # finer would tessellate without bound
-        raise TmmError(f"RegionTolerance must be in [{TOLERANCE_RANGE[0]:g}, {TOLERANCE_RANGE[1]:g}] mm, got "
-                       f"{tolerance:g} mm")
+    check(TOLERANCE_SPEC, tolerance)  # finer would tessellate without bound
     if kind == FACES:
         shape = faces_region(list(op.RegionFaces or []), model_objects(op, job), tolerance)
     else:
@@ -132,18 +131,14 @@ def region_of(op: Any, job: Any) -> Optional[Shape]:
     return shape
 
 
-def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
-               tolerance: Optional[float]) -> dict[str, Any]:
-    """The Surface op's region, spiral and slope properties for run_surface's arguments:
-    region None (the box), an object with closed edges (a sketch), or faces: names of the model's faces
-    ("Face3", ["Face3", "Face5"]) or (object, names) pairs; slope_range (min, max) deg or None."""
-    from tmm_workbench.core.strategies.raster_drop import SurfaceParams
+def api_values(args: Args, model: Any) -> dict[str, Any]:
+    """The Surface op's region and slope properties for run_surface's arguments `region`: None (the box), an
+    object with closed edges (a sketch), or faces: names of the model's faces ("Face3", ["Face3", "Face5"]) or
+    (object, names) pairs; and `slope_range`: (min, max) deg or None."""
+    from tmm_workbench.core.strategies.surface.params import SurfaceParams
 
-    values: dict[str, Any] = {"SpiralDirection": option("spiral_direction", spiral_direction,
-                                                         {"outward": "Outward", "inward": "Inward"})}
-    if tolerance is not None:
-        numbers(region_tolerance=(tolerance, Spec("", "mm", low=TOLERANCE_RANGE[0], high=TOLERANCE_RANGE[1])))
-        values["RegionTolerance"] = tolerance
+    region, slope_range = args.get("region"), args.get("slope_range")
+    values: dict[str, Any] = {}
     if slope_range is not None:
         try:
             low, high = (float(v) for v in slope_range)
@@ -179,3 +174,22 @@ def api_values(region: Any, model: Any, spiral_direction: str, slope_range: Any,
                            f"names) pairs, got {item!r}")
     values.update(Region=FACES, RegionFaces=links)
     return values
+
+
+STAGE = Stage("region", (
+    Field("Region", "choice", "Region",
+          "Where the tool centre may go: Box (BoundaryShape with BoundaryMargin), Faces (RegionFaces seen from "
+          "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes)",
+          choices={r: r for r in REGIONS}, default=BOX, widget="region"),
+    Field("RegionFaces", "sublinks", "Region", "Faces of the model bounding the region"),
+    Field("RegionSketch", "link", "Region", "Sketch (or closed edges) bounding the region"),
+    Field("RegionTolerance", "length", "Region",
+          "How far the region's polygon may depart from the faces' or the sketch's exact outline",
+          api="region_tolerance", default=0.01, spec=TOLERANCE_SPEC, widget="regionTolerance"),
+    Field("SlopeMin", "angle", "Surface",
+          "Cut only where the surface slope is at least this (shallower areas left to another op)", "slope_min_deg",
+          widget="slopeMin"),
+    Field("SlopeMax", "angle", "Surface",
+          "Cut only where the surface slope is at most this (steeper walls left to waterline)", "slope_max_deg",
+          widget="slopeMax"),
+), composite=("region", "slope_range"), composite_values=api_values)

@@ -11,37 +11,40 @@ from typing import Any
 
 import FreeCAD
 
-from tmm_workbench.app.op_base import Prop
-from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT, FinishParams, stepover_of_percent
-from tmm_workbench.core.strategies.raster_drop import ADAPTIVE, CUSP, OFFSET3D, STEPOVER
-from tmm_workbench.core.tools.cutter import Cutter
+from dataclasses import replace
 
-# the Surface's step-over modes, op property value -> core name; 3D offset: closed loops from the region's edge
-# inward, CuspHeight apart across the surface (a document saved before it gets the choice on restore, op_base)
-SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE, "Offset3D": OFFSET3D}
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.params import Spec, check, check_finite, spec_of
+from tmm_workbench.core.stage import Args, Field, Stage
+from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT, FinishParams, stepover_of_percent
+from tmm_workbench.core.strategies.surface.params import STEPOVER
+from tmm_workbench.core.strategies.surface.pattern import SPACINGS
+from tmm_workbench.core.tools.cutter import Cutter
 
 MM, PERCENT = "mm", "%"
 
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyEnumeration", "StepOverUnit", "Surface",
-         "mm: passes StepOver apart; %: StepOverPercent of the tool diameter apart (StepOver spacing)"),
-    Prop("App::PropertyFloat", "StepOverPercent", "Surface",
-         "Distance between raster passes in % of the tool diameter, when StepOverUnit is %"),
-    Prop("App::PropertyBool", "UseFinalDepth", "Depths", "No tool tip below FinalDepth (off: the model's lowest point)"),
-    Prop("App::PropertyDistance", "FinalDepth", "Depths", "Lowest tool tip height, when UseFinalDepth is set"),
-    Prop("App::PropertyInteger", "FinishPasses", "Depths",
-         "Passes over the surface: the first ones leave StockToLeave + k x StepDown (semi-finish), the last "
-         "StockToLeave"),
-    Prop("App::PropertyDistance", "StepDown", "Depths",
-         "Stock each finishing pass removes over the next one (FinishPasses > 1)"),
-    Prop("App::PropertyBool", "UseStartPoint", "Start Point",
-         "Each pass set begins at the end of the raster nearest StartPoint (X, Y)"),
-    Prop("App::PropertyVectorDistance", "StartPoint", "Start Point", "Where the cutting starts (X and Y are used)"),
-]
-CHOICES: dict[str, dict[str, Any]] = {"StepOverUnit": {MM: MM, PERCENT: PERCENT}}
-DEFAULTS: dict[str, Any] = {"StepOverUnit": MM, "StepOverPercent": 10.0, "UseFinalDepth": False, "FinalDepth": 0.0,
-                            "FinishPasses": 1, "StepDown": 0.5, "UseStartPoint": False,
-                            "StartPoint": FreeCAD.Vector(0, 0, 0)}
+_FIELDS = (
+    Field("StepOverUnit", "choice", "Surface",
+          "mm: passes StepOver apart; %: StepOverPercent of the tool diameter apart (StepOver spacing)",
+          choices={MM: MM, PERCENT: PERCENT}, default=MM, widget="stepOverUnit"),
+    Field("StepOverPercent", "percent", "Surface",
+          "Distance between raster passes in % of the tool diameter, when StepOverUnit is %", default=10.0,
+          spec=STEPOVER_PERCENT),
+    Field("UseFinalDepth", "bool", "Depths", "No tool tip below FinalDepth (off: the model's lowest point)",
+          default=False, widget="useFinalDepth"),
+    Field("FinalDepth", "length", "Depths", "Lowest tool tip height, when UseFinalDepth is set", default=0.0,
+          spec=Spec("final depth", "mm", low=-10_000.0, high=10_000.0), widget="finalDepth"),
+    Field("FinishPasses", "int", "Depths",
+          "Passes over the surface: the first ones leave StockToLeave + k x StepDown (semi-finish), the last "
+          "StockToLeave", default=1),
+    Field("StepDown", "length", "Depths", "Stock each finishing pass removes over the next one (FinishPasses > 1)",
+          default=0.5, spec=Spec("finishing step-down", "mm", low=0.0, high=1000.0, low_open=True),
+          widget="stepDown"),
+    Field("UseStartPoint", "bool", "Start Point", "Each pass set begins at the end of the raster nearest StartPoint "
+          "(X, Y)", default=False, widget="useStartPoint"),
+    Field("StartPoint", "vector", "Start Point", "Where the cutting starts (X and Y are used)",
+          default=FreeCAD.Vector(0, 0, 0)),
+)
 
 
 def params_extra(obj: Any, cutter: Cutter) -> dict[str, Any]:
@@ -51,16 +54,12 @@ def params_extra(obj: Any, cutter: Cutter) -> dict[str, Any]:
     return {}
 
 
-def api_values(stepover_percent: Any, final_depth: Any, finish_passes: Any, finish_step_down: Any,
-               start_point: Any) -> dict[str, Any]:
+def api_values(args: Args, model: Any = None) -> dict[str, Any]:
     """The op's property values for run_surface's arguments (None: the op's default), each checked by its
     argument's name as the core checks the field: a % step-over (in (0, 100]: the mm step-over is then
     ignored), a final depth, the finishing passes and their step-down, a start point (x, y)."""
-    from dataclasses import replace
-
-    from tmm_workbench.core.errors import TmmError
-    from tmm_workbench.core.params import check, check_finite, spec_of
-
+    stepover_percent, final_depth, finish_passes, finish_step_down, start_point = (
+        args.get(name) for name in COMPOSITE)
     values: dict[str, Any] = {}
     if stepover_percent is not None:
         check(replace(STEPOVER_PERCENT, label="stepover_percent"), stepover_percent)
@@ -84,6 +83,10 @@ def api_values(stepover_percent: Any, final_depth: Any, finish_passes: Any, fini
         check_finite("start_point (x, y)", (x, y))
         values.update(UseStartPoint=True, StartPoint=FreeCAD.Vector(x, y, 0.0))
     return values
+
+
+COMPOSITE = ("stepover_percent", "final_depth", "finish_passes", "finish_step_down", "start_point")
+STAGE = Stage("depths", _FIELDS, composite=COMPOSITE, composite_values=api_values)
 
 
 def finish_params(obj: Any) -> FinishParams:

@@ -15,21 +15,20 @@ from typing import Any
 
 import FreeCAD
 
-from tmm_workbench.app.op_base import Prop
+from tmm_workbench.core.stage import Field, Stage
 
-PROPERTIES: list[Prop] = [
-    Prop("App::PropertyBool", "VerifyCusp", "Surface",
-         "Cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds "
-         "CuspHeight (any StepOverMode; ZigZag or OneWay over the Box region); cells out of the tool's reach are "
-         "reported, not chased", "verify_cusp"),
-    Prop("App::PropertyEnumeration", "CheckCusp", "Surface",
-         "Cusp modes (Cusp, Adaptive, Offset3D): measure the passes in the stock simulation as VerifyCusp does, "
-         "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where (Auto: a "
-         "few seconds, a large region on coarser cells, saying how far a crest may read low; On: always on the "
-         "verification's cells, about as long again as the passes)",
-         "cusp_check"),
-]
-CHOICES = {"CheckCusp": {"Auto": "auto", "On": "on", "Off": "off"}}
+STAGE = Stage("verification", (
+    Field("VerifyCusp", "bool", "Surface",
+          "Cut the passes in the stock simulation and add partial passes where the simulated cusp exceeds "
+          "CuspHeight (any StepOverMode; ZigZag or OneWay over the Box region); cells out of the tool's reach are "
+          "reported, not chased", "verify_cusp", "verify_cusp", widget="verifyCusp"),
+    Field("CheckCusp", "choice", "Surface",
+          "Cusp modes (Cusp, Adaptive, Offset3D): measure the passes in the stock simulation as VerifyCusp does, "
+          "without adding passes, and report in CuspReport how many cells stay above CuspHeight and where (Auto: a "
+          "few seconds, a large region on coarser cells, saying how far a crest may read low; On: always on the "
+          "verification's cells, about as long again as the passes)", "cusp_check",
+          choices={"Auto": "auto", "On": "on", "Off": "off"}),
+))
 REPORT = "CuspReport"
 
 

@@ -8,17 +8,16 @@ panel's minimum and maximum for them, checked here like the params' own.
 """
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, Mapping, Optional
 
 import FreeCAD
 
 from tmm_workbench.app import geometry
 from tmm_workbench.core import limits
-from tmm_workbench.core.errors import TmmError, WorkLimitError
+from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, check, spec_of
-from tmm_workbench.core.strategies.finish_passes import STEPOVER_PERCENT
+from tmm_workbench.core.work import Work
 
 # properties that name no params field: their allowed range (a length beyond 10 m is a typing slip)
 EXTRA_SPECS: dict[str, Spec] = {
@@ -30,16 +29,11 @@ EXTRA_SPECS: dict[str, Spec] = {
     "BottomZ": Spec("bottom", "mm", low=-10_000.0, high=10_000.0),
     "PlungeAngle": Spec("plunge angle", "deg", low=0.0, high=90.0),
     "SampleStep": Spec("sample step", "mm", low=0.0, high=1000.0, optional=True),  # waterline: 0 derives it
-    # the 3-axis Surface's depths (app.surface_passes): as core.strategies.finish_passes checks them
-    "StepOverPercent": STEPOVER_PERCENT,
-    "StepDown": Spec("finishing step-down", "mm", low=0.0, high=1000.0, low_open=True),
-    "FinalDepth": Spec("final depth", "mm", low=-10_000.0, high=10_000.0),
 }
 # compute seconds per counted unit on this project's reference machine (2 cores, loaded by other work: the upper
 # of the runs that benchmarks/compute_estimate.py measured; a machine to itself computes up to ~2x faster)
 PACE = {"surface": 2e-5, "adaptive": 7e-5, "surface_flat_cusp": 4e-5, "offset3d": 5e-4, "verify": 4e-6,
         "waterline": 2e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025}
-PACE_TOOL_MM = 6.0      # the surface paces are a 6 mm tool's; a larger one covers more triangles per drop
 TELL_COMPUTE_S = 5.0    # the panel's estimate names the compute time from here
 LONG_COMPUTE_S = 30.0   # the op says so before it starts (console), with how to cancel
 # a side of a range the params leave open, for the panel's minimum / maximum
@@ -103,8 +97,8 @@ def _field_spec(proxy: Any, prop: str) -> Optional[Spec]:
 
 
 def spec_for(proxy: Any, prop: str) -> Optional[Spec]:
-    """The allowed range of the op's property `prop`: its params field's Spec, else EXTRA_SPECS."""
-    return _field_spec(proxy, prop) or EXTRA_SPECS.get(prop)
+    """The allowed range of the op's property `prop`: its params field's Spec, else its stage's, else EXTRA_SPECS."""
+    return _field_spec(proxy, prop) or getattr(proxy, "SPECS", {}).get(prop) or EXTRA_SPECS.get(prop)
 
 
 def check_value(proxy: Any, prop: str, value: float) -> None:
@@ -120,7 +114,7 @@ def check_ranges(obj: Any, overrides: Optional[Mapping[str, float]] = None) -> N
     """The op's properties that name no params field inside EXTRA_SPECS (a tessellation tolerance of 1e-6 mm
     would tessellate a Part model into more triangles than memory holds)."""
     ov = dict(overrides or {})
-    for prop in EXTRA_SPECS:
+    for prop in {**EXTRA_SPECS, **getattr(obj.Proxy, "SPECS", {})}:
         if prop not in ov and hasattr(obj, prop) and _field_spec(obj.Proxy, prop) is None:
             check_value(obj.Proxy, prop, _value(obj, prop, ov))
 
@@ -203,95 +197,26 @@ def _feed(obj: Any) -> Optional[float]:
     return value if value > 0 else None
 
 
-def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
-    from tmm_workbench.core.footprint.cusp import stepover_for_cusp
-    from tmm_workbench.core.footprint.raster import pass_count
-    from tmm_workbench.core.strategies import raster_drop
+Inputs = Optional[tuple[Any, Any, tuple[float, ...]]]   # (params, cutter, bounds) of core.work; None: not known
 
+
+def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
+    """The Surface's params over its boundary box (the stock's or the model's, with the margin)."""
     if obj.BoundaryShape == "Stock":
         bb = _stock(obj)
-        x0, y0, x1, y1 = bb.XMin, bb.YMin, bb.XMax, bb.YMax
+        box = (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
     else:
-        b = model_bounds(proxy, obj, load_stl)
-        if b is None:
+        box = model_bounds(proxy, obj, load_stl)
+        if box is None:
             return None
-        x0, y0, x1, y1 = b[0], b[1], b[3], b[4]
     m = _value(obj, "BoundaryMargin", ov)
-    params = _params(proxy, obj, ov, boundary=(x0 - m, y0 - m, x1 + m, y1 + m))
-    params.validate()
-    if params.stepover_mode == raster_drop.OFFSET3D:  # the 3D offset's passes
-        return _verified(_offset3d(obj, params), obj, params)
-    stepover = params.stepover
-    if params.stepover_mode != raster_drop.STEPOVER:  # the closest spacing the cusp can ask for
-        stepover = stepover_for_cusp(_cutter(obj), params.cusp, params.max_slope_deg)
-        if params.stepover_mode == raster_drop.CUSP:  # the section rule's smallest step (core.footprint.cusp_section)
-            stepover *= 0.5
-    count = raster_drop.estimate_work(replace(params, stepover=stepover))
-    w, h = x1 - x0 + 2 * m, y1 - y0 + 2 * m
-    # passes cover the boundary at the step-over: their length is its area over the spacing
-    return _verified(Estimate(count, "CL points", pass_count(math.hypot(w, h), stepover), w * h / stepover,
-                              _feed(obj), compute_seconds=count * _surface_pace(obj, params)), obj, params)
+    params = _params(proxy, obj, ov, boundary=(box[0] - m, box[1] - m, box[3] + m, box[4] + m))
+    return params, _cutter(obj), box
 
 
-def _surface_kind(obj: Any, params: Any) -> str:
-    """The PACE row of a raster: a flat or bull-nose cutter's cusp spacing costs more per point than a ball's."""
-    from tmm_workbench.core.strategies import raster_drop
-
-    cutter = _cutter(obj)
-    ball = cutter.corner_radius >= cutter.radius
-    if params.stepover_mode == raster_drop.ADAPTIVE:
-        return "adaptive"
-    return "surface" if ball or params.stepover_mode == raster_drop.STEPOVER else "surface_flat_cusp"
-
-
-def _surface_pace(obj: Any, params: Any) -> float:
-    return PACE[_surface_kind(obj, params)] * max(1.0, (_cutter(obj).diameter / PACE_TOOL_MM) ** 2)
-
-
-def _verified(est: Estimate, obj: Any, params: Any) -> Estimate:
-    """With VerifyCusp: the verification's dense raster added (known before it runs; its partial
-    passes are not)."""
-    from tmm_workbench.core.strategies.surface import cusp_check, variable_step
-
-    if not params.verify_cusp:  # CheckCusp measures the cusp modes' passes (skipped above the limits)
-        if not cusp_check.applies(params):
-            return est
-        try:
-            dense = cusp_check.cost_points(params.boundary, _cutter(obj), params.cusp,
-                                           cusp_check.check_cell(params, _cutter(obj)))
-        except WorkLimitError:
-            return replace(est, note="(the cusp check is skipped: its measurement is above the work limit)")
-        return replace(est, count=est.count + dense, note="(with the cusp check's dense raster, at most)",
-                       compute_seconds=_plus(est.compute_seconds, dense * PACE["verify"]))
-    dense = variable_step.estimate_params(_cutter(obj), params)
-    return replace(est, count=est.count + dense, compute_seconds=_plus(est.compute_seconds, dense * PACE["verify"]),
-                   note=f"(with the verification's dense raster; + up to {variable_step.ROUNDS} rounds of partial "
-                        "passes where the simulated cusp is over, not counted)")
-
-
-def _plus(seconds: Optional[float], more: float) -> Optional[float]:
-    return None if seconds is None else seconds + more
-
-
-def _offset3d(obj: Any, params: Any) -> Estimate:
-    """The 3D offset's passes over the boundary box: their points and length on a plane (the region's area over
-    the flat step and its boundary: raster_offset3d.loop_length), the loops from the box's edge to its middle."""
-    from tmm_workbench.core.footprint import offset_field, region
-    from tmm_workbench.core.strategies import raster_offset3d
-
-    cutter = _cutter(obj)
-    shape = region.box_region(params.boundary)
-    count = raster_offset3d.estimate_work(shape, cutter, params)
-    length = raster_offset3d.loop_length(shape, cutter, params)
-    x0, y0, x1, y1 = params.boundary
-    flat = offset_field.step_rule(cutter, params.cusp, params.max_slope_deg).flat
-    return Estimate(count, "CL points", math.ceil(0.5 * min(x1 - x0, y1 - y0) / flat) + 1, length, _feed(obj),
-                    compute_seconds=count * PACE["offset3d"])
-
-
-def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
-    from tmm_workbench.core.strategies import waterline
-
+def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
+    """Waterline's params: its boundary (the stock's box, or the model's grown by the tool radius, with the
+    margin), the sample step (0: derived) and the Z range when it is used."""
     cutter = _cutter(obj)
     b = model_bounds(proxy, obj, load_stl)
     if b is None:
@@ -306,59 +231,37 @@ def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> 
     sample = _value(obj, "SampleStep", ov)
     extra: dict[str, Any] = {"boundary": (box[0] - m, box[1] - m, box[2] + m, box[3] + m),
                              "sample_step": None if sample == 0 else sample}
-    top, bottom = b[5], b[2]
     if obj.UseZRange:
-        top, bottom = _value(obj, "TopZ", ov), _value(obj, "BottomZ", ov)
-        extra.update(top_z=top, bottom_z=bottom)
-    params = _params(proxy, obj, ov, **extra)
-    count = waterline.estimate_work(params, cutter, top, bottom)
-    n = len(waterline.levels(top, bottom, params.step_down))
-    # a level's loops run round the model: its box's outline offset by the tool radius, per level
-    outline = 2 * (b[3] - b[0] + b[4] - b[1]) + 2 * math.pi * cutter.radius
-    return Estimate(count, "waterline drops and points", n, n * outline, _feed(obj),
-                    compute_seconds=count * PACE["waterline"])
+        extra.update(top_z=_value(obj, "TopZ", ov), bottom_z=_value(obj, "BottomZ", ov))
+    return _params(proxy, obj, ov, **extra), cutter, b
 
 
-def roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
+def roughing(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
+    """Roughing's params over the Job's stock solid (its box)."""
     from tmm_workbench.app.compat import PathUtils
-    from tmm_workbench.core.strategies import zlevel_rough
 
     job = PathUtils.findParentJob(obj)
     stock = getattr(job, "Stock", None) if job is not None else None
     if stock is None or stock.Shape.isNull() or not stock.Shape.Solids:
         raise TmmError("the Job has no stock solid to rough from")
     final_z = _value(obj, "FinalZ", ov) if obj.UseFinalZ else None
-    params = _params(proxy, obj, ov, final_z=final_z, stock_box=geometry.stock_box_of(stock))
-    params.validate()
-    cutter = _cutter(obj)
-    layers = zlevel_rough.layer_count(params, cutter)
-    b = params.stock_box
-    # an upper bound: every layer clears the whole stock outline at the step-over
-    length = layers * (b[3] - b[0]) * (b[4] - b[1]) / params.stepover(cutter)
-    count = zlevel_rough.estimate_work(params, cutter, layers)
-    return Estimate(count, "roughing loop points", None, length, _feed(obj), compute_seconds=count * PACE["roughing"])
+    box = geometry.stock_box_of(stock)
+    return _params(proxy, obj, ov, final_z=final_z, stock_box=box), _cutter(obj), box
 
 
-def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Optional[Estimate]:
-    from tmm_workbench.core.footprint.raster import pass_count
-    from tmm_workbench.core.strategies import multipoint
-
+def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
+    """Multipoint's params over its face's box (None before a face is chosen: the op says so when it computes)."""
     if not obj.Base or not obj.Base[0][1]:
-        return None  # the op says what is missing when it computes
+        return None
     base, subs = obj.Base[0]
     bb = base.Shape.getElement(subs[0]).BoundBox
-    params = _params(proxy, obj, ov)
-    params.validate()
-    m = float(params.margin)
-    rect = (bb.XMin - m, bb.YMin - m, bb.XMax + m, bb.YMax + m)
-    count = multipoint.estimate_work(rect, params)
-    area = (rect[2] - rect[0]) * (rect[3] - rect[1])
-    return Estimate(count, "tool positions",
-                    pass_count(math.hypot(rect[2] - rect[0], rect[3] - rect[1]), params.side_step),
-                    area / params.side_step, _feed(obj),
-                    compute_seconds=count * PACE["multipoint_scallop" if params.pass_spacing == multipoint.SCALLOP
-                                                 else "multipoint"])
+    return _params(proxy, obj, ov), None, (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
 
+
+def of_work(work: Work, feed: Optional[float]) -> Estimate:
+    """The panel's estimate of a strategy's work: its compute at the measured paces, its cutting time at `feed`."""
+    seconds = sum(units * PACE[pace] for pace, units in work.paces)
+    return Estimate(work.count, work.what, work.passes, work.cut_length, feed, work.note, compute_seconds=seconds)
 
 
 def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl: bool = True) -> Optional[Estimate]:
@@ -370,8 +273,11 @@ def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl
     for prop, value in ov.items():
         check_value(proxy, prop, value)
     check_ranges(obj, ov)
-    run = getattr(type(proxy), "ESTIMATE", None)  # each op names its estimator
-    if run is None:
+    inputs_of = getattr(type(proxy), "ESTIMATE", None)  # each op names how its strategy's inputs are told
+    if inputs_of is None:
         return None
     apply_work_limits()
-    return run(proxy, obj, ov, load_stl)
+    inputs = inputs_of(proxy, obj, ov, load_stl)
+    if inputs is None:
+        return None
+    return of_work(type(proxy).STRATEGY.estimate_work(*inputs), _feed(obj))

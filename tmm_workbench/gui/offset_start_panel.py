@@ -7,7 +7,6 @@ from typing import Any
 
 from tmm_workbench.gui import object_chooser
 
-COMBOS = {"offsetStart": "OffsetStart"}
 
 
 def curve_candidates(obj: Any) -> list[Any]:

@@ -6,33 +6,15 @@ from typing import Any
 
 from PySide import QtGui
 
-from tmm_workbench.app import model_proxy, registry
+from tmm_workbench.app import model_proxy, op_surface, registry, stages
 from tmm_workbench.app.compat import PathUtils
-from tmm_workbench.gui import op_page, region_panel, resources, surface_depths_gui
-from tmm_workbench.gui import offset_start_panel
+from tmm_workbench.gui import offset_start_panel, op_page, region_panel, resources, surface_depths_gui
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
 JOB_MODEL = "(Job model)"
-# widget name -> property
-SPIN_BOXES = {"boundaryMargin": "BoundaryMargin", "stepOver": "StepOver", "sampleStep": "SampleStep",
-              "rasterAngle": "RasterAngle", "stockToLeave": "StockToLeave",
-              "linearDeflection": "LinearDeflection", "cuspHeight": "CuspHeight",
-              "cuspSlopeLimit": "CuspSlopeLimit"}
-COMBOS = {"boundaryShape": "BoundaryShape", "pattern": "Pattern", "offModel": "OffModel",
-          "stepOverMode": "StepOverMode"}
-SPIN_BOXES.update(region_panel.SPIN_BOXES)  # the region group box
-COMBOS.update(region_panel.COMBOS)
-# lean passes
-SPIN_BOXES["chordTolerance"] = "ChordTolerance"
-COMBOS["forwardStep"] = "ForwardStep"
-CHECKS = {"arcFitting": "ArcFitting"}
-CHECKS["verifyCusp"] = "VerifyCusp"  # the verification pass
-# the group 'Depths, passes and start point'
-SPIN_BOXES.update(surface_depths_gui.SPIN_BOXES)
-COMBOS.update(surface_depths_gui.COMBOS)
-CHECKS.update(surface_depths_gui.CHECKS)
-COMBOS.update(offset_start_panel.COMBOS)  # the 3D offset's start
+# widget name -> property, from the op's stages (app.stages); StepOverPercent and StartPoint: surface_depths_gui
+SPIN_BOXES, COMBOS, CHECKS = stages.widgets(op_surface.STAGES)
 
 
 class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):

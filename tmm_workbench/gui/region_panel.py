@@ -10,8 +10,6 @@ import FreeCADGui
 from tmm_workbench.app import region_source
 from tmm_workbench.gui import object_chooser
 
-SPIN_BOXES = {"regionTolerance": "RegionTolerance", "slopeMin": "SlopeMin", "slopeMax": "SlopeMax"}
-COMBOS = {"region": "Region", "spiralDirection": "SpiralDirection"}
 NO_SKETCH = "(none)"
 
 

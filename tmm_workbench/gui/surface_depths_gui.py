@@ -14,9 +14,6 @@ from tmm_workbench.app.surface_passes import PERCENT
 from tmm_workbench.core.strategies.finish_passes import MAX_PASSES
 
 # widget name -> property, merged into op_surface_gui's tables
-SPIN_BOXES = {"finalDepth": "FinalDepth", "stepDown": "StepDown"}
-COMBOS = {"stepOverUnit": "StepOverUnit"}
-CHECKS = {"useFinalDepth": "UseFinalDepth", "useStartPoint": "UseStartPoint"}
 # the properties whose change enables or disables fields
 ENABLING = ("StepOverUnit", "StepOverMode", "UseFinalDepth", "FinishPasses", "UseStartPoint")
 

@@ -112,7 +112,7 @@ def estimate_work(params: SurfaceParams, finish: FinishParams) -> float:
     is made. The cusp spacings are estimated per pass set by raster_drop as it places them."""
     if params.stepover_mode != STEPOVER or finish.passes == 1:
         return 0.0
-    per_set = raster_drop.estimate_work(params)
+    per_set = raster_drop.count_points(params)
     check_work("CL points", per_set * finish.passes, raster_drop._BYTES_PER_POINT,
                f"{finish.passes} finishing passes of sample step {params.sample_step:g} mm and step-over "
                f"{params.stepover:g} mm")

@@ -33,6 +33,7 @@ from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.linking import ALONG_AXIS, LinkPolicy, link
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.segments import CutSegment, StrategyResult
+from tmm_workbench.core.work import Box, Work
 # the positioner's status codes, also read from here by the op, the pictures and the tests
 from tmm_workbench.core.strategies.multipoint_status import (STATUS_FAILED, STATUS_NAMES, STATUS_ONE,  # noqa: F401
                                                              STATUS_TWO)
@@ -155,7 +156,7 @@ def multipoint_footprint(face: BezierFace, params: MultipointParams) -> list[np.
     if params.pass_spacing == SCALLOP:
         raise TmmError("pass spacing 'scallop' places passes from the tool positions: use compute()")
     rect = footprint_rect(face, params)
-    estimate_work(rect, params)
+    count_positions(rect, params)
     lines = raster_lines(rect, params.side_step, params.feed_angle_deg, params.pass_spacing)
     # Start with the pass nearest the boundary's (xmin, ymin) corner.
     corner = np.array(rect[:2])
@@ -179,7 +180,7 @@ def footprint_rect(face: BezierFace, params: MultipointParams) -> Rect:
     return (x0 - m, y0 - m, x1 + m, y1 + m)
 
 
-def estimate_work(rect: Rect, params: MultipointParams) -> float:
+def count_positions(rect: Rect, params: MultipointParams) -> float:
     """Footprint points over `rect` (an upper bound), refused above the limits before any is made."""
     w, h = rect[2] - rect[0], rect[3] - rect[1]
     if not (w > 0 and h > 0):
@@ -190,6 +191,17 @@ def estimate_work(rect: Rect, params: MultipointParams) -> float:
                f"side step {params.side_step:g} mm and forward step {params.forward_step:g} mm over a "
                f"{w:.6g} x {h:.6g} mm boundary", "max_positions")
     return count
+
+
+def estimate_work(params: MultipointParams, cutter: Cutter, bounds: Box) -> Work:
+    """The footprint's tool positions over the face's box `bounds` grown by the margin (core.work)."""
+    params.validate()
+    m = float(params.margin)
+    rect = (bounds[0] - m, bounds[1] - m, bounds[3] + m, bounds[4] + m)
+    count = count_positions(rect, params)
+    w, h = rect[2] - rect[0], rect[3] - rect[1]
+    return Work(count, "tool positions", pass_count(math.hypot(w, h), params.side_step), w * h / params.side_step,
+                paces=(("multipoint_scallop" if params.pass_spacing == SCALLOP else "multipoint", count),))
 
 
 def _torus(tool: Cutter) -> tuple[float, float]:
@@ -323,7 +335,7 @@ def _scallop_passes(surface: BezierFace, tool: Cutter, params: MultipointParams,
     Ro, Ri = tool.torus_radii
     check_scallop(params.scallop, Ri)
     rect = footprint_rect(surface, params)
-    estimate_work(rect, params)
+    count_positions(rect, params)
     ms.estimate_work(rect, params, Ri)
     frame = ms.Frame.of(rect, params.feed_angle_deg)
     rows = params.scallop_row_spacing or min(4.0, max(1.0, 2.0 * params.forward_step))

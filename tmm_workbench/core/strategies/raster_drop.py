@@ -13,7 +13,8 @@ The Surface's pipeline, one module per stage in core.strategies.surface: pattern
 positioning (the points dropped and refined) -> forward_step (segments in cutting order, the lean fit) ->
 verification (variable_step's partial passes, given this module's compute for its dense raster; cusp_check's
 report) -> linking (compute_surface_toolpath: core.linking). Its shared declarations (params: SurfaceParams, the
-mode and pattern names, raster_points), the pass segments (segments) and the work estimate are re-exported here.
+mode and pattern names, raster_points), the pass segments (segments) and the work (estimate: estimate_work, one
+signature for every strategy, core.work) are re-exported here.
 """
 from __future__ import annotations
 
@@ -30,7 +31,8 @@ from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - the S
     _BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY, OUTWARD, SAMPLED,
     SPIRAL, STEPOVER, TOLERANCE, ZIGZAG, SurfaceParams, raster_points)
 from tmm_workbench.core.strategies.surface import forward_step
-from tmm_workbench.core.strategies.surface.pattern import estimate_work, pattern  # noqa: F401 - the app uses it
+from tmm_workbench.core.strategies.surface.estimate import estimate_work  # noqa: F401 - the strategy's work
+from tmm_workbench.core.strategies.surface.pattern import count_points, pattern
 from tmm_workbench.core.strategies.surface.positioning import _AIR_DEPTH_MM, Positioner, position  # noqa: F401
 from tmm_workbench.core.strategies.surface.segments import _COLLINEAR_MM, reduce_chords  # noqa: F401
 from tmm_workbench.core.strategies.surface.segments import segments as _segments  # noqa: F401

@@ -34,6 +34,7 @@ from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
 from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.work import Box, Work
 
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 CLIMB, CONVENTIONAL = "climb", "conventional"
@@ -101,7 +102,7 @@ def _range(mesh: TriMesh, params: WaterlineParams) -> tuple[float, float]:
     return top, bottom
 
 
-def estimate_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: float) -> float:
+def count_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: float) -> float:
     """Drops of the shared grid and loop points of all levels (an estimate; the levels counted, not made),
     refused above core.limits before anything is allocated."""
     params.validate()
@@ -109,6 +110,17 @@ def estimate_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: f
     step = wl.default_sample_step(cutter, b) if params.sample_step is None else params.sample_step
     count = level_count(top, bottom, params.step_down)
     return wl.estimate_work(b, count, step, f"step-down {params.step_down:g} mm from {top:g} to {bottom:g} mm")
+
+
+def estimate_work(params: WaterlineParams, cutter: Cutter, bounds: Box) -> Work:
+    """The waterline's work over the model's box `bounds` (core.work): its levels from the top (or `top_z`) to the
+    lowest point (or `bottom_z`), a level's loops as long as the box's outline offset by the tool radius."""
+    top = bounds[5] if params.top_z is None else params.top_z
+    bottom = bounds[2] if params.bottom_z is None else params.bottom_z
+    count = count_work(params, cutter, top, bottom)
+    n = len(levels(top, bottom, params.step_down))
+    outline = 2 * (bounds[3] - bounds[0] + bounds[4] - bounds[1]) + 2 * math.pi * cutter.radius
+    return Work(count, "waterline drops and points", n, n * outline, paces=(("waterline", count),))
 
 
 def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Optional[Progress] = None,
@@ -125,7 +137,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
         raise TmmError(f"boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} lies outside the model "
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
     top, bottom = _range(mesh, params)
-    estimate_work(params, cutter, top, bottom)
+    count_work(params, cutter, top, bottom)
     zs = levels(top, bottom, params.step_down)
     s = params.stock_to_leave
     surface = surface or DropSurface(mesh)

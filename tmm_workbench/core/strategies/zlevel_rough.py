@@ -59,6 +59,7 @@ from tmm_workbench.core.strategies import zlevel_clearing as clearing
 from tmm_workbench.core.strategies import zlevel_layers as layers_mod
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
+from tmm_workbench.core.work import Box, Work
 
 SUPPORTED_TOOLS = ("flat", "bull", "ball")
 _AIR_MARGIN = 1.0           # mm: the tool-centre box reaches this far past the tool touching the stock
@@ -179,7 +180,7 @@ def layer_count(params: RoughingParams, cutter: Cutter) -> int:
     return max(1, math.ceil((b[5] - b[2]) / depth))
 
 
-def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] = None) -> float:
+def count_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] = None) -> float:
     """Loop points over all layers (layers x loops x points, an upper bound: every loop as long as the
     stock's outline, at the waterline's sample spacing), refused above the limits before any is made.
     `layers` when known; else from the step-down (tolerance mode: the shallowest layer eq. 3.11 allows)."""
@@ -198,6 +199,17 @@ def estimate_work(params: RoughingParams, cutter: Cutter, layers: Optional[int] 
                f"of D{cutter.diameter:g} over a {w:.6g} x {h:.6g} mm stock, entry {params.entry} at ramp angle "
                f"{params.ramp_angle_deg:g} deg, helix diameter {params.helix_diameter_percent:g} %")
     return count
+
+
+def estimate_work(params: RoughingParams, cutter: Cutter, bounds: Box) -> Work:
+    """Roughing's work (core.work; its stock is the params', `bounds` the model's box, unused): an upper bound,
+    every layer clearing the whole stock outline at the step-over."""
+    params.validate()
+    layers = layer_count(params, cutter)
+    b = params.stock_box
+    count = count_work(params, cutter, layers)
+    return Work(count, "roughing loop points", None, layers * (b[3] - b[0]) * (b[4] - b[1]) / params.stepover(cutter),
+                paces=(("roughing", count),))
 
 
 def entry_points(params: RoughingParams, cutter: Cutter) -> float:
@@ -461,9 +473,9 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     passes too small for any entry (a spot the tool centre just fits), left uncut)."""
     params.validate()
     top, final = _check(mesh, cutter, params)
-    estimate_work(params, cutter)
+    count_work(params, cutter)
     zs = layer_heights(mesh, cutter, params, top, final)
-    estimate_work(params, cutter, len(zs))
+    count_work(params, cutter, len(zs))
     steps = _Steps(progress)
     steps.at(0.0)
     b = params.stock_box

@@ -2,7 +2,7 @@
 (pass_lines: the step-over, the constant cusp's section rule, the adaptive placement), turned for zig-zag, clipped
 to a region or replaced by the spiral (core.strategies.raster_region) or by the 3D offset's loops (raster_offset3d),
 and sampled into runs of XY points (passes and zig-zag links) for positioning (core.strategies.surface.
-positioning). The work is estimated from the parameters before anything is allocated (estimate_work)."""
+positioning). The work is counted from the parameters before anything is allocated (count_points)."""
 from __future__ import annotations
 
 import math
@@ -17,8 +17,10 @@ from tmm_workbench.core.footprint.raster import clip_line_to_rect, raster_lines,
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface, Progress
-from tmm_workbench.core.strategies.surface.params import (_BYTES_PER_POINT, CUSP, OFFSET3D, SPIRAL, STEPOVER, ZIGZAG,
-                                                          SurfaceParams, raster_points)
+from tmm_workbench.core.stage import Args, Field, Stage
+from tmm_workbench.core.strategies.surface.params import (_BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFFSET3D, ONEWAY,
+                                                          OUTWARD, SPIRAL, STEPOVER, ZIGZAG, SurfaceParams,
+                                                          raster_points)
 from tmm_workbench.core.tools.cutter import Cutter
 
 Run = tuple[bool, np.ndarray]  # (is_link, xy)
@@ -33,7 +35,7 @@ class Pattern:
     levels: Any = None                    # the 3D offset's arrival field (its loops are level sets of it)
 
 
-def estimate_work(params: SurfaceParams) -> float:
+def count_points(params: SurfaceParams) -> float:
     """raster_points, refused above the limits before any is made."""
     count = raster_points(params)
     b = params.boundary
@@ -103,7 +105,7 @@ def pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: fl
                            cusp_limited=int(step.limited), cusp_creases=step.creases)
     else:
         # the adaptive placement drops its passes on the way (its own work estimate, then pass by pass)
-        estimate_work(replace(params, stepover=stepover_for_cusp(cutter, params.cusp, params.max_slope_deg)))
+        count_points(replace(params, stepover=stepover_for_cusp(cutter, params.cusp, params.max_slope_deg)))
         placed = adaptive_pass_offsets(mesh, cutter, b, params.angle_deg, params.cusp, params.sample_step,
                                        floor_z, params.stock_to_leave, params.max_slope_deg,
                                        None if progress is None else lambda f: progress(0.5 * f))
@@ -112,6 +114,55 @@ def pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: fl
         a = math.radians(params.angle_deg)
         d, n = np.array([math.cos(a), math.sin(a)]), np.array([-math.sin(a), math.cos(a)])
         return [seg for seg in (clip_line_to_rect(c * n, d, b) for c in placed.offsets) if seg is not None]
-    estimate_work(replace(params, stepover=stepover))
+    count_points(replace(params, stepover=stepover))
     diagnostics["stepover"] = stepover
     return raster_lines(b, stepover, params.angle_deg)
+
+
+# --- the stage's declaration (core.stage) ---------------------------------------------------------------------
+PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL}
+# the step-over modes; 3D offset: closed loops from the region's edge inward, CuspHeight apart across the surface
+SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE, "Offset3D": OFFSET3D}
+SPIRAL_DIRECTIONS = {"Outward": OUTWARD, "Inward": INWARD}
+
+
+def ignored(args: Args) -> Optional[str]:
+    """The spacing or pattern argument the chosen mode would not use."""
+    mode = str(args.get("stepover_mode") or STEPOVER).lower()
+    stepover, percent = args.get("stepover"), args.get("stepover_percent")
+    if mode != STEPOVER and (stepover is not None or percent is not None):
+        name = "stepover" if stepover is not None else "stepover_percent"
+        return (f"{name} is not used with stepover_mode {args.get('stepover_mode')!r}: the spacing comes from the "
+                "cusp height (cusp); leave it out, or use stepover_mode 'stepover'")
+    if stepover is not None and percent is not None:
+        return "give stepover (mm) or stepover_percent (of the tool diameter), not both"
+    if mode == STEPOVER and args.get("cusp") is not None and args.get("verify_cusp") is False:
+        return (f"cusp {args['cusp']!r} is not used with stepover_mode 'stepover' (passes `stepover` apart): give "
+                "stepover_mode 'cusp', 'adaptive' or 'offset3d' to space the passes by it, or verify_cusp=True")
+    if args.get("spiral_direction") is not None and str(args.get("pattern") or ZIGZAG).lower() != SPIRAL:
+        return f"spiral_direction is used with pattern 'spiral' only, got pattern {args.get('pattern')!r}"
+    return None
+
+
+STAGE = Stage("pattern", (
+    Field("StepOver", "length", "Surface", "Distance between raster passes", "stepover", "stepover",
+          widget="stepOver"),
+    Field("StepOverMode", "choice", "Surface",
+          "StepOver: passes StepOver apart; Cusp: the step-over that keeps CuspHeight on the worst crossing of the "
+          "boundary, slope and curvature (up to CuspSlopeLimit); Adaptive: each pass placed from the previous one's "
+          "tool positions so that the cusp between them is CuspHeight", "stepover_mode", "stepover_mode",
+          choices=SPACINGS, widget="stepOverMode"),
+    Field("CuspHeight", "length", "Surface",
+          "Largest scallop left between passes (Cusp and Adaptive spacing), along the surface normal", "cusp",
+          "cusp", widget="cuspHeight"),
+    Field("CuspSlopeLimit", "angle", "Surface",
+          "Steeper places are not held to CuspHeight (walls are waterline's)", "max_slope_deg",
+          widget="cuspSlopeLimit"),
+    Field("RasterAngle", "angle", "Surface", "Direction of the passes, from +X", "angle_deg", "angle_deg",
+          widget="rasterAngle"),
+    Field("Pattern", "choice", "Surface",
+          "ZigZag: cut both ways, linked over the surface; OneWay: cut one way, retract between passes; Spiral: "
+          "from the region's centre (SpiralDirection)", "pattern", "pattern", choices=PATTERNS, widget="pattern"),
+    Field("SpiralDirection", "choice", "Surface", "Spiral pattern: from the region's centre Outward, or Inward to it",
+          "spiral_direction", "spiral_direction", choices=SPIRAL_DIRECTIONS, widget="spiralDirection"),
+), ignored=ignored)

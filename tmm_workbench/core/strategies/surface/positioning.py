@@ -13,7 +13,9 @@ import numpy as np
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface, Progress
-from tmm_workbench.core.strategies.surface.params import OFF_MODEL_SKIP, SPIRAL, ZIGZAG, SurfaceParams
+from tmm_workbench.core.stage import Field, Stage
+from tmm_workbench.core.strategies.surface.params import (OFF_MODEL_FLOOR, OFF_MODEL_SKIP, SPIRAL, ZIGZAG,
+                                                          SurfaceParams)
 from tmm_workbench.core.strategies.surface.pattern import Run
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -71,3 +73,17 @@ def position(runs: list[Run], passes: int, drop: Positioner, cutter: Cutter, par
         air = raster_region.slope_flags(runs, z, air, drop, cutter, params, diagnostics)
     diagnostics["top"] = float(z[~air].max())
     return runs, z, air
+
+
+# --- the stage's declaration (core.stage) ---------------------------------------------------------------------
+OFF_MODEL = {"Floor": OFF_MODEL_FLOOR, "Skip": OFF_MODEL_SKIP}
+STAGE = Stage("positioning", (
+    Field("SampleStep", "length", "Surface", "Sampling step along a pass", "sample_step", "sample_step",
+          widget="sampleStep"),
+    Field("StockToLeave", "length", "Surface", "Material left on the surface", "stock_to_leave", "stock_to_leave",
+          widget="stockToLeave"),
+    Field("OffModel", "choice", "Surface",
+          "Where no part of the model is under the tool (beside an open surface, in a hole): Floor cuts along the "
+          "floor (the model's lowest point); Skip lifts over it and cuts only over the model", "off_model",
+          "off_model", choices=OFF_MODEL, widget="offModel"),
+))
