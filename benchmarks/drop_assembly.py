@@ -1,0 +1,114 @@
+"""Cost of dropping the whole tool assembly (cutter + shank + holder, with clearances) against the cutter alone.
+
+    .venv/bin/python benchmarks/drop_assembly.py              # the table (about a minute)
+    .venv/bin/python benchmarks/drop_assembly.py --quick      # coarser rasters
+    .venv/bin/python benchmarks/drop_assembly.py --threads 0  # all cores, wall-clock time
+
+Per case: the same raster of CL points dropped with native.drop_cutter (the cutter alone) and with
+native.drop_assembly (cutter, shank and holder), best of a few runs each; their ratio (the target: at most
+1.5), the share of points the shank or holder lifted, and how far they lifted the tool at most. Cases: real STL
+files from the shared benchmark folder and a synthetic deep pocket where the holder sets the height. By default
+one thread and the process's CPU time, which other jobs on the machine disturb less than wall-clock time.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from tmm_workbench.core.kernel import native  # noqa: E402
+from tmm_workbench.core.geometry.mesh import load_stl  # noqa: E402
+from tmm_workbench.core.shared_data import shared_dir  # noqa: E402
+
+
+def pocket_mesh(cells: int, size: float = 120.0, pocket: float = 50.0, depth: float = 40.0):
+    """A plate `size` wide at z = 0 with a square pocket `pocket` wide and `depth` deep with a domed floor,
+    as a height field of cells^2 quads (steep walls one cell wide)."""
+    g = np.linspace(-size / 2, size / 2, cells + 1)
+    x, y = np.meshgrid(g, g, indexing="ij")
+    inside = (np.abs(x) < pocket / 2) & (np.abs(y) < pocket / 2)
+    z = np.where(inside, -depth + 5 * np.cos(x / 8) * np.cos(y / 8), 0.0)
+    v = np.column_stack([x.ravel(), y.ravel(), z.ravel()])
+    i, j = np.meshgrid(np.arange(cells), np.arange(cells), indexing="ij")
+    a = (i * (cells + 1) + j).ravel()
+    b, c, d = a + cells + 1, a + 1, a + cells + 2
+    return v, np.concatenate([np.column_stack([a, b, c]), np.column_stack([c, b, d])]).astype(np.int32)
+
+
+def raster(lo, hi, step: float) -> np.ndarray:
+    """Zig-zag raster rows over the XY box, as a path would visit them."""
+    xs = np.arange(lo[0], hi[0] + 1e-9, step)
+    rows = []
+    for k, y in enumerate(np.arange(lo[1], hi[1] + 1e-9, step)):
+        row = np.column_stack([xs if k % 2 == 0 else xs[::-1], np.full(xs.size, y)])
+        rows.append(row)
+    return np.concatenate(rows)
+
+
+def best_time(fn, repeats: int, clock=time.perf_counter) -> tuple[float, object]:
+    best, out = np.inf, None
+    for _ in range(repeats):
+        t0 = clock()
+        out = fn()
+        best = min(best, clock() - t0)
+    return best, out
+
+
+def cases(quick: bool):
+    stl = shared_dir() / "benchmarks" / "stl"
+    step = 0.5 if quick else 0.25
+    ball6 = native.Cutter(3.0, 3.0)
+    # (z0, z1, r0, r1, clearance) above the tip: shank from the flutes' end, then a holder.
+    shank_holder = lambda stick, shank_r, holder_r: np.array([  # noqa: E731
+        [stick - 15.0, stick, shank_r, shank_r, 0.5],
+        [stick, stick + 60.0, holder_r, holder_r, 2.0]])
+    tapered_neck = lambda stick: np.array([  # noqa: E731
+        [12.0, stick - 10.0, 2.5, 2.5, 0.5],
+        [stick - 10.0, stick, 2.5, 8.0, 1.0],
+        [stick, stick + 60.0, 16.0, 16.0, 2.0]])
+    m = load_stl(stl / "mount_rush.stl")
+    yield "mount_rush, ball d6, stick-out 25, holder r15", m.vertices, m.triangles, ball6, shank_holder(25, 3, 15), step
+    yield "mount_rush, ball d6, neck cone + holder r16", m.vertices, m.triangles, ball6, tapered_neck(30), step
+    m = load_stl(stl / "wheel_in_box.stl")
+    yield "wheel_in_box, ball d6, stick-out 30, holder r20", m.vertices, m.triangles, ball6, shank_holder(30, 3, 20), 2 * step
+    m = load_stl(stl / "sphere_on_plate.stl")
+    yield "sphere_on_plate, bull d10 r2, stick-out 20, holder r25", m.vertices, m.triangles, native.Cutter(5.0, 2.0), \
+        shank_holder(20, 5, 25), step
+    v, f = pocket_mesh(300 if quick else 600)
+    yield "deep pocket 40 deep, ball d6, stick-out 25, holder r20", v, f, ball6, shank_holder(25, 3, 20), \
+        2 * step
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--threads", type=int, default=1, help="0: all cores (then wall-clock time)")
+    ap.add_argument("--repeats", type=int, default=5)
+    args = ap.parse_args()
+    clock = time.process_time if args.threads == 1 else time.perf_counter
+    head = f"{'case':62s} {'tri':>7s} {'points':>8s} {'cutter s':>9s} {'assembly s':>10s} {'ratio':>6s} " \
+           f"{'lifted':>7s} {'max lift':>8s}"
+    print(head)
+    print("-" * len(head))
+    for name, v, f, cutter, bodies, step in cases(args.quick):
+        index = native.MeshIndex(v, f)
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        xy = raster(lo[:2], hi[:2], step)
+        floor = float(lo[2]) - 1.0
+        t0, z0 = best_time(lambda: native.drop_cutter(index, cutter, xy, floor, args.threads), args.repeats, clock)
+        t1, (z1, by) = best_time(lambda: native.drop_assembly(index, cutter, bodies, xy, floor,
+                                                              threads=args.threads), args.repeats, clock)
+        lifted = by >= 0
+        assert np.all(z1 >= z0) and np.array_equal(z1[~lifted], z0[~lifted])
+        print(f"{name:62s} {len(f):7d} {len(xy):8d} {t0:9.3f} {t1:10.3f} {t1 / t0:6.2f} "
+              f"{lifted.mean():7.1%} {np.max(z1 - z0):8.2f}")
+
+
+if __name__ == "__main__":
+    main()
