@@ -14,6 +14,7 @@ from tmm_workbench.core.arcs import Arc
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.axes import slerp
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tests.core.cavity import cavity_mesh
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop, body_pieces
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
@@ -22,33 +23,14 @@ from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.verify.body_distance import SurfacePoints, signed_distance
 from tmm_workbench.core.verify.holder_clearance import check_holder_clearance, minimum_stick_out, sample_moves
 
-DRAFT = math.tan(math.radians(3.0))
 STEP = 0.5
 ROWS = np.arange(-30.0, 30.1, 6.0)
 BRUTE_ROWS = (-30.0, 0.0, 12.0)   # near a wall, across the boss, beside it
 
 
-def square_rings(levels: list[tuple[float, float]], name: str) -> TriMesh:
-    """Concentric squares (half width, z) from the outside in, each joined to the next by four trapezoids
-    (two triangles each), the innermost capped."""
-    corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], dtype=float)
-    v = np.array([[hw * x, hw * y, z] for hw, z in levels for x, y in corners])
-    f = []
-    for k in range(len(levels) - 1):
-        o, i = 4 * k, 4 * (k + 1)
-        for e in range(4):
-            a, b, c, d = o + e, o + (e + 1) % 4, i + (e + 1) % 4, i + e
-            f += [[a, b, c], [a, c, d]]
-    n = 4 * (len(levels) - 1)
-    f += [[n, n + 1, n + 2], [n, n + 2, n + 3]]
-    return TriMesh(v, np.array(f), name)
-
-
 @pytest.fixture(scope="module")
 def cavity() -> TriMesh:
-    """A plate 100 mm square at z = 0 with a pocket 70 mm square and 40 mm deep, walls drafted 3 degrees, and
-    a boss 20 mm square at the top, 20 mm high, drafted too."""
-    return square_rings([(50, 0), (35, 0), (35 - 40 * DRAFT, -40), (10 + 20 * DRAFT, -40), (10, -20)], "cavity")
+    return cavity_mesh()
 
 
 @pytest.fixture(scope="module")

@@ -23,15 +23,15 @@ def close(actual, expected, test: unittest.TestCase) -> None:
 
 class ShankFromToolBits(FreeCADTestCase):
     def test_made_end_mill(self) -> None:
-        # FreeCAD's endmill shape gives a made bit its defaults: 3 mm shank, 30 mm flutes, 50 mm long
+        # a bit TMM makes: a shank of its diameter, flutes of 3 diameters, 50 mm long (tools.make_tool_bit)
         bit = tools.make_tool_bit(new_doc(), "endmill", 6.0)
         self.assertEqual([float(getattr(bit, p).Value) for p in ("ShankDiameter", "CuttingEdgeHeight", "Length")],
-                         [3.0, 30.0, 50.0])
+                         [6.0, 18.0, 50.0])
         a = tools.assembly_from_tool(bit, "ER11 nut", 35.0, holders_file=None)
-        self.assertEqual((a.cutter.kind, a.flute_length, a.shank_diameter, a.overall_length), ("flat", 30, 3, 50))
-        close(a.bodies(), [(30, 35, 1.5, 1.5, 1), (35, 46.5, 9.5, 9.5, 1)], self)
+        self.assertEqual((a.cutter.kind, a.flute_length, a.shank_diameter, a.overall_length), ("flat", 18, 6, 50))
+        close(a.bodies(), [(18, 35, 3, 3, 1), (35, 46.5, 9.5, 9.5, 1)], self)
         # no stick-out: Length minus 3 shank diameters
-        self.assertAlmostEqual(tools.assembly_from_tool(bit, holders_file=None).stick_out, 50 - 9)
+        self.assertAlmostEqual(tools.assembly_from_tool(bit, holders_file=None).stick_out, 50 - 18)
 
     def test_shipped_ball_end_mill(self) -> None:
         bit = compat.toolbit_from_file(new_doc(), compat.stock_bit_file("6mm_Ball_End.fctb"))

@@ -63,7 +63,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 stepover_percent: Optional[float] = None, final_depth: Optional[float] = None,
                 finish_passes: Optional[int] = None, finish_step_down: Optional[float] = None,
                 start_point: Optional[tuple[float, float]] = None,
-                offset_from: Any = None) -> SurfaceResult:
+                offset_from: Any = None, holder: Optional[str] = None, stick_out: Optional[float] = None,
+                shank_clearance: Optional[float] = None, holder_clearance: Optional[float] = None,
+                holder_collision: Optional[str] = None) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
 
     tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose), or a
@@ -102,6 +104,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     of `stepover`); final_depth (mm, no tool tip below it); finish_passes (1-50: the first ones leave
     stock_to_leave + k x finish_step_down, the last stock_to_leave); start_point (x, y): each pass set begins at
     the raster's end nearest it.
+    The whole tool (app.tool_assembly, docs/holders.md): holder (a name from TMM's holder library; None: the cutter
+    alone), stick_out (mm from the holder's face to the tip; None: the ToolBit's Length minus 3 shank diameters),
+    shank_clearance and holder_clearance (mm, default 1), holder_collision 'lift' (the tool rises where the shank
+    or holder would come closer, material is left there: the op's HolderReport) | 'leave_out' (not cut there).
     """
     args = dict(locals())  # the call's arguments by name, as the op's stages declare them
     from tmm_workbench.app import op_surface, stages

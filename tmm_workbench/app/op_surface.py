@@ -19,7 +19,7 @@ from typing import Any, Optional
 import FreeCAD
 
 from tmm_workbench.app import offset_start, op_base, op_mesh, progress, region_source, simulation, stages
-from tmm_workbench.app import surface_passes, surface_verify, work_estimate
+from tmm_workbench.app import surface_passes, surface_verify, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
@@ -51,7 +51,8 @@ LINKING_STAGE = Stage("linking", (
 # the op's stages in the order of their properties (documents keep that order); the Surface's pipeline runs
 # pattern -> positioning -> forward step -> verification -> linking (core.strategies.raster_drop)
 STAGES = (op_mesh.MODEL_STAGE, BOUNDARY_STAGE, pattern.STAGE, positioning.STAGE, forward_step.STAGE,
-          LINKING_STAGE, region_source.STAGE, surface_passes.STAGE, surface_verify.STAGE, offset_start.STAGE)
+          LINKING_STAGE, region_source.STAGE, surface_passes.STAGE, surface_verify.STAGE, offset_start.STAGE,
+          tool_assembly.STAGE)
 PROPERTIES: list[Prop] = stages.properties(STAGES)
 CHOICES = stages.choices(STAGES)
 DEFAULTS: dict[str, Any] = stages.defaults(STAGES)
@@ -101,9 +102,12 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value,
                             material_top=simulation.material_left(obj, cutter))
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
+        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
+        params.holder_notes = [] if params.assembly is not None else None
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy, cb)
         surface_verify.report(obj, notes)
+        tool_assembly.report(obj, params.holder_notes or [])
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 

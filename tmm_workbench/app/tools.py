@@ -152,9 +152,15 @@ def corner_radius_of(tool: Any) -> Optional[float]:
     return cutter.corner_radius
 
 
+FLUTE_DIAMETERS = 3.0     # flute length of the bits TMM makes, in diameters
+LENGTH_PAST_FLUTES = 4.0  # their length beyond the flutes, in diameters (at least MIN_LENGTH_MM overall)
+MIN_LENGTH_MM = 50.0
+
+
 def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 0.0, label: str = "") -> Any:
-    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape in `doc`. For a bull-nose, the 0.20 and 1.0 shape
-    stores FlatRadius = diameter/2 - corner radius (see the module doc), 1.1's CornerRadius."""
+    """A ToolBit of FreeCAD's endmill/ballend/bullnose shape in `doc`, with a shank of its diameter, flutes of 3
+    diameters and a length of 7 diameters, at least 50 mm. For a bull-nose, the 0.20 and 1.0 shape stores
+    FlatRadius = diameter/2 - corner radius (see the module doc), 1.1's CornerRadius."""
     from tmm_workbench.app import compat
 
     if shape not in BIT_SHAPES:
@@ -168,7 +174,11 @@ def make_tool_bit(doc: Any, shape: str, diameter: float, corner_radius: float = 
         raise TmmError(f"bull-nose tool: corner radius {corner_radius:g} mm is larger than the tool radius "
                        f"{diameter / 2:g} mm" if corner_radius > 0 else
                        f"bull-nose tool: corner radius must be >= 0 mm, got {corner_radius:g}")
-    params = {"Diameter": f"{diameter} mm"}
+    # a solid carbide end mill's proportions (the shape files' defaults are one 3 mm shank, 30-40 mm flutes and
+    # 50 mm length for every diameter): the shank of the cutting diameter, flutes of FLUTE_DIAMETERS diameters
+    flutes = FLUTE_DIAMETERS * diameter
+    params = {"Diameter": f"{diameter} mm", "ShankDiameter": f"{diameter} mm", "CuttingEdgeHeight": f"{flutes} mm",
+              "Length": f"{max(MIN_LENGTH_MM, flutes + LENGTH_PAST_FLUTES * diameter)} mm"}
     if shape == "bullnose" and compat.toolbits_are_assets():
         params["CornerRadius"] = f"{corner_radius} mm"
     elif shape == "bullnose":

@@ -27,6 +27,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import StrategyResult
+from tmm_workbench.core.strategies import holder_guard
 from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - the Surface's names, used from here
     _BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY, OUTWARD, SAMPLED,
     SPIRAL, STEPOVER, TOLERANCE, ZIGZAG, SurfaceParams, raster_points)
@@ -97,6 +98,13 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             segments = segments[:n] + extra
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
+    if params.assembly is not None:  # the whole tool: the shank and holder kept clear of the model
+        segments, holder = holder_guard.guard(mesh, params.assembly, segments, params.holder_collision,
+                                              params.sample_step, surface)
+        diagnostics["holder"] = holder
+        diagnostics["top"] = max([diagnostics["top"]] + [float(seg.tips[:, 2].max()) for seg in segments if len(seg)])
+        if params.holder_notes is not None:
+            params.holder_notes.append(holder)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

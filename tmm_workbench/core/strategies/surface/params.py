@@ -79,6 +79,12 @@ class SurfaceParams(StrategyParams):
     # cusp reported (diagnostics["cusp_check"], a CuspCheck appended to verify_notes; core.strategies.surface.cusp_check);
     # "auto": where it is cheap (a small region), "on": always, "off"
     cusp_check: str = param("auto", "cusp check", choices=("auto", "on", "off"))
+    # --- the whole tool (core.strategies.holder_guard): the shank and holder kept their clearance from the
+    # model, the tool lifted where they would come closer ("lift") or those places not cut ("leave_out"); its
+    # HolderReport is appended to holder_notes. None: the cutter alone
+    assembly: Any = None
+    holder_collision: str = param("lift", "holder collision", choices=("lift", "leave_out"))
+    holder_notes: Optional[list] = None
 
     def validate(self) -> None:
         super().validate()

@@ -1,0 +1,76 @@
+"""The whole tool in the 3-axis Surface op (app.tool_assembly, core.strategies.holder_guard): a ball D4 on a 20 mm
+stick-out in an ER32 collet chuck finishing a 40 mm deep cavity, through run_surface and the op's properties. The
+op keeps the shank and holder their clearance from the model (checked along every move by
+core.verify.holder_clearance), says in HolderReport what it left and the stick-out that would cut it; with the
+holder ignored the same path drives the holder into the part; bad values are refused by name; documents save
+and reopen with it, and older ones restore without a holder."""
+from __future__ import annotations
+
+import FreeCAD
+
+from fc_helpers import OUT, FreeCADTestCase, reopened, write_ascii_stl
+from tests.core.cavity import cavity_mesh
+from tmm_workbench.app import tool_assembly
+from tmm_workbench.app.api import run_surface
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.verify.holder_clearance import check_holder_clearance
+
+HOLDER = "SK40 ER32x70"
+FAST = dict(tool="ballend", diameter=4.0, stepover=4.0, sample_step=0.5, boundary="model", margin=-5.0,
+            progress=False)
+
+
+def cavity_stl() -> str:
+    mesh = cavity_mesh()
+    tris = [tuple(tuple(map(float, mesh.vertices[i])) for i in f) for f in mesh.triangles]
+    return str(write_ascii_stl(OUT / "cavity.stl", tris, "cavity"))
+
+
+class HolderInTheSurface(FreeCADTestCase):
+    def test_the_op_keeps_the_holder_clear_and_says_what_it_left(self) -> None:
+        r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolder", **FAST)
+        assembly = tool_assembly.assembly_of(r.op)
+        self.assertEqual(assembly.stick_out, 20.0)
+        check = check_holder_clearance(r.mesh, assembly, r.toolpath, sample_step=0.25, tolerance=0.05)
+        self.assertTrue(check.ok, check.summary())
+        self.assertIn("points raised where the shank or holder would come closer", r.op.HolderReport)
+        self.assertIn("stick-out", r.op.HolderReport)
+        self.assertEqual(r.op.getEditorMode("HolderReport"), ["ReadOnly"])
+        ignored = run_surface(cavity_stl(), doc_name="TmmNoHolder", **FAST)   # the same job, the holder ignored
+        self.assertFalse(check_holder_clearance(ignored.mesh, assembly, ignored.toolpath).ok)
+        left = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, holder_collision="leave_out",
+                           doc_name="TmmLeaveOut", **FAST)
+        self.assertEqual(left.op.HolderCollision, "LeaveOut")
+        self.assertTrue(check_holder_clearance(left.mesh, assembly, left.toolpath, sample_step=0.25,
+                                               tolerance=0.05).ok)
+        self.assertIn("points left out", left.op.HolderReport)
+
+    def test_it_saves_and_reopens_and_an_older_document_has_no_holder(self) -> None:
+        r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolderSave", **FAST)
+        before = [(c.Name, dict(c.Parameters)) for c in r.op.Path.Commands]
+        op = reopened(r.doc, r.op, "holder.FCStd")
+        self.assertEqual((op.Holder, op.StickOut.Value), (HOLDER, 20.0))
+        op.Proxy.progress_enabled = False
+        op.touch()
+        op.Document.recompute()
+        self.assertEqual([(c.Name, dict(c.Parameters)) for c in op.Path.Commands], before)
+        for name in ("Holder", "StickOut", "ShankClearance", "HolderClearance", "HolderCollision"):
+            op.removeProperty(name)
+        op = reopened(op.Document, op, "holder_old.FCStd")
+        self.assertEqual(op.Holder, "None")   # as computed before the holder existed
+
+    def test_bad_values_are_refused_by_name(self) -> None:
+        cases = [(dict(holder="ER99 collet"), "holder must be one of none, er11 nut"),
+                 (dict(stick_out=30.0), "stick_out is used with a holder only"),
+                 (dict(holder=HOLDER, stick_out=-1.0), "stick_out must be in [0, 1000] mm, got -1"),
+                 (dict(holder=HOLDER, holder_clearance=-0.5), "holder_clearance must be in [0, 100] mm, got -0.5"),
+                 (dict(holder=HOLDER, holder_collision="dodge"), "holder_collision must be 'lift' or 'leave_out'")]
+        before = set(FreeCAD.listDocuments())
+        for kwargs, said in cases:
+            with self.subTest(kwargs=kwargs), self.assertRaises(TmmError) as ctx:
+                run_surface(cavity_stl(), doc_name="TmmHolderBad", **{**FAST, **kwargs})
+            self.assertIn(said, str(ctx.exception))
+        self.assertEqual(set(FreeCAD.listDocuments()), before)
+        with self.assertRaises(TmmError) as ctx:   # shorter than the flutes: the op fails and says why
+            run_surface(cavity_stl(), holder=HOLDER, stick_out=8.0, doc_name="TmmHolderShort", **FAST)
+        self.assertIn("stick-out", str(ctx.exception))

@@ -1,0 +1,163 @@
+"""The holder guard: a 3-axis strategy's cut segments made safe for the whole tool (core.tools.assembly). The
+shank, neck and holder are dropped over every CL point and along every move (core.query.drop_assembly, the cutter
+left out: its own drop made the points); where one of them would come closer to the model than its clearance:
+  lift       the tool rises there to where they keep it (the surface below keeps material); a move that had to
+             rise becomes lines through its samples, each at least the bodies' height (arcs dropped there);
+  leave_out  the moves there are not cut: the segment is split and the linker retracts over the gap.
+Raising a 3-axis tool never gouges (the cutter's drop is below), and the bodies' drop is monotone in height, so
+a vertical entry to a kept point is clear. Between two samples the bodies' height can rise steeply (a shank's
+edge rolling over a sharp rim: 0.19 mm under it halfway along a 0.5 mm step was measured): lifted moves get
+points inserted halfway until they pass at most BETWEEN_MM under it, inside the clearance. What it changed is reported with the shortest stick-out that cuts everything
+(core.verify.holder_clearance.minimum_stick_out)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Optional
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.tools.assembly import ToolAssembly
+from tmm_workbench.core.verify.holder_clearance import StickOut, minimum_stick_out
+
+LIFT, LEAVE_OUT = "lift", "leave_out"
+BODIES = ("neck", "shank", "holder")
+TOLERANCE_MM = 1e-4    # a body this little above a point is not a collision (the drops' own accuracy is ~1e-9)
+BETWEEN_MM = 0.005     # a lifted move may pass this far under the bodies' height between its points (of ~1 mm)
+MIN_GAP_MM = 0.005     # and points are not inserted closer than this
+MAX_ROUNDS = 12        # halvings: a 0.5 mm sample step down to about 0.1 um
+
+
+@dataclass
+class HolderReport:
+    mode: str
+    points: int                                   # CL points and move samples checked
+    affected: int = 0                             # of them raised (lift) or left out (leave_out)
+    max_lift: float = 0.0                         # mm, the most a point was raised (or would have been)
+    region: Optional[tuple[float, float, float, float]] = None   # xmin, ymin, xmax, ymax of the affected points
+    pieces: dict = field(default_factory=dict)    # piece -> affected points it set
+    stick_out: Optional[StickOut] = None          # the shortest stick-out that cuts everything
+    note: str = ""
+
+    def summary(self) -> str:
+        if not self.affected:
+            return f"the shank and holder keep their clearance everywhere ({self.points} points checked)"
+        what = "raised" if self.mode == LIFT else "left out"
+        by = ", ".join(f"{p} {n}" for p, n in sorted(self.pieces.items()))
+        x0, y0, x1, y1 = self.region
+        text = (f"{self.affected} of {self.points} points {what} where the shank or holder would come closer than "
+                f"its clearance ({by}; up to {self.max_lift:.3f} mm), within x {x0:.1f}..{x1:.1f}, "
+                f"y {y0:.1f}..{y1:.1f} mm: material is left there")
+        if self.stick_out is not None:
+            text += f"; {self.stick_out.summary()}"
+        return text + (f" ({self.note})" if self.note else "")
+
+
+def _move_samples(seg: CutSegment, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """(points, move): the segment's tips with samples at most `step` apart along each move (arcs by their
+    chords), each point's move (the tip it ends at; a tip is its own move's end)."""
+    pts, move = [seg.tips[:1]], [np.zeros(1, dtype=np.int64)]
+    for i in range(1, len(seg)):
+        a, b = seg.tips[i - 1], seg.tips[i]
+        arc = seg.arc(i)
+        if arc is not None:
+            chord = np.asarray(arc.chords(tuple(a), tuple(b), 1e-3), dtype=float).reshape(-1, 3)
+        else:
+            n = max(1, int(np.ceil(np.hypot(*(b[:2] - a[:2])) / step)))
+            chord = a + np.outer(np.arange(1, n + 1) / n, b - a)
+        pts.append(chord)
+        move.append(np.full(len(chord), i, dtype=np.int64))
+    return np.vstack(pts), np.concatenate(move)
+
+
+def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mode: str, step: float,
+          surface: Optional[DropSurface] = None, progress: Optional[Progress] = None
+          ) -> tuple[list[CutSegment], HolderReport]:
+    """The segments made safe for the shank and holder (see the module) and what was changed."""
+    if mode not in (LIFT, LEAVE_OUT):
+        raise TmmError(f"holder collision must be '{LIFT}' or '{LEAVE_OUT}', got {mode!r}")
+    if not step > 0:
+        raise TmmError(f"holder guard sample step must be > 0 mm, got {step!r}")
+    if any(seg.axes is not None for seg in segments):
+        raise TmmError("the holder guard takes 3-axis segments (a vertical tool); 5-axis moves are checked by "
+                       "core.verify.holder_clearance")
+    drop = AssemblyDrop(mesh, assembly, surface)
+    sampled = [_move_samples(seg, step) for seg in segments]
+    allpts = np.vstack([p for p, _ in sampled]) if sampled else np.zeros((0, 3))
+    zb, owner = drop.heights_of(BODIES, allpts[:, :2], progress=progress)
+    over = zb - allpts[:, 2]
+    hit = over > TOLERANCE_MM
+    report = HolderReport(mode, len(allpts))
+    if not hit.any():
+        return segments, report
+    report.affected = int(hit.sum())
+    report.max_lift = float(over[hit].max())
+    p = allpts[hit]
+    report.region = (float(p[:, 0].min()), float(p[:, 1].min()), float(p[:, 0].max()), float(p[:, 1].max()))
+    names, counts = np.unique(drop.piece_names(owner[hit]), return_counts=True)
+    report.pieces = {str(n): int(c) for n, c in zip(names, counts)}
+    out: list[CutSegment] = []
+    start = 0
+    for seg, (pts, move) in zip(segments, sampled):
+        end = start + len(pts)
+        seg_hit, seg_z = hit[start:end], zb[start:end]
+        start = end
+        if not seg_hit.any():
+            out.append(seg)
+        elif mode == LIFT:
+            tips = pts.copy()
+            tips[:, 2] = np.maximum(tips[:, 2], seg_z)
+            out.append(replace(seg, tips=_refined(drop, tips), arcs=None))
+        else:
+            out += _leave_out(seg, seg_hit, move)
+    try:
+        report.stick_out = minimum_stick_out(mesh, assembly, allpts[:, :2], surface=drop.surface)  # along the moves
+    except TmmError as exc:  # a holder narrower than the shank somewhere: no stick-out is monotone
+        report.note = f"no shortest stick-out told: {exc}"
+    return out, report
+
+
+def _refined(drop: AssemblyDrop, tips: np.ndarray) -> np.ndarray:
+    """Lifted tips with points inserted halfway wherever the straight move between two would pass more than
+    BETWEEN_MM under the bodies' height (a holder's rounded edge over a sharp rim), down to MIN_GAP_MM apart."""
+    for _ in range(MAX_ROUNDS):
+        gap = np.hypot(*np.diff(tips[:, :2], axis=0).T)
+        mid = 0.5 * (tips[1:] + tips[:-1])
+        zb, _ = drop.heights_of(BODIES, mid[:, :2])
+        low = (zb - mid[:, 2] > BETWEEN_MM) & (gap > MIN_GAP_MM)
+        if not low.any():
+            break
+        mid[:, 2] = np.maximum(mid[:, 2], zb)
+        at = np.flatnonzero(low) + 1
+        tips = np.insert(tips, at, mid[low], axis=0)
+    return tips
+
+
+def _leave_out(seg: CutSegment, hit: np.ndarray, move: np.ndarray) -> list[CutSegment]:
+    """The segment's runs of clear tips joined by clear moves (`hit` per sample, `move` its move), each run
+    entered anew by the linker (the first kept as it was entered when it starts at the first tip)."""
+    n = len(seg)
+    tip_sample = np.searchsorted(move, np.arange(n), side="right") - 1   # a move's last sample is its tip
+    ok_tip = ~hit[tip_sample]
+    ok_move = np.ones(n, dtype=bool)
+    ok_move[np.unique(move[hit])] = False
+    pieces: list[CutSegment] = []
+    i = 0
+    while i < n:
+        if not ok_tip[i]:
+            i += 1
+            continue
+        j = i + 1
+        while j < n and ok_move[j] and ok_tip[j]:
+            j += 1
+        if j - i >= 2:
+            arcs = None if seg.arcs is None else (None,) + tuple(seg.arcs[i + 1:j])
+            first = i == 0
+            pieces.append(replace(seg, tips=seg.tips[i:j], arcs=arcs, joined=seg.joined and first, closed=False,
+                                  entry_z=seg.entry_z if first else None))
+        i = j
+    return pieces
