@@ -45,6 +45,26 @@ class HolderInTheSurface(FreeCADTestCase):
                                                tolerance=0.05).ok)
         self.assertIn("points left out", left.op.HolderReport)
 
+    def test_the_simulation_shows_the_holder_hitting_a_job_computed_without_it(self) -> None:
+        from tmm_workbench.app.api import simulate
+
+        ignored = run_surface(cavity_stl(), doc_name="TmmSimNoHolder", **FAST)
+        report = simulate(ignored, cell=0.5, progress=False, holder=HOLDER, stick_out=20.0)
+        ((label, check),) = report.holder_collisions
+        self.assertEqual(label, ignored.op.Label)
+        self.assertGreater(check.per_piece.get("holder", 0), 0)
+        self.assertLess(float(check.tip[:, 2].min()), -20.0)   # down in the cavity
+        with self.assertRaises(TmmError) as ctx:
+            simulate(ignored, cell=0.5, progress=False, holder=HOLDER, stick_out=20.0, fail_on_gouge=True)
+        self.assertIn("holder", str(ctx.exception))
+        safe = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmSimHolder", **FAST)
+        report = simulate(safe, cell=0.5, progress=False)
+        self.assertEqual(report.holder_collisions, [])
+        self.assertTrue(report.simulation.ops[0].holder.ok)   # checked with the op's own holder
+        with self.assertRaises(TmmError) as ctx:
+            simulate(safe, progress=False, stick_out=20.0)
+        self.assertIn("stick_out is used with a holder only", str(ctx.exception))
+
     def test_it_saves_and_reopens_and_an_older_document_has_no_holder(self) -> None:
         r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolderSave", **FAST)
         before = [(c.Name, dict(c.Parameters)) for c in r.op.Path.Commands]

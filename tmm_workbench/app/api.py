@@ -17,7 +17,7 @@ by the call is closed first).
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
@@ -363,18 +363,23 @@ class SimulationReport:
     cell: float
     tolerance: float
     simulation: Any            # app.simulation.JobSimulation (grids, heights, deviation)
+    holder_collisions: list = field(default_factory=list)   # [(op label, HolderClearance)] where one came too close
 
 
 @plain_numbers
 def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
              png_path: Optional[Union[str, os.PathLike]] = None, progress: Union[bool, Callable[[float], bool]] = True,
-             fail_on_gouge: bool = False) -> SimulationReport:
+             fail_on_gouge: bool = False, holder: Optional[str] = None,
+             stick_out: Optional[float] = None) -> SimulationReport:
     """Cuts the stock of a Job with its active ops in order (or with one op), compares it with the Job's model
     and reports: the deviation (vertical, + material left, - gouge) extremes and percentiles, removed and
     remaining volume, rapids through stock, cycle time. `target`: a Job, an op, or a SurfaceResult /
     MultipointResult of this API. png_path: writes the heat map. A gouge deeper than `tolerance` is printed
     as an error; with fail_on_gouge it raises TmmError. 5-axis moves are sub-stepped `max_step` mm apart
-    (default: the step whose cusp between tool instances is a tenth of the tolerance, core.sim.simulate.sub_step)."""
+    (default: the step whose cusp between tool instances is a tenth of the tolerance, core.sim.simulate.sub_step).
+    The shank and holder of each op (its Holder; or `holder`, a name of the holder library, with `stick_out` for
+    every op: a job computed without one) are checked along its moves against the design: `holder_collisions`,
+    printed as an error (with fail_on_gouge: raised)."""
     from tmm_workbench.app import simulation
     from tmm_workbench.core.preview.deviation_png import render_deviation_png
 
@@ -382,11 +387,15 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     numbers(cell=(cell, Spec(low=1e-4, high=100.0, unit="mm", label="cell")),
              tolerance=(tolerance, Spec(low=0.0, high=10.0, unit="mm", label="tolerance")),
              max_step=(max_step, Spec(low=1e-3, high=10.0, unit="mm", label="max_step", optional=True)))
+    if stick_out is not None and holder is None:
+        raise TmmError("stick_out is used with a holder only: give holder= (a name from the holder library) as well")
+    numbers(stick_out=(stick_out, Spec(low=0.0, high=1000.0, unit="mm", label="stick_out", low_open=True)))
     label = str(getattr(target, "Label", "simulation"))
     factory = (lambda _: CallbackProgress(progress)) if callable(progress) else None
     with progress_mod.using(factory):
         with progress_mod.reporter(f"{label} simulation", bool(progress)) as cb:
-            sim = simulation.simulate_job(target, cell, tolerance, max_step, cb)
+            sim = simulation.simulate_job(target, cell, tolerance, max_step, cb,
+                                          None if holder is None else (holder, stick_out))
     o = sim.comparison.overall
     png = None
     if png_path:
@@ -395,8 +404,9 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
                               o.remaining_volume, o.gouge_cells, sim.comparison.gouged, sim.collisions,
                               sim.cycle_seconds,
                               {k: v.as_dict() for k, v in sim.comparison.regions.items()}, sim.ops, png, cell,
-                              tolerance, sim)
-    problems = []
+                              tolerance, sim, [(o.label, o.holder) for o in sim.ops if o.holder is not None
+                                               and not o.holder.ok])
+    problems = [f"op '{op_label}': {check.summary()}" for op_label, check in report.holder_collisions]
     if report.gouged:
         problems.append(f"the simulated stock is gouged {-o.min_deviation:.4f} mm below the design in "
                         f"{o.gouge_cells} cells (tolerance {tolerance:g} mm)")

@@ -38,6 +38,7 @@ class OpSimulation:
     cycle_seconds: float
     collisions: list            # [(move index, depth mm)]
     seconds: float              # simulation time
+    holder: Any = None          # core.verify.holder_clearance.HolderClearance (None: no holder to check)
 
 
 @dataclass
@@ -150,10 +151,9 @@ def stock_heights(job: Any, grid: Grid, progress: Optional[Callable[[float], boo
     return np.where(np.isfinite(h), h, float(stock.Shape.BoundBox.ZMin))  # outside the stock: none
 
 
-def _design_heights(job: Any, ops: list, grid: Grid, progress: Optional[Callable[[float], bool]] = None) -> np.ndarray:
-    """The design under each cell: the Job's models (TMM's stand-in boxes give the mesh or STL they stand for)
-    and any model an op machines instead (its StlFile or Model), highest where they overlap."""
-
+def design_mesh(job: Any, ops: list) -> Any:
+    """The design: the Job's models (TMM's stand-in boxes give the mesh or STL they stand for) and any model an op
+    machines instead (its StlFile or Model), as one mesh."""
     meshes = [model_proxy.mesh_of_model(m, DESIGN_DEFLECTION_MM) for m in list(getattr(job.Model, "Group", []) or [])]
     for op in ops:
         if getattr(op, "StlFile", ""):
@@ -162,7 +162,7 @@ def _design_heights(job: Any, ops: list, grid: Grid, progress: Optional[Callable
             meshes.append(model_proxy.mesh_of_model(op.Model, DESIGN_DEFLECTION_MM))
     if not meshes:
         raise TmmError(f"Job '{job.Label}' has no model to compare with")
-    return mesh_heights(geometry.combine(meshes), grid, progress=progress)
+    return geometry.combine(meshes)
 
 
 def slope_regions(design: np.ndarray, cell: float) -> dict:
@@ -214,9 +214,11 @@ def simulation_grid(target: Any, cell: float) -> Grid:
 
 
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
-                 progress: Optional[Callable[[float], bool]] = None) -> JobSimulation:
+                 progress: Optional[Callable[[float], bool]] = None,
+                 holder: Optional[tuple[str, Optional[float]]] = None) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
-    compares the result with the Job's model."""
+    compares the result with the Job's model; each op's shank and holder checked along its moves against the
+    model (its own Holder, or `holder` = (name, stick-out) for every op: a job computed without one)."""
     job = job_of(target)
     if job is None:
         raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
@@ -228,7 +230,8 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     def share(lo: float, hi: float) -> Optional[Callable[[float], bool]]:  # a phase's part of the whole
         return (lambda f: progress(lo + (hi - lo) * f)) if progress else None
     initial = stock_heights(job, grid, share(0.0, 0.05))
-    design = _design_heights(job, ops, grid, share(0.05, 0.2))
+    model = design_mesh(job, ops)  # the design under each cell, highest where models overlap
+    design = mesh_heights(model, grid, progress=share(0.05, 0.2))
     heights, done = initial, []
     result = None
     for k, op in enumerate(ops):
@@ -242,7 +245,8 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
                      max_step=max_step, tolerance=tolerance,
                      progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)))
         seconds = op_cycle_seconds(op, (tp, feeds))
-        done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds))
+        done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds,
+                                 _holder_check(op, model, tp, holder)))
         heights = r.heights
         result = r if result is None else SimResult(grid, result.initial, r.heights,
                                                     np.vstack([result.collisions, r.collisions]),
@@ -254,6 +258,21 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     regions = {**slope_regions(design_here, grid.cell), **bucket_regions(grid, design_here)}
     comparison = compare_mod.compare(result, design_here, tolerance, regions)
     return JobSimulation(grid, result, comparison, done, design_here)
+
+
+def _holder_check(op: Any, model: Any, tp: Toolpath, holder: Optional[tuple[str, Optional[float]]]) -> Any:
+    """The op's shank and holder along its moves against the design (core.verify.holder_clearance): the op's own
+    Holder, or `holder` (name, stick-out) given for the check; None without either. The design is below the stock
+    at every moment, so what hits it hits the stock; the stock above it is not checked here."""
+    from tmm_workbench.app import tool_assembly
+    from tmm_workbench.core.verify.holder_clearance import check_holder_clearance
+
+    if holder is not None:
+        name, stick_out = holder
+        assembly = tools.assembly_from_tool(op.ToolController.Tool, name, stick_out)
+    else:
+        assembly = tool_assembly.assembly_of(op) if hasattr(op, "Holder") else None
+    return None if assembly is None else check_holder_clearance(model, assembly, tp)
 
 
 KNOWN_CELL_MM = 0.25  # the stock heights the entries are placed over (a quarter of the tool radius if finer)
