@@ -9,17 +9,19 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 T0=$SECONDS
-cpu() {  # the CPU seconds the finished child processes took so far (user + system)
-  local line
-  line="$(times | tail -1)"
-  echo "$line" | awk '{ s = 0; for (i = 1; i <= 2; i++) { split($i, a, /[ms]/); s += 60 * a[1] + a[2] }; printf "%d", s }'
+TIMES="$(mktemp)"
+trap 'rm -f "$TIMES"' EXIT
+cpu() {  # the CPU seconds this shell's finished child processes took so far (user + system), into CPU
+  times > "$TIMES"  # in this shell: in a $(...) subshell it would count that subshell's children only
+  CPU="$(tail -1 "$TIMES" | awk '{ s = 0; for (i = 1; i <= 2; i++) { split($i, a, /[ms]/); s += 60 * a[1] + a[2] }; printf "%d", s }')"
 }
 step() {  # step NAME COMMAND...: runs it, then says how long it took (wall clock, and CPU: the machine is shared)
   local name="$1" t=$SECONDS c
-  c="$(cpu)"
+  cpu; c=$CPU
   shift
   "$@"
-  echo "[test] $name: $((SECONDS - t)) s, CPU $(($(cpu) - c)) s (total $((SECONDS - T0)) s)"
+  cpu
+  echo "[test] $name: $((SECONDS - t)) s, CPU $((CPU - c)) s (total $((SECONDS - T0)) s)"
 }
 CACHE="${TMM_ENV_CACHE:-/var/cache/tmm-envs}"
 if [ -z "${CCACHE_DIR:-}" ] && mkdir -p "$CACHE/ccache" 2>/dev/null && [ -w "$CACHE/ccache" ]; then
