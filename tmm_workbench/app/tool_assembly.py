@@ -44,18 +44,19 @@ def ignored(args: Args) -> Optional[str]:
 STAGE = Stage("tool assembly", (
     Field("Holder", "choice", "Tool",
           "The tool holder (TMM's library, docs/holders.md): its shank and the holder are kept their clearance "
-          "away from the model; None: the cutter alone", api="holder", choices=holder_choices(), default=NONE),
+          "away from the model; None: the cutter alone", api="holder", choices=holder_choices(), default=NONE, widget="holder"),
     Field("StickOut", "length", "Tool",
           "Gauge length from the holder's face to the tool tip, mm; 0: the ToolBit's Length minus a grip of 3 "
-          "shank diameters", api="stick_out", default=0.0, spec=STICK_OUT),
+          "shank diameters", api="stick_out", default=0.0, spec=STICK_OUT, widget="stickOut"),
     Field("ShankClearance", "length", "Tool", "Least distance the shank and neck keep from the model, mm",
-          api="shank_clearance", default=1.0, spec=CLEARANCE),
+          api="shank_clearance", default=1.0, spec=CLEARANCE, widget="shankClearance"),
     Field("HolderClearance", "length", "Tool", "Least distance the holder keeps from the model, mm",
-          api="holder_clearance", default=1.0, spec=CLEARANCE),
+          api="holder_clearance", default=1.0, spec=CLEARANCE, widget="holderClearance"),
     Field("HolderCollision", "choice", "Tool",
           "Where the shank or holder would come closer: Lift the tool there (the surface below keeps material, "
           "reported as regions), or LeaveOut those places (for a longer tool or 5-axis)", "holder_collision",
-          "holder_collision", choices=COLLISIONS, api_names={"lift": "Lift", "leave_out": "LeaveOut"}),
+          "holder_collision", choices=COLLISIONS, api_names={"lift": "Lift", "leave_out": "LeaveOut"},
+          widget="holderCollision"),
 ), ignored=ignored)
 
 
