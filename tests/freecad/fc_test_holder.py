@@ -65,6 +65,21 @@ class HolderInTheSurface(FreeCADTestCase):
             simulate(safe, progress=False, stick_out=20.0)
         self.assertIn("stick_out is used with a holder only", str(ctx.exception))
 
+    def test_waterline_keeps_the_holder_clear(self) -> None:
+        from tmm_workbench.app.api import run_waterline
+
+        common = dict(tool="ballend", diameter=4.0, step_down=8.0, progress=False)
+        r = run_waterline(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmWlHolder", **common)
+        assembly = tool_assembly.assembly_of(r.op)
+        check = check_holder_clearance(r.mesh, assembly, r.toolpath, sample_step=0.25, tolerance=0.05)
+        self.assertTrue(check.ok, check.summary())
+        self.assertIn("points raised", r.op.HolderReport)
+        ignored = run_waterline(cavity_stl(), doc_name="TmmWlNoHolder", **common)
+        self.assertFalse(check_holder_clearance(ignored.mesh, assembly, ignored.toolpath).ok)
+        with self.assertRaises(TmmError) as ctx:
+            run_waterline(cavity_stl(), stick_out=20.0, doc_name="TmmWlBad", **common)
+        self.assertIn("stick_out is used with a holder only", str(ctx.exception))
+
     def test_it_saves_and_reopens_and_an_older_document_has_no_holder(self) -> None:
         r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolderSave", **FAST)
         before = [(c.Name, dict(c.Parameters)) for c in r.op.Path.Commands]

@@ -194,7 +194,9 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
                   horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                   post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                   fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
-                  progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+                  progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
+                  stick_out: Optional[float] = None, shank_clearance: Optional[float] = None,
+                  holder_clearance: Optional[float] = None, holder_collision: Optional[str] = None) -> SurfaceResult:
     """Waterline finishing of `model` (STL path, Mesh::Feature or Part::Feature): closed loops at constant
     heights `step_down` apart (a 'TMM Waterline' op in a new Job, or in `job`: e.g. after run_roughing, with
     its own tool controller; `model` None for the Job's model).
@@ -203,8 +205,11 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     the highest and lowest level (both or neither; default the model's top and lowest point). sample_step:
     None automatic. direction 'climb' | 'conventional'. The stock of a new Job as run_roughing's. Heights,
     feeds (mm/min), post, files and progress as run_surface; the result is a SurfaceResult (op: the waterline op).
+    The whole tool (holder, stick_out, shank_clearance, holder_clearance, holder_collision) as run_surface.
     """
-    from tmm_workbench.app import op_waterline
+    whole_tool = dict(holder=holder, stick_out=stick_out, shank_clearance=shank_clearance,
+                      holder_clearance=holder_clearance, holder_collision=holder_collision)
+    from tmm_workbench.app import op_waterline, stages
     from tmm_workbench.core.strategies.waterline import WaterlineParams
 
     numbers(**_specs(WaterlineParams, step_down=step_down, stock_to_leave=stock_to_leave, sample_step=sample_step),
@@ -223,6 +228,7 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
         values["ChordTolerance"] = chord_tolerance
     if top_z is not None:
         values.update(UseZRange=True, TopZ=top_z, BottomZ=bottom_z)
+    values.update(stages.api_values(op_waterline.TOOL_STAGES, WaterlineParams, whole_tool, model))
     return run(op_waterline.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,

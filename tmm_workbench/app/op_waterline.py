@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from tmm_workbench.app import op_base, op_mesh, progress, simulation, work_estimate
+from tmm_workbench.app import op_base, op_mesh, progress, simulation, stages, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
@@ -52,6 +52,11 @@ CHOICES = {"BoundaryShape": {b: b for b in BOUNDARIES}, "Direction": DIRECTIONS}
 DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "BoundaryShape": "Model",
                             "BoundaryMargin": 0.0, "SampleStep": 0.0, "UseZRange": False, "TopZ": 0.0,
                             "BottomZ": 0.0}
+# the whole tool: holder, stick-out, clearances (app.tool_assembly), declared once for every mesh op
+TOOL_STAGES = (tool_assembly.STAGE,)
+PROPERTIES += stages.properties(TOOL_STAGES)
+CHOICES.update(stages.choices(TOOL_STAGES))
+DEFAULTS.update(stages.defaults(TOOL_STAGES))
 
 
 class ObjectTmmWaterline(op_mesh.MeshOp):
@@ -66,6 +71,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
+    SPECS = stages.specs(TOOL_STAGES)
     params: Optional[WaterlineParams] = None
     diagnostics: Optional[dict] = None
 
@@ -86,6 +92,8 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
             bb = self.stock.Shape.BoundBox
             extra["stock_z"] = (bb.ZMin, bb.ZMax)
         params = self.params_from(obj, **extra)
+        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
+        params.holder_notes = [] if params.assembly is not None else None
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
         policy.validate()
         policy.material_top = simulation.material_left(obj, cutter)
@@ -100,6 +108,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
         self.diagnostics = dict(result.diagnostics)
+        tool_assembly.report(obj, params.holder_notes or [])
         self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 

@@ -12,12 +12,13 @@ points inserted halfway until they pass at most BETWEEN_MM under it, inside the 
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.segments import CutSegment
@@ -30,6 +31,30 @@ TOLERANCE_MM = 1e-4    # a body this little above a point is not a collision (th
 BETWEEN_MM = 0.005     # a lifted move may pass this far under the bodies' height between its points (of ~1 mm)
 MIN_GAP_MM = 0.005     # and points are not inserted closer than this
 MAX_ROUNDS = 12        # halvings: a 0.5 mm sample step down to about 0.1 um
+
+
+@dataclass
+class WholeToolParams:
+    """The fields a 3-axis strategy's params carry for the holder guard: the assembly (None: the cutter alone),
+    what to do where a body would come too close, and the list its HolderReport is appended to."""
+    assembly: Any = None
+    holder_collision: str = param(LIFT, "holder collision", choices=(LIFT, LEAVE_OUT))
+    holder_notes: Optional[list] = None
+
+
+def apply(mesh: TriMesh, params: WholeToolParams, segments: list[CutSegment], step: float,
+          surface: Optional[DropSurface], diagnostics: dict) -> list[CutSegment]:
+    """A strategy's segments through the guard when its params carry an assembly: diagnostics "holder" (the
+    report, also appended to params.holder_notes) and "top" raised to the highest lifted tip."""
+    if params.assembly is None:
+        return segments
+    segments, report = guard(mesh, params.assembly, segments, params.holder_collision, step, surface)
+    diagnostics["holder"] = report
+    if "top" in diagnostics:
+        diagnostics["top"] = max([diagnostics["top"]] + [float(seg.tips[:, 2].max()) for seg in segments if len(seg)])
+    if params.holder_notes is not None:
+        params.holder_notes.append(report)
+    return segments
 
 
 @dataclass

@@ -98,13 +98,8 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             segments = segments[:n] + extra
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
-    if params.assembly is not None:  # the whole tool: the shank and holder kept clear of the model
-        segments, holder = holder_guard.guard(mesh, params.assembly, segments, params.holder_collision,
-                                              params.sample_step, surface)
-        diagnostics["holder"] = holder
-        diagnostics["top"] = max([diagnostics["top"]] + [float(seg.tips[:, 2].max()) for seg in segments if len(seg)])
-        if params.holder_notes is not None:
-            params.holder_notes.append(holder)
+    # the whole tool: the shank and holder kept clear of the model
+    segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

@@ -33,6 +33,8 @@ from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
+from tmm_workbench.core.strategies import holder_guard
+from tmm_workbench.core.strategies.holder_guard import WholeToolParams
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.work import Box, Work
 
@@ -47,7 +49,7 @@ _HAS_CLOSED = "closed" in {f.name for f in fields(CutSegment)}  # the linker's r
 
 
 @dataclass
-class WaterlineParams(StrategyParams):
+class WaterlineParams(StrategyParams, WholeToolParams):  # + the whole tool (holder_guard)
     boundary: Rect = (0.0, 0.0, 0.0, 0.0)        # xmin, ymin, xmax, ymax of the tip positions (mm)
     step_down: float = param(1.0, "step-down", "mm", low=0, low_open=True, kind="length")
     top_z: Optional[float] = param(None, "top", "mm", optional=True)        # default: the model's top
@@ -170,7 +172,8 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                        f"between {bottom:g} and {top:g} mm: the model lies outside it or below the levels")
     diagnostics = {"levels": len(zs), "loops": loops, "points": points, "joined": joined,
                    "top": max(float(seg.tips[0, 2]) for seg in segments)}
-    return StrategyResult(segments, diagnostics)
+    step = params.sample_step or wl.default_sample_step(cutter, b)
+    return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 
 def _join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:

@@ -14,6 +14,7 @@ from tmm_workbench.core.footprint.cusp import MIN_CUSP
 from tmm_workbench.core.footprint.raster import Rect, pass_count
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.polygons import Shape
+from tmm_workbench.core.strategies.holder_guard import WholeToolParams
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
@@ -34,7 +35,7 @@ _BYTES_PER_POINT = 400
 
 
 @dataclass
-class SurfaceParams(StrategyParams):
+class SurfaceParams(StrategyParams, WholeToolParams):  # + the whole tool (holder_guard)
     boundary: Rect = (0.0, 0.0, 0.0, 0.0)  # xmin, ymin, xmax, ymax of the tip positions (mm)
     stepover: float = param(1.0, "step-over", "mm", low=0, low_open=True, kind="length")
     sample_step: float = param(0.5, "sample step", "mm", low=0, low_open=True, kind="length")
@@ -79,12 +80,6 @@ class SurfaceParams(StrategyParams):
     # cusp reported (diagnostics["cusp_check"], a CuspCheck appended to verify_notes; core.strategies.surface.cusp_check);
     # "auto": where it is cheap (a small region), "on": always, "off"
     cusp_check: str = param("auto", "cusp check", choices=("auto", "on", "off"))
-    # --- the whole tool (core.strategies.holder_guard): the shank and holder kept their clearance from the
-    # model, the tool lifted where they would come closer ("lift") or those places not cut ("leave_out"); its
-    # HolderReport is appended to holder_notes. None: the cutter alone
-    assembly: Any = None
-    holder_collision: str = param("lift", "holder collision", choices=("lift", "leave_out"))
-    holder_notes: Optional[list] = None
 
     def validate(self) -> None:
         super().validate()
