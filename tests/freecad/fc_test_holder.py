@@ -80,6 +80,20 @@ class HolderInTheSurface(FreeCADTestCase):
             run_waterline(cavity_stl(), stick_out=20.0, doc_name="TmmWlBad", **common)
         self.assertIn("stick_out is used with a holder only", str(ctx.exception))
 
+    def test_roughing_keeps_the_holder_clear_either_way(self) -> None:
+        from tmm_workbench.app.api import run_roughing
+
+        common = dict(tool="endmill", diameter=6.0, step_down=10.0, stepover_percent=45.0, stock_to_leave=0.5,
+                      progress=False)
+        for mode in ("lift", "leave_out"):
+            with self.subTest(mode=mode):
+                r = run_roughing(cavity_stl(), holder="ER32 nut", stick_out=25.0, holder_collision=mode,
+                                 doc_name=f"TmmRoughHolder_{mode}", **common)
+                check = check_holder_clearance(r.mesh, tool_assembly.assembly_of(r.op), r.toolpath,
+                                               sample_step=0.25, tolerance=0.05)
+                self.assertTrue(check.ok, check.summary())
+                self.assertIn("points raised" if mode == "lift" else "points left out", r.op.HolderReport)
+
     def test_it_saves_and_reopens_and_an_older_document_has_no_holder(self) -> None:
         r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolderSave", **FAST)
         before = [(c.Name, dict(c.Parameters)) for c in r.op.Path.Commands]

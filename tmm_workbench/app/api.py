@@ -139,7 +139,9 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
                  horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                  post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                  fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
-                 progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+                 progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
+                 stick_out: Optional[float] = None, shank_clearance: Optional[float] = None,
+                 holder_clearance: Optional[float] = None, holder_collision: Optional[str] = None) -> SurfaceResult:
     """Z-level roughing of a block down to `model` (STL path, Mesh::Feature or Part::Feature) + stock to leave,
     to G-code (a 'TMM Roughing' op in a new Job, or in `job`).
 
@@ -152,8 +154,11 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
     'plunge'. stock_to_leave_axial: None follows stock_to_leave. final_z: None roughs down to the model's
     lowest point. None for the other optional numbers keeps the op's defaults. Heights, feeds (mm/min), post,
     files and progress as run_surface; the result is a SurfaceResult (op: the roughing op).
+    The whole tool (holder, stick_out, shank_clearance, holder_clearance, holder_collision) as run_surface.
     """
-    from tmm_workbench.app import op_roughing
+    whole_tool = dict(holder=holder, stick_out=stick_out, shank_clearance=shank_clearance,
+                      holder_clearance=holder_clearance, holder_collision=holder_collision)
+    from tmm_workbench.app import op_roughing, stages
     from tmm_workbench.core.strategies.zlevel_rough import RoughingParams
 
     numbers(**_specs(RoughingParams, step_down=step_down, stepover_percent=stepover_percent,
@@ -176,6 +181,7 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
             values[prop] = value
     if final_z is not None:
         values.update(UseFinalZ=True, FinalZ=final_z)
+    values.update(stages.api_values(op_roughing.TOOL_STAGES, RoughingParams, whole_tool, model))
     return run(op_roughing.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from typing import Any, Optional
 
-from tmm_workbench.app import geometry, op_base, op_mesh, progress, simulation, work_estimate
+from tmm_workbench.app import geometry, op_base, op_mesh, progress, simulation, stages, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.tools import label_of
@@ -70,6 +70,11 @@ PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
 ]
 CHOICES = {"LayerMode": LAYER_MODES, "Pattern": PATTERNS, "Direction": DIRECTIONS, "Entry": ENTRIES}
 DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "UseFinalZ": False, "FinalZ": 0.0}
+# the whole tool: holder, stick-out, clearances (app.tool_assembly), declared once for every mesh op
+TOOL_STAGES = (tool_assembly.STAGE,)
+PROPERTIES += stages.properties(TOOL_STAGES)
+CHOICES.update(stages.choices(TOOL_STAGES))
+DEFAULTS.update(stages.defaults(TOOL_STAGES))
 AXIAL_EXPRESSION = "StockToLeave"  # the axial stock to leave follows the radial one unless given
 
 
@@ -111,6 +116,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
+    SPECS = stages.specs(TOOL_STAGES)
     params: Optional[RoughingParams] = None
 
     def opSetDefaultValues(self, obj: Any, job: Any) -> None:
@@ -132,6 +138,8 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
         if rest is not None:
             stock["stock_heights"] = rest
         params = self.params_from(obj, final_z=final_z, **stock)
+        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
+        params.holder_notes = [] if params.assembly is not None else None
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy, cb)
@@ -139,6 +147,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
             left = "what the Job's earlier ops left" if rest is not None else "the stock"
             raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
+        tool_assembly.report(obj, params.holder_notes or [])
         self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 

@@ -27,8 +27,15 @@ STICK_OUT = Spec("stick-out", "mm", low=0.0, high=1000.0)   # 0: from the ToolBi
 
 
 def holder_choices() -> dict[str, Optional[str]]:
-    """None and the library's holders (shipped and the user's), property value -> holder name."""
-    return {NONE: None, **{name: name for name in holders.names(tools.user_holders_file())}}
+    """None and the library's holders (shipped and the user's), property value -> holder name. A library that
+    cannot be read (a broken user file) leaves None only here: documents still open, and an op with a holder
+    says what is wrong with the file when it computes."""
+    try:
+        names = holders.names(tools.user_holders_file())
+    except (TmmError, OSError) as exc:
+        FreeCAD.Console.PrintWarning(f"TMM holder library: {exc}\n")
+        names = []
+    return {NONE: None, **{name: name for name in names}}
 
 
 def ignored(args: Args) -> Optional[str]:

@@ -18,6 +18,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import RAMP
 from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
@@ -182,7 +183,10 @@ def _leave_out(seg: CutSegment, hit: np.ndarray, move: np.ndarray) -> list[CutSe
         if j - i >= 2:
             arcs = None if seg.arcs is None else (None,) + tuple(seg.arcs[i + 1:j])
             first = i == 0
+            # a piece has no helix circle of its own: it ramps down along itself where the segment had an entry
+            entry = seg.entry if first or (seg.entry is None and seg.helix_centre is None) else RAMP
             pieces.append(replace(seg, tips=seg.tips[i:j], arcs=arcs, joined=seg.joined and first, closed=False,
-                                  entry_z=seg.entry_z if first else None))
+                                  entry_z=seg.entry_z if first else None, entry=entry,
+                                  helix_centre=seg.helix_centre if first else None))
         i = j
     return pieces

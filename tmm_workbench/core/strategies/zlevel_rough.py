@@ -55,7 +55,9 @@ from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
+from tmm_workbench.core.strategies import holder_guard
 from tmm_workbench.core.strategies import zlevel_clearing as clearing
+from tmm_workbench.core.strategies.holder_guard import WholeToolParams
 from tmm_workbench.core.strategies import zlevel_layers as layers_mod
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
@@ -74,7 +76,7 @@ HELIX_MIN_PERCENT = 10.0    # a helix narrower than a tenth of the tool is a plu
 
 
 @dataclass
-class RoughingParams(StrategyParams):
+class RoughingParams(StrategyParams, WholeToolParams):  # + the whole tool (holder_guard)
     stock_box: tuple = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)   # xmin, ymin, zmin, xmax, ymax, zmax of the stock (mm)
     step_down: float = param(2.0, "step-down", "mm", low=0, low_open=True, kind="length")
     layer_mode: str = param("fixed", "layers", choices=("fixed", "tolerance"))   # tolerance: seed eq. 3.11
@@ -533,7 +535,8 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
     diagnostics = {"layers": len(zs), "layer_z": [float(z) for z in zs], "regions": region_count, "points": pts,
                    "unreachable": unreachable, "top": float(max(zs)) if len(zs) else top, "entries": kinds,
                    "stock_top": top, "not_entered": list(ctx.not_entered)}
-    return StrategyResult(segments, diagnostics)
+    step = wl.default_sample_step(cutter, params.stock_box[:2] + params.stock_box[3:5])
+    return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 
 def compute_roughing_toolpath(mesh: TriMesh, cutter: Cutter, params: RoughingParams, policy: LinkPolicy,
