@@ -94,6 +94,24 @@ class HolderInTheSurface(FreeCADTestCase):
                 self.assertTrue(check.ok, check.summary())
                 self.assertIn("points raised" if mode == "lift" else "points left out", r.op.HolderReport)
 
+    def test_the_shortest_stick_out_per_op_of_a_job(self) -> None:
+        from tmm_workbench.app.api import minimum_stick_out, run_waterline
+
+        ignored = run_surface(cavity_stl(), doc_name="TmmStickOut", **FAST)
+        run_waterline(job=ignored.job, tool="ballend", diameter=4.0, step_down=8.0, progress=False)
+        told = minimum_stick_out(ignored.job, holder=HOLDER)
+        self.assertEqual(len(told), 2)
+        for label, stick_out in told.items():
+            with self.subTest(op=label):
+                self.assertGreater(stick_out.stick_out, 30.0)   # a 40 mm deep pocket under a D50 collet nut
+        surface_needs = told[ignored.op.Label].stick_out
+        longer = run_surface(cavity_stl(), holder=HOLDER, stick_out=surface_needs + 0.01, doc_name="TmmStickLong",
+                             **FAST)
+        self.assertNotIn("holder", longer.op.HolderReport.split("(")[1].split(";")[0])  # only the shank lifts
+        with self.assertRaises(TmmError) as ctx:
+            minimum_stick_out(ignored.job)   # no op has a holder
+        self.assertIn("no 3-axis op with a holder", str(ctx.exception))
+
     def test_it_saves_and_reopens_and_an_older_document_has_no_holder(self) -> None:
         r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmHolderSave", **FAST)
         before = [(c.Name, dict(c.Parameters)) for c in r.op.Path.Commands]

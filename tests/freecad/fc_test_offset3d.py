@@ -203,7 +203,7 @@ class Offset3DEstimate(FreeCADTestCase):
         """The panel's estimate for StepOverMode Offset3D (not the raster's): the passes' points and cutting time
         within 0.5-2x of what the op computes."""
         from tmm_workbench.app import work_estimate
-        from tmm_workbench.app.simulation import _toolpath_and_feeds
+        from tmm_workbench.app.simulation import toolpath_and_feeds
         from tmm_workbench.app.tools import cutter_from_tool
         from tmm_workbench.core.sim.cycle_time import three_axis_time
         from tmm_workbench.core.strategies import raster_drop
@@ -224,7 +224,7 @@ class Offset3DEstimate(FreeCADTestCase):
         check = variable_step.estimate_params(cutter_from_tool(tc.Tool), params)
         self.assertIn("cusp check", est.note)
         self.assertTrue(0.5 * points <= est.count - check <= 2.0 * points, (est.count, check, points))
-        tp, feeds = _toolpath_and_feeds(op)
+        tp, feeds = toolpath_and_feeds(op)
         cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
         self.assertTrue(0.5 * cutting < est.cutting_seconds < 2.0 * cutting, (est.cutting_seconds, cutting))
         self.assertTrue(0.5 * result.diagnostics["levels"] <= est.passes <= 2.0 * result.diagnostics["levels"],

@@ -97,7 +97,7 @@ class FreeCADArcs(FreeCADTestCase):
                               Path.Command("G2", {"X": 15.0, "Y": 10.0, "Z": top - 0.5, "I": -5.0, "J": 0.0}),
                               Path.Command("G0", {"X": 15.0, "Y": 10.0, "Z": top + 5})])
         job.Operations.addObject(arc)
-        tp, feeds = simulation._toolpath_and_feeds(arc)
+        tp, feeds = simulation.toolpath_and_feeds(arc)
         pts = tp.points()[2:-1]
         self.assertGreater(len(pts), 100)
         np.testing.assert_allclose(np.hypot(pts[:, 0] - 10.0, pts[:, 1] - 10.0), 5.0, atol=1e-9)

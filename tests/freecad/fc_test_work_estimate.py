@@ -68,7 +68,7 @@ class WorkEstimate(FreeCADTestCase):
     def test_estimate_tells_the_cutting_time(self) -> None:
         """The status line's time: the cut length the boxes and the spacing imply at the tool controller's
         feed, near the cutting time of the path the op then computes; none without a feed."""
-        from tmm_workbench.app.simulation import _toolpath_and_feeds
+        from tmm_workbench.app.simulation import toolpath_and_feeds
         from tmm_workbench.core.sim.cycle_time import three_axis_time
 
         doc = new_doc("TmmEstimateTime")
@@ -76,7 +76,7 @@ class WorkEstimate(FreeCADTestCase):
                                                               "SampleStep": 0.4})
         self.assertTrue(op.isValid(), op.getStatusString())
         est = work_estimate.estimate(op)
-        tp, feeds = _toolpath_and_feeds(op)
+        tp, feeds = toolpath_and_feeds(op)
         cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
         self.assertGreater(cutting, 0.0)
         self.assertAlmostEqual(est.feed, tc.HorizFeed.Value)

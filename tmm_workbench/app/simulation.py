@@ -82,7 +82,7 @@ def operations(job: Any) -> list:
     return out
 
 
-def _toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
+def toolpath_and_feeds(op: Any) -> tuple[Toolpath, list]:
     commands = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
     moves = path5.decode_commands(commands)
     # the arc plane in force at each command (G17 XY, G18 XZ, G19 YZ: TMM's lean passes write G18/G19 arcs)
@@ -134,7 +134,7 @@ def op_cycle_seconds(op: Any, decoded: Optional[tuple[Toolpath, list]] = None) -
     """The op's cycle time, s: 5-axis paths from the Tarus post (joint speeds, A and C planned), 3-axis from
     the Path's feeds and the tool controller's rapid rates (core.sim.cycle_time). `decoded`: the op's
     (toolpath, feeds) when the caller has read its Path already."""
-    tp, feeds = decoded or _toolpath_and_feeds(op)
+    tp, feeds = decoded or toolpath_and_feeds(op)
     if len(tp) < 2:
         return 0.0
     if tp.is_five_axis():
@@ -235,7 +235,7 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     heights, done = initial, []
     result = None
     for k, op in enumerate(ops):
-        tp, feeds = _toolpath_and_feeds(op)
+        tp, feeds = toolpath_and_feeds(op)
         if len(tp) < 2:
             raise TmmError(f"op '{op.Label}' has no tool path: recompute it first")
         cutter = tools.cutter_from_tool(op.ToolController.Tool)
@@ -301,7 +301,7 @@ def rest_stock(obj: Any, cutter: Cutter) -> Optional[tuple[Grid, np.ndarray]]:
     centres rises to the higher). None when no earlier op has a path (the stock solid itself is then exact) or
     one waits for its recompute."""
     earlier = earlier_ops(obj)
-    if not earlier or not any(len(_toolpath_and_feeds(op)[0]) >= 2 for op in earlier):
+    if not earlier or not any(len(toolpath_and_feeds(op)[0]) >= 2 for op in earlier):
         return None
     left = material_left(obj, cutter)
     if left is None:
@@ -325,7 +325,7 @@ def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
     grid = simulation_grid(job, cell)
     heights = stock_heights(job, grid)
     for op in earlier:
-        tp, _ = _toolpath_and_feeds(op)
+        tp, _ = toolpath_and_feeds(op)
         if len(tp) >= 2:
             shape = _five_axis_shape(op) if tp.is_five_axis() else "bull_nose"
             heights = simulate(tp, tools.cutter_from_tool(op.ToolController.Tool), grid, heights,
