@@ -23,17 +23,9 @@ from typing import Optional, Union
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.tools import holders
 from tmm_workbench.core.tools.cutter import Cutter
-from tmm_workbench.core.tools.holders import Holder
+from tmm_workbench.core.tools.holders import Holder, length
 
 Body = tuple[float, float, float, float, float]  # (z0, z1, r0, r1, clearance)
-
-
-def _number(what: str, v: object, lo: float = 0.0, strict: bool = True) -> float:
-    """A finite number > lo (or >= lo); TmmError naming `what`, the value and the allowed range."""
-    bad = isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v)
-    if bad or (v <= lo if strict else v < lo):
-        raise TmmError(f"{what} must be a finite number {'>' if strict else '>='} {lo:g} mm, got {v!r}")
-    return float(v)
 
 
 @dataclass(frozen=True)
@@ -55,10 +47,10 @@ class ToolAssembly:
         if not isinstance(self.cutter, Cutter):
             raise TmmError(f"a tool assembly needs a Cutter, got {self.cutter!r}")
         object.__setattr__(self, "flute_length", self._checked_flute_length())
-        object.__setattr__(self, "shank_diameter", _number("shank diameter", self.shank_diameter))
-        object.__setattr__(self, "stick_out", _number("stick-out", self.stick_out))
+        object.__setattr__(self, "shank_diameter", length("shank diameter", self.shank_diameter))
+        object.__setattr__(self, "stick_out", length("stick-out", self.stick_out))
         for what in ("cutter_clearance", "shank_clearance", "holder_clearance"):
-            object.__setattr__(self, what, _number(what.replace("_", " "), getattr(self, what), strict=False))
+            object.__setattr__(self, what, length(what.replace("_", " "), getattr(self, what), positive=False))
         self._check_neck()
         cone = self.shank_cone_deg
         if isinstance(cone, bool) or not isinstance(cone, (int, float)) or not 0 < cone <= 90:
@@ -75,7 +67,7 @@ class ToolAssembly:
                 raise TmmError(f"the {self.cutter.describe()} cutter needs a flute length (cutting-edge height) "
                                "for its assembly: give flute_length in mm (> 0)")
             return float(lc)
-        fl = _number("flute length", self.flute_length)
+        fl = length("flute length", self.flute_length)
         if math.isfinite(lc) and fl < lc - 1e-9:
             raise TmmError(f"flute length {fl:g} mm must be at least the {self.cutter.describe()} cutter's "
                            f"cutting-edge height {lc:g} mm")
@@ -86,8 +78,8 @@ class ToolAssembly:
             if self.neck_length != 0:
                 raise TmmError(f"neck length {self.neck_length!r} mm is given without a neck diameter")
             return
-        dn = _number("neck diameter", self.neck_diameter)
-        _number("neck length", self.neck_length)
+        dn = length("neck diameter", self.neck_diameter)
+        length("neck length", self.neck_length)
         top = min(self.cutter.diameter, self.shank_diameter)
         if dn > top + 1e-9:
             raise TmmError(f"neck diameter {dn:g} mm must be at most the cutter diameter "
@@ -103,7 +95,7 @@ class ToolAssembly:
                            f"({self.flute_length:g} mm), the neck ({self.neck_length:g} mm) and the cone up to "
                            f"the shank ({self._cone_height():g} mm) must stand out of the holder")
         if self.overall_length is not None:
-            total = _number("overall length", self.overall_length)
+            total = length("overall length", self.overall_length)
             if self.stick_out > total + 1e-9:
                 raise TmmError(f"stick-out {self.stick_out:g} mm must be at most the tool's overall length "
                                f"{total:g} mm")

@@ -27,7 +27,7 @@ _KEYS = {"name", "kind", "interface", "shank", "stack", "source", "note"}
 Segment = tuple[float, float, float]  # (height, bottom diameter, top diameter) in mm
 
 
-def _length(what: str, v: object, positive: bool = True) -> float:
+def length(what: str, v: object, positive: bool = True) -> float:
     """A finite length in mm: > 0 (or >= 0); TmmError naming `what` and the allowed range."""
     if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
             or (v <= 0 if positive else v < 0):
@@ -51,8 +51,8 @@ class Holder:
             raise TmmError(f"holder name must be a non-empty text, got {self.name!r}")
         if self.kind not in KINDS:
             raise TmmError(f"{who}: kind {self.kind!r} is not one of {', '.join(KINDS)}")
-        lo = _length(f"{who}: smallest shank diameter", self.shank_min)
-        hi = _length(f"{who}: largest shank diameter", self.shank_max)
+        lo = length(f"{who}: smallest shank diameter", self.shank_min)
+        hi = length(f"{who}: largest shank diameter", self.shank_max)
         if lo > hi:
             raise TmmError(f"{who}: shank range {lo:g}-{hi:g} mm is empty (smallest above largest)")
         if not self.stack:
@@ -97,9 +97,9 @@ class Holder:
 def _segment(who: str, i: int, s: object) -> Segment:
     if not isinstance(s, (list, tuple)) or len(s) != 3:
         raise TmmError(f"{who}: stack segment {i} must be [height, bottom diameter, top diameter] in mm, got {s!r}")
-    return (_length(f"{who}: stack segment {i} height", s[0]),
-            _length(f"{who}: stack segment {i} bottom diameter", s[1]),
-            _length(f"{who}: stack segment {i} top diameter", s[2]))
+    return (length(f"{who}: stack segment {i} height", s[0]),
+            length(f"{who}: stack segment {i} bottom diameter", s[1]),
+            length(f"{who}: stack segment {i} top diameter", s[2]))
 
 
 def holder_from_entry(entry: Any) -> Holder:
