@@ -68,11 +68,11 @@ def _value(f: Field, params_class: Optional[type], value: Any) -> Any:
 def api_values(stages: tuple[Stage, ...], params_class: Optional[type], args: Args, model: Any) -> dict[str, Any]:
     """The op's property values for an API call's `args` (None: the op's default): arguments a stage's chosen mode
     would ignore refused by name, each value checked by its argument's name, choices in the API's spelling."""
-    refuse_ignored(stages, args)
     values: dict[str, Any] = {}
-    for f in fields_of(stages):
+    for f in fields_of(stages):  # each value in its range first: a bad number is named as such
         if f.api and args.get(f.api) is not None:
             values[f.prop] = _value(f, params_class, args[f.api])
+    refuse_ignored(stages, args)
     for stage in stages:
         if stage.composite_values is not None:
             values.update(stage.composite_values(args, model))
