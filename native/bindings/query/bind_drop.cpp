@@ -6,7 +6,6 @@
 #include <pybind11/pybind11.h>
 
 #include <memory>
-#include <sstream>
 
 #include "tmm/query/drop_cutter.hpp"
 #include "tmm/mesh/mesh_index.hpp"
@@ -23,11 +22,7 @@ using XY = py::array_t<double, py::array::c_style | py::array::forcecast>;
 py::array_t<double> drop_cutter(const tmm::MeshIndex& index, const tmm::Cutter& cutter,
                                 const XY& xy, double floor_z, int threads, const py::object& progress,
                                 py::dict* stats_out) {
-  if (xy.ndim() != 2 || xy.shape(1) != 2) {
-    std::ostringstream msg;
-    msg << "points must have shape (n, 2), got ndim " << xy.ndim();
-    throw std::invalid_argument(msg.str());
-  }
+  tmm_bindings::check_points(xy, 2, "points");
   tmm_bindings::check_range(xy, "points");
   const std::size_t n = static_cast<std::size_t>(xy.shape(0));
   py::array_t<double> z(static_cast<py::ssize_t>(n));

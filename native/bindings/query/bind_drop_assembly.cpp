@@ -41,11 +41,7 @@ py::tuple drop_assembly(const tmm::MeshIndex& index, const tmm::Cutter& cutter, 
                         const Array& xy, double floor_z, double cutter_clearance, int threads,
                         const py::object& progress) {
   const tmm::ToolAssembly tool(cutter, bodies_from(bodies), cutter_clearance);
-  if (xy.ndim() != 2 || xy.shape(1) != 2) {
-    std::ostringstream msg;
-    msg << "points must have shape (n, 2), got ndim " << xy.ndim();
-    throw std::invalid_argument(msg.str());
-  }
+  tmm_bindings::check_points(xy, 2, "points");
   tmm_bindings::check_range(xy, "points");
   const std::size_t n = static_cast<std::size_t>(xy.shape(0));
   py::array_t<double> z(static_cast<py::ssize_t>(n));

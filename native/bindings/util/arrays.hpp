@@ -23,10 +23,16 @@ namespace tmm_bindings {
 using Arr = pybind11::array_t<double, pybind11::array::c_style | pybind11::array::forcecast>;
 
 // a, checked to have shape (n, cols).
-inline Arr check_points(const Arr& a, pybind11::ssize_t cols, const char* what) {
+template <class A>
+const A& check_points(const A& a, pybind11::ssize_t cols, const char* what) {
   if (a.ndim() != 2 || a.shape(1) != cols) {
     std::ostringstream msg;
-    msg << what << " must have shape (n, " << cols << ")";
+    msg << what << " must have shape (n, " << cols << "), got ";
+    if (a.ndim() == 2) {
+      msg << "(" << a.shape(0) << ", " << a.shape(1) << ")";
+    } else {
+      msg << "ndim " << a.ndim();
+    }
     throw std::invalid_argument(msg.str());
   }
   return a;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "drop_tile_scan.hpp"
 #include "tmm/util/range.hpp"
 
 namespace tmm {
@@ -114,15 +115,7 @@ class HeightCells {
   static constexpr double kCellsPerSide = 256;
 
   HeightCells(const MeshIndex& index, const double* xy, std::size_t n, double reach) {
-    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double x = xy[2 * i], y = xy[2 * i + 1];
-      if (!std::isfinite(x) || !std::isfinite(y)) continue;
-      x0 = std::min(x0, x);
-      x1 = std::max(x1, x);
-      y0 = std::min(y0, y);
-      y1 = std::max(y1, y);
-    }
+    const auto [x0, y0, x1, y1] = drop_detail::finite_box(xy, n);
     if (!(x0 <= x1) || index.nodes().empty()) return;  // no finite point: every point walks
     x0_ = x0 - reach;
     y0_ = y0 - reach;

@@ -36,15 +36,7 @@ struct TileRuns {
 void tile_keys(const Cutter& cutter, const double* xy, std::size_t n, TileRuns& t, double& tiles_x,
                double& tiles_y) {
   const double tile = kTileFactor * cutter.max_radius();
-  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double x = xy[2 * i], y = xy[2 * i + 1];
-    if (!std::isfinite(x) || !std::isfinite(y)) continue;
-    x0 = std::min(x0, x);
-    x1 = std::max(x1, x);
-    y0 = std::min(y0, y);
-    y1 = std::max(y1, y);
-  }
+  const auto [x0, y0, x1, y1] = finite_box(xy, n);
   const double span = std::max(x1 - x0, y1 - y0);
   constexpr double kMaxTiles = 1 << 26;  // per side; beyond it tiles are pointless anyway
   t.tiled = n > 0 && x0 <= x1 && span / tile < kMaxTiles;

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -19,6 +20,24 @@
 
 namespace tmm {
 namespace drop_detail {
+
+// The box of a batch's finite points; x0 > x1 when there is none.
+struct PointsBox {
+  double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+};
+
+inline PointsBox finite_box(const double* xy, std::size_t n) {
+  PointsBox b;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double x = xy[2 * i], y = xy[2 * i + 1];
+    if (!std::isfinite(x) || !std::isfinite(y)) continue;
+    b.x0 = std::min(b.x0, x);
+    b.x1 = std::max(b.x1, x);
+    b.y0 = std::min(b.y0, y);
+    b.y1 = std::max(b.y1, y);
+  }
+  return b;
+}
 
 // The highest contact above `above` of the edges (and so the vertices) this triangle owns (see
 // IndexedTriangle::owned_edges), or -inf.
