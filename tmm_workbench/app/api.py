@@ -434,25 +434,6 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     return report
 
 
-def _cutting_xy(tp: Toolpath, feed: Any, step: float) -> Any:
-    """XY of the cutting moves' ends and of points at most `step` apart along them, arcs by their chords (rapids
-    and plunges are not where the tool cuts)."""
-    import numpy as np
-
-    out = []
-    prev = None
-    for m in tp.moves:
-        tip = np.array([m.x, m.y, m.z], dtype=float)
-        if m.kind is feed and prev is not None:
-            if m.arc is not None:
-                out.append(np.asarray(m.arc.chords(tuple(prev), tuple(tip), 1e-3), dtype=float)[:, :2])
-            else:
-                n = max(1, int(np.ceil(np.hypot(*(tip[:2] - prev[:2])) / step)))
-                out.append(prev[:2] + np.outer(np.arange(1, n + 1) / n, tip[:2] - prev[:2]))
-        prev = tip
-    return np.vstack(out) if out else np.zeros((0, 2))
-
-
 @plain_numbers
 def minimum_stick_out(target: Any, *, holder: Optional[str] = None) -> dict:
     """The shortest stick-out per 3-axis op of a Job (or of one op, or an API result) with which the holder
@@ -460,8 +441,10 @@ def minimum_stick_out(target: Any, *, holder: Optional[str] = None) -> dict:
     {op label: StickOut}. `holder`: a name of the holder library for every op; None: each op's own Holder (an op
     without one is left out). 5-axis ops are left out (their tool tilts)."""
     from tmm_workbench.app import simulation, tool_assembly
+    import numpy as np
+
     from tmm_workbench.core.toolpath import MoveKind
-    from tmm_workbench.core.verify.holder_clearance import minimum_stick_out as core_stick_out
+    from tmm_workbench.core.verify.holder_clearance import minimum_stick_out as core_stick_out, sample_moves
 
     target = getattr(target, "job", None) or getattr(target, "op", None) or target
     job = simulation.job_of(target)
@@ -480,7 +463,9 @@ def minimum_stick_out(target: Any, *, holder: Optional[str] = None) -> dict:
             assembly = tool_assembly.assembly_of(op) if hasattr(op, "Holder") else None
         if assembly is None:
             continue
-        out[str(op.Label)] = core_stick_out(model, assembly, _cutting_xy(tp, MoveKind.FEED, 0.5))
+        tips, _, move = sample_moves(tp, 0.5, 0.0)   # along every move, arcs by their chords
+        cutting = np.array([m.kind is MoveKind.FEED for m in tp.moves])[move]   # rapids and plunges cut nothing
+        out[str(op.Label)] = core_stick_out(model, assembly, tips[cutting, :2])
     if not out:
         raise TmmError("no 3-axis op with a holder: give holder= (a name from the holder library)")
     return out

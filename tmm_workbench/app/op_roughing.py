@@ -138,8 +138,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
         if rest is not None:
             stock["stock_heights"] = rest
         params = self.params_from(obj, final_z=final_z, **stock)
-        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
-        params.holder_notes = [] if params.assembly is not None else None
+        tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy, cb)
@@ -147,7 +146,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
             left = "what the Job's earlier ops left" if rest is not None else "the stock"
             raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
-        tool_assembly.report(obj, params.holder_notes or [])
+        tool_assembly.report(obj, params)
         self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 

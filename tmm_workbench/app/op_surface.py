@@ -102,12 +102,11 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value,
                             material_top=simulation.material_left(obj, cutter))
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
-        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
-        params.holder_notes = [] if params.assembly is not None else None
+        tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy, cb)
         surface_verify.report(obj, notes)
-        tool_assembly.report(obj, params.holder_notes or [])
+        tool_assembly.report(obj, params)
         self.mesh, self.toolpath = mesh, toolpath
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 

@@ -92,8 +92,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
             bb = self.stock.Shape.BoundBox
             extra["stock_z"] = (bb.ZMin, bb.ZMax)
         params = self.params_from(obj, **extra)
-        params.assembly = tool_assembly.assembly_of(obj)  # the shank and holder kept clear (None: the cutter)
-        params.holder_notes = [] if params.assembly is not None else None
+        tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
         policy.validate()
         policy.material_top = simulation.material_left(obj, cutter)
@@ -108,7 +107,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
         self.diagnostics = dict(result.diagnostics)
-        tool_assembly.report(obj, params.holder_notes or [])
+        tool_assembly.report(obj, params)
         self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 

@@ -85,9 +85,17 @@ def assembly_of(obj: Any) -> Any:
 REPORT = "HolderReport"
 
 
-def report(obj: Any, notes: list) -> None:
+def prepare(obj: Any, params: Any) -> None:
+    """A strategy's params (core.strategies.holder_guard.WholeToolParams) given the op's assembly and, with one,
+    the list its guard reports to."""
+    params.assembly = assembly_of(obj)
+    params.holder_notes = [] if params.assembly is not None else None
+
+
+def report(obj: Any, params: Any) -> None:
     """What the holder guard changed (core.strategies.holder_guard): in the read-only HolderReport, and a warning
     when it left material (with the stick-out that would cut it)."""
+    notes = params.holder_notes or []
     if not hasattr(obj, REPORT):
         obj.addProperty("App::PropertyString", REPORT, "Tool",
                         "What the shank and holder left uncut on the last computed path, and the stick-out that "

@@ -9,7 +9,7 @@ type): length, angle, float, percent, int, bool, choice, vector, file, link, sub
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Optional
 
 from tmm_workbench.core.errors import TmmError
@@ -60,7 +60,6 @@ class Stage:
     # values for them (all of the call's arguments and its model given; each checked by its own name)
     composite: tuple[str, ...] = ()
     composite_values: Optional[Callable[[Args, Any], dict[str, Any]]] = None
-    extra: Mapping[str, Any] = field(default_factory=dict)   # the stage's own further declarations, by name
 
 
 def fields_of(stages: tuple[Stage, ...]) -> list[Field]:
