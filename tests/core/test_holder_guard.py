@@ -5,6 +5,7 @@ distance over a dense sample of the model's surface), the report names the regio
 everything; that stick-out cuts everything; leave_out cuts only where the holder is clear."""
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from tests.core.cavity import cavity_mesh
@@ -51,6 +52,11 @@ def test_lift_keeps_every_body_clear_and_says_what_it_left(cavity) -> None:
     assert -35 <= x0 and x1 <= 35   # inside the pocket, where the holder cannot follow
     assert report.stick_out is not None and report.stick_out.stick_out > 20
     assert "points raised" in report.summary() and "stick-out" in report.summary()
+    spots = report.spots   # what the view draws: inside the region, one per cell
+    assert 0 < len(spots) <= report.affected
+    assert x0 <= spots[:, 0].min() and spots[:, 0].max() <= x1 and y0 <= spots[:, 1].min() <= spots[:, 1].max() <= y1
+    cells = np.floor(spots[:, :2] / holder_guard.MARK_CELL_MM)
+    assert len(np.unique(cells, axis=0)) == len(spots)
 
 
 def test_the_stick_out_it_tells_cuts_everything(cavity) -> None:
@@ -88,3 +94,18 @@ def test_bad_input_is_refused_by_name(cavity) -> None:
         holder_guard.guard(cavity, tool(), [], "dodge", 0.5)
     with pytest.raises(TmmError, match="holder collision"):
         params(assembly=tool(), holder_collision="dodge").validate()
+
+
+def test_the_spots_are_the_lowest_point_of_each_cell_and_bounded() -> None:
+    rng = np.random.default_rng(7)
+    pts = np.column_stack([rng.uniform(0, 10, 5000), rng.uniform(0, 3, 5000), rng.uniform(-5, 5, 5000)])
+    spots = holder_guard.spots(pts, cell=1.0)
+    keys = np.floor(pts[:, :2]).astype(int)
+    expected = {}
+    for k, z in zip(map(tuple, keys), pts[:, 2]):   # brute force: the lowest z per 1 mm cell
+        expected[k] = min(expected.get(k, np.inf), z)
+    assert len(spots) == len(expected) == 30
+    for p in spots:
+        assert p[2] == expected[tuple(np.floor(p[:2]).astype(int))]
+    assert len(holder_guard.spots(pts, cell=0.01, most=100)) <= 100
+    assert holder_guard.spots(np.zeros((0, 3))).shape == (0, 3)

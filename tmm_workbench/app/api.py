@@ -104,8 +104,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     of `stepover`); final_depth (mm, no tool tip below it); finish_passes (1-50: the first ones leave
     stock_to_leave + k x finish_step_down, the last stock_to_leave); start_point (x, y): each pass set begins at
     the raster's end nearest it.
-    The whole tool (app.tool_assembly, docs/holders.md): holder (a name from TMM's holder library; None: the cutter
-    alone), stick_out (mm from the holder's face to the tip; None: the ToolBit's Length minus 3 shank diameters),
+    The whole tool (app.tool_assembly, docs/holders.md): holder (a name from TMM's holder library, or
+    'tool_controller': the holder set on the job's tool controller (set_holder); None: the tool controller's when
+    `job` is given and its tool controller carries one, else the cutter alone), stick_out (mm from the holder's face to the tip; None: the ToolBit's Length minus 3 shank diameters),
     shank_clearance and holder_clearance (mm, default 1), holder_collision 'lift' (the tool rises where the shank
     or holder would come closer, material is left there: the op's HolderReport) | 'leave_out' (not cut there).
     """
@@ -438,37 +439,22 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
 def minimum_stick_out(target: Any, *, holder: Optional[str] = None) -> dict:
     """The shortest stick-out per 3-axis op of a Job (or of one op, or an API result) with which the holder
     never lifts the tool (core.verify.holder_clearance.minimum_stick_out over the op's moves against the design):
-    {op label: StickOut}. `holder`: a name of the holder library for every op; None: each op's own Holder (an op
-    without one is left out). 5-axis ops are left out (their tool tilts)."""
-    from tmm_workbench.app import simulation, tool_assembly
-    import numpy as np
+    {op label: StickOut}. `holder`: a name of the holder library for every op; None: each op's own Holder (or its
+    tool controller's; an op without one is left out). 5-axis ops are left out (their tool tilts)."""
+    from tmm_workbench.app import stick_out
 
-    from tmm_workbench.core.toolpath import MoveKind
-    from tmm_workbench.core.verify.holder_clearance import minimum_stick_out as core_stick_out, sample_moves
+    return stick_out.per_op(getattr(target, "job", None) or getattr(target, "op", None) or target, holder)
 
-    target = getattr(target, "job", None) or getattr(target, "op", None) or target
-    job = simulation.job_of(target)
-    if job is None:
-        raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
-    ops = simulation.operations(job) if target is job else [target]
-    model = simulation.design_mesh(job, ops)
-    out = {}
-    for op in ops:
-        tp = simulation.toolpath_and_feeds(op)[0]
-        if tp.is_five_axis():
-            continue
-        if holder is not None:
-            assembly = tools.assembly_from_tool(op.ToolController.Tool, holder, None)
-        else:
-            assembly = tool_assembly.assembly_of(op) if hasattr(op, "Holder") else None
-        if assembly is None:
-            continue
-        tips, _, move = sample_moves(tp, 0.5, 0.0)   # along every move, arcs by their chords
-        cutting = np.array([m.kind is MoveKind.FEED for m in tp.moves])[move]   # rapids and plunges cut nothing
-        out[str(op.Label)] = core_stick_out(model, assembly, tips[cutting, :2])
-    if not out:
-        raise TmmError("no 3-axis op with a holder: give holder= (a name from the holder library)")
-    return out
+
+def set_holder(tool_controller: Any, holder: Optional[str], stick_out: float = 0.0) -> None:
+    """Clamps a tool controller's tool (or an API result's) in `holder` (a name of the holder library; None: no
+    holder) at `stick_out` mm from the holder's face to the tip (0: the ToolBit's Length minus 3 shank diameters).
+    Ops whose Holder is FromToolController (the default of a new op) then keep that holder clear of the model."""
+    from tmm_workbench.app import tool_assembly
+
+    op = getattr(tool_controller, "op", None)
+    tc = op.ToolController if op is not None else tool_controller
+    tool_assembly.set_tool_controller_holder(tc, holder, stick_out)
 
 
 @plain_numbers

@@ -158,6 +158,11 @@ class TmmOp(PathOp.ObjectOp):
             setattr(obj, name, value)
         self._initial_values = {}
         self.new_op_state(obj, job)
+        tc = getattr(obj, "ToolController", None)
+        if hasattr(obj, "Holder") and tc is not None:  # the holder may be set on the tool controller
+            from tmm_workbench.app import tool_assembly
+
+            tool_assembly.ensure_tool_controller(tc)
 
     # --- a new op tells the truth before its first compute ----------------------
     def new_op_state(self, obj: Any, job: Any) -> None:

@@ -117,6 +117,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
     SPECS = stages.specs(TOOL_STAGES)
+    RESTORED_DEFAULTS = stages.restored(TOOL_STAGES)
     params: Optional[RoughingParams] = None
 
     def opSetDefaultValues(self, obj: Any, job: Any) -> None:

@@ -72,7 +72,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
     DEFAULTS = DEFAULTS
     SPECS = SPECS
     # documents from before them kept every point, on the samples
-    RESTORED_DEFAULTS = {"ChordTolerance": 0.0, "ForwardStep": "SampleStep"}
+    RESTORED_DEFAULTS = {"ChordTolerance": 0.0, "ForwardStep": "SampleStep", **stages.restored(STAGES)}
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:

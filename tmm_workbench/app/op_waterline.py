@@ -72,6 +72,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
     SPECS = stages.specs(TOOL_STAGES)
+    RESTORED_DEFAULTS = stages.restored(TOOL_STAGES)
     params: Optional[WaterlineParams] = None
     diagnostics: Optional[dict] = None
 

@@ -34,6 +34,11 @@ def defaults(stages: tuple[Stage, ...]) -> dict[str, Any]:
     return {f.prop: f.default for f in fields_of(stages) if f.default is not NO_DEFAULT}
 
 
+def restored(stages: tuple[Stage, ...]) -> dict[str, Any]:
+    """What an older document that lacks a property gets when its default would change what it computed."""
+    return {f.prop: f.restored for f in fields_of(stages) if f.restored is not NO_DEFAULT}
+
+
 def specs(stages: tuple[Stage, ...]) -> dict[str, Spec]:
     """The ranges of the properties that name no params field."""
     return {f.prop: f.spec for f in fields_of(stages) if f.spec is not None}

@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any, Optional
 
 import FreeCAD
+import numpy as np
 
 from tmm_workbench.app import tools
 from tmm_workbench.core.errors import TmmError
@@ -20,22 +21,28 @@ from tmm_workbench.core.stage import Args, Field, Stage
 from tmm_workbench.core.tools import holders
 
 NONE = "None"
+FROM_TC = "FromToolController"   # the holder the op's tool controller carries (TC_HOLDER): the default
+TC_HOLDER, TC_STICK_OUT = "TmmHolder", "TmmStickOut"
 LIFT, LEAVE_OUT = "lift", "leave_out"
 COLLISIONS = {"Lift": LIFT, "LeaveOut": LEAVE_OUT}
 CLEARANCE = Spec("clearance", "mm", low=0.0, high=100.0)
 STICK_OUT = Spec("stick-out", "mm", low=0.0, high=1000.0)   # 0: from the ToolBit's Length (tools.assembly_from_tool)
 
 
-def holder_choices() -> dict[str, Optional[str]]:
-    """None and the library's holders (shipped and the user's), property value -> holder name. A library that
-    cannot be read (a broken user file) leaves None only here: documents still open, and an op with a holder
-    says what is wrong with the file when it computes."""
+def _library_names() -> list[str]:
+    """The library's holder names (shipped and the user's). A library that cannot be read (a broken user file)
+    gives none here: documents still open, and an op with a holder says what is wrong with the file when it
+    computes."""
     try:
-        names = holders.names(tools.user_holders_file())
+        return holders.names(tools.user_holders_file())
     except (TmmError, OSError) as exc:
         FreeCAD.Console.PrintWarning(f"TMM holder library: {exc}\n")
-        names = []
-    return {NONE: None, **{name: name for name in names}}
+        return []
+
+
+def holder_choices() -> dict[str, Optional[str]]:
+    """Property value -> holder: None, the library's holders, and the tool controller's (its TmmHolder)."""
+    return {NONE: None, **{name: name for name in _library_names()}, FROM_TC: FROM_TC}
 
 
 def ignored(args: Args) -> Optional[str]:
@@ -51,10 +58,13 @@ def ignored(args: Args) -> Optional[str]:
 STAGE = Stage("tool assembly", (
     Field("Holder", "choice", "Tool",
           "The tool holder (TMM's library, docs/holders.md): its shank and the holder are kept their clearance "
-          "away from the model; None: the cutter alone", api="holder", choices=holder_choices(), default=NONE, widget="holder"),
+          "away from the model; FromToolController: the one set on the tool controller (its TmmHolder); None: "
+          "the cutter alone", api="holder", choices=holder_choices(),
+          api_names={**{str(n).lower(): n for n in holder_choices() if n != FROM_TC}, "tool_controller": FROM_TC},
+          default=FROM_TC, restored=NONE, widget="holder"),
     Field("StickOut", "length", "Tool",
-          "Gauge length from the holder's face to the tool tip, mm; 0: the ToolBit's Length minus a grip of 3 "
-          "shank diameters", api="stick_out", default=0.0, spec=STICK_OUT, widget="stickOut"),
+          "Gauge length from the holder's face to the tool tip, mm; 0: the tool controller's (TmmStickOut), or "
+          "the ToolBit's Length minus a grip of 3 shank diameters", api="stick_out", default=0.0, spec=STICK_OUT, widget="stickOut"),
     Field("ShankClearance", "length", "Tool", "Least distance the shank and neck keep from the model, mm",
           api="shank_clearance", default=1.0, spec=CLEARANCE, widget="shankClearance"),
     Field("HolderClearance", "length", "Tool", "Least distance the holder keeps from the model, mm",
@@ -67,22 +77,66 @@ STAGE = Stage("tool assembly", (
 ), ignored=ignored)
 
 
-def assembly_of(obj: Any) -> Any:
-    """The op's core ToolAssembly (its tool controller's ToolBit with the op's holder, stick-out and clearances),
-    or None without a holder."""
+def ensure_tool_controller(tc: Any) -> None:
+    """The tool controller's holder properties (TmmHolder: None or a library holder; TmmStickOut: 0 for the
+    ToolBit's), added when missing, the library's names offered (a value no longer in it kept as None)."""
+    names = [NONE] + _library_names()
+    if not hasattr(tc, TC_HOLDER):
+        tc.addProperty("App::PropertyEnumeration", TC_HOLDER, "TMM",
+                       "The holder this tool is clamped in (TMM's library, docs/holders.md): TMM ops whose Holder is "
+                       "FromToolController keep its shank and holder clear of the model")
+        tc.addProperty("App::PropertyLength", TC_STICK_OUT, "TMM",
+                       "Gauge length from the holder's face to the tool tip, mm; 0: the ToolBit's Length minus a "
+                       "grip of 3 shank diameters")
+    if list(tc.getEnumerationsOfProperty(TC_HOLDER) or []) != names:
+        value = str(getattr(tc, TC_HOLDER) or NONE)
+        setattr(tc, TC_HOLDER, names)
+        setattr(tc, TC_HOLDER, value if value in names else NONE)
+
+
+def set_tool_controller_holder(tc: Any, holder: Optional[str], stick_out: float = 0.0) -> None:
+    """Clamps the tool controller's tool in `holder` (a library name; None: no holder) at `stick_out` mm (0: the
+    ToolBit's Length minus 3 shank diameters). TmmError naming an unknown holder or a stick-out out of range."""
+    from tmm_workbench.app.api_args import numbers
+
+    ensure_tool_controller(tc)
+    name = NONE if holder is None else str(holder)
+    known = list(tc.getEnumerationsOfProperty(TC_HOLDER))
+    if name not in known:
+        raise TmmError(f"holder must be one of {', '.join(known)}, got {holder!r}")
+    numbers(stick_out=(stick_out, STICK_OUT))
+    setattr(tc, TC_HOLDER, name)
+    setattr(tc, TC_STICK_OUT, float(stick_out))
+
+
+def holder_of(obj: Any) -> tuple[str, float]:
+    """(holder name or NONE, stick-out mm or 0) the op computes with: its own, or its tool controller's."""
     name = str(getattr(obj, "Holder", NONE) or NONE)
+    stick_out = float(obj.StickOut.Value) if hasattr(obj, "StickOut") else 0.0
+    if name != FROM_TC:
+        return name, stick_out
+    tc = getattr(obj, "ToolController", None)
+    name = str(getattr(tc, TC_HOLDER, NONE) or NONE)
+    if stick_out <= 0 and hasattr(tc, TC_STICK_OUT):
+        stick_out = float(getattr(tc, TC_STICK_OUT).Value)
+    return name, stick_out
+
+
+def assembly_of(obj: Any) -> Any:
+    """The op's core ToolAssembly (its tool controller's ToolBit with the holder and stick-out of holder_of and
+    the op's clearances), or None without a holder."""
+    name, stick_out = holder_of(obj)
     if name == NONE:
         return None
     tc = getattr(obj, "ToolController", None)
     if tc is None:
         raise TmmError(f"Holder '{name}' needs a tool controller with a ToolBit (its shank and length)")
-    stick_out = float(obj.StickOut.Value)
     return tools.assembly_from_tool(tc.Tool, name, stick_out if stick_out > 0 else None,
                                     shank_clearance=float(obj.ShankClearance.Value),
                                     holder_clearance=float(obj.HolderClearance.Value))
 
 
-REPORT = "HolderReport"
+REPORT, REGIONS = "HolderReport", "HolderRegions"
 
 
 def prepare(obj: Any, params: Any) -> None:
@@ -93,16 +147,24 @@ def prepare(obj: Any, params: Any) -> None:
 
 
 def report(obj: Any, params: Any) -> None:
-    """What the holder guard changed (core.strategies.holder_guard): in the read-only HolderReport, and a warning
-    when it left material (with the stick-out that would cut it)."""
+    """What the holder guard changed (core.strategies.holder_guard): in the read-only HolderReport, the places it
+    left material in HolderRegions (the view draws them), and a warning when it left any (with the stick-out
+    that would cut it)."""
     notes = params.holder_notes or []
     if not hasattr(obj, REPORT):
         obj.addProperty("App::PropertyString", REPORT, "Tool",
                         "What the shank and holder left uncut on the last computed path, and the stick-out that "
                         "would cut it")
-    obj.setEditorMode(REPORT, 1)
+    if not hasattr(obj, REGIONS):
+        obj.addProperty("App::PropertyVectorList", REGIONS, "Tool",
+                        "Where the shank or holder kept the tool off the model on the last computed path (material "
+                        "is left there): drawn on the 3D view")
+    for name in (REPORT, REGIONS):
+        obj.setEditorMode(name, 1)
     text = "; ".join(note.summary() for note in notes)
     setattr(obj, REPORT, text)
+    spots = [note.spots for note in notes if note.spots is not None and len(note.spots)]
+    setattr(obj, REGIONS, [FreeCAD.Vector(*map(float, p)) for p in np.vstack(spots)] if spots else [])
     if any(note.affected for note in notes):
         FreeCAD.Console.PrintWarning(f"{obj.Label}: {text}\n")
     elif notes:

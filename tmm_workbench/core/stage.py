@@ -35,6 +35,7 @@ class Field:
     default: Any = NO_DEFAULT                  # when no params field holds it
     spec: Optional[Spec] = None                # its range when no params field holds it
     widget: str = ""                           # the panel's widget for it ("" for none)
+    restored: Any = NO_DEFAULT                 # what an older document without it gets (what it computed then)
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:

@@ -32,6 +32,8 @@ TOLERANCE_MM = 1e-4    # a body this little above a point is not a collision (th
 BETWEEN_MM = 0.005     # a lifted move may pass this far under the bodies' height between its points (of ~1 mm)
 MIN_GAP_MM = 0.005     # and points are not inserted closer than this
 MAX_ROUNDS = 12        # halvings: a 0.5 mm sample step down to about 0.1 um
+MARK_CELL_MM = 0.5     # the report's spots: one affected point per cell this wide (the view draws them)
+MAX_SPOTS = 20000      # and at most this many (a larger region keeps every k-th)
 
 
 @dataclass
@@ -68,6 +70,8 @@ class HolderReport:
     pieces: dict = field(default_factory=dict)    # piece -> affected points it set
     stick_out: Optional[StickOut] = None          # the shortest stick-out that cuts everything
     note: str = ""
+    spots: Optional[np.ndarray] = None            # (n, 3) where material is left: affected CL points at their
+    #                                               own height, thinned to one per MARK_CELL_MM cell for the view
 
     def summary(self) -> str:
         if not self.affected:
@@ -116,7 +120,7 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     allpts = np.vstack([p for p, _ in sampled]) if sampled else np.zeros((0, 3))
     zb, owner = drop.heights_of(BODIES, allpts[:, :2], progress=progress)
     over = zb - allpts[:, 2]
-    hit = over > TOLERANCE_MM
+    hit = (over > TOLERANCE_MM) & (owner >= 0)   # where the needle standing in for the cutter set it, no body did
     report = HolderReport(mode, len(allpts))
     if not hit.any():
         return segments, report
@@ -124,6 +128,7 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     report.max_lift = float(over[hit].max())
     p = allpts[hit]
     report.region = (float(p[:, 0].min()), float(p[:, 1].min()), float(p[:, 0].max()), float(p[:, 1].max()))
+    report.spots = spots(p)
     names, counts = np.unique(drop.piece_names(owner[hit]), return_counts=True)
     report.pieces = {str(n): int(c) for n, c in zip(names, counts)}
     out: list[CutSegment] = []
@@ -145,6 +150,19 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     except TmmError as exc:  # a holder narrower than the shank somewhere: no stick-out is monotone
         report.note = f"no shortest stick-out told: {exc}"
     return out, report
+
+
+def spots(points: np.ndarray, cell: float = MARK_CELL_MM, most: int = MAX_SPOTS) -> np.ndarray:
+    """One of `points` per `cell`-wide XY cell (the lowest there: where the most is left), at most `most`."""
+    if not len(points):
+        return np.zeros((0, 3))
+    keys = np.floor(points[:, :2] / cell).astype(np.int64)
+    order = np.lexsort((points[:, 2], keys[:, 1], keys[:, 0]))
+    k = keys[order]
+    first = np.ones(len(k), dtype=bool)
+    first[1:] = np.any(k[1:] != k[:-1], axis=1)
+    kept = points[order[first]]
+    return kept[:: max(1, -(-len(kept) // most))]
 
 
 def _refined(drop: AssemblyDrop, tips: np.ndarray) -> np.ndarray:
