@@ -18,11 +18,11 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import RAMP
 from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.strategies.segment_split import keep_runs, move_samples
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.verify.holder_clearance import StickOut, minimum_stick_out
 
@@ -87,23 +87,6 @@ class HolderReport:
         return text + (f" ({self.note})" if self.note else "")
 
 
-def _move_samples(seg: CutSegment, step: float) -> tuple[np.ndarray, np.ndarray]:
-    """(points, move): the segment's tips with samples at most `step` apart along each move (arcs by their
-    chords), each point's move (the tip it ends at; a tip is its own move's end)."""
-    pts, move = [seg.tips[:1]], [np.zeros(1, dtype=np.int64)]
-    for i in range(1, len(seg)):
-        a, b = seg.tips[i - 1], seg.tips[i]
-        arc = seg.arc(i)
-        if arc is not None:
-            chord = np.asarray(arc.chords(tuple(a), tuple(b), 1e-3), dtype=float).reshape(-1, 3)
-        else:
-            n = max(1, int(np.ceil(np.hypot(*(b[:2] - a[:2])) / step)))
-            chord = a + np.outer(np.arange(1, n + 1) / n, b - a)
-        pts.append(chord)
-        move.append(np.full(len(chord), i, dtype=np.int64))
-    return np.vstack(pts), np.concatenate(move)
-
-
 def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mode: str, step: float,
           surface: Optional[DropSurface] = None, progress: Optional[Progress] = None
           ) -> tuple[list[CutSegment], HolderReport]:
@@ -116,7 +99,7 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
         raise TmmError("the holder guard takes 3-axis segments (a vertical tool); 5-axis moves are checked by "
                        "core.verify.holder_clearance")
     drop = AssemblyDrop(mesh, assembly, surface)
-    sampled = [_move_samples(seg, step) for seg in segments]
+    sampled = [move_samples(seg, step) for seg in segments]
     allpts = np.vstack([p for p, _ in sampled]) if sampled else np.zeros((0, 3))
     zb, owner = drop.heights_of(BODIES, allpts[:, :2], progress=progress)
     over = zb - allpts[:, 2]
@@ -133,18 +116,20 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     report.pieces = {str(n): int(c) for n, c in zip(names, counts)}
     out: list[CutSegment] = []
     start = 0
+    end_kept = True   # the previous segment's last tip: a segment joined to it stays joined only then
     for seg, (pts, move) in zip(segments, sampled):
         end = start + len(pts)
         seg_hit, seg_z = hit[start:end], zb[start:end]
         start = end
         if not seg_hit.any():
-            out.append(seg)
+            out.append(seg if end_kept else replace(seg, joined=False))
         elif mode == LIFT:
             tips = pts.copy()
             tips[:, 2] = np.maximum(tips[:, 2], seg_z)
-            out.append(replace(seg, tips=_refined(drop, tips), arcs=None))
+            out.append(replace(seg, tips=_refined(drop, tips), arcs=None, joined=seg.joined and end_kept))
         else:
-            out += _leave_out(seg, seg_hit, move)
+            out += _leave_out(seg, seg_hit, move, end_kept)
+        end_kept = mode == LIFT or not seg_hit[-1]
     try:
         report.stick_out = minimum_stick_out(mesh, assembly, allpts[:, :2], surface=drop.surface)  # along the moves
     except TmmError as exc:  # a holder narrower than the shank somewhere: no stick-out is monotone
@@ -181,30 +166,11 @@ def _refined(drop: AssemblyDrop, tips: np.ndarray) -> np.ndarray:
     return tips
 
 
-def _leave_out(seg: CutSegment, hit: np.ndarray, move: np.ndarray) -> list[CutSegment]:
-    """The segment's runs of clear tips joined by clear moves (`hit` per sample, `move` its move), each run
-    entered anew by the linker (the first kept as it was entered when it starts at the first tip)."""
+def _leave_out(seg: CutSegment, hit: np.ndarray, move: np.ndarray, joined: bool) -> list[CutSegment]:
+    """The segment's runs of clear tips joined by clear moves (`hit` per sample, `move` its move); `joined`:
+    whether the previous segment's end was kept (keep_runs)."""
     n = len(seg)
     tip_sample = np.searchsorted(move, np.arange(n), side="right") - 1   # a move's last sample is its tip
-    ok_tip = ~hit[tip_sample]
     ok_move = np.ones(n, dtype=bool)
     ok_move[np.unique(move[hit])] = False
-    pieces: list[CutSegment] = []
-    i = 0
-    while i < n:
-        if not ok_tip[i]:
-            i += 1
-            continue
-        j = i + 1
-        while j < n and ok_move[j] and ok_tip[j]:
-            j += 1
-        if j - i >= 2:
-            arcs = None if seg.arcs is None else (None,) + tuple(seg.arcs[i + 1:j])
-            first = i == 0
-            # a piece has no helix circle of its own: it ramps down along itself where the segment had an entry
-            entry = seg.entry if first or (seg.entry is None and seg.helix_centre is None) else RAMP
-            pieces.append(replace(seg, tips=seg.tips[i:j], arcs=arcs, joined=seg.joined and first, closed=False,
-                                  entry_z=seg.entry_z if first else None, entry=entry,
-                                  helix_centre=seg.helix_centre if first else None))
-        i = j
-    return pieces
+    return keep_runs(seg, ~hit[tip_sample], ok_move, joined)

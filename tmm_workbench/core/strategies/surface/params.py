@@ -15,6 +15,7 @@ from tmm_workbench.core.footprint.raster import Rect, pass_count
 from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.polygons import Shape
 from tmm_workbench.core.strategies.holder_guard import WholeToolParams
+from tmm_workbench.core.strategies.rest_filter import RestParams
 
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
@@ -35,7 +36,7 @@ _BYTES_PER_POINT = 400
 
 
 @dataclass
-class SurfaceParams(StrategyParams, WholeToolParams):  # + the whole tool (holder_guard)
+class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole tool (holder_guard), the rest
     boundary: Rect = (0.0, 0.0, 0.0, 0.0)  # xmin, ymin, xmax, ymax of the tip positions (mm)
     stepover: float = param(1.0, "step-over", "mm", low=0, low_open=True, kind="length")
     sample_step: float = param(0.5, "sample step", "mm", low=0, low_open=True, kind="length")
