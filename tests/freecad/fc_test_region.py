@@ -126,7 +126,7 @@ class RegionFromFaces(FreeCADTestCase):
             run_surface(model, diameter=4, region=ring, slope_range=(0, 120), progress=False)
         with self.assertRaisesRegex(Exception, r"region_tolerance must be .*got 0"):
             run_surface(model, diameter=4, region=ring, region_tolerance=0.0, progress=False)
-        with self.assertRaisesRegex(Exception, r"region must be None \(the box\), a sketch, face names"):
+        with self.assertRaisesRegex(Exception, r"region must be None \(the box\), 'rest', a sketch, face names"):
             run_surface(model, diameter=4, region=[3.5], progress=False)
         other = sketch(new_doc("TmmRegionElsewhere"), [(5, 5), (50, 5), (50, 35)])
         with self.assertRaisesRegex(Exception, r"region 'Region' must be in the model's document"):

@@ -21,7 +21,7 @@ _single_shot = QtCore.QTimer.singleShot
 QtCore.QTimer.singleShot = staticmethod(lambda *args: None)  # the smoke script's helpers, not its run
 try:
     import gui_smoke  # noqa: E402,F401 (loads the smoke script's helpers)
-    from gui_smoke import pump, screenshot  # noqa: E402
+    from gui_smoke import close_panel, find_panel, pump, screenshot  # noqa: E402
 finally:
     QtCore.QTimer.singleShot = _single_shot
 
@@ -37,20 +37,20 @@ def run() -> dict:
     pump(0.5)
     from fc_test_holder import FAST, HOLDER, cavity_stl
     from tmm_workbench.app.api import run_surface
-    from tmm_workbench.gui import holder_regions_view, stick_out_cmd
+    from tmm_workbench.gui import region_marks_view, stick_out_cmd
 
     r = run_surface(cavity_stl(), holder=HOLDER, stick_out=20.0, doc_name="TmmGuiHolder", **{**FAST, "progress": True})
     vobj = r.op.ViewObject
     vp = vobj.Proxy
     info["regions"] = len(r.op.HolderRegions)
-    info["drawn"] = holder_regions_view.drawn(vp.regions_switch)
+    info["drawn"] = region_marks_view.drawn(vp.mark_switches, "HolderRegions")
     assert info["regions"] > 10 and info["drawn"] == info["regions"], info
     vobj.ShowHolderRegions = False
     pump(0.2)
-    info["drawn_hidden"] = holder_regions_view.drawn(vp.regions_switch)
+    info["drawn_hidden"] = region_marks_view.drawn(vp.mark_switches, "HolderRegions")
     vobj.ShowHolderRegions = True
     pump(0.2)
-    info["drawn_again"] = holder_regions_view.drawn(vp.regions_switch)
+    info["drawn_again"] = region_marks_view.drawn(vp.mark_switches, "HolderRegions")
     assert info["drawn_hidden"] == 0 and info["drawn_again"] == info["regions"], info
     FreeCADGui.activeDocument().activeView().viewIsometric()
     FreeCADGui.SendMsgToActiveView("ViewFit")
@@ -70,6 +70,28 @@ def run() -> dict:
     assert info["command_active"] and r.op.Label in info["box"] and "stick-out" in info["box"], info
     for box in boxes:
         box.close()
+    # a rest op after it: its rest cells drawn; its panel offers the Job's other tool controller as reference
+    rest = run_surface(job=r.job, tool="ballend", diameter=3.0, stepover=0.3, region="rest", sample_step=0.5,
+                       boundary="model", progress=False, post=None)
+    rvp = rest.op.ViewObject.Proxy
+    info["rest_marks"] = len(rest.op.RestRegions)
+    info["rest_drawn"] = region_marks_view.drawn(rvp.mark_switches, "RestRegions")
+    assert info["rest_marks"] > 10 and info["rest_drawn"] == info["rest_marks"], info
+    r.op.ViewObject.Visibility = False   # its marks hide with it
+    pump(0.2)
+    info["hidden_op_drawn"] = region_marks_view.drawn(vp.mark_switches, "HolderRegions")
+    assert info["hidden_op_drawn"] == 0, info
+    FreeCADGui.SendMsgToActiveView("ViewFit")
+    pump(0.5)
+    screenshot(PNG.with_name("rest_regions.png"))
+    rest.op.ViewObject.Document.setEdit(rest.op.ViewObject, 0)
+    pump(1.0)
+    page = find_panel("TmmSurfaceOpPage")
+    reference = page.findChild(QtGui.QComboBox, "restReference")
+    info["reference_items"] = [reference.itemText(i) for i in range(reference.count())]
+    info["rest_from"] = page.findChild(QtGui.QComboBox, "restFrom").currentText()
+    assert info["rest_from"] == "EarlierOps" and r.op.ToolController.Label in info["reference_items"], info
+    close_panel(rest.op)
     gui_runner.close_document(r.doc)
     return info
 

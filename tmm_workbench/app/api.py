@@ -44,7 +44,8 @@ STEPOVER_MODE_NAMES["offset3d"] = "Offset3D"  # 3D offset: loops from the region
 
 
 @plain_numbers
-def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter] = "ballend",
+def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = None,
+                tool: Union[str, Cutter] = "ballend",
                 diameter: float = 6.0, corner_radius: float = 0.0, stepover: Optional[float] = None,
                 sample_step: float = 0.5,
                 angle_deg: float = 0.0, pattern: str = "zigzag", stock_to_leave: float = 0.0,
@@ -65,8 +66,10 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
                 start_point: Optional[tuple[float, float]] = None,
                 offset_from: Any = None, holder: Optional[str] = None, stick_out: Optional[float] = None,
                 shank_clearance: Optional[float] = None, holder_clearance: Optional[float] = None,
-                holder_collision: Optional[str] = None) -> SurfaceResult:
-    """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code.
+                holder_collision: Optional[str] = None, rest_from: Optional[str] = None,
+                rest_reference: Any = None, rest_tolerance: Optional[float] = None) -> SurfaceResult:
+    """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code, in a new Job or
+    added to `job` (a Job or an API result: its model when `model` is None, a further tool controller).
 
     tool: 'ballend' | 'endmill' | 'bullnose' (FreeCAD ToolBit shapes; corner_radius for bullnose), or a
     core.tools.Cutter (any APT cutter, e.g. Cutter(10, 2, 5, 3, 20): a ToolBit of TMM's tmm_apt shape when
@@ -89,6 +92,9 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     region (where the tool centre may go; app.region_source): None (the boundary box), a sketch or any
     object with closed edges (inner loops are holes), or faces of the model seen from above: face names
     ("Face3" or a list) of a Part model, or (object, names) pairs; region_tolerance: its discretisation, mm.
+    region 'rest' (app.rest_source): only where more than rest_tolerance (mm, default 0.01) is left that this
+    tool reaches; rest_from 'earlier_ops' (default: the stock the `job`'s earlier ops leave, simulated) |
+    'reference_tool' (what rest_reference, a tool controller or ToolBit of the larger tool, would leave).
     pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
     max) deg, cut only where the surface slope lies in it (default all).
     forward_step: 'tolerance' (default: the fewest moves within +-chord_tolerance of the exact tool path, lean
@@ -117,7 +123,7 @@ def run_surface(model: Union[str, os.PathLike, Any], *, tool: Union[str, Cutter]
     if stepover is None and str(stepover_mode).lower() == "stepover" and stepover_percent is None:
         args["stepover"] = DEFAULT_STEPOVER
     values = stages.api_values(op_surface.STAGES, SurfaceParams, args, model)
-    return run("TMM_Surface", model, tool=tool, diameter=diameter, corner_radius=corner_radius,
+    return run("TMM_Surface", model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius,
                safe_height=safe_height, clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
                doc_name=doc_name, progress=progress, **values)

@@ -19,7 +19,7 @@ from typing import Any, Optional
 import FreeCAD
 
 from tmm_workbench.app import offset_start, op_base, op_mesh, progress, region_source, simulation, stages
-from tmm_workbench.app import surface_passes, surface_verify, tool_assembly, work_estimate
+from tmm_workbench.app import rest_source, surface_passes, surface_verify, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
@@ -52,7 +52,7 @@ LINKING_STAGE = Stage("linking", (
 # pattern -> positioning -> forward step -> verification -> linking (core.strategies.raster_drop)
 STAGES = (op_mesh.MODEL_STAGE, BOUNDARY_STAGE, pattern.STAGE, positioning.STAGE, forward_step.STAGE,
           LINKING_STAGE, region_source.STAGE, surface_passes.STAGE, surface_verify.STAGE, offset_start.STAGE,
-          tool_assembly.STAGE)
+          tool_assembly.STAGE, rest_source.STAGE)
 PROPERTIES: list[Prop] = stages.properties(STAGES)
 CHOICES = stages.choices(STAGES)
 DEFAULTS: dict[str, Any] = stages.defaults(STAGES)
@@ -60,7 +60,8 @@ SPECS = stages.specs(STAGES)
 
 
 class ObjectTmmSurface(op_mesh.MeshOp):
-    """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`."""
+    """Proxy of the operation. Transient results of the last run (not saved): `toolpath`, `mesh`, `rest`
+    (app.rest_source.Rest of a rest op)."""
 
     ESTIMATE = staticmethod(work_estimate.surface)  # its strategy's inputs from the properties
     STRATEGY = raster_drop  # its estimate_work (core.work)
@@ -76,18 +77,26 @@ class ObjectTmmSurface(op_mesh.MeshOp):
 
     # --- computation -------------------------------------------------------------------------
     def clear_results(self) -> None:
-        self.mesh = self.toolpath = None
+        self.mesh = self.toolpath = self.rest = None
 
     def compute(self, obj: Any) -> None:
         mesh = self.model_mesh(obj)
         cutter = self.cutter()
-        region = region_source.region_of(obj, PathUtils.findParentJob(obj))  # None: the box
+        job = PathUtils.findParentJob(obj)
+        left = simulation.material_left(obj, cutter)   # what the Job's earlier ops left (None: not known)
+        rest = None
+        if getattr(obj, "Region", "") == region_source.REST:   # only where they (or a larger tool) left material
+            rest = rest_source.rest_of(obj, job, mesh, cutter, left, self.boundary(obj, mesh))
+            region = rest.region
+        else:
+            region = region_source.region_of(obj, job)  # None: the box
         boundary = self.boundary(obj, mesh) if region is None else polygons.bounds(region)
         params = self.params_from(obj, boundary=boundary, region=region,
                                   forward_step=forward_step.FORWARD_STEPS.get(getattr(obj, "ForwardStep", ""),
                                                                               SAMPLED),
                                   **surface_passes.params_extra(obj, cutter))
         params.offset_from = offset_start.curves_of(obj, params.stepover_mode == OFFSET3D)
+        params.rest = None if rest is None else rest.stock
         flat_cusp = check_tool_fit(params, cutter)
         if flat_cusp:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")
@@ -99,15 +108,15 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         finish = surface_passes.finish_params(obj)
         check_final_depth(obj, finish.final_depth)
         # entries rapid to just above what the Job's earlier ops left and feed from there
-        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value,
-                            material_top=simulation.material_left(obj, cutter))
+        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, material_top=left)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy, cb)
         surface_verify.report(obj, notes)
         tool_assembly.report(obj, params)
-        self.mesh, self.toolpath = mesh, toolpath
+        rest_source.report(obj, rest)
+        self.mesh, self.toolpath, self.rest = mesh, toolpath, rest
         self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
 
     def post_without_k(self, obj: Any) -> str:

@@ -24,8 +24,8 @@ from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.polygons import Shape
 from tmm_workbench.core.stage import Args, Field, Stage
 
-BOX, FACES, SKETCH = "Box", "Faces", "Sketch"
-REGIONS = (BOX, FACES, SKETCH)
+BOX, FACES, SKETCH, REST = "Box", "Faces", "Sketch", "Rest"
+REGIONS = (BOX, FACES, SKETCH, REST)   # Rest: where the Job's earlier ops or a reference tool left material
 TOLERANCE_SPEC = Spec("region tolerance", "mm", low=0.001, high=10.0)
 MAX_TRIANGLES = 500_000          # of the selected faces' tessellation: refused above, before the union (~20 s)
 
@@ -117,6 +117,8 @@ def region_of(op: Any, job: Any) -> Optional[Shape]:
     kind = getattr(op, "Region", BOX)
     if kind == BOX:
         return None
+    if kind == REST:
+        raise TmmError("Region 'Rest' is computed from the model and the tool (app.rest_source.rest_of)")
     tolerance = float(op.RegionTolerance.Value)
     check(TOLERANCE_SPEC, tolerance)  # finer would tessellate without bound
     if kind == FACES:
@@ -149,6 +151,9 @@ def api_values(args: Args, model: Any) -> dict[str, Any]:
         values.update(SlopeMin=low, SlopeMax=high)
     if region is None:
         return values
+    if isinstance(region, str) and region.lower() == "rest":
+        values.update(Region=REST)
+        return values
     doc = getattr(model, "Document", None)  # an STL path gets a new document: no object of the caller's is in it
     for obj in ([region] if hasattr(region, "TypeId") else
                 [i[0] for i in (region if isinstance(region, list) else [region]) if isinstance(i, tuple) and i]):
@@ -170,8 +175,8 @@ def api_values(args: Args, model: Any) -> dict[str, Any]:
             subs = (item[1],) if isinstance(item[1], str) else tuple(item[1])
             links.append((item[0], subs))
         else:
-            raise TmmError(f"region must be None (the box), a sketch, face names of the model or (object, face "
-                           f"names) pairs, got {item!r}")
+            raise TmmError(f"region must be None (the box), 'rest', a sketch, face names of the model or (object, "
+                           f"face names) pairs, got {item!r}")
     values.update(Region=FACES, RegionFaces=links)
     return values
 
@@ -179,7 +184,8 @@ def api_values(args: Args, model: Any) -> dict[str, Any]:
 STAGE = Stage("region", (
     Field("Region", "choice", "Region",
           "Where the tool centre may go: Box (BoundaryShape with BoundaryMargin), Faces (RegionFaces seen from "
-          "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes)",
+          "above), Sketch (the closed loops of RegionSketch seen from above, inner loops are holes), Rest (where "
+          "the Job's earlier ops or a reference tool left more than RestTolerance that this tool reaches)",
           choices={r: r for r in REGIONS}, default=BOX, widget="region"),
     Field("RegionFaces", "sublinks", "Region", "Faces of the model bounding the region"),
     Field("RegionSketch", "link", "Region", "Sketch (or closed edges) bounding the region"),

@@ -61,6 +61,10 @@ def widgets(stages: tuple[Stage, ...]) -> tuple[dict[str, str], dict[str, str], 
 def _value(f: Field, params_class: Optional[type], value: Any) -> Any:
     if f.kind == "choice":
         return option(f.api, value, f.api_choices())
+    if f.kind == "link":
+        if not hasattr(value, "TypeId"):
+            raise TmmError(f"{f.api} must be a FreeCAD object, got {value!r}")
+        return value
     if f.kind == "bool":
         if not isinstance(value, bool):
             raise TmmError(f"{f.api} must be True or False, got {value!r}")

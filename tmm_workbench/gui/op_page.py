@@ -164,29 +164,27 @@ class OpViewProvider(PathOpGui.ViewProvider):
     no selection gate (PathSelection only knows FreeCAD's own ops; each TMM op checks its own input)."""
 
     ICON = ""
-    regions_switch: Any = None
+    mark_switches: Any = None
 
     def attach(self, vobj: Any) -> None:
         super().attach(vobj)
-        from tmm_workbench.gui import holder_regions_view
+        from tmm_workbench.gui import region_marks_view
 
-        self.regions_switch = holder_regions_view.attach(vobj)
+        self.mark_switches = region_marks_view.attach(vobj)
 
     def updateData(self, obj: Any, prop: str) -> None:
         super().updateData(obj, prop)
-        if prop == "HolderRegions":
-            from tmm_workbench.gui import holder_regions_view
+        from tmm_workbench.gui import region_marks_view
 
-            holder_regions_view.refresh(self.regions_switch, getattr(self, "vobj", None))
+        region_marks_view.refresh(self.mark_switches, getattr(self, "vobj", None), prop)
 
     def onChanged(self, vobj: Any, prop: str) -> None:
         base = getattr(super(), "onChanged", None)   # FreeCAD 1.x's view provider may have one
         if base is not None:
             base(vobj, prop)
-        if prop == "ShowHolderRegions":
-            from tmm_workbench.gui import holder_regions_view
+        from tmm_workbench.gui import region_marks_view
 
-            holder_regions_view.refresh(self.regions_switch, vobj)
+        region_marks_view.refresh(self.mark_switches, vobj, prop)
 
     def getSelectionFactory(self) -> Any:
         return lambda: None

@@ -54,18 +54,35 @@ def init_fields(page: Any, obj: Any) -> None:
         page.form.regionFacesButton.clicked.connect(lambda: use_selection(page, obj))
 
 
+def reference_candidates(obj: Any) -> list[Any]:
+    """The tool controllers of the op's Job but its own: a rest's reference tool."""
+    from tmm_workbench.app.simulation import job_of
+
+    job = job_of(obj)
+    own = getattr(obj, "ToolController", None)
+    tcs = list(getattr(getattr(job, "Tools", None), "Group", []) or []) if job is not None else []
+    return [tc for tc in tcs if own is None or tc.Name != own.Name]
+
+
 def get_fields(page: Any, obj: Any) -> None:
     if not _has_group(page):
         return
     object_chooser.write(page.form.regionSketch, obj, "RegionSketch")
+    if hasattr(page.form, "restReference") and hasattr(obj, "RestReference"):
+        object_chooser.write(page.form.restReference, obj, "RestReference")
 
 
 def set_fields(page: Any, obj: Any) -> None:
     if not _has_group(page):
         return
     object_chooser.fill(page.form.regionSketch, sketch_candidates(obj), obj.RegionSketch)
+    if hasattr(page.form, "restReference") and hasattr(obj, "RestReference"):
+        object_chooser.fill(page.form.restReference, reference_candidates(obj), obj.RestReference)
     page.form.regionFacesInfo.setText(faces_text(obj))
 
 
 def signals(page: Any) -> list[Any]:
-    return [page.form.regionSketch.currentIndexChanged] if _has_group(page) else []
+    if not _has_group(page):
+        return []
+    return [page.form.regionSketch.currentIndexChanged] + (
+        [page.form.restReference.currentIndexChanged] if hasattr(page.form, "restReference") else [])

@@ -1,0 +1,139 @@
+"""Rest machining in the 3-axis Surface op (Region 'Rest'): what is left comes from the Job's earlier ops (the
+simulation of their paths on the stock: RestFrom EarlierOps) or from a reference tool (RestReference: a tool
+controller or ToolBit whose envelope over the model, below the stock's top, is what it would leave); the op's tool
+machines only where it takes off more than RestTolerance of it (core.footprint.rest, core.strategies.rest_filter),
+with the Surface's pattern, clipped to the rest region and its box. RestReport says the area and the volume left
+before and after; RestRegions marks the rest cells for the 3D view.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Optional
+
+import FreeCAD
+import numpy as np
+
+from tmm_workbench.app import simulation, tools
+from tmm_workbench.core import polygons
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.rest import RestArea, rest_area, tool_envelope
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.params import Spec
+from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.stage import Args, Field, Stage
+from tmm_workbench.core.strategies.rest_filter import RestStock
+from tmm_workbench.core.tools.cutter import Cutter
+
+REST = "Rest"                     # the Region choice (app.region_source.REGIONS)
+EARLIER_OPS, REFERENCE_TOOL = "EarlierOps", "ReferenceTool"
+SOURCES = {EARLIER_OPS: EARLIER_OPS, REFERENCE_TOOL: REFERENCE_TOOL}
+TOLERANCE = Spec("rest tolerance", "mm", low=0.0, high=10.0, low_open=True)
+REPORT, MARKS = "RestReport", "RestRegions"
+MAX_MARKS = 20_000                # rest cells marked on the view (every k-th of a larger area)
+
+
+@dataclass
+class Rest:
+    area: RestArea
+    stock: RestStock              # what the rest filter cuts against
+    region: Any                   # the CL region clipped to the op's box
+
+
+def _reference_cutter(op: Any, cutter: Cutter) -> Cutter:
+    ref = getattr(op, "RestReference", None)
+    if ref is None:
+        raise TmmError("Region 'Rest' from ReferenceTool: no reference tool (RestReference is empty): choose the "
+                       "tool controller of the larger tool that finished before")
+    bit = getattr(ref, "Tool", ref)   # a tool controller carries its ToolBit
+    reference = tools.cutter_from_tool(bit)
+    if reference.diameter < cutter.diameter:
+        raise TmmError(f"Region 'Rest': the reference tool {reference.describe()} is smaller than the rest tool "
+                       f"{cutter.describe()}: it must be at least {cutter.diameter:g} mm (a larger tool that "
+                       f"finished before)")
+    return reference
+
+
+def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tuple) -> Rest:
+    """The op's rest (Region 'Rest'): `left` the Job's earlier ops' stock (app.simulation.material_left, None
+    without one), `box` the op's boundary box (xmin, ymin, xmax, ymax). TmmError naming what is missing, or when
+    nothing is left for the tool."""
+    tolerance = float(op.RestTolerance.Value)
+    if not (math.isfinite(tolerance) and TOLERANCE.low < tolerance <= TOLERANCE.high):
+        raise TmmError(f"RestTolerance must be in (0, {TOLERANCE.high:g}] mm, got {tolerance:g}")
+    if op.RestFrom == EARLIER_OPS:
+        earlier = simulation.earlier_ops(op)
+        if left is None or not earlier or not any(len(simulation.toolpath_and_feeds(o)[0]) >= 2 for o in earlier):
+            raise TmmError("Region 'Rest' from EarlierOps: no earlier operation of the Job has a path to leave "
+                           "material (or one waits for its recompute): put the rest op after the finishing op, or "
+                           "take the rest from a reference tool (RestFrom ReferenceTool)")
+        grid, heights = left.grid, np.array(left.heights)   # a copy: the linker cuts the material top as it links
+    else:
+        reference = _reference_cutter(op, cutter)
+        cell = max(min(simulation.KNOWN_CELL_MM, cutter.radius / 4),
+                   math.sqrt(job.Stock.Shape.BoundBox.XLength * job.Stock.Shape.BoundBox.YLength /
+                             simulation.KNOWN_CELLS))
+        grid = simulation.simulation_grid(job, cell)
+        heights = np.minimum(simulation.stock_heights(job, grid), tool_envelope(mesh, reference, grid))
+    area = rest_area(heights, mesh_heights(mesh, grid), tool_envelope(mesh, cutter, grid), grid, tolerance,
+                     cutter.radius)
+    if area.empty:
+        raise TmmError(f"Region 'Rest': {area.summary()} ({cutter.describe()})")
+    region = polygons.intersection(area.region, [polygons.rectangle(*box)])
+    if not region:
+        raise TmmError(f"Region 'Rest': the rest area lies outside the op's boundary x {box[0]:g}..{box[2]:g}, "
+                       f"y {box[1]:g}..{box[3]:g} mm")
+    return Rest(area, RestStock(grid, heights, tolerance), region)
+
+
+def report(obj: Any, rest: Optional[Rest]) -> None:
+    """RestReport (the area and volumes) and RestRegions (the rest cells at the height left, for the view);
+    both emptied when the op is not a rest op."""
+    for name, kind, tip in ((REPORT, "App::PropertyString", "The rest area of the last computation: its size "
+                             "and the volume above the design before and after this tool"),
+                            (MARKS, "App::PropertyVectorList", "The rest cells of the last computation (drawn "
+                             "on the 3D view)")):
+        if not hasattr(obj, name):
+            obj.addProperty(kind, name, "Region", tip)
+        obj.setEditorMode(name, 1)
+    if rest is None:
+        obj.RestReport, obj.RestRegions = "", []
+        return
+    xy = rest.area.cells_xy()
+    g = rest.area.grid
+    i = np.floor((xy[:, 0] - g.x0) / g.cell).astype(int)
+    j = np.floor((xy[:, 1] - g.y0) / g.cell).astype(int)
+    pts = np.column_stack([xy, rest.stock.heights[j, i]])[:: max(1, -(-len(xy) // MAX_MARKS))]
+    obj.RestReport = rest.area.summary()
+    obj.RestRegions = [FreeCAD.Vector(*map(float, p)) for p in pts]
+    FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")
+
+
+def ignored(args: Args) -> Optional[str]:
+    """The rest's settings mean nothing outside Region 'Rest'; a reference tool nothing when the rest comes from
+    the earlier ops."""
+    rest = str(args.get("region") or "").lower() == REST.lower()
+    for name in ("rest_from", "rest_reference", "rest_tolerance"):
+        if args.get(name) is not None and not rest:
+            return f"{name} is used with region='rest' only"
+    source = str(args.get("rest_from") or "earlier_ops").lower()
+    if args.get("rest_reference") is not None and source != "reference_tool":
+        return "rest_reference is used with rest_from='reference_tool' only"
+    if source == "reference_tool" and args.get("rest_reference") is None:
+        return "rest_from='reference_tool' needs rest_reference= (a tool controller or ToolBit of the larger tool)"
+    return None
+
+
+STAGE = Stage("rest", (
+    Field("RestFrom", "choice", "Region",
+          "Region 'Rest': what is left comes from the Job's earlier operations (EarlierOps: their paths simulated "
+          "on the stock) or from what RestReference would leave (ReferenceTool)", api="rest_from",
+          choices=SOURCES, api_names={"earlier_ops": EARLIER_OPS, "reference_tool": REFERENCE_TOOL},
+          default=EARLIER_OPS, widget="restFrom"),
+    Field("RestReference", "link", "Region",
+          "Region 'Rest' from ReferenceTool: the tool controller (or ToolBit) of the larger tool that finished "
+          "before", api="rest_reference"),
+    Field("RestTolerance", "length", "Region",
+          "Region 'Rest': cut where more than this is left above what this tool reaches, mm",
+          api="rest_tolerance", default=0.01, spec=TOLERANCE, widget="restTolerance"),
+), ignored=ignored)
