@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from tmm_workbench.core.linking import HELIX, LinkPolicy, heights_top, link
+from tmm_workbench.core.linking import HELIX, LinkPolicy, StockHeights, heights_top, link
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
@@ -114,3 +114,28 @@ def test_a_wall_between_two_cell_centres_is_above_the_lower_one():
     assert top == 10.0
     far = heights_top(grid, h, radius)(np.array([[x + 1.2, 2.5]]))[0]
     assert far == 0.0                     # two cells away the wall cannot reach
+
+
+def test_low_links_hop_just_above_the_material_between_and_never_through_it():
+    """The slotted stock above with a 7 mm rib left standing across the slot at x = 20: passes in the slot either
+    side of it. Low links hop at 1 mm over the highest material top along the way (the rib), never up to the safe
+    height, and the simulation sees no rapid cut; without a known top they stay at the safe height."""
+    grid = Grid.covering(0, 0, 40, 40, 0.25)
+    stock = box_heights(grid, 10.0)
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    stock[np.abs(Y - 20.0) < 8.0] = 4.0
+    stock[(np.abs(Y - 20.0) < 8.0) & (np.abs(X - 20.0) < 1.0)] = 7.0
+    tool = Cutter.ball(4)
+    segs = [CutSegment(line(3.0, 5.0, 15.0, 18.0)), CutSegment(line(3.0, 25.0, 35.0, 22.0)),
+            CutSegment(line(3.0, 35.0, 25.0, 20.0))]
+    policy = LinkPolicy(30.0, 35.0, material_top=StockHeights(grid, stock, tool), low_links=True)
+    tp = link(segs, policy)
+    assert len(simulate(tp, tool, grid, stock).collisions) == 0
+    rapids = [m for m in tp.moves[2:-1] if m.kind is MoveKind.RAPID]
+    assert rapids and max(m.z for m in rapids) < 9.0        # over the rib (7 + 1), below the stock's 10 top
+    end = next(i for i, m in enumerate(tp.moves) if (m.x, m.y, m.z) == (15.0, 18.0, 3.0))
+    up, across = tp.moves[end + 1], tp.moves[end + 2]   # the hop over the rib to the second pass
+    assert (up.kind, across.kind) == (MoveKind.RAPID, MoveKind.RAPID) and (up.x, up.y) == (15.0, 18.0)
+    assert up.z == across.z == pytest.approx(8.0, abs=0.01) and (across.x, across.y) == (25.0, 22.0)
+    high = link(segs, LinkPolicy(30.0, 35.0, material_top=StockHeights(grid, stock, tool)))
+    assert max(m.z for m in high.moves[2:-1]) == 30.0

@@ -52,12 +52,12 @@ def test_the_envelope_is_the_lowest_tool_surface_over_every_cl_position(cavity) 
     assert (env - design).max() > 1.0            # the ball cannot reach into the wall's foot
 
 
-def test_the_rest_is_what_the_tool_lowers_by_more_than_the_tolerance() -> None:
+def test_the_rest_is_above_the_tolerance_where_the_tool_takes_some_off() -> None:
     grid = Grid.covering(0.0, 0.0, 10.0, 10.0, 1.0)
     design = np.zeros((10, 10))
     design[0, 0] = np.nan                         # no design: never rest
     left = np.full((10, 10), 1.0)
-    env = np.full((10, 10), 0.995)                # within the tolerance everywhere but
+    env = np.full((10, 10), 0.999)                # takes less than LEAST_CUT of the tolerance off everywhere but
     env[4:7, 2:5] = 0.2                           # a 3 x 3 patch it can lower
     env[9, 9] = 0.0                               # and a single cell (the grid's noise)
     env[0, 0] = -5.0
@@ -65,7 +65,7 @@ def test_the_rest_is_what_the_tool_lowers_by_more_than_the_tolerance() -> None:
     assert area.mask.sum() == 9 and area.mask[4:7, 2:5].all()
     assert area.area == 9.0
     assert math.isclose(area.volume_before, 99.0)
-    assert math.isclose(area.volume_after, 90 * 0.995 + 9 * 0.2 - 0.995 + 0.0)
+    assert math.isclose(area.volume_after, 89 * 0.999 + 9 * 0.2 + 0.0)
     assert area.out_of_reach == 99.0 - 1         # the single cell lowered to the design
     for x, y in area.cells_xy():                  # every rest cell is inside the region
         assert polygons.contains_point(area.region, (x, y))
@@ -128,7 +128,7 @@ def test_a_d3_rest_after_a_d10_finish_cuts_what_the_d3_reaches_and_little_else(c
     assert area.volume_before > 5 * area.volume_after > 0
     step = 2 * math.sqrt(2 * d3.radius * 0.008)   # a cusp of 0.008 mm between the rest passes
     params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, stepover=step, sample_step=0.25,
-                           rest=rest_filter.RestStock(grid, left, 0.01))
+                           rest=area.stock(left))
     rest_path = link(raster_drop.compute(cavity, d3, params).segments, policy)
     full = raster_drop.compute_surface_toolpath(cavity, d3, SurfaceParams(boundary=box, stepover=step,
                                                                           sample_step=0.25), policy)

@@ -108,7 +108,8 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         finish = surface_passes.finish_params(obj)
         check_final_depth(obj, finish.final_depth)
         # entries rapid to just above what the Job's earlier ops left and feed from there
-        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, material_top=left)
+        policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, material_top=left,
+                            low_links=rest is not None)   # a rest's many short pieces: hop over, not up
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         with progress.reporter(obj.Label, self.progress_enabled) as cb:

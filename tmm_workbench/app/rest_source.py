@@ -17,12 +17,11 @@ import numpy as np
 from tmm_workbench.app import simulation, tools
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.footprint.rest import RestArea, rest_area, tool_envelope
+from tmm_workbench.core.footprint.rest import RestArea, RestStock, rest_area, tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import Spec
 from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.stage import Args, Field, Stage
-from tmm_workbench.core.strategies.rest_filter import RestStock
 from tmm_workbench.core.tools.cutter import Cutter
 
 REST = "Rest"                     # the Region choice (app.region_source.REGIONS)
@@ -83,7 +82,7 @@ def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tu
     if not region:
         raise TmmError(f"Region 'Rest': the rest area lies outside the op's boundary x {box[0]:g}..{box[2]:g}, "
                        f"y {box[1]:g}..{box[3]:g} mm")
-    return Rest(area, RestStock(grid, heights, tolerance), region)
+    return Rest(area, area.stock(heights), region)
 
 
 def report(obj: Any, rest: Optional[Rest]) -> None:

@@ -72,6 +72,9 @@ class LinkPolicy:
     arc_tol: float = 0.01               # HELIX: chord deviation of the helix from its circle, mm
     entry_clearance: float = 1.0        # mm above the known material top where the rapid down ends
     material_top: Optional[MaterialTop] = None   # 3-axis: what earlier ops left (None: unknown)
+    # 3-axis with a material top: hop from one segment to the next just above the material between them (a rapid
+    # at entry_clearance over the highest of it along the way) when that is below the safe height
+    low_links: bool = False
 
     def validate(self) -> None:
         check(Spec("safe height", "mm"), self.safe_height)
@@ -222,6 +225,22 @@ def _approach(tp: Toolpath, seg: CutSegment, policy: LinkPolicy, descent: np.nda
     return z
 
 
+def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float) -> Optional[float]:
+    """The height of a low link from the tool's position to above (x, y): `entry_clearance` (at least 1 mm) over
+    the highest material top along the straight line, sampled a tenth of the tool's reach apart (the top is the
+    tool dropped on the material, so the samples' footprints overlap); None when the policy keeps links at the
+    safe height, the top is not known, or the hop would not be lower."""
+    top = policy.material_top
+    if not policy.low_links or top is None:
+        return None
+    reach = float(getattr(getattr(getattr(top, "cutter", None), "native", None), "max_radius", 1.0))
+    step = min(0.5, max(0.05, 0.1 * reach))
+    n = max(2, int(math.ceil(math.hypot(x - last.x, y - last.y) / step)) + 1)
+    xy = np.column_stack([np.linspace(last.x, x, n), np.linspace(last.y, y, n)])
+    hop = max(float(np.max(top(xy))), last.z) + max(policy.entry_clearance, 1.0)
+    return hop if math.isfinite(hop) and hop < policy.safe_height else None
+
+
 def heights_top(grid: Any, heights: np.ndarray, radius: float,
                 profile: Optional[Callable[[np.ndarray], np.ndarray]] = None,
                 outside: float = -math.inf) -> MaterialTop:
@@ -331,12 +350,18 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
                 raise TmmError(f"entry must be one of {', '.join(ENTRIES)}, got {name!r}")
             descent = _descent(seg, policy, name)
             x0, y0, top = descent[0]
-            if tp.moves:  # lift straight up, cross over at the safe height
+            hop = _hop_height(policy, tp.moves[-1], x0, y0) if tp.moves else None
+            if hop is not None:  # up to just above the material between, across
+                last = tp.moves[-1]
+                tp.add(MoveKind.RAPID, last.x, last.y, hop, last.axis)
+                tp.add(MoveKind.RAPID, x0, y0, hop, seg.axis(0))
+            elif tp.moves:  # lift straight up, cross over at the safe height
                 last = tp.moves[-1]
                 tp.add(MoveKind.RAPID, last.x, last.y, policy.safe_height, last.axis)
             else:
                 tp.add(MoveKind.RAPID, x0, y0, policy.clearance_height)
-            tp.add(MoveKind.RAPID, x0, y0, policy.safe_height, seg.axis(0))
+            if hop is None:
+                tp.add(MoveKind.RAPID, x0, y0, policy.safe_height, seg.axis(0))
             z = _approach(tp, seg, policy, descent)
             start = len(tp.moves) - 1             # ... or where its rapid down ends
             if len(descent) == 1:                 # straight down onto the tip

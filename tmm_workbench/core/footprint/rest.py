@@ -32,13 +32,30 @@ from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
 MIN_CELLS = 3          # a rest patch of fewer cells is the grid's noise, not material
+LEAST_CUT = 0.2        # of the tolerance: a rest cell is one the tool lowers by at least this much
 MAX_RUNS = 400_000     # row runs of rest cells turned into rectangles: a finer grid is refused above this
+
+
+@dataclass
+class RestStock:
+    """What is left to machine: heights on a grid (-inf: nothing there), and how deep below them the tool must
+    come to count as cutting it (core.strategies.rest_filter)."""
+    grid: Grid
+    heights: np.ndarray
+    tolerance: float
+
+    def __post_init__(self) -> None:
+        if np.shape(self.heights) != (self.grid.ny, self.grid.nx):
+            raise TmmError(f"rest heights have shape {np.shape(self.heights)}, the grid {self.grid.ny} x "
+                           f"{self.grid.nx}")
+        if not (math.isfinite(self.tolerance) and self.tolerance > 0):
+            raise TmmError(f"rest tolerance must be a length > 0 mm, got {self.tolerance!r}")
 
 
 @dataclass
 class RestArea:
     grid: Grid
-    mask: np.ndarray            # (ny, nx) cells the rest tool lowers by more than the tolerance
+    mask: np.ndarray            # (ny, nx) cells above the tolerance that the rest tool lowers
     region: Shape               # where its CL points go: those cells grown by the tool radius
     tolerance: float
     area: float                 # mm^2 of rest cells
@@ -59,6 +76,11 @@ class RestArea:
         if self.out_of_reach > 0:
             text += f"; {self.out_of_reach:.0f} mm2 stay more than {self.tolerance:g} mm above it (out of its reach)"
         return text
+
+    def stock(self, left: np.ndarray) -> "RestStock":
+        """What the rest filter cuts against: `left` on the rest cells only, a cut being LEAST_CUT of the
+        tolerance."""
+        return RestStock(self.grid, np.where(self.mask, left, -np.inf), LEAST_CUT * self.tolerance)
 
     def cells_xy(self) -> np.ndarray:
         """(n, 2) centres of the rest cells (what the view marks)."""
@@ -100,15 +122,17 @@ def tool_envelope(mesh: TriMesh, cutter: Cutter, grid: Grid, surface: Optional[D
 def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: Grid, tolerance: float,
               radius: float) -> RestArea:
     """The rest of `left` ((ny, nx) heights on `grid`) for a tool whose envelope is `envelope`, over the design
-    heights (NaN where there is no design: never rest). The region bounds the tool centre: the rest cells
-    (patches of fewer than MIN_CELLS dropped) grown by `radius`."""
+    heights (NaN where there is no design: never rest): the cells more than the tolerance above the design that
+    the tool lowers by LEAST_CUT of it or more. The region bounds the tool centre: the rest cells (patches of
+    fewer than MIN_CELLS dropped) grown by `radius`."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"rest tolerance must be a length > 0 mm, got {tolerance!r}")
     for name, a in (("left", left), ("design", design), ("envelope", envelope)):
         if np.shape(a) != (grid.ny, grid.nx):
             raise TmmError(f"rest {name} heights have shape {np.shape(a)}, the grid {grid.ny} x {grid.nx}")
     has_design = np.isfinite(design)
-    mask = has_design & (left - envelope > tolerance)
+    # above the tolerance, and the tool takes some of it off (to within the tolerance where it reaches)
+    mask = has_design & (left - design > tolerance) & (left - envelope > LEAST_CUT * tolerance)
     mask = _without_specks(mask)
     after = np.minimum(left, envelope)
     above = np.where(has_design, np.clip(left - design, 0, None), 0.0)

@@ -1,7 +1,7 @@
-"""The rest filter: a 3-axis strategy's cut segments kept only where the tool takes off more than the tolerance
-of what is left (core.footprint.rest's stock heights: the Job's earlier ops, or a reference tool). A tip cuts
-when, over some cell within the tool radius, what is left stands more than the tolerance above the tool's surface
-there; a tip next to a cutting one is kept too (the move into a cut sweeps its way in). Elsewhere the segment is
+"""The rest filter: a 3-axis strategy's cut segments kept only where the tool takes off rest material
+(core.footprint.rest's RestStock: what the Job's earlier ops or a reference tool left, on the rest cells). A
+point cuts when, over some rest cell within the tool radius, what is left stands more than the stock's tolerance
+above the tool's surface there; a tip next to a cutting one is kept too (the move into a cut sweeps its way in). Elsewhere the segment is
 split (core.strategies.segment_split) and the linker lifts over the gap: on a wall the rest raster does not climb
 to the rim and back for material that is only at the wall's foot."""
 from __future__ import annotations
@@ -12,28 +12,15 @@ from typing import Any, Optional
 
 import numpy as np
 
-from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.strategies.segment_split import keep_runs, move_samples
 from tmm_workbench.core.tools.cutter import Cutter
 
 CHUNK = 20_000   # tips per vectorised block (x the cells under the tool: ~200 for a D3 on 0.25 mm cells)
-
-
-@dataclass
-class RestStock:
-    """What is left to machine: heights on a grid, and how far above the tool's surface counts as a cut."""
-    grid: Grid
-    heights: np.ndarray
-    tolerance: float
-
-    def __post_init__(self) -> None:
-        if np.shape(self.heights) != (self.grid.ny, self.grid.nx):
-            raise TmmError(f"rest heights have shape {np.shape(self.heights)}, the grid {self.grid.ny} x "
-                           f"{self.grid.nx}")
-        if not (math.isfinite(self.tolerance) and self.tolerance > 0):
-            raise TmmError(f"rest tolerance must be a length > 0 mm, got {self.tolerance!r}")
+BRIDGE_DIAMETERS = 3.0   # a gap in a pass shorter than this many tool diameters is cut through, not lifted over:
+#                          feeding a few mm through air is quicker than a retract, a rapid and an entry
 
 
 @dataclass
@@ -86,6 +73,7 @@ def apply(params: Any, cutter: Cutter, segments: list[CutSegment], diagnostics: 
         pts, move = move_samples(seg, rest.grid.cell)
         ok_move = np.zeros(len(seg), dtype=bool)
         ok_move[np.unique(move[cutting(pts, cutter, rest)])] = True   # move 0: the first tip itself
+        _bridge(seg, ok_move, BRIDGE_DIAMETERS * cutter.diameter)
         ok_tip = ok_move.copy()
         ok_tip[:-1] |= ok_move[1:]    # a kept move's start
         moves += len(seg)
@@ -95,3 +83,15 @@ def apply(params: Any, cutter: Cutter, segments: list[CutSegment], diagnostics: 
         end_kept = bool(ok_tip[-1])
     diagnostics["rest"] = {"moves": moves, "kept": kept}
     return out
+
+
+def _bridge(seg: CutSegment, ok_move: np.ndarray, longest: float) -> None:
+    """Marks the moves of every gap between two kept stretches of the segment as kept when the gap is at most
+    `longest` mm long (in place)."""
+    kept = np.flatnonzero(ok_move)
+    if len(kept) < 2:
+        return
+    length = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(seg.tips, axis=0), axis=1))])
+    for a, b in zip(kept[:-1], kept[1:]):
+        if b > a + 1 and length[b - 1] - length[a] <= longest:
+            ok_move[a + 1:b] = True
