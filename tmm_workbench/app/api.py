@@ -67,7 +67,10 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
                 offset_from: Any = None, holder: Optional[str] = None, stick_out: Optional[float] = None,
                 shank_clearance: Optional[float] = None, holder_clearance: Optional[float] = None,
                 holder_collision: Optional[str] = None, rest_from: Optional[str] = None,
-                rest_reference: Any = None, rest_tolerance: Optional[float] = None) -> SurfaceResult:
+                rest_reference: Any = None, rest_tolerance: Optional[float] = None,
+                pencil_source: Optional[str] = None, pencil_curve: Any = None,
+                pencil_file: Optional[Union[str, os.PathLike]] = None, pencil_side: Optional[str] = None,
+                pencil_passes: Optional[int] = None) -> SurfaceResult:
     """3-axis raster finishing of `model` (STL path, Mesh::Feature or Part::Feature) to G-code, in a new Job or
     added to `job` (a Job or an API result: its model when `model` is None, a further tool controller).
 
@@ -95,6 +98,11 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
     region 'rest' (app.rest_source): only where more than rest_tolerance (mm, default 0.01) is left that this
     tool reaches; rest_from 'earlier_ops' (default: the stock the `job`'s earlier ops leave, simulated) |
     'reference_tool' (what rest_reference, a tool controller or ToolBit of the larger tool, would leave).
+    pattern 'pencil' (app.pencil_source): along concave creases (pencil_source 'creases', default: where the tool
+    touches the model on two sides, CL valleys deeper than `cusp`), an outline (pencil_source 'outline':
+    pencil_curve, a sketch or edges of the model's document, offset by the tool radius to pencil_side 'outside' |
+    'inside' | 'both') or a footprint file (pencil_source 'file': pencil_file, x y lift per line);
+    pencil_passes: 1 (pencil) or more (multi-pencil, outward, `stepover` apart or the cusp's spacing).
     pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
     max) deg, cut only where the surface slope lies in it (default all).
     forward_step: 'tolerance' (default: the fewest moves within +-chord_tolerance of the exact tool path, lean

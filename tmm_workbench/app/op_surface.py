@@ -18,7 +18,8 @@ from typing import Any, Optional
 
 import FreeCAD
 
-from tmm_workbench.app import offset_start, op_base, op_mesh, progress, region_source, simulation, stages
+from tmm_workbench.app import offset_start, op_base, op_mesh, pencil_source, progress, region_source, simulation
+from tmm_workbench.app import stages
 from tmm_workbench.app import rest_source, surface_passes, surface_verify, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
 from tmm_workbench.app.op_base import Prop
@@ -52,7 +53,7 @@ LINKING_STAGE = Stage("linking", (
 # pattern -> positioning -> forward step -> verification -> linking (core.strategies.raster_drop)
 STAGES = (op_mesh.MODEL_STAGE, BOUNDARY_STAGE, pattern.STAGE, positioning.STAGE, forward_step.STAGE,
           LINKING_STAGE, region_source.STAGE, surface_passes.STAGE, surface_verify.STAGE, offset_start.STAGE,
-          tool_assembly.STAGE, rest_source.STAGE)
+          tool_assembly.STAGE, rest_source.STAGE, pencil_source.STAGE)
 PROPERTIES: list[Prop] = stages.properties(STAGES)
 CHOICES = stages.choices(STAGES)
 DEFAULTS: dict[str, Any] = stages.defaults(STAGES)
@@ -97,6 +98,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                                   **surface_passes.params_extra(obj, cutter))
         params.offset_from = offset_start.curves_of(obj, params.stepover_mode == OFFSET3D)
         params.rest = None if rest is None else rest.stock
+        params.pencil_curves = pencil_source.curves_of(obj)   # an outline's or a footprint file's (pattern Pencil)
         flat_cusp = check_tool_fit(params, cutter)
         if flat_cusp:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")

@@ -4,6 +4,8 @@ field, the panel's widgets, and the API's arguments turned into property values 
 the arguments a chosen mode would ignore refused)."""
 from __future__ import annotations
 
+import os
+
 from typing import Any, Optional
 
 from tmm_workbench.app.api_args import numbers, option
@@ -61,6 +63,10 @@ def widgets(stages: tuple[Stage, ...]) -> tuple[dict[str, str], dict[str, str], 
 def _value(f: Field, params_class: Optional[type], value: Any) -> Any:
     if f.kind == "choice":
         return option(f.api, value, f.api_choices())
+    if f.kind in ("file", "text"):
+        if not isinstance(value, (str, os.PathLike)):
+            raise TmmError(f"{f.api} must be a path or text, got {value!r}")
+        return str(value)
     if f.kind == "link":
         if not hasattr(value, "TypeId"):
             raise TmmError(f"{f.api} must be a FreeCAD object, got {value!r}")

@@ -20,6 +20,8 @@ from tmm_workbench.core.strategies.rest_filter import RestParams
 ZIGZAG = "zigzag"
 ONEWAY = "oneway"
 SPIRAL = "spiral"  # an Archimedean spiral from the region's centre (core.footprint.spiral)
+PENCIL = "pencil"  # along concave creases, an outline or a footprint file (core.footprint.pencil)
+PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE = "creases", "outline", "file"
 OUTWARD, INWARD = "outward", "inward"
 # Where no triangle lies under the cutter ("air": beside an open surface or a relief without a base, in a
 # hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
@@ -41,7 +43,7 @@ class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole
     stepover: float = param(1.0, "step-over", "mm", low=0, low_open=True, kind="length")
     sample_step: float = param(0.5, "sample step", "mm", low=0, low_open=True, kind="length")
     angle_deg: float = param(0.0, "raster angle", "deg")                # from +X
-    pattern: str = param(ZIGZAG, "pattern", choices=(ZIGZAG, ONEWAY, SPIRAL))
+    pattern: str = param(ZIGZAG, "pattern", choices=(ZIGZAG, ONEWAY, SPIRAL, PENCIL))
     stock_to_leave: float = param(0.0, "stock to leave", "mm")        # material left on the surface
     floor_z: Optional[float] = param(None, "floor", "mm", optional=True)  # default: the model's lowest point
     off_model: str = param(OFF_MODEL_FLOOR, "off-model", choices=(OFF_MODEL_FLOOR, OFF_MODEL_SKIP))
@@ -67,6 +69,13 @@ class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole
     # offset from, to both sides across the region; None: from the region's boundary inward
     offset_from: Optional[list] = None
     spiral_direction: str = param(OUTWARD, "spiral direction", choices=(OUTWARD, INWARD))
+    # --- pencil (pattern PENCIL, core.strategies.surface.pencil_pattern): creases found on the model (CL valleys
+    # deeper than `cusp`), an outline (`pencil_curves`: closed loops and open curves, XY) offset by the radius to
+    # `pencil_side`, or a footprint file's curves (`pencil_curves`); `pencil_passes` outward, `stepover` apart
+    pencil_source: str = param(PENCIL_CREASES, "pencil source", choices=(PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE))
+    pencil_curves: Optional[list] = None
+    pencil_side: str = param("outside", "pencil side", choices=("outside", "inside", "both"))
+    pencil_passes: int = param(1, "pencil passes", low=1, high=50, integer=True)
     # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
     slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
     slope_max_deg: float = param(90.0, "slope maximum", "deg", low=0, high=90)
@@ -103,6 +112,10 @@ def raster_points(params: SurfaceParams) -> float:
     count = passes * (diagonal / params.sample_step + 2)
     if params.pattern == ZIGZAG:
         count += passes * (params.stepover / params.sample_step + 2)
+    if params.pattern == PENCIL:  # the creases' grid of drops and the curves' points (a bound)
+        from tmm_workbench.core.strategies.surface.pencil_pattern import grid_points
+
+        return grid_points(params) + params.pencil_passes * 4 * diagonal / params.sample_step
     if params.pattern == SPIRAL:  # the spiral out to the region's farthest point (core.footprint.spiral)
         from tmm_workbench.core.footprint.spiral import spiral_length
 
@@ -124,6 +137,13 @@ def validate_region(params: Any) -> None:
     if params.slope_min_deg > params.slope_max_deg:
         raise TmmError(f"slope range: minimum {params.slope_min_deg:g} deg is above the maximum "
                        f"{params.slope_max_deg:g} deg (allowed: 0 <= minimum <= maximum <= 90)")
+    if params.pattern == PENCIL:
+        if params.stepover_mode not in (STEPOVER, CUSP):
+            raise TmmError(f"the pencil pattern spaces its passes by the step-over or the cusp height, not "
+                           f"step-over mode {params.stepover_mode!r}")
+        if params.pencil_source != PENCIL_CREASES and not params.pencil_curves:
+            raise TmmError(f"pencil source {params.pencil_source!r} needs its curves (an outline or a footprint "
+                           f"file), got none")
     if params.pattern == SPIRAL and params.stepover_mode == ADAPTIVE:
         raise TmmError("the adaptive step-over mode places raster passes; with the spiral pattern use the "
                        "step-over or cusp mode")

@@ -19,7 +19,7 @@ from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.stage import Args, Field, Stage
 from tmm_workbench.core.strategies.surface.params import (_BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFFSET3D, ONEWAY,
-                                                          OUTWARD, SPIRAL, STEPOVER, ZIGZAG, SurfaceParams,
+                                                          OUTWARD, PENCIL, SPIRAL, STEPOVER, ZIGZAG, SurfaceParams,
                                                           raster_points)
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -50,6 +50,14 @@ def pattern(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: float
             progress: Optional[Progress], surface: Optional[DropSurface]) -> tuple[Pattern, Optional[DropSurface]]:
     """The runs the tool follows (see the module), and the drop surface (made here for the 3D offset, which drops
     as it places its loops; otherwise as given)."""
+    if params.pattern == PENCIL:  # curves along creases or an outline, each a chain (pencil_pattern)
+        from tmm_workbench.core.strategies import raster_region
+        from tmm_workbench.core.strategies.surface import pencil_pattern
+
+        count_points(params)
+        surface = surface or DropSurface(mesh)
+        chains = pencil_pattern.chains(mesh, surface, cutter, params, floor_z, diagnostics)
+        return Pattern(raster_region.flatten(chains), diagnostics["passes"], chains), surface
     lines = [] if params.stepover_mode == OFFSET3D else pass_lines(mesh, cutter, params, floor_z, diagnostics,
                                                                     progress)
     if params.pattern == ZIGZAG:
@@ -120,7 +128,7 @@ def pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: fl
 
 
 # --- the stage's declaration (core.stage) ---------------------------------------------------------------------
-PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL}
+PATTERNS = {"ZigZag": ZIGZAG, "OneWay": ONEWAY, "Spiral": SPIRAL, "Pencil": PENCIL}
 # the step-over modes; 3D offset: closed loops from the region's edge inward, CuspHeight apart across the surface
 SPACINGS = {"StepOver": STEPOVER, "Cusp": CUSP, "Adaptive": ADAPTIVE, "Offset3D": OFFSET3D}
 SPIRAL_DIRECTIONS = {"Outward": OUTWARD, "Inward": INWARD}

@@ -1,0 +1,81 @@
+"""The 3-axis Surface op's pencil (Pattern 'Pencil', core.strategies.surface.pencil_pattern): the curves come from
+the model's creases (PencilSource Creases: found by the tool itself), from an outline in the drawing (Outline:
+`PencilCurve`, a sketch or any object with edges, closed loops offset by the tool radius to `PencilSide`; seed
+003's pencil along lettering and logos) or from a footprint file (File: `PencilFile`, x y lift per line);
+`PencilPasses` passes outward from them (multi-pencil), the step-over or the cusp height's spacing apart."""
+from __future__ import annotations
+
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.app.offset_start import curves_of_object
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint import pencil
+from tmm_workbench.core.stage import Args, Field, Stage
+
+CREASES, OUTLINE, FILE = "Creases", "Outline", "File"
+SOURCES = {CREASES: "creases", OUTLINE: "outline", FILE: "file"}
+SIDES = {"Outside": pencil.OUTSIDE, "Inside": pencil.INSIDE, "Both": pencil.BOTH}
+
+
+def curves_of(op: Any) -> Optional[list[np.ndarray]]:
+    """The op's given pencil curves: the outline's XY polylines, or the footprint file's; None for creases or
+    another pattern."""
+    if getattr(op, "Pattern", "") != "Pencil":
+        return None
+    source = getattr(op, "PencilSource", CREASES)
+    if source == OUTLINE:
+        if op.PencilCurve is None:
+            raise TmmError("PencilSource 'Outline': no outline chosen (PencilCurve is empty): choose the sketch of "
+                           "the lettering or logo")
+        try:
+            return curves_of_object(op.PencilCurve, float(op.RegionTolerance.Value))
+        except TmmError as exc:   # said in the pencil's terms
+            raise TmmError(str(exc).replace("OffsetStart 'Curve'", "PencilSource 'Outline'")
+                           .replace("OffsetCurve", "PencilCurve")) from None
+    if source == FILE:
+        if not str(op.PencilFile or ""):
+            raise TmmError("PencilSource 'File': no footprint file chosen (PencilFile is empty)")
+        return pencil.read_footprint(str(op.PencilFile))
+    return None
+
+
+def ignored(args: Args) -> Optional[str]:
+    """The pencil's settings mean nothing with another pattern; each source's input nothing with another."""
+    is_pencil = str(args.get("pattern") or "").lower() == "pencil"
+    for name in ("pencil_source", "pencil_curve", "pencil_file", "pencil_side", "pencil_passes"):
+        if args.get(name) is not None and not is_pencil:
+            return f"{name} is used with pattern='pencil' only"
+    source = str(args.get("pencil_source") or "creases").lower()
+    if args.get("pencil_curve") is not None and source != "outline":
+        return "pencil_curve is used with pencil_source='outline' only"
+    if args.get("pencil_side") is not None and source != "outline":
+        return "pencil_side is used with pencil_source='outline' only"
+    if args.get("pencil_file") is not None and source != "file":
+        return "pencil_file is used with pencil_source='file' only"
+    if source == "outline" and args.get("pencil_curve") is None:
+        return "pencil_source='outline' needs pencil_curve= (a sketch or an object with edges: the outline)"
+    if source == "file" and args.get("pencil_file") is None:
+        return "pencil_source='file' needs pencil_file= (a footprint file: x y lift per line)"
+    return None
+
+
+STAGE = Stage("pencil", (
+    Field("PencilSource", "choice", "Pencil",
+          "Pattern Pencil: along the model's concave creases (Creases, found by the tool: where it touches the "
+          "model on two sides at once), along an outline of the drawing offset by the tool radius (Outline: "
+          "PencilCurve), or along a footprint file (File: PencilFile)", "pencil_source", "pencil_source",
+          choices=SOURCES,
+          api_names={"creases": CREASES, "outline": OUTLINE, "file": FILE}, default=CREASES, widget="pencilSource"),
+    Field("PencilCurve", "link", "Pencil", "PencilSource Outline: the sketch (or edges) of the lettering or logo",
+          api="pencil_curve"),
+    Field("PencilFile", "file", "Pencil", "PencilSource File: the footprint file, a point per line: x y lift "
+          "(1: lift before this point)", api="pencil_file"),
+    Field("PencilSide", "choice", "Pencil",
+          "PencilSource Outline: the tool runs Outside the loops (around raised letters), Inside them (engraved), "
+          "or on Both sides", "pencil_side", "pencil_side", choices=SIDES, default="Outside", widget="pencilSide"),
+    Field("PencilPasses", "int", "Pencil",
+          "Pattern Pencil: passes outward from each curve (1: pencil; more: multi-pencil), the step-over apart (or "
+          "the cusp height's spacing)", "pencil_passes", "pencil_passes", widget="pencilPasses"),
+), ignored=ignored)

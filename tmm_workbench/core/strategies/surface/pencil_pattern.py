@@ -1,0 +1,84 @@
+"""The Surface's pencil pattern: its curves (core.footprint.pencil: creases found on the model, an outline offset
+by the tool radius, a footprint file's curves), multi-pencil passes outward from them, clipped to the region (or
+the boundary box), ordered nearest first, sampled into one chain each: positioned, split and linked as any
+pattern's (the tool lifts between chains). Multi-pencil passes are `stepover` apart, or by the cusp height's
+planar rule in the cusp mode; the creases are the CL valleys deeper than the cusp height (the tolerance the
+finish is held to: a shallower fold leaves less than it between the two contacts)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tmm_workbench.core import polygons
+from tmm_workbench.core.footprint import pencil
+from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.strategies.surface.params import PENCIL_CREASES, PENCIL_OUTLINE, STEPOVER, SurfaceParams
+from tmm_workbench.core.tools.cutter import Cutter
+
+Run = tuple[bool, np.ndarray]
+
+
+def crease_cell(params: SurfaceParams) -> float:
+    """The creases' grid: half the sample step."""
+    return 0.5 * params.sample_step
+
+
+def grid_points(params: SurfaceParams) -> float:
+    """Drops of the creases' grid (0 for the other sources)."""
+    if params.pencil_source != PENCIL_CREASES:
+        return 0.0
+    b, c = params.boundary, crease_cell(params)
+    return ((b[2] - b[0]) / c + 2) * ((b[3] - b[1]) / c + 2)
+
+
+def spacing(params: SurfaceParams, cutter: Cutter) -> float:
+    return params.stepover if params.stepover_mode == STEPOVER else stepover_for_cusp(cutter, params.cusp, 0.0)
+
+
+def curves(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceParams,
+           floor_z: float) -> list[np.ndarray]:
+    """The pencil's XY curves, innermost pass first (not yet clipped)."""
+    step, passes = spacing(params, cutter), params.pencil_passes
+    if params.pencil_source == PENCIL_CREASES:
+        found = pencil.crease_curves(surface, cutter, params.boundary, crease_cell(params), params.cusp, floor_z)
+        return pencil.around_creases(found, passes, step) if found else []
+    given = [np.asarray(c, dtype=float) for c in params.pencil_curves or []]
+    if params.pencil_source == PENCIL_OUTLINE:
+        closed = [c[:-1] if np.allclose(c[0], c[-1]) else c for c in given if _is_closed(c)]
+        open_ = [c for c in given if not _is_closed(c)]
+        return pencil.outline_curves(closed, open_, cutter.radius, params.pencil_side, passes, step)
+    return pencil.around_creases(given, passes, step)   # a footprint file: the tool centre's own curves
+
+
+def _is_closed(c: np.ndarray) -> bool:
+    return len(c) >= 4 and bool(np.allclose(c[0], c[-1]))
+
+
+def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceParams, floor_z: float,
+           diagnostics: dict) -> list[list[Run]]:
+    """One chain per clipped curve, in the order that walks least between them: diagnostics "passes" (chains)
+    and "pencil_curves" (the curves before clipping)."""
+    found = curves(mesh, surface, cutter, params, floor_z)
+    area = params.region if params.region is not None else [polygons.rectangle(*params.boundary)]
+    pieces = [p for p in polygons.clip_open(found, area) if len(p) >= 2] if found else []
+    ordered = _nearest_first(pieces)
+    diagnostics["pencil_curves"] = len(found)
+    diagnostics["passes"] = len(ordered)
+    return [[(False, c)] for c in pencil.sampled(ordered, params.sample_step)]
+
+
+def _nearest_first(pieces: list[np.ndarray]) -> list[np.ndarray]:
+    """Each next piece the one whose nearer end is nearest the last end (turned to start there)."""
+    pool, out = list(pieces), []
+    at = np.array([-math.inf, -math.inf])
+    while pool:
+        d = [min(np.hypot(*(p[0] - at)), np.hypot(*(p[-1] - at))) if np.isfinite(at).all() else 0.0 for p in pool]
+        p = pool.pop(int(np.argmin(d)))
+        if np.isfinite(at).all() and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
+            p = p[::-1]
+        out.append(p)
+        at = p[-1]
+    return out
