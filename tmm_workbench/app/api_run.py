@@ -238,7 +238,7 @@ def check_properties(op: str, properties: dict[str, Any]) -> None:
         if choices is not None and isinstance(value, str):
             option(name, value, {c.lower(): c for c in choices})
         elif isinstance(value, (int, float)) and not isinstance(value, bool):
-            work_estimate.check_value(cls, name, float(value))
+            work_estimate.check_value(cls, name, value if isinstance(value, int) else float(value))
 
 
 def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter] = "ballend", diameter: float = 6.0,

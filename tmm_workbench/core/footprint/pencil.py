@@ -22,6 +22,7 @@ import numpy as np
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.offset_field import resampled
+from tmm_workbench.core.footprint.region import loops_region
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -38,13 +39,15 @@ def _closed(loop: np.ndarray) -> np.ndarray:
 
 def outline_curves(loops: list[np.ndarray], open_curves: list[np.ndarray], radius: float, side: str,
                    passes: int = 1, step: float = 0.0) -> list[np.ndarray]:
-    """The tool centre's curves along an outline: the closed `loops` (a shape: inner loops are holes) offset by
-    radius + k step, k < passes, to `side`; each open curve's band of that half width (its outline, both sides).
-    The innermost pass first (along the wall), each curve closed."""
+    """The tool centre's curves along an outline: the shape the closed `loops` bound (nested loops are holes:
+    core.footprint.region.loops_region) offset by radius + k step, k < passes, to `side` (outside: away from the
+    shape, inside: into it); each open curve's band of that half width (its outline, both sides). The innermost
+    pass first (along the wall), each curve closed. A sign's drawing with its border's inner edge bounds the
+    background: its letters are holes, the pencil runs inside it."""
     if side not in SIDES:
         raise TmmError(f"pencil side must be one of {', '.join(SIDES)}, got {side!r}")
     _check_passes(passes, step)
-    shape = polygons.union([np.asarray(p, dtype=float) for p in loops]) if loops else []
+    shape = loops_region(loops, "pencil outline") if loops else []
     out: list[np.ndarray] = []
     for k in range(passes):
         d = radius + k * step
