@@ -113,3 +113,11 @@ def test_seed_003s_pencil_experiment_on_our_sign() -> None:
     assert penciled <= 0.56 * finish          # seed 003: 0.0399 / 0.0711
     assert t_pencil < t_small                 # finishing + pencil beats the small ball everywhere
     assert min(low_f, low_p) > -0.005         # no gouge
+
+
+def test_the_estimate_counts_the_creases_grid_before_it_runs() -> None:
+    from tmm_workbench.core.strategies.surface.estimate import estimate_work
+
+    params = SurfaceParams(boundary=(0, 0, 84, 44), pattern="pencil", pencil_passes=3, stepover=0.5, sample_step=0.5)
+    work = estimate_work(params, Cutter.ball(1.5), None)
+    assert work.passes == 3 and work.count > (84 / 0.25) * (44 / 0.25)

@@ -12,7 +12,7 @@ from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.raster import pass_count
 from tmm_workbench.core.strategies import raster_offset3d
 from tmm_workbench.core.strategies.surface import cusp_check, variable_step
-from tmm_workbench.core.strategies.surface.params import ADAPTIVE, CUSP, OFFSET3D, STEPOVER, SurfaceParams
+from tmm_workbench.core.strategies.surface.params import ADAPTIVE, CUSP, OFFSET3D, PENCIL, STEPOVER, SurfaceParams
 from tmm_workbench.core.strategies.surface.pattern import count_points
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.work import Box, Work
@@ -24,6 +24,11 @@ def estimate_work(params: SurfaceParams, cutter: Cutter, bounds: Box) -> Work:
     """The Surface's work over `params.boundary` (`bounds`: the model's box, unused: the boundary is the
     params')."""
     params.validate()
+    if params.pattern == PENCIL:  # the creases' grid of drops and the curves' points (count_points' bound)
+        count = count_points(params)
+        x0, y0, x1, y1 = params.boundary
+        return Work(count, "CL points", params.pencil_passes, 2 * ((x1 - x0) + (y1 - y0)) * params.pencil_passes,
+                    paces=((_pace(params, cutter), count),))
     if params.stepover_mode == OFFSET3D:
         return _checked(_offset3d(params, cutter), params, cutter)
     stepover = params.stepover
