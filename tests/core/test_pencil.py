@@ -121,3 +121,36 @@ def test_the_estimate_counts_the_creases_grid_before_it_runs() -> None:
     params = SurfaceParams(boundary=(0, 0, 84, 44), pattern="pencil", pencil_passes=3, stepover=0.5, sample_step=0.5)
     work = estimate_work(params, Cutter.ball(1.5), None)
     assert work.passes == 3 and work.count > (84 / 0.25) * (44 / 0.25)
+
+
+def test_a_clean_up_of_a_finish_is_a_multi_pencil_over_its_rest() -> None:
+    """Seed 000's clean-up (section 3.6) as Region Rest with the pencil: the creases inside the strips a D10 finish
+    left, as many passes around them as cover the strips (pencil_passes 0): most of what the D3 reaches is then
+    within the tolerance, with no gouge, on a path shorter than the rest raster's."""
+    from tmm_workbench.core.footprint import rest
+    from tmm_workbench.core.linking import StockHeights
+
+    mesh = cavity_mesh()
+    grid = Grid.covering(-50, -50, 50, 50, 0.25)
+    design = mesh_heights(mesh, grid)
+    box = (-50.0, -50.0, 50.0, 50.0)
+    d10, d3 = Cutter.ball(10), Cutter.ball(3)
+    left = simulate(raster_drop.compute_surface_toolpath(mesh, d10, SurfaceParams(boundary=box, stepover=0.6,
+                                                                                  sample_step=0.25),
+                                                         LinkPolicy(5.0, 10.0)), d10, grid, box_heights(grid, 0.0)).heights
+    envelope = rest.tool_envelope(mesh, d3, grid)
+    area = rest.rest_area(left, design, envelope, grid, 0.01, d3.radius)
+    policy = LinkPolicy(5.0, 10.0, material_top=StockHeights(grid, left, d3), low_links=True)
+    common = dict(boundary=polygons.bounds(area.region), region=area.region, rest=area.stock(left), stepover=0.31,
+                  sample_step=0.25)
+    cleanup = link(raster_drop.compute(mesh, d3, SurfaceParams(pattern="pencil", pencil_passes=0, **common)).segments,
+                   policy)
+    raster = link(raster_drop.compute(mesh, d3, SurfaceParams(**common)).segments,
+                  LinkPolicy(5.0, 10.0, material_top=StockHeights(grid, left, d3), low_links=True))
+    reach = np.isfinite(design) & (envelope - design <= 0.01)
+    before = np.sum(reach & (left - design > 0.01))
+    dev = simulate(cleanup, d3, grid, left).heights - design
+    assert np.sum(reach & (dev > 0.01)) < 0.06 * before
+    assert np.nanmin(dev) > -0.005
+    length = lambda tp: float(np.linalg.norm(np.diff(tp.points(), axis=0), axis=1).sum())  # noqa: E731
+    assert length(cleanup) < 0.6 * length(raster)

@@ -60,7 +60,7 @@ class PencilInTheSurface(FreeCADTestCase):
         big = finished("TmmPencilBad")
         bad = OUT / "bad.fp"
         bad.write_text("0 0 0\n1 nan 0\n")
-        cases = [(dict(pencil_passes=0), "pencil_passes must be a whole number in [1, 50], got 0"),
+        cases = [(dict(pencil_passes=-1), "pencil_passes must be a whole number in [0, 50], got -1"),
                  (dict(pencil_curve=drawing(big.doc)), "pencil_curve is used with pencil_source='outline' only"),
                  (dict(pencil_source="outline"), "pencil_source='outline' needs pencil_curve="),
                  (dict(pencil_side="inside"), "pencil_side is used with pencil_source='outline' only"),

@@ -77,5 +77,6 @@ STAGE = Stage("pencil", (
           "or on Both sides", "pencil_side", "pencil_side", choices=SIDES, default="Outside", widget="pencilSide"),
     Field("PencilPasses", "int", "Pencil",
           "Pattern Pencil: passes outward from each curve (1: pencil; more: multi-pencil), the step-over apart (or "
-          "the cusp height's spacing)", "pencil_passes", "pencil_passes", widget="pencilPasses"),
+          "the cusp height's spacing); 0 with Region Rest: as many as cover the rest (a clean-up of the strips "
+          "the finish left)", "pencil_passes", "pencil_passes", widget="pencilPasses"),
 ), ignored=ignored)

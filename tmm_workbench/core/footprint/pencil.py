@@ -59,7 +59,7 @@ def outline_curves(loops: list[np.ndarray], open_curves: list[np.ndarray], radiu
 
 
 def _check_passes(passes: int, step: float) -> None:
-    if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or not 1 <= passes <= 50:
+    if isinstance(passes, bool) or not isinstance(passes, (int, np.integer)) or not 1 <= passes <= 50:   # resolved
         raise TmmError(f"pencil passes must be a whole number in [1, 50], got {passes!r}")
     if passes > 1 and not (math.isfinite(step) and step > 0):
         raise TmmError(f"pencil step must be a length > 0 mm with more than one pass, got {step!r}")

@@ -75,7 +75,8 @@ class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole
     pencil_source: str = param(PENCIL_CREASES, "pencil source", choices=(PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE))
     pencil_curves: Optional[list] = None
     pencil_side: str = param("outside", "pencil side", choices=("outside", "inside", "both"))
-    pencil_passes: int = param(1, "pencil passes", low=1, high=50, integer=True)
+    # 0: as many as cover the rest cells (Region Rest: 95 % of them within reach of a pass), else 1
+    pencil_passes: int = param(1, "pencil passes", low=0, high=50, integer=True)
     # keep only CL points whose surface slope lies in [slope_min_deg, slope_max_deg] (0..90: all)
     slope_min_deg: float = param(0.0, "slope minimum", "deg", low=0, high=90)
     slope_max_deg: float = param(90.0, "slope maximum", "deg", low=0, high=90)

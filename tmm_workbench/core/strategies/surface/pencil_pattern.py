@@ -44,13 +44,33 @@ def curves(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceP
     step, passes = spacing(params, cutter), params.pencil_passes
     if params.pencil_source == PENCIL_CREASES:
         found = pencil.crease_curves(surface, cutter, params.boundary, crease_cell(params), params.cusp, floor_z)
+        if passes == 0:
+            passes = covering_passes(found, params, step)
         return pencil.around_creases(found, passes, step) if found else []
+    passes = max(passes, 1)
     given = [np.asarray(c, dtype=float) for c in params.pencil_curves or []]
     if params.pencil_source == PENCIL_OUTLINE:
         closed = [c[:-1] if np.allclose(c[0], c[-1]) else c for c in given if _is_closed(c)]
         open_ = [c for c in given if not _is_closed(c)]
         return pencil.outline_curves(closed, open_, cutter.radius, params.pencil_side, passes, step)
     return pencil.around_creases(given, passes, step)   # a footprint file: the tool centre's own curves
+
+
+def covering_passes(found: list[np.ndarray], params: SurfaceParams, step: float) -> int:
+    """Passes around the creases that reach 95 % of the rest cells (params.rest; none: 1), at most 50: the
+    clean-up of a finish's strips (seed 000 section 3.6) as a multi-pencil over them."""
+    rest = params.rest
+    if rest is None or not found:
+        return 1
+    from scipy.spatial import cKDTree
+
+    cells = np.argwhere(np.isfinite(rest.heights))
+    if not len(cells):
+        return 1
+    g = rest.grid
+    xy = np.column_stack([g.x0 + (cells[:, 1] + 0.5) * g.cell, g.y0 + (cells[:, 0] + 0.5) * g.cell])
+    reach = np.percentile(cKDTree(np.vstack(pencil.sampled(found, g.cell))).query(xy)[0], 95)
+    return int(min(50, max(1, math.ceil(reach / step) + 1)))
 
 
 def _is_closed(c: np.ndarray) -> bool:
