@@ -45,7 +45,7 @@ TILTED = "tilted away from the shank or holder: one contact (P: the contact befo
 INSERTED = "inserted on a move for the shank or holder: one contact on the interpolated axis"
 HOLDER = "the shank or holder comes closer to the face than its clearance at every tilt within the limits: not cut"
 TILT_STEP_DEG = 2.5          # turns tried, this far apart
-ASIDE_DEG = (0.0, 45.0, -45.0, 90.0, -90.0)   # directions tried, from straight away from the face
+ASIDE_DEG = (0.0, 30.0, -30.0, 60.0, -60.0, 90.0, -90.0)   # directions tried, from straight away from the face
 SURFACE_STEP_MM = 0.25       # the face's point sample (error 0.14 mm)
 MESH_EDGE_MM = 1.0           # the face's tessellation, about this fine
 MOVE_STEP_MM = 0.5           # samples along a move, at most this far apart (tip and the bodies' reach)
@@ -126,8 +126,8 @@ class MultipointHolderReport:
         if self.pieces:
             parts.append("too close at first: " + ", ".join(f"{p} {n}" for p, n in sorted(self.pieces.items())))
         if self.tilted:
-            parts.append(f"{self.tilted} positions tilted away (up to {self.max_turn_deg:.1f} deg, tilt "
-                         f"{lo:g}..{hi:g} deg)")
+            parts.append(f"{self.tilted} positions tilted away (the axis turned up to {self.max_turn_deg:.1f} deg, "
+                         f"within a tilt of {lo:g}..{hi:g} deg from the vertical)")
         if self.inserted:
             parts.append(f"{self.inserted} positions inserted on moves")
         if len(self.unreachable):
@@ -217,57 +217,76 @@ def put_down(positioner: Any, xy: np.ndarray, z0: np.ndarray, axes: np.ndarray, 
     return np.column_stack([xy, z]), ok
 
 
-def _turned(axis: np.ndarray, contact: np.ndarray, tip: np.ndarray, turn: float, aside: float) -> np.ndarray:
-    """The axis turned by `turn` (rad) away from `contact`, `aside` (rad) off the straight way."""
-    d = contact - tip
-    d = d - np.dot(d, axis) * axis
-    if np.linalg.norm(d) < 1e-9:  # the face point on the axis: away from it in XY
-        d = np.array([contact[0] - tip[0], contact[1] - tip[1], 0.0])
-        d = d - np.dot(d, axis) * axis
-    norm = np.linalg.norm(d)
-    d = d / norm if norm > 1e-12 else np.cross(axis, [0.0, 0.0, 1.0] if abs(axis[2]) < 0.9 else [1.0, 0.0, 0.0])
-    d = d / np.linalg.norm(d)
-    m = -math.cos(aside) * d + math.sin(aside) * np.cross(axis, d)
-    a = math.cos(turn) * axis + math.sin(turn) * m
-    return a / np.linalg.norm(a)
+def _turned(axes: np.ndarray, contacts: np.ndarray, tips: np.ndarray, turn: np.ndarray, aside: np.ndarray
+            ) -> np.ndarray:
+    """Each axis turned by `turn` (rad) away from its face point `contacts`, `aside` (rad) off the straight way
+    (rows; the way away in XY where the face point lies on the axis)."""
+    def across(d: np.ndarray) -> np.ndarray:
+        return d - np.einsum("ij,ij->i", d, axes)[:, None] * axes
+
+    d = across(contacts - tips)
+    flat = np.linalg.norm(d, axis=1) < 1e-9
+    if flat.any():
+        xy = np.column_stack([(contacts - tips)[:, :2], np.zeros(len(d))])
+        d[flat] = across(xy)[flat]
+    n = np.linalg.norm(d, axis=1)
+    none = n < 1e-12   # no way away told: any direction across the axis
+    if none.any():
+        ref = np.where(np.abs(axes[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+        d[none] = np.cross(axes, ref)[none]
+        n = np.linalg.norm(d, axis=1)
+    d = d / n[:, None]
+    m = -np.cos(aside)[:, None] * d + np.sin(aside)[:, None] * np.cross(axes, d)
+    a = np.cos(turn)[:, None] * axes + np.sin(turn)[:, None] * m
+    return a / np.linalg.norm(a, axis=1, keepdims=True)
 
 
 def _tilt(axes: np.ndarray) -> np.ndarray:
     return np.arctan2(np.hypot(axes[:, 0], axes[:, 1]), axes[:, 2])
 
 
+def _try(positioner: Any, tool: WholeTool, tips: np.ndarray, axes: np.ndarray, contacts: np.ndarray,
+         rows: np.ndarray, turn: np.ndarray, aside: np.ndarray, z0: np.ndarray, limits: tuple[float, float],
+         tol: float, threads: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates (rows of the poses, turn, aside; z0 the tips' first guess) within the tilt limits, put down:
+    (candidate index, tip, axis) of those put down, and which of them keep every body clear."""
+    a = _turned(axes[rows], contacts[rows], tips[rows], turn, aside)
+    t = _tilt(a)
+    k = np.flatnonzero((t >= limits[0] - 1e-12) & (t <= limits[1] + 1e-12))
+    if not len(k):
+        return k, np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, bool)
+    put, down = put_down(positioner, tips[rows[k], :2], z0[k], a[k], tol, tool.z_range, threads)
+    k, put = k[down], put[down]
+    v, _, _ = tool.worst(put, a[k])
+    return k, put, a[k], v <= 0
+
+
 def tilt_away(positioner: Any, tool: WholeTool, tips: np.ndarray, axes: np.ndarray, contacts: np.ndarray,
               limits: tuple[float, float], tol: float, threads: int = 0
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """(tips, axes, ok, turn) for colliding poses: the smallest turn away (module doc) whose pose, put down on
-    the face, keeps every body its clearance within the tilt `limits` (rad); ok False where none does."""
+    """(tips, axes, ok, turn) for colliding poses: the smallest turn away (module doc, TILT_STEP_DEG apart: the
+    turns that clear can be a narrow window, a coarser search misses some) whose pose, put down on the face,
+    keeps every body its clearance within the tilt `limits` (rad); ok False where none does."""
     n = len(tips)
     out_t, out_a = tips.copy(), axes.copy()
     ok, turn_of = np.zeros(n, bool), np.zeros(n)
-    lo, hi = limits
-    steps = max(1, math.ceil(math.pi / 2 / math.radians(TILT_STEP_DEG)))
-    for k in range(1, steps + 1):
-        turn = k * math.radians(TILT_STEP_DEG)
-        for asides in (ASIDE_DEG[:1], ASIDE_DEG[1:]):  # straight away first: most clear there
+    step = math.radians(TILT_STEP_DEG)
+    asides = np.radians(ASIDE_DEG)
+    z_last = np.repeat(tips[:, 2:3], len(asides), axis=1)  # the put-down height at the last turn: the next's guess
+    for k in range(1, math.ceil(math.pi / 2 / step) + 1):
+        for group in (np.arange(1), np.arange(1, len(asides))):  # straight away first: most clear there
             todo = np.flatnonzero(~ok)
             if not len(todo):
                 break
-            cand_i = np.repeat(todo, len(asides))
-            cand_a = np.array([_turned(axes[i], contacts[i], tips[i], turn, math.radians(aside))
-                               for i in todo for aside in asides])
-            t = _tilt(cand_a)
-            inside = (t >= lo - 1e-12) & (t <= hi + 1e-12)
-            cand_i, cand_a = cand_i[inside], cand_a[inside]
-            if not len(cand_i):
-                continue
-            put, down = put_down(positioner, tips[cand_i, :2], tips[cand_i, 2], cand_a, tol, tool.z_range,
-                                 threads)
-            cand_i, cand_a, put = cand_i[down], cand_a[down], put[down]
-            v, _, _ = tool.worst(put, cand_a)
-            clear = v <= 0
-            for i, a, p in zip(cand_i[clear], cand_a[clear], put[clear]):
+            rows, which = np.repeat(todo, len(group)), np.tile(group, len(todo))
+            turn = np.full(len(rows), k * step)
+            cand, put, axis, clear = _try(positioner, tool, tips, axes, contacts, rows, turn, asides[which],
+                                          z_last[rows, which], limits, tol, threads)
+            z_last[rows[cand], which[cand]] = put[:, 2]
+            for c, t, a in zip(cand[clear], put[clear], axis[clear]):
+                i = rows[c]
                 if not ok[i]:  # the first clear candidate, in ASIDE_DEG's order
-                    ok[i], out_t[i], out_a[i], turn_of[i] = True, p, a, turn
+                    ok[i], out_t[i], out_a[i], turn_of[i] = True, t, a, turn[c]
     return out_t, out_a, ok, turn_of
 
 
