@@ -231,3 +231,18 @@ def test_face_mesh_chord_error_is_measured(face):
     coarse, coarse_error = mh.face_mesh(face, edge=8.0)
     assert 0 <= error < coarse_error
     assert len(mesh.triangles) > len(coarse.triangles)
+
+
+def test_put_down_on_the_floor_matches_the_tilted_torus_lowest_point(face):
+    """On the flat floor (z = 0) the tilted torus touches when its tip stands lowest_below_tip above it."""
+    positioner = make_positioner(face, *CUTTER.torus_radii, params())
+    tilts = np.radians([0.0, 5.0, 20.0, 35.0, 50.0])
+    axes = np.column_stack([np.sin(tilts) * np.cos(1.0), np.sin(tilts) * np.sin(1.0), np.cos(tilts)])
+    xy = np.tile([[20.0, 30.0]], (len(tilts), 1))
+    tips, ok = mh.put_down(positioner, xy, np.full(len(tilts), 7.0), axes, 1e-3, (-20.0, 100.0))
+    assert ok.all()
+    expected = [CUTTER.lowest_below_tip(tuple(a)) for a in axes]
+    assert np.all(tips[:, 2] - expected >= -1e-9) and np.all(tips[:, 2] - expected <= 0.5e-3 + 1e-9)
+    assert np.array_equal(tips[:, :2], xy)
+    _, off = mh.put_down(positioner, np.array([[500.0, 500.0]]), np.zeros(1), axes[:1], 1e-3, (-20.0, 100.0))
+    assert not off.any()   # no face under the tool

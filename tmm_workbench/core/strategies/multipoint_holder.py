@@ -155,9 +155,9 @@ class WholeTool:
         mesh, chord = face_mesh(face)
         self.points = SurfacePoints(mesh, surface_step)
         self.slack = self.points.error + chord
-        (_, _, z0), (_, _, z1) = face.bounds
+        (_, _, low), (_, _, high) = face.bounds
         size = assembly.cutter.diameter + 1.0   # a tip further than this from the face's box is off it
-        self.z_range = (z0 - size, z1 + size)
+        self.z_range = (low - size, high + size)
         self.reach = max(math.hypot(z1, max(r0, r1)) + c for z0, z1, r0, r1, c in self.bodies)
 
     def worst(self, tips: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -172,8 +172,9 @@ class WholeTool:
 def put_down(positioner: Any, xy: np.ndarray, z0: np.ndarray, axes: np.ndarray, tol: float,
              z_range: tuple[float, float], threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """(tips, ok): the torus with the fixed unit `axes` moved along Z over the tips' `xy` until the face's
-    signed clearance from it is within 0..tol/2 (it touches, no gouge); z0 the first guess. The clearance is
-    1-Lipschitz in z, so a step down by it never enters the face; secants inside the bracket speed it up.
+    signed clearance from it is within 0..tol/2 (it touches, no gouge); z0 the first guess. The clearance falls
+    at most 1 mm per mm down (1-Lipschitz): from above, a step of 1.5 times it reaches the contact or passes it
+    (a bracket), then regula falsi with bisections inside the bracket.
     ok False: no face under the tool, the tip out of `z_range` (it fell past the face), or no convergence."""
     n = len(xy)
     z = np.asarray(z0, float).copy()
