@@ -294,8 +294,10 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
                    horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
                    posts: Sequence[str] = ("tarus", "apt_cl"), out_dir: Optional[Union[str, os.PathLike]] = None,
                    name: str = "multipoint", fcstd_path: Optional[Union[str, os.PathLike]] = None,
-                   doc_name: str = "TMM5", progress: Union[bool, Callable[[float], bool]] = True
-                   ) -> MultipointResult:
+                   doc_name: str = "TMM5", progress: Union[bool, Callable[[float], bool]] = True,
+                   holder: Optional[str] = None, stick_out: Optional[float] = None,
+                   shank_clearance: Optional[float] = None, holder_clearance: Optional[float] = None,
+                   holder_collision: Optional[str] = None) -> MultipointResult:
     """5-axis multipoint finishing (seed 001) of one Bézier/B-spline face, to G-code for each post.
 
     face_source: a Bézier control net (array (m+1, n+1, 3), mm), a Part.BezierSurface / BSplineSurface
@@ -317,11 +319,18 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
     (the tilted tip on it).
     Heights default to the face's or the Job stock's top, whichever is higher, + 5 mm (safe, for the tool's
     lowest point) and + 10 mm (clearance).
+    The whole tool (app.tool_assembly, docs/holders.md): holder (a name from TMM's holder library; None: the
+    cutter alone), stick_out, shank_clearance, holder_clearance as run_surface; holder_collision 'tilt' (the
+    default: the tool tilts away from the face within tilt_limit_deg and the Tarus's C limits, positions no
+    tilt clears are left out, the pass split there) | 'leave_out' (not cut where they would come closer). What
+    was done: the op's HolderReport, `result.op.Proxy` diagnostics.
     Feeds in mm/min. Each post's output goes to out_dir/<name><suffix> (tarus: .tarus.ngc, apt_cl: .apt,
     others .<post>.ngc) when out_dir is given. On failure a TmmError with the op's message is raised (a
     document opened by the call is closed first).
     """
-    from tmm_workbench.app import op_multipoint
+    whole_tool = dict(holder=holder, stick_out=stick_out, shank_clearance=shank_clearance,
+                      holder_clearance=holder_clearance, holder_collision=holder_collision)
+    from tmm_workbench.app import op_multipoint, stages
     from tmm_workbench.app import posts as posts_mod
     from tmm_workbench.core.strategies.multipoint import MultipointParams
 
@@ -352,6 +361,7 @@ def run_multipoint(face_source: Any, *, Ro: float = 6.7, Ri: float = 6.0, method
                         ("Scallop", scallop)):
         if value is not None:
             values[prop] = value
+    values.update(stages.api_values(op_multipoint.TOOL_STAGES, MultipointParams, whole_tool, face_source))
     out = Path(out_dir) if out_dir else None
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)

@@ -27,6 +27,7 @@ goes to the report view and the op is marked invalid with that message (as op_su
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Optional
 
 import numpy as np
@@ -34,13 +35,14 @@ import numpy as np
 import FreeCAD
 import Path
 
-from tmm_workbench.app import geometry, hooks, op_base, progress, work_estimate
+from tmm_workbench.app import geometry, hooks, op_base, progress, stages, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathOp, PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.linking import link
+from tmm_workbench.core.machine import TarusMachine
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, MultipointParams, MultipointResults,
                                                       face_top)
@@ -103,6 +105,19 @@ PROPERTIES: list[Prop] = [
 ]
 CHOICES = {"Method": METHODS, "ToolShape": TOOL_SHAPES, "FootprintAnchor": ANCHORS, "PassSpacing": PASS_SPACINGS}
 DEFAULTS: dict[str, Any] = {"AxisRetract": 5.0}
+
+# the whole tool (app.tool_assembly) as the mesh ops have it, where a 5-axis tool can tilt away instead of rising
+HOLDER_COLLISIONS = {"Tilt": "tilt", "LeaveOut": "leave_out"}
+_COLLISION_TIP = ("Where the shank or holder would come closer to the face: Tilt the tool away from it (within "
+                  "TiltLimit and the Tarus's C limits; what no tilt clears is left out, reported in HolderReport), "
+                  "or LeaveOut those positions (the pass split there)")
+TOOL_STAGE = replace(tool_assembly.STAGE, fields=tuple(
+    replace(f, choices=HOLDER_COLLISIONS, api_names={"tilt": "Tilt", "leave_out": "LeaveOut"}, tip=_COLLISION_TIP)
+    if f.prop == "HolderCollision" else f for f in tool_assembly.STAGE.fields))
+TOOL_STAGES = (TOOL_STAGE,)
+PROPERTIES += stages.properties(TOOL_STAGES)
+CHOICES.update(stages.choices(TOOL_STAGES))
+DEFAULTS.update(stages.defaults(TOOL_STAGES))
 
 
 def face_surface(obj: Any, sub: str) -> Any:
@@ -214,6 +229,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
+    SPECS = stages.specs(TOOL_STAGES)
     READ_ONLY = ("ContactSummary",)
     toolpath: Optional[Toolpath] = None
     segments: Optional[list] = None
@@ -267,6 +283,9 @@ class ObjectTmmMultipoint(op_base.TmmOp):
             raise TmmError(f"safe height {safe:g} mm must be above the face's top {top:g} mm")
         if clearance < safe:
             raise TmmError(f"clearance height {clearance:g} mm is below the safe height {safe:g} mm")
+        tool_assembly.prepare(obj, params)  # the shank and holder kept off the face (no holder: the cutter alone)
+        if params.assembly is not None:
+            params.machine = TarusMachine()  # the post's machine: its C limits bound a tilt away
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             result = multipoint.compute(face, cutter, params, cb)
         res = result.diagnostics["results"]
@@ -294,6 +313,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
                 f"{params.between_tol:g} mm after {params.between_rounds} rounds of inserted positions (cutting "
                 f"up to {between['deepest']:.4f} mm in, leaving up to {between['widest_gap']:.4f} mm); use a "
                 "smaller ForwardStep\n")
+        tool_assembly.report(obj, params)
         self.commandlist.extend(Path.Command(n, p) for n, p in
                                 path5.encode_toolpath(toolpath, self.horizFeed, self.vertFeed))
 

@@ -16,7 +16,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from tmm_workbench.app import registry
+from tmm_workbench.app import op_multipoint, registry, stages
 from tmm_workbench.core import path5
 from tmm_workbench.core.preview.tool_axes import COLOURINGS, axis_lines
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED
@@ -30,6 +30,9 @@ SPIN_BOXES = {"sideStep": "SideStep", "forwardStep": "ForwardStep", "feedAngle":
               "axisRetract": "AxisRetract", "surfaceExtension": "SurfaceExtension", "scallop": "Scallop"}
 COMBOS = {"method": "Method", "toolShape": "ToolShape", "footprintAnchor": "FootprintAnchor",
           "passSpacing": "PassSpacing"}
+_HOLDER_SPINS, _HOLDER_COMBOS, _ = stages.widgets(op_multipoint.TOOL_STAGES)  # the "Tool holder" group
+SPIN_BOXES.update(_HOLDER_SPINS)
+COMBOS.update(_HOLDER_COMBOS)
 
 
 class TaskPanelOpPage(op_page.OpPage):
@@ -58,7 +61,7 @@ class TaskPanelOpPage(op_page.OpPage):
 
     def warn_side_step(self, *_: Any) -> None:
         """Shows under the side step whether the typed value leaves uncut strips for the op's tool."""
-        from tmm_workbench.app import op_multipoint, tools
+        from tmm_workbench.app import tools
 
         text = ""
         try:
@@ -130,6 +133,7 @@ class ViewProvider(op_page.OpViewProvider):
             self.refresh_axes()
 
     def onChanged(self, vobj: Any, prop: str) -> None:
+        super().onChanged(vobj, prop)   # the marks (holder, rest) of every TMM op
         if prop in ("ShowToolAxes", "AxisEvery", "AxisColouring", "AxisLength", "Visibility"):
             self.refresh_axes()
 

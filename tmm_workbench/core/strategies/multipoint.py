@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -89,6 +89,13 @@ class MultipointParams(StrategyParams):
     # deviation the motion stays within 0.01 mm
     between_tol: float = param(0.005, "tolerance between positions", "mm", low=0)
     between_rounds: int = param(4, "refinement rounds", low=0, high=12, integer=True)
+    # the whole tool (multipoint_holder): the assembly whose neck, shank and holder keep their clearance from the
+    # face (None: the cutter alone), what is done where they would not ('tilt' away, else left out; or
+    # 'leave_out'), the list its report is appended to, and a TarusMachine whose C limits bound the tilt
+    assembly: Any = None
+    holder_collision: str = param("tilt", "holder collision", choices=("tilt", "leave_out"))
+    holder_notes: Optional[list] = None
+    machine: Any = None
 
     def validate(self) -> None:
         super().validate()
@@ -275,7 +282,8 @@ def compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
     """The strategy: multipoint positions over the footprint, as cut segments (runs of good positions of
     one pass); diagnostics: "results" (MultipointResults per footprint point), "counts",
     "unreached_positions" ((k, 2) XY of the footprint points no position was found for: not cut), "between"
-    (multipoint_refine), and with the scallop rule "scallop" (its ScallopPlacement: `unreached` lists the
+    (multipoint_refine), with an assembly "holder" (multipoint_holder's report: positions tilted, unreachable),
+    and with the scallop rule "scallop" (its ScallopPlacement: `unreached` lists the
     areas where the scallop is not held). What cannot be reached is reported, never a failure of the op."""
     with cancel.watching(progress) as report:  # the scallop meter's Python loops poll it (core.cancel)
         return _compute(surface, tool, params, report)
@@ -317,6 +325,12 @@ def _compute(surface: BezierFace, tool: Cutter, params: MultipointParams,
 
         diagnostics["between"] = multipoint_refine.refine(
             positioner, params, runs, res, lambda pts: _position(positioner, pts, params))
+    if params.assembly is not None:  # after the refinement: its inserted positions are checked too
+        from tmm_workbench.core.strategies import multipoint_holder
+
+        runs, diagnostics["holder"] = multipoint_holder.guard(surface, positioner, params, res, runs, progress)
+        if params.holder_notes is not None:
+            params.holder_notes.append(diagnostics["holder"])
     diagnostics["counts"] = res.counts()
     # what is not machined, for the report: footprint points the tool could not be placed at
     diagnostics["unreached_positions"] = res.xy[res.status == STATUS_FAILED]
