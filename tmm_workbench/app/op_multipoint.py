@@ -230,6 +230,7 @@ class ObjectTmmMultipoint(op_base.TmmOp):
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
     SPECS = stages.specs(TOOL_STAGES)
+    RESTORED_DEFAULTS = stages.restored(TOOL_STAGES)   # documents from before the holder: none
     READ_ONLY = ("ContactSummary",)
     toolpath: Optional[Toolpath] = None
     segments: Optional[list] = None
