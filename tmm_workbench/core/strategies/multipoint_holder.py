@@ -114,6 +114,11 @@ class MultipointHolderReport:
         return len(self.unreachable) + self.split_moves
 
     @property
+    def spots(self) -> np.ndarray:
+        """Where material is left (the positions left out), for the view's marks."""
+        return self.unreachable
+
+    @property
     def region(self) -> Optional[tuple[float, float, float, float]]:
         if not len(self.unreachable):
             return None
