@@ -45,8 +45,10 @@ def test_outline_passes_are_the_radius_and_the_step_away_from_the_loops() -> Non
     inside = pencil.outline_curves([square], [], 1.5, pencil.INSIDE)
     assert len(inside) == 1 and np.abs(distance_to_square(inside[0] - 5.0, 5.0) - 1.5).max() < 1e-6   # inside
     assert len(pencil.outline_curves([square], [], 1.5, pencil.BOTH)) == 2
-    band = pencil.outline_curves([], [np.array([[0.0, 0.0], [10.0, 0.0]])], 1.0, pencil.OUTSIDE)
+    band = pencil.outline_curves([], [np.array([[0.0, 0.0], [10.0, 0.0]])], 1.0, pencil.BOTH)
     assert len(band) == 1 and polygons.bounds([band[0]]) == pytest.approx((-1, -1, 11, 1), abs=0.01)
+    with pytest.raises(TmmError, match=r"pencil side 'outside' needs closed loops .* an open curve from \(0, 0\) to \(10, 0\)"):
+        pencil.outline_curves([], [np.array([[0.0, 0.0], [10.0, 0.0]])], 1.0, pencil.OUTSIDE)
     with pytest.raises(TmmError, match="pencil side must be one of outside, inside, both"):
         pencil.outline_curves([square], [], 1.0, "around")
     with pytest.raises(TmmError, match=r"pencil passes must be a whole number in \[1, 50\], got 0"):

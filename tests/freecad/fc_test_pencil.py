@@ -60,9 +60,12 @@ class PencilInTheSurface(FreeCADTestCase):
         big = finished("TmmPencilBad")
         bad = OUT / "bad.fp"
         bad.write_text("0 0 0\n1 nan 0\n")
+        line = big.doc.addObject("Part::Feature", "OpenStroke")
+        line.Shape = Part.makePolygon([FreeCAD.Vector(10, 10, 0), FreeCAD.Vector(30, 10, 0)])
         cases = [(dict(pencil_passes=-1), "pencil_passes must be a whole number in [0, 50], got -1"),
                  (dict(pencil_curve=drawing(big.doc)), "pencil_curve is used with pencil_source='outline' only"),
                  (dict(pencil_source="outline"), "pencil_source='outline' needs pencil_curve="),
+                 (dict(pencil_source="outline", pencil_curve=line), "pencil side 'outside' needs closed loops"),
                  (dict(pencil_side="inside"), "pencil_side is used with pencil_source='outline' only"),
                  (dict(pencil_source="file"), "pencil_source='file' needs pencil_file="),
                  (dict(pencil_source="file", pencil_file=str(bad)), "bad.fp line 2: x and y must be finite"),

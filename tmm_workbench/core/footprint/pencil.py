@@ -41,11 +41,15 @@ def outline_curves(loops: list[np.ndarray], open_curves: list[np.ndarray], radiu
                    passes: int = 1, step: float = 0.0) -> list[np.ndarray]:
     """The tool centre's curves along an outline: the shape the closed `loops` bound (nested loops are holes:
     core.footprint.region.loops_region) offset by radius + k step, k < passes, to `side` (outside: away from the
-    shape, inside: into it); each open curve's band of that half width (its outline, both sides). The innermost
+    shape, inside: into it); each open curve's band of that half width (its outline: side both only). The innermost
     pass first (along the wall), each curve closed. A sign's drawing with its border's inner edge bounds the
     background: its letters are holes, the pencil runs inside it."""
     if side not in SIDES:
         raise TmmError(f"pencil side must be one of {', '.join(SIDES)}, got {side!r}")
+    if open_curves and side != BOTH:
+        a, b = open_curves[0][0], open_curves[0][-1]
+        raise TmmError(f"pencil side {side!r} needs closed loops (a side of a shape); the outline has an open curve "
+                       f"from ({a[0]:.6g}, {a[1]:.6g}) to ({b[0]:.6g}, {b[1]:.6g}): close it, or run on both sides")
     _check_passes(passes, step)
     shape = loops_region(loops, "pencil outline") if loops else []
     out: list[np.ndarray] = []
