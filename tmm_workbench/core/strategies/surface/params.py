@@ -114,14 +114,25 @@ def raster_points(params: SurfaceParams) -> float:
     if params.pattern == ZIGZAG:
         count += passes * (params.stepover / params.sample_step + 2)
     if params.pattern == PENCIL:  # the creases' grid of drops and the curves' points (a bound)
-        from tmm_workbench.core.strategies.surface.pencil_pattern import grid_points
-
-        return grid_points(params) + params.pencil_passes * 4 * diagonal / params.sample_step
+        return crease_points(params) + params.pencil_passes * 4 * diagonal / params.sample_step
     if params.pattern == SPIRAL:  # the spiral out to the region's farthest point (core.footprint.spiral)
         from tmm_workbench.core.footprint.spiral import spiral_length
 
         count = spiral_length(spiral_radius(params), params.stepover) / params.sample_step + 8 * passes
     return count
+
+
+def crease_cell(params: SurfaceParams) -> float:
+    """The pencil's creases are looked for on a grid of half the sample step."""
+    return 0.5 * params.sample_step
+
+
+def crease_points(params: SurfaceParams) -> float:
+    """Drops of the pencil's creases grid (0 for the other pencil sources)."""
+    if params.pencil_source != PENCIL_CREASES:
+        return 0.0
+    b, c = params.boundary, crease_cell(params)
+    return ((b[2] - b[0]) / c + 2) * ((b[3] - b[1]) / c + 2)
 
 
 def validate_region(params: Any) -> None:

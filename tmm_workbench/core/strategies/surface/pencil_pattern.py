@@ -15,23 +15,11 @@ from tmm_workbench.core.footprint import pencil
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.strategies.surface.params import PENCIL_CREASES, PENCIL_OUTLINE, STEPOVER, SurfaceParams
+from tmm_workbench.core.strategies.surface.params import (PENCIL_CREASES, PENCIL_OUTLINE, STEPOVER, SurfaceParams,
+                                                          crease_cell)
 from tmm_workbench.core.tools.cutter import Cutter
 
 Run = tuple[bool, np.ndarray]
-
-
-def crease_cell(params: SurfaceParams) -> float:
-    """The creases' grid: half the sample step."""
-    return 0.5 * params.sample_step
-
-
-def grid_points(params: SurfaceParams) -> float:
-    """Drops of the creases' grid (0 for the other sources)."""
-    if params.pencil_source != PENCIL_CREASES:
-        return 0.0
-    b, c = params.boundary, crease_cell(params)
-    return ((b[2] - b[0]) / c + 2) * ((b[3] - b[1]) / c + 2)
 
 
 def spacing(params: SurfaceParams, cutter: Cutter) -> float:
