@@ -43,7 +43,7 @@ py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips
     py::gil_scoped_release release;
     report = tmm::cut_3axis(stock, cutter, tips.data(), k.data(), n, options, batch);
   }
-  return report_dict(report);
+  return report_dict(report, options.body_check != nullptr);
 }
 
 }  // namespace
@@ -93,6 +93,6 @@ void bind_sim(py::module_& m) {
         "coordinates): each move's bodies are checked against the stock (poses body_step mm apart, 0: half a "
         "cell; the flutes cut only up to flute_top above the tip); a cell closer than a body's clearance by "
         "more than body_tol is a collision (tmm/sim/body_check.hpp). Returns {'moves_cut', 'cells_lowered', "
-        "'collisions': (k, 2) [move index, depth], 'body_collisions': (m, 6) [move, piece, x, y, z, depth], "
-        "the deepest cell per move and piece}.");
+        "'collisions': (k, 2) [move index, depth], with bodies 'body_collisions': (m, 6) [move, piece, x, y, z, "
+        "depth], the deepest cell per move and piece}.");
 }

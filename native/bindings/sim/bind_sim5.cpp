@@ -63,7 +63,7 @@ py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& sh
     py::gil_scoped_release release;
     report = tmm::cut_5axis(stock, tool, tips.data(), axes.data(), k.data(), n, options, batch, &stats);
   }
-  py::dict out = report_dict(report);
+  py::dict out = report_dict(report, options.body_check != nullptr);
   out["instances"] = stats.instances;
   out["cells_tested"] = stats.cells_tested;
   out["exact_solves"] = stats.exact_solves;
@@ -92,7 +92,7 @@ void bind_sim5(py::module_& m) {
         "point on its vertical line. A rapid removing more than collision_tol mm is a collision. "
         "progress(fraction) -> bool; False cancels (raises Cancelled, the stock partly cut). Returns "
         "{'moves_cut', 'cells_lowered', 'collisions': (k, 2) [move index, depth], 'instances', "
-        "'cells_tested', 'exact_solves', 'fallback_solves', 'body_collisions': (m, 6) [move, piece, x, y, z, depth]}. "
+        "'cells_tested', 'exact_solves', 'fallback_solves'; with bodies 'body_collisions': (m, 6) [move, piece, x, y, z, depth]}. "
         "bodies: None, or (k, 5) rows (z0, z1, r0, r1, clearance) of the tool above the flutes, checked at each "
         "instance against the stock before it is stamped (enclosing frusta, tmm/sim/body_check.hpp).");
   m.def("lowest_on_vertical",

@@ -84,8 +84,8 @@ inline bool body_check_from(const pybind11::object& bodies, double flute_top, do
 }
 
 // {"moves_cut", "cells_lowered", "collisions": (k, 2) float64 [move index, depth],
-//  "body_collisions": (m, 6) float64 [move index, piece, x, y, z, depth]}.
-inline pybind11::dict report_dict(const tmm::SimReport& report) {
+//  and with a body check "body_collisions": (m, 6) float64 [move index, piece, x, y, z, depth]}.
+inline pybind11::dict report_dict(const tmm::SimReport& report, bool body_check = false) {
   namespace py = pybind11;
   py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
   auto c = collisions.mutable_unchecked<2>();
@@ -102,7 +102,7 @@ inline pybind11::dict report_dict(const tmm::SimReport& report) {
     for (py::ssize_t col = 0; col < 6; ++col) b(static_cast<py::ssize_t>(i), col) = row[col];
   }
   py::dict out;
-  out["body_collisions"] = body;
+  if (body_check) out["body_collisions"] = body;
   out["moves_cut"] = report.moves_cut;
   out["cells_lowered"] = report.cells_lowered;
   out["collisions"] = collisions;
