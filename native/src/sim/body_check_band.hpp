@@ -50,6 +50,7 @@ class MoveWorst {
     BodyCollision& w = worst_[piece];
     if (depth > w.depth) w.x = x, w.y = y, w.z = z, w.depth = depth;
   }
+  double depth(std::size_t piece) const { return worst_[piece].depth; }
   // Those deeper than the tolerance appended to out.
   void finish(double tolerance, std::vector<BodyCollision>& out) const;
 
@@ -68,6 +69,10 @@ class BodyBand3 {
 
  private:
   double lowest(double d2, std::size_t& owner) const;  // grown bodies' lowest height above the tip, +inf: none
+  // Whether a tile at the squared distance near2 from the axis whose cells stand at most `top` above the tip
+  // can deepen the move's worst of a piece reaching it (else its cells cannot change the report): each grown
+  // piece's lowest point over the tile is at the tile's nearest point (it rises outwards).
+  bool may_deepen(double near2, double top) const;
   // Cell c of the stock (j * nx + i, a row of the band) as the move's poses so far left it.
   double read(std::size_t c) const { return gen_[c - off_] == move_gen_ ? scratch_[c - off_] : z_.heights()[c]; }
   void write(std::size_t c, double v) { scratch_[c - off_] = v, gen_[c - off_] = move_gen_; }
