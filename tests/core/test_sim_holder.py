@@ -132,13 +132,18 @@ def boss_pass(z: float) -> Toolpath:
     return tp
 
 
-def test_simulate_returns_the_stock_collisions_of_the_assembly():
-    grid = Grid.covering(-30, -30, 30, 30, 0.25)
+def boss_case(cell: float) -> tuple:
+    """A block at 0 with a boss 10 mm square and 40 mm tall; a flat D6 (flutes 12) at 25 mm in an ER32 chuck."""
+    grid = Grid.covering(-30, -30, 30, 30, cell)
     stock = box_heights(grid, 0.0)
     x, y = np.meshgrid(grid.xs(), grid.ys())
     stock[(np.abs(x) <= 5) & (np.abs(y) <= 5)] = 40.0
     cutter = Cutter.flat(6)
-    assembly = ToolAssembly(cutter, 6, 25, flute_length=12, holder="SK40 ER32x70")
+    return grid, stock, cutter, ToolAssembly(cutter, 6, 25, flute_length=12, holder="SK40 ER32x70")
+
+
+def test_simulate_returns_the_stock_collisions_of_the_assembly():
+    grid, stock, cutter, assembly = boss_case(0.25)
     res = simulate(boss_pass(0.0), cutter, grid, stock, assembly=assembly)
     found = res.stock_collisions
     assert found is not None and found.count >= 1 and found.per_piece == {"holder": found.count}
@@ -160,12 +165,7 @@ def test_heat_map_marks_the_collisions(tmp_path):
     from tmm_workbench.core.preview.deviation_png import COLLISION_LABEL, render_deviation_png
     from tmm_workbench.core.sim.compare import compare
 
-    grid = Grid.covering(-30, -30, 30, 30, 0.5)
-    stock = box_heights(grid, 0.0)
-    x, y = np.meshgrid(grid.xs(), grid.ys())
-    stock[(np.abs(x) <= 5) & (np.abs(y) <= 5)] = 40.0
-    cutter = Cutter.flat(6)
-    assembly = ToolAssembly(cutter, 6, 25, flute_length=12, holder="SK40 ER32x70")
+    grid, stock, cutter, assembly = boss_case(0.5)
     res = simulate(boss_pass(0.0), cutter, grid, stock, assembly=assembly)
     cmp = compare(res, np.full_like(stock, -1.0), 0.01)
     marked = render_deviation_png(cmp, grid, str(tmp_path / "marked.png"), "t", collisions=res.stock_collisions)

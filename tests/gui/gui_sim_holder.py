@@ -18,7 +18,6 @@ sys.path.insert(0, str(ROOT / "tests" / "gui"))
 _single_shot = QtCore.QTimer.singleShot
 QtCore.QTimer.singleShot = staticmethod(lambda *args: None)  # the smoke script's helpers, not its run
 try:
-    import gui_smoke  # noqa: E402,F401
     from gui_smoke import click_close, find_panel, pump, screenshot  # noqa: E402
 finally:
     QtCore.QTimer.singleShot = _single_shot
