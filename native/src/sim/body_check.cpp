@@ -141,7 +141,7 @@ void MoveWorst::finish(double tolerance, std::vector<BodyCollision>& out) const 
 }
 
 BodyBand5::BodyBand5(ZMap& stock, const BodyCheck& check, std::size_t j0, std::size_t j1)
-    : z_(stock), check_(check), j0_(j0), j1_(j1), tiles_(stock, j0, j1), worst_(check.bodies.size()) {}
+    : z_(stock), check_(check), tiles_(stock, j0, j1), worst_(check.bodies.size()) {}
 
 void BodyBand5::y_range(const BodyCheck& check, const Eigen::Vector3d& tip, const Eigen::Vector3d& axis,
                         double& ylo, double& yhi) {
@@ -171,7 +171,8 @@ void BodyBand5::pose(const Eigen::Vector3d& tip, const Eigen::Vector3d& axis) {
     for (std::size_t ty = u0; ty <= u1; ++ty)
       for (std::size_t tx = t0; tx <= t1; ++tx) {
         double& bound = tiles_.bound(tx, ty);
-        if (bound <= zlow) continue;
+        // No cell here reaches deeper than bound - zlow into this body: skip unless that beats its worst.
+        if (bound <= zlow || bound - zlow <= worst_.depth(p)) continue;
         std::size_t i0, i1, ja, jb;
         tiles_.cells(tx, ty, i0, i1, ja, jb);
         double top = -kInf;

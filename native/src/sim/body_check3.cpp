@@ -32,7 +32,7 @@ double BodyBand3::reach(const Cutter& cutter, const BodyCheck& check) {
 }
 
 BodyBand3::BodyBand3(ZMap& stock, const Cutter& cutter, const BodyCheck& check, std::size_t j0, std::size_t j1)
-    : z_(stock), cutter_(cutter), check_(check), assembly_(cutter, check.bodies), j0_(j0), j1_(j1),
+    : z_(stock), cutter_(cutter), check_(check), assembly_(cutter, check.bodies),
       off_(j0 * stock.nx()), tiles_(stock, j0, j1), scratch_((j1 - j0 + 1) * stock.nx()), gen_(scratch_.size(), 0),
       worst_(check.bodies.size()) {
   reach_ = reach(cutter, check);

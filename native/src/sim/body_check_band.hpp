@@ -81,7 +81,7 @@ class BodyBand3 {
   const Cutter& cutter_;
   const BodyCheck& check_;
   ToolAssembly assembly_;
-  std::size_t j0_, j1_, off_;
+  std::size_t off_;
   TileBounds tiles_;
   double reach_ = 0, lowest_ = 0, step_ = 0;
   std::vector<double> scratch_;      // the move's stock as its poses leave it (band cells, offset j0 * nx)
@@ -105,7 +105,6 @@ class BodyBand5 {
  private:
   ZMap& z_;
   const BodyCheck& check_;
-  std::size_t j0_, j1_;
   TileBounds tiles_;
   MoveWorst worst_;
 };

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "tmm/sim/body_check.hpp"
 #include "tmm/sim/sweep3.hpp"
 #include "tmm/sim/sweep5.hpp"
@@ -308,6 +310,65 @@ TEST(BodyCheck, FiveAxisHolderOverTheBossAndTiltedAwayFromIt) {
   o.body_check = nullptr;
   tmm::cut_5axis(plain, tool, tips.data(), toward.data(), kinds.data(), 2, o, {});
   EXPECT_EQ(plain.heights(), z3.heights());
+}
+
+// The grown tilted bodies sampled on their surface (rings about the axis in the tool's frame), each sample's
+// clearance ball met by the vertical line: the exact grown body's lowest point, to sampling accuracy.
+double sampled_lowest_tilted(const ToolBody& b, const Eigen::Vector3d& tip, const Eigen::Vector3d& a, double x,
+                             double y, double ds = 0.05) {
+  const Eigen::Vector3d u = a.unitOrthogonal(), v = a.cross(u);
+  double best = INFINITY;
+  auto ring = [&](double h, double r) {
+    const int n = std::max(1, static_cast<int>(std::ceil(2 * M_PI * r / ds)));
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * M_PI * i / n;
+      const Eigen::Vector3d q = tip + h * a + r * (std::cos(t) * u + std::sin(t) * v);
+      const double e2 = (q.x() - x) * (q.x() - x) + (q.y() - y) * (q.y() - y);
+      if (e2 <= b.clearance * b.clearance) best = std::min(best, q.z() - std::sqrt(b.clearance * b.clearance - e2));
+    }
+  };
+  const int nh = static_cast<int>(std::ceil((b.z1 - b.z0) / ds));
+  for (int i = 0; i <= nh; ++i) ring(b.z0 + (b.z1 - b.z0) * i / nh, b.r0 + (b.r1 - b.r0) * i / nh);
+  for (double r = 0.0; r < b.r0; r += ds) ring(b.z0, r);
+  for (double r = 0.0; r < b.r1; r += ds) ring(b.z1, r);
+  return best;
+}
+
+TEST(BodyCheck, FiveAxisEnclosureIsConservativeAgainstTheSampledGrownBody) {
+  // A tilted pass beside a boss that only the holder cone reaches (the torus and its endless shank stay off it,
+  // so the stock does not change during the move): the kernel's depth is never below the sampled grown body's
+  // and above it by at most what the enclosure adds (c (1 + |dr/dh|) sideways, c down the axis).
+  BodyCheck check;
+  check.bodies = {{10.0, 20.0, 1.5, 1.5, 0.5}, {20.0, 28.0, 6.0, 12.0, 1.0}};
+  ZMap z = block_stock(4, 9, -3, 3, 19.0, 0.5);
+  const std::vector<double> tips{-3, -8, 1, -3, 8, 1};  // the tilted ball's lowest point is below its tip
+  const std::vector<MoveKind> kinds{MoveKind::Cut};
+  const double tilt = 15 * M_PI / 180;
+  const Eigen::Vector3d axis(std::sin(tilt), 0.0, std::cos(tilt));
+  const std::vector<double> axes{axis.x(), 0, axis.z(), axis.x(), 0, axis.z()};
+  tmm::Sweep5Options o;
+  o.max_step = 0.5;
+  o.body_check = &check;
+  const ZMap before = z;
+  const tmm::SimReport r = tmm::cut_5axis(z, tmm::TorusTool{0.0, 2.0, tmm::ToolShape::BullNose}, tips.data(),
+                                          axes.data(), kinds.data(), 2, o, {});
+  EXPECT_EQ(z.heights(), before.heights());  // the tool itself cut nothing
+  const BodyCollision* holder = find(r.body_collisions, 0, 1);
+  ASSERT_NE(holder, nullptr);
+  // The brute force over the same instances (the tip every 0.5 mm: the kernel's sub-steps for a fixed axis).
+  double brute = -INFINITY;
+  for (int step = 0; step <= 32; ++step) {
+    const Eigen::Vector3d tip(-3.0, -8.0 + 0.5 * step, 1.0);
+    for (std::size_t j = 0; j < z.ny(); ++j)
+      for (std::size_t i = 0; i < z.nx(); ++i) {
+        if (z.at(i, j) < 18.0) continue;
+        brute = std::max(brute, z.at(i, j) - sampled_lowest_tilted(check.bodies[1], tip, axis, z.cx(i), z.cy(j), 0.1));
+      }
+  }
+  ASSERT_GT(brute, 0.5);
+  EXPECT_GE(holder->depth, brute - 5e-3);  // the samples' sag: the brute force is at most that shallow
+  const double k = (12.0 - 6.0) / 8.0;
+  EXPECT_LE(holder->depth, brute + 1.0 * (1.0 + k) * 2.0);
 }
 
 TEST(BodyCheck, RefusesBadChecksNamingTheValue) {
