@@ -25,6 +25,9 @@
 //     The simulated tool's solid is endless above the torus, so cells its earlier instances passed count as
 //     cut even above the flutes (unlike 3-axis); material entered at the leading edge within a body's
 //     clearance below it counts.
+// A cell stands for the vertical line through its centre (the z-map's own model). Tiles of cells whose height
+// bound cannot reach a body, or cannot deepen a piece's worst of the move, are skipped: the depths do not depend
+// on it, nor on the threads or bands; among cells of equal depth the one reported may differ with the band split.
 // Memory: collisions are aggregated per move and piece (the deepest cell); per band a scratch of its cells.
 #pragma once
 
