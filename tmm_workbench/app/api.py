@@ -401,6 +401,7 @@ class SimulationReport:
     tolerance: float
     simulation: Any            # app.simulation.JobSimulation (grids, heights, deviation)
     holder_collisions: list = field(default_factory=list)   # [(op label, HolderClearance)] where one came too close
+    stock_collisions: list = field(default_factory=list)    # [(op label, StockCollisions)]: the same against the stock
 
 
 @plain_numbers
@@ -416,7 +417,8 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     (default: the step whose cusp between tool instances is a tenth of the tolerance, core.sim.simulate.sub_step).
     The shank and holder of each op (its Holder; or `holder`, a name of the holder library, with `stick_out` for
     every op: a job computed without one) are checked along its moves against the design: `holder_collisions`,
-    printed as an error (with fail_on_gouge: raised)."""
+    and during the cut against the stock as each move finds it (uncut material too): `stock_collisions`, each
+    printed as an error (with fail_on_gouge: raised); png_path's heat map marks the stock collisions."""
     from tmm_workbench.app import simulation
     from tmm_workbench.core.preview.deviation_png import render_deviation_png
 
@@ -436,14 +438,16 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     o = sim.comparison.overall
     png = None
     if png_path:
-        png = render_deviation_png(sim.comparison, sim.grid, str(png_path), f"{label}: simulated stock vs design")
+        png = render_deviation_png(sim.comparison, sim.grid, str(png_path), f"{label}: simulated stock vs design",
+                                   collisions=sim.result.stock_collisions)
     report = SimulationReport(o.max_left, o.min_deviation, dict(o.percentiles), sim.comparison.removed_volume,
                               o.remaining_volume, o.gouge_cells, sim.comparison.gouged, sim.collisions,
                               sim.cycle_seconds,
                               {k: v.as_dict() for k, v in sim.comparison.regions.items()}, sim.ops, png, cell,
                               tolerance, sim, [(o.label, o.holder) for o in sim.ops if o.holder is not None
-                                               and not o.holder.ok])
+                                               and not o.holder.ok], sim.stock_collisions)
     problems = [f"op '{op_label}': {check.summary()}" for op_label, check in report.holder_collisions]
+    problems += [f"op '{op_label}': {found.summary()}" for op_label, found in report.stock_collisions]
     if report.gouged:
         problems.append(f"the simulated stock is gouged {-o.min_deviation:.4f} mm below the design in "
                         f"{o.gouge_cells} cells (tolerance {tolerance:g} mm)")

@@ -22,6 +22,7 @@ from tmm_workbench.core.sim.cycle_time import three_axis_time
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import SimResult, simulate
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.sim.stock_collisions import combined
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -39,6 +40,7 @@ class OpSimulation:
     collisions: list            # [(move index, depth mm)]
     seconds: float              # simulation time
     holder: Any = None          # core.verify.holder_clearance.HolderClearance (None: no holder to check)
+    stock: Any = None           # core.sim.stock_collisions.StockCollisions (None: no holder to check)
 
 
 @dataclass
@@ -56,6 +58,11 @@ class JobSimulation:
     @property
     def collisions(self) -> list:
         return [(o.label, int(m), float(d)) for o in self.ops for m, d in o.collisions]
+
+    @property
+    def stock_collisions(self) -> list:
+        """[(op label, StockCollisions)] of the ops whose neck, shank or holder came too close to the stock."""
+        return [(o.label, o.stock) for o in self.ops if o.stock is not None and not o.stock.ok]
 
 
 def job_of(obj: Any) -> Any:
@@ -218,7 +225,8 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
                  holder: Optional[tuple[str, Optional[float]]] = None) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
     compares the result with the Job's model; each op's shank and holder checked along its moves against the
-    model (its own Holder, or `holder` = (name, stick-out) for every op: a job computed without one)."""
+    model and, during the cut, against the stock as the earlier moves left it (its own Holder, or `holder` =
+    (name, stick-out) for every op: a job computed without one)."""
     job = job_of(target)
     if job is None:
         raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
@@ -241,18 +249,20 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
         cutter = tools.cutter_from_tool(op.ToolController.Tool)
         five = tp.is_five_axis()
 
+        assembly = _assembly(op, holder)
         r = simulate(tp, cutter, grid, heights, shape=_five_axis_shape(op) if five else "bull_nose",
                      max_step=max_step, tolerance=tolerance,
-                     progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)))
+                     progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)), assembly=assembly)
         seconds = op_cycle_seconds(op, (tp, feeds))
         done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds,
-                                 _holder_check(op, model, tp, holder)))
+                                 _holder_check(assembly, model, tp), r.stock_collisions))
         heights = r.heights
         result = r if result is None else SimResult(grid, result.initial, r.heights,
                                                     np.vstack([result.collisions, r.collisions]),
                                                     result.moves_cut + r.moves_cut,
                                                     result.cells_lowered + r.cells_lowered,
-                                                    result.seconds + r.seconds, result.five_axis or five)
+                                                    result.seconds + r.seconds, result.five_axis or five,
+                                                    combined([result.stock_collisions, r.stock_collisions]))
     # cells compared: the design under them and stock there to begin with
     design_here = np.where(initial >= design - tolerance, design, np.nan)
     regions = {**slope_regions(design_here, grid.cell), **bucket_regions(grid, design_here)}
@@ -260,18 +270,24 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
     return JobSimulation(grid, result, comparison, done, design_here)
 
 
-def _holder_check(op: Any, model: Any, tp: Toolpath, holder: Optional[tuple[str, Optional[float]]]) -> Any:
-    """The op's shank and holder along its moves against the design (core.verify.holder_clearance): the op's own
-    Holder, or `holder` (name, stick-out) given for the check; None without either. The design is below the stock
-    at every moment, so what hits it hits the stock; the stock above it is not checked here."""
+def _assembly(op: Any, holder: Optional[tuple[str, Optional[float]]]) -> Any:
+    """The op's tool assembly to check: `holder` (name, stick-out) given for the check, else the op's own Holder;
+    None without either."""
     from tmm_workbench.app import tool_assembly
-    from tmm_workbench.core.verify.holder_clearance import check_holder_clearance
 
     if holder is not None:
         name, stick_out = holder
-        assembly = tools.assembly_from_tool(op.ToolController.Tool, name, stick_out)
-    else:
-        assembly = tool_assembly.assembly_of(op) if hasattr(op, "Holder") else None
+        return tools.assembly_from_tool(op.ToolController.Tool, name, stick_out)
+    return tool_assembly.assembly_of(op) if hasattr(op, "Holder") else None
+
+
+def _holder_check(assembly: Any, model: Any, tp: Toolpath) -> Any:
+    """The shank and holder along the moves against the design (core.verify.holder_clearance); None without an
+    assembly. Kept beside the stock check of the simulation: what hits the design hits the stock over it, but
+    the design check is exact against the triangles (the stock check sees the z-map's cells), and it measures
+    how far the tool would have to rise."""
+    from tmm_workbench.core.verify.holder_clearance import check_holder_clearance
+
     return None if assembly is None else check_holder_clearance(model, assembly, tp)
 
 

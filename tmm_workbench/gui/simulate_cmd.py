@@ -22,7 +22,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.preview.deviation_colours import NO_DESIGN_HEX, cmap as _cmap, colour_range
 from tmm_workbench.core.sim.cycle_time import hms
 from tmm_workbench.gui import resources
-from tmm_workbench.gui.stock_view import stock_node
+from tmm_workbench.gui.stock_view import collision_node, stock_node
 
 COMMAND_NAME = "TMM_Simulate"
 PANEL_NAME = "TmmSimulatePanel"
@@ -264,6 +264,9 @@ class SimulatePanel:
         wrap.setLayout(row)
         row.setContentsMargins(0, 0, 0, 0)
         v.addWidget(wrap)
+        red = QtGui.QLabel("red crosses: holder/shank collision with the stock")
+        red.setStyleSheet("QLabel { color: #c00000; }")
+        v.addWidget(red)
         grey = QtGui.QLabel("grey: no design under the cell")
         grey.setStyleSheet(f"QLabel {{ background: {NO_DESIGN_HEX}; color: white; padding: 1px 4px; }}")
         v.addWidget(grey)
@@ -325,8 +328,10 @@ class SimulatePanel:
     def show_report(self, r: Any, seconds: float) -> None:
         verdict = (f"GOUGED: {r.gouge_cells} cells below the design by more than {r.tolerance:g} mm"
                    if r.gouged else "no gouge")
-        self._say(verdict + (f"; {len(r.collisions)} rapids cut stock" if r.collisions else ""),
-                  error=bool(r.gouged or r.collisions))
+        hits = sum(found.count for _, found in r.stock_collisions)
+        self._say(verdict + (f"; {len(r.collisions)} rapids cut stock" if r.collisions else "")
+                  + (f"; {hits} holder/shank collisions with the stock (red in the 3D view)" if hits else ""),
+                  error=bool(r.gouged or r.collisions or hits))
         self._set("maxLeft", mm(r.max_left), r.max_left)
         self._set("minDeviation", mm(r.min_deviation), r.min_deviation, RED if r.gouged else "")
         for p in (50, 95, 99):
@@ -355,6 +360,9 @@ class SimulatePanel:
         if not hasattr(view, "getSceneGraph"):
             raise TmmError("the document's active view is not a 3D view")
         node, block = stock_node(sim.grid, sim.result.heights, sim.comparison.deviation, r.tolerance)
+        found = sim.result.stock_collisions
+        if found is not None and found.count:  # a child of the stock: hidden and removed with it
+            node.addChild(collision_node(found.positions))
         self.scene = view.getSceneGraph()
         self.scene.addChild(node)
         self.node = node

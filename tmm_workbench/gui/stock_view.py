@@ -1,6 +1,7 @@
 """The simulated stock in the 3D view: a Coin quad mesh coloured by deviation (core.preview
 .deviation_colours), a node of the view's scene graph (never a document object), named so tests and users
-find it."""
+find it. The cells where the neck, shank or holder came too close to the stock are red markers inside the
+stock's node: they show and hide with it."""
 from __future__ import annotations
 
 from typing import Any
@@ -10,6 +11,8 @@ import numpy as np
 from tmm_workbench.core.preview.deviation_colours import block_centres, colour_range, colours, decimate
 
 NODE_NAME = "TmmSimulatedStock"
+COLLISIONS_NAME = "TmmStockCollisions"
+COLLISION_RGB = (0.9, 0.0, 0.0)
 
 
 def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float) -> tuple[Any, int]:
@@ -40,6 +43,29 @@ def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance:
     for child in (hints, coords, material, binding, mesh):
         root.addChild(child)
     return root, b
+
+
+def collision_node(positions: np.ndarray) -> Any:
+    """A SoSeparator named COLLISIONS_NAME with a red cross marker at each (x, y, z) of `positions` (the cells of
+    core.sim.stock_collisions), drawn over the stock."""
+    from pivy import coin
+
+    pts = np.asarray(positions, dtype=float).reshape(-1, 3)
+    root = coin.SoSeparator()
+    root.setName(COLLISIONS_NAME)
+    material = coin.SoMaterial()
+    material.diffuseColor.setValue(*COLLISION_RGB)
+    material.emissiveColor.setValue(*COLLISION_RGB)
+    binding = coin.SoMaterialBinding()  # one colour: not the stock's per-vertex binding this node inherits
+    binding.value = coin.SoMaterialBinding.OVERALL
+    coords = coin.SoCoordinate3()
+    coords.point.setValues(0, len(pts), pts.tolist())
+    markers = coin.SoMarkerSet()
+    markers.markerIndex = coin.SoMarkerSet.CROSS_9_9
+    markers.numPoints = len(pts)
+    for child in (material, binding, coords, markers):
+        root.addChild(child)
+    return root
 
 
 def find_node(scene: Any, name: str = NODE_NAME) -> bool:

@@ -26,12 +26,15 @@ using tmm_bindings::report_dict;
 using Tips = tmm_bindings::Rows;
 
 py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips, const py::handle& kinds,
-                   double collision_tol, int threads, const py::object& progress) {
+                   double collision_tol, int threads, const py::object& progress, const py::object& bodies,
+                   double flute_top, double body_tol, double body_step) {
   check_rows(tips, "tips");
   const std::size_t n = static_cast<std::size_t>(tips.shape(0));
   const std::vector<tmm::MoveKind> k = kinds_from(kinds, n > 0 ? n - 1 : 0);
   tmm::Sweep3Options options;
   options.collision_tol = collision_tol;
+  tmm::BodyCheck check;
+  if (tmm_bindings::body_check_from(bodies, flute_top, body_tol, body_step, check)) options.body_check = &check;
   tmm::BatchOptions batch;
   batch.threads = threads;
   batch.progress = python_progress(progress);
@@ -40,7 +43,7 @@ py::dict cut_3axis(tmm::ZMap& stock, const tmm::Cutter& cutter, const Tips& tips
     py::gil_scoped_release release;
     report = tmm::cut_3axis(stock, cutter, tips.data(), k.data(), n, options, batch);
   }
-  return report_dict(report);
+  return report_dict(report, options.body_check != nullptr);
 }
 
 }  // namespace
@@ -80,9 +83,16 @@ void bind_sim(py::module_& m) {
 
   m.def("cut_3axis", &cut_3axis, py::arg("stock"), py::arg("cutter"), py::arg("tips"), py::arg("kinds"),
         py::arg("collision_tol") = 1e-3, py::arg("threads") = 0, py::arg("progress") = py::none(),
+        py::arg("bodies") = py::none(), py::arg("flute_top") = 0.0, py::arg("body_tol") = 1e-3,
+        py::arg("body_step") = 0.0,
         "Cuts the tool path into the stock: tips (n, 3) tool tips, kinds (n - 1,) integers (0 cut, 1 rapid, "
         "2 jump) for the moves tips[k] -> tips[k + 1]. Each cell within the tool's radius of a Cut or Rapid "
         "move is lowered to the exact swept envelope. A rapid removing more than collision_tol mm is a "
         "collision. progress(fraction) -> bool; False cancels (raises Cancelled, the stock partly cut). "
-        "Returns {'moves_cut', 'cells_lowered', 'collisions': (k, 2) [move index, depth]}.");
+        "bodies: None, or (k, 5) rows (z0, z1, r0, r1, clearance) of the tool above the flutes (tip "
+        "coordinates): each move's bodies are checked against the stock (poses body_step mm apart, 0: half a "
+        "cell; the flutes cut only up to flute_top above the tip); a cell closer than a body's clearance by "
+        "more than body_tol is a collision (tmm/sim/body_check.hpp). Returns {'moves_cut', 'cells_lowered', "
+        "'collisions': (k, 2) [move index, depth], with bodies 'body_collisions': (m, 6) [move, piece, x, y, z, "
+        "depth], the deepest cell per move and piece}.");
 }

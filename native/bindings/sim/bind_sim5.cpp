@@ -38,7 +38,7 @@ tmm::TorusTool tool_from(double Ro, double Ri, const std::string& shape) {
 
 py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& shape, const Rows& tips,
                    const Rows& axes, const py::handle& kinds, double max_step, double collision_tol, int threads,
-                   const py::object& progress) {
+                   const py::object& progress, const py::object& bodies, double body_tol) {
   const tmm::TorusTool tool = tool_from(Ro, Ri, shape);
   check_rows(tips, "tips");
   check_rows(axes, "axes");
@@ -52,6 +52,8 @@ py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& sh
   tmm::Sweep5Options options;
   options.max_step = max_step;
   options.collision_tol = collision_tol;
+  tmm::BodyCheck check;
+  if (tmm_bindings::body_check_from(bodies, 0.0, body_tol, 0.0, check)) options.body_check = &check;
   tmm::BatchOptions batch;
   batch.threads = threads;
   batch.progress = python_progress(progress);
@@ -61,7 +63,7 @@ py::dict cut_5axis(tmm::ZMap& stock, double Ro, double Ri, const std::string& sh
     py::gil_scoped_release release;
     report = tmm::cut_5axis(stock, tool, tips.data(), axes.data(), k.data(), n, options, batch, &stats);
   }
-  py::dict out = report_dict(report);
+  py::dict out = report_dict(report, options.body_check != nullptr);
   out["instances"] = stats.instances;
   out["cells_tested"] = stats.cells_tested;
   out["exact_solves"] = stats.exact_solves;
@@ -82,6 +84,7 @@ void bind_sim5(py::module_& m) {
   m.def("cut_5axis", &cut_5axis, py::arg("stock"), py::arg("tool_Ro"), py::arg("tool_Ri"), py::arg("tool_shape"),
         py::arg("tips"), py::arg("axes"), py::arg("kinds"), py::arg("max_step") = 0.05,
         py::arg("collision_tol") = 1e-3, py::arg("threads") = 0, py::arg("progress") = py::none(),
+        py::arg("bodies") = py::none(), py::arg("body_tol") = 1e-3,
         "Cuts a 5-axis tool path into the ZMap stock with the toroidal tool (Ro, Ri, 'round_insert' | "
         "'bull_nose'): tips, axes (n, 3) (axes tip -> spindle, normalised, a_z > 0), kinds (n - 1,) integers "
         "(0 cut, 1 rapid, 2 jump) for the moves k -> k + 1. Tip linear, axis by slerp, sub-stepped so that no "
@@ -89,7 +92,9 @@ void bind_sim5(py::module_& m) {
         "point on its vertical line. A rapid removing more than collision_tol mm is a collision. "
         "progress(fraction) -> bool; False cancels (raises Cancelled, the stock partly cut). Returns "
         "{'moves_cut', 'cells_lowered', 'collisions': (k, 2) [move index, depth], 'instances', "
-        "'cells_tested', 'exact_solves', 'fallback_solves'}.");
+        "'cells_tested', 'exact_solves', 'fallback_solves'; with bodies 'body_collisions': (m, 6) [move, piece, x, y, z, depth]}. "
+        "bodies: None, or (k, 5) rows (z0, z1, r0, r1, clearance) of the tool above the flutes, checked at each "
+        "instance against the stock before it is stamped (enclosing frusta, tmm/sim/body_check.hpp).");
   m.def("lowest_on_vertical",
         [](double Ro, double Ri, const std::string& shape, const Rows& tip, const Rows& axis, double x, double y) {
           const tmm::TorusTool tool = tool_from(Ro, Ri, shape);

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "tmm/sim/body_check.hpp"
 #include "tmm/sim/sim_report.hpp"
 
 namespace tmm_bindings {
@@ -60,8 +61,31 @@ inline std::vector<tmm::MoveKind> kinds_from(const pybind11::handle& obj, std::s
   return out;
 }
 
-// {"moves_cut", "cells_lowered", "collisions": (k, 2) float64 [move index, depth]}.
-inline pybind11::dict report_dict(const tmm::SimReport& report) {
+// The body check from Python: bodies None (no check) or a (k, 5) array of (z0, z1, r0, r1, clearance) rows;
+// false without a check. The values are checked by the kernel (tmm::validate).
+inline bool body_check_from(const pybind11::object& bodies, double flute_top, double tolerance, double step,
+                            tmm::BodyCheck& out) {
+  namespace py = pybind11;
+  if (bodies.is_none()) return false;
+  const Rows a = Rows::ensure(bodies);
+  if (!a || a.ndim() != 2 || a.shape(1) != 5) {
+    std::ostringstream msg;
+    msg << "bodies must be None or an (k, 5) array of (z0, z1, r0, r1, clearance) rows";
+    if (a) msg << ", got ndim " << a.ndim() << (a.ndim() == 2 ? " and " + std::to_string(a.shape(1)) + " columns" : "");
+    throw std::invalid_argument(msg.str());
+  }
+  const auto r = a.unchecked<2>();
+  out.bodies.clear();
+  for (py::ssize_t k = 0; k < r.shape(0); ++k) out.bodies.push_back({r(k, 0), r(k, 1), r(k, 2), r(k, 3), r(k, 4)});
+  out.flute_top = flute_top;
+  out.tolerance = tolerance;
+  out.step = step;
+  return true;
+}
+
+// {"moves_cut", "cells_lowered", "collisions": (k, 2) float64 [move index, depth],
+//  and with a body check "body_collisions": (m, 6) float64 [move index, piece, x, y, z, depth]}.
+inline pybind11::dict report_dict(const tmm::SimReport& report, bool body_check = false) {
   namespace py = pybind11;
   py::array_t<double> collisions({static_cast<py::ssize_t>(report.collisions.size()), py::ssize_t{2}});
   auto c = collisions.mutable_unchecked<2>();
@@ -69,7 +93,16 @@ inline pybind11::dict report_dict(const tmm::SimReport& report) {
     c(static_cast<py::ssize_t>(i), 0) = static_cast<double>(report.collisions[i].move);
     c(static_cast<py::ssize_t>(i), 1) = report.collisions[i].depth;
   }
+  const auto& bodies = report.body_collisions;
+  py::array_t<double> body({static_cast<py::ssize_t>(bodies.size()), py::ssize_t{6}});
+  auto b = body.mutable_unchecked<2>();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const tmm::BodyCollision& e = bodies[i];
+    const double row[6] = {static_cast<double>(e.move), static_cast<double>(e.piece), e.x, e.y, e.z, e.depth};
+    for (py::ssize_t col = 0; col < 6; ++col) b(static_cast<py::ssize_t>(i), col) = row[col];
+  }
   py::dict out;
+  if (body_check) out["body_collisions"] = body;
   out["moves_cut"] = report.moves_cut;
   out["cells_lowered"] = report.cells_lowered;
   out["collisions"] = collisions;

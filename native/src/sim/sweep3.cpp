@@ -7,8 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 #include <vector>
 
+#include "body_check_band.hpp"
 #include "sweep3_band.hpp"
 #include "tmm/util/range.hpp"
 
@@ -102,7 +104,9 @@ BandMoves assign_bands(const ZMap& stock, double R, const double* tips, const Mo
 // those deeper than the tolerance reported as collisions in move order.
 void gather(const std::vector<BandResult>& results, double collision_tol, SimReport& report) {
   std::vector<RapidCollision> removals;
+  std::vector<BodyCollision> bodies;
   for (const BandResult& r : results) {
+    bodies.insert(bodies.end(), r.bodies.begin(), r.bodies.end());
     report.cells_lowered += r.lowered;
     removals.insert(removals.end(), r.removals.begin(), r.removals.end());
   }
@@ -113,6 +117,26 @@ void gather(const std::vector<BandResult>& results, double collision_tol, SimRep
     for (++i; i < removals.size() && removals[i].move == c.move; ++i) c.depth = maxd(c.depth, removals[i].depth);
     if (c.depth > collision_tol) report.collisions.push_back(c);
   }
+  report.body_collisions = merge_body_collisions(std::move(bodies));
+}
+
+// The body check's inputs, and the poses of each move within bounds; the bodies' reach from the axis.
+double check_bodies(const BodyCheck& check, const Cutter& cutter, const ZMap& stock, const double* tips,
+                    std::size_t n) {
+  validate(check);
+  const double step = check.step > 0.0 ? check.step : 0.5 * stock.cell();
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    const double* a = tips + 3 * k;
+    const double len = std::sqrt((a[3] - a[0]) * (a[3] - a[0]) + (a[4] - a[1]) * (a[4] - a[1]) +
+                                 (a[5] - a[2]) * (a[5] - a[2]));
+    if (len / step > 1e9) {
+      std::ostringstream msg;
+      msg << "body check: move " << k << " (" << len << " mm) needs more than 1e9 poses of step " << step
+          << " mm: use a larger step";
+      refuse(msg.str());
+    }
+  }
+  return body_detail::BodyBand3::reach(cutter, check);
 }
 
 }  // namespace
@@ -133,7 +157,12 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
                                         : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   std::size_t band_rows = options.band_rows;
   if (band_rows == 0) band_rows = std::max<std::size_t>(8, (ny + 8 * threads - 1) / (8 * threads));
-  const BandMoves bm = assign_bands(stock, cutter.max_radius(), tips, kinds, n, band_rows, report);
+  // With the body check a band also replays the moves whose bodies reach it (a move that misses the band's
+  // cells cuts nothing there: the heights are the same).
+  const double reach = options.body_check ? std::max(cutter.max_radius(),
+                                                     check_bodies(*options.body_check, cutter, stock, tips, n))
+                                          : cutter.max_radius();
+  const BandMoves bm = assign_bands(stock, reach, tips, kinds, n, band_rows, report);
 
   // Each band on its own (a rapid sees the stock before it: its band's moves in move order), the bands in
   // parallel: the heights do not depend on the thread count.
@@ -143,7 +172,7 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
       const std::size_t first = bm.count[bd];
       sweep3_detail::cut_band(stock, cutter, tips, kinds, bm.moves.data() + first, bm.count[bd + 1] - first,
                               bd * band_rows, std::min(ny, (bd + 1) * band_rows) - 1,
-                              static_cast<double>(bd - b0), ctx, results[bd]);
+                              static_cast<double>(bd - b0), ctx, results[bd], options.body_check);
     }
   });
   gather(results, options.collision_tol, report);

@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
+#include "body_check_band.hpp"
 #include "sweep3_profiles.hpp"
 
 namespace tmm {
@@ -312,7 +314,7 @@ class BandCutter {
 template <class Profile>
 void cut_moves(BandCutter& band, Profile& profile, const double* tips, const MoveKind* kinds,
                const std::uint32_t* moves, std::size_t count, double R, double done_before, ChunkContext& ctx,
-               BandResult& out) {
+               BandResult& out, body_detail::BodyBand3* bodies) {
   const double in_band = static_cast<double>(count);
   for (std::size_t e = 0; e < count; ++e) {
     // Progress and cancel between the moves of a band (a band can hold the whole path).
@@ -320,6 +322,7 @@ void cut_moves(BandCutter& band, Profile& profile, const double* tips, const Mov
     ctx.done_within(done_before + static_cast<double>(e) / in_band);
     const std::size_t k = moves[e];
     band.set_move_index(k);
+    if (bodies) bodies->move(k, tips + 3 * k, tips + 3 * k + 3, out.bodies);  // the stock before the move
     band.cut(profile, make_move(tips + 3 * k, tips + 3 * k + 3, kinds[k] == MoveKind::Rapid), R, out);
   }
 }
@@ -328,21 +331,23 @@ void cut_moves(BandCutter& band, Profile& profile, const double* tips, const Mov
 
 void cut_band(ZMap& stock, const Cutter& cutter, const double* tips, const MoveKind* kinds,
               const std::uint32_t* moves, std::size_t count, std::size_t j0, std::size_t j1, double done_before,
-              ChunkContext& ctx, BandResult& out) {
+              ChunkContext& ctx, BandResult& out, const BodyCheck* check) {
   BandCutter band(stock, j0, j1);
+  std::unique_ptr<body_detail::BodyBand3> bodies;
+  if (check) bodies = std::make_unique<body_detail::BodyBand3>(stock, cutter, *check, j0, j1);
   const double R = cutter.max_radius();
   if (cutter.kind() == CutterKind::Ball) {
     BallProfile p(cutter);
-    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out);
+    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out, bodies.get());
   } else if (cutter.kind() == CutterKind::Flat) {
     FlatProfile p(cutter);
-    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out);
+    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out, bodies.get());
   } else if (cutter.kind() == CutterKind::Bull) {
     BullProfile p(cutter);
-    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out);
+    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out, bodies.get());
   } else {
     GeneralProfile p(cutter);
-    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out);
+    cut_moves(band, p, tips, kinds, moves, count, R, done_before, ctx, out, bodies.get());
   }
   out.lowered = band.lowered();
 }

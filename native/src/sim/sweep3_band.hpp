@@ -35,14 +35,16 @@ inline bool index_range(double a, double b, double g0, double cell, std::size_t 
 struct BandResult {
   std::size_t lowered = 0;
   std::vector<RapidCollision> removals;  // rapids that removed anything, in move order
+  std::vector<BodyCollision> bodies;     // the body check's, per move and piece
 };
 
 // Cuts the band's moves (moves[0..count), indices of tips and kinds, in move order) into rows j0..j1 of the
 // stock. Progress within the batch's chunk: done_before bands, then the fraction of this band's moves; the
 // band stops between moves when the batch stops.
+// With check (may be null), each move's bodies are tested against the stock before the move is cut.
 void cut_band(ZMap& stock, const Cutter& cutter, const double* tips, const MoveKind* kinds,
               const std::uint32_t* moves, std::size_t count, std::size_t j0, std::size_t j1, double done_before,
-              ChunkContext& ctx, BandResult& out);
+              ChunkContext& ctx, BandResult& out, const BodyCheck* check = nullptr);
 
 }  // namespace sweep3_detail
 }  // namespace tmm

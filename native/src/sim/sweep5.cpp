@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 #include <vector>
 
 #include "tmm/util/range.hpp"
+#include "body_check_band.hpp"
 #include "torus_line.hpp"
 
 namespace tmm {
@@ -34,11 +36,14 @@ struct Pose {
   double zmin = 0;   // lowest point of the solid
   double ex = 0, ey = 0;  // the footprint is the stadium of radius Ro + Ri about C_xy .. C_xy + (ex, ey)
   double ylo = 0, yhi = 0;
+  Vector3d tip;
+  double bylo = kInf, byhi = -kInf;  // the rows the checked bodies reach (none without a body check)
 };
 
 Pose make_pose(const TorusTool& tool, const Vector3d& tip, const Vector3d& axis, double stock_top) {
   Pose p;
   p.a = axis;
+  p.tip = tip;
   p.C = tip + tool.Ri * axis;
   const double az = axis.z(), Rt = tool.radius();
   p.sin_b = std::sqrt(std::max(1.0 - az * az, 0.0));
@@ -115,6 +120,7 @@ std::pair<double, double> stadium_row(const Pose& p, double Rt, double y) {
 struct BandResult {
   std::size_t lowered = 0;
   std::vector<RapidCollision> removals;  // rapids that removed anything in this band
+  std::vector<BodyCollision> bodies;     // the body check's, per move and piece
   Sweep5Stats stats;
 };
 
@@ -219,8 +225,8 @@ std::vector<Move> plan_moves(const std::vector<Vector3d>& tip, const std::vector
 class Stamper {
  public:
   Stamper(ZMap& stock, const TorusTool& tool, const std::vector<Vector3d>& tip, const std::vector<Vector3d>& axis,
-          double stock_top)
-      : stock_(stock), tool_(tool), tip_(tip), axis_(axis), stock_top_(stock_top), Ro_(tool.Ro), Ri_(tool.Ri),
+          double stock_top, const BodyCheck* check)
+      : check_(check), stock_(stock), tool_(tool), tip_(tip), axis_(axis), stock_top_(stock_top), Ro_(tool.Ro), Ri_(tool.Ri),
         Rt_(tool.radius()), core_(tool.shape == ToolShape::BullNose && Ro_ > 0.0), ball_(Ro_ == 0.0),
         // Squared radii and margins of the pruning tests: a line within the tangent tolerance counts as
         // touching.
@@ -232,7 +238,9 @@ class Stamper {
   Pose pose_at(const Move& m, std::size_t step) const {
     const double s = static_cast<double>(step) / static_cast<double>(m.steps);
     const Vector3d t = (1.0 - s) * tip_[m.k] + s * tip_[m.k + 1];
-    return make_pose(tool_, t, slerp(axis_[m.k], axis_[m.k + 1], m.theta, s), stock_top_);
+    Pose p = make_pose(tool_, t, slerp(axis_[m.k], axis_[m.k + 1], m.theta, s), stock_top_);
+    if (check_) body_detail::BodyBand5::y_range(*check_, p.tip, p.a, p.bylo, p.byhi);
+    return p;
   }
 
   // The rows each move's instances reach (progress: this pass is cheap next to the stamping).
@@ -246,8 +254,8 @@ class Stamper {
             ctx.done_within(static_cast<double>(i - b) + static_cast<double>(step) / static_cast<double>(m.steps));
           }
           const Pose p = pose_at(m, step);
-          m.ylo = std::min(m.ylo, p.ylo);
-          m.yhi = std::max(m.yhi, p.yhi);
+          m.ylo = std::min({m.ylo, p.ylo, p.bylo});
+          m.yhi = std::max({m.yhi, p.yhi, p.byhi});
         }
       }
     });
@@ -263,15 +271,20 @@ class Stamper {
     const double band_ylo = stock_.cy(j0), band_yhi = stock_.cy(j1);
     const std::vector<double> before(z.begin() + static_cast<std::ptrdiff_t>(j0 * nx),
                                      z.begin() + static_cast<std::ptrdiff_t>((j1 + 1) * nx));
+    std::unique_ptr<body_detail::BodyBand5> bodies;
+    if (check_) bodies = std::make_unique<body_detail::BodyBand5>(stock_, *check_, j0, j1);
     double band_steps = 0.0, steps_done = 0.0;
     for (const Move& m : moves) band_steps += m.yhi < band_ylo || m.ylo > band_yhi ? 0.0 : m.steps + 1.0;
     for (const Move& m : moves) {
       if (m.yhi < band_ylo || m.ylo > band_yhi) continue;
       removed.clear();  // (cell, height before) lowered by this move when it is a rapid
+      if (bodies) bodies->start_move(m.k);
       for (std::size_t step = m.first ? 0 : 1; step <= m.steps; ++step, ++steps_done) {
         if (ctx.stopping()) return false;
         ctx.done_within(done_before + steps_done / band_steps);
         const Pose p = pose_at(m, step);
+        // The bodies before the instance is stamped: its endless shank would cut what they are tested on.
+        if (bodies && !(p.byhi < band_ylo || p.bylo > band_yhi)) bodies->pose(p.tip, p.a);
         if (p.yhi < band_ylo || p.ylo > band_yhi) continue;
         ++out.stats.instances;
         stamp(p, j0, j1, m.rapid, removed, out.stats);
@@ -281,6 +294,7 @@ class Stamper {
         for (const auto& [c, zb] : removed) depth = std::max(depth, zb - z[c]);
         out.removals.push_back({m.k, depth});
       }
+      if (bodies) bodies->finish_move(out.bodies);
     }
     for (std::size_t c = 0; c < before.size(); ++c) out.lowered += z[j0 * nx + c] < before[c];
     return true;
@@ -377,6 +391,7 @@ class Stamper {
     return t;
   }
 
+  const BodyCheck* check_;
   ZMap& stock_;
   const TorusTool& tool_;
   const std::vector<Vector3d>& tip_;
@@ -392,7 +407,9 @@ class Stamper {
 void merge_bands(const std::vector<BandResult>& bands, const std::vector<Move>& moves, double collision_tol,
                  SimReport& report, Sweep5Stats& stats) {
   std::vector<RapidCollision> all;
+  std::vector<BodyCollision> bodies;
   for (const BandResult& b : bands) {
+    bodies.insert(bodies.end(), b.bodies.begin(), b.bodies.end());
     report.cells_lowered += b.lowered;
     all.insert(all.end(), b.removals.begin(), b.removals.end());
     stats.cells_tested += b.stats.cells_tested;
@@ -408,6 +425,7 @@ void merge_bands(const std::vector<BandResult>& bands, const std::vector<Move>& 
     if (c.depth > collision_tol) report.collisions.push_back(c);
   }
   for (const Move& m : moves) stats.instances += m.steps + (m.first ? 1 : 0);
+  report.body_collisions = merge_body_collisions(std::move(bodies));
 }
 
 }  // namespace
@@ -417,12 +435,13 @@ SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, cons
                     Sweep5Stats* stats_out) {
   std::vector<Vector3d> tip, axis;
   read_path(tool, tips, axes_in, kinds, n, options, tip, axis);
+  if (options.body_check) validate(*options.body_check);
   const double stock_top = stock_top_of(stock);
   const double reach = std::hypot(tool.radius(), 2.0 * tool.Ri);
   std::vector<Move> moves = plan_moves(tip, axis, kinds, n, reach, options.max_step);
   SimReport report;
   report.moves_cut = moves.size();
-  Stamper stamper(stock, tool, tip, axis, stock_top);
+  Stamper stamper(stock, tool, tip, axis, stock_top, options.body_check);
   stamper.move_rows(moves, BatchOptions{batch.threads, progress_phase(batch.progress, 0.0, 0.02)});
 
   // Bands of rows, each cutting every instance that reaches it, in path order; the bands in parallel (the

@@ -1,20 +1,24 @@
 """The simulated stock's deviation from the design as a heat map (PNG, matplotlib Agg): red where material
 is left, blue where the design is gouged, a colour bar in mm, the numbers in the title. Cells without the
-design under them are grey (the colours are core.preview.deviation_colours', as the GUI's). matplotlib is
-imported inside the function (no GUI backend on import)."""
+design under them are grey (the colours are core.preview.deviation_colours', as the GUI's). Where the neck,
+shank or holder came too close to the stock (core.sim.stock_collisions), black crosses. matplotlib is imported
+inside the function (no GUI backend on import)."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Optional
 
 import numpy as np
 
 if TYPE_CHECKING:
     from tmm_workbench.core.sim.compare import Comparison
     from tmm_workbench.core.sim.grid import Grid
+    from tmm_workbench.core.sim.stock_collisions import StockCollisions
+
+COLLISION_LABEL = "holder/shank collision"
 
 
 def render_deviation_png(comparison: "Comparison", grid: "Grid", path: str, title: str = "",
-                         dpi: int = 110) -> str:
+                         dpi: int = 110, collisions: Optional["StockCollisions"] = None) -> str:
     import matplotlib
     matplotlib.use("Agg", force=False)
     import matplotlib.pyplot as plt
@@ -37,6 +41,13 @@ def render_deviation_png(comparison: "Comparison", grid: "Grid", path: str, titl
     ax.set_xlabel("x mm")
     ax.set_ylabel("y mm")
     ax.set_aspect("equal")
+    if collisions is not None and collisions.count:
+        xy = collisions.positions[:, :2]
+        ax.scatter(xy[:, 0], xy[:, 1], marker="x", c="black", s=36, linewidths=1.4, zorder=3,
+                   label=f"{COLLISION_LABEL} ({collisions.count:,})")
+        ax.set_xlim(x0, x1)
+        ax.set_ylim(y0, y1)
+        ax.legend(loc="upper right", fontsize=7, framealpha=0.85)
     verdict = f"GOUGE in {o.gouge_cells} cells" if o.gouge_cells else "no gouge"
     ax.set_title(f"{title}\nmax left {o.max_left:.4f} mm, min {o.min_deviation:.4f} mm, "
                  f"p95 {o.percentiles.get(95, 0.0):.4f} mm; {verdict} (tolerance {tol:g} mm)\n"

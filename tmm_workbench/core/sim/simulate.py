@@ -1,7 +1,8 @@
 """What a tool path leaves in the stock: the kernel cuts the z-map along every move (3-axis: the APT cutter's
 swept envelope, exact per cell; 5-axis: the torus sub-stepped along the move, tip straight and axis by slerp,
 bound in the kernel's sweep5.hpp). Rapids cut too; one that removes material is a collision (a crash on the
-machine), reported with its move."""
+machine), reported with its move. With a tool assembly, its neck, shank and holder are checked against the stock
+as it is at each move (core.sim.stock_collisions)."""
 from __future__ import annotations
 
 import math
@@ -14,7 +15,9 @@ import numpy as np
 from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.stock_collisions import CheckedBodies, StockCollisions
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
@@ -32,6 +35,7 @@ class SimResult:
     cells_lowered: int
     seconds: float
     five_axis: bool
+    stock_collisions: Optional[StockCollisions] = None  # with an assembly: its bodies against the stock
 
     @property
     def removed_volume(self) -> float:
@@ -53,11 +57,14 @@ def sub_step(tool: Cutter, tolerance: float) -> float:
 
 def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *, shape: str = "bull_nose",
              max_step: Optional[float] = None, tolerance: float = 0.01, collision_tol: float = 1e-3, threads: int = 0,
-             progress: Optional[Progress] = None) -> SimResult:
+             progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None,
+             body_tolerance: float = 1e-3) -> SimResult:
     """Cuts `stock` ((ny, nx) heights on `grid`, copied) along `toolpath` with `tool`. A 5-axis path (any
     axis off vertical) needs a toroidal or ball tool (`tool.torus_radii`); `shape` is its solid
     ('bull_nose': a solid end mill; 'round_insert': the seed's insert cutter with its hollow); its moves are
-    sub-stepped `max_step` mm apart (default: sub_step(tool, tolerance))."""
+    sub-stepped `max_step` mm apart (default: sub_step(tool, tolerance)). `assembly`: the tool's neck, shank and
+    holder are checked against the stock as each move finds it (`stock_collisions`; deeper than `body_tolerance`
+    mm into a clearance counts); its cutter is `tool`'s, so only what stands above the flutes is taken."""
     if len(toolpath) < 2:
         raise TmmError("the tool path to simulate has no moves")
     stock = np.asarray(stock, dtype=float)
@@ -73,6 +80,10 @@ def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *,
     five = toolpath.is_five_axis()
     if five and shape not in SHAPES_5AXIS:
         raise TmmError(f"5-axis tool shape must be one of {', '.join(SHAPES_5AXIS)}, got {shape!r}")
+    bodies = None if assembly is None else CheckedBodies.of(assembly)
+    if not (isinstance(body_tolerance, (int, float)) and math.isfinite(body_tolerance) and body_tolerance >= 0):
+        raise TmmError(f"body tolerance must be a finite length >= 0 mm, got {body_tolerance!r}")
+    check = {} if bodies is None else {"bodies": bodies.rows, "body_tol": float(body_tolerance)}
     zmap = native.ZMap(grid.x0, grid.y0, grid.cell, grid.nx, grid.ny, 0.0)
     zmap.heights[:] = stock
     t0 = time.perf_counter()
@@ -81,12 +92,16 @@ def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *,
             Ro, Ri = tool.torus_radii
             max_step = sub_step(tool, tolerance) if max_step is None else max_step
             rep = native.cut_5axis(zmap, Ro, Ri, shape, tips, np.ascontiguousarray(toolpath.axes()), kinds,
-                                   max_step, collision_tol, threads, progress)
+                                   max_step, collision_tol, threads, progress, **check)
         else:
-            rep = native.cut_3axis(zmap, tool.native, tips, kinds, collision_tol, threads, progress)
+            if bodies is not None:
+                check["flute_top"] = bodies.flute_top
+            rep = native.cut_3axis(zmap, tool.native, tips, kinds, collision_tol, threads, progress, **check)
     except native.Cancelled as exc:
         raise Cancelled("simulation cancelled") from exc
     except ValueError as exc:
         raise TmmError(f"simulation: {exc}") from exc
+    found = None if bodies is None else StockCollisions.from_kernel(rep["body_collisions"], bodies,
+                                                                    int(rep["moves_cut"]))
     return SimResult(grid, stock.copy(), np.array(zmap.heights), np.asarray(rep["collisions"]).reshape(-1, 2),
-                     int(rep["moves_cut"]), int(rep["cells_lowered"]), time.perf_counter() - t0, five)
+                     int(rep["moves_cut"]), int(rep["cells_lowered"]), time.perf_counter() - t0, five, found)

@@ -30,6 +30,7 @@
 #include <cstddef>
 
 #include "tmm/cutter/cutter.hpp"
+#include "tmm/sim/body_check.hpp"
 #include "tmm/sim/sim_report.hpp"
 #include "tmm/sim/zmap.hpp"
 #include "tmm/util/parallel.hpp"
@@ -42,11 +43,14 @@ inline constexpr double kVerticalLength = 1e-12;   // mm of XY travel below whic
 struct Sweep3Options {
   double collision_tol = 1e-3;  // mm a rapid may remove before it counts as a collision (finite, >= 0)
   std::size_t band_rows = 0;    // rows per parallel band, 0: automatic (results do not depend on it)
+  const BodyCheck* body_check = nullptr;  // the bodies above the flutes against the stock; null: no check
 };
 
 // tips: n tool tips (x, y, z), row-major n x 3; kinds: n - 1 move kinds (kinds[k] for tips[k] -> tips[k+1];
 // may be null when n < 2). Cut and Rapid moves lower the stock; Jump moves are skipped. Collisions: the
 // rapids that removed more than options.collision_tol, in move order, with their deepest removal.
+// With options.body_check, report.body_collisions holds the bodies' collisions with the stock (body_check.hpp);
+// the heights are the same with or without it.
 // Throws std::invalid_argument naming the bad input (a non-finite tip and its row, an unknown kind and its
 // move, a bad tolerance), before touching the stock; Cancelled when batch.progress returns false (the stock
 // is then partly cut).

@@ -49,6 +49,7 @@
 #include <cstddef>
 
 #include "tmm/cutter/torus_tool.hpp"
+#include "tmm/sim/body_check.hpp"
 #include "tmm/sim/sim_report.hpp"
 #include "tmm/sim/zmap.hpp"
 #include "tmm/util/parallel.hpp"
@@ -58,6 +59,7 @@ namespace tmm {
 struct Sweep5Options {
   double max_step = 0.05;       // mm: no torus point moves more than this between two stamped instances
   double collision_tol = 1e-3;  // mm: a rapid removing more than this is a collision
+  const BodyCheck* body_check = nullptr;  // the bodies above the flutes against the stock; null: no check
 };
 
 // Counters of one simulation (for benchmarks and tests).
@@ -78,7 +80,8 @@ double lowest_on_vertical(const TorusTool& tool, const Eigen::Vector3d& tip, con
 // a_z > 0 (the tool pointing down onto the z-map); kinds: n - 1 moves k -> k + 1 (may be null when n < 2).
 // Throws std::invalid_argument naming the offending row or parameter (non-finite tip, zero, non-finite or
 // non-upward axis, unknown move kind, max_step not > 0, collision_tol < 0, invalid tool), Cancelled when
-// batch.progress returns false. Collisions are sorted by move index.
+// batch.progress returns false. Collisions are sorted by move index. With options.body_check, each instance's
+// bodies are tested before it is stamped (body_check.hpp): report.body_collisions; the heights are the same.
 SimReport cut_5axis(ZMap& stock, const TorusTool& tool, const double* tips, const double* axes,
                     const MoveKind* kinds, std::size_t n, const Sweep5Options& options, const BatchOptions& batch,
                     Sweep5Stats* stats = nullptr);
