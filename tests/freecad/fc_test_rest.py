@@ -84,3 +84,22 @@ class RestInTheSurface(FreeCADTestCase):
             run_surface(cavity_stl(), tool="ballend", diameter=3.0, region="rest", doc_name="TmmRestNone", **HALF)
         self.assertIn("no earlier operation of the Job has a path", str(ctx.exception))
         self.assertNotIn("TmmRestNone", FreeCAD.listDocuments())
+
+
+class RestInTheWaterline(FreeCADTestCase):
+    def test_the_waterline_cuts_only_the_rest_on_the_walls(self) -> None:
+        from tmm_workbench.app.api import run_waterline
+
+        big = finished("TmmRestWl")
+        rest = run_waterline(job=big.job, tool="ballend", diameter=3.0, step_down=1.0, rest=True, progress=False,
+                             post=None)
+        self.assertIn("rest", rest.op.RestReport)
+        after = simulate(big.job, cell=0.25, progress=False)   # the finish and the rest's loops
+        full = run_waterline(job=big.job, tool="ballend", diameter=3.0, step_down=1.0, progress=False, post=None)
+        # (the D10 raster leaves its passes 11 mm apart in z on the walls along it: the rest is most of those walls)
+        self.assertLess(feed_length(rest.op.Proxy.toolpath), 0.95 * feed_length(full.op.Proxy.toolpath))
+        self.assertFalse(after.gouged, after.min_deviation)
+        self.assertEqual(after.collisions, [])
+        with self.assertRaises(TmmError) as ctx:
+            run_waterline(job=big.job, tool="ballend", diameter=3.0, rest_tolerance=0.02, progress=False, post=None)
+        self.assertIn("rest_tolerance is used with rest=True only", str(ctx.exception))

@@ -217,7 +217,9 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
                   fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                   progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
                   stick_out: Optional[float] = None, shank_clearance: Optional[float] = None,
-                  holder_clearance: Optional[float] = None, holder_collision: Optional[str] = None) -> SurfaceResult:
+                  holder_clearance: Optional[float] = None, holder_collision: Optional[str] = None,
+                  rest: Optional[bool] = None, rest_from: Optional[str] = None, rest_reference: Any = None,
+                  rest_tolerance: Optional[float] = None) -> SurfaceResult:
     """Waterline finishing of `model` (STL path, Mesh::Feature or Part::Feature): closed loops at constant
     heights `step_down` apart (a 'TMM Waterline' op in a new Job, or in `job`: e.g. after run_roughing, with
     its own tool controller; `model` None for the Job's model).
@@ -227,9 +229,12 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     None automatic. direction 'climb' | 'conventional'. The stock of a new Job as run_roughing's. Heights,
     feeds (mm/min), post, files and progress as run_surface; the result is a SurfaceResult (op: the waterline op).
     The whole tool (holder, stick_out, shank_clearance, holder_clearance, holder_collision) as run_surface.
+    rest=True: the loops only where the `job`'s earlier ops (or rest_reference) left more than rest_tolerance that
+    this tool reaches (rest_from, rest_reference, rest_tolerance as run_surface's region 'rest').
     """
     whole_tool = dict(holder=holder, stick_out=stick_out, shank_clearance=shank_clearance,
-                      holder_clearance=holder_clearance, holder_collision=holder_collision)
+                      holder_clearance=holder_clearance, holder_collision=holder_collision, rest=rest,
+                      rest_from=rest_from, rest_reference=rest_reference, rest_tolerance=rest_tolerance)
     from tmm_workbench.app import op_waterline, stages
     from tmm_workbench.core.strategies.waterline import WaterlineParams
 

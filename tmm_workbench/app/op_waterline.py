@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-from tmm_workbench.app import op_base, op_mesh, progress, simulation, stages, tool_assembly, work_estimate
+from tmm_workbench.app import op_base, op_mesh, progress, rest_source, simulation, stages, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
@@ -53,7 +53,7 @@ DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "BoundaryShape": "Model",
                             "BoundaryMargin": 0.0, "SampleStep": 0.0, "UseZRange": False, "TopZ": 0.0,
                             "BottomZ": 0.0}
 # the whole tool: holder, stick-out, clearances (app.tool_assembly), declared once for every mesh op
-TOOL_STAGES = (tool_assembly.STAGE,)
+TOOL_STAGES = (tool_assembly.STAGE, rest_source.WATERLINE_STAGE)   # and the rest (its steep walls)
 PROPERTIES += stages.properties(TOOL_STAGES)
 CHOICES.update(stages.choices(TOOL_STAGES))
 DEFAULTS.update(stages.defaults(TOOL_STAGES))
@@ -97,6 +97,10 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
         policy.validate()
         policy.material_top = simulation.material_left(obj, cutter)
+        rest = rest_source.rest_of_op(obj, simulation.job_of(obj), mesh, cutter, policy.material_top,
+                                      extra["boundary"])
+        params.rest = None if rest is None else rest.stock
+        policy.low_links = rest is not None
         with progress.reporter(obj.Label, self.progress_enabled) as cb:
             result = waterline.compute(mesh, cutter, params, cb)
         top = result.diagnostics.get("top")
@@ -109,6 +113,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         self.mesh, self.toolpath, self.params = mesh, toolpath, params
         self.diagnostics = dict(result.diagnostics)
         tool_assembly.report(obj, params)
+        rest_source.report(obj, rest)
         self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
 
 

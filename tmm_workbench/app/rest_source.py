@@ -8,7 +8,7 @@ before and after; RestRegions marks the rest cells for the 3D view.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Optional
 
 import FreeCAD
@@ -108,13 +108,13 @@ def report(obj: Any, rest: Optional[Rest]) -> None:
     FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")
 
 
-def ignored(args: Args) -> Optional[str]:
-    """The rest's settings mean nothing outside Region 'Rest'; a reference tool nothing when the rest comes from
-    the earlier ops."""
-    rest = str(args.get("region") or "").lower() == REST.lower()
+def ignored(args: Args, asked: str = "region='rest'") -> Optional[str]:
+    """The rest's settings mean nothing outside Region 'Rest' (the waterline: rest=True); a reference tool nothing
+    when the rest comes from the earlier ops."""
+    rest = str(args.get("region") or "").lower() == REST.lower() or args.get("rest") is True
     for name in ("rest_from", "rest_reference", "rest_tolerance"):
         if args.get(name) is not None and not rest:
-            return f"{name} is used with region='rest' only"
+            return f"{name} is used with {asked} only"
     source = str(args.get("rest_from") or "earlier_ops").lower()
     if args.get("rest_reference") is not None and source != "reference_tool":
         return "rest_reference is used with rest_from='reference_tool' only"
@@ -136,3 +136,19 @@ STAGE = Stage("rest", (
           "Region 'Rest': cut where more than this is left above what this tool reaches, mm",
           api="rest_tolerance", default=0.01, spec=TOLERANCE, widget="restTolerance"),
 ), ignored=ignored)
+
+
+def rest_of_op(obj: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tuple) -> Optional[Rest]:
+    """The op's rest when it machines only the rest (Region 'Rest', or the waterline's RestOnly), else None."""
+    if getattr(obj, "Region", "") == REST or bool(getattr(obj, "RestOnly", False)):
+        return rest_of(obj, job, mesh, cutter, left, box)
+    return None
+
+
+# the Waterline's: its loops only where they take off rest material (no region: the loops are levels)
+WATERLINE_STAGE = Stage("rest", (
+    Field("RestOnly", "bool", "Rest",
+          "Cut only where the Job's earlier ops (or RestReference) left more than RestTolerance that this tool "
+          "reaches: the steep walls of a rest", api="rest", default=False),
+    *(replace(f, group="Rest", widget="") for f in STAGE.fields),
+), ignored=lambda args: ignored(args, "rest=True"))

@@ -33,8 +33,9 @@ from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
-from tmm_workbench.core.strategies import holder_guard
+from tmm_workbench.core.strategies import holder_guard, rest_filter
 from tmm_workbench.core.strategies.holder_guard import WholeToolParams
+from tmm_workbench.core.strategies.rest_filter import RestParams
 from tmm_workbench.core.tools.cutter import Cutter
 from tmm_workbench.core.work import Box, Work
 
@@ -49,7 +50,7 @@ _HAS_CLOSED = "closed" in {f.name for f in fields(CutSegment)}  # the linker's r
 
 
 @dataclass
-class WaterlineParams(StrategyParams, WholeToolParams):  # + the whole tool (holder_guard)
+class WaterlineParams(StrategyParams, WholeToolParams, RestParams):  # + the whole tool (holder_guard), the rest
     boundary: Rect = (0.0, 0.0, 0.0, 0.0)        # xmin, ymin, xmax, ymax of the tip positions (mm)
     step_down: float = param(1.0, "step-down", "mm", low=0, low_open=True, kind="length")
     top_z: Optional[float] = param(None, "top", "mm", optional=True)        # default: the model's top
@@ -173,6 +174,9 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     diagnostics = {"levels": len(zs), "loops": loops, "points": points, "joined": joined,
                    "top": max(float(seg.tips[0, 2]) for seg in segments)}
     step = params.sample_step or wl.default_sample_step(cutter, b)
+    segments = rest_filter.apply(params, cutter, segments, diagnostics)   # a rest: only where material is left
+    if not segments:
+        raise TmmError("no waterline loop takes off rest material: nothing is left for this tool on the walls")
     return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 
