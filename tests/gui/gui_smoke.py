@@ -315,7 +315,7 @@ def smoke() -> dict:
     # the region group box (issue 14 item 3): its choices and the op's values
     reg = page.findChild(QtGui.QComboBox, "region")
     info["panel_region"] = [reg.currentText(), [reg.itemText(i) for i in range(reg.count())]]
-    assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch"]], info["panel_region"]
+    assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch", "Rest"]], info["panel_region"]
     pattern = page.findChild(QtGui.QComboBox, "pattern")
     assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
     # the 3D offset's start (issue 14 item 1): Boundary as the new op, the curve chooser empty

@@ -78,5 +78,5 @@ STAGE = Stage("pencil", (
     Field("PencilPasses", "int", "Pencil",
           "Pattern Pencil: passes outward from each curve (1: pencil; more: multi-pencil), the step-over apart (or "
           "the cusp height's spacing); 0 with Region Rest: as many as cover the rest (a clean-up of the strips "
-          "the finish left)", "pencil_passes", "pencil_passes", widget="pencilPasses"),
+          "the finish left)", "pencil_passes", "pencil_passes"),   # its spin box: gui.region_panel
 ), ignored=ignored)

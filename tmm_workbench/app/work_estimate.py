@@ -107,6 +107,8 @@ def check_value(proxy: Any, prop: str, value: float) -> None:
     spec = spec_for(proxy, prop)
     if spec is None or (spec.optional and value == 0):
         return
+    if spec.integer and isinstance(value, float) and value.is_integer():   # a spin box's count read as a number
+        value = int(value)
     check(spec, value)
 
 

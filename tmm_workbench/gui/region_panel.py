@@ -70,6 +70,10 @@ def get_fields(page: Any, obj: Any) -> None:
     object_chooser.write(page.form.regionSketch, obj, "RegionSketch")
     if hasattr(page.form, "restReference") and hasattr(obj, "RestReference"):
         object_chooser.write(page.form.restReference, obj, "RestReference")
+    if hasattr(page.form, "pencilPasses") and hasattr(obj, "PencilPasses"):
+        passes = int(page.form.pencilPasses.value())   # a count: a plain spin box, not a quantity
+        if obj.PencilPasses != passes:
+            obj.PencilPasses = passes
 
 
 def set_fields(page: Any, obj: Any) -> None:
@@ -78,6 +82,8 @@ def set_fields(page: Any, obj: Any) -> None:
     object_chooser.fill(page.form.regionSketch, sketch_candidates(obj), obj.RegionSketch)
     if hasattr(page.form, "restReference") and hasattr(obj, "RestReference"):
         object_chooser.fill(page.form.restReference, reference_candidates(obj), obj.RestReference)
+    if hasattr(page.form, "pencilPasses") and hasattr(obj, "PencilPasses"):
+        page.form.pencilPasses.setValue(int(obj.PencilPasses))
     page.form.regionFacesInfo.setText(faces_text(obj))
 
 
@@ -85,4 +91,5 @@ def signals(page: Any) -> list[Any]:
     if not _has_group(page):
         return []
     return [page.form.regionSketch.currentIndexChanged] + (
-        [page.form.restReference.currentIndexChanged] if hasattr(page.form, "restReference") else [])
+        [page.form.restReference.currentIndexChanged, page.form.pencilPasses.valueChanged]
+        if hasattr(page.form, "restReference") else [])
