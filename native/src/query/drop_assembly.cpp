@@ -44,7 +44,6 @@ void check_bodies(const std::vector<ToolBody>& bodies) {
   }
 }
 
-constexpr std::size_t kNoBody = ~std::size_t{0};
 // Fewer points walk without the height cells (building them costs about a walk per cell row).
 constexpr std::size_t kCellsFromPoints = 256;
 // Pieces reaching at most this many times the cutter's radius are dropped with tile lists, wider ones by walks.
@@ -83,7 +82,7 @@ void add_cutter(std::vector<AssemblyPiece>& out, const Cutter& k, double c, cons
   const double b2 = k.beta2();
   out.push_back({Cutter::apt(k.radius() + c * std::cos(b2), r, Lc + c * (1.0 - std::sin(b2)), 0.0, b2), -c,
                  kSetByCutter});
-  if (b2 > 0.0 && !disc_covered(bodies, kNoBody, Lc, k.radius(), c))
+  if (b2 > 0.0 && !disc_covered(bodies, ToolAssembly::kNoBody, Lc, k.radius(), c))
     out.push_back({Cutter(k.radius() + c, c), Lc - c, kSetByCutter});
 }
 
@@ -248,7 +247,7 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
 }  // namespace
 
 ToolAssembly::ToolAssembly(const Cutter& cutter, const std::vector<ToolBody>& bodies, double cutter_clearance)
-    : body_count_(bodies.size()) {
+    : cutter_(cutter), bodies_(bodies), cutter_clearance_(cutter_clearance) {
   if (!(in_range(cutter_clearance) && cutter_clearance >= 0.0)) {
     std::ostringstream msg;
     msg << "cutter clearance must be >= 0 and finite, got " << cutter_clearance;
@@ -263,6 +262,10 @@ ToolAssembly::ToolAssembly(const Cutter& cutter, const std::vector<ToolBody>& bo
       refuse_body(i, bodies[i], e.what());
     }
   }
+}
+
+bool ToolAssembly::disc_covered(std::size_t skip, double z, double radius, double clearance) const {
+  return tmm::disc_covered(bodies_, skip, z, radius, clearance);
 }
 
 double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, double x, double y, double floor_z,
@@ -282,17 +285,20 @@ double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, dou
   return z;
 }
 
-void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
-                         double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
-                         DropStats* stats) {
-  require_in_range(floor_z, "floor_z");
+namespace {
+
+// drop_assembly_batch with the floor of point i = floors ? floors[i] : floor_z.
+void drop_assembly_floors(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                          const double* floors, double floor_z, double* z_out, int32_t* set_by,
+                          const BatchOptions& options, DropStats* stats) {
   const std::vector<AssemblyPiece>& pieces = tool.pieces();
   const double passes = static_cast<double>(pieces.size());
   std::vector<double> base(n), top(n);
   double reach = 0.0;  // of the bodies' pieces
   for (std::size_t k = 1; k < pieces.size(); ++k) reach = std::max(reach, pieces[k].profile.max_radius());
   const HeightCells cells(index, xy, pieces.size() > 1 && n >= kCellsFromPoints ? n : 0, reach);
-  std::fill(z_out, z_out + n, floor_z);
+  if (floors) std::copy(floors, floors + n, z_out);
+  else std::fill(z_out, z_out + n, floor_z);
   if (set_by) std::fill(set_by, set_by + n, kSetByFloor);
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     const AssemblyPiece& p = pieces[k];
@@ -300,8 +306,10 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
     if (options.progress)
       pass.progress = [&options, k, passes](double f) { return options.progress((static_cast<double>(k) + f) / passes); };
     for (std::size_t i = 0; i < n; ++i) base[i] = z_out[i] + p.lift;
-    if (k == 0)  // one floor: the plain batch (with no clearance, the very heights of drop_batch)
+    if (k == 0 && !floors)  // one floor: the plain batch (with no clearance, the very heights of drop_batch)
       drop_batch(index, p.profile, xy, n, floor_z + p.lift, top.data(), pass, stats);
+    else if (k == 0)
+      drop_batch(index, p.profile, xy, n, base.data(), top.data(), pass, stats);
     else
       drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells,
                  p.profile.max_radius() <= kTilesUpTo * pieces[0].profile.max_radius(), pass, stats);
@@ -312,6 +320,23 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
       }
     }
   }
+}
+
+}  // namespace
+
+void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                         double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
+                         DropStats* stats) {
+  require_in_range(floor_z, "floor_z");
+  drop_assembly_floors(index, tool, xy, n, nullptr, floor_z, z_out, set_by, options, stats);
+}
+
+void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                         const double* floors, double* z_out, int32_t* set_by, const BatchOptions& options,
+                         DropStats* stats) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::isnan(floors[i])) throw std::invalid_argument("drop floors must not be NaN (floor " + std::to_string(i) + ")");
+  drop_assembly_floors(index, tool, xy, n, floors, 0.0, z_out, set_by, options, stats);
 }
 
 }  // namespace tmm

@@ -37,17 +37,8 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kTravelTol = 1e-12;       // mm, bracket width of the vertex entry
 constexpr double kUnitTol = 1e-9;          // |norm - 1| accepted for axis and direction
-constexpr double kParallelAxisTol = 1e-12; // |axis + V| below which the -Z contacts are used in the tool frame
-
-void require_unit(const Vector3d& v, const char* what) {
-  const double n = v.norm();
-  if (!(std::isfinite(n) && std::fabs(n - 1.0) <= kUnitTol)) {
-    std::ostringstream msg;
-    msg << what << " must be a finite unit vector, got (" << v.x() << ", " << v.y() << ", " << v.z()
-        << ") of length " << n;
-    throw std::invalid_argument(msg.str());
-  }
-}
+using direction_detail::kParallelAxisTol;
+using direction_detail::require_unit;
 
 }  // namespace
 
@@ -59,6 +50,16 @@ ToolFrame::ToolFrame(const Vector3d& axis) : a(axis.normalized()) {
 }
 
 namespace direction_detail {
+
+void require_unit(const Vector3d& v, const char* what) {
+  const double n = v.norm();
+  if (!(std::isfinite(n) && std::fabs(n - 1.0) <= kUnitTol)) {
+    std::ostringstream msg;
+    msg << what << " must be a finite unit vector, got (" << v.x() << ", " << v.y() << ", " << v.z()
+        << ") of length " << n;
+    throw std::invalid_argument(msg.str());
+  }
+}
 
 Support support(const Cutter& c, const Vector3d& d_in) {
   // (sqrt of sums of squares rather than hypot: this is the inner loop of the edge solver.)

@@ -51,6 +51,10 @@ double drop_along_general(const Cutter& cutter, const Eigen::Vector3d& tip_start
 
 // Pieces of the general method, in the tool frame with the start tip at the origin; W = V in tool coordinates.
 namespace direction_detail {
+// |axis + V| below which the axis counts as opposite to the direction (the -Z drop in the rotated frame).
+constexpr double kParallelAxisTol = 1e-12;
+// std::invalid_argument naming `what` unless v is a finite unit vector (within 1e-9).
+void require_unit(const Eigen::Vector3d& v, const char* what);
 // Point of K extreme in direction d (maximising d . X); value = d . X (+inf when unbounded: L_C = inf).
 struct Support {
   Eigen::Vector3d point;
