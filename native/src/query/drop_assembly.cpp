@@ -132,8 +132,9 @@ class HeightCells {
   std::vector<double> dilated(double reach) const {
     const auto k = static_cast<std::size_t>(std::ceil(reach / side_)) + 1;
     std::vector<double> rows(top_.size()), out(top_.size());
-    for (std::size_t j = 0; j < ny_; ++j) window_max(&top_[j * nx_], &rows[j * nx_], nx_, 1, k);
-    for (std::size_t i = 0; i < nx_; ++i) window_max(&rows[i], &out[i], ny_, nx_, k);
+    WindowMax w(std::max(nx_, ny_), k);
+    for (std::size_t j = 0; j < ny_; ++j) w(&top_[j * nx_], &rows[j * nx_], nx_, 1);
+    for (std::size_t i = 0; i < nx_; ++i) w(&rows[i], &out[i], ny_, nx_);
     return out;
   }
 
@@ -181,41 +182,72 @@ class HeightCells {
     }
   }
 
-  // out[i] = max(in[i - k .. i + k]) over the m values at `stride` (van Herk / Gil-Werman: blocks of 2k + 1,
-  // a running max from each block's start and from its end, two reads per value whatever k).
-  static void window_max(const double* in, double* out, std::size_t m, std::size_t stride, std::size_t k) {
-    const std::size_t w = 2 * k + 1, len = m + 2 * k;
-    std::vector<double> pad(len, -INFINITY), from_start(len), to_end(len);
-    for (std::size_t i = 0; i < m; ++i) pad[i + k] = in[i * stride];
-    for (std::size_t j = 0; j < len; ++j) from_start[j] = j % w == 0 ? pad[j] : std::max(from_start[j - 1], pad[j]);
-    for (std::size_t j = len; j-- > 0;)
-      to_end[j] = (j + 1 == len || (j + 1) % w == 0) ? pad[j] : std::max(to_end[j + 1], pad[j]);
-    for (std::size_t i = 0; i < m; ++i) out[i * stride] = std::max(to_end[i], from_start[i + 2 * k]);
-  }
+  // out[i] = max(in[i - k .. i + k]) over the m <= most values at `stride` (van Herk / Gil-Werman: blocks of
+  // 2k + 1, a running max from each block's start and from its end, two reads per value whatever k); the
+  // buffers are kept from line to line.
+  class WindowMax {
+   public:
+    WindowMax(std::size_t most, std::size_t k) : k_(k), pad_(most + 2 * k), from_start_(pad_.size()), to_end_(pad_.size()) {}
+    void operator()(const double* in, double* out, std::size_t m, std::size_t stride) {
+      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_;
+      std::fill(pad_.begin(), pad_.begin() + static_cast<std::ptrdiff_t>(len), -INFINITY);
+      for (std::size_t i = 0; i < m; ++i) pad_[i + k_] = in[i * stride];
+      for (std::size_t j = 0; j < len; ++j)
+        from_start_[j] = j % w == 0 ? pad_[j] : std::max(from_start_[j - 1], pad_[j]);
+      for (std::size_t j = len; j-- > 0;)
+        to_end_[j] = (j + 1 == len || (j + 1) % w == 0) ? pad_[j] : std::max(to_end_[j + 1], pad_[j]);
+      for (std::size_t i = 0; i < m; ++i) out[i * stride] = std::max(to_end_[i], from_start_[i + 2 * k_]);
+    }
+
+   private:
+    std::size_t k_;
+    std::vector<double> pad_, from_start_, to_end_;
+  };
 
   double x0_ = 0, y0_ = 0, side_ = 1;
   std::size_t nx_ = 0, ny_ = 0;
   std::vector<double> top_;
 };
 
+// Does `profile`'s flat bottom rest at height h at (x, y) on triangle t: a corner or an edge of t at h (both
+// ends) within the flat bottom's radius? With h the cells' bound at (x, y) (nothing within reach is higher),
+// the drop is then h exactly: the flat bottom cannot pass below that edge, nothing lifts it above. (A holder
+// over a plateau: the common case, answered without a walk.)
+bool rests_flat(const Cutter& profile, const IndexedTriangle& t, double x, double y, double h) {
+  const double e = profile.flat_radius();
+  if (!(t.zmax == h && e > 0.0 && profile.beta1() == 0.0)) return false;
+  for (int k = 0; k < 3; ++k) {
+    const double* p = t.p[k];
+    const double* q = t.p[(k + 1) % 3];
+    if (p[2] != h) continue;
+    double s = 0.0;  // the closest point of the edge p-q (of p alone when q is lower)
+    const double ex = q[0] - p[0], ey = q[1] - p[1], l2 = ex * ex + ey * ey;
+    if (q[2] == h && l2 > 0.0) s = std::clamp(((x - p[0]) * ex + (y - p[1]) * ey) / l2, 0.0, 1.0);
+    const double dx = p[0] + s * ex - x, dy = p[1] + s * ey - y;
+    if (dx * dx + dy * dy <= e * e) return true;
+  }
+  return false;
+}
+
 // One body's piece over the batch, each point from its own floor `base` (the height so far + the lift). Points
-// whose cells' bound is not above the floor keep it (top = base). The others are dropped with `tiles` as a
-// batch (drop_batch's tile lists: a shank or neck about the cutter's size), else each by the index walk warm-
-// started with the previous point's winner (a holder: its reach spans so many triangles that gathering them
-// per tile costs more than the walks; measured, benchmarks/drop_assembly.py).
+// whose cells' bound is not above the floor keep it (top = base); points where the previous winner holds the
+// flat bottom at the bound get the bound (rests_flat). The others are dropped with `tiles` as a batch
+// (drop_batch's tile lists: a shank or neck about the cutter's size), else each by the index walk warm-started
+// with the previous point's winner (a holder: its reach spans so many triangles that gathering them per tile
+// costs more than the walks; measured, benchmarks/drop_assembly.py).
 void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy, std::size_t n, const double* base,
                 double* top, const HeightCells& cells, bool tiles, const BatchOptions& options, DropStats* stats) {
   std::vector<double> bound;
   if (!cells.empty()) bound = cells.dilated(profile.max_radius());
-  auto clears = [&](std::size_t i) {
+  auto bound_at = [&](std::size_t i) {
     const double x = xy[2 * i], y = xy[2 * i + 1];
-    return !bound.empty() && std::isfinite(x) && std::isfinite(y) && bound[cells.cell(x, y)] <= base[i];
+    return !bound.empty() && std::isfinite(x) && std::isfinite(y) ? bound[cells.cell(x, y)] : INFINITY;
   };
   if (tiles) {
     std::vector<std::size_t> kept;
     std::vector<double> kxy, kbase;
     for (std::size_t i = 0; i < n; ++i) {
-      if (clears(i)) {
+      if (bound_at(i) <= base[i]) {
         top[i] = base[i];
         continue;
       }
@@ -228,16 +260,20 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
     for (std::size_t k = 0; k < kept.size(); ++k) top[kept[k]] = ktop[k];
     return;
   }
+  const auto& tris = index.triangles();
   std::atomic<std::size_t> tested{0};
   parallel_chunks(n, 512, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
     int32_t hint = -1;
     for (std::size_t i = begin; i < end; ++i) {
-      if (clears(i)) {
+      const double x = xy[2 * i], y = xy[2 * i + 1], ub = bound_at(i);
+      if (ub <= base[i]) {
         top[i] = base[i];
-        continue;
+      } else if (hint >= 0 && rests_flat(profile, tris[static_cast<std::size_t>(hint)], x, y, ub)) {
+        top[i] = ub;
+      } else {
+        top[i] = drop_point(index, profile, x, y, base[i], &local, &hint);
       }
-      top[i] = drop_point(index, profile, xy[2 * i], xy[2 * i + 1], base[i], &local, &hint);
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
   });
