@@ -46,6 +46,8 @@ void check_bodies(const std::vector<ToolBody>& bodies) {
 
 // Fewer points walk without the height cells (building them costs about a walk per cell row).
 constexpr std::size_t kCellsFromPoints = 256;
+// Pieces reaching at most this many cells look up the cells within their reach of a point (about 4 k^2).
+constexpr double kFineCells = 6.0;
 // Pieces reaching at most this many times the cutter's radius are dropped with tile lists, wider ones by walks.
 constexpr double kTilesUpTo = 2.0;
 
@@ -126,16 +128,39 @@ class HeightCells {
   }
 
   bool empty() const { return top_.empty(); }
+  double side() const { return side_; }
 
   // The maxima over squares of cells reaching `reach` around each cell (any triangle whose box comes within
   // `reach` of a point lies in the square around the point's cell).
   std::vector<double> dilated(double reach) const {
     const auto k = static_cast<std::size_t>(std::ceil(reach / side_)) + 1;
     std::vector<double> rows(top_.size()), out(top_.size());
-    WindowMax w(std::max(nx_, ny_), k);
-    for (std::size_t j = 0; j < ny_; ++j) w(&top_[j * nx_], &rows[j * nx_], nx_, 1);
-    for (std::size_t i = 0; i < nx_; ++i) w(&rows[i], &out[i], ny_, nx_);
+    WindowMax w(nx_, k, 1);
+    for (std::size_t j = 0; j < ny_; ++j) w(&top_[j * nx_], &rows[j * nx_], nx_);
+    WindowMax columns(ny_, k, nx_);  // all columns at once, row after row (no strided reads)
+    columns(rows.data(), out.data(), ny_);
     return out;
+  }
+
+  // Do all cells whose squares come within `reach` of (x, y) stay at or below `z` (false for a point outside
+  // the grid)? Finer than the dilated square around the point's cell, worth it for a few cells: row by row,
+  // the run of cells the disc meets, stopping at the first cell above z.
+  bool below_within(double x, double y, double reach, double z) const {
+    const double fx = (x - x0_) / side_, fy = (y - y0_) / side_, fr = reach / side_;
+    if (!(fx >= 0 && fy >= 0 && fx < static_cast<double>(nx_) && fy < static_cast<double>(ny_))) return false;
+    const auto j0 = static_cast<std::size_t>(std::max(fy - fr, 0.0));
+    const std::size_t j1 = std::min(static_cast<std::size_t>(fy + fr), ny_ - 1);
+    for (std::size_t j = j0; j <= j1; ++j) {
+      // The row's nearest y to the point, then the half-width of the disc there.
+      const double dy = std::max({static_cast<double>(j) - fy, fy - static_cast<double>(j + 1), 0.0});
+      const double half = std::sqrt(std::max(fr * fr - dy * dy, 0.0));
+      const auto i0 = static_cast<std::size_t>(std::max(fx - half, 0.0));
+      const std::size_t i1 = std::min(static_cast<std::size_t>(fx + half), nx_ - 1);
+      const double* row = &top_[j * nx_];
+      for (std::size_t i = i0; i <= i1; ++i)
+        if (row[i] > z) return false;
+    }
+    return true;
   }
 
   // The cell holding (x, y), or the nearest one (a node's corner outside the grid); clamped before the cast.
@@ -182,25 +207,35 @@ class HeightCells {
     }
   }
 
-  // out[i] = max(in[i - k .. i + k]) over the m <= most values at `stride` (van Herk / Gil-Werman: blocks of
-  // 2k + 1, a running max from each block's start and from its end, two reads per value whatever k); the
-  // buffers are kept from line to line.
+  // out[i] = max(in[i - k .. i + k]) over m <= most values, each a run of `width` contiguous lanes (one
+  // window per lane: width 1 along a row, nx along the columns) (van Herk / Gil-Werman: blocks of 2k + 1, a
+  // running max from each block's start and from its end, two reads per value whatever k). Buffers are kept.
   class WindowMax {
    public:
-    WindowMax(std::size_t most, std::size_t k) : k_(k), pad_(most + 2 * k), from_start_(pad_.size()), to_end_(pad_.size()) {}
-    void operator()(const double* in, double* out, std::size_t m, std::size_t stride) {
-      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_;
-      std::fill(pad_.begin(), pad_.begin() + static_cast<std::ptrdiff_t>(len), -INFINITY);
-      for (std::size_t i = 0; i < m; ++i) pad_[i + k_] = in[i * stride];
-      for (std::size_t j = 0; j < len; ++j)
-        from_start_[j] = j % w == 0 ? pad_[j] : std::max(from_start_[j - 1], pad_[j]);
-      for (std::size_t j = len; j-- > 0;)
-        to_end_[j] = (j + 1 == len || (j + 1) % w == 0) ? pad_[j] : std::max(to_end_[j + 1], pad_[j]);
-      for (std::size_t i = 0; i < m; ++i) out[i * stride] = std::max(to_end_[i], from_start_[i + 2 * k_]);
+    WindowMax(std::size_t most, std::size_t k, std::size_t width)
+        : k_(k), width_(width), pad_((most + 2 * k) * width), from_start_(pad_.size()), to_end_(pad_.size()) {}
+    void operator()(const double* in, double* out, std::size_t m) {
+      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_, W = width_;
+      std::fill(pad_.begin(), pad_.begin() + static_cast<std::ptrdiff_t>(len * W), -INFINITY);
+      std::copy(in, in + m * W, pad_.begin() + static_cast<std::ptrdiff_t>(k_ * W));
+      for (std::size_t j = 0; j < len; ++j) {
+        double* f = &from_start_[j * W];
+        const double* p = &pad_[j * W];
+        if (j % w == 0) std::copy(p, p + W, f);
+        else for (std::size_t l = 0; l < W; ++l) f[l] = std::max(f[l - W], p[l]);
+      }
+      for (std::size_t j = len; j-- > 0;) {
+        double* t = &to_end_[j * W];
+        const double* p = &pad_[j * W];
+        if (j + 1 == len || (j + 1) % w == 0) std::copy(p, p + W, t);
+        else for (std::size_t l = 0; l < W; ++l) t[l] = std::max(t[l + W], p[l]);
+      }
+      for (std::size_t i = 0; i < m; ++i)
+        for (std::size_t l = 0; l < W; ++l) out[i * W + l] = std::max(to_end_[i * W + l], from_start_[(i + 2 * k_) * W + l]);
     }
 
    private:
-    std::size_t k_;
+    std::size_t k_, width_;
     std::vector<double> pad_, from_start_, to_end_;
   };
 
@@ -246,8 +281,11 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
   if (tiles) {
     std::vector<std::size_t> kept;
     std::vector<double> kxy, kbase;
+    // A small piece: the cells within its reach of the point, where the dilated square is not low enough.
+    const bool fine = !bound.empty() && profile.max_radius() <= kFineCells * cells.side();
     for (std::size_t i = 0; i < n; ++i) {
-      if (bound_at(i) <= base[i]) {
+      if (bound_at(i) <= base[i] ||
+          (fine && cells.below_within(xy[2 * i], xy[2 * i + 1], profile.max_radius(), base[i]))) {
         top[i] = base[i];
         continue;
       }
