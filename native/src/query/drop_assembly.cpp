@@ -132,14 +132,18 @@ class HeightCells {
 
   // The maxima over squares of cells reaching `reach` around each cell (any triangle whose box comes within
   // `reach` of a point lies in the square around the point's cell).
-  std::vector<double> dilated(double reach) const {
+  // into `out` (resized; `rows` is scratch: both kept by the caller from piece to piece, fresh pages cost more
+  // than the pass).
+  void dilate(double reach, std::vector<double>& rows, std::vector<double>& out) const {
     const auto k = static_cast<std::size_t>(std::ceil(reach / side_)) + 1;
-    std::vector<double> rows(top_.size()), out(top_.size());
-    WindowMax w(nx_, k, 1);
-    for (std::size_t j = 0; j < ny_; ++j) w(&top_[j * nx_], &rows[j * nx_], nx_);
-    WindowMax columns(ny_, k, nx_);  // all columns at once, row after row (no strided reads)
-    columns(rows.data(), out.data(), ny_);
-    return out;
+    rows.resize(top_.size());
+    out.resize(top_.size());
+    WindowMax along_rows(nx_, k, 1);
+    for (std::size_t j = 0; j < ny_; ++j) along_rows(&top_[j * nx_], &rows[j * nx_], nx_, 1, 1);
+    constexpr std::size_t kLanes = 16;  // columns at once, row after row (no strided reads of single values)
+    WindowMax along_columns(ny_, k, kLanes);
+    for (std::size_t i = 0; i < nx_; i += kLanes)
+      along_columns(&rows[i], &out[i], ny_, std::min(kLanes, nx_ - i), nx_);
   }
 
   // Do all cells whose squares come within `reach` of (x, y) stay at or below `z` (false for a point outside
@@ -207,17 +211,17 @@ class HeightCells {
     }
   }
 
-  // out[i] = max(in[i - k .. i + k]) over m <= most values, each a run of `width` contiguous lanes (one
-  // window per lane: width 1 along a row, nx along the columns) (van Herk / Gil-Werman: blocks of 2k + 1, a
-  // running max from each block's start and from its end, two reads per value whatever k). Buffers are kept.
+  // out[i] = max(in[i - k .. i + k]) over m <= most values, each a run of `width` <= lanes contiguous lanes
+  // `stride` apart (one window per lane) (van Herk / Gil-Werman: blocks of 2k + 1, a running max from each
+  // block's start and from its end, two reads per value whatever k). Buffers are kept from call to call.
   class WindowMax {
    public:
-    WindowMax(std::size_t most, std::size_t k, std::size_t width)
-        : k_(k), width_(width), pad_((most + 2 * k) * width), from_start_(pad_.size()), to_end_(pad_.size()) {}
-    void operator()(const double* in, double* out, std::size_t m) {
-      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_, W = width_;
+    WindowMax(std::size_t most, std::size_t k, std::size_t lanes)
+        : k_(k), pad_((most + 2 * k) * lanes), from_start_(pad_.size()), to_end_(pad_.size()) {}
+    void operator()(const double* in, double* out, std::size_t m, std::size_t width, std::size_t stride) {
+      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_, W = width;
       std::fill(pad_.begin(), pad_.begin() + static_cast<std::ptrdiff_t>(len * W), -INFINITY);
-      std::copy(in, in + m * W, pad_.begin() + static_cast<std::ptrdiff_t>(k_ * W));
+      for (std::size_t i = 0; i < m; ++i) std::copy(in + i * stride, in + i * stride + W, &pad_[(i + k_) * W]);
       for (std::size_t j = 0; j < len; ++j) {
         double* f = &from_start_[j * W];
         const double* p = &pad_[j * W];
@@ -231,11 +235,12 @@ class HeightCells {
         else for (std::size_t l = 0; l < W; ++l) t[l] = std::max(t[l + W], p[l]);
       }
       for (std::size_t i = 0; i < m; ++i)
-        for (std::size_t l = 0; l < W; ++l) out[i * W + l] = std::max(to_end_[i * W + l], from_start_[(i + 2 * k_) * W + l]);
+        for (std::size_t l = 0; l < W; ++l)
+          out[i * stride + l] = std::max(to_end_[i * W + l], from_start_[(i + 2 * k_) * W + l]);
     }
 
    private:
-    std::size_t k_, width_;
+    std::size_t k_;
     std::vector<double> pad_, from_start_, to_end_;
   };
 
@@ -271,9 +276,10 @@ bool rests_flat(const Cutter& profile, const IndexedTriangle& t, double x, doubl
 // with the previous point's winner (a holder: its reach spans so many triangles that gathering them per tile
 // costs more than the walks; measured, benchmarks/drop_assembly.py).
 void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy, std::size_t n, const double* base,
-                double* top, const HeightCells& cells, bool tiles, const BatchOptions& options, DropStats* stats) {
-  std::vector<double> bound;
-  if (!cells.empty()) bound = cells.dilated(profile.max_radius());
+                double* top, const HeightCells& cells, std::vector<double>& rows, std::vector<double>& bound,
+                bool tiles, const BatchOptions& options, DropStats* stats) {
+  bound.clear();
+  if (!cells.empty()) cells.dilate(profile.max_radius(), rows, bound);
   auto bound_at = [&](std::size_t i) {
     const double x = xy[2 * i], y = xy[2 * i + 1];
     return !bound.empty() && std::isfinite(x) && std::isfinite(y) ? bound[cells.cell(x, y)] : INFINITY;
@@ -367,7 +373,7 @@ void drop_assembly_floors(const MeshIndex& index, const ToolAssembly& tool, cons
                           const BatchOptions& options, DropStats* stats) {
   const std::vector<AssemblyPiece>& pieces = tool.pieces();
   const double passes = static_cast<double>(pieces.size());
-  std::vector<double> base(n), top(n);
+  std::vector<double> base(n), top(n), rows, bound;  // rows, bound: the cells' scratch, kept from piece to piece
   double reach = 0.0;  // of the bodies' pieces
   for (std::size_t k = 1; k < pieces.size(); ++k) reach = std::max(reach, pieces[k].profile.max_radius());
   const HeightCells cells(index, xy, pieces.size() > 1 && n >= kCellsFromPoints ? n : 0, reach);
@@ -385,7 +391,7 @@ void drop_assembly_floors(const MeshIndex& index, const ToolAssembly& tool, cons
     else if (k == 0)
       drop_batch(index, p.profile, xy, n, base.data(), top.data(), pass, stats);
     else
-      drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells,
+      drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells, rows, bound,
                  p.profile.max_radius() <= kTilesUpTo * pieces[0].profile.max_radius(), pass, stats);
     for (std::size_t i = 0; i < n; ++i) {
       if (top[i] > base[i] && top[i] - p.lift > z_out[i]) {
