@@ -14,6 +14,7 @@
 #include "tmm/query/drop_assembly_direction.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
+#include "starts.hpp"
 
 namespace py = pybind11;
 
@@ -63,12 +64,8 @@ py::tuple drop_assembly_along(const tmm::DirectionalIndex& index, const tmm::Cut
                               const Array& starts, const Array& axes, double max_travel, double cutter_clearance,
                               int threads, const py::object& progress) {
   const tmm::ToolAssembly tool(cutter, bodies_from(bodies), cutter_clearance);
-  tmm_bindings::check_points(starts, 3, "start points");
+  const bool per_point = tmm_bindings::check_starts_and_axes(starts, axes, max_travel);
   const std::size_t n = static_cast<std::size_t>(starts.shape(0));
-  const bool per_point = axes.ndim() == 2;
-  if (per_point ? (axes.shape(0) != starts.shape(0) || axes.shape(1) != 3) : axes.size() != 3)
-    throw std::invalid_argument("axes must have shape (3,) or (n, 3) like the start points");
-  if (std::isnan(max_travel)) throw std::invalid_argument("max_travel must not be NaN");
   py::array_t<double> travel(static_cast<py::ssize_t>(n));
   py::array_t<int32_t> set_by(static_cast<py::ssize_t>(n));
   tmm::BatchOptions options;

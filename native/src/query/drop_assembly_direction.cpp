@@ -142,16 +142,10 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   }
   if (all_along && !axes_per_point) {
     // The vertical assembly batch in the rotated frame, each point's floor max_travel below its start.
-    std::vector<double> xy(2 * n), floors(n), z(n), start_z(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
-      xy[2 * i] = s.x();
-      xy[2 * i + 1] = s.y();
-      start_z[i] = s.z();
-      floors[i] = s.z() - max_travel;
-    }
-    drop_assembly_batch(index.index(), tool, xy.data(), n, floors.data(), z.data(), set_by, options, stats);
-    for (std::size_t i = 0; i < n; ++i) travel_out[i] = z[i] <= floors[i] ? max_travel : start_z[i] - z[i];
+    const direction_detail::RotatedStarts s(index, starts, n, max_travel);
+    std::vector<double> z(n);
+    drop_assembly_batch(index.index(), tool, s.xy.data(), n, s.floors.data(), z.data(), set_by, options, stats);
+    for (std::size_t i = 0; i < n; ++i) travel_out[i] = s.travel(i, z[i], max_travel);
     return;
   }
   std::vector<AssemblySolid> solids;

@@ -420,6 +420,18 @@ std::shared_ptr<const MeshIndex> rotated_index(const VerticesRef& vertices, cons
 
 }  // namespace
 
+direction_detail::RotatedStarts::RotatedStarts(const DirectionalIndex& index, const double* starts, std::size_t n,
+                                              double max_travel)
+    : xy(2 * n), z(n), floors(n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+    xy[2 * i] = s.x();
+    xy[2 * i + 1] = s.y();
+    z[i] = s.z();
+    floors[i] = s.z() - max_travel;
+  }
+}
+
 DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Vector3d& V,
                                    int threads)
     : V_(V) {
@@ -505,17 +517,10 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
     if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
       // V = -axis for every point: the tiled -Z batch in the rotated frame, each point's floor max_travel
       // below its start (as drop_along_point's fast path, point by point).
-      std::vector<double> xy(2 * n), floors(n), z(n);
-      std::vector<double> start_z(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
-        xy[2 * i] = s.x();
-        xy[2 * i + 1] = s.y();
-        start_z[i] = s.z();
-        floors[i] = s.z() - max_travel;
-      }
-      drop_batch(index.index(), cutter, xy.data(), n, floors.data(), z.data(), options, stats);
-      for (std::size_t i = 0; i < n; ++i) travel_out[i] = z[i] <= floors[i] ? max_travel : start_z[i] - z[i];
+      const direction_detail::RotatedStarts s(index, starts, n, max_travel);
+      std::vector<double> z(n);
+      drop_batch(index.index(), cutter, s.xy.data(), n, s.floors.data(), z.data(), options, stats);
+      for (std::size_t i = 0; i < n; ++i) travel_out[i] = s.travel(i, z[i], max_travel);
       return;
     }
   }

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -68,6 +69,20 @@ double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vect
                    double cap = kNoTravel);
 double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                     const Eigen::Vector3d& W, double cap = kNoTravel);
+}  // namespace direction_detail
+
+class DirectionalIndex;
+
+namespace direction_detail {
+// Start points seen in the frame where V = -Z: their (x, y) and heights, and each one's floor max_travel below.
+struct RotatedStarts {
+  std::vector<double> xy, z, floors;
+  RotatedStarts(const DirectionalIndex& index, const double* starts, std::size_t n, double max_travel);
+  // The travel to tip height `tip` of start i: max_travel where nothing lifted it above the floor.
+  double travel(std::size_t i, double tip, double max_travel) const {
+    return tip <= floors[i] ? max_travel : z[i] - tip;
+  }
+};
 }  // namespace direction_detail
 
 // A mesh indexed for drops along one direction V: the mesh rotated so that V = -Z' and indexed by MeshIndex
