@@ -12,6 +12,7 @@
 #include "tmm/query/drop_direction.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
+#include "starts.hpp"
 
 namespace py = pybind11;
 using tmm_bindings::python_progress;
@@ -32,16 +33,8 @@ Eigen::Vector3d vec3(const Array& a, const char* what) {
 py::array_t<double> drop_along(const tmm::DirectionalIndex& index, const tmm::Cutter& cutter, const Array& starts,
                                const Array& axes, double max_travel, int threads, const py::object& progress,
                                py::dict* stats_out) {
-  if (starts.ndim() != 2 || starts.shape(1) != 3) {
-    std::ostringstream msg;
-    msg << "start points must have shape (n, 3), got ndim " << starts.ndim();
-    throw std::invalid_argument(msg.str());
-  }
+  const bool per_point = tmm_bindings::check_starts_and_axes(starts, axes, max_travel);
   const std::size_t n = static_cast<std::size_t>(starts.shape(0));
-  const bool per_point = axes.ndim() == 2;
-  if (per_point ? (axes.shape(0) != starts.shape(0) || axes.shape(1) != 3) : axes.size() != 3)
-    throw std::invalid_argument("axes must have shape (3,) or (n, 3) like the start points");
-  if (std::isnan(max_travel)) throw std::invalid_argument("max_travel must not be NaN");
   py::array_t<double> travel(static_cast<py::ssize_t>(n));
   tmm::BatchOptions options;
   options.threads = threads;

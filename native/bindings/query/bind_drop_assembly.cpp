@@ -4,13 +4,17 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 #include <vector>
 
 #include "tmm/query/drop_assembly.hpp"
+#include "tmm/query/drop_assembly_direction.hpp"
 #include "util/arrays.hpp"
 #include "util/progress.hpp"
+#include "starts.hpp"
 
 namespace py = pybind11;
 
@@ -56,6 +60,25 @@ py::tuple drop_assembly(const tmm::MeshIndex& index, const tmm::Cutter& cutter, 
   return py::make_tuple(std::move(z), std::move(set_by));
 }
 
+py::tuple drop_assembly_along(const tmm::DirectionalIndex& index, const tmm::Cutter& cutter, const Array& bodies,
+                              const Array& starts, const Array& axes, double max_travel, double cutter_clearance,
+                              int threads, const py::object& progress) {
+  const tmm::ToolAssembly tool(cutter, bodies_from(bodies), cutter_clearance);
+  const bool per_point = tmm_bindings::check_starts_and_axes(starts, axes, max_travel);
+  const std::size_t n = static_cast<std::size_t>(starts.shape(0));
+  py::array_t<double> travel(static_cast<py::ssize_t>(n));
+  py::array_t<int32_t> set_by(static_cast<py::ssize_t>(n));
+  tmm::BatchOptions options;
+  options.threads = threads;
+  options.progress = tmm_bindings::python_progress(progress);
+  {
+    py::gil_scoped_release release;
+    tmm::drop_assembly_along_batch(index, tool, starts.data(), axes.data(), per_point, n, max_travel,
+                                   travel.mutable_data(), set_by.mutable_data(), options);
+  }
+  return py::make_tuple(std::move(travel), std::move(set_by));
+}
+
 }  // namespace
 
 void bind_drop_assembly(py::module_& m) {
@@ -71,4 +94,15 @@ void bind_drop_assembly(py::module_& m) {
         "the tool, as drop_cutter), set_by (n,) int32: -1 the cutter, i body i, -2 nothing above floor_z. With "
         "no bodies and no clearance z equals drop_cutter's exactly. Bad bodies raise ValueError naming the "
         "body. progress(fraction) -> bool; False cancels (raises Cancelled).");
+  m.def("drop_assembly_along", &drop_assembly_along, py::arg("index"), py::arg("cutter"), py::arg("bodies"),
+        py::arg("starts"), py::arg("axes"), py::arg("max_travel") = std::numeric_limits<double>::infinity(),
+        py::arg("cutter_clearance") = 0.0, py::arg("threads") = 0, py::arg("progress") = py::none(),
+        "Drop of the whole tool assembly along the DirectionalIndex's direction: from each (n, 3) start the tool "
+        "(tip at start + t * direction, t from -inf) travels until a piece first comes as close to the mesh as "
+        "its clearance. axes: the tool axis, (3,) or (n, 3) unit vectors. bodies and cutter_clearance as "
+        "drop_assembly; along a tilted axis an endless cutter is cut where the first body starts and nothing "
+        "above the last body is modelled. Returns (travel, set_by): travel (n,) float64 (max_travel where "
+        "nothing is touched before it), set_by (n,) int32: -1 the cutter, i body i, -2 nothing. With the axis "
+        "opposite to the direction: drop_assembly in the rotated frame (travel = start height - tip height). "
+        "progress(fraction) -> bool; False cancels (raises Cancelled).");
 }

@@ -44,9 +44,10 @@ void check_bodies(const std::vector<ToolBody>& bodies) {
   }
 }
 
-constexpr std::size_t kNoBody = ~std::size_t{0};
 // Fewer points walk without the height cells (building them costs about a walk per cell row).
 constexpr std::size_t kCellsFromPoints = 256;
+// Pieces reaching at most this many cells look up the cells within their reach of a point (about 4 k^2).
+constexpr double kFineCells = 6.0;
 // Pieces reaching at most this many times the cutter's radius are dropped with tile lists, wider ones by walks.
 constexpr double kTilesUpTo = 2.0;
 
@@ -83,7 +84,7 @@ void add_cutter(std::vector<AssemblyPiece>& out, const Cutter& k, double c, cons
   const double b2 = k.beta2();
   out.push_back({Cutter::apt(k.radius() + c * std::cos(b2), r, Lc + c * (1.0 - std::sin(b2)), 0.0, b2), -c,
                  kSetByCutter});
-  if (b2 > 0.0 && !disc_covered(bodies, kNoBody, Lc, k.radius(), c))
+  if (b2 > 0.0 && !disc_covered(bodies, ToolAssembly::kNoBody, Lc, k.radius(), c))
     out.push_back({Cutter(k.radius() + c, c), Lc - c, kSetByCutter});
 }
 
@@ -127,15 +128,43 @@ class HeightCells {
   }
 
   bool empty() const { return top_.empty(); }
+  double side() const { return side_; }
 
   // The maxima over squares of cells reaching `reach` around each cell (any triangle whose box comes within
   // `reach` of a point lies in the square around the point's cell).
-  std::vector<double> dilated(double reach) const {
+  // into `out` (resized; `rows` is scratch: both kept by the caller from piece to piece, fresh pages cost more
+  // than the pass).
+  void dilate(double reach, std::vector<double>& rows, std::vector<double>& out) const {
     const auto k = static_cast<std::size_t>(std::ceil(reach / side_)) + 1;
-    std::vector<double> rows(top_.size()), out(top_.size());
-    for (std::size_t j = 0; j < ny_; ++j) window_max(&top_[j * nx_], &rows[j * nx_], nx_, 1, k);
-    for (std::size_t i = 0; i < nx_; ++i) window_max(&rows[i], &out[i], ny_, nx_, k);
-    return out;
+    rows.resize(top_.size());
+    out.resize(top_.size());
+    WindowMax along_rows(nx_, k, 1);
+    for (std::size_t j = 0; j < ny_; ++j) along_rows(&top_[j * nx_], &rows[j * nx_], nx_, 1, 1);
+    constexpr std::size_t kLanes = 16;  // columns at once, row after row (no strided reads of single values)
+    WindowMax along_columns(ny_, k, kLanes);
+    for (std::size_t i = 0; i < nx_; i += kLanes)
+      along_columns(&rows[i], &out[i], ny_, std::min(kLanes, nx_ - i), nx_);
+  }
+
+  // Do all cells whose squares come within `reach` of (x, y) stay at or below `z` (false for a point outside
+  // the grid)? Finer than the dilated square around the point's cell, worth it for a few cells: row by row,
+  // the run of cells the disc meets, stopping at the first cell above z.
+  bool below_within(double x, double y, double reach, double z) const {
+    const double fx = (x - x0_) / side_, fy = (y - y0_) / side_, fr = reach / side_;
+    if (!(fx >= 0 && fy >= 0 && fx < static_cast<double>(nx_) && fy < static_cast<double>(ny_))) return false;
+    const auto j0 = static_cast<std::size_t>(std::max(fy - fr, 0.0));
+    const std::size_t j1 = std::min(static_cast<std::size_t>(fy + fr), ny_ - 1);
+    for (std::size_t j = j0; j <= j1; ++j) {
+      // The row's nearest y to the point, then the half-width of the disc there.
+      const double dy = std::max({static_cast<double>(j) - fy, fy - static_cast<double>(j + 1), 0.0});
+      const double half = std::sqrt(std::max(fr * fr - dy * dy, 0.0));
+      const auto i0 = static_cast<std::size_t>(std::max(fx - half, 0.0));
+      const std::size_t i1 = std::min(static_cast<std::size_t>(fx + half), nx_ - 1);
+      const double* row = &top_[j * nx_];
+      for (std::size_t i = i0; i <= i1; ++i)
+        if (row[i] > z) return false;
+    }
+    return true;
   }
 
   // The cell holding (x, y), or the nearest one (a node's corner outside the grid); clamped before the cast.
@@ -182,41 +211,87 @@ class HeightCells {
     }
   }
 
-  // out[i] = max(in[i - k .. i + k]) over the m values at `stride` (van Herk / Gil-Werman: blocks of 2k + 1,
-  // a running max from each block's start and from its end, two reads per value whatever k).
-  static void window_max(const double* in, double* out, std::size_t m, std::size_t stride, std::size_t k) {
-    const std::size_t w = 2 * k + 1, len = m + 2 * k;
-    std::vector<double> pad(len, -INFINITY), from_start(len), to_end(len);
-    for (std::size_t i = 0; i < m; ++i) pad[i + k] = in[i * stride];
-    for (std::size_t j = 0; j < len; ++j) from_start[j] = j % w == 0 ? pad[j] : std::max(from_start[j - 1], pad[j]);
-    for (std::size_t j = len; j-- > 0;)
-      to_end[j] = (j + 1 == len || (j + 1) % w == 0) ? pad[j] : std::max(to_end[j + 1], pad[j]);
-    for (std::size_t i = 0; i < m; ++i) out[i * stride] = std::max(to_end[i], from_start[i + 2 * k]);
-  }
+  // out[i] = max(in[i - k .. i + k]) over m <= most values, each a run of `width` <= lanes contiguous lanes
+  // `stride` apart (one window per lane) (van Herk / Gil-Werman: blocks of 2k + 1, a running max from each
+  // block's start and from its end, two reads per value whatever k). Buffers are kept from call to call.
+  class WindowMax {
+   public:
+    WindowMax(std::size_t most, std::size_t k, std::size_t lanes)
+        : k_(k), pad_((most + 2 * k) * lanes), from_start_(pad_.size()), to_end_(pad_.size()) {}
+    void operator()(const double* in, double* out, std::size_t m, std::size_t width, std::size_t stride) {
+      const std::size_t w = 2 * k_ + 1, len = m + 2 * k_, W = width;
+      std::fill(pad_.begin(), pad_.begin() + static_cast<std::ptrdiff_t>(len * W), -INFINITY);
+      for (std::size_t i = 0; i < m; ++i) std::copy(in + i * stride, in + i * stride + W, &pad_[(i + k_) * W]);
+      for (std::size_t j = 0; j < len; ++j) {
+        double* f = &from_start_[j * W];
+        const double* p = &pad_[j * W];
+        if (j % w == 0) std::copy(p, p + W, f);
+        else for (std::size_t l = 0; l < W; ++l) f[l] = std::max(f[l - W], p[l]);
+      }
+      for (std::size_t j = len; j-- > 0;) {
+        double* t = &to_end_[j * W];
+        const double* p = &pad_[j * W];
+        if (j + 1 == len || (j + 1) % w == 0) std::copy(p, p + W, t);
+        else for (std::size_t l = 0; l < W; ++l) t[l] = std::max(t[l + W], p[l]);
+      }
+      for (std::size_t i = 0; i < m; ++i)
+        for (std::size_t l = 0; l < W; ++l)
+          out[i * stride + l] = std::max(to_end_[i * W + l], from_start_[(i + 2 * k_) * W + l]);
+    }
+
+   private:
+    std::size_t k_;
+    std::vector<double> pad_, from_start_, to_end_;
+  };
 
   double x0_ = 0, y0_ = 0, side_ = 1;
   std::size_t nx_ = 0, ny_ = 0;
   std::vector<double> top_;
 };
 
+// Does `profile`'s flat bottom rest at height h at (x, y) on triangle t: a corner or an edge of t at h (both
+// ends) within the flat bottom's radius? With h the cells' bound at (x, y) (nothing within reach is higher),
+// the drop is then h exactly: the flat bottom cannot pass below that edge, nothing lifts it above. (A holder
+// over a plateau: the common case, answered without a walk.)
+bool rests_flat(const Cutter& profile, const IndexedTriangle& t, double x, double y, double h) {
+  const double e = profile.flat_radius();
+  if (!(t.zmax == h && e > 0.0 && profile.beta1() == 0.0)) return false;
+  for (int k = 0; k < 3; ++k) {
+    const double* p = t.p[k];
+    const double* q = t.p[(k + 1) % 3];
+    if (p[2] != h) continue;
+    double s = 0.0;  // the closest point of the edge p-q (of p alone when q is lower)
+    const double ex = q[0] - p[0], ey = q[1] - p[1], l2 = ex * ex + ey * ey;
+    if (q[2] == h && l2 > 0.0) s = std::clamp(((x - p[0]) * ex + (y - p[1]) * ey) / l2, 0.0, 1.0);
+    const double dx = p[0] + s * ex - x, dy = p[1] + s * ey - y;
+    if (dx * dx + dy * dy <= e * e) return true;
+  }
+  return false;
+}
+
 // One body's piece over the batch, each point from its own floor `base` (the height so far + the lift). Points
-// whose cells' bound is not above the floor keep it (top = base). The others are dropped with `tiles` as a
-// batch (drop_batch's tile lists: a shank or neck about the cutter's size), else each by the index walk warm-
-// started with the previous point's winner (a holder: its reach spans so many triangles that gathering them
-// per tile costs more than the walks; measured, benchmarks/drop_assembly.py).
+// whose cells' bound is not above the floor keep it (top = base); points where the previous winner holds the
+// flat bottom at the bound get the bound (rests_flat). The others are dropped with `tiles` as a batch
+// (drop_batch's tile lists: a shank or neck about the cutter's size), else each by the index walk warm-started
+// with the previous point's winner (a holder: its reach spans so many triangles that gathering them per tile
+// costs more than the walks; measured, benchmarks/drop_assembly.py).
 void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy, std::size_t n, const double* base,
-                double* top, const HeightCells& cells, bool tiles, const BatchOptions& options, DropStats* stats) {
-  std::vector<double> bound;
-  if (!cells.empty()) bound = cells.dilated(profile.max_radius());
-  auto clears = [&](std::size_t i) {
+                double* top, const HeightCells& cells, std::vector<double>& rows, std::vector<double>& bound,
+                bool tiles, const BatchOptions& options, DropStats* stats) {
+  bound.clear();
+  if (!cells.empty()) cells.dilate(profile.max_radius(), rows, bound);
+  auto bound_at = [&](std::size_t i) {
     const double x = xy[2 * i], y = xy[2 * i + 1];
-    return !bound.empty() && std::isfinite(x) && std::isfinite(y) && bound[cells.cell(x, y)] <= base[i];
+    return !bound.empty() && std::isfinite(x) && std::isfinite(y) ? bound[cells.cell(x, y)] : INFINITY;
   };
   if (tiles) {
     std::vector<std::size_t> kept;
     std::vector<double> kxy, kbase;
+    // A small piece: the cells within its reach of the point, where the dilated square is not low enough.
+    const bool fine = !bound.empty() && profile.max_radius() <= kFineCells * cells.side();
     for (std::size_t i = 0; i < n; ++i) {
-      if (clears(i)) {
+      if (bound_at(i) <= base[i] ||
+          (fine && cells.below_within(xy[2 * i], xy[2 * i + 1], profile.max_radius(), base[i]))) {
         top[i] = base[i];
         continue;
       }
@@ -229,16 +304,20 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
     for (std::size_t k = 0; k < kept.size(); ++k) top[kept[k]] = ktop[k];
     return;
   }
+  const auto& tris = index.triangles();
   std::atomic<std::size_t> tested{0};
   parallel_chunks(n, 512, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
     int32_t hint = -1;
     for (std::size_t i = begin; i < end; ++i) {
-      if (clears(i)) {
+      const double x = xy[2 * i], y = xy[2 * i + 1], ub = bound_at(i);
+      if (ub <= base[i]) {
         top[i] = base[i];
-        continue;
+      } else if (hint >= 0 && rests_flat(profile, tris[static_cast<std::size_t>(hint)], x, y, ub)) {
+        top[i] = ub;
+      } else {
+        top[i] = drop_point(index, profile, x, y, base[i], &local, &hint);
       }
-      top[i] = drop_point(index, profile, xy[2 * i], xy[2 * i + 1], base[i], &local, &hint);
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
   });
@@ -248,7 +327,7 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
 }  // namespace
 
 ToolAssembly::ToolAssembly(const Cutter& cutter, const std::vector<ToolBody>& bodies, double cutter_clearance)
-    : body_count_(bodies.size()) {
+    : cutter_(cutter), bodies_(bodies), cutter_clearance_(cutter_clearance) {
   if (!(in_range(cutter_clearance) && cutter_clearance >= 0.0)) {
     std::ostringstream msg;
     msg << "cutter clearance must be >= 0 and finite, got " << cutter_clearance;
@@ -263,6 +342,10 @@ ToolAssembly::ToolAssembly(const Cutter& cutter, const std::vector<ToolBody>& bo
       refuse_body(i, bodies[i], e.what());
     }
   }
+}
+
+bool ToolAssembly::disc_covered(std::size_t skip, double z, double radius, double clearance) const {
+  return tmm::disc_covered(bodies_, skip, z, radius, clearance);
 }
 
 double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, double x, double y, double floor_z,
@@ -282,17 +365,20 @@ double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, dou
   return z;
 }
 
-void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
-                         double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
-                         DropStats* stats) {
-  require_in_range(floor_z, "floor_z");
+namespace {
+
+// drop_assembly_batch with the floor of point i = floors ? floors[i] : floor_z.
+void drop_assembly_floors(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                          const double* floors, double floor_z, double* z_out, int32_t* set_by,
+                          const BatchOptions& options, DropStats* stats) {
   const std::vector<AssemblyPiece>& pieces = tool.pieces();
   const double passes = static_cast<double>(pieces.size());
-  std::vector<double> base(n), top(n);
+  std::vector<double> base(n), top(n), rows, bound;  // rows, bound: the cells' scratch, kept from piece to piece
   double reach = 0.0;  // of the bodies' pieces
   for (std::size_t k = 1; k < pieces.size(); ++k) reach = std::max(reach, pieces[k].profile.max_radius());
   const HeightCells cells(index, xy, pieces.size() > 1 && n >= kCellsFromPoints ? n : 0, reach);
-  std::fill(z_out, z_out + n, floor_z);
+  if (floors) std::copy(floors, floors + n, z_out);
+  else std::fill(z_out, z_out + n, floor_z);
   if (set_by) std::fill(set_by, set_by + n, kSetByFloor);
   for (std::size_t k = 0; k < pieces.size(); ++k) {
     const AssemblyPiece& p = pieces[k];
@@ -300,10 +386,12 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
     if (options.progress)
       pass.progress = [&options, k, passes](double f) { return options.progress((static_cast<double>(k) + f) / passes); };
     for (std::size_t i = 0; i < n; ++i) base[i] = z_out[i] + p.lift;
-    if (k == 0)  // one floor: the plain batch (with no clearance, the very heights of drop_batch)
+    if (k == 0 && !floors)  // one floor: the plain batch (with no clearance, the very heights of drop_batch)
       drop_batch(index, p.profile, xy, n, floor_z + p.lift, top.data(), pass, stats);
+    else if (k == 0)
+      drop_batch(index, p.profile, xy, n, base.data(), top.data(), pass, stats);
     else
-      drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells,
+      drop_piece(index, p.profile, xy, n, base.data(), top.data(), cells, rows, bound,
                  p.profile.max_radius() <= kTilesUpTo * pieces[0].profile.max_radius(), pass, stats);
     for (std::size_t i = 0; i < n; ++i) {
       if (top[i] > base[i] && top[i] - p.lift > z_out[i]) {
@@ -312,6 +400,23 @@ void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const
       }
     }
   }
+}
+
+}  // namespace
+
+void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                         double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
+                         DropStats* stats) {
+  require_in_range(floor_z, "floor_z");
+  drop_assembly_floors(index, tool, xy, n, nullptr, floor_z, z_out, set_by, options, stats);
+}
+
+void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                         const double* floors, double* z_out, int32_t* set_by, const BatchOptions& options,
+                         DropStats* stats) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (std::isnan(floors[i])) throw std::invalid_argument("drop floors must not be NaN (floor " + std::to_string(i) + ")");
+  drop_assembly_floors(index, tool, xy, n, floors, 0.0, z_out, set_by, options, stats);
 }
 
 }  // namespace tmm

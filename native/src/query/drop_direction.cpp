@@ -37,17 +37,8 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kTravelTol = 1e-12;       // mm, bracket width of the vertex entry
 constexpr double kUnitTol = 1e-9;          // |norm - 1| accepted for axis and direction
-constexpr double kParallelAxisTol = 1e-12; // |axis + V| below which the -Z contacts are used in the tool frame
-
-void require_unit(const Vector3d& v, const char* what) {
-  const double n = v.norm();
-  if (!(std::isfinite(n) && std::fabs(n - 1.0) <= kUnitTol)) {
-    std::ostringstream msg;
-    msg << what << " must be a finite unit vector, got (" << v.x() << ", " << v.y() << ", " << v.z()
-        << ") of length " << n;
-    throw std::invalid_argument(msg.str());
-  }
-}
+using direction_detail::kParallelAxisTol;
+using direction_detail::require_unit;
 
 }  // namespace
 
@@ -59,6 +50,16 @@ ToolFrame::ToolFrame(const Vector3d& axis) : a(axis.normalized()) {
 }
 
 namespace direction_detail {
+
+void require_unit(const Vector3d& v, const char* what) {
+  const double n = v.norm();
+  if (!(std::isfinite(n) && std::fabs(n - 1.0) <= kUnitTol)) {
+    std::ostringstream msg;
+    msg << what << " must be a finite unit vector, got (" << v.x() << ", " << v.y() << ", " << v.z()
+        << ") of length " << n;
+    throw std::invalid_argument(msg.str());
+  }
+}
 
 Support support(const Cutter& c, const Vector3d& d_in) {
   // (sqrt of sums of squares rather than hypot: this is the inner loop of the edge solver.)
@@ -419,6 +420,18 @@ std::shared_ptr<const MeshIndex> rotated_index(const VerticesRef& vertices, cons
 
 }  // namespace
 
+direction_detail::RotatedStarts::RotatedStarts(const DirectionalIndex& index, const double* starts, std::size_t n,
+                                              double max_travel)
+    : xy(2 * n), z(n), floors(n) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+    xy[2 * i] = s.x();
+    xy[2 * i + 1] = s.y();
+    z[i] = s.z();
+    floors[i] = s.z() - max_travel;
+  }
+}
+
 DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesRef& triangles, const Vector3d& V,
                                    int threads)
     : V_(V) {
@@ -504,17 +517,10 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
     if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
       // V = -axis for every point: the tiled -Z batch in the rotated frame, each point's floor max_travel
       // below its start (as drop_along_point's fast path, point by point).
-      std::vector<double> xy(2 * n), floors(n), z(n);
-      std::vector<double> start_z(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
-        xy[2 * i] = s.x();
-        xy[2 * i + 1] = s.y();
-        start_z[i] = s.z();
-        floors[i] = s.z() - max_travel;
-      }
-      drop_batch(index.index(), cutter, xy.data(), n, floors.data(), z.data(), options, stats);
-      for (std::size_t i = 0; i < n; ++i) travel_out[i] = z[i] <= floors[i] ? max_travel : start_z[i] - z[i];
+      const direction_detail::RotatedStarts s(index, starts, n, max_travel);
+      std::vector<double> z(n);
+      drop_batch(index.index(), cutter, s.xy.data(), n, s.floors.data(), z.data(), options, stats);
+      for (std::size_t i = 0; i < n; ++i) travel_out[i] = s.travel(i, z[i], max_travel);
       return;
     }
   }

@@ -19,6 +19,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop_direction import DirectionalDrop, check_starts
 from tmm_workbench.core.tools.assembly import Body, ToolAssembly
 
 Progress = Callable[[float], bool]
@@ -85,6 +86,7 @@ class AssemblyDrop:
         self.assembly = assembly
         self.bodies: list[Body] = assembly.bodies()
         self.pieces: tuple[str, ...] = body_pieces(assembly)
+        self._directional: Optional[DirectionalDrop] = None  # the last direction's index, kept for the next call
 
     @property
     def floor(self) -> float:
@@ -141,6 +143,32 @@ class AssemblyDrop:
         # The needle stands at the face's centre, under the holder's nose: it never sets a higher height.
         return self._drop(native.Cutter(NEEDLE_RADIUS, 0.0), holder.bodies(0.0, self.assembly.holder_clearance),
                           xy, floor_z, progress, threads, 0.0)
+
+    def along(self, starts: np.ndarray, axis, direction, max_travel: float = math.inf,
+              progress: Optional[Progress] = None, threads: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """(travel, owner): the assembly translated along the unit `direction` from each (n, 3) start (tip at
+        start + t * direction, t from -inf), its axis `axis` ((3,) or (n, 3) unit vectors), until a piece first
+        comes as close to the mesh as its clearance: the travel t of that contact (max_travel where nothing is
+        touched before it, owner -2) and what touched, as heights(). With the axis opposite to the direction this
+        is heights() along that axis (travel = start height - tip height). Along a tilted axis the cutter is
+        modelled up to where the first body starts and nothing above the holder. The mesh is indexed once per
+        direction (the last one is kept)."""
+        d = self._directional
+        if d is None or not np.array_equal(d.direction, np.asarray(direction, dtype=np.float64).reshape(-1)):
+            d = self._directional = DirectionalDrop(self.mesh, direction)
+        pts, axes, _ = check_starts(starts, axis, d.direction, max_travel)
+        rows = np.array(self.bodies, dtype=np.float64).reshape(-1, 5)
+        if progress is None:
+            progress = cancel.asker()
+        try:
+            travel, owner = native.drop_assembly_along(d.index, self.assembly.cutter.native, rows, pts, axes,
+                                                       float(max_travel), float(self.assembly.cutter_clearance),
+                                                       int(threads), progress)
+        except native.Cancelled as exc:
+            raise Cancelled("tool assembly drop cancelled") from exc
+        except ValueError as exc:
+            raise TmmError(f"{self.mesh.name}, {self.assembly.describe()}: {exc}") from exc
+        return np.asarray(travel), np.asarray(owner, dtype=np.int32)
 
     def _drop(self, cutter: "native.Cutter", bodies: list[Body], xy: np.ndarray, floor_z: Optional[float],
               progress: Optional[Progress], threads: int, cutter_clearance: float) -> tuple[np.ndarray, np.ndarray]:

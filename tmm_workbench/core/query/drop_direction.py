@@ -67,6 +67,29 @@ def _native_cutter(cutter: Cutter, needs_length: bool) -> "native.Cutter":
     return cutter.native
 
 
+def check_starts(starts: np.ndarray, axis, direction: np.ndarray,
+                 max_travel: float) -> Tuple[np.ndarray, np.ndarray, bool]:
+    """The (n, 3) starts and the axes ((3,) or (n, 3) unit vectors) as float arrays, max_travel checked; and
+    whether every axis is opposite to the unit `direction` (the drop along the tool's own axis)."""
+    pts = np.ascontiguousarray(starts, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise TmmError(f"start points must have shape (n, 3), got {pts.shape}")
+    if not np.isfinite(pts).all():
+        raise TmmError("start points contain a non-finite coordinate")
+    if isinstance(max_travel, bool) or not isinstance(max_travel, (int, float)) or math.isnan(max_travel):
+        raise TmmError(f"max_travel must be a number, got {max_travel!r}")
+    ax = np.ascontiguousarray(axis, dtype=np.float64)
+    if ax.ndim == 2:
+        if ax.shape != pts.shape:
+            raise TmmError(f"axes must have shape (3,) or {pts.shape}, got {ax.shape}")
+        axes = _unit_rows("cutter axes", ax)
+        opposite = bool(np.all(np.linalg.norm(axes + direction, axis=1) <= _AXIS_OPPOSITE_TOL))
+    else:
+        axes = _unit("cutter axis", ax)
+        opposite = float(np.linalg.norm(axes + direction)) <= _AXIS_OPPOSITE_TOL
+    return pts, axes, opposite
+
+
 class DirectionalDrop:
     """A mesh indexed for drops along one unit `direction` (build once per direction, e.g. per 3+2 setup)."""
 
@@ -78,27 +101,17 @@ class DirectionalDrop:
         except ValueError as exc:
             raise TmmError(f"{mesh.name}: {exc}") from exc
 
+    @property
+    def index(self) -> "native.DirectionalIndex":
+        """The kernel's index of the mesh for this direction (shared by the tool assembly's drop)."""
+        return self._index
+
     def drop(self, cutter: Cutter, starts: np.ndarray, axis, max_travel: float = math.inf,
              progress: Optional[Progress] = None, threads: int = 0) -> Tuple[np.ndarray, np.ndarray]:
         """Travel (n,) and tip positions (n, 3) of the first contact from each (n, 3) start along the direction.
         `axis`: one unit vector (3,) or one per start (n, 3). Where nothing is touched within `max_travel`
         the travel is `max_travel` (inf by default: then the tip position is NaN)."""
-        pts = np.ascontiguousarray(starts, dtype=np.float64)
-        if pts.ndim != 2 or pts.shape[1] != 3:
-            raise TmmError(f"start points must have shape (n, 3), got {pts.shape}")
-        if not np.isfinite(pts).all():
-            raise TmmError("start points contain a non-finite coordinate")
-        if isinstance(max_travel, bool) or not isinstance(max_travel, (int, float)) or math.isnan(max_travel):
-            raise TmmError(f"max_travel must be a number, got {max_travel!r}")
-        ax = np.ascontiguousarray(axis, dtype=np.float64)
-        if ax.ndim == 2:
-            if ax.shape != pts.shape:
-                raise TmmError(f"axes must have shape (3,) or {pts.shape}, got {ax.shape}")
-            axes = _unit_rows("cutter axes", ax)
-            opposite = bool(np.all(np.linalg.norm(axes + self.direction, axis=1) <= _AXIS_OPPOSITE_TOL))
-        else:
-            axes = _unit("cutter axis", ax)
-            opposite = float(np.linalg.norm(axes + self.direction)) <= _AXIS_OPPOSITE_TOL
+        pts, axes, opposite = check_starts(starts, axis, self.direction, max_travel)
         ncut = _native_cutter(cutter, needs_length=not opposite)
         try:
             travel = native.drop_along(self._index, ncut, pts, axes, float(max_travel), threads, progress)

@@ -58,11 +58,21 @@ class ToolAssembly {
   // The grown cutter first (with no clearance the cutter itself, lift 0), then the bodies' pieces from the
   // lowest up: the order the drop raises the height in.
   const std::vector<AssemblyPiece>& pieces() const { return pieces_; }
-  std::size_t body_count() const { return body_count_; }
+  std::size_t body_count() const { return bodies_.size(); }
+  const Cutter& cutter() const { return cutter_; }
+  const std::vector<ToolBody>& bodies() const { return bodies_; }
+  double cutter_clearance() const { return cutter_clearance_; }
+
+  // Does a body other than `skip` (kNoBody: none skipped), grown by its clearance, hold the disc of radius
+  // `radius` at height `z` grown by `clearance`? Then that disc's grown piece never touches first.
+  static constexpr std::size_t kNoBody = ~std::size_t{0};
+  bool disc_covered(std::size_t skip, double z, double radius, double clearance) const;
 
  private:
+  Cutter cutter_;
+  std::vector<ToolBody> bodies_;
+  double cutter_clearance_ = 0;
   std::vector<AssemblyPiece> pieces_;
-  std::size_t body_count_ = 0;
 };
 
 // One point: the tip height, never below floor_z. `set_by` (may be null) receives kSetByCutter, the body or
@@ -79,6 +89,12 @@ double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, dou
 // range).
 void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
                          double floor_z, double* z_out, int32_t* set_by, const BatchOptions& options,
+                         DropStats* stats = nullptr);
+
+// As above with a floor per point (floors: n heights, -inf allowed), e.g. starts at different heights: with
+// every floor equal to floor_z the very heights of the one-floor batch.
+void drop_assembly_batch(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
+                         const double* floors, double* z_out, int32_t* set_by, const BatchOptions& options,
                          DropStats* stats = nullptr);
 
 }  // namespace tmm

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -51,6 +52,10 @@ double drop_along_general(const Cutter& cutter, const Eigen::Vector3d& tip_start
 
 // Pieces of the general method, in the tool frame with the start tip at the origin; W = V in tool coordinates.
 namespace direction_detail {
+// |axis + V| below which the axis counts as opposite to the direction (the -Z drop in the rotated frame).
+constexpr double kParallelAxisTol = 1e-12;
+// std::invalid_argument naming `what` unless v is a finite unit vector (within 1e-9).
+void require_unit(const Eigen::Vector3d& v, const char* what);
 // Point of K extreme in direction d (maximising d . X); value = d . X (+inf when unbounded: L_C = inf).
 struct Support {
   Eigen::Vector3d point;
@@ -64,6 +69,20 @@ double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vect
                    double cap = kNoTravel);
 double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                     const Eigen::Vector3d& W, double cap = kNoTravel);
+}  // namespace direction_detail
+
+class DirectionalIndex;
+
+namespace direction_detail {
+// Start points seen in the frame where V = -Z: their (x, y) and heights, and each one's floor max_travel below.
+struct RotatedStarts {
+  std::vector<double> xy, z, floors;
+  RotatedStarts(const DirectionalIndex& index, const double* starts, std::size_t n, double max_travel);
+  // The travel to tip height `tip` of start i: max_travel where nothing lifted it above the floor.
+  double travel(std::size_t i, double tip, double max_travel) const {
+    return tip <= floors[i] ? max_travel : z[i] - tip;
+  }
+};
 }  // namespace direction_detail
 
 // A mesh indexed for drops along one direction V: the mesh rotated so that V = -Z' and indexed by MeshIndex

@@ -1,0 +1,174 @@
+// The tool assembly dropped along any direction: its grown pieces as convex drop_direction solids (see
+// drop_assembly_direction.hpp), each dropped with the travel so far as its cap, or along the tool's own axis
+// the vertical assembly drop in the rotated frame.
+#include "tmm/query/drop_assembly_direction.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "tmm/util/range.hpp"
+
+namespace tmm {
+
+using Eigen::Vector3d;
+using direction_detail::kParallelAxisTol;
+using direction_detail::require_unit;
+
+namespace {
+
+// A frustum grown by c from its narrow end (radius rn, `narrow` along the tool axis from the tip) to its wide
+// end (radius rw, `length` further towards dir: +1 up the axis, -1 down it). `wide_covered`: another grown
+// body holds the wide disc grown by c, so the rim's ball is left out.
+void add_grown_frustum(std::vector<AssemblySolid>& out, double narrow, double dir, double rn, double rw,
+                       double length, double c, bool wide_covered, int32_t owner) {
+  const bool flipped = dir < 0.0;
+  const double beta = std::atan2(rw - rn, length);
+  // The APT cutter of the vertical drop: flat bottom rn, corner c, the side offset by c up to the rim's ball.
+  out.push_back({Cutter::apt(rw + c * std::cos(beta), c, length + c * (1.0 - std::sin(beta)), 0.0, beta),
+                 narrow - dir * c, flipped, owner});
+  if (c == 0.0 || wide_covered) return;
+  const Cutter rim = Cutter::apt(rw + c, c, c, 0.0, 0.0);  // the wide disc grown by c, one half
+  const double wide = narrow + dir * length;
+  if (beta > 0.0) out.push_back({rim, wide - dir * c, flipped, owner});  // the ball between side and disc
+  out.push_back({rim, wide + dir * c, !flipped, owner});                 // beyond the wide end
+}
+
+// The cutter solid of drop_direction (an endless one cut where the first body starts), grown by the cutter's
+// clearance c: a flat-bottomed profile offset by c (as drop_assembly.cpp's), the top rim's ball and the top
+// disc. With beta2 <= 0 the solid is the cylinder of the widest radius above the arc, grown as one.
+void add_cutter(std::vector<AssemblySolid>& out, const ToolAssembly& tool) {
+  Cutter k = tool.cutter();
+  if (!std::isfinite(k.cutting_length())) {
+    if (tool.bodies().empty())
+      throw std::invalid_argument(
+          "a drop with the tool axis not opposite to the direction needs a cutter with a finite cutting length "
+          "or a body above it (nothing above the cutter is modelled)");
+    try {
+      k = Cutter::apt(k.radius(), k.corner_radius(), tool.bodies()[0].z0, k.beta1(), 0.0);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("the endless cutter cut where the first tool body starts: ") + e.what());
+    }
+  }
+  const double c = tool.cutter_clearance();
+  if (c == 0.0) {
+    out.push_back({k, 0.0, false, kSetByCutter});
+    return;
+  }
+  const double Lc = k.cutting_length(), R = k.max_radius(), b2 = std::max(k.beta2(), 0.0);
+  out.push_back({Cutter::apt(R + c * std::cos(b2), k.corner_radius() + c, Lc + c * (1.0 - std::sin(b2)), 0.0, b2),
+                 -c, false, kSetByCutter});
+  if (tool.disc_covered(ToolAssembly::kNoBody, Lc, R, c)) return;
+  const Cutter rim = Cutter::apt(R + c, c, c, 0.0, 0.0);
+  if (b2 > 0.0) out.push_back({rim, Lc - c, false, kSetByCutter});
+  out.push_back({rim, Lc + c, true, kSetByCutter});
+}
+
+bool along_axis(const DirectionalIndex& index, const Vector3d& axis) {
+  return (index.rotation() * axis.normalized() - Vector3d::UnitZ()).norm() <= kParallelAxisTol;
+}
+
+// Along the tool's axis: the vertical drop in the rotated frame, travel = start height - tip height.
+double axial_drop(const DirectionalIndex& index, const ToolAssembly& tool, const Vector3d& start, double max_travel,
+                  int32_t* set_by, DropStats* stats) {
+  const Vector3d s = index.rotation() * start;
+  const double floor_z = s.z() - max_travel;
+  const double z = drop_assembly_point(index.index(), tool, s.x(), s.y(), floor_z, set_by, stats);
+  return z <= floor_z ? max_travel : s.z() - z;
+}
+
+// The earliest contact of the solids from `start` (hints: one per solid, or null), capped at max_travel.
+double along_solids(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids, const Vector3d& start,
+                    const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats, int32_t* hints) {
+  double best = max_travel;
+  int32_t by = kSetByFloor;
+  for (std::size_t k = 0; k < solids.size(); ++k) {
+    const AssemblySolid& s = solids[k];
+    // Only a contact before the best so far matters: it caps this solid's search.
+    const double t = drop_along_point(index, s.profile, start + s.lift * axis, s.flipped ? Vector3d(-axis) : axis,
+                                      best, stats, hints ? &hints[k] : nullptr);
+    if (t < best) {
+      best = t;
+      by = s.owner;
+    }
+  }
+  if (set_by) *set_by = by;
+  return best;
+}
+
+}  // namespace
+
+std::vector<AssemblySolid> assembly_solids(const ToolAssembly& tool) {
+  std::vector<AssemblySolid> out;
+  add_cutter(out, tool);
+  const std::vector<ToolBody>& bodies = tool.bodies();
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const ToolBody& b = bodies[i];
+    const auto owner = static_cast<int32_t>(i);
+    try {
+      if (b.r1 > b.r0)
+        add_grown_frustum(out, b.z0, 1.0, b.r0, b.r1, b.z1 - b.z0, b.clearance,
+                          tool.disc_covered(i, b.z1, b.r1, b.clearance), owner);
+      else  // narrowing upwards, or a cylinder: from the top down
+        add_grown_frustum(out, b.z1, -1.0, b.r1, b.r0, b.z1 - b.z0, b.clearance,
+                          tool.disc_covered(i, b.z0, b.r0, b.clearance), owner);
+    } catch (const std::invalid_argument& e) {  // a cone too flat for an APT profile
+      throw std::invalid_argument("tool body " + std::to_string(i) + " along a direction: " + e.what());
+    }
+  }
+  return out;
+}
+
+double drop_assembly_along_point(const DirectionalIndex& index, const ToolAssembly& tool, const Vector3d& start,
+                                 const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats) {
+  require_unit(axis, "tool axis");
+  if (along_axis(index, axis)) return axial_drop(index, tool, start, max_travel, set_by, stats);
+  return along_solids(index, assembly_solids(tool), start, axis.normalized(), max_travel, set_by, stats, nullptr);
+}
+
+void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly& tool, const double* starts,
+                               const double* axes, bool axes_per_point, std::size_t n, double max_travel,
+                               double* travel_out, int32_t* set_by, const BatchOptions& options,
+                               DropStats* stats) {
+  // Validate up front: workers must not throw.
+  require_rows_in_range(starts, n, 3, "start points");
+  if (!(in_range(max_travel) || max_travel == INFINITY)) require_in_range(max_travel, "max_travel");
+  bool all_along = n > 0;
+  for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}); ++i) {
+    const Vector3d ax(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]);
+    require_unit(ax, "tool axis");
+    all_along = all_along && along_axis(index, ax);
+  }
+  if (all_along && !axes_per_point) {
+    // The vertical assembly batch in the rotated frame, each point's floor max_travel below its start.
+    const direction_detail::RotatedStarts s(index, starts, n, max_travel);
+    std::vector<double> z(n);
+    drop_assembly_batch(index.index(), tool, s.xy.data(), n, s.floors.data(), z.data(), set_by, options, stats);
+    for (std::size_t i = 0; i < n; ++i) travel_out[i] = s.travel(i, z[i], max_travel);
+    return;
+  }
+  std::vector<AssemblySolid> solids;
+  bool any_tilted = false;
+  for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
+    any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
+  if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
+  std::atomic<std::size_t> tested{0};
+  // Hints start afresh with each chunk, so results do not depend on the thread count.
+  parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
+    DropStats local;
+    std::vector<int32_t> hints(solids.size(), -1);
+    for (std::size_t i = begin; i < end; ++i) {
+      const double* ax = axes + (axes_per_point ? 3 * i : 0);
+      const Vector3d start(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]), axis(ax[0], ax[1], ax[2]);
+      int32_t* by = set_by ? set_by + i : nullptr;
+      travel_out[i] = along_axis(index, axis)
+                          ? axial_drop(index, tool, start, max_travel, by, &local)
+                          : along_solids(index, solids, start, axis.normalized(), max_travel, by, &local, hints.data());
+    }
+    tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+  });
+  if (stats) stats->triangles_tested += tested.load();
+}
+
+}  // namespace tmm
