@@ -28,7 +28,7 @@ def test_a_property_declared_by_two_stages_is_refused() -> None:
 
 def test_the_api_spelling_of_choices() -> None:
     by = {f.prop: f for f in fields_of(SURFACE_CORE)}
-    assert by["Pattern"].api_choices() == {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral"}
+    assert by["Pattern"].api_choices() == {"zigzag": "ZigZag", "oneway": "OneWay", "spiral": "Spiral", "pencil": "Pencil"}
     assert by["StepOverMode"].api_choices()["offset3d"] == "Offset3D"
     assert by["ForwardStep"].api_choices() == {"tolerance": "Tolerance", "sample": "SampleStep"}
     assert {"stepover", "cusp", "pattern", "sample_step", "arcs", "forward_step"} <= api_names(SURFACE_CORE)
