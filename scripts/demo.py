@@ -1,6 +1,7 @@
 """TMM's main job, headless: three models finished with a 3-axis surface raster, a block roughed down to
-sphere_on_plate and its walls finished by waterline (one Job), then seed 001's convex Bézier patch finished
-5-axis by multipoint positioning (tarus G-code, APT CL, document, pictures).
+sphere_on_plate and its walls finished by waterline (one Job), sphere_on_plate finished with a ball D10 and its
+rest taken by a ball D3 (one Job), then seed 001's convex Bézier patch finished 5-axis by multipoint positioning
+(tarus G-code, APT CL, document, pictures).
 
     freecadcmd scripts/demo.py            # G-code (.ngc), FreeCAD document (.FCStd) and picture (.png)
     /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
@@ -205,6 +206,11 @@ def main() -> None:
     t_r = time.perf_counter()
     print_rough_finish(run_rough_finish_case(out, with_freecad), time.perf_counter() - t_r)
 
+    # rest: what a ball D10 leaves in sphere_on_plate's fillet, taken off by a ball D3 in the same Job
+    if with_freecad:
+        t_rest = time.perf_counter()
+        print_rest(run_rest_case(out), time.perf_counter() - t_rest)
+
     # 5-axis part: seed 001's convex patch, multipoint positioning (the 3-axis part above is unchanged)
     t5 = time.perf_counter()
     row5 = run_multipoint_case(out, with_freecad)
@@ -294,6 +300,54 @@ def print_rough_finish(r: dict[str, Any], total: float) -> None:
         size = f.stat().st_size if f.exists() else -1
         print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
     print(f"stock to part {total:.1f} s", flush=True)
+
+
+# --- rest -----------------------------------------------------------------------------------------------
+REST_NAME = "rest_finish"
+REST_FINISH = dict(tool="ballend", diameter=10.0, stepover=0.6, sample_step=0.25, boundary="model")
+REST_SMALL = dict(tool="ballend", diameter=3.0, stepover=0.3, sample_step=0.25, boundary="model", region="rest")
+
+
+def run_rest_case(out: Path) -> dict[str, Any]:
+    """sphere_on_plate.stl finished with a ball D10, then a ball D3 only where the D10 left more than 0.01 mm
+    that the D3 reaches (Region Rest, app.rest_source) in the same Job; both posted, the Job simulated."""
+    import FreeCAD
+    from tmm_workbench.app.api import run_surface
+    from tmm_workbench.core.preview.toolpath_png import render_toolpath_png
+
+    model = str(bench() / "stl" / "sphere_on_plate.stl")
+    print(f"--- {REST_NAME}: sphere_on_plate.stl, {describe_tool(REST_FINISH)} finish then {describe_tool(REST_SMALL)}"
+          f" rest", flush=True)
+    t0 = time.perf_counter()
+    big = run_surface(model, gcode_path=str(out / f"{REST_NAME}_d10.ngc"), doc_name=REST_NAME, progress=False,
+                      **REST_FINISH)
+    small = run_surface(None, job=big, gcode_path=str(out / f"{REST_NAME}_d3.ngc"),
+                        fcstd_path=str(out / f"{REST_NAME}.FCStd"), progress=False, **REST_SMALL)
+    seconds = time.perf_counter() - t0
+    files = [out / f"{REST_NAME}_d10.ngc", out / f"{REST_NAME}_d3.ngc", out / f"{REST_NAME}.FCStd"]
+    png = out / f"{REST_NAME}_d3.png"
+    render_toolpath_png(small.mesh, small.toolpath, str(png), title="TMM rest: a ball D3 where a D10 left material")
+    sim = simulate_case(small, out / f"{REST_NAME}_sim.png", 0.2)
+    files += [png, out / f"{REST_NAME}_sim.png"]
+    report = str(small.op.RestReport)
+    try:
+        FreeCAD.closeDocument(big.doc.Name)
+    except Exception:  # noqa: BLE001 - closing is a courtesy
+        pass
+    return dict(name=REST_NAME, moves=(len(big.toolpath), len(small.toolpath)), seconds=seconds, sim=sim,
+                report=report, files=files)
+
+
+def print_rest(r: dict[str, Any], total: float) -> None:
+    print(f"\n{'case (rest)':<22} {'D10 moves':>10} {'D3 rest moves':>14} {'both s':>8}")
+    print(f"{r['name']:<22} {r['moves'][0]:>10} {r['moves'][1]:>14} {r['seconds']:>8.2f}")
+    print(f"the rest: {r['report']}")
+    print("simulated (D10 finish + D3 rest): " + sim_line(r["name"], r["sim"]))
+    print("written (rest):")
+    for f in r["files"]:
+        size = f.stat().st_size if f.exists() else -1
+        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print(f"rest {total:.1f} s", flush=True)
 
 
 # --- 5-axis part -------------------------------------------------------------------------------------
