@@ -61,18 +61,14 @@ def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tu
     if not (math.isfinite(tolerance) and TOLERANCE.low < tolerance <= TOLERANCE.high):
         raise TmmError(f"RestTolerance must be in (0, {TOLERANCE.high:g}] mm, got {tolerance:g}")
     if op.RestFrom == EARLIER_OPS:
-        earlier = simulation.earlier_ops(op)
-        if left is None or not earlier or not any(len(simulation.toolpath_and_feeds(o)[0]) >= 2 for o in earlier):
+        if left is None or not simulation.earlier_paths(op):
             raise TmmError("Region 'Rest' from EarlierOps: no earlier operation of the Job has a path to leave "
                            "material (or one waits for its recompute): put the rest op after the finishing op, or "
                            "take the rest from a reference tool (RestFrom ReferenceTool)")
         grid, heights = left.grid, np.array(left.heights)   # a copy: the linker cuts the material top as it links
     else:
         reference = _reference_cutter(op, cutter)
-        cell = max(min(simulation.KNOWN_CELL_MM, cutter.radius / 4),
-                   math.sqrt(job.Stock.Shape.BoundBox.XLength * job.Stock.Shape.BoundBox.YLength /
-                             simulation.KNOWN_CELLS))
-        grid = simulation.simulation_grid(job, cell)
+        grid = simulation.simulation_grid(job, simulation.known_cell(job, cutter))   # as the earlier ops' stock
         heights = np.minimum(simulation.stock_heights(job, grid), tool_envelope(mesh, reference, grid))
     area = rest_area(heights, mesh_heights(mesh, grid), tool_envelope(mesh, cutter, grid), grid, tolerance,
                      cutter.radius)
@@ -98,11 +94,8 @@ def report(obj: Any, rest: Optional[Rest]) -> None:
     if rest is None:
         obj.RestReport, obj.RestRegions = "", []
         return
-    xy = rest.area.cells_xy()
-    g = rest.area.grid
-    i = np.floor((xy[:, 0] - g.x0) / g.cell).astype(int)
-    j = np.floor((xy[:, 1] - g.y0) / g.cell).astype(int)
-    pts = np.column_stack([xy, rest.stock.heights[j, i]])[:: max(1, -(-len(xy) // MAX_MARKS))]
+    mask = rest.area.mask
+    pts = np.column_stack([rest.area.cells_xy(), rest.stock.heights[mask]])[:: max(1, -(-mask.sum() // MAX_MARKS))]
     obj.RestReport = rest.area.summary()
     obj.RestRegions = [FreeCAD.Vector(*map(float, p)) for p in pts]
     FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")

@@ -311,13 +311,26 @@ def earlier_ops(obj: Any) -> Optional[list]:
     return earlier
 
 
+def earlier_paths(obj: Any) -> bool:
+    """Whether an active op before `obj` in its Job has a path to cut the stock with (False while one waits for
+    its recompute)."""
+    earlier = earlier_ops(obj)
+    return bool(earlier) and any(len(toolpath_and_feeds(op)[0]) >= 2 for op in earlier)
+
+
+def known_cell(job: Any, cutter: Cutter) -> float:
+    """The cell of the stock heights an op works over: KNOWN_CELL_MM (a quarter of the tool radius if finer),
+    larger on a stock so big that it would hold more than KNOWN_CELLS."""
+    bb = job.Stock.Shape.BoundBox
+    return max(min(KNOWN_CELL_MM, cutter.radius / 4), math.sqrt(bb.XLength * bb.YLength / KNOWN_CELLS))
+
+
 def rest_stock(obj: Any, cutter: Cutter) -> Optional[tuple[Grid, np.ndarray]]:
     """What the Job's earlier ops left, as (grid, heights) for a roughing to cut only where material lies, each
     cell the highest of its neighbours (a height is the stock's at a cell's centre only; a wall between two
     centres rises to the higher). None when no earlier op has a path (the stock solid itself is then exact) or
     one waits for its recompute."""
-    earlier = earlier_ops(obj)
-    if not earlier or not any(len(toolpath_and_feeds(op)[0]) >= 2 for op in earlier):
+    if not earlier_paths(obj):
         return None
     left = material_left(obj, cutter)
     if left is None:
@@ -336,9 +349,7 @@ def material_left(obj: Any, cutter: Cutter) -> Optional[StockHeights]:
     earlier = earlier_ops(obj)
     if earlier is None:
         return None
-    bb = job.Stock.Shape.BoundBox
-    cell = max(min(KNOWN_CELL_MM, cutter.radius / 4), math.sqrt(bb.XLength * bb.YLength / KNOWN_CELLS))
-    grid = simulation_grid(job, cell)
+    grid = simulation_grid(job, known_cell(job, cutter))
     heights = stock_heights(job, grid)
     for op in earlier:
         tp, _ = toolpath_and_feeds(op)

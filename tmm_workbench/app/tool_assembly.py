@@ -55,12 +55,13 @@ def ignored(args: Args) -> Optional[str]:
     return None
 
 
+HOLDERS = holder_choices()   # the library read once, at import (the panel and the API offer these)
 STAGE = Stage("tool assembly", (
     Field("Holder", "choice", "Tool",
           "The tool holder (TMM's library, docs/holders.md): its shank and the holder are kept their clearance "
           "away from the model; FromToolController: the one set on the tool controller (its TmmHolder); None: "
-          "the cutter alone", api="holder", choices=holder_choices(),
-          api_names={**{str(n).lower(): n for n in holder_choices() if n != FROM_TC}, "tool_controller": FROM_TC},
+          "the cutter alone", api="holder", choices=HOLDERS,
+          api_names={**{str(n).lower(): n for n in HOLDERS if n != FROM_TC}, "tool_controller": FROM_TC},
           default=FROM_TC, restored=NONE, widget="holder"),
     Field("StickOut", "length", "Tool",
           "Gauge length from the holder's face to the tool tip, mm; 0: the tool controller's (TmmStickOut), or "

@@ -84,8 +84,7 @@ class RestArea:
 
     def cells_xy(self) -> np.ndarray:
         """(n, 2) centres of the rest cells (what the view marks)."""
-        j, i = np.nonzero(self.mask)
-        return np.column_stack([self.grid.x0 + (i + 0.5) * self.grid.cell, self.grid.y0 + (j + 0.5) * self.grid.cell])
+        return self.grid.centres()[self.mask.ravel()]
 
 
 def tool_envelope(mesh: TriMesh, cutter: Cutter, grid: Grid, surface: Optional[DropSurface] = None,

@@ -52,12 +52,10 @@ def covering_passes(found: list[np.ndarray], params: SurfaceParams, step: float)
         return 1
     from scipy.spatial import cKDTree
 
-    cells = np.argwhere(np.isfinite(rest.heights))
-    if not len(cells):
+    xy = rest.grid.centres()[np.isfinite(rest.heights).ravel()]   # the rest cells
+    if not len(xy):
         return 1
-    g = rest.grid
-    xy = np.column_stack([g.x0 + (cells[:, 1] + 0.5) * g.cell, g.y0 + (cells[:, 0] + 0.5) * g.cell])
-    reach = np.percentile(cKDTree(np.vstack(pencil.sampled(found, g.cell))).query(xy)[0], 95)
+    reach = np.percentile(cKDTree(np.vstack(pencil.sampled(found, rest.grid.cell))).query(xy)[0], 95)
     return int(min(50, max(1, math.ceil(reach / step) + 1)))
 
 
