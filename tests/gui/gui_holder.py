@@ -12,18 +12,15 @@ import sys
 from pathlib import Path
 
 import FreeCADGui
-from PySide import QtCore, QtGui
+from PySide import QtGui
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 sys.path.insert(0, str(ROOT / "tests" / "gui"))
 sys.path.insert(0, str(ROOT / "tests" / "freecad"))
-_single_shot = QtCore.QTimer.singleShot
-QtCore.QTimer.singleShot = staticmethod(lambda *args: None)  # the smoke script's helpers, not its run
-try:
-    import gui_smoke  # noqa: E402,F401 (loads the smoke script's helpers)
-    from gui_smoke import close_panel, find_panel, pump, screenshot  # noqa: E402
-finally:
-    QtCore.QTimer.singleShot = _single_shot
+import gui_runner  # noqa: E402
+
+gui_runner.helpers_of("gui_smoke")  # its helpers, not its run
+from gui_smoke import close_panel, find_panel, pump, screenshot  # noqa: E402
 
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui" / "holder_regions.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_holder.json")
@@ -95,7 +92,5 @@ def run() -> dict:
     gui_runner.close_document(r.doc)
     return info
 
-
-import gui_runner  # noqa: E402
 
 gui_runner.run(lambda info: info.update(run()), RESULT)

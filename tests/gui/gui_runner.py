@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import faulthandler
 import gc
+import importlib
 import json
 import os
 import sys
 import time
 import traceback
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 from PySide import QtCore, QtGui
 
@@ -20,6 +21,17 @@ except ImportError:  # FreeCAD 0.20 and 1.0: PySide2
     import shiboken2 as shiboken
 
 _STDERR = os.fdopen(os.dup(2), "w")  # the process's stderr (FreeCAD's sys.stderr has no file descriptor)
+
+
+def helpers_of(script: str) -> Any:
+    """Another GUI script imported for its helpers, not its session: importing it schedules its run on the event
+    loop (run()), so the scheduling is held off meanwhile."""
+    single_shot = QtCore.QTimer.singleShot
+    QtCore.QTimer.singleShot = staticmethod(lambda *args: None)
+    try:
+        return importlib.import_module(script)
+    finally:
+        QtCore.QTimer.singleShot = single_shot
 
 
 def pump(seconds: float) -> None:

@@ -11,16 +11,14 @@ import sys
 from pathlib import Path
 
 import FreeCADGui
-from PySide import QtCore, QtGui
+from PySide import QtGui
 
 ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.cwd()
 sys.path.insert(0, str(ROOT / "tests" / "gui"))
-_single_shot = QtCore.QTimer.singleShot
-QtCore.QTimer.singleShot = staticmethod(lambda *args: None)  # the smoke script's helpers, not its run
-try:
-    from gui_smoke import click_close, find_panel, pump, screenshot  # noqa: E402
-finally:
-    QtCore.QTimer.singleShot = _single_shot
+import gui_runner  # noqa: E402
+
+gui_runner.helpers_of("gui_smoke")  # its helpers, not its run
+from gui_smoke import click_close, find_panel, pump, screenshot  # noqa: E402
 
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui" / "sim_holder.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_sim_holder.json")
@@ -101,12 +99,8 @@ def run() -> dict:
     info["markers_after_close"] = markers_in(scene)
     info["stock_node_after_close"] = stock_view.find_node(scene)
     assert info["panel_closed"] and info["markers_after_close"] == -1 and not info["stock_node_after_close"], info
-    import gui_runner  # noqa: E402
-
     gui_runner.close_document(r.doc)
     return info
 
-
-import gui_runner  # noqa: E402
 
 gui_runner.run(lambda info: info.update(run()), RESULT)
