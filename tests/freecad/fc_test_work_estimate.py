@@ -88,6 +88,29 @@ class WorkEstimate(FreeCADTestCase):
         self.assertIsNone(work_estimate.estimate(op).cutting_seconds)
         self.assertNotIn("cutting", work_estimate.estimate(op).text())
 
+    def test_estimate_counts_the_region_and_the_slopes(self) -> None:
+        """A cusp finish inside a sketch circle: the time told counts the circle (not the model's box) and, the STL
+        at hand, the slopes its passes climb and the spacing the cusp takes there; near the computed path's."""
+        from tmm_workbench.app.simulation import toolpath_and_feeds
+        from tmm_workbench.core.sim.cycle_time import three_axis_time
+
+        doc = new_doc("TmmEstimateRegion")
+        circle = doc.addObject("Sketcher::SketchObject", "Circle")
+        circle.addGeometry(Part.Circle(FreeCAD.Vector(2, 1, 0), FreeCAD.Vector(0, 0, 1), 5.0))
+        doc.recompute()
+        _, tc, op = job_with_op(doc, str(bump_stl()), values={"SampleStep": 0.4, "StepOverMode": "Adaptive",
+                                                              "CuspHeight": 0.01})
+        whole = work_estimate.estimate(op)
+        op.Region, op.RegionSketch = "Sketch", circle
+        doc.recompute()
+        self.assertTrue(op.isValid(), op.getStatusString())
+        est = work_estimate.estimate(op)
+        self.assertLess(est.cutting_seconds, 0.4 * whole.cutting_seconds)   # pi 5^2 of the bump's 20 x 20
+        tp, feeds = toolpath_and_feeds(op)
+        cutting = three_axis_time(tp.points(), feeds, tc.HorizRapid.Value, tc.VertRapid.Value).cutting_seconds
+        self.assertTrue(0.6 * cutting < est.cutting_seconds < 1.6 * cutting, (est.cutting_seconds, cutting))
+        self.assertTrue(est.climbs)   # the STL was at hand: the sample's slopes are in it
+
     def test_estimate_tells_the_compute_time(self) -> None:
         """The count at the strategy's measured pace (benchmarks/compute_estimate.py compares it with real runs):
         a quick op says nothing of it; values that would compute for minutes say so in the status line, and the

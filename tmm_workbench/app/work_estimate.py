@@ -8,13 +8,14 @@ panel's minimum and maximum for them, checked here like the params' own.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional
 
 import FreeCAD
 
 from tmm_workbench.app import geometry
-from tmm_workbench.core import limits
+from tmm_workbench.core import limits, polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, check, spec_of
 from tmm_workbench.core.work import Work
@@ -64,13 +65,19 @@ class Estimate:
     feed: Optional[float] = None         # mm/s, the tool controller's horizontal feed
     note: str = ""                       # what the count leaves out (VerifyCusp's partial passes)
     compute_seconds: Optional[float] = None   # the count at the strategy's measured pace (PACE)
+    climbs: tuple[tuple[float, float], ...] = ()   # core.work.Work.climbs
+    vert_feed: Optional[float] = None    # mm/s, the tool controller's vertical feed
+    plunge_deg: float = 45.0             # moves going down steeper than this are cut at vert_feed (the op's)
 
     @property
     def cutting_seconds(self) -> Optional[float]:
-        """The cutting time the estimate implies (cut length at the horizontal feed); None without a feed."""
+        """The cutting time the estimate implies (cut length at the horizontal feed, the half of it that goes down
+        slopes steeper than the plunge angle at the vertical feed); None without a feed."""
         if self.cut_length is None or not self.feed or self.feed <= 0:
             return None
-        return self.cut_length / self.feed
+        steep = math.tan(math.radians(self.plunge_deg))
+        down = 0.5 * sum(mm for t, mm in self.climbs if t > steep) if self.vert_feed and self.vert_feed > 0 else 0.0
+        return (self.cut_length - down) / self.feed + (down / self.vert_feed if down else 0.0)
 
     def text(self) -> str:
         from tmm_workbench.core.sim.cycle_time import hms
@@ -156,23 +163,11 @@ def model_bounds(proxy: Any, obj: Any, load_stl: bool) -> Optional[tuple[float, 
             max(b.XMax for b in boxes), max(b.YMax for b in boxes), max(b.ZMax for b in boxes))
 
 
-_stl_cache: dict[tuple[str, float, int], tuple[float, ...]] = {}
-
-
 def _stl_bounds(path: str) -> tuple[float, ...]:
-    """An STL file's bounds, read once per file version (the panel asks on every value entered)."""
-    import os
-
-    try:
-        st = os.stat(path)
-        key = (path, st.st_mtime, st.st_size)
-    except OSError:
-        key = (path, 0.0, -1)
-    if key not in _stl_cache:
-        lo, hi = geometry.mesh_from_stl(path).bounds  # a missing or bad file: its TmmError
-        _stl_cache.clear()
-        _stl_cache[key] = (*map(float, lo), *map(float, hi))
-    return _stl_cache[key]
+    """An STL file's bounds (min x, y, z, max x, y, z); app.geometry keeps the file's mesh (the panel asks on
+    every value entered)."""
+    lo, hi = geometry.mesh_from_stl(path).bounds  # a missing or bad file: its TmmError
+    return (*map(float, lo), *map(float, hi))
 
 
 def _stock(obj: Any) -> Any:
@@ -191,10 +186,10 @@ def _cutter(obj: Any) -> Any:
     return cutter_from_tool(obj.ToolController.Tool)
 
 
-def _feed(obj: Any) -> Optional[float]:
-    """The tool controller's horizontal feed in mm/s (None without one: no time is told)."""
+def _feed(obj: Any, which: str = "HorizFeed") -> Optional[float]:
+    """The tool controller's horizontal (or `which`) feed in mm/s (None without one: no time is told)."""
     tc = getattr(obj, "ToolController", None)
-    feed = getattr(tc, "HorizFeed", None) if tc is not None else None
+    feed = getattr(tc, which, None) if tc is not None else None
     value = float(getattr(feed, "Value", feed)) if feed is not None else 0.0
     return value if value > 0 else None
 
@@ -203,7 +198,12 @@ Inputs = Optional[tuple[Any, Any, tuple[float, ...]]]   # (params, cutter, bound
 
 
 def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
-    """The Surface's params over its boundary box (the stock's or the model's, with the margin)."""
+    """The Surface's params over its region (a sketch's or faces' polygons and their box; Rest is known only when
+    it computes: its box) or its boundary box (the stock's or the model's, with the margin), and a coarse sample
+    of the model's heights when the model is at hand (core.query.height_sample: the passes and time told)."""
+    from tmm_workbench.app import region_source
+    from tmm_workbench.app.compat import PathUtils
+
     if obj.BoundaryShape == "Stock":
         bb = _stock(obj)
         box = (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
@@ -212,8 +212,48 @@ def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> In
         if box is None:
             return None
     m = _value(obj, "BoundaryMargin", ov)
-    params = _params(proxy, obj, ov, boundary=(box[0] - m, box[1] - m, box[3] + m, box[4] + m))
-    return params, _cutter(obj), box
+    region = None
+    if getattr(obj, "Region", region_source.BOX) not in (region_source.BOX, region_source.REST):
+        region = region_source.region_of(obj, PathUtils.findParentJob(obj))
+    boundary = (box[0] - m, box[1] - m, box[3] + m, box[4] + m) if region is None else polygons.bounds(region)
+    params = _params(proxy, obj, ov, boundary=boundary, region=region)
+    cutter = _cutter(obj)
+    mesh = _mesh_at_hand(proxy, obj, load_stl)
+    if mesh is None:
+        return params, cutter, box
+    floor = float(mesh.bounds[0][2]) if params.floor_z is None else params.floor_z
+    return params, cutter, box, _sample(mesh, cutter, params.boundary, floor)
+
+
+def _mesh_at_hand(proxy: Any, obj: Any, load_stl: bool) -> Any:
+    """The op's model as a mesh without tessellating anything: its last computation's, or its STL file's (read
+    anyway for the bounds when `load_stl`); None for a Part model not computed yet."""
+    mesh = getattr(proxy, "mesh", None)
+    if mesh is not None:
+        return mesh
+    if getattr(obj, "StlFile", "") and load_stl:
+        return geometry.mesh_from_stl(obj.StlFile)
+    return None
+
+
+_samples: dict[tuple, Any] = {}
+
+
+def _sample(mesh: Any, cutter: Any, boundary: tuple[float, ...], floor: float) -> Any:
+    """The model's coarse height sample for this cutter over `boundary` (the panel asks on every value entered:
+    the last few are kept, and the mesh's index with them)."""
+    from tmm_workbench.core.query.drop import DropSurface
+    from tmm_workbench.core.query.height_sample import sample_heights
+
+    key = (id(mesh), cutter.diameter, cutter.corner_radius, repr(cutter.native), tuple(round(v, 6) for v in boundary),
+           round(floor, 6))
+    if key not in _samples:
+        surfaces = {k[0]: v[1] for k, v in _samples.items()}
+        surface = surfaces.get(id(mesh)) or DropSurface(mesh)
+        if len(_samples) >= 4:
+            _samples.clear()
+        _samples[key] = (sample_heights(surface, cutter, boundary, floor), surface, mesh)  # the mesh: its id stays its
+    return _samples[key][0]
 
 
 def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
@@ -260,10 +300,12 @@ def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
     return _params(proxy, obj, ov), None, (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
 
 
-def of_work(work: Work, feed: Optional[float]) -> Estimate:
-    """The panel's estimate of a strategy's work: its compute at the measured paces, its cutting time at `feed`."""
+def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> Estimate:
+    """The panel's estimate of a strategy's work: its compute at the measured paces, its cutting time at `feed`
+    (and `vert_feed` down slopes steeper than `plunge_deg`)."""
     seconds = sum(units * PACE[pace] for pace, units in work.paces)
-    return Estimate(work.count, work.what, work.passes, work.cut_length, feed, work.note, compute_seconds=seconds)
+    return Estimate(work.count, work.what, work.passes, work.cut_length, feed, work.note, compute_seconds=seconds,
+                    climbs=work.climbs, vert_feed=vert_feed, plunge_deg=plunge_deg)
 
 
 def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl: bool = True) -> Optional[Estimate]:
@@ -282,4 +324,5 @@ def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl
     inputs = inputs_of(proxy, obj, ov, load_stl)
     if inputs is None:
         return None
-    return of_work(type(proxy).STRATEGY.estimate_work(*inputs), _feed(obj))
+    plunge = _value(obj, "PlungeAngle", ov) if hasattr(obj, "PlungeAngle") else 45.0
+    return of_work(type(proxy).STRATEGY.estimate_work(*inputs), _feed(obj), _feed(obj, "VertFeed"), plunge)

@@ -177,6 +177,23 @@ def contains_point(shape: Shape, point: Sequence[float]) -> bool:
     return winding != 0
 
 
+def grid_inside(shape: Shape, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+    """(len(ys), len(xs)) bool: the grid nodes inside the shape (even-odd rule, one scanline per row: the
+    shapes here are Clipper's, outer boundaries and holes that do not overlap)."""
+    a = np.vstack([np.asarray(p, float) for p in shape])
+    b = np.vstack([np.roll(np.asarray(p, float), -1, axis=0) for p in shape])
+    out = np.zeros((len(ys), len(xs)), dtype=bool)
+    for j, y in enumerate(ys):
+        cross = (a[:, 1] > y) != (b[:, 1] > y)
+        if not cross.any():
+            continue
+        pa, pb = a[cross], b[cross]
+        xc = np.sort(pa[:, 0] + (y - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / (pb[:, 1] - pa[:, 1]))
+        count = np.searchsorted(xc, xs, side="right")
+        out[j] = count % 2 == 1
+    return out
+
+
 def covers(outer: Shape, inner: Shape, tol_area: float = 1e-6) -> bool:
     """`inner` lies in `outer` (what sticks out is below `tol_area` mm^2)."""
     return area(difference(inner, outer)) <= tol_area

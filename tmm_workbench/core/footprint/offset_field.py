@@ -233,23 +233,6 @@ def node_count(shape: Shape, flat_step: float, start: Optional[Sequence[np.ndarr
     return (math.ceil((x1 - x0) / cell) + 6) * (math.ceil((y1 - y0) / cell) + 6)
 
 
-def _inside(shape: Shape, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
-    """(len(ys), len(xs)) bool: the grid nodes inside the shape (even-odd rule, one scanline per row: the
-    shapes here are Clipper's, outer boundaries and holes that do not overlap)."""
-    a = np.vstack([np.asarray(p, float) for p in shape])
-    b = np.vstack([np.roll(np.asarray(p, float), -1, axis=0) for p in shape])
-    out = np.zeros((len(ys), len(xs)), dtype=bool)
-    for j, y in enumerate(ys):
-        cross = (a[:, 1] > y) != (b[:, 1] > y)
-        if not cross.any():
-            continue
-        pa, pb = a[cross], b[cross]
-        xc = np.sort(pa[:, 0] + (y - pa[:, 1]) * (pb[:, 0] - pa[:, 0]) / (pb[:, 1] - pa[:, 1]))
-        count = np.searchsorted(xc, xs, side="right")
-        out[j] = count % 2 == 1
-    return out
-
-
 def _band(curves: Sequence[np.ndarray], xs: np.ndarray, ys: np.ndarray, reach: float) -> tuple[np.ndarray, np.ndarray]:
     """Distance (mm) from each grid node within `reach` of the polylines to the nearest of their segments
     (inf elsewhere), and that segment's unit normal there ((ny, nx, 2))."""
@@ -351,7 +334,7 @@ def arrival(shape: Shape, heights: Heights, cutter: Cutter, cusp: float, max_slo
     z = np.asarray(heights(np.column_stack([gx.ravel(), gy.ravel()])), float).reshape(gx.shape)
     reach = _BAND_CELLS * cell
     if start is None:
-        inside = _inside(shape, xs, ys)
+        inside = polygons.grid_inside(shape, xs, ys)
         active = inside
         dist, normal = _band([_closed(np.asarray(p, float)) for p in shape], xs, ys, reach)
         dist = np.where(inside, dist, -dist)       # outside: before the start (negative T)
