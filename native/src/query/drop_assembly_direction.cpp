@@ -78,19 +78,28 @@ double axial_drop(const DirectionalIndex& index, const ToolAssembly& tool, const
   return z <= floor_z ? max_travel : s.z() - z;
 }
 
-// The earliest contact of the solids from `start` (hints: one per solid, or null), capped at max_travel.
-double along_solids(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids, const Vector3d& start,
-                    const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats, int32_t* hints) {
+// The solids set up for drops along the index's direction with the tool axis `axis` (once per axis).
+std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids,
+                                       const Vector3d& axis) {
+  std::vector<AlongCutter> out;
+  out.reserve(solids.size());
+  for (const AssemblySolid& s : solids) out.emplace_back(index, s.profile, s.flipped ? Vector3d(-axis) : axis);
+  return out;
+}
+
+// The earliest contact of the solids (set up by along_cutters) from `start` (hints: one per solid, or null),
+// capped at max_travel.
+double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
+                    const Vector3d& start, const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats,
+                    int32_t* hints) {
   double best = max_travel;
   int32_t by = kSetByFloor;
   for (std::size_t k = 0; k < solids.size(); ++k) {
-    const AssemblySolid& s = solids[k];
     // Only a contact before the best so far matters: it caps this solid's search.
-    const double t = drop_along_point(index, s.profile, start + s.lift * axis, s.flipped ? Vector3d(-axis) : axis,
-                                      best, stats, hints ? &hints[k] : nullptr);
+    const double t = cutters[k].drop(start + solids[k].lift * axis, best, stats, hints ? &hints[k] : nullptr);
     if (t < best) {
       best = t;
-      by = s.owner;
+      by = solids[k].owner;
     }
   }
   if (set_by) *set_by = by;
@@ -124,7 +133,9 @@ double drop_assembly_along_point(const DirectionalIndex& index, const ToolAssemb
                                  const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats) {
   require_unit(axis, "tool axis");
   if (along_axis(index, axis)) return axial_drop(index, tool, start, max_travel, set_by, stats);
-  return along_solids(index, assembly_solids(tool), start, axis.normalized(), max_travel, set_by, stats, nullptr);
+  const Vector3d a = axis.normalized();
+  const std::vector<AssemblySolid> solids = assembly_solids(tool);
+  return along_solids(solids, along_cutters(index, solids, a), start, a, max_travel, set_by, stats, nullptr);
 }
 
 void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly& tool, const double* starts,
@@ -153,6 +164,8 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
+  std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
+  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized());
   std::atomic<std::size_t> tested{0};
   // Hints start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
@@ -162,9 +175,13 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
       const double* ax = axes + (axes_per_point ? 3 * i : 0);
       const Vector3d start(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]), axis(ax[0], ax[1], ax[2]);
       int32_t* by = set_by ? set_by + i : nullptr;
-      travel_out[i] = along_axis(index, axis)
-                          ? axial_drop(index, tool, start, max_travel, by, &local)
-                          : along_solids(index, solids, start, axis.normalized(), max_travel, by, &local, hints.data());
+      if (along_axis(index, axis)) {
+        travel_out[i] = axial_drop(index, tool, start, max_travel, by, &local);
+      } else {
+        const Vector3d a = axis.normalized();
+        travel_out[i] = along_solids(solids, axes_per_point ? along_cutters(index, solids, a) : shared, start, a,
+                                     max_travel, by, &local, hints.data());
+      }
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
   });
