@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "tmm/query/drop_direction.hpp"
+#include "tmm/query/swept_clearance.hpp"
 #include "tmm/util/range.hpp"
 
 namespace tmm {
@@ -24,8 +25,8 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // Best-first walk of the index's hierarchy for a cutter whose lowest point is `floor` high at best: visits
 // the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point, lowered by
-// rise(d, x0, x1, y0, y1) (d: the box's XY' distance from (x, y), [x0, x1] x [y0, y1] the box less (x, y)),
-// is above `floor`; `floor` may rise during the walk.
+// rise(d, x0, x1, y0, y1, enough) (d: the box's XY' distance from (x, y), [x0, x1] x [y0, y1] the box less
+// (x, y); it may stop at `enough`, which prunes the box), is above `floor`; `floor` may rise during the walk.
 // Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
 template <class Rise, class Visit>
 void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Rise&& rise,
@@ -37,7 +38,8 @@ void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const d
     const double dx = std::max(std::max(xmin - x, x - xmax), 0.0);
     const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
-    return d2 > r2 ? -kInfinity : zmax - rise(std::sqrt(d2), xmin - x, xmax - x, ymin - y, ymax - y);
+    if (d2 > r2 || zmax <= floor) return -kInfinity;
+    return zmax - rise(std::sqrt(d2), xmin - x, xmax - x, ymin - y, ymax - y, zmax - floor);
   };
   struct Entry {
     int32_t node;
@@ -80,7 +82,7 @@ void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const d
 // Planes under K, as directions in the tool frame at these angles from the axis (8 around it, one at 0 and 180
 // degrees); those facing down in the index's frame are kept. Along the axis: the tip's end (a flat bottom);
 // across it: the side, which a tilted tool leans on.
-constexpr double kPlaneAngles[] = {0.0, 30.0, 60.0, 80.0, 90.0, 100.0, 120.0, 150.0, 180.0};
+constexpr double kPlaneAngles[] = {0.0, 60.0, 90.0, 120.0, 180.0};
 
 }  // namespace
 
@@ -92,6 +94,7 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
                                 "drop direction (use drop_along_point)");
   require_finite_length(cutter);
   W_ = frame_.to_tool(Vector3d(0, 0, -1));
+  ahead_ = direction_detail::support(cutter, W_).value;
   // Lowest point of K along Z' below the tip: no triangle whose highest point is below the cutter's lowest
   // point can touch it, so the index walks on that height in place of the tip's. An edge shared by several
   // triangles is solved by its owner only (IndexedTriangle::owned_edges): the owner's bound covers the edge
@@ -115,7 +118,9 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   }
 }
 
-double AlongCutter::rise(double d, double x0, double x1, double y0, double y1) const {
+double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
+  const double margin = 1e-9 * (1.0 + std::fabs(lowest_));  // against rounding
+  enough += margin;
   double r = 0.0;
   // A point X = z a + r of K (|r| <= rmax, r perpendicular to a, z >= 0) at horizontal distance >= d from the
   // tip has z >= (d - rmax) / ah, so its height is at least a.z (d - rmax) / ah - rmax ah (axis leaning up):
@@ -123,11 +128,12 @@ double AlongCutter::rise(double d, double x0, double x1, double y0, double y1) c
   const double rmax = cutter_.max_radius(), ah = axis_xy_;
   if (a_.z() > 0 && ah > 0 && d > rmax) r = a_.z() * (d - rmax) / ah - rmax * ah - lowest_;
   // Over the box K is no lower than any plane under it at the box's corner where that plane is lowest.
-  for (const Plane& p : planes_) {
+  for (std::size_t k = 0; k < planes_.size() && r < enough; ++k) {
+    const Plane& p = planes_[k];
     const double low = p.c - std::max(p.gx * x0, p.gx * x1) - std::max(p.gy * y0, p.gy * y1);
-    r = std::max(r, low - lowest_);
+    r = std::max(r, low - lowest_ - 1e-9 * std::fabs(low));
   }
-  return std::max(0.0, r - 1e-9 * (1.0 + std::fabs(r) + std::fabs(lowest_)));  // margin against rounding
+  return std::max(0.0, r - margin);
 }
 
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
@@ -140,9 +146,16 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   double floor_ref = floor_of(best);
   auto test = [&](const IndexedTriangle& t, int32_t i) {
     ++tested;
-    const double tr = direction_detail::triangle_travel(
-        cutter_, frame_.to_tool(Vector3d(t.p[0]) - s), frame_.to_tool(Vector3d(t.p[1]) - s),
-        frame_.to_tool(Vector3d(t.p[2]) - s), W_, best, t.owned_edges);
+    const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
+                   q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
+    if (best < kNoTravel) {
+      // Most candidates are not touched before the best contact so far: a separating plane proves it for the
+      // whole triangle (its edges included) at a fraction of the cost of its pieces.
+      const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
+      if (t0 >= best) return;
+      if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best)) return;
+    }
+    const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, best, t.owned_edges);
     if (tr < best) {
       best = tr;
       winner = i;
@@ -154,7 +167,9 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   const int32_t skip = hint ? *hint : -1;
   walk_lowest(
       mi, s.x(), s.y(), reach_, floor_ref,
-      [&](double d, double x0, double x1, double y0, double y1) { return rise(d, x0, x1, y0, y1); },
+      [&](double d, double x0, double x1, double y0, double y1, double enough) {
+        return rise(d, x0, x1, y0, y1, enough);
+      },
       [&](const IndexedTriangle& t, int32_t i) {
         if (i != skip) test(t, i);
       });

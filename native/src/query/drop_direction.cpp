@@ -26,7 +26,6 @@
 #include <vector>
 
 #include "tmm/query/drop_contacts.hpp"
-#include "tmm/query/swept_clearance.hpp"
 #include "tmm/util/range.hpp"
 
 namespace tmm {
@@ -280,13 +279,6 @@ double facet_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, con
 
 double triangle_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
                        const Vector3d& W, double cap, unsigned edges) {
-  if (cap < kNoTravel) {
-    // Most candidates of a mesh query are not touched before the best contact so far: a separating plane
-    // proves it for the whole triangle (edges included) at a fraction of the cost of its pieces.
-    const double t0 = std::min({q0.dot(W), q1.dot(W), q2.dot(W)}) - support(c, W).value;
-    if (t0 >= cap) return kNoTravel;
-    if (triangle_clear(c, q0, q1, q2, W, t0 - 1e-9 * (1 + std::fabs(t0)), cap)) return kNoTravel;
-  }
   double t = std::min(cap, facet_travel(c, q0, q1, q2, W, cap));
   t = std::min(t, vertex_travel(c, q0, W, t));
   t = std::min(t, vertex_travel(c, q1, W, t));

@@ -69,9 +69,8 @@ double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vect
                    double cap = kNoTravel);
 double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                     const Eigen::Vector3d& W, double cap = kNoTravel);
-// The triangle's first contact before cap (kNoTravel if none): with a finite cap the clearance certificate
-// (swept_clearance.hpp) first, then facet, vertices and the edges selected by bit k of `edges` (corner k to
-// k + 1; see IndexedTriangle::owned_edges).
+// The triangle's first contact before cap (kNoTravel if none): facet, vertices and the edges selected by bit k
+// of `edges` (corner k to k + 1; see IndexedTriangle::owned_edges).
 double triangle_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
                        const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double cap = kNoTravel,
                        unsigned edges = 7u);
@@ -135,7 +134,7 @@ class AlongCutter {
   struct Plane {
     double c, gx, gy;
   };
-  double rise(double d, double x0, double x1, double y0, double y1) const;
+  double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
 
   const DirectionalIndex* index_;
   Cutter cutter_;
@@ -143,6 +142,7 @@ class AlongCutter {
   ToolFrame frame_;
   Eigen::Vector3d W_;   // the motion in tool coordinates
   double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
+  double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
 };
 
