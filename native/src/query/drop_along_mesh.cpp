@@ -1,6 +1,7 @@
 // The mesh query of the drop along a direction (drop_direction.hpp): a best-first walk of the rotated index's
-// hierarchy bounded by the cutter solid's lowest point and its supporting planes from below, each candidate
-// triangle solved by the general method with the best travel so far as its cap.
+// hierarchy bounded by the cutter solid's lowest point and its supporting planes from below; each candidate
+// triangle first given the clearance certificate (swept_clearance.hpp), then, unless it is proven clear, solved
+// by the general method, both with the best travel so far as the cap (docs/drop_direction.md, "Mesh query").
 #include <algorithm>
 #include <atomic>
 #include <cmath>

@@ -1,6 +1,7 @@
 // The tool assembly dropped along any direction: its grown pieces as convex drop_direction solids (see
-// drop_assembly_direction.hpp), each dropped with the travel so far as its cap, or along the tool's own axis
-// the vertical assembly drop in the rotated frame.
+// drop_assembly_direction.hpp), each set up once per axis and dropped with the travel so far as its cap (the
+// solid that stopped the previous start first), or along the tool's own axis the vertical assembly drop in the
+// rotated frame.
 #include "tmm/query/drop_assembly_direction.hpp"
 
 #include <atomic>
