@@ -1,6 +1,7 @@
 // The tool assembly dropped along any direction: its grown pieces as convex drop_direction solids (see
-// drop_assembly_direction.hpp), each dropped with the travel so far as its cap, or along the tool's own axis
-// the vertical assembly drop in the rotated frame.
+// drop_assembly_direction.hpp), each set up once per axis and dropped with the travel so far as its cap (the
+// solid that stopped the previous start first), or along the tool's own axis the vertical assembly drop in the
+// rotated frame.
 #include "tmm/query/drop_assembly_direction.hpp"
 
 #include <atomic>
@@ -78,22 +79,40 @@ double axial_drop(const DirectionalIndex& index, const ToolAssembly& tool, const
   return z <= floor_z ? max_travel : s.z() - z;
 }
 
-// The earliest contact of the solids from `start` (hints: one per solid, or null), capped at max_travel.
-double along_solids(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids, const Vector3d& start,
-                    const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats, int32_t* hints) {
+// The solids set up for drops along the index's direction with the tool axis `axis` (once per axis).
+std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids,
+                                       const Vector3d& axis) {
+  std::vector<AlongCutter> out;
+  out.reserve(solids.size());
+  for (const AssemblySolid& s : solids) out.emplace_back(index, s.profile, s.flipped ? Vector3d(-axis) : axis);
+  return out;
+}
+
+// The earliest contact of the solids (set up by along_cutters) from `start` (hints: one per solid, or null),
+// capped at max_travel. `lead` (or null): the solid dropped first, then set to the one that set the travel. The
+// next start is likely stopped by the same solid: its travel, found first, caps the others' searches (a holder
+// that holds the tool well above the part leaves the cutter little to test). A solid earlier in the list than
+// the one that stopped the tool so far wins a tie, as in the list's order.
+double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
+                    const Vector3d& start, const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats,
+                    int32_t* hints, std::size_t* lead) {
+  constexpr std::size_t kNone = ~std::size_t{0};
   double best = max_travel;
-  int32_t by = kSetByFloor;
-  for (std::size_t k = 0; k < solids.size(); ++k) {
-    const AssemblySolid& s = solids[k];
-    // Only a contact before the best so far matters: it caps this solid's search.
-    const double t = drop_along_point(index, s.profile, start + s.lift * axis, s.flipped ? Vector3d(-axis) : axis,
-                                      best, stats, hints ? &hints[k] : nullptr);
-    if (t < best) {
+  std::size_t winner = kNone;
+  auto drop = [&](std::size_t k) {
+    const double cap = winner != kNone && k < winner ? std::nextafter(best, INFINITY) : best;
+    const double t = cutters[k].drop(start + solids[k].lift * axis, cap, stats, hints ? &hints[k] : nullptr);
+    if (t < best || (t == best && winner != kNone && k < winner)) {
       best = t;
-      by = s.owner;
+      winner = k;
     }
-  }
-  if (set_by) *set_by = by;
+  };
+  const std::size_t first = lead && *lead < solids.size() ? *lead : 0;
+  drop(first);
+  for (std::size_t k = 0; k < solids.size(); ++k)
+    if (k != first) drop(k);
+  if (lead) *lead = winner == kNone ? 0 : winner;
+  if (set_by) *set_by = winner == kNone ? kSetByFloor : solids[winner].owner;
   return best;
 }
 
@@ -124,7 +143,9 @@ double drop_assembly_along_point(const DirectionalIndex& index, const ToolAssemb
                                  const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats) {
   require_unit(axis, "tool axis");
   if (along_axis(index, axis)) return axial_drop(index, tool, start, max_travel, set_by, stats);
-  return along_solids(index, assembly_solids(tool), start, axis.normalized(), max_travel, set_by, stats, nullptr);
+  const Vector3d a = axis.normalized();
+  const std::vector<AssemblySolid> solids = assembly_solids(tool);
+  return along_solids(solids, along_cutters(index, solids, a), start, a, max_travel, set_by, stats, nullptr, nullptr);
 }
 
 void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly& tool, const double* starts,
@@ -153,18 +174,25 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
+  std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
+  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized());
   std::atomic<std::size_t> tested{0};
-  // Hints start afresh with each chunk, so results do not depend on the thread count.
+  // Hints and the solid dropped first start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
     std::vector<int32_t> hints(solids.size(), -1);
+    std::size_t lead = 0;
     for (std::size_t i = begin; i < end; ++i) {
       const double* ax = axes + (axes_per_point ? 3 * i : 0);
       const Vector3d start(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]), axis(ax[0], ax[1], ax[2]);
       int32_t* by = set_by ? set_by + i : nullptr;
-      travel_out[i] = along_axis(index, axis)
-                          ? axial_drop(index, tool, start, max_travel, by, &local)
-                          : along_solids(index, solids, start, axis.normalized(), max_travel, by, &local, hints.data());
+      if (along_axis(index, axis)) {
+        travel_out[i] = axial_drop(index, tool, start, max_travel, by, &local);
+      } else {
+        const Vector3d a = axis.normalized();
+        travel_out[i] = along_solids(solids, axes_per_point ? along_cutters(index, solids, a) : shared, start, a,
+                                     max_travel, by, &local, hints.data(), &lead);
+      }
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
   });

@@ -38,6 +38,7 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr double kTravelTol = 1e-12;       // mm, bracket width of the vertex entry
 constexpr double kUnitTol = 1e-9;          // |norm - 1| accepted for axis and direction
 using direction_detail::kParallelAxisTol;
+using direction_detail::require_finite_length;
 using direction_detail::require_unit;
 
 }  // namespace
@@ -276,16 +277,8 @@ double facet_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, con
   return t;
 }
 
-}  // namespace direction_detail
-
-namespace {
-
-// Triangle corners q0..q2 in tool coordinates (start tip at the origin), W = V in tool coordinates.
-// Each piece only looks for contacts earlier than the best so far (cheap closed forms first). Bit k of
-// `edges` selects edge k (corner k to k + 1); see IndexedTriangle::owned_edges.
-double general_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                          const Vector3d& W, double cap = kNoTravel, unsigned edges = 7u) {
-  using namespace direction_detail;
+double triangle_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
+                       const Vector3d& W, double cap, unsigned edges) {
   double t = std::min(cap, facet_travel(c, q0, q1, q2, W, cap));
   t = std::min(t, vertex_travel(c, q0, W, t));
   t = std::min(t, vertex_travel(c, q1, W, t));
@@ -295,6 +288,16 @@ double general_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d& q
   if (edges & 4u) t = std::min(t, edge_travel(c, q2, q0, W, t));
   return t < cap ? t : kNoTravel;
 }
+
+void require_finite_length(const Cutter& c) {
+  if (!std::isfinite(c.cutting_length()))
+    throw std::invalid_argument("a drop with the cutter axis not opposite to the direction needs a cutter with a "
+                                "finite cutting length (the shank is not modelled)");
+}
+
+}  // namespace direction_detail
+
+namespace {
 
 // V = -axis: the exact -Z contacts (facet, concave edge form, vertices) in the tool frame; travel = -tip z.
 double along_axis_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2) {
@@ -311,23 +314,13 @@ double along_axis_tool_frame(const Cutter& c, const Vector3d& q0, const Vector3d
 
 }  // namespace
 
-namespace {
-
-void require_finite_length(const Cutter& c) {
-  if (!std::isfinite(c.cutting_length()))
-    throw std::invalid_argument("a drop with the cutter axis not opposite to the direction needs a cutter with a "
-                                "finite cutting length (the shank is not modelled)");
-}
-
-}  // namespace
-
 double drop_along_general(const Cutter& cutter, const Vector3d& tip_start, const Vector3d& axis,
                           const Vector3d& V, const Vector3d& p0, const Vector3d& p1, const Vector3d& p2) {
   require_unit(axis, "cutter axis");
   require_unit(V, "drop direction");
   require_finite_length(cutter);
   const ToolFrame fr(axis);
-  return general_tool_frame(cutter, fr.to_tool(p0 - tip_start), fr.to_tool(p1 - tip_start),
+  return direction_detail::triangle_travel(cutter, fr.to_tool(p0 - tip_start), fr.to_tool(p1 - tip_start),
                             fr.to_tool(p2 - tip_start), fr.to_tool(V.normalized()));
 }
 
@@ -339,7 +332,7 @@ double drop_along(const Cutter& cutter, const Vector3d& tip_start, const Vector3
   const Vector3d q0 = fr.to_tool(p0 - tip_start), q1 = fr.to_tool(p1 - tip_start), q2 = fr.to_tool(p2 - tip_start);
   if ((axis + V).norm() <= kParallelAxisTol) return along_axis_tool_frame(cutter, q0, q1, q2);
   require_finite_length(cutter);
-  return general_tool_frame(cutter, q0, q1, q2, fr.to_tool(V.normalized()));
+  return direction_detail::triangle_travel(cutter, q0, q1, q2, fr.to_tool(V.normalized()));
 }
 
 double drop_along(const Cutter& cutter, const Vector3d& tip_start, const Vector3d& axis, const Vector3d& V,
@@ -347,63 +340,9 @@ double drop_along(const Cutter& cutter, const Vector3d& tip_start, const Vector3
   return drop_along(cutter, tip_start, axis, V, Vector3d(t.p[0]), Vector3d(t.p[1]), Vector3d(t.p[2]));
 }
 
-// ---- mesh level ------------------------------------------------------------------------------------------
+// ---- the index ----------------------------------------------------------------------------------------
 
 namespace {
-
-// Best-first walk of the index's hierarchy for a cutter whose lowest point is `floor` high at best: visits
-// the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point, lowered by
-// lift(d) (d: the box's XY' distance from (x, y)), is above `floor`; `floor` may rise during the walk.
-// Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
-template <class Lift, class Visit>
-void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Lift&& lift,
-                 Visit&& visit) {
-  const auto& nodes = mi.nodes();
-  const auto& tris = mi.triangles();
-  const double r2 = radius * radius;
-  auto bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
-    const double dx = std::max(std::max(xmin - x, x - xmax), 0.0);
-    const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
-    const double d2 = dx * dx + dy * dy;
-    return d2 > r2 ? -kInfinity : zmax - lift(std::sqrt(d2));
-  };
-  struct Entry {
-    int32_t node;
-    double bound;
-  };
-  std::vector<Entry> stack;  // depth-first: at most ~2 entries per level
-  stack.reserve(128);
-  stack.push_back({0, kInfinity});
-  while (!stack.empty()) {
-    const Entry e = stack.back();
-    stack.pop_back();
-    if (e.bound <= floor) continue;
-    const BvhNode& node = nodes[e.node];
-    if (node.count > 0) {
-      for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
-        const IndexedTriangle& t = tris[i];
-        if (t.zmax <= floor) continue;
-        const double b = bound(std::min({t.p[0][0], t.p[1][0], t.p[2][0]}), std::min({t.p[0][1], t.p[1][1], t.p[2][1]}),
-                               std::max({t.p[0][0], t.p[1][0], t.p[2][0]}), std::max({t.p[0][1], t.p[1][1], t.p[2][1]}),
-                               t.zmax);
-        if (b > floor) visit(t, i);
-      }
-    } else {
-      const BvhNode& l = nodes[node.first];
-      const BvhNode& r = nodes[node.first + 1];
-      const double bl = bound(l.xmin, l.ymin, l.xmax, l.ymax, l.zmax);
-      const double br = bound(r.xmin, r.ymin, r.xmax, r.ymax, r.zmax);
-      // The more promising child last, so it is popped first: its contacts prune more of the other.
-      if (bl > br) {
-        if (br > floor) stack.push_back({node.first + 1, br});
-        if (bl > floor) stack.push_back({node.first, bl});
-      } else {
-        if (bl > floor) stack.push_back({node.first, bl});
-        if (br > floor) stack.push_back({node.first + 1, br});
-      }
-    }
-  }
-}
 
 Eigen::Matrix3d rotation_to_minus_z(const Vector3d& V) {
   const Vector3d down(0, 0, -1);
@@ -440,103 +379,6 @@ DirectionalIndex::DirectionalIndex(const VerticesRef& vertices, const TrianglesR
   V_ = V.normalized();
   rot_ = rotation_to_minus_z(V_);
   index_ = rotated_index(vertices, triangles, rot_, threads);
-}
-
-double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& start,
-                        const Vector3d& axis, double max_travel, DropStats* stats, int32_t* hint) {
-  require_unit(axis, "cutter axis");
-  const Vector3d s = index.rotation() * start;
-  const Vector3d a = index.rotation() * axis.normalized();
-  const MeshIndex& mi = index.index();
-  if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
-    // V = -axis: the fast -Z drop-cutter in the rotated frame.
-    const double floor_z = s.z() - max_travel;
-    const double z = drop_point(mi, cutter, s.x(), s.y(), floor_z, stats, hint);
-    return z <= floor_z ? max_travel : s.z() - z;
-  }
-  require_finite_length(cutter);
-  const ToolFrame fr(a);
-  const Vector3d W = fr.to_tool(Vector3d(0, 0, -1));
-  // Lowest point of K along Z' below the tip: no triangle whose highest point is below the cutter's lowest
-  // point can touch it, so the index walks on that height in place of the tip's. An edge shared by several
-  // triangles is solved by its owner only (IndexedTriangle::owned_edges): the owner's bound covers the edge
-  // (the edge lies in its box and below its highest point), so when the owner is pruned so is the edge.
-  const double lowest = -direction_detail::support(cutter, -fr.to_tool(Vector3d::UnitZ())).value;
-  // K's shadow on the XY' plane lies within this distance of the tip.
-  const double rmax = cutter.max_radius();
-  const double ah = std::hypot(a.x(), a.y());
-  const double reach = (rmax + cutter.cutting_length() * ah) * (1 + 1e-12) + 1e-12;
-  // A point X = z a + r of K (|r| <= rmax, r perpendicular to a, z >= 0) at horizontal distance >= d from the
-  // tip has z >= (d - rmax) / ah, so its height is at least a.z (d - rmax) / ah - rmax ah (axis leaning up):
-  // boxes far from the tip can only meet the cutter's higher parts.
-  auto lift = [&](double d) {
-    if (!(a.z() > 0 && ah > 0 && d > rmax)) return 0.0;
-    return std::max(0.0, a.z() * (d - rmax) / ah - rmax * ah - lowest - 1e-9);
-  };
-  double best = max_travel;
-  int32_t winner = -1;
-  std::size_t tested = 0;
-  auto floor_of = [&](double t) { return s.z() - t + lowest - 1e-9; };  // margin against rounding
-  double floor_ref = floor_of(best);
-  auto test = [&](const IndexedTriangle& t, int32_t i) {
-    ++tested;
-    const double tr = general_tool_frame(cutter, fr.to_tool(Vector3d(t.p[0]) - s), fr.to_tool(Vector3d(t.p[1]) - s),
-                                         fr.to_tool(Vector3d(t.p[2]) - s), W, best, t.owned_edges);
-    if (tr < best) {
-      best = tr;
-      winner = i;
-      floor_ref = floor_of(best);
-    }
-  };
-  const auto& tris = mi.triangles();
-  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) test(tris[*hint], *hint);
-  const int32_t skip = hint ? *hint : -1;
-  walk_lowest(mi, s.x(), s.y(), reach, floor_ref, lift,
-          [&](const IndexedTriangle& t, int32_t i) {
-            if (i != skip) test(t, i);
-          });
-  if (stats) stats->triangles_tested += tested;
-  if (hint) *hint = winner;
-  return best;
-}
-
-void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const double* starts,
-                      const double* axes, bool axes_per_point, std::size_t n, double max_travel,
-                      double* travel_out, const BatchOptions& options, DropStats* stats) {
-  // Validate up front: workers must not throw.
-  require_rows_in_range(starts, n, 3, "start points");
-  if (!(in_range(max_travel) || max_travel == kInfinity)) require_in_range(max_travel, "max_travel");
-  for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}); ++i) {
-    const Vector3d ax(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]);
-    require_unit(ax, "cutter axis");
-    if ((index.rotation() * ax.normalized() - Vector3d::UnitZ()).norm() > kParallelAxisTol)
-      require_finite_length(cutter);
-  }
-  if (!axes_per_point && n > 0) {
-    const Vector3d a = index.rotation() * Vector3d(axes[0], axes[1], axes[2]).normalized();
-    if ((a - Vector3d::UnitZ()).norm() <= kParallelAxisTol) {
-      // V = -axis for every point: the tiled -Z batch in the rotated frame, each point's floor max_travel
-      // below its start (as drop_along_point's fast path, point by point).
-      const direction_detail::RotatedStarts s(index, starts, n, max_travel);
-      std::vector<double> z(n);
-      drop_batch(index.index(), cutter, s.xy.data(), n, s.floors.data(), z.data(), options, stats);
-      for (std::size_t i = 0; i < n; ++i) travel_out[i] = s.travel(i, z[i], max_travel);
-      return;
-    }
-  }
-  std::atomic<std::size_t> tested{0};
-  // The hint starts afresh with each chunk, so results do not depend on the thread count.
-  parallel_chunks(n, 128, options, [&](std::size_t begin, std::size_t end) {
-    DropStats local;
-    int32_t hint = -1;
-    for (std::size_t i = begin; i < end; ++i) {
-      const double* ax = axes + (axes_per_point ? 3 * i : 0);
-      travel_out[i] = drop_along_point(index, cutter, Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]),
-                                       Vector3d(ax[0], ax[1], ax[2]), max_travel, &local, &hint);
-    }
-    tested.fetch_add(local.triangles_tested);
-  });
-  if (stats) stats->triangles_tested += tested.load();
 }
 
 }  // namespace tmm

@@ -296,6 +296,66 @@ TEST(DropAssemblyDirection, BatchIsPointByPointAndThreadsAgree) {
   EXPECT_LT(misses, static_cast<int>(n) / 2);
 }
 
+// One tilted axis for the whole batch (the solids set up once, the solid that stopped the last start dropped
+// first) over a pocket: the points where a body stops the tool come in runs, so that order changes along the
+// batch; every travel and piece is the point's own, and the exact per-triangle reference's on a sample.
+TEST(DropAssemblyDirection, SharedTiltedAxisBatchIsPointByPoint) {
+  // A plate 40 wide with a pocket 16 wide and 18 deep (its floor a dome): the bodies meet the walls and the rim.
+  const int cells = 40;
+  tmm::Vertices V((cells + 1) * (cells + 1), 3);
+  tmm::Triangles F(2 * cells * cells, 3);
+  for (int i = 0; i <= cells; ++i)
+    for (int j = 0; j <= cells; ++j) {
+      const double x = i - 20.0, y = j - 20.0;
+      const bool inside = std::fabs(x) < 8 && std::fabs(y) < 8;
+      V.row(i * (cells + 1) + j) << x, y, inside ? -18 + 2 * std::cos(x / 4) * std::cos(y / 4) : 0.0;
+    }
+  for (int i = 0, f = 0; i < cells; ++i)
+    for (int j = 0; j < cells; ++j) {
+      const int a = i * (cells + 1) + j;
+      F.row(f++) << a, a + cells + 1, a + 1;
+      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
+    }
+  const Vector3d dir = Vector3d(0.2, 0.1, -1).normalized();
+  const tmm::DirectionalIndex index(V, F, dir);
+  const Vector3d axis = Vector3d(0.45, -0.2, 1).normalized();  // about 26 deg off -dir
+  const std::size_t n = 900;
+  std::vector<double> starts;
+  for (std::size_t i = 0; i < n; ++i)  // a zig-zag raster, as a path visits it
+    starts.insert(starts.end(), {-13 + 0.9 * static_cast<double>(i / 30 % 2 ? 29 - i % 30 : i % 30),
+                                 -13 + 0.9 * static_cast<double>(i / 30), 20.0});
+  for (const Tool& t : tools()) {
+    const ToolAssembly tool(t.cutter, t.bodies, t.clearance);
+    const auto solids = tmm::assembly_solids(tool);
+    tmm::BatchOptions one, two;
+    two.threads = 2;
+    std::vector<double> t1(n), t2(n);
+    std::vector<int32_t> b1(n), b2(n);
+    tmm::drop_assembly_along_batch(index, tool, starts.data(), axis.data(), false, n, 60.0, t1.data(), b1.data(), one);
+    tmm::drop_assembly_along_batch(index, tool, starts.data(), axis.data(), false, n, 60.0, t2.data(), b2.data(), two);
+    int by_body = 0, switches = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_EQ(t1[i], t2[i]) << i;
+      ASSERT_EQ(b1[i], b2[i]) << i;
+      int32_t b = 0;
+      const double tp = tmm::drop_assembly_along_point(index, tool, Vector3d(&starts[3 * i]), axis, 60.0, &b);
+      ASSERT_NEAR(t1[i], tp, 1e-12) << i;
+      ASSERT_EQ(b1[i], b) << i;
+      by_body += b1[i] >= 0;
+      switches += i > 0 && b1[i] != b1[i - 1];
+      if (i % 30 == 0) {
+        int32_t brute_by = 0;
+        const double brute = brute_travel(solids, V, F, Vector3d(&starts[3 * i]), axis, dir, brute_by);
+        ASSERT_NEAR(t1[i], std::min(brute, 60.0), 1e-9) << i;
+        ASSERT_EQ(b1[i], brute < 60.0 ? brute_by : tmm::kSetByFloor) << i;
+      }
+    }
+    EXPECT_GT(by_body, 20);
+    EXPECT_LT(by_body, static_cast<int>(n) * 19 / 20);
+    EXPECT_GT(switches, 10);
+  }
+}
+
 TEST(DropAssemblyDirection, Refusals) {
   const auto [V, F] = big_plane({0, 0, 0}, Vector3d::UnitX(), Vector3d::UnitY());
   const tmm::DirectionalIndex index(V, F, -Vector3d::UnitZ());

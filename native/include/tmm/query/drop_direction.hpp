@@ -69,6 +69,13 @@ double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vect
                    double cap = kNoTravel);
 double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                     const Eigen::Vector3d& W, double cap = kNoTravel);
+// The triangle's first contact before cap (kNoTravel if none): facet, vertices and the edges selected by bit k
+// of `edges` (corner k to k + 1; see IndexedTriangle::owned_edges).
+double triangle_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
+                       const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double cap = kNoTravel,
+                       unsigned edges = 7u);
+// std::invalid_argument for an endless cutter (L_C = inf): the general method needs a bounded solid.
+void require_finite_length(const Cutter& c);
 }  // namespace direction_detail
 
 class DirectionalIndex;
@@ -110,6 +117,34 @@ class DirectionalIndex {
 double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Eigen::Vector3d& start,
                         const Eigen::Vector3d& axis, double max_travel = kNoTravel, DropStats* stats = nullptr,
                         int32_t* hint = nullptr);
+
+// A cutter set up for drops along the index's direction with one tool axis that is not -V (the general
+// method): the per-axis work of drop_along_point done once (the tool frame, the motion in it, the solid's
+// lowest point, its supporting planes from below that bound the walk of the index). The index must outlive it.
+class AlongCutter {
+ public:
+  // axis: a unit vector in the model's frame, not -V; std::invalid_argument otherwise or for an endless cutter.
+  AlongCutter(const DirectionalIndex& index, const Cutter& cutter, const Eigen::Vector3d& axis);
+  // drop_along_point with this cutter and axis.
+  double drop(const Eigen::Vector3d& start, double max_travel = kNoTravel, DropStats* stats = nullptr,
+              int32_t* hint = nullptr) const;
+
+ private:
+  // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
+  struct Plane {
+    double c, gx, gy;
+  };
+  double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
+
+  const DirectionalIndex* index_;
+  Cutter cutter_;
+  Eigen::Vector3d a_;   // the axis in the index's frame
+  ToolFrame frame_;
+  Eigen::Vector3d W_;   // the motion in tool coordinates
+  double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
+  double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
+  std::vector<Plane> planes_;
+};
 
 // starts: n points (x, y, z, ...); axes: one unit axis (axes_per_point = false) or n of them; travel_out: n.
 // Threads, progress and cancel (Cancelled) as drop_batch.
