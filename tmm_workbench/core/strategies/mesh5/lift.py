@@ -150,6 +150,10 @@ def _drop_atlas(cutter: Cutter, pairs, tris, out: np.ndarray, lift_limit: float)
         corners.append(shifted)
         first += len(post)
     V = np.ascontiguousarray(np.concatenate(corners).reshape(-1, 3))
+    if len(V) == 0:                                   # nothing within reach of any copy: nothing to clear
+        for i, post, _ in pairs:
+            out[i, post] = 0.0
+        return
     F = np.arange(len(V), dtype=np.int32).reshape(-1, 3)
     index = native.MeshIndex(V, F)
     floor = -1e-6 * max(1.0, cutter.radius)
