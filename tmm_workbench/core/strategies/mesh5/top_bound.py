@@ -51,15 +51,21 @@ def profile_arcs(cutter: Cutter, lam: np.ndarray, omg: np.ndarray,
     a2 = rot[:, 2, 1:]                                                     # lift direction in (LY, LZ)
     au = a2 / np.linalg.norm(a2, axis=1, keepdims=True)
     bu = np.stack([au[:, 1], -au[:, 0]], axis=1)                           # across the lift, towards +LY
-    th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)
-    # outward normals of the arc that faces against the lift: n = -cos(th) a + sin(th) b
-    n = -np.cos(th)[None, :, None] * au[:, None, :] + np.sin(th)[None, :, None] * bu[:, None, :]
-    mtn = np.einsum("pji,psj->psi", M, n)                                  # M^T n
-    norm = np.linalg.norm(mtn, axis=2, keepdims=True)
-    s = np.where(norm > 1e-15, mtn / np.where(norm > 1e-15, norm, 1.0), 0.0)
-    pts = c2[:, None, :] + np.einsum("pij,psj->psi", M, s) + r * n          # support points of E + disc_r
-    across = np.einsum("psi,pi->ps", pts, bu)
-    along = np.einsum("psi,pi->ps", pts, au)
+    th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
+    # outward normals of the arc that faces against the lift: n = -cos(th) a + sin(th) b, (P, S) components
+    ny = -np.cos(th) * au[:, :1] + np.sin(th) * bu[:, :1]
+    nz = -np.cos(th) * au[:, 1:] + np.sin(th) * bu[:, 1:]
+    m = [[M[:, i, j][:, None] for j in range(2)] for i in range(2)]
+    s0 = m[0][0] * ny + m[1][0] * nz                                       # M^T n
+    s1 = m[0][1] * ny + m[1][1] * nz
+    norm = np.hypot(s0, s1)
+    inv = np.where(norm > 1e-15, 1.0 / np.where(norm > 1e-15, norm, 1.0), 0.0)
+    s0 *= inv
+    s1 *= inv
+    py = c2[:, :1] + m[0][0] * s0 + m[0][1] * s1 + r * ny                  # support points of E + disc_r
+    pz = c2[:, 1:] + m[1][0] * s0 + m[1][1] * s1 + r * nz
+    across = py * bu[:, :1] + pz * bu[:, 1:]
+    along = py * au[:, :1] + pz * au[:, 1:]
     return a2, np.maximum.accumulate(across, axis=1), along
 
 
