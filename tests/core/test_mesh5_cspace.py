@@ -333,3 +333,18 @@ def test_bad_input_is_refused_by_name():
         build_cspace(mesh, Cutter.vbit(6, 90), ORIGIN, IDENTITY, grid, 0.05, 1.0)
     with pytest.raises(TmmError, match="inclination"):
         PostureGrid.degrees((0, 95))
+
+
+def test_batched_lifts_equal_one_posture_at_a_time():
+    """The atlas lays many (CC point, posture) copies side by side: no copy may touch another's triangles."""
+    mesh = trough()
+    reach = MeshReach(mesh)
+    path = cc_paths(mesh, (1, 0), np.array([2.0]), 3.0, 0.01)[0]
+    pts, frames = path.points[2:4], path.frames[2:4]
+    lam, omg = (np.radians(g.ravel()) for g in np.meshgrid([0.0, 6.0, 20.0, 40.0], [-40.0, -5.0, 0.0, 30.0],
+                                                            indexing="ij"))
+    batch = lifts(reach, FLAT, pts, frames, lam, omg, 20.0)
+    single = np.array([[lifts(reach, FLAT, pts[i:i + 1], frames[i:i + 1], lam[p:p + 1], omg[p:p + 1], 20.0)[0, 0]
+                        for p in range(len(lam))] for i in range(len(pts))])
+    assert np.abs(batch - single).max() < 1e-12
+    assert batch.max() > 0.1                                          # the heel at lambda = 0 is lifted
