@@ -348,3 +348,25 @@ def test_batched_lifts_equal_one_posture_at_a_time():
                         for p in range(len(lam))] for i in range(len(pts))])
     assert np.abs(batch - single).max() < 1e-12
     assert batch.max() > 0.1                                          # the heel at lambda = 0 is lifted
+
+
+def test_world_placement_touches_the_cc_point_and_clears_the_mesh():
+    """A C-space set turned into a CL point (eq. 3.6-3.9): the axis is lambda from the normal, and the tool
+    placed there with the lift S2 touches the mesh without gouging (the kernel's drop along the axis from that
+    tip travels nothing)."""
+    from tmm_workbench.core.query.drop_direction import drop_along
+    from tmm_workbench.core.strategies.mesh5.posture import world_placement
+
+    mesh = trough()
+    path = cc_paths(mesh, (1, 0), np.array([3.0]), 3.0, 0.01)[0]
+    cutter = Cutter.bull(2 * R, 1.5)
+    grid = PostureGrid(np.radians([0.0, 12.0, 30.0]), np.radians([-30.0, 0.0, 25.0]))
+    cs = build_cspace(mesh, cutter, path.points[3:4], path.frames[3:4], grid, 0.05, 1.0, all_lifts=True)
+    L, W = grid.mesh()
+    for i, j in [(0, 1), (1, 0), (2, 2)]:
+        tip, axis = world_placement(cutter, path.points[3], path.frames[3], L[i, j], W[i, j], cs.lift[0, i, j])
+        angle = math.degrees(math.acos(float(axis[0] @ path.normals[3])))
+        assert angle == pytest.approx(math.degrees(L[i, j]), abs=1e-9)
+        long = Cutter(cutter.diameter, cutter.corner_radius, cutting_length=4 * R)
+        travel, _ = drop_along(mesh, long, tip + 5.0 * axis, axis[0], -axis[0])
+        assert travel[0] == pytest.approx(5.0, abs=1e-6)               # it comes down exactly to the CL point

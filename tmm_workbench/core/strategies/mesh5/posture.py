@@ -89,3 +89,16 @@ def touch_tip(cutter: Cutter, rot: np.ndarray) -> np.ndarray:
     rp = cutter.radius - r
     ez = np.array([0.0, 0.0, 1.0])
     return r * ez - r * rot[..., 2, :] - rp * rot[..., 0, :]
+
+
+def world_placement(cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray, omg: np.ndarray,
+                    delta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The tool's tip (centre of the bottom) and unit axis (tip -> spindle) in world coordinates, (n, 3) each,
+    for n C-space sets (lam, omg radians, delta mm) at CC points (n, 3) with LCS frames (n, 3, 3) (rows LX,
+    LY, LZ): the CL point of eq. 3.6-3.9."""
+    rot = tool_rotation(np.asarray(lam, dtype=float).reshape(-1), np.asarray(omg, dtype=float).reshape(-1))
+    tip_l = touch_tip(cutter, rot) + np.asarray(delta, dtype=float).reshape(-1, 1) * rot[:, 2, :]
+    F = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
+    tips = np.asarray(points, dtype=float).reshape(-1, 3) + np.einsum("nji,nj->ni", F, tip_l)
+    axes = np.einsum("nji,nj->ni", F, rot[:, 2, :])
+    return tips, axes
