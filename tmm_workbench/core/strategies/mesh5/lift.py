@@ -85,7 +85,26 @@ def _pair_copies(reach: MeshReach, cutter: Cutter, point: np.ndarray, frame: np.
     k_of, p_of = np.nonzero(keep)
     loc = (reach.corners[idx] - point) @ frame.T
     tri = np.matmul(loc[k_of], rp[p_of].transpose(0, 2, 1)) - tip_t[postures][p_of][:, None, :]
-    return p_of, tri
+    # the exact test on the candidates: the triangle's shadow within R of the axis, and its z range
+    z = tri[..., 2]
+    ok = (_axis_distance(tri[..., :2]) <= R * (1 + 1e-9)) & (z.max(axis=1) >= -1e-9 * R) & (z.min(axis=1) <= top)
+    return p_of[ok], tri[ok]
+
+
+def _axis_distance(xy: np.ndarray) -> np.ndarray:
+    """(m,) distance from the origin to each triangle (m, 3, 2) in the plane (0 inside)."""
+    best = np.full(len(xy), np.inf)
+    cross = []
+    for i in range(3):
+        a, b = xy[:, i], xy[:, (i + 1) % 3]
+        e = b - a
+        ee = np.einsum("ij,ij->i", e, e)
+        t = np.clip(-np.einsum("ij,ij->i", a, e) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+        best = np.minimum(best, np.hypot(a[:, 0] + t * e[:, 0], a[:, 1] + t * e[:, 1]))
+        cross.append(a[:, 0] * e[:, 1] - a[:, 1] * e[:, 0])          # the origin's side of each edge
+    c = np.stack(cross, 1)
+    inside = (c >= 0).all(axis=1) | (c <= 0).all(axis=1)
+    return np.where(inside, 0.0, best)
 
 
 def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,

@@ -25,6 +25,7 @@ profile: the profile can only be higher, the bound smaller (on the safe side).
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 from typing import Optional
 
 import numpy as np
@@ -41,7 +42,15 @@ def profile_arcs(cutter: Cutter, lam: np.ndarray, omg: np.ndarray,
                  samples: int = PROFILE_SAMPLES) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For P postures: the lift direction a2 = (TZ_y, TZ_z) (P, 2) and the profile's entry arc seen along
     it, as its coordinate across a2 (P, samples, increasing) and along the unit a2 (P, samples), at delta = 0
-    in LCS (LY, LZ)."""
+    in LCS (LY, LZ). The same for every CC point and pass: kept for the last few (cutter, grid)s."""
+    lam = np.ascontiguousarray(lam, dtype=float).reshape(-1)
+    omg = np.ascontiguousarray(omg, dtype=float).reshape(-1)
+    return _profile_arcs(cutter, lam.tobytes(), omg.tobytes(), int(samples))
+
+
+@lru_cache(maxsize=4)
+def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: int):
+    lam, omg = np.frombuffer(lam_bytes), np.frombuffer(omg_bytes)
     rot = tool_rotation(lam, omg)                                          # (P, 3, 3)
     tip = touch_tip(cutter, rot)
     r = cutter.corner_radius
@@ -66,7 +75,10 @@ def profile_arcs(cutter: Cutter, lam: np.ndarray, omg: np.ndarray,
     pz = c2[:, 1:] + m[1][0] * s0 + m[1][1] * s1 + r * nz
     across = py * bu[:, :1] + pz * bu[:, 1:]
     along = py * au[:, :1] + pz * au[:, 1:]
-    return a2, np.maximum.accumulate(across, axis=1), along
+    arcs = (a2, np.maximum.accumulate(across, axis=1), along)
+    for a in arcs:
+        a.flags.writeable = False                                          # shared by the cache
+    return arcs
 
 
 def surface_heights(reach: MeshReach, points: np.ndarray, frames: np.ndarray, lateral: np.ndarray,
