@@ -42,7 +42,7 @@ class CSpace:
     @property
     def empty(self) -> np.ndarray:
         """(n,): CC points with no available posture (for clean-up)."""
-        return ~self.available.reshape(len(self.lift), -1).any(axis=1)
+        return ~self.available.any(axis=(1, 2))
 
     def report(self, names: Optional[List[str]] = None) -> str:
         """One line: how many CC points have an empty C-space, and which (first few)."""
@@ -69,6 +69,9 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
     frm = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
     if len(frm) != len(pts):
         raise TmmError(f"{len(pts)} CC points but {len(frm)} frames")
+    shape = (len(pts),) + grid.shape
+    if len(pts) == 0:
+        return CSpace(grid, np.zeros(shape), np.zeros(shape))
     lam, omg = (g.ravel() for g in grid.mesh())
     top = top_bounds(reach, cutter, pts, frm, lam, omg, tolerance, side_step, profile_arcs(cutter, lam, omg))
     finite = top[np.isfinite(top)]
@@ -78,5 +81,4 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
         raise TmmError(f"lift limit must be a finite number of mm >= 0, got {lift_limit!r}")
     mask = None if all_lifts else top >= 0
     lf = lifts(reach, cutter, pts, frm, lam, omg, float(lift_limit), mask, tool_length, progress)
-    shape = (len(pts),) + grid.shape
     return CSpace(grid, lf.reshape(shape), top.reshape(shape))
