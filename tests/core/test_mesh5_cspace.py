@@ -370,3 +370,25 @@ def test_world_placement_touches_the_cc_point_and_clears_the_mesh():
         long = Cutter(cutter.diameter, cutter.corner_radius, cutting_length=4 * R)
         travel, _ = drop_along(mesh, long, tip + 5.0 * axis, axis[0], -axis[0])
         assert travel[0] == pytest.approx(5.0, abs=1e-6)               # it comes down exactly to the CL point
+
+
+def test_the_holder_bounds_the_lift_as_the_kernels_assembly_drop_along_the_axis():
+    """With a ToolAssembly the shank and holder keep their clearances: a wall the cutter never reaches lifts
+    the tool when the holder comes over it; each lift equals the kernel's assembly drop along the axis
+    (AssemblyDrop.along, another code path) from high above that CL point."""
+    from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+    from tmm_workbench.core.strategies.mesh5.posture import world_placement
+    from tmm_workbench.core.tools.assembly import ToolAssembly
+
+    mesh = grid_mesh(lambda x, y: np.where(y > 9.0, 30.0, 0.0), 60, 120, (-30, -30, 30, 30), "wall")
+    tool = ToolAssembly(FLAT, shank_diameter=10.0, stick_out=25.0, flute_length=15.0, holder="SK40 ER32x70")
+    lam, omg = np.radians([0.0, 15.0, 15.0, 30.0]), np.radians([0.0, 0.0, 60.0, -45.0])
+    reach = MeshReach(mesh)
+    bare = lifts(reach, FLAT, ORIGIN, IDENTITY, lam, omg, 40.0)[0]
+    held = lifts(reach, FLAT, ORIGIN, IDENTITY, lam, omg, 40.0, assembly=tool)[0]
+    assert np.all(bare < 1e-9) and held.min() > 1.0
+    drop = AssemblyDrop(mesh, tool)
+    for k in range(len(lam)):
+        tip, axis = world_placement(FLAT, ORIGIN, IDENTITY, lam[k:k + 1], omg[k:k + 1], np.zeros(1))
+        travel, _ = drop.along(tip + 100.0 * axis, axis[0], -axis[0])
+        assert held[k] == pytest.approx(100.0 - travel[0], abs=1e-6)

@@ -20,6 +20,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain
 from tmm_workbench.core.strategies.mesh5.top_bound import profile_arcs, top_bounds
+from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
@@ -58,11 +59,12 @@ class CSpace:
 def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray,
                  grid: PostureGrid, tolerance: float, side_step, lift_limit: Optional[float] = None,
                  tool_length: Optional[float] = None, all_lifts: bool = False,
-                 progress: Optional[Progress] = None) -> CSpace:
+                 progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None) -> CSpace:
     """The C-spaces at the n CC points (points (n, 3), frames (n, 3, 3) rows LX, LY, LZ, as cc_paths gives
     them). `side_step`: the half step-over on each side (number, (n,) or (n, 2): left +LY, right -LY).
     `lift_limit`: lifts above it count as unavailable (default: the largest finite top bound, at least the
-    tolerance; with `all_lifts` the cutter radius)."""
+    tolerance; with `all_lifts` the cutter radius). `assembly`: the cutter's ToolAssembly, whose shank and
+    holder (with their clearances) then bound S2 too."""
     require_plain(cutter)
     reach = mesh if isinstance(mesh, MeshReach) else MeshReach(mesh)
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -80,5 +82,5 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
     elif not (isinstance(lift_limit, (int, float)) and math.isfinite(lift_limit) and lift_limit >= 0):
         raise TmmError(f"lift limit must be a finite number of mm >= 0, got {lift_limit!r}")
     mask = None if all_lifts else top >= 0
-    lf = lifts(reach, cutter, pts, frm, lam, omg, float(lift_limit), mask, tool_length, progress)
+    lf = lifts(reach, cutter, pts, frm, lam, omg, float(lift_limit), mask, tool_length, progress, assembly)
     return CSpace(grid, lf.reshape(shape), top.reshape(shape))

@@ -12,9 +12,10 @@ into that posture's tool frame and laid side by side in XY on an "atlas"; one sp
 one batched drop-cutter call answer all pairs (chunked to bound the memory). The kernel's DirectionalIndex
 would need one index per axis, and the axes differ for every posture and CC point.
 
-Reach: the triangles within `2 R + tool_length + lift_limit` of the CC point (the tool modelled up to
-tool_length above its tip), and of those, per posture, the ones that can meet the cylinder of radius R about
-the axis above the tip's plane. A lift above `lift_limit` is returned as inf (not resolved: the far parts of
+Reach: the triangles within reach of the CC point (the tool modelled up to tool_length above its tip), and
+of those, per posture, the ones whose shadow along the axis comes within the tool's radius (each column's:
+cutter, and with a ToolAssembly the flutes, neck, shank and holder grown by their clearances, dropped by the
+kernel's assembly drop) above the column's bottom. A lift above `lift_limit` is returned as inf (not resolved: the far parts of
 the mesh were left out), which the C-space treats as unavailable.
 """
 from __future__ import annotations
@@ -29,6 +30,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.kernel import native
 from tmm_workbench.core.strategies.mesh5.posture import tool_rotation, touch_tip
+from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
@@ -61,18 +63,32 @@ def default_tool_length(cutter: Cutter) -> float:
     return float(cutter.cutting_length) if math.isfinite(cutter.cutting_length) else 2.0 * cutter.diameter
 
 
+def tool_columns(cutter: Cutter, tool_length: float, assembly: Optional[ToolAssembly] = None) -> np.ndarray:
+    """(c, 3) columns (radius, lowest z, highest z) about the axis in the tool frame (tip at the origin) that
+    hold the modelled tool: the cutter up to tool_length, or the assembly's cutter and bodies (each grown by
+    its clearance) up to its top."""
+    if assembly is None:
+        return np.array([[cutter.radius, 0.0, tool_length]])
+    cc = assembly.cutter_clearance
+    cols = [[cutter.radius + cc, -cc, assembly.top]]
+    cols += [[max(r0, r1) + c, z0 - c, assembly.top] for z0, z1, r0, r1, c in assembly.bodies()]
+    return np.array(cols, dtype=float)
+
+
 def _pair_copies(reach: MeshReach, cutter: Cutter, point: np.ndarray, frame: np.ndarray, rot: np.ndarray,
-                 tip_t: np.ndarray, postures: np.ndarray, tool_length: float, lift_limit: float):
+                 tip_t: np.ndarray, postures: np.ndarray, columns: np.ndarray, lift_limit: float):
     """For one CC point: (posture of each copy, triangles of each copy (k, 3, 3) in the posture's tool frame)."""
     R = cutter.radius
-    top = tool_length + lift_limit
-    idx = reach.near(point, 2 * R + top)
+    rmax = float(columns[:, 0].max())
+    top = float(columns[:, 2].max()) + lift_limit
+    zlow = float(columns[:, 1].min())
+    idx = reach.near(point, R + rmax + top)
     cen = (reach.centroids[idx] - point) @ frame.T                       # LCS
     rad = reach.radii[idx]
-    # the tool of any posture stays within 2 R + tan(lambda) (z + 2 R) of LZ at height z above the plane
+    # the tool of any posture stays within R + rmax + tan(lambda) (z + rmax) of LZ at height z above the plane
     rp = rot[postures]                                                   # (P, 3, 3)
     tan_max = float(np.max(np.hypot(rp[:, 2, 0], rp[:, 2, 1]) / rp[:, 2, 2]))
-    cone = 2 * R + tan_max * (np.maximum(cen[:, 2] + rad, 0.0) + 2 * R) + rad
+    cone = R + rmax + tan_max * (np.maximum(cen[:, 2] + rad, 0.0) + rmax) + rad
     near = np.hypot(cen[:, 0], cen[:, 1]) <= cone
     idx, cen, rad = idx[near], cen[near], rad[near]
     # centroids in every posture's tool frame, one matrix product per component: (k, P) each
@@ -80,14 +96,19 @@ def _pair_copies(reach: MeshReach, cutter: Cutter, point: np.ndarray, frame: np.
     qx *= qx
     qy *= qy
     qx += qy
-    reach_r = R * (1 + 1e-9) + rad[:, None]
-    keep = (qx <= reach_r * reach_r) & (qz + rad[:, None] >= -1e-9 * R) & (qz - rad[:, None] <= top)
+    reach_r = rmax * (1 + 1e-9) + rad[:, None]
+    eps = 1e-9 * R
+    keep = (qx <= reach_r * reach_r) & (qz + rad[:, None] >= zlow - eps) & (qz - rad[:, None] <= top)
     k_of, p_of = np.nonzero(keep)
     loc = (reach.corners[idx] - point) @ frame.T
     tri = np.matmul(loc[k_of], rp[p_of].transpose(0, 2, 1)) - tip_t[postures][p_of][:, None, :]
-    # the exact test on the candidates: the triangle's shadow within R of the axis, and its z range
-    z = tri[..., 2]
-    ok = (_axis_distance(tri[..., :2]) <= R * (1 + 1e-9)) & (z.max(axis=1) >= -1e-9 * R) & (z.min(axis=1) <= top)
+    # the exact test on the candidates: the triangle's shadow within a column's radius, its z range reaching it
+    dist = _axis_distance(tri[..., :2])
+    zmax, zmin = tri[..., 2].max(axis=1), tri[..., 2].min(axis=1)
+    ok = np.zeros(len(tri), dtype=bool)
+    for radius, low, _high in columns:
+        ok |= (dist <= radius * (1 + 1e-9)) & (zmax >= low - eps)
+    ok &= zmin <= top
     return p_of[ok], tri[ok]
 
 
@@ -109,20 +130,28 @@ def _axis_distance(xy: np.ndarray) -> np.ndarray:
 
 def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
           omg: np.ndarray, lift_limit: float, mask: Optional[np.ndarray] = None,
-          tool_length: Optional[float] = None, progress: Optional[Progress] = None) -> np.ndarray:
+          tool_length: Optional[float] = None, progress: Optional[Progress] = None,
+          assembly: Optional[ToolAssembly] = None) -> np.ndarray:
     """Lifts (n, P) of the P postures (lam, omg: (P,) radians) at the n CC points (points (n, 3), frames
-    (n, 3, 3) rows LX, LY, LZ). NaN where `mask` (n, P) is False (not asked), inf above `lift_limit`."""
+    (n, 3, 3) rows LX, LY, LZ). NaN where `mask` (n, P) is False (not asked), inf above `lift_limit`. With an
+    `assembly` (of this cutter) the flutes, neck, shank and holder keep their clearances too (the kernel's
+    assembly drop), and tool_length is the assembly's top."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     frm = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
     lam = np.asarray(lam, dtype=float).reshape(-1)
     omg = np.asarray(omg, dtype=float).reshape(-1)
     if not (isinstance(lift_limit, (int, float)) and math.isfinite(lift_limit) and lift_limit >= 0):
         raise TmmError(f"lift limit must be a finite number of mm >= 0, got {lift_limit!r}")
+    if assembly is not None:
+        if not isinstance(assembly, ToolAssembly) or assembly.cutter != cutter:
+            raise TmmError(f"assembly must be a ToolAssembly of the {cutter.describe()} cutter, got {assembly!r}")
+        tool_length = assembly.top
     tool_length = default_tool_length(cutter) if tool_length is None else float(tool_length)
     if not (math.isfinite(tool_length) and tool_length > 0):
         raise TmmError(f"tool length must be a positive number of mm, got {tool_length!r}")
     n, P = len(pts), len(lam)
     ask = np.ones((n, P), dtype=bool) if mask is None else np.asarray(mask, dtype=bool).reshape(n, P)
+    columns = tool_columns(cutter, tool_length, assembly)
     rot = tool_rotation(lam, omg)                                        # (P, 3, 3)
     tip_t = np.einsum("pij,pj->pi", rot, touch_tip(cutter, rot))         # tip in each tool frame
     out = np.full((n, P), np.nan)
@@ -133,14 +162,14 @@ def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarr
     def flush() -> None:
         nonlocal pairs, tris, budget
         if pairs:
-            _drop_atlas(cutter, pairs, tris, out, lift_limit)
+            _drop_atlas(cutter, assembly, float(columns[:, 0].max()), pairs, tris, out, lift_limit)
         pairs, tris, budget = [], [], 0
 
     for i in range(n):
         postures = np.flatnonzero(ask[i])
         if postures.size == 0:
             continue
-        p_of, tri = _pair_copies(reach, cutter, pts[i], frm[i], rot, tip_t, postures, tool_length, lift_limit)
+        p_of, tri = _pair_copies(reach, cutter, pts[i], frm[i], rot, tip_t, postures, columns, lift_limit)
         pairs.append((i, postures, p_of))
         tris.append(tri)
         budget += len(tri)
@@ -152,12 +181,13 @@ def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarr
     return out
 
 
-def _drop_atlas(cutter: Cutter, pairs, tris, out: np.ndarray, lift_limit: float) -> None:
-    """Lays the copies side by side, indexes them once and drops the cutter on each copy's origin."""
+def _drop_atlas(cutter: Cutter, assembly: Optional[ToolAssembly], reach_radius: float, pairs, tris,
+                out: np.ndarray, lift_limit: float) -> None:
+    """Lays the copies side by side, indexes them once and drops the tool on each copy's origin."""
     counts = [len(post) for _, post, _ in pairs]
     ncopy = int(sum(counts))
     grid = int(math.ceil(math.sqrt(ncopy)))
-    spacing = 2.0 * cutter.radius + 2.0 * max(float(np.abs(t[..., :2]).max(initial=0.0)) for t in tris) + 1.0
+    spacing = 2.0 * reach_radius + 2.0 * max(float(np.abs(t[..., :2]).max(initial=0.0)) for t in tris) + 1.0
     cx = (np.arange(ncopy) % grid) * spacing
     cy = (np.arange(ncopy) // grid) * spacing
     corners, first = [], 0
@@ -176,7 +206,13 @@ def _drop_atlas(cutter: Cutter, pairs, tris, out: np.ndarray, lift_limit: float)
     F = np.arange(len(V), dtype=np.int32).reshape(-1, 3)
     index = native.MeshIndex(V, F)
     floor = -1e-6 * max(1.0, cutter.radius)
-    z = native.drop_cutter(index, cutter.native, np.column_stack([cx, cy]), floor, 0, None)
+    xy = np.column_stack([cx, cy])
+    if assembly is None:
+        z = native.drop_cutter(index, cutter.native, xy, floor, 0, None)
+    else:
+        rows = np.array(assembly.bodies(), dtype=np.float64).reshape(-1, 5)
+        z, _owner = native.drop_assembly(index, cutter.native, rows, xy, floor, float(assembly.cutter_clearance),
+                                         0, None)
     lift = np.maximum(z, 0.0)
     lift[lift > lift_limit] = np.inf
     first = 0
