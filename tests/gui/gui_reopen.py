@@ -2,7 +2,7 @@
 
 One Job with each TMM op the API makes (3-axis Surface, Roughing, Waterline on a mesh; 5-axis Multipoint on a Bézier
 face in a second document), saved, closed and reopened: the report view gets no error while the documents load
-(FreeCAD 0.20 printed "setAttr failed" for each op's view provider). The report view's text after each reopen goes
+(FreeCAD 0.20 printed "setAttr failed" for each tool controller). The report view's text after each reopen goes
 to env TMM_GUI_RESULT (JSON) with the exit code."""
 import os
 import sys
@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.
 sys.path.insert(0, str(ROOT / "tests" / "gui"))
 import gui_runner  # noqa: E402
 from gui_runner import pump  # noqa: E402
+
 
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_reopen.json")
 
