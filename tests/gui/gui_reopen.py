@@ -2,7 +2,8 @@
 
 One Job with each TMM op the API makes (3-axis Surface, Roughing, Waterline on a mesh; 5-axis Multipoint on a Bézier
 face in a second document), saved, closed and reopened: the report view gets no error while the documents load
-(FreeCAD 0.20 printed "setAttr failed" for each tool controller). The report view's text after each reopen goes
+(FreeCAD 0.20 printed "setAttr failed" for each tool controller). Before saving, the Surface op's panel: a good
+Apply's undo step is named after the op ("Edit <label>"), not "TMM operation". The report view's text after each reopen goes
 to env TMM_GUI_RESULT (JSON) with the exit code."""
 import os
 import sys
@@ -16,6 +17,9 @@ ROOT = Path(__file__).resolve().parents[2] if "__file__" in globals() else Path.
 sys.path.insert(0, str(ROOT / "tests" / "gui"))
 import gui_runner  # noqa: E402
 from gui_runner import pump  # noqa: E402
+
+gui_runner.helpers_of("gui_smoke")  # its helpers, not its run
+from gui_smoke import close_panel  # noqa: E402
 
 
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_reopen.json")
@@ -37,6 +41,24 @@ def reopened_messages(path: Path, name: str) -> str:
     return text
 
 
+def applied_undo_steps(op) -> list:
+    """The op's panel: Apply (commits what opening the panel wrote), a change (the op's comment), Apply: the undo
+    steps, newest first (then Cancel). Apply is what the task view calls on its button (panel.clicked)."""
+    op.Label = "Finish sphere"
+    op.Document.clearUndos()  # the stack keeps the last 20 steps: only the panel's from here
+    op.ViewObject.Document.setEdit(op.ViewObject, 0)
+    pump(1.0)
+    panel = op.ViewObject.Proxy.panel
+    panel.clicked(QtGui.QDialogButtonBox.Apply)
+    pump(0.5)
+    op.Comment = "finish after the roughing"
+    panel.clicked(QtGui.QDialogButtonBox.Apply)
+    pump(0.5)
+    steps = list(op.Document.UndoNames)
+    close_panel(op)
+    return steps
+
+
 def run(out: Path) -> dict:
     info: dict = {}
     if str(ROOT) not in sys.path:
@@ -55,6 +77,7 @@ def run(out: Path) -> dict:
     net = bezier.load_seed_patch(benchmark_file("seed_surfaces.json"), "convex")
     m = api.run_multipoint(net, scallop=1.0, forward_step=10.0, posts=(), doc_name="TmmGuiReopen5", progress=False)
     info["ops"] = sorted(o.Name for o in r.doc.Objects if o.Name.startswith("TMM_"))
+    info["undo"] = applied_undo_steps(r.op)
     for doc, key in ((r.doc, "mesh"), (m.doc, "face")):
         path = out / f"{doc.Name}.FCStd"
         doc.saveAs(str(path))

@@ -1,5 +1,6 @@
 """GUI test of reopening saved TMM documents: FreeCAD under Xvfb runs tests/gui/gui_reopen.py (a Job with each TMM op
-saved and reopened) and must exit 0; the report view shows no error while they load (no "setAttr failed")."""
+saved and reopened) and must exit 0; the report view shows no error while they load (no "setAttr failed");
+a good Apply's undo step is named after the op."""
 from __future__ import annotations
 
 import json
@@ -24,5 +25,7 @@ def test_gui_reopen(tmp_path: Path) -> None:
     assert code == 0 and info.get("ok"), \
         f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     assert len(info["ops"]) == 3, info["ops"]
+    # the panel's first step keeps FreeCAD's name ("AreaOp Operation"); a good Apply after it is named after the op
+    assert info["undo"][0] == "Edit Finish sphere" and "TMM operation" not in info["undo"], info["undo"]
     for key in ("mesh_messages", "face_messages"):
         assert "setAttr failed" not in info[key] and "Traceback" not in info[key], f"{key}:\n{info[key]}"
