@@ -20,6 +20,9 @@ import gui_runner  # noqa: E402
 gui_runner.helpers_of("gui_smoke")  # its helpers, not its run
 from gui_smoke import pump, screenshot  # noqa: E402
 
+gui_runner.helpers_of("gui_state")
+from gui_state import click  # noqa: E402
+
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui" / "first_job_panel.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_first_steps.json")
 
@@ -36,17 +39,6 @@ def action(text: str) -> QtGui.QAction:
 def toolbar_texts(name: str) -> list:
     bars = [b for b in FreeCADGui.getMainWindow().findChildren(QtGui.QToolBar) if b.objectName() == name]
     return [a.text().replace("&", "") for b in bars for a in b.actions() if a.text()]
-
-
-def click_ok() -> None:
-    for box in FreeCADGui.getMainWindow().findChildren(QtGui.QDialogButtonBox):
-        button = box.button(QtGui.QDialogButtonBox.Ok)
-        if button is not None and button.isVisible():
-            button.click()
-            pump(0.5)
-            gui_runner.forget_found_widgets()
-            return
-    raise AssertionError("the task panel has no visible OK button")
 
 
 def run() -> dict:
@@ -85,7 +77,7 @@ def run() -> dict:
     FreeCADGui.activeDocument().activeView().viewIsometric()
     pump(0.3)
     screenshot(PNG)
-    click_ok()
+    click(QtGui.QDialogButtonBox.Ok)
     info["panel_closed"] = not FreeCADGui.Control.activeDialog()
     pump(0.5)
     # FreeCAD's Job panel outlives its widgets: none of their dead wrappers may stay in PySide's map
