@@ -74,11 +74,12 @@ def create_job_gui(model: Any, open_panel: bool = True) -> Any:
     doc.recompute()
     if job.Stock is not None and job.Stock.ViewObject is not None:
         job.Stock.ViewObject.Visibility = True
-    if open_panel and not FreeCADGui.Control.activeDialog():
-        job.ViewObject.Proxy.deleteOnReject = False  # Cancel closes the panel, the Job stays
-        job.ViewObject.Proxy.editObject(job.Stock)
-        panel = getattr(job.ViewObject.Proxy, "taskPanel", None)
-        if panel is not None:
+    proxy = job.ViewObject.Proxy
+    if open_panel and hasattr(proxy, "editObject") and not FreeCADGui.Control.activeDialog():
+        proxy.deleteOnReject = False  # Cancel closes the panel, the Job stays
+        proxy.editObject(job.Stock)
+        panel = getattr(proxy, "taskPanel", None)
+        if panel is not None and hasattr(panel, "cleanup"):  # 0.20 to 1.1's Job panel
             forget_form_on_close(panel)
     return job
 
