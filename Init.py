@@ -10,3 +10,10 @@ try:
     _tmm_posts.install_post_dir()
 except Exception as _exc:  # never break FreeCAD's start-up because of the add-on
     FreeCAD.Console.PrintWarning(f"TMM: post-processor folder not registered: {_exc}\n")
+
+try:
+    from tmm_workbench.app import compat as _tmm_compat
+
+    _tmm_compat.mend_tool_controller_restore()
+except Exception as _exc:  # never break FreeCAD's start-up because of the add-on
+    FreeCAD.Console.PrintWarning(f"TMM: tool controllers' restore not mended: {_exc}\n")

@@ -131,3 +131,20 @@ def test_poll_asks_the_innermost_callback_and_cancels():
         cancel.poll()
     cancel.poll()   # nothing watched: nothing asked
     assert asked == [("outer", 0.4), ("outer", 0.4), ("inner", 0.0), ("outer", 0.4)]
+
+
+def test_a_work_refusal_names_the_setting_to_raise():
+    """Headless, the environment variables; once the App names its preferences, those (never a Python call)."""
+    old = limits.set_limits(max_points=1000, max_positions=1000)
+    try:
+        with pytest.raises(WorkLimitError, match=r"environment variables TMM_MAX_POINTS and TMM_MAX_MEMORY_GB"):
+            limits.check_work("CL points", 2000, 8, "sample step 0.001 mm")
+        limits.name_settings("the TMM preferences", {"max_points": "MaxPoints", "max_positions": "MaxPositions",
+                                                     "max_memory_bytes": "MaxMemoryGB"})
+        with pytest.raises(WorkLimitError) as refused:
+            limits.check_work("positions", 2000, 8, "side step 0.01 mm", limit="max_positions")
+        assert "TMM preferences MaxPositions and MaxMemoryGB" in str(refused.value)
+        assert "set_limits" not in str(refused.value) and "TMM_MAX" not in str(refused.value)
+    finally:
+        limits.set_limits(max_points=old.max_points, max_positions=old.max_positions)
+        limits.name_settings(*limits.ENV_SETTINGS)

@@ -21,7 +21,7 @@ sys.path.insert(0, str(ROOT / "tests" / "gui"))
 import gui_runner  # noqa: E402
 
 gui_runner.helpers_of("gui_smoke")  # its helpers, not its run
-from gui_smoke import close_panel, find_panel, pump, screenshot  # noqa: E402
+from gui_smoke import click_close, close_panel, find_panel, pump, screenshot  # noqa: E402
 
 PNG = Path(os.environ.get("TMM_GUI_PNG") or ROOT / "out" / "gui" / "multipoint_axes.png")
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_multipoint.json")
@@ -32,6 +32,19 @@ def colours_of(vp) -> list:
     material = sep.getChild(1)
     return [tuple(round(c, 3) for c in material.diffuseColor[i].getValue())
             for i in range(material.diffuseColor.getNum())]
+
+
+def legend_lines(vp) -> list:
+    """The texts of the axes' legend under the op's axes switch."""
+    from pivy import coin
+
+    search = coin.SoSearchAction()
+    search.setType(coin.SoText2.getClassTypeId())
+    search.setInterest(coin.SoSearchAction.ALL)
+    search.apply(vp.axes_switch)
+    paths = search.getPaths()
+    texts = [paths[i].getTail().string for i in range(paths.getLength())]
+    return [t[t.getNum() - 1].getString() for t in texts]
 
 
 def run() -> dict:
@@ -51,6 +64,9 @@ def run() -> dict:
     r = run_multipoint(net, scallop=0.5, forward_step=6.0, posts=(), doc_name="TmmGuiMultipointAxes",
                        progress=True)
     op, vobj = r.op, r.op.ViewObject
+    clone = op.Base[0][0]
+    face = (getattr(clone, "Objects", None) or [clone])[0]  # what the user sees: the Job's model is a clone of it
+    assert face.ViewObject.Visibility, "the face is hidden before any simulation"
     assert isinstance(vobj.Proxy, ViewProvider), type(vobj.Proxy)
     vp = vobj.Proxy
     good = r.results.status != 2
@@ -68,6 +84,16 @@ def run() -> dict:
     info["axes_hidden"] = vp.axis_count()
     assert info["axes_hidden"] == 0, info
     vobj.ShowToolAxes = True
+    pump(0.2)
+    info["legend_lines"] = legend_lines(vp)
+    assert info["legend_lines"][:2] == ["tool axes: contact", "green: two contacts"], info["legend_lines"]
+    vobj.Visibility = False  # the axes hide with their op (not only with ShowToolAxes)
+    pump(0.2)
+    info["axes_op_hidden"] = vp.axis_count()
+    vobj.Visibility = True
+    pump(0.2)
+    info["axes_op_shown"] = vp.axis_count()
+    assert info["axes_op_hidden"] == 0 and info["axes_op_shown"] == info["axes_shown"], info
     vobj.AxisEvery = 1
     pump(0.2)
     info["axes_every_1"] = vp.axis_count()
@@ -132,7 +158,13 @@ def run() -> dict:
     info["sim_max_left"] = sim.findChild(QtGui.QLabel, "maxLeft").property("value")
     info["sim_min_deviation"] = sim.findChild(QtGui.QLabel, "minDeviation").property("value")
     assert info["sim_max_left"] is not None, f"TMM Simulate gave no 5-axis result: {info['sim_status']}"
+    # the face and the axes out of the way of the coloured stock, back on Close
+    info["sim_face_visible"], info["sim_axes"] = bool(face.ViewObject.Visibility), vp.axis_count()
+    assert not info["sim_face_visible"] and info["sim_axes"] == 0, info
     screenshot(PNG.with_name("multipoint_simulate.png"))
+    click_close()
+    info["closed_face_visible"], info["closed_axes"] = bool(face.ViewObject.Visibility), vp.axis_count()
+    assert info["closed_face_visible"] and info["closed_axes"] > 0, info
     gui_runner.close_document(r.doc)
     return info
 

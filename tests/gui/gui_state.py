@@ -158,6 +158,7 @@ def job_from_mesh(info: dict, stl: str):
     FreeCADGui.Selection.addSelection(mesh)
     FreeCADGui.runCommand(job_cmd.COMMAND_NAME)
     pump(1.0)
+    click(QtGui.QDialogButtonBox.Ok)  # the Job's panel the command opens: the user accepts the stock
     job = next(o for o in doc.Objects if o.TypeId == "Path::FeaturePython" and hasattr(o, "Operations"))
     info["job_post"] = job.PostProcessor
     info["job_post_first_offered"] = job.getEnumerationsOfProperty("PostProcessor")[0]

@@ -30,6 +30,11 @@ def test_gui_multipoint(tmp_path: Path) -> None:
         f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     assert info["axes_shown"] > 0 and info["axes_hidden"] == 0 and info["axes_every_1"] == info["positions"]
     assert info["contact_colours_match"] and info["tilt_colours_distinct"] > 10
+    # the axes hide with their op, carry a legend, and are out of the way while the simulated stock shows
+    assert info["axes_op_hidden"] == 0 and info["axes_op_shown"] == info["axes_shown"], info
+    assert info["legend_lines"][1:] == ["green: two contacts", "orange: one contact"], info["legend_lines"]
+    assert not info["sim_face_visible"] and info["sim_axes"] == 0, info
+    assert info["closed_face_visible"] and info["closed_axes"] > 0, info
     assert info["pass_spacing"][0] == "Scallop" and abs(info["scallop_field"][0] - 0.5) < 1e-9
     assert info["warning_fixed_30"][0] and not info["warning_fixed_20"] and not info["warning_scallop_30"]
     assert info["page_height"] < 760 and info["task_panel_height"] <= 1000, info

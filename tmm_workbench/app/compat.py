@@ -8,8 +8,10 @@ App-level modules are imported here; Gui-level ones are only named here and impo
 from __future__ import annotations
 
 import importlib
+import importlib.util
+import sys
 from types import ModuleType
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 # role -> (0.20 module, 0.21+ module[, 1.1 module])
 _APP_MODULES: dict[str, tuple[str, ...]] = {
@@ -84,6 +86,57 @@ def freecad_version() -> tuple[int, int]:
 MIN_VERSION = (0, 20)
 # Path modules TMM cannot work without, by role (the rest are looked up where used)
 REQUIRED_ROLES = ("op", "job", "tool_controller", "tool_bit", "preferences", "utils", "setup_sheet")
+
+
+def restore_tool_controllers() -> None:
+    """FreeCAD 0.20 on Python 3.11: a tool controller's proxy has no attributes, so Python's default __getstate__
+    gives None, saved as "null"; on reopening, 0.20 restores a proxy without __setstate__ by setting its __dict__
+    to that None, which fails: a red "setAttr failed" per tool controller on every reopen (also for a Job made by
+    FreeCAD alone). A __setstate__ that takes the saved state (None or a dict) ends it, for documents saved before
+    too. FreeCAD 0.21+ saves proxies through dumps/loads and needs nothing."""
+    if freecad_version() >= (0, 21):
+        return
+    cls = import_app("tool_controller").ToolController
+    if "__setstate__" in vars(cls) or hasattr(cls, "loads"):
+        return
+
+    def __setstate__(self: Any, state: Any) -> None:
+        if isinstance(state, dict):
+            self.__dict__.update(state)
+
+    cls.__setstate__ = __setstate__
+
+
+def mend_tool_controller_restore() -> None:
+    """restore_tool_controllers as soon as FreeCAD 0.20's tool controller module is imported (Init.py cannot
+    import it: the module reads FreeCAD.GuiUp, which does not exist yet), before any document restores one."""
+    if freecad_version() < (0, 21):
+        after_import(_APP_MODULES["tool_controller"][0], restore_tool_controllers)
+
+
+def after_import(name: str, action: Callable[[], None]) -> None:
+    """Runs `action` once the module `name` has been imported (at once if it is already)."""
+    if name in sys.modules:
+        action()
+        return
+
+    class Finder:
+        def find_spec(self, fullname: str, path: Any, target: Any = None) -> Any:
+            if fullname != name:
+                return None
+            sys.meta_path.remove(self)
+            spec = importlib.util.find_spec(fullname)
+            if spec is None or spec.loader is None:
+                return spec
+            load = spec.loader.exec_module
+
+            def load_then_act(module: ModuleType) -> None:
+                load(module)
+                action()
+            spec.loader.exec_module = load_then_act  # type: ignore[method-assign]
+            return spec
+
+    sys.meta_path.insert(0, Finder())
 
 
 def support_problem(version: Optional[tuple[int, int]] = None,

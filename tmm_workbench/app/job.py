@@ -52,6 +52,27 @@ def create_job(doc: Any, base: Any, name: str = "Job") -> Any:
     return job
 
 
+# --- the tool a Job from a mesh starts with ------------------------------------------------------------
+# A ball end mill (what sculptured surfaces are finished with) and its feeds from this table: diameter mm ->
+# (feed mm/min, plunge mm/min, spindle rpm), moderate values for a carbide ball in aluminium or plastics (the
+# API's defaults for 6 mm). A start the user adjusts to the material and the machine, never a feed of 0.
+BALL_FEEDS = {3.0: (600.0, 200.0, 14000.0), 6.0: (1000.0, 300.0, 10000.0), 10.0: (1400.0, 400.0, 8000.0)}
+START_BALL_MM = 6.0
+
+
+def start_tool(job: Any, diameter: float = START_BALL_MM) -> Any:
+    """The Job's first tool controller with a ball end mill of `diameter` (a BALL_FEEDS size) and its feeds, in
+    place of FreeCAD's default 5 mm end mill at feed 0."""
+    from tmm_workbench.app import tools
+
+    if diameter not in BALL_FEEDS:
+        raise TmmError(f"start tool diameter must be one of {', '.join(f'{d:g}' for d in BALL_FEEDS)} mm, "
+                       f"got {diameter:g}")
+    feed, plunge, rpm = BALL_FEEDS[diameter]
+    bit = tools.make_tool_bit(job.Document, "ballend", diameter)
+    return set_tool(job, bit, feed / 60.0, plunge / 60.0, rpm)
+
+
 # --- the Job's post: a working one, not FreeCAD's first in the list -------------------------------------
 DEFAULT_POST = "linuxcnc"
 FIVE_AXIS_POSTS = ("tarus", "apt_cl")  # the first is the default for a Job whose first op is 5-axis

@@ -68,6 +68,9 @@ def create(doc: Any, source: Any = None, stl_file: Optional[str] = None, name: s
     if stl_file:
         obj.StlFile = str(stl_file)
         obj.Label = f"{os.path.splitext(os.path.basename(str(stl_file)))[0]}-bounds"
+    # what the user reads in the tree (Description) and the property view, beside the "-bounds" label
+    obj.Label2 = ("TMM stand-in: the mesh's bounding box, the Job's model for its extents and stock; hidden, "
+                  "the ops machine the mesh")
     obj.recompute()
     if obj.Shape.isNull():
         message = obj.getStatusString()

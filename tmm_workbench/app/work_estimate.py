@@ -42,6 +42,9 @@ OPEN_HIGH = {"mm": 10_000.0, "deg": 360.0, "%": 100.0}
 
 
 PREFERENCES = "User parameter:BaseApp/Preferences/Mod/TMM"
+# where a refusal sends the user (FreeCAD's parameter editor: TMM has no preference page)
+PREFERENCES_WHERE = "the TMM preferences (Tools > Edit parameters..., BaseApp/Preferences/Mod/TMM)"
+PREFERENCE_NAMES = {"max_points": "MaxPoints", "max_positions": "MaxPositions", "max_memory_bytes": "MaxMemoryGB"}
 
 
 def apply_work_limits() -> None:
@@ -51,6 +54,7 @@ def apply_work_limits() -> None:
     points, positions = group.GetInt("MaxPoints", 0), group.GetInt("MaxPositions", 0)
     memory = group.GetFloat("MaxMemoryGB", 0.0)
     defaults = limits.WorkLimits()
+    limits.name_settings(PREFERENCES_WHERE, PREFERENCE_NAMES)
     limits.set_limits(points if points > 0 else defaults.max_points,
                       memory if memory > 0 else defaults.max_memory_bytes / 1e9,
                       positions if positions > 0 else defaults.max_positions)

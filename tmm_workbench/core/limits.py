@@ -1,8 +1,9 @@
 """Work limits: every strategy estimates its work from its parameters, before allocating anything, and
 refuses what this kind of machine (2 cores, 24 GB) cannot do in reasonable time and memory.
 
-The limits are a setting: `set_limits(...)` (the App layer applies the user's FreeCAD preferences), or the
-environment variables TMM_MAX_POINTS / TMM_MAX_POSITIONS / TMM_MAX_MEMORY_GB for headless runs. CL points
+The limits are a setting: `set_limits(...)` (the App layer applies the user's FreeCAD preferences and names
+them in refusals: `name_settings`), or the environment variables TMM_MAX_POINTS / TMM_MAX_POSITIONS /
+TMM_MAX_MEMORY_GB for headless runs. CL points
 of a drop-cutter cost microseconds each; multipoint positions (two-contact searches) milliseconds, so they
 have a limit of their own.
 """
@@ -34,6 +35,11 @@ class WorkLimits:
 
 
 _current = WorkLimits()
+# how the user raises each limit, named in a refusal: a headless run's environment variables, or what the App
+# layer names instead (name_settings: FreeCAD's preferences)
+ENV_SETTINGS: tuple[str, dict] = ("the environment variables", {
+    "max_points": "TMM_MAX_POINTS", "max_positions": "TMM_MAX_POSITIONS", "max_memory_bytes": "TMM_MAX_MEMORY_GB"})
+_settings = ENV_SETTINGS
 
 
 def current() -> WorkLimits:
@@ -56,6 +62,13 @@ def set_limits(max_points: int | None = None, max_memory_gb: float | None = None
     return previous
 
 
+def name_settings(where: str, names: dict) -> None:
+    """How refusals tell the user to raise a limit: `where` ("the TMM preferences ...") and the setting's name
+    for each WorkLimits field."""
+    global _settings
+    _settings = (where, dict(names))
+
+
 def check_work(what: str, count: float, bytes_each: float, cause: str, limit: str = "max_points") -> None:
     """Refuses `count` items of `what` (bytes_each each) above the limits (`limit`: the WorkLimits field
     that bounds the count); `cause` names the parameters that set the count, with their values ("sample
@@ -67,4 +80,5 @@ def check_work(what: str, count: float, bytes_each: float, cause: str, limit: st
         raise WorkLimitError(
             f"{cause} gives about {count:.3g} {what} ({memory / 1e9:.3g} GB): more than this machine's limit of "
             f"{most:.3g} {what} and {limits.max_memory_bytes / 1e9:.3g} GB; use coarser values or a smaller "
-            f"boundary (limits: TMM_{limit.upper()} / TMM_MAX_MEMORY_GB, or core.limits.set_limits)")
+            f"boundary, or raise the limits: {_settings[0]} {_settings[1][limit]} and "
+            f"{_settings[1]['max_memory_bytes']}")

@@ -38,3 +38,12 @@ def rewrapped(form: Any) -> Any:
         if found is not None:
             setattr(form, name, found)
     return form
+
+
+def forget(form: Any) -> None:
+    """A closed panel's form and its named widgets taken out of the wrapper map, once Qt has deleted them (a panel
+    FreeCAD keeps alive after it closes would hold their dead wrappers, handed out for the next widgets at those
+    addresses)."""
+    for widget in [form] + [w for w in vars(form).values() if isinstance(w, QtCore.QObject)]:
+        if not shiboken.isValid(widget):
+            shiboken.invalidate(widget)

@@ -18,7 +18,7 @@ import numpy as np
 
 from tmm_workbench.app import op_multipoint, registry, stages
 from tmm_workbench.core import path5
-from tmm_workbench.core.preview.tool_axes import COLOURINGS, axis_lines
+from tmm_workbench.core.preview.tool_axes import COLOURINGS, axis_lines, legend
 from tmm_workbench.core.strategies.multipoint import STATUS_FAILED
 from tmm_workbench.gui import op_page, resources
 
@@ -152,7 +152,8 @@ class ViewProvider(op_page.OpViewProvider):
             return
         sw.removeAllChildren()
         sw.whichChild = coin.SO_SWITCH_NONE
-        if not vobj.ShowToolAxes:
+        # the switch is the root node's child, beside the display modes hiding the op hides: hidden with it
+        if not (vobj.ShowToolAxes and vobj.Visibility):
             return
         try:
             source = axis_source(vobj.Object)
@@ -176,8 +177,30 @@ class ViewProvider(op_page.OpViewProvider):
         style.lineWidth = 1.5
         for node in (style, material, binding, coords, lines):
             sep.addChild(node)
+        sep.addChild(legend_node(legend(vobj.AxisColouring, status is not None, limit), points))
         sw.addChild(sep)
         sw.whichChild = 0
+
+
+def legend_node(lines: list, points: np.ndarray) -> Any:
+    """The axes' colour legend as screen-aligned text beside the highest axis end (drawn over the model):
+    each line a text of its own colour, pushed down by empty lines before it."""
+    from pivy import coin
+
+    top = points[int(np.argmax(points[:, 2]))]
+    root = coin.SoAnnotation()
+    root.setName("TmmToolAxesLegend")
+    move = coin.SoTranslation()
+    move.translation = coin.SbVec3f(*map(float, top))
+    root.addChild(move)
+    for i, (text, rgb) in enumerate(lines):
+        colour = coin.SoBaseColor()
+        colour.rgb = coin.SbColor(*map(float, rgb))
+        label = coin.SoText2()
+        label.string.setValues(0, i + 1, [""] * i + [text])
+        root.addChild(colour)
+        root.addChild(label)
+    return root
 
 
 GUI = op_page.OpGui(ENTRY, TaskPanelOpPage, ViewProvider, " (a bullnose or ballend tool is needed)")

@@ -237,12 +237,17 @@ def create(res: Any, view_provider: type, no_tool_text: str) -> Any:
     return None
 
 
+# an op's button is grey until the document has a Job (PathOpGui's IsActive): its tooltip and status tip say so
+NEEDS_JOB = "Greyed out until the document has a Job: create one first with TMM > Job from mesh / STL."
+
+
 def command(entry: Any, page: type, create_op: Callable[[Any], Any]) -> Any:
     """PathOpGui.SetupOperation's command for a registry entry (resources and registration), creating
     through `create_op`: its own would attach PathOpGui's view provider."""
     op_module = entry.app()
+    tooltip = f"{entry.tooltip.rstrip('.')}. {NEEDS_JOB}"
     cmd = PathOpGui.SetupOperation(entry.name, op_module.Create, page, resources.icon(entry.icon),
-                                   entry.menu_text, entry.tooltip, op_module.SetupProperties)
+                                   entry.menu_text, tooltip, op_module.SetupProperties)
     cmd.Activated = lambda: create_op(cmd.res)
     return cmd
 

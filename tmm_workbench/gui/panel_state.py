@@ -18,7 +18,13 @@ from typing import Any
 
 from PySide import QtCore, QtGui
 
-TRANSACTION = "TMM operation"
+
+
+def transaction_name(obj: Any) -> str:
+    """The undo step of an op panel's edits after a good Apply: the action and the op's label (as the user named
+    it). (The panel's first step keeps FreeCAD's name, "AreaOp Operation": its pages write the op while FreeCAD's
+    panel builds them, and opening another transaction then would split that step in two.)"""
+    return f"Edit {obj.Label}"
 
 
 def commit_on_apply(panel: Any) -> None:
@@ -116,5 +122,5 @@ def keep_if_good(panel: Any) -> None:
         return
     doc = obj.Document
     doc.commitTransaction()
-    doc.openTransaction(TRANSACTION)
+    doc.openTransaction(transaction_name(obj))
     panel.deleteOnReject = False

@@ -19,9 +19,10 @@ import FreeCADGui
 from PySide import QtCore, QtGui
 
 from tmm_workbench.core.errors import Cancelled, TmmError
-from tmm_workbench.core.preview.deviation_colours import NO_DESIGN_HEX, cmap as _cmap, colour_range
+from tmm_workbench.core.sim import compare
 from tmm_workbench.core.sim.cycle_time import hms
 from tmm_workbench.gui import resources
+from tmm_workbench.gui.deviation_legend import DeviationLegend
 from tmm_workbench.gui.stock_view import collision_node, stock_node
 
 COMMAND_NAME = "TMM_Simulate"
@@ -100,7 +101,9 @@ RESULT_ROWS = ((("maxLeft",), "Max material left"), (("minDeviation",), "Min dev
                (("removedVolume",), "Removed volume"), (("remainingVolume",), "Remaining above design"),
                (("cycleTime",), "Cycle time"), (("opTimes",), "Per op"), (("collisions",), "Rapid collisions"),
                (("cellSize",), "Cell size"), (("simTime",), "Simulation time"), (("heatMap",), "Heat map"))
-LEGEND_SIZE = (260, 14)
+# the deviation's direction: (combo text, how the legend says it); Auto picks the normal where walls are steep
+DIRECTIONS = (("Auto (along the normal where walls are steep)", ""), ("Along the normal", "along the normal"),
+              ("Vertical", "vertical"))
 
 
 def _spin(name: str, value: float, decimals: int, low: float, high: float, step: float) -> QtGui.QDoubleSpinBox:
@@ -114,18 +117,6 @@ def _spin(name: str, value: float, decimals: int, low: float, high: float, step:
     return spin
 
 
-def _legend_image(width: int, height: int) -> QtGui.QImage:
-    """The colour bar: RdBu_r from the most negative deviation (left) through 0 (centre) to the largest."""
-    image = QtGui.QImage(width, height, QtGui.QImage.Format_RGB32)
-    gradient = QtGui.QLinearGradient(0, 0, width, 0)
-    for t in np.linspace(0.0, 1.0, 33):
-        gradient.setColorAt(float(t), QtGui.QColor.fromRgbF(*map(float, _cmap()(t)[:3])))
-    painter = QtGui.QPainter(image)
-    painter.fillRect(0, 0, width, height, QtGui.QBrush(gradient))
-    painter.end()
-    return image
-
-
 class SimulatePanel:
     """Inputs (cell, tolerance), the Simulate button, the results and legend; the coloured stock in the view."""
 
@@ -136,6 +127,7 @@ class SimulatePanel:
         self.scene: Any = None
         self.node: Any = None
         self.hidden: list[Any] = []      # view objects we hid, to show again
+        self.report: Any = None          # the last simulation's, recoloured when the band or direction changes
         self.tmp = Path(tempfile.mkdtemp(prefix="tmm_simulate_"))
         self.runs = 0
         self.form = self._build_form()
@@ -187,8 +179,23 @@ class SimulatePanel:
                              "and takes (1 / cell)² longer")
         self.tolerance = _spin("tolerance", 0.01, 4, 0.0, 10.0, 0.005)
         self.tolerance.setToolTip("Cells below the design by more than this are gouges")
+        self.band = _spin("band", self.tolerance.value(), 4, 0.0001, 100.0, 0.005)
+        self.band.setToolTip("The colours of the stock span -band .. +band (white on the design); cells beyond "
+                             "the band take the darkest blue or red. Follows the tolerance until changed")
+        self.direction = QtGui.QComboBox()
+        self.direction.setObjectName("direction")
+        self.direction.addItems([text for text, _ in DIRECTIONS])
+        self.direction.setToolTip("The deviation coloured: vertical (what the simulation measures), or along the "
+                                  "design's normal (the vertical one times the cosine of the slope: a wall's "
+                                  "vertical +2 mm is a few µm along its normal)")
         grid.addRow("Cell size", self.cell)
         grid.addRow("Tolerance", self.tolerance)
+        grid.addRow("Colour band ±", self.band)
+        grid.addRow("Deviation", self.direction)
+        self.tolerance.valueChanged.connect(self.follow_tolerance)
+        self.band.valueChanged.connect(lambda *_: self.recolour())
+        self.direction.currentIndexChanged.connect(lambda *_: self.recolour())
+        self.band_tolerance = self.tolerance.value()  # the band follows the tolerance while they are equal
         self.button = QtGui.QPushButton("Simulate")
         self.button.setObjectName("simulate")
         self.button.clicked.connect(self.simulate)
@@ -220,10 +227,11 @@ class SimulatePanel:
         self.button.setEnabled(True)
 
     def _results_box(self) -> QtGui.QGroupBox:
-        box = QtGui.QGroupBox("Results (deviation: vertical, + material left, - gouge)")
+        box = QtGui.QGroupBox("Results (vertical deviation: + left, - gouge)")
         box.setObjectName("results")
         grid = QtGui.QFormLayout(box)
-        grid.addRow(self._legend())  # first: it explains the 3D view, and stays in sight
+        self.legend = DeviationLegend()
+        grid.addRow(self.legend.widget)  # first: it explains the 3D view, and stays in sight
         self.values: dict[str, QtGui.QLabel] = {}
         for names, text in RESULT_ROWS:
             row = QtGui.QHBoxLayout()
@@ -239,38 +247,6 @@ class SimulatePanel:
         box.setEnabled(False)
         self.results = box
         return box
-
-    def _legend(self) -> QtGui.QWidget:
-        legend = QtGui.QWidget()
-        legend.setObjectName("legend")
-        v = QtGui.QVBoxLayout(legend)
-        v.setContentsMargins(0, 0, 0, 4)
-        v.addWidget(QtGui.QLabel("Colours of the stock in the 3D view: deviation, mm"))
-        bar = QtGui.QLabel()
-        bar.setObjectName("colourBar")
-        bar.setPixmap(QtGui.QPixmap.fromImage(_legend_image(*LEGEND_SIZE)))
-        v.addWidget(bar)
-        row = QtGui.QHBoxLayout()
-        self.legend_labels = []
-        for name, align in (("legendMin", QtCore.Qt.AlignLeft), ("legendZero", QtCore.Qt.AlignHCenter),
-                            ("legendMax", QtCore.Qt.AlignRight)):
-            label = QtGui.QLabel("")
-            label.setObjectName(name)
-            label.setAlignment(align)
-            row.addWidget(label, 1)
-            self.legend_labels.append(label)
-        wrap = QtGui.QWidget()
-        wrap.setFixedWidth(LEGEND_SIZE[0])
-        wrap.setLayout(row)
-        row.setContentsMargins(0, 0, 0, 0)
-        v.addWidget(wrap)
-        red = QtGui.QLabel("red crosses: holder/shank collision with the stock")
-        red.setStyleSheet("QLabel { color: #c00000; }")
-        v.addWidget(red)
-        grey = QtGui.QLabel("grey: no design under the cell")
-        grey.setStyleSheet(f"QLabel {{ background: {NO_DESIGN_HEX}; color: white; padding: 1px 4px; }}")
-        v.addWidget(grey)
-        return legend
 
     def _set(self, name: str, text: str, value: Optional[float] = None, style: str = "") -> None:
         label = self.values[name]
@@ -288,6 +264,7 @@ class SimulatePanel:
 
         self.remove_node()
         self.clear_results()
+        self.report = None
         self.runs += 1
         png = self.tmp / f"deviation_{self.runs}.png"
         self._say("simulating...")
@@ -311,6 +288,7 @@ class SimulatePanel:
             QtGui.QApplication.restoreOverrideCursor()
             self.check_cell()
         self.show_report(report, time.monotonic() - t0)
+        self.report = report
         try:
             self.show_node(report)
         except Exception as exc:  # the numbers stand; say why the view has no coloured stock
@@ -321,8 +299,7 @@ class SimulatePanel:
         """No numbers of an earlier run beside a new one's error or cancel."""
         for name in self.values:
             self._set(name, "-")
-        for label in self.legend_labels:
-            label.setText("")
+        self.legend.clear()
         self.results.setEnabled(False)
 
     def show_report(self, r: Any, seconds: float) -> None:
@@ -349,17 +326,29 @@ class SimulatePanel:
         self._set("simTime", f"{seconds:.2f} s (cutting {kernel:.2f} s)", seconds)
         link = QtCore.QUrl.fromLocalFile(str(r.png)).toString() if r.png else ""
         self._set("heatMap", f'<a href="{link}">deviation map (PNG)</a>' if link else "-")
-        low, high = colour_range(r.simulation.comparison.deviation, r.tolerance)
-        for label, text in zip(self.legend_labels, (f"{low:.4f}", "0", f"{high:+.4f} mm")):
-            label.setText(text)
         self.results.setEnabled(True)
 
-    def show_node(self, r: Any) -> None:
+    def shown_deviation(self, sim: Any) -> tuple[np.ndarray, str]:
+        """The deviation the colours show and its direction's words: the vertical one the simulation measures,
+        or its estimate along the design's normal (Auto: where the design has steep walls)."""
+        along = DIRECTIONS[max(0, self.direction.currentIndex())][1]
+        design = getattr(sim, "design", None)
+        if design is None:
+            return sim.comparison.deviation, "vertical"
+        if not along:
+            along = "along the normal" if compare.has_steep_walls(design, sim.grid.cell) else "vertical"
+        if along == "vertical":
+            return sim.comparison.deviation, along
+        return compare.normal_deviation(sim.comparison.deviation, design, sim.grid.cell), along
+
+    def show_node(self, r: Any, fit: bool = True) -> None:
         sim = r.simulation
         view = FreeCADGui.getDocument(self.job.Document.Name).activeView()
         if not hasattr(view, "getSceneGraph"):
             raise TmmError("the document's active view is not a 3D view")
-        node, block = stock_node(sim.grid, sim.result.heights, sim.comparison.deviation, r.tolerance)
+        deviation, along = self.shown_deviation(sim)
+        band = self.band.value()
+        node, block = stock_node(sim.grid, sim.result.heights, deviation, r.tolerance, band)
         found = sim.result.stock_collisions
         if found is not None and found.count:  # a child of the stock: hidden and removed with it
             node.addChild(collision_node(found.positions))
@@ -367,15 +356,37 @@ class SimulatePanel:
         self.scene.addChild(node)
         self.node = node
         self.hide_job()
-        if block > 1:
-            self._set("cellSize", self.values["cellSize"].text() + f"; shown every {block} cells", r.cell)
-        view.fitAll()
+        self.legend.show(deviation, band, along)
+        if fit:
+            if block > 1:
+                self._set("cellSize", self.values["cellSize"].text() + f"; shown every {block} cells", r.cell)
+            view.fitAll()
+
+    def follow_tolerance(self, value: float) -> None:
+        """The colour band keeps the tolerance's value until the user sets another."""
+        if abs(self.band.value() - self.band_tolerance) < 1e-9:
+            self.band.setValue(max(value, self.band.minimum()))
+        self.band_tolerance = value
+
+    def recolour(self) -> None:
+        """The shown stock in the band and direction now chosen, without simulating again."""
+        if self.report is None or self.node is None:
+            return
+        self.drop_node()
+        try:
+            self.show_node(self.report, fit=False)
+        except Exception as exc:  # noqa: BLE001 - the numbers stand; say why the view has no coloured stock
+            FreeCAD.Console.PrintError(traceback.format_exc())
+            self._say(f"not shown in the 3D view: {exc}", error=True)
 
     # the view as it was
     def hide_job(self) -> None:
         """The Job's model, stock and paths would hide the coloured stock or fight with it (the design is
-        where the stock is, within the scallops): hidden while it shows."""
-        objs = list(getattr(self.job.Model, "Group", []) or []) + [self.job.Stock]
+        where the stock is, within the scallops): hidden while it shows. The model is the Job's clones and what
+        they copy: the source mesh or face (through TMM's stand-in box for a mesh), which is what the user sees;
+        a 5-axis op's tool axes hide with their op."""
+        models = list(getattr(self.job.Model, "Group", []) or [])
+        objs = models + [o for m in models for o in m.OutListRecursive] + [self.job.Stock]
         objs += self.job.Operations.OutListRecursive if self.job.Operations else []
         for obj in objs:
             vo = getattr(obj, "ViewObject", None)
@@ -392,6 +403,11 @@ class SimulatePanel:
         self.hidden = []
 
     def remove_node(self) -> None:
+        self.drop_node()
+        self.show_job()
+
+    def drop_node(self) -> None:
+        """The coloured stock out of the scene (the Job's objects stay hidden)."""
         if self.node is not None and self.scene is not None:
             try:
                 index = self.scene.findChild(self.node)
@@ -400,7 +416,6 @@ class SimulatePanel:
             except Exception:  # the view (its document) was closed: the node went with it
                 pass
         self.node = self.scene = None
-        self.show_job()
 
     def cleanup(self) -> None:
         self.remove_node()

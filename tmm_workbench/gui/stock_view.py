@@ -8,20 +8,20 @@ from typing import Any
 
 import numpy as np
 
-from tmm_workbench.core.preview.deviation_colours import block_centres, colour_range, colours, decimate
+from tmm_workbench.core.preview.deviation_colours import band_colours, block_centres, decimate
 
 NODE_NAME = "TmmSimulatedStock"
 COLLISIONS_NAME = "TmmStockCollisions"
 COLLISION_RGB = (0.9, 0.0, 0.0)
 
 
-def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float) -> tuple[Any, int]:
-    """A SoSeparator holding the simulated stock as a quad mesh with per-vertex colours, and the block size
-    of the decimation."""
+def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance: float,
+               band: float) -> tuple[Any, int]:
+    """A SoSeparator holding the simulated stock as a quad mesh with per-vertex colours (a colour band of
+    +-`band` mm, the cells beyond it darkest), and the block size of the decimation."""
     from pivy import coin
 
     h, d, b = decimate(np.asarray(heights, dtype=float), np.asarray(deviation, dtype=float), tolerance)
-    low, high = colour_range(np.asarray(deviation, dtype=float), tolerance)
     X, Y = np.meshgrid(block_centres(grid.x0, grid.cell, grid.nx, b),
                        block_centres(grid.y0, grid.cell, grid.ny, b))
     points = np.column_stack([X.ravel(), Y.ravel(), h.ravel()])
@@ -33,7 +33,7 @@ def stock_node(grid: Any, heights: np.ndarray, deviation: np.ndarray, tolerance:
     coords = coin.SoCoordinate3()
     coords.point.setValues(0, len(points), points.tolist())
     material = coin.SoMaterial()
-    material.diffuseColor.setValues(0, len(points), colours(d, low, high).tolist())
+    material.diffuseColor.setValues(0, len(points), band_colours(d, band).tolist())
     binding = coin.SoMaterialBinding()
     # a quad mesh is not indexed: Coin reads PER_VERTEX_INDEXED as PER_VERTEX there, so say what it is
     binding.value = coin.SoMaterialBinding.PER_VERTEX

@@ -10,6 +10,9 @@ from tmm_workbench.app.compat import command_prefix
 
 # FreeCAD's own commands, without their prefix (Path_ on 0.20, CAM_ from 1.0)
 JOB_TOOLS = ["Job", "Post", "Inspect", "Simulator"]
+# the toolbar offers what works with a mesh: FreeCAD's Job offers only solids as its model (an empty list for an
+# imported STL), so it stays in the menu only; TMM's Job from mesh / STL is the toolbar's first button
+JOB_TOOLBAR = [t for t in JOB_TOOLS if t != "Job"]
 TOOL_TOOLS = ["ToolBitLibraryOpen", "ToolBitDock", "ToolBitCreate", "ToolBitLoad", "ToolController"]
 
 
@@ -51,7 +54,7 @@ class TMMWorkbench(FreeCADGui.Workbench):
                + [simulate_cmd.COMMAND_NAME, stick_out_cmd.COMMAND_NAME])
         self.appendToolbar("TMM", tmm)
         job_tools, tool_tools = path_commands(JOB_TOOLS), path_commands(TOOL_TOOLS)
-        self.appendToolbar("TMM Path", job_tools)
+        self.appendToolbar("TMM Path", path_commands(JOB_TOOLBAR))
         self.appendToolbar("TMM Tools", tool_tools)
         self.appendMenu("&TMM", tmm + ["Separator"] + job_tools + ["Separator"] + tool_tools)
 

@@ -63,6 +63,40 @@ def colour_range(deviation: np.ndarray, tolerance: float) -> tuple[float, float]
     return low, high
 
 
+# inside a colour band the map's [0.1, 0.9] is used: its darkest ends mark the cells beyond the band
+BAND_INSIDE = (0.1, 0.9)
+
+
+def band_position(deviation: np.ndarray, band: float) -> np.ndarray:
+    """Deviation -> place on the colour map for a band of +-`band` mm: 0 mm at 0.5, the band's ends at
+    BAND_INSIDE, 0.0 below -band and 1.0 above +band (the extremes stand out, not scaled into the band)."""
+    if not (math.isfinite(band) and band > 0):
+        raise ValueError(f"colour band must be > 0 mm, got {band!r}")
+    d = np.asarray(deviation, dtype=float)
+    lo, hi = BAND_INSIDE
+    t = 0.5 + 0.5 * (hi - lo) * np.clip(d / band, -1.0, 1.0)
+    return np.where(d > band, 1.0, np.where(d < -band, 0.0, t))
+
+
+def band_colours(deviation: np.ndarray, band: float) -> np.ndarray:
+    """(n, 3) RGB in [0, 1] per deviation value (flattened) for a band of +-`band` mm: RdBu_r inside, its
+    darkest ends beyond, grey where NaN."""
+    d = np.asarray(deviation, dtype=float).ravel()
+    rgb = cmap()(band_position(np.nan_to_num(d), band))[:, :3]
+    rgb[~np.isfinite(d)] = NO_DESIGN_RGB
+    return rgb
+
+
+def beyond_band(deviation: np.ndarray, band: float) -> tuple[int, int, float, float]:
+    """(cells above +band, cells below -band, largest, smallest deviation; 0.0 without design): the extremes
+    a colour band shows only as its darkest ends."""
+    d = np.asarray(deviation, dtype=float)
+    d = d[np.isfinite(d)]
+    if not d.size:
+        return 0, 0, 0.0, 0.0
+    return int(np.sum(d > band)), int(np.sum(d < -band)), float(d.max()), float(d.min())
+
+
 def cmap() -> Any:
     """matplotlib's RdBu_r (imported here: no GUI backend at import)."""
     from matplotlib import colormaps

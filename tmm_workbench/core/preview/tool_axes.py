@@ -35,3 +35,13 @@ def axis_lines(tips: np.ndarray, axes: np.ndarray, every: int, length: float, co
         f = np.clip(tilt / max(float(tilt_limit_deg), 1e-9), 0.0, 1.0)[:, None]
         colours = VERTICAL_RGB * (1 - f) + TILTED_RGB * f
     return points, colours
+
+
+def legend(colouring: str, status_known: bool, tilt_limit_deg: float = 45.0) -> list[tuple[str, tuple]]:
+    """(text, RGB) lines telling what the axes' colours of `colouring` mean (without the kernel's status the
+    contact colouring falls back to the tilt's, as axis_lines does)."""
+    if colouring == "Contact" and status_known:
+        return [("tool axes: contact", (0.0, 0.0, 0.0)), ("green: two contacts", CONTACT_RGB[0]),
+                ("orange: one contact", CONTACT_RGB[1])]
+    return [(f"tool axes: tilt{'' if colouring == 'Tilt' else ' (no contact data)'}", (0.0, 0.0, 0.0)),
+            ("blue: vertical", tuple(VERTICAL_RGB)), (f"red: {tilt_limit_deg:g} deg (the limit)", tuple(TILTED_RGB))]

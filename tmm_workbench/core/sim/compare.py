@@ -2,7 +2,7 @@
 design's on the same vertical line; positive = material left, negative = gouge), its extremes and
 percentiles, removed and remaining volume, overall and per region (boolean masks over the grid: selected
 faces, seed 003's buckets). Deviations are measured vertically: on a wall of slope a the distance along the
-surface normal is the vertical one times cos a (`slope_deg`)."""
+surface normal is the vertical one times cos a (`slope_deg`, `normal_deviation`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -80,3 +80,33 @@ def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
     gy = np.gradient(filled, cell, axis=0) if filled.shape[0] > 1 else np.zeros_like(filled)
     gx = np.gradient(filled, cell, axis=1) if filled.shape[1] > 1 else np.zeros_like(filled)
     return np.degrees(np.arctan(np.hypot(gx, gy)))
+
+
+STEEP_DEG = 45.0     # a wall: its vertical deviation is over 1.4 times the one along its normal
+STEEP_SHARE = 0.02   # a design with this share of its cells on walls reads better along the normal
+
+
+def slope_cosine(design: np.ndarray, cell: float) -> np.ndarray:
+    """(ny, nx) cos of the design's slope from its heights' central differences: 1 where a neighbour has no
+    design (no slope known there: the vertical deviation is kept)."""
+    z = np.asarray(design, dtype=float)
+    gy = np.gradient(z, cell, axis=0) if z.shape[0] > 1 else np.zeros_like(z)
+    gx = np.gradient(z, cell, axis=1) if z.shape[1] > 1 else np.zeros_like(z)
+    cos = 1.0 / np.sqrt(1.0 + gx * gx + gy * gy)
+    return np.where(np.isfinite(cos), cos, 1.0)
+
+
+def normal_deviation(deviation: np.ndarray, design: np.ndarray, cell: float) -> np.ndarray:
+    """The deviation along the design's normal, estimated from the vertical one: on a plane of slope a the
+    distance along the normal is the vertical one times cos a (a wall's +2 mm vertical is a few µm normal)."""
+    return np.asarray(deviation, dtype=float) * slope_cosine(design, cell)
+
+
+def has_steep_walls(design: np.ndarray, cell: float) -> bool:
+    """Whether at least STEEP_SHARE of the design's cells slope more than STEEP_DEG: where the vertical
+    deviation misleads."""
+    finite = np.isfinite(np.asarray(design, dtype=float))
+    if not finite.any():
+        return False
+    steep = slope_cosine(design, cell) < np.cos(np.radians(STEEP_DEG))
+    return float(np.sum(steep & finite)) >= STEEP_SHARE * float(finite.sum())
