@@ -13,6 +13,7 @@ import numpy as np
 from tmm_workbench.core import polygons
 from tmm_workbench.core.footprint import pencil
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.footprint.rest import LEAST_CUT
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.strategies.surface.params import (PENCIL_CLEANUP, PENCIL_CREASES, PENCIL_OUTLINE, STEPOVER,
@@ -73,7 +74,9 @@ def cleanup_passes(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: 
     grid = rest.grid if rest is not None else Grid.covering(*params.boundary, crease_cell(params))
     cells = None if rest is None else np.isfinite(rest.heights)
     finishing = params.cleanup_reference
-    found = cleanup.strips(mesh, surface, finishing, grid, mesh_heights(mesh, grid), cells, params.cusp,
+    # the tolerance the finish is judged by: the rest's (its stock cuts at LEAST_CUT of it), else the cusp height
+    tolerance = params.cusp if rest is None else rest.tolerance / LEAST_CUT
+    found = cleanup.strips(mesh, surface, finishing, grid, mesh_heights(mesh, grid), cells, tolerance,
                            cutter.diameter)
     curves, _ = cleanup.cleanup_curves(mesh, surface, cutter, found, floor_z, finishing.diameter,
                                        crease_cell(params))
