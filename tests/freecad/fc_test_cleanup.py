@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from fc_helpers import OUT, FreeCADTestCase, write_ascii_stl
+from fc_helpers import FreeCADTestCase, mesh_stl
 from tests.core.crease_case import crease_mesh, fold_x
 from tmm_workbench.app.api import run_surface, simulate
 from tmm_workbench.core.errors import TmmError
@@ -20,9 +20,7 @@ STEP_D2 = 2 * math.sqrt(2 * 1.0 * 0.008)   # a cusp of 0.008 mm between D2 passe
 
 
 def crease_stl() -> str:
-    mesh = crease_mesh()
-    tris = [tuple(tuple(map(float, mesh.vertices[i])) for i in f) for f in mesh.triangles]
-    return str(write_ascii_stl(OUT / "crease_groove.stl", tris, "crease_groove"))
+    return mesh_stl(crease_mesh(), "crease_groove")
 
 
 def finished(doc_name: str):
