@@ -55,6 +55,12 @@ def write_ascii_stl(path: Path, tris: Iterable[Triangle], name: str = "tmm") -> 
     return path
 
 
+def mesh_stl(mesh: Any, name: str) -> str:
+    """A core TriMesh written as OUT/<name>.stl (ASCII); its path."""
+    tris = [tuple(tuple(map(float, mesh.vertices[i])) for i in f) for f in mesh.triangles]
+    return str(write_ascii_stl(OUT / f"{name}.stl", tris, name))
+
+
 def bump_stl() -> Path:
     path = OUT / "bump.stl"
     if not path.exists():

@@ -7,7 +7,7 @@ from __future__ import annotations
 import FreeCAD
 import Part
 
-from fc_helpers import OUT, FreeCADTestCase, write_ascii_stl
+from fc_helpers import OUT, FreeCADTestCase, mesh_stl
 from tests.core.sign import outlines, sign_mesh
 from tmm_workbench.app.api import run_surface, simulate
 from tmm_workbench.core.errors import TmmError
@@ -16,9 +16,7 @@ COMMON = dict(boundary="model", margin=0.0, sample_step=0.5, progress=False, pos
 
 
 def sign_stl() -> str:
-    mesh = sign_mesh(0.5)
-    tris = [tuple(tuple(map(float, mesh.vertices[i])) for i in f) for f in mesh.triangles]
-    return str(write_ascii_stl(OUT / "sign.stl", tris, "sign"))
+    return mesh_stl(sign_mesh(0.5), "sign")
 
 
 def finished(doc_name: str):

@@ -208,6 +208,10 @@ def zlevel_panels(info: dict) -> None:
         key = name.split("_")[1].lower()
         info[f"{key}_page_height"] = page.sizeHint().height()
         assert info[f"{key}_page_height"] < 760, f"the {name} page needs {info[f'{key}_page_height']} px"
+        if name == "TMM_Waterline":   # its rest row: RestOnly, off as the new op
+            rest_only = page.findChild(QtGui.QCheckBox, "restOnly")
+            info["waterline_rest_only"] = [rest_only.isChecked(), op.RestOnly]
+            assert info["waterline_rest_only"] == [False, False], info["waterline_rest_only"]
         if name == "TMM_Roughing":
             step_over = page.findChild(QtGui.QDoubleSpinBox, "stepOver")
             info["roughing_step_over"] = [step_over.value(), step_over.suffix().strip()]
@@ -318,6 +322,19 @@ def smoke() -> dict:
     assert info["panel_region"] == ["Box", ["Box", "Faces", "Sketch", "Rest"]], info["panel_region"]
     pattern = page.findChild(QtGui.QComboBox, "pattern")
     assert "Spiral" in [pattern.itemText(i) for i in range(pattern.count())], "no Spiral pattern in the panel"
+    # the pencil's sources (CleanUp: seed 000's strips) and its curve and file rows, enabled with their source
+    source = page.findChild(QtGui.QComboBox, "pencilSource")
+    pencil_curve = page.findChild(QtGui.QComboBox, "pencilCurve")
+    pencil_file = page.findChild(QtGui.QLineEdit, "pencilFile")
+    info["panel_pencil"] = [[source.itemText(i) for i in range(source.count())], pencil_curve.currentText(),
+                            pencil_curve.isEnabled(), pencil_file.isEnabled()]
+    assert info["panel_pencil"] == [["Creases", "Outline", "File", "CleanUp"], "(none)", False, False], \
+        info["panel_pencil"]
+    ops[-1].PencilSource = "File"
+    pump(0.3)
+    info["panel_pencil_file_enabled"] = [pencil_file.isEnabled(), pencil_curve.isEnabled()]
+    assert info["panel_pencil_file_enabled"] == [True, False], info["panel_pencil_file_enabled"]
+    ops[-1].PencilSource = "Creases"
     # the 3D offset's start (issue 14 item 1): Boundary as the new op, the curve chooser empty
     start = page.findChild(QtGui.QComboBox, "offsetStart")
     curve = page.findChild(QtGui.QComboBox, "offsetCurve")

@@ -101,8 +101,12 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
     pattern 'pencil' (app.pencil_source): along concave creases (pencil_source 'creases', default: where the tool
     touches the model on two sides, CL valleys deeper than `cusp`), an outline (pencil_source 'outline':
     pencil_curve, a sketch or edges of the model's document, offset by the tool radius to pencil_side 'outside' |
-    'inside' | 'both') or a footprint file (pencil_source 'file': pencil_file, x y lift per line);
-    pencil_passes: 1 (pencil) or more (multi-pencil, outward, `stepover` apart or the cusp's spacing).
+    'inside' | 'both'), a footprint file (pencil_source 'file': pencil_file, x y lift per line) or seed 000's
+    clean-up strips (pencil_source 'cleanup', with region 'rest': where the finishing tool's contact normals jump
+    more than its corner and rest_tolerance allow, joined with the rest cells, each point slid to the crease by the
+    drop along a vector; the finishing tool is rest_reference, or the job's last earlier op with a ball or bull
+    nose); pencil_passes: 1 (pencil) or more (multi-pencil, outward, `stepover` apart or the cusp's spacing); 0 with
+    region 'rest': as many as cover the rest (clean-up: up each flank to the strip's edge).
     pattern 'spiral': from the region's centre, spiral_direction 'outward' | 'inward'. slope_range: (min,
     max) deg, cut only where the surface slope lies in it (default all).
     forward_step: 'tolerance' (default: the fewest moves within +-chord_tolerance of the exact tool path, lean

@@ -99,6 +99,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         params.offset_from = offset_start.curves_of(obj, params.stepover_mode == OFFSET3D)
         params.rest = None if rest is None else rest.stock
         params.pencil_curves = pencil_source.curves_of(obj)   # an outline's or a footprint file's (pattern Pencil)
+        params.cleanup_reference = pencil_source.finishing_cutter(obj, cutter)   # the clean-up's finishing tool
         flat_cusp = check_tool_fit(params, cutter)
         if flat_cusp:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")

@@ -39,7 +39,8 @@ class Rest:
     region: Any                   # the CL region clipped to the op's box
 
 
-def _reference_cutter(op: Any, cutter: Cutter) -> Cutter:
+def reference_cutter(op: Any, cutter: Cutter) -> Cutter:
+    """The cutter of RestReference, at least as large as the op's `cutter` (TmmError naming what is wrong)."""
     ref = getattr(op, "RestReference", None)
     if ref is None:
         raise TmmError("Region 'Rest' from ReferenceTool: no reference tool (RestReference is empty): choose the "
@@ -67,7 +68,7 @@ def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tu
                            "take the rest from a reference tool (RestFrom ReferenceTool)")
         grid, heights = left.grid, np.array(left.heights)   # a copy: the linker cuts the material top as it links
     else:
-        reference = _reference_cutter(op, cutter)
+        reference = reference_cutter(op, cutter)
         grid = simulation.simulation_grid(job, simulation.known_cell(job, cutter))   # as the earlier ops' stock
         heights = np.minimum(simulation.stock_heights(job, grid), tool_envelope(mesh, reference, grid))
     area = rest_area(heights, mesh_heights(mesh, grid), tool_envelope(mesh, cutter, grid), grid, tolerance,

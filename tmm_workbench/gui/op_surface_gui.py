@@ -8,7 +8,7 @@ from PySide import QtGui
 
 from tmm_workbench.app import model_proxy, op_surface, registry, stages
 from tmm_workbench.app.compat import PathUtils
-from tmm_workbench.gui import offset_start_panel, op_page, region_panel, resources, surface_depths_gui
+from tmm_workbench.gui import offset_start_panel, op_page, pencil_panel, region_panel, resources, surface_depths_gui
 
 ENTRY = registry.entry("TMM_Surface")
 ICON = resources.icon(ENTRY.icon)
@@ -29,6 +29,7 @@ class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
     def init_extra(self, obj: Any) -> None:
         self.form.stlFileBrowse.clicked.connect(self.browseStl)
         region_panel.init_fields(self, obj)
+        pencil_panel.init_fields(self, obj)
 
     def model_candidates(self, obj: Any) -> list[Any]:
         """Meshes and top-level Part objects of the document, without the Job's own objects
@@ -65,6 +66,7 @@ class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
         if obj.Model != target:
             obj.Model = target
         region_panel.get_fields(self, obj)
+        pencil_panel.get_fields(self, obj)
         offset_start_panel.get_fields(self, obj)
         self.get_depths(obj)
 
@@ -80,17 +82,20 @@ class TaskPanelOpPage(surface_depths_gui.DepthFields, op_page.OpPage):
         combo.setCurrentIndex(max(index, 0))
         combo.blockSignals(False)
         region_panel.set_fields(self, obj)
+        pencil_panel.set_fields(self, obj)
         offset_start_panel.set_fields(self, obj)
         self.set_depths(obj)
 
     def extra_signals(self) -> list[Any]:
         return ([self.form.stlFile.editingFinished, self.form.model.currentIndexChanged] + region_panel.signals(self)
-                + self.depth_signals() + offset_start_panel.signals(self))
+                + self.depth_signals() + offset_start_panel.signals(self) + pencil_panel.signals(self))
 
     def updateData(self, obj: Any, prop: str) -> None:
         super().updateData(obj, prop)
         if prop in surface_depths_gui.ENABLING:
             self.enable_depths(obj)
+        if prop == "PencilSource":
+            pencil_panel.enable(self, obj)
 
 
 class ViewProvider(op_page.OpViewProvider):

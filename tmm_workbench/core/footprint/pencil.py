@@ -30,7 +30,8 @@ OUTSIDE, INSIDE, BOTH = "outside", "inside", "both"
 SIDES = (OUTSIDE, INSIDE, BOTH)
 ARC_TOL = 0.005          # mm: the offsets' round corners
 SMOOTH = 5               # points in the moving average that smooths a crease chained from grid cells
-_STEPS = ((1, 0), (0, 1), (1, 1), (1, -1))   # the directions a valley is looked for across
+STEPS = ((1, 0), (0, 1), (1, 1), (1, -1))   # the directions a valley is looked for across (di, dj)
+_STEPS = STEPS
 
 
 def _closed(loop: np.ndarray) -> np.ndarray:
@@ -111,11 +112,33 @@ def crease_curves(surface: DropSurface, cutter: Cutter, box: tuple, cell: float,
     xs, ys = x0 + np.arange(nx) * cell, y0 + np.arange(ny) * cell
     X, Y = np.meshgrid(xs, ys)
     z = surface.drop(cutter, np.column_stack([X.ravel(), Y.ravel()]), floor_z).reshape(ny, nx)
+    return valley_curves(xs, ys, z, depth, cutter.diameter if min_length is None else min_length)
+
+
+def valley_curves(xs: np.ndarray, ys: np.ndarray, z: np.ndarray, depth: float, min_length: float,
+                  within: Optional[np.ndarray] = None, strict: bool = False) -> list[np.ndarray]:
+    """The valleys of the heights `z` on the grid (xs, ys) as XY curves: the points more than `depth` below the
+    mean of their two neighbours across some direction (and inside the mask `within`, if given), thinned to the
+    deepest across the fold, chained 8-connected, joined where the thinning broke them, smoothed, and kept when
+    at least `min_length` long. A crease's CL valley, or a strip's ridge of distance (its medial curve: `strict`,
+    a ridge two cells wide is one curve)."""
+    cell = float(xs[1] - xs[0]) if len(xs) > 1 else float(ys[1] - ys[0])
     fold, along = _folds(z)
-    valley = (fold > depth) & _deepest_across(fold, along)
+    valley = (fold > depth) & _deepest_across(fold, along, strict)
+    if within is not None:
+        valley &= within
     curves = _joined([np.column_stack([xs[c[:, 1]], ys[c[:, 0]]]) for c in _chains(valley)], 2.5 * cell)
-    least = cutter.diameter if min_length is None else min_length
-    return [c for c in (_smoothed(c) for c in curves) if _length(c) >= least]
+    return [c for c in (_smoothed(c) for c in curves) if _length(c) >= min_length]
+
+
+def neighbours(z: np.ndarray, reach: int = 1):
+    """For each direction k of _STEPS: (k, before, after), the heights `reach` steps behind and ahead of each
+    inner point (the points at least `reach` from the border: z[reach:-reach, reach:-reach])."""
+    ny, nx = z.shape
+    m = reach
+    for k, (di, dj) in enumerate(_STEPS):
+        yield (k, z[m - m * dj:ny - m - m * dj, m - m * di:nx - m - m * di],
+               z[m + m * dj:ny - m + m * dj, m + m * di:nx - m + m * di])
 
 
 def _folds(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -124,22 +147,22 @@ def _folds(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ny, nx = z.shape
     folds = np.zeros((len(_STEPS), ny, nx))
     inner = (slice(1, ny - 1), slice(1, nx - 1))
-    for k, (di, dj) in enumerate(_STEPS):
-        before = z[1 - dj:ny - 1 - dj, 1 - di:nx - 1 - di]
-        after = z[1 + dj:ny - 1 + dj, 1 + di:nx - 1 + di]
+    for k, before, after in neighbours(z):
         folds[k][inner] = 0.5 * (before + after) - z[inner]
     return folds.max(axis=0), folds.argmax(axis=0)
 
 
-def _deepest_across(fold: np.ndarray, along: np.ndarray) -> np.ndarray:
-    """Points whose fold is at least their two neighbours' across the fold's direction (a valley one cell wide)."""
+def _deepest_across(fold: np.ndarray, along: np.ndarray, strict: bool = False) -> np.ndarray:
+    """Points whose fold is at least their two neighbours' across the fold's direction (a valley one cell wide);
+    `strict`: above the one ahead (of two equal neighbours across, only the one ahead is kept)."""
     ny, nx = fold.shape
     keep = np.zeros_like(fold, dtype=bool)
     jj, ii = np.mgrid[1:ny - 1, 1:nx - 1]
     f = fold[1:ny - 1, 1:nx - 1]
     steps = np.array(_STEPS)[along[1:ny - 1, 1:nx - 1]]
     di, dj = steps[..., 0], steps[..., 1]
-    keep[1:ny - 1, 1:nx - 1] = (f >= fold[jj - dj, ii - di]) & (f >= fold[jj + dj, ii + di])
+    ahead = fold[jj + dj, ii + di]
+    keep[1:ny - 1, 1:nx - 1] = (f >= fold[jj - dj, ii - di]) & ((f > ahead) if strict else (f >= ahead))
     return keep
 
 

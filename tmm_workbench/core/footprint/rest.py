@@ -132,7 +132,7 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
     has_design = np.isfinite(design)
     # above the tolerance, and the tool takes some of it off (to within the tolerance where it reaches)
     mask = has_design & (left - design > tolerance) & (left - envelope > LEAST_CUT * tolerance)
-    mask = _without_specks(mask)
+    mask = without_specks(mask)
     after = np.minimum(left, envelope)
     above = np.where(has_design, np.clip(left - design, 0, None), 0.0)
     above_after = np.where(has_design, np.clip(after - design, 0, None), 0.0)
@@ -142,7 +142,7 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
                     float(above_after.sum() * a), float(np.sum(above_after > tolerance) * a))
 
 
-def _without_specks(mask: np.ndarray) -> np.ndarray:
+def without_specks(mask: np.ndarray) -> np.ndarray:
     """The mask without 8-connected patches of fewer than MIN_CELLS cells."""
     from scipy import ndimage
 

@@ -22,6 +22,7 @@ ONEWAY = "oneway"
 SPIRAL = "spiral"  # an Archimedean spiral from the region's centre (core.footprint.spiral)
 PENCIL = "pencil"  # along concave creases, an outline or a footprint file (core.footprint.pencil)
 PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE = "creases", "outline", "file"
+PENCIL_CLEANUP = "cleanup"  # seed 000's clean-up strips, CL points by translation (core.footprint.cleanup)
 OUTWARD, INWARD = "outward", "inward"
 # Where no triangle lies under the cutter ("air": beside an open surface or a relief without a base, in a
 # hole): FLOOR runs the tool along the floor there, as a drop-cutter does; SKIP does not cut there: the pass
@@ -72,7 +73,10 @@ class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole
     # --- pencil (pattern PENCIL, core.strategies.surface.pencil_pattern): creases found on the model (CL valleys
     # deeper than `cusp`), an outline (`pencil_curves`: closed loops and open curves, XY) offset by the radius to
     # `pencil_side`, or a footprint file's curves (`pencil_curves`); `pencil_passes` outward, `stepover` apart
-    pencil_source: str = param(PENCIL_CREASES, "pencil source", choices=(PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE))
+    pencil_source: str = param(PENCIL_CREASES, "pencil source",
+                               choices=(PENCIL_CREASES, PENCIL_OUTLINE, PENCIL_FILE, PENCIL_CLEANUP))
+    # the clean-up's finishing tool (pencil source PENCIL_CLEANUP): its normal jumps find the strips
+    cleanup_reference: Optional[Any] = None
     pencil_curves: Optional[list] = None
     pencil_side: str = param("outside", "pencil side", choices=("outside", "inside", "both"))
     # 0: as many as cover the rest cells (Region Rest: 95 % of them within reach of a pass), else 1
@@ -129,7 +133,7 @@ def crease_cell(params: SurfaceParams) -> float:
 
 def crease_points(params: SurfaceParams) -> float:
     """Drops of the pencil's creases grid (0 for the other pencil sources)."""
-    if params.pencil_source != PENCIL_CREASES:
+    if params.pencil_source not in (PENCIL_CREASES, PENCIL_CLEANUP):
         return 0.0
     b, c = params.boundary, crease_cell(params)
     return ((b[2] - b[0]) / c + 2) * ((b[3] - b[1]) / c + 2)
@@ -153,7 +157,11 @@ def validate_region(params: Any) -> None:
         if params.stepover_mode not in (STEPOVER, CUSP):
             raise TmmError(f"the pencil pattern spaces its passes by the step-over or the cusp height, not "
                            f"step-over mode {params.stepover_mode!r}")
-        if params.pencil_source != PENCIL_CREASES and not params.pencil_curves:
+        if params.pencil_source == PENCIL_CLEANUP:
+            if params.cleanup_reference is None:
+                raise TmmError("pencil source 'cleanup' needs the finishing tool (cleanup_reference): its normal "
+                               "jumps along its paths find the strips")
+        elif params.pencil_source != PENCIL_CREASES and not params.pencil_curves:
             raise TmmError(f"pencil source {params.pencil_source!r} needs its curves (an outline or a footprint "
                            f"file), got none")
     if params.pattern == SPIRAL and params.stepover_mode == ADAPTIVE:
