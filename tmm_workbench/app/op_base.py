@@ -7,8 +7,9 @@ from __future__ import annotations
 
 import math
 import traceback
+from contextlib import contextmanager
 from dataclasses import MISSING, fields
-from typing import Any, Callable, NamedTuple, Optional
+from typing import Any, Callable, Iterator, NamedTuple, Optional
 
 import FreeCAD
 import numpy as np
@@ -208,14 +209,44 @@ class TmmOp(PathOp.ObjectOp):
         if not self._computed:
             self.fail(obj, "FreeCAD did not compute the operation (its Job, model or stock is missing; "
                            "see the report view)")
-        if self._rows is not None:   # after obj.Path was set: its change forgets the previous record
-            self.path_record = path_build.record(self.commandlist, *self._rows)
+        self.keep_record()
         self.note_path_change(obj)
         self.set_cycle_time(obj)
+
+    def keep_record(self) -> None:
+        """The record of the Path just set from the command list (after obj.Path was set: its change forgets
+        the previous record)."""
+        if self._rows is not None and self.path_record is None:
+            self.path_record = path_build.record(self.commandlist, *self._rows)
+
+    def getCycleTimeEstimate(self, obj: Any) -> str:
+        """ObjectOp's estimate reads the Path back (a copy of every command): TMM's from the rows instead
+        (set_cycle_time replaces ObjectOp's anyway)."""
+        from tmm_workbench.core.sim.cycle_time import hms
+
+        if getattr(self, "_rows", None) is not None:
+            self.keep_record()
+            try:
+                seconds = self.record_cycle_seconds(obj)
+            except TmmError:
+                seconds = None
+            if seconds is not None:
+                return hms(seconds)
+        return super().getCycleTimeEstimate(obj)
 
     def opOnChanged(self, obj: Any, prop: str) -> None:
         if prop == "Path":   # a new Path (a compute, an undo, a paste): what was known of the old one is void
             self.path_record, self.path_counts, self.cancelled = None, None, False
+
+    @contextmanager
+    def reporting(self, obj: Any) -> Iterator[Callable[[float], bool]]:
+        """The op's progress (the GUI's dialog with Cancel) from the kernel's start to the last command made,
+        watched (core.cancel.poll) so the Python loops between the kernel's calls (linking, the rows) are heard."""
+        from tmm_workbench.app import progress
+        from tmm_workbench.core import cancel
+
+        with progress.reporter(obj.Label, self.progress_enabled) as cb, cancel.watching(cb):
+            yield cb
 
     def add_rows(self, rows: path_build.MoveRows, progress: Optional[Callable[[float], bool]] = None) -> None:
         """The commands of `rows` at the end of the op's command list, made in chunks (`progress` between
@@ -250,11 +281,12 @@ class TmmOp(PathOp.ObjectOp):
         from tmm_workbench.core.sim.cycle_time import three_axis_time
 
         rec = self.path_record
-        moves = path_build.line_moves(rec) if rec is not None else None
-        if moves is None:
-            return None
-        tc = obj.ToolController
-        return three_axis_time(moves[0], moves[1], tc.HorizRapid.Value, tc.VertRapid.Value).seconds
+        if rec is not None and rec.cycle_s is None:
+            moves = path_build.line_moves(rec)
+            if moves is not None:
+                tc = obj.ToolController
+                rec.cycle_s = three_axis_time(moves[0], moves[1], tc.HorizRapid.Value, tc.VertRapid.Value).seconds
+        return rec.cycle_s if rec is not None else None
 
     def input_problem(self, obj: Any) -> str:
         """What makes computing impossible, in the user's terms ('' when nothing)."""

@@ -141,7 +141,7 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
         params = self.params_from(obj, final_z=final_z, **stock)
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
+        with self.reporting(obj) as cb:
             toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy,
                                                               progress.phase(cb, 0.0, progress.KERNEL_SHARE))
             if not len(toolpath):

@@ -114,7 +114,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                             low_links=rest is not None)   # a rest's many short pieces: hop over, not up
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
+        with self.reporting(obj) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy,
                                                              progress.phase(cb, 0.0, progress.KERNEL_SHARE))
             surface_verify.report(obj, notes)

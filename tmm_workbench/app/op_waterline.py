@@ -101,7 +101,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
                                       extra["boundary"])
         params.rest = None if rest is None else rest.stock
         policy.low_links = rest is not None
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
+        with self.reporting(obj) as cb:
             result = waterline.compute(mesh, cutter, params, progress.phase(cb, 0.0, progress.KERNEL_SHARE))
             top = result.diagnostics.get("top")
             if top is not None and policy.safe_height <= top:

@@ -16,6 +16,7 @@ from typing import Any, Callable, Iterator, NamedTuple, Optional
 import numpy as np
 
 from tmm_workbench.core.arcs import PLANE_CODES
+from tmm_workbench.core.cancel import poll
 from tmm_workbench.core.errors import Cancelled
 from tmm_workbench.core.toolpath import MoveKind, Toolpath, steep_mask
 
@@ -69,15 +70,19 @@ def rows_of(toolpath: Toolpath, horiz_feed: float, vert_feed: float, plunge_angl
     out = MoveRows()
     if not n:
         return out
-    pts = np.array([(m.x, m.y, m.z) for m in moves], dtype=float).reshape(-1, 3)
-    rapid = np.array([m.kind is MoveKind.RAPID for m in moves])
-    feed = np.array([m.kind is MoveKind.FEED for m in moves])
+    pts, rapid, feed, arcs = np.empty((n, 3)), np.empty(n, dtype=bool), np.empty(n, dtype=bool), []
+    for a in range(0, n, CHUNK):   # the moves are Python objects: read a chunk at a time, Cancel heard between
+        part = moves[a:a + CHUNK]
+        pts[a:a + len(part)] = [(m.x, m.y, m.z) for m in part]
+        rapid[a:a + len(part)] = [m.kind is MoveKind.RAPID for m in part]
+        feed[a:a + len(part)] = [m.kind is MoveKind.FEED for m in part]
+        arcs += [a + i for i, m in enumerate(part) if m.arc is not None and a + i > 0]
+        poll()
     down = steep_mask(pts, feed, plunge_angle_deg)
     codes = np.where(rapid, G0, G1).astype(np.int32)
     values = np.zeros((n, WIDTH))
     values[:, :3] = pts
     values[:, 3] = np.where(rapid, 0.0, np.where(down | ~feed, vert_feed, horiz_feed))
-    arcs = [i for i, m in enumerate(moves) if m.arc is not None and i > 0]
     if arcs:
         codes, values = _with_arcs(out, moves, arcs, codes, values, horiz_feed)
     if clearance is not None:
@@ -146,6 +151,7 @@ class PathRecord:
     before: list[Cmd]
     rows: MoveRows
     after: list[Cmd]
+    cycle_s: Optional[float] = None   # its cycle time once estimated (s)
 
     def __len__(self) -> int:
         return len(self.before) + len(self.rows) + len(self.after)
