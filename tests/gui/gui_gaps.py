@@ -14,7 +14,6 @@ import sys
 import time
 from pathlib import Path
 
-import FreeCAD
 import FreeCADGui
 from PySide import QtCore, QtGui
 

@@ -170,7 +170,7 @@ class PathRecord:
         yield from self.after
 
 
-def line_moves(rec: PathRecord) -> Optional[tuple[np.ndarray, list[float]]]:
+def line_moves(rec: PathRecord) -> Optional[tuple[np.ndarray, np.ndarray]]:
     """The tool tip's points and the feed of the move ending at each (inf for a rapid) as the cycle time reads
     them, when the Path is straight moves (G0/G1 rows, a Z-only rapid first, comments before, Z-only rapids after);
     None otherwise (read the Path)."""
@@ -186,7 +186,7 @@ def line_moves(rec: PathRecord) -> Optional[tuple[np.ndarray, list[float]]]:
         return None
     pts = [v[:, :3]] + [np.array([[v[-1, 0], v[-1, 1], c.Parameters["Z"]]]) for c in rec.after]
     feeds = np.where(rows.codes[int(first_z):] == G0, np.inf, v[:, 3])
-    return np.vstack(pts), feeds.tolist() + [np.inf] * len(rec.after)
+    return np.vstack(pts), np.concatenate([feeds, np.full(len(rec.after), np.inf)])
 
 
 def _state(name: str) -> int:

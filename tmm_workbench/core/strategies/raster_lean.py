@@ -73,6 +73,7 @@ def _straight_parts(pts: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[Run]:
+    poll()
     if len(pts) < 2 or seg.axes is not None:
         return None
     xy = pts[:, :2]
