@@ -159,8 +159,9 @@ class FastPostsTest(FreeCADTestCase):
         and write what FreeCAD's posts write from it; an edit of the Path (undo, a script) forgets the record."""
         path = str(OUT / "fast_posts_reopen.FCStd")
         doc = self.results["lines"].doc
-        doc.saveAs(path)
+        doc.saveCopy(path)
         again = FreeCAD.openDocument(path)
+        self.assertNotEqual(again.Name, doc.Name)
         try:
             op = next(o for o in again.Objects if o.Name == self.results["lines"].op.Name)
             self.assertIsNone(path_build.record_of(op))
