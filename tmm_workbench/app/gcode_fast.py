@@ -22,6 +22,7 @@ from typing import Any, Callable, ClassVar, Iterable, Optional
 import numpy as np
 
 from tmm_workbench.app.path_build import MoveRows, record_of
+from tmm_workbench.core.post import fixed_text
 
 # Quantity(v, Length).getValueAs('in') is v / 25.4; Quantity(v, Velocity).getValueAs('mm/min') is v / (1/60):
 # dividing by the same doubles keeps every rounding FreeCAD's
@@ -233,8 +234,9 @@ class Writer:
         self.fast_lines(rec.after)
 
     def row_lines(self, rows: MoveRows) -> None:
-        """Each run of rows of one kind as one `%` format of all its values (the values divided by their unit
-        as arrays: the same doubles); line numbers, a special command or a feed not positive: line by line."""
+        """Each run of rows of one kind written at once (core.post.fixed_text: the text of the line's `%` format,
+        built with numpy; the values divided by their unit as arrays: the same doubles); line numbers, a special
+        command or a feed not positive: line by line."""
         if self.opts.line_numbers:
             self.fast_lines(rows.commands())
             return
@@ -252,7 +254,8 @@ class Writer:
                 v = values[:, [words.index(k) for k in order]]
                 if any(d != 1.0 for d in divisors):
                     v = v / np.array(divisors)
-                self.out.append((fmt * (b - a)) % tuple(v.ravel().tolist()))
+                text = fixed_text.lines(fmt, v)   # numpy's bytes; else Python's % of the run
+                self.out.append(text if text is not None else (fmt * (b - a)) % tuple(v.ravel().tolist()))
 
     def commands_of(self, obj: Any) -> Iterable[Any]:
         """`obj`'s commands (Name, Parameters): from the op's record when it has one, else from the Path."""
