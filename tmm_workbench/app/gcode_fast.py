@@ -1,12 +1,13 @@
 """Fast G-code writers in the dialects of FreeCAD's linuxcnc and grbl script posts.
 
 FreeCAD's posts build every word through a `Units.Quantity` and append to one growing string, 30-40 us a line
-on a loaded machine (6-7 s for a 192k-line surface job, docs/posts.md). Here each Path is read once
-(`Commands`, one `Parameters` dict per command) and every line is one `%` format by a function generated once
-per command name and parameter set, so reading the commands from FreeCAD is most of the time left (about 3 of
-every 4 us a line). The words written are FreeCAD's: the same order, the same dropped parameters (linuxcnc
-has no K), F in mm/min without F on rapids, T/S as integers, the same rounding (`%.<n>f` of the same double
-FreeCAD formats), the same tool-change and coolant lines. Only the header's post name and time differ.
+on a loaded machine (6-12 s for a 192k-line surface job, docs/posts.md). Here a TMM op's moves are read from its
+record of its Path (app.path_build: rows of arrays), each run of rows of one kind written at once
+(core.post.fixed_text); other objects' Paths are read once (`Commands`, one `Parameters` dict per command) and
+every line is one `%` format by a function generated once per command name and parameter set. The words written
+are FreeCAD's: the same order, the same dropped parameters (linuxcnc has no K), F in mm/min without F on rapids,
+T/S as integers, the same rounding (`%.<n>f` of the same double FreeCAD formats), the same tool-change and
+coolant lines. Only the header's post name and time differ.
 Reference: FreeCAD 0.20 `linuxcnc_post.py`, `grbl_post.py` (1.0/1.1 `*_legacy_post.py` write the same motion
 lines).
 """
