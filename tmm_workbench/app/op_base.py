@@ -193,6 +193,7 @@ class TmmOp(PathOp.ObjectOp):
         """FreeCAD's ObjectOp.execute returns early, keeping the old Path and leaving the op valid, when the
         tool controller is missing or the tool's diameter is 0; these and a missing kernel are checked
         first here and fail the op. If ObjectOp still returns before computing, the op fails too."""
+        self._rows: Optional[tuple[int, path_build.MoveRows]] = None   # set by add_rows
         if not obj.Active:
             super().execute(obj)
             return
@@ -202,7 +203,6 @@ class TmmOp(PathOp.ObjectOp):
             self.fail(obj, problem)
         self.check_work(obj)
         self._computed = False
-        self._rows: Optional[tuple[int, path_build.MoveRows]] = None
         self._cancel_pending = False
         super().execute(obj)
         self.cancelled = self._cancel_pending   # after obj.Path was set (its change clears the flag)
