@@ -16,7 +16,10 @@ import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-STL = Path(os.environ.get("TMM_GAPS_STL", "/work/shared/benchmarks/stl/mount_rush.stl"))
+sys.path.insert(0, str(ROOT))
+from tmm_workbench.core.shared_data import benchmark_file  # noqa: E402
+
+STL = Path(os.environ.get("TMM_GAPS_STL") or benchmark_file("stl", "mount_rush.stl"))
 
 
 def run(home: str) -> dict:
