@@ -11,8 +11,8 @@ from typing import Any, Optional
 
 import FreeCAD
 
-from fc_helpers import SPHERE_ON_PLATE, FreeCADTestCase, close_all
-from tmm_workbench.app import api, gcode_fast, posts
+from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase, close_all
+from tmm_workbench.app import api, gcode_fast, path_build, posts
 from tmm_workbench.app.compat import PathPreferences
 
 _WORD = re.compile(r"([A-Z])\s*([-+]?\d*\.?\d+)")
@@ -132,6 +132,50 @@ class FastPostsTest(FreeCADTestCase):
             self.assertEqual("%.4f" % (v / gcode_fast.MM_PER_MIN), format(float(speed.getValueAs("mm/min")), ".4f"))
             self.assertEqual("%.4f" % (v / gcode_fast.IN_PER_MIN), format(float(speed.getValueAs("in/min")), ".4f"))
             self.assertEqual("%.4f" % (v / gcode_fast.IN), format(float(length.getValueAs("in")), ".4f"))
+
+    def test_the_ops_record_is_their_path(self) -> None:
+        """The fast posts read a TMM op's record of its Path (app.path_build), not the Path: the record holds the
+        Path's commands exactly (names, words, doubles), and the program written from it is the program written
+        from the Path read back."""
+        for job, objects in self.objects.items():
+            for op in objects[1::2]:
+                rec = path_build.record_of(op)
+                self.assertIsNotNone(rec, f"{job}: {op.Label} keeps no record of its Path")
+                path = [(c.Name, dict(c.Parameters)) for c in op.Path.Commands]
+                self.assertEqual([(c.Name, c.Parameters) for c in rec.commands()], path, f"{job}: {op.Label}")
+            for fast in ("tmm_linuxcnc", "tmm_grbl"):
+                from_record = posts.export(fast, objects)
+                kept = [op.Proxy.path_record for op in objects[1::2]]
+                try:
+                    for op in objects[1::2]:
+                        op.Proxy.path_record = None
+                    self.assertEqual(body(from_record), body(posts.export(fast, objects)), f"{job} {fast}")
+                finally:
+                    for op, rec in zip(objects[1::2], kept):
+                        op.Proxy.path_record = rec
+
+    def test_reopened_document(self) -> None:
+        """A document saved and reopened has no record (the ops are not recomputed): the fast posts read the Path,
+        and write what FreeCAD's posts write from it; an edit of the Path (undo, a script) forgets the record."""
+        path = str(OUT / "fast_posts_reopen.FCStd")
+        doc = self.results["lines"].doc
+        doc.saveCopy(path)
+        again = FreeCAD.openDocument(path)
+        self.assertNotEqual(again.Name, doc.Name)
+        try:
+            op = next(o for o in again.Objects if o.Name == self.results["lines"].op.Name)
+            self.assertIsNone(path_build.record_of(op))
+            self.objects["reopened"] = [op.ToolController, op]
+            for stock in ("linuxcnc", "grbl"):
+                self.compare("reopened", stock, "tmm_" + stock)
+        finally:
+            self.objects.pop("reopened", None)
+            FreeCAD.closeDocument(again.Name)
+        op = self.results["arcs"].op
+        rec = op.Proxy.path_record
+        op.Path = op.Path
+        self.assertIsNone(path_build.record_of(op))
+        op.Proxy.path_record = rec
 
     def test_offered_by_the_job(self) -> None:
         """The fast posts are in FreeCAD's post list and the Job's choices; run_surface chose the one asked for."""

@@ -108,6 +108,8 @@ def compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
     with progress_mod.using(factory):
         op.touch()
         op.Document.recompute()
+    if op.isValid() and getattr(op.Proxy, "cancelled", False):
+        raise TmmError(f"{op.Label}: tool path computation cancelled")
     if not op.isValid() or op.Proxy.toolpath is None:
         raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
 

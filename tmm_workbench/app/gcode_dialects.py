@@ -4,7 +4,7 @@ and the few commands they treat specially. The posts in app/posts/ call `export(
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Iterable, Optional
 
 from tmm_workbench.app.gcode_fast import _MC_RUN, LineFn, Options, Writer, export_with, has_path
 
@@ -64,9 +64,9 @@ class LinuxCNC(Writer):
         if not has_path(obj):
             return
         if self.opts.modal or self.opts.axis_modal:
-            self.modal_lines(obj.Path.Commands)
+            self.modal_lines(self.commands_of(obj))
         else:
-            self.fast_lines(obj.Path.Commands)
+            self.op_lines(obj)
 
     def special_function(self, name: str) -> Optional[LineFn]:
         if name.startswith("(") and not self.opts.comments:
@@ -77,7 +77,7 @@ class LinuxCNC(Writer):
             return lambda p: self.plain_line(name, p, False) if self.opts.comments else ""
         return None
 
-    def modal_lines(self, path_commands: list[Any]) -> None:
+    def modal_lines(self, path_commands: Iterable[Any]) -> None:
         """The lines with --modal (a command word equal to the previous left out) or --axis-modal (a value equal
         to the previous left out; T H D S always written, as FreeCAD does); both restart with every Path."""
         o = self.opts
@@ -187,7 +187,7 @@ class Grbl(Writer):
             return
         if self.opts.comments:
             self.emit(f"(Path: {obj.Label})\n")
-        self.fast_lines(obj.Path.Commands)
+        self.op_lines(obj)
 
     def special_function(self, name: str) -> Optional[LineFn]:
         if name in ("M6", "M06", "M3", "M03", "M4", "M04", "message") or name.startswith("(MC_RUN_COMMAND"):

@@ -1,12 +1,13 @@
 """Fast G-code writers in the dialects of FreeCAD's linuxcnc and grbl script posts.
 
 FreeCAD's posts build every word through a `Units.Quantity` and append to one growing string, 30-40 us a line
-on a loaded machine (6-7 s for a 192k-line surface job, docs/posts.md). Here each Path is read once
-(`Commands`, one `Parameters` dict per command) and every line is one `%` format by a function generated once
-per command name and parameter set, so reading the commands from FreeCAD is most of the time left (about 3 of
-every 4 us a line). The words written are FreeCAD's: the same order, the same dropped parameters (linuxcnc
-has no K), F in mm/min without F on rapids, T/S as integers, the same rounding (`%.<n>f` of the same double
-FreeCAD formats), the same tool-change and coolant lines. Only the header's post name and time differ.
+on a loaded machine (6-12 s for a 192k-line surface job, docs/posts.md). Here a TMM op's moves are read from its
+record of its Path (app.path_build: rows of arrays), each run of rows of one kind written at once
+(core.post.fixed_text); other objects' Paths are read once (`Commands`, one `Parameters` dict per command) and
+every line is one `%` format by a function generated once per command name and parameter set. The words written
+are FreeCAD's: the same order, the same dropped parameters (linuxcnc has no K), F in mm/min without F on rapids,
+T/S as integers, the same rounding (`%.<n>f` of the same double FreeCAD formats), the same tool-change and
+coolant lines. Only the header's post name and time differ.
 Reference: FreeCAD 0.20 `linuxcnc_post.py`, `grbl_post.py` (1.0/1.1 `*_legacy_post.py` write the same motion
 lines).
 """
@@ -18,6 +19,11 @@ import re
 import shlex
 from dataclasses import dataclass, field
 from typing import Any, Callable, ClassVar, Iterable, Optional
+
+import numpy as np
+
+from tmm_workbench.app.path_build import MoveRows, record_of
+from tmm_workbench.core.post import fixed_text
 
 # Quantity(v, Length).getValueAs('in') is v / 25.4; Quantity(v, Velocity).getValueAs('mm/min') is v / (1/60):
 # dividing by the same doubles keeps every rounding FreeCAD's
@@ -150,20 +156,26 @@ class Writer:
             return "F" + prec, self.speed_unit
         return key + prec, (1.0 if key in self.ANGLES else self.length_unit)
 
-    def compile_line(self, name: str, keys: Iterable[str], with_name: bool) -> LineFn:
-        """The function writing a command `name` with parameters `keys`: one generated expression, one `%`
-        format of the values in FreeCAD's order (divided by their unit where it is not 1), so a line costs no
-        Python loop over its words. F not positive: FreeCAD writes no F, a second format."""
+    def line_format(self, name: str, keys: Iterable[str], with_name: bool) -> tuple[str, list[str], list[float]]:
+        """A line of command `name` with parameters `keys` as FreeCAD writes it: its `%` format, the words in
+        the format's order and their divisors."""
         present = set(keys)
         order = [k for k in self.ORDER if k in present and not (k == "F" and name in RAPIDS)]
         words = [self.word_format(k) for k in order]
         fmt = self.join(([name.replace("%", "%%")] if with_name else []) + [w for w, _ in words])
+        return fmt, order, [d for _, d in words]
+
+    def compile_line(self, name: str, keys: Iterable[str], with_name: bool) -> LineFn:
+        """The function writing a command `name` with parameters `keys`: one generated expression, one `%`
+        format of the values in FreeCAD's order (divided by their unit where it is not 1), so a line costs no
+        Python loop over its words. F not positive: FreeCAD writes no F, a second format."""
+        fmt, order, divisors = self.line_format(name, keys, with_name)
         if not fmt:
             return lambda p: ""
         # keys come from ORDER (single letters), the divisors are passed as names: nothing user-made is evaluated
         namespace: dict[str, Any] = {"fmt": fmt}
         values = []
-        for i, (k, (_, divisor)) in enumerate(zip(order, words)):
+        for i, (k, divisor) in enumerate(zip(order, divisors)):
             namespace[f"d{i}"] = divisor
             values.append(f"p[{k!r}]" if divisor == 1.0 else f"p[{k!r}] / d{i}")
         src = f"fmt % ({', '.join(values)}{',' if values else ''})"
@@ -209,6 +221,47 @@ class Writer:
             line = fn(p)
             if line:
                 out.append(line if not numbered else self.number() + pad + line)
+
+    # --- an op's record of its Path (app.path_build): whole runs of rows in one format --------------------------
+    def op_lines(self, obj: Any) -> None:
+        """The lines of `obj`'s Path: from the op's record of it when it has one (no command read back from
+        FreeCAD), else from the Path."""
+        rec = record_of(obj)
+        if rec is None:
+            self.fast_lines(obj.Path.Commands)
+            return
+        self.fast_lines(rec.before)
+        self.row_lines(rec.rows)
+        self.fast_lines(rec.after)
+
+    def row_lines(self, rows: MoveRows) -> None:
+        """Each run of rows of one kind written at once (core.post.fixed_text: the text of the line's `%` format,
+        built with numpy; the values divided by their unit as arrays: the same doubles); line numbers, a special
+        command or a feed not positive: line by line."""
+        if self.opts.line_numbers:
+            self.fast_lines(rows.commands())
+            return
+        codes = rows.codes
+        cuts = (np.flatnonzero(np.diff(codes)) + 1).tolist()
+        for a, b in zip([0] + cuts, cuts + [len(codes)]):
+            name, words = rows.kinds[int(codes[a])]
+            values = rows.values[a:b, :len(words)]
+            simple = self.special_function(name) is None and not set(words) & set(self.INTS + self.RAW)
+            if not simple or ("F" in words and not (values[:, words.index("F")] > 0).all()):
+                self.fast_lines(rows.commands(a, b))
+                continue
+            fmt, order, divisors = self.line_format(name, words, True)
+            if fmt:
+                v = values[:, [words.index(k) for k in order]]
+                if any(d != 1.0 for d in divisors):
+                    v = v / np.array(divisors)
+                text = fixed_text.lines(fmt, v)   # numpy's bytes; else Python's % of the run
+                self.out.append(text if text is not None else (fmt * (b - a)) % tuple(v.ravel().tolist()))
+
+    def commands_of(self, obj: Any) -> Iterable[Any]:
+        """`obj`'s commands (Name, Parameters): from the op's record when it has one, else from the Path."""
+        rec = record_of(obj)
+        return rec.commands() if rec is not None else obj.Path.Commands
 
     # --- programs --------------------------------------------------------------------------------------------
     def write(self, objects: list[Any]) -> str:

@@ -7,14 +7,15 @@ from __future__ import annotations
 
 import math
 import traceback
+from contextlib import contextmanager
 from dataclasses import MISSING, fields
-from typing import Any, Callable, NamedTuple, Optional
+from typing import Any, Callable, Iterator, NamedTuple, Optional
 
 import FreeCAD
 import numpy as np
 import Path
 
-from tmm_workbench.app import hooks, work_estimate
+from tmm_workbench.app import hooks, path_build, work_estimate
 from tmm_workbench.app.compat import PathOp
 from tmm_workbench.app.tools import TOOLBIT_SHAPES, cutter_from_tool, label_of, shape_name
 from tmm_workbench.core import kernel
@@ -22,6 +23,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError, WorkLimitError
 from tmm_workbench.core.tools.cutter import Cutter
 
 
+CANCELLED = "computation cancelled: no tool path (recompute the operation to compute it)"
 MAX_WORD = 1e9  # mm, mm/min, deg: any G-code word beyond it is a computation gone wrong, not a move
 class Prop(NamedTuple):
     """One row of an op's property table. `field`: the params dataclass field it sets ("" for none)."""
@@ -56,6 +58,9 @@ class TmmOp(PathOp.ObjectOp):
     ESTIMATE: Optional[Callable[..., Any]] = None   # the strategy's inputs from the properties (app.work_estimate)
     STRATEGY: Any = None         # the core strategy module: its estimate_work(params, cutter, bounds) (core.work)
     progress_enabled: bool = True
+    path_record: Optional[path_build.PathRecord] = None   # the current Path as rows (None: read the Path)
+    cancelled: bool = False   # the last compute was cancelled by the user: no path, no failure
+    path_counts: Optional[tuple[int, int]] = None   # the status line's (moves, cuts) of a Path read once
 
     def __init__(self, obj: Any, name: str, parentJob: Any = None,
                  values: Optional[dict[str, Any]] = None) -> None:
@@ -188,6 +193,7 @@ class TmmOp(PathOp.ObjectOp):
         """FreeCAD's ObjectOp.execute returns early, keeping the old Path and leaving the op valid, when the
         tool controller is missing or the tool's diameter is 0; these and a missing kernel are checked
         first here and fail the op. If ObjectOp still returns before computing, the op fails too."""
+        self._rows: Optional[tuple[int, path_build.MoveRows]] = None   # set by add_rows
         if not obj.Active:
             super().execute(obj)
             return
@@ -197,12 +203,60 @@ class TmmOp(PathOp.ObjectOp):
             self.fail(obj, problem)
         self.check_work(obj)
         self._computed = False
+        self._cancel_pending = False
         super().execute(obj)
+        self.cancelled = self._cancel_pending   # after obj.Path was set (its change clears the flag)
         if not self._computed:
             self.fail(obj, "FreeCAD did not compute the operation (its Job, model or stock is missing; "
                            "see the report view)")
+        self.keep_record()
         self.note_path_change(obj)
         self.set_cycle_time(obj)
+
+    def keep_record(self) -> None:
+        """The record of the Path just set from the command list (after obj.Path was set: its change forgets
+        the previous record)."""
+        if self._rows is not None and self.path_record is None:
+            self.path_record = path_build.record(self.commandlist, *self._rows)
+
+    def getCycleTimeEstimate(self, obj: Any) -> str:
+        """ObjectOp's estimate reads the Path back (a copy of every command): TMM's from the rows instead
+        (set_cycle_time replaces ObjectOp's anyway)."""
+        from tmm_workbench.core.sim.cycle_time import hms
+
+        if getattr(self, "_rows", None) is not None:
+            self.keep_record()
+            try:
+                seconds = self.record_cycle_seconds(obj)
+            except TmmError:
+                seconds = None
+            if seconds is not None:
+                return hms(seconds)
+        return super().getCycleTimeEstimate(obj)
+
+    def opOnChanged(self, obj: Any, prop: str) -> None:
+        if prop == "Path":   # a new Path (a compute, an undo, a paste): what was known of the old one is void
+            self.path_record, self.path_counts, self.cancelled = None, None, False
+
+    @contextmanager
+    def reporting(self, obj: Any) -> Iterator[Callable[[float], bool]]:
+        """The op's progress (the GUI's dialog with Cancel) from the kernel's start to the last command made,
+        watched (core.cancel.poll) so the Python loops between the kernel's calls (linking, the rows) are heard."""
+        from tmm_workbench.app import progress
+        from tmm_workbench.core import cancel
+
+        with progress.reporter(obj.Label, self.progress_enabled) as cb, cancel.watching(cb):
+            yield cb
+
+    def add_rows(self, rows: path_build.MoveRows, progress: Optional[Callable[[float], bool]] = None) -> None:
+        """The commands of `rows` at the end of the op's command list, made in chunks (`progress` between
+        them); the rows are kept as the record of the Path they go into."""
+        bad = path_build.unusable_row(rows, MAX_WORD)
+        if bad is not None:
+            raise TmmError(unusable_word(len(self.commandlist) + bad[0], *bad[1:]))
+        start = len(self.commandlist)
+        self.commandlist.extend(path_build.path_commands(rows, progress))
+        self._rows = (start, rows)
 
     def set_cycle_time(self, obj: Any) -> None:
         """FreeCAD's CycleTime counts no rotary axis and no joint speed: TMM's estimate replaces it
@@ -211,7 +265,9 @@ class TmmOp(PathOp.ObjectOp):
         from tmm_workbench.core.sim.cycle_time import hms
 
         try:
-            seconds = op_cycle_seconds(obj)
+            seconds = self.record_cycle_seconds(obj)
+            if seconds is None:
+                seconds = op_cycle_seconds(obj)
         except TmmError as exc:  # the op's own estimate stays; say why ours is missing
             FreeCAD.Console.PrintWarning(f"{obj.Label}: no cycle time estimate ({exc})\n")
             return
@@ -219,6 +275,18 @@ class TmmOp(PathOp.ObjectOp):
         job = getattr(self, "job", None)
         if job is not None and hasattr(getattr(job, "Proxy", None), "getCycleTime"):
             job.Proxy.getCycleTime()
+
+    def record_cycle_seconds(self, obj: Any) -> Optional[float]:
+        """The 3-axis cycle time from the record of the Path (no command read back), or None without one."""
+        from tmm_workbench.core.sim.cycle_time import three_axis_time
+
+        rec = self.path_record
+        if rec is not None and rec.cycle_s is None:
+            moves = path_build.line_moves(rec)
+            if moves is not None:
+                tc = obj.ToolController
+                rec.cycle_s = three_axis_time(moves[0], moves[1], tc.HorizRapid.Value, tc.VertRapid.Value).seconds
+        return rec.cycle_s if rec is not None else None
 
     def input_problem(self, obj: Any) -> str:
         """What makes computing impossible, in the user's terms ('' when nothing)."""
@@ -279,15 +347,15 @@ class TmmOp(PathOp.ObjectOp):
         """The last look before FreeCAD makes the Path: a NaN or infinite word would reach the G-code and the
         machine (0.20 writes NaN as Z-922337203685.477581). Every cause is refused at its input; this
         catches one not yet found."""
-        values = np.fromiter((v for c in self.commandlist for v in c.Parameters.values()), float)
+        start, n = (self._rows[0], len(self._rows[1])) if getattr(self, "_rows", None) else (0, 0)
+        others = self.commandlist[:start] + self.commandlist[start + n:]   # the rows are checked as arrays
+        values = np.fromiter((v for c in others for v in c.Parameters.values()), float)
         if (np.abs(values) <= MAX_WORD).all():
             return
         for k, c in enumerate(self.commandlist):  # only on failure: name the first bad word
             bad = [(w, v) for w, v in c.Parameters.items() if not abs(v) <= MAX_WORD]
             if bad:
-                self.fail(obj, f"the computed tool path has a word that is not a usable number ({c.Name} "
-                               f"{bad[0][0]}{bad[0][1]:g} in command {k + 1}): nothing was written. Please report "
-                               "this with the document")
+                self.fail(obj, unusable_word(k, c.Name, bad[0][0], bad[0][1]))
 
     def compute(self, obj: Any) -> None:
         raise NotImplementedError
@@ -305,12 +373,22 @@ class TmmOp(PathOp.ObjectOp):
         try:
             compute()
         except Cancelled:
-            self.fail(obj, "tool path computation cancelled")
+            self.cancel(obj)
         except TmmError as exc:
             self.fail(obj, str(exc))
         except Exception as exc:
             FreeCAD.Console.PrintLog(traceback.format_exc())
             self.fail(obj, f"unexpected {type(exc).__name__}: {exc}")
+
+    def cancel(self, obj: Any) -> None:
+        """The user's Cancel: an ordinary outcome, not a failure (no error, no box, the op stays valid). The op is
+        left without a path (its properties may have changed since the last one: an old path would not be
+        theirs) and says so in its status line and the report view; a recompute computes it."""
+        self.commandlist = []
+        self._rows = None
+        self.clear_results()
+        self._cancel_pending = True
+        FreeCAD.Console.PrintMessage(f"{obj.Label}: {CANCELLED}\n")
 
     def fail(self, obj: Any, message: str) -> None:
         """Empty Path, message in the report view, and an exception: FreeCAD marks the op invalid
@@ -325,6 +403,12 @@ class TmmOp(PathOp.ObjectOp):
 
     def on_fail(self, obj: Any) -> None:
         """Clears what a subclass shows of its last result."""
+
+
+def unusable_word(index: int, name: str, word: str, value: float) -> str:
+    """The failure of a path with a word that is no usable number (command `index`, from 0)."""
+    return (f"the computed tool path has a word that is not a usable number ({name} {word}{value:g} in command "
+            f"{index + 1}): nothing was written. Please report this with the document")
 
 
 def feed_problem(tc: Any) -> str:

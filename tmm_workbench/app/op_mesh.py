@@ -5,18 +5,15 @@ or the model, and the Path commands of a tool path (feeds from the tool controll
 """
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
-import Path
-
-from tmm_workbench.app import geometry, hooks, model_proxy, op_base, stages
+from tmm_workbench.app import geometry, hooks, model_proxy, op_base, path_build, stages
 from tmm_workbench.app.compat import PathOp, PathUtils
 from tmm_workbench.app.op_base import Prop
-from tmm_workbench.core.arcs import PLANE_CODES
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.stage import Field, Stage
-from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.toolpath import Toolpath
 
 MODEL_STAGE = Stage("model", (
     Field("StlFile", "file", "Model", "STL file to machine (takes precedence over Model)"),
@@ -72,33 +69,14 @@ class MeshOp(op_base.TmmOp):
         m = obj.BoundaryMargin.Value
         return (x0 - m, y0 - m, x1 + m, y1 + m)
 
-    def commands(self, toolpath: Toolpath, plunge_angle_deg: float = 45.0,
-                 clearance: Optional[float] = None) -> list[Any]:
-        """G0 for rapids (no F, as the stock ops), G1 with the vertical feed for plunges and for cutting moves
-        going down more steeply than `plunge_angle_deg`, the horizontal feed for the other cutting moves; an
-        arc move as G2/G3 in its plane, the plane selected before it. With `clearance`, the path starts with a
-        Z-only rapid to it: after a tool change the tool goes up before it moves in X and Y."""
+    def add_moves(self, toolpath: Toolpath, plunge_angle_deg: float = 45.0, clearance: Optional[float] = None,
+                  progress: Optional[Callable[[float], bool]] = None) -> None:
+        """The tool path's commands at the end of the op's command list (app.path_build.rows_of: G0 for rapids,
+        no F; G1 at the vertical feed for plunges and for cutting moves going down more steeply than
+        `plunge_angle_deg`, at the horizontal feed for the others; G2/G3 in their plane; with `clearance`, a
+        Z-only rapid to it first: after a tool change the tool goes up before it moves in X and Y), made
+        in chunks with `progress` between them; the rows are kept for the readers of the Path."""
         if not (0.0 <= plunge_angle_deg <= 90.0):
             raise TmmError(f"plunge angle must be in [0, 90] deg, got {plunge_angle_deg:g}")
-        steep = toolpath.steep_descents(plunge_angle_deg)
-        out = []
-        if clearance is not None and len(toolpath):
-            out.append(Path.Command("G0", {"Z": max(clearance, toolpath.moves[0].z)}))
-        plane = "XY"
-        for i, (m, down) in enumerate(zip(toolpath, steep)):
-            if m.arc is not None and i > 0:
-                if m.arc.plane != plane:
-                    out.append(Path.Command(PLANE_CODES[m.arc.plane], {}))
-                    plane = m.arc.plane
-                prev = toolpath.moves[i - 1]
-                name, words = m.arc.command((prev.x, prev.y, prev.z), (m.x, m.y, m.z))
-                out.append(Path.Command(name, {**words, "F": self.horizFeed}))
-                continue
-            if m.kind is MoveKind.RAPID:
-                out.append(Path.Command("G0", {"X": m.x, "Y": m.y, "Z": m.z}))
-            else:
-                feed = self.vertFeed if m.kind is MoveKind.PLUNGE or down else self.horizFeed
-                out.append(Path.Command("G1", {"X": m.x, "Y": m.y, "Z": m.z, "F": feed}))
-        if plane != "XY":
-            out.append(Path.Command(PLANE_CODES["XY"], {}))
-        return out
+        rows = path_build.rows_of(toolpath, self.horizFeed, self.vertFeed, plunge_angle_deg, clearance)
+        self.add_rows(rows, progress)

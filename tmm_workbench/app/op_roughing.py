@@ -141,14 +141,16 @@ class ObjectTmmRoughing(op_mesh.MeshOp):
         params = self.params_from(obj, final_z=final_z, **stock)
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value)
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy, cb)
-        if not len(toolpath):
-            left = "what the Job's earlier ops left" if rest is not None else "the stock"
-            raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
-        self.mesh, self.toolpath, self.params = mesh, toolpath, params
-        tool_assembly.report(obj, params)
-        self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
+        with self.reporting(obj) as cb:
+            toolpath = zlevel_rough.compute_roughing_toolpath(mesh, cutter, params, policy,
+                                                              progress.phase(cb, 0.0, progress.KERNEL_SHARE))
+            if not len(toolpath):
+                left = "what the Job's earlier ops left" if rest is not None else "the stock"
+                raise TmmError(f"no material to remove: {left} lies within the model plus stock to leave")
+            self.mesh, self.toolpath, self.params = mesh, toolpath, params
+            tool_assembly.report(obj, params)
+            self.add_moves(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value,
+                           progress.phase(cb, progress.KERNEL_SHARE, 1.0))
 
 
 def SetupProperties() -> list[str]:

@@ -115,13 +115,15 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                             low_links=rest is not None)   # a rest's many short pieces: hop over, not up
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy, cb)
-        surface_verify.report(obj, notes)
-        tool_assembly.report(obj, params)
-        rest_source.report(obj, rest)
-        self.mesh, self.toolpath, self.rest = mesh, toolpath, rest
-        self.commandlist.extend(self.commands(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value))
+        with self.reporting(obj) as cb:
+            toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy,
+                                                             progress.phase(cb, 0.0, progress.KERNEL_SHARE))
+            surface_verify.report(obj, notes)
+            tool_assembly.report(obj, params)
+            rest_source.report(obj, rest)
+            self.mesh, self.toolpath, self.rest = mesh, toolpath, rest
+            self.add_moves(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value,
+                           progress.phase(cb, progress.KERNEL_SHARE, 1.0))
 
     def post_without_k(self, obj: Any) -> str:
         """The Job's post processor when it drops the K word of arcs, else ''."""

@@ -101,20 +101,21 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
                                       extra["boundary"])
         params.rest = None if rest is None else rest.stock
         policy.low_links = rest is not None
-        with progress.reporter(obj.Label, self.progress_enabled) as cb:
-            result = waterline.compute(mesh, cutter, params, cb)
-        top = result.diagnostics.get("top")
-        if top is not None and policy.safe_height <= top:
-            raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
-                           f"{top:.4g} mm")
-        # each loop is entered from above onto one of its points: a loop point is free (the tool's drop
-        # height there is its level), so the plunge down to it cuts nothing of the model
-        toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
-        self.mesh, self.toolpath, self.params = mesh, toolpath, params
-        self.diagnostics = dict(result.diagnostics)
-        tool_assembly.report(obj, params)
-        rest_source.report(obj, rest)
-        self.commandlist.extend(self.commands(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value))
+        with self.reporting(obj) as cb:
+            result = waterline.compute(mesh, cutter, params, progress.phase(cb, 0.0, progress.KERNEL_SHARE))
+            top = result.diagnostics.get("top")
+            if top is not None and policy.safe_height <= top:
+                raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
+                               f"{top:.4g} mm")
+            # each loop is entered from above onto one of its points: a loop point is free (the tool's drop
+            # height there is its level), so the plunge down to it cuts nothing of the model
+            toolpath = link(result.segments, policy)  # the strategy refuses a result without loops
+            self.mesh, self.toolpath, self.params = mesh, toolpath, params
+            self.diagnostics = dict(result.diagnostics)
+            tool_assembly.report(obj, params)
+            rest_source.report(obj, rest)
+            self.add_moves(toolpath, STEEP_DESCENT_DEG, obj.ClearanceHeight.Value,
+                           progress.phase(cb, progress.KERNEL_SHARE, 1.0))
 
 
 def SetupProperties() -> list[str]:

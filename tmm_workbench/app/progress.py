@@ -62,6 +62,15 @@ def default_factory(label: str) -> ProgressReporter:
 progress_factory: ProgressFactory = default_factory
 
 
+# the kernel's share of an op's progress; the rest is the Path's commands being made (app.path_build)
+KERNEL_SHARE = 0.9
+
+
+def phase(progress: Optional[Progress], lo: float, hi: float) -> Optional[Progress]:
+    """`progress` for one phase of a computation: its 0..1 shown as lo..hi of the whole."""
+    return (lambda f: progress(lo + (hi - lo) * min(max(f, 0.0), 1.0))) if progress else None
+
+
 def reporter(label: str, enabled: bool = True) -> ProgressReporter:
     return progress_factory(label) if enabled else QuietProgress()
 

@@ -37,6 +37,7 @@ from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
+from tmm_workbench.core.cancel import poll
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.params import Spec, check
@@ -341,6 +342,7 @@ def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:
 def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
     tp = Toolpath()
     for seg in segments:
+        poll()   # Python per move: a million moves take seconds, Cancel is heard and a dialog repaints
         pts = seg.tips
         first = 0
         start = len(tp.moves) - 1                 # the cut begins where the tool is (joined) ...
@@ -400,6 +402,7 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
     tp.add(MoveKind.RAPID, x, y, max(policy.clearance_height, z), Z_AXIS)
     tp.add(MoveKind.RAPID, x, y, max(policy.clearance_height, z), a0)
     for k, seg in enumerate(segments):
+        poll()
         start = 0
         if k == 0 or not seg.joined:
             a = seg.axis(0)

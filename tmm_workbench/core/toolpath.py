@@ -88,15 +88,18 @@ class Toolpath:
     def steep_descents(self, angle_deg: float) -> np.ndarray:
         """(n,) bool: FEED moves going down more steeply than `angle_deg` below the horizontal (a machinist
         runs these at the plunge feed); the first move and non-FEED moves are False."""
-        if not (0.0 <= angle_deg <= 90.0):
-            raise ValueError(f"plunge angle must be in [0, 90] degrees, got {angle_deg!r}")
-        p = self.points()
-        out = np.zeros(len(p), dtype=bool)
-        if len(p) < 2:
-            return out
-        d = np.diff(p, axis=0)
-        horizontal = np.hypot(d[:, 0], d[:, 1])
-        steep = (d[:, 2] < 0) & (-d[:, 2] > horizontal * np.tan(np.radians(angle_deg)))
-        feed = np.array([m.kind is MoveKind.FEED for m in self.moves[1:]])
-        out[1:] = steep & feed
+        return steep_mask(self.points(), np.array([m.kind is MoveKind.FEED for m in self.moves]), angle_deg)
+
+
+def steep_mask(points: np.ndarray, feed: np.ndarray, angle_deg: float) -> np.ndarray:
+    """(n,) bool: the moves ending at `points[i]` with `feed[i]` (a FEED move) going down more steeply than
+    `angle_deg` below the horizontal; the first move is False."""
+    if not (0.0 <= angle_deg <= 90.0):
+        raise ValueError(f"plunge angle must be in [0, 90] degrees, got {angle_deg!r}")
+    out = np.zeros(len(points), dtype=bool)
+    if len(points) < 2:
         return out
+    d = np.diff(points, axis=0)
+    horizontal = np.hypot(d[:, 0], d[:, 1])
+    out[1:] = (d[:, 2] < 0) & (-d[:, 2] > horizontal * np.tan(np.radians(angle_deg))) & feed[1:]
+    return out

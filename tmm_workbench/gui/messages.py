@@ -82,15 +82,34 @@ def guarded_command(what: str, run: Callable[[], Any]) -> Callable[[], Any]:
 
 def result_text(obj: Any) -> str:
     """The op's last result for its panel's status line: moves, cutting passes and cycle time from its
-    Path (so also after reopening a document), or '' before the first compute."""
-    commands = obj.Path.Commands
-    if not commands:
+    Path (so also after reopening a document), or '' before the first compute. The op's record of its Path
+    is read when it has one (app.path_build: the status line costs the same whatever the path's size); a
+    Path read once is recorded on the proxy until the Path changes."""
+    from tmm_workbench.app import op_base, path_build
+
+    proxy = getattr(obj, "Proxy", None)
+    if getattr(proxy, "cancelled", False):
+        return op_base.CANCELLED
+    rec = path_build.record_of(obj)
+    if rec is not None:
+        moves, passes = len(rec), rec.cuts()
+    elif getattr(proxy, "path_counts", None) is not None:
+        moves, passes = proxy.path_counts
+    else:
+        moves, passes = _count(obj.Path.Commands)
+        if proxy is not None and hasattr(proxy, "path_counts"):
+            proxy.path_counts = (moves, passes)
+    if not moves:
         return ""
+    time = str(getattr(obj, "CycleTime", "") or "")
+    return f"{moves} moves, {passes} cut{'s' if passes != 1 else ''}" + (f", cycle time {time}" if time else "")
+
+
+def _count(commands: Any) -> tuple[int, int]:
     passes, cutting = 0, False  # a cut: feed moves between two rapids
     for c in commands:
         if c.Name in ("G0", "G00"):
             cutting = False
         elif c.Name in ("G1", "G01", "G2", "G02", "G3", "G03") and not cutting:
             passes, cutting = passes + 1, True
-    time = str(getattr(obj, "CycleTime", "") or "")
-    return f"{len(commands)} moves, {passes} cut{'s' if passes != 1 else ''}" + (f", cycle time {time}" if time else "")
+    return len(commands), passes

@@ -26,6 +26,8 @@ class DialogProgress(ProgressReporter):
     def __call__(self, fraction: float) -> bool:
         if self.dialog is None:
             if time.monotonic() - self.t0 < SHOW_AFTER_S:
+                # no dialog yet: the window repaints and timers run, the user's clicks and keys wait for it
+                QtGui.QApplication.processEvents(QtCore.QEventLoop.ExcludeUserInputEvents)
                 return True
             self.dialog = self._open()
         # a phase that restarts its own count never moves the bar back

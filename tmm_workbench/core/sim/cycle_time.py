@@ -36,7 +36,8 @@ def hms(seconds: float) -> str:
 
 def three_axis_time(tips: np.ndarray, feeds: Sequence[Optional[float]], horiz_rapid: Optional[float] = None,
                     vert_rapid: Optional[float] = None) -> CycleTime:
-    """tips (n, 3); feeds[i] the feed of the move ending at point i, mm/s (None: a rapid; feeds[0] unused);
+    """tips (n, 3); feeds[i] the feed of the move ending at point i, mm/s (None: a rapid; feeds[0] unused; or an
+    array with inf or nan for a rapid);
     rapid rates in mm/s per axis (X and Y at horiz_rapid, Z at vert_rapid), DEFAULT_RAPID_MM_S when not
     given or 0. Each move takes the longer of its slowest axis at the rapid rate and its length at its feed."""
     p = np.asarray(tips, dtype=float).reshape(-1, 3)
@@ -44,7 +45,10 @@ def three_axis_time(tips: np.ndarray, feeds: Sequence[Optional[float]], horiz_ra
         raise TmmError(f"{len(feeds)} feeds for {len(p)} points")
     if len(p) < 2:
         return CycleTime(0.0, 0.0, 0.0, 0.0, 0.0)
-    f = np.array([math.inf if v is None else float(v) for v in list(feeds)[1:]])
+    if isinstance(feeds, np.ndarray):   # a million moves: no Python per move (inf or nan for a rapid)
+        f = np.where(np.isnan(feeds[1:]), math.inf, feeds[1:].astype(float))
+    else:
+        f = np.array([math.inf if v is None else float(v) for v in list(feeds)[1:]])
     bad = np.flatnonzero(~(f > 0))
     if len(bad):
         raise TmmError(f"move {int(bad[0]) + 1} has the feed {float(f[bad[0]])!r} mm/s: a feed must be > 0 for a cycle time")

@@ -31,6 +31,7 @@ from typing import Callable, Container, Mapping, Optional
 
 import numpy as np
 
+from tmm_workbench.core.cancel import poll
 from tmm_workbench.core.segments import ArcsAt, CutSegment
 
 FLAT = 1e-7               # mm: collinearity, a vertical move's horizontal length
@@ -56,6 +57,7 @@ class Run:
 def _straight_parts(pts: np.ndarray) -> list[tuple[int, int]]:
     """[first, last] index ranges of the points that run straight in one XY direction (vertical moves join
     either side): a zig-zag pass carries the first points of the turn to its link at its end."""
+    poll()   # one segment of a Python pass over every point: Cancel heard, the dialog repaints
     d = np.diff(pts[:, :2], axis=0)
     length = np.hypot(d[:, 0], d[:, 1])
     cuts, u_prev = [], None
@@ -71,6 +73,7 @@ def _straight_parts(pts: np.ndarray) -> list[tuple[int, int]]:
 
 
 def _as_run(seg: CutSegment, pts: np.ndarray) -> Optional[Run]:
+    poll()
     if len(pts) < 2 or seg.axes is not None:
         return None
     xy = pts[:, :2]

@@ -11,6 +11,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from tmm_workbench.core.cancel import poll
 from tmm_workbench.core.footprint.adaptive_raster import adaptive_pass_offsets
 from tmm_workbench.core.footprint.cusp import check_cusp, steepest_crossing_deg, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import clip_line_to_rect, raster_lines, sample_segment
@@ -79,6 +80,7 @@ def pattern(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: float
         chains = raster_region.chains(lines, cutter, params, diagnostics)
         runs = raster_region.flatten(chains)
     for i, ln in enumerate(lines if chains is None else ()):
+        poll()   # thousands of passes sampled in Python: Cancel heard, the dialog repaints
         if i > 0 and params.pattern == ZIGZAG:
             link_xy = sample_segment(lines[i - 1][1], ln[0], params.sample_step)[1:-1]
             runs.append((True, link_xy))

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from tmm_workbench.core.cancel import poll
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.strategies.surface.params import ONEWAY
 
@@ -23,6 +24,7 @@ def segments(runs: list[tuple[bool, np.ndarray]], z: np.ndarray, air: np.ndarray
     k = 0
     index = -1  # pass number (a link belongs to the pass it leads to)
     for is_link, xy in runs:
+        poll()   # Python per pass over millions of points: Cancel heard, the dialog repaints
         index += 0 if is_link else 1
         pts, gap = np.column_stack([xy, z[k:k + len(xy)]]), air[k:k + len(xy)]
         k += len(xy)
