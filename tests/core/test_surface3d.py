@@ -84,6 +84,18 @@ def test_stock_to_leave_offsets_the_surface():
         np.testing.assert_allclose(tp.cutting_points()[:, 2], 5.3, atol=1e-12)
 
 
+def test_negative_stock_to_leave_cuts_into_the_model_also_at_its_lowest_point():
+    """Below the model's lowest point too (the default floor follows it; an explicit floor is a final depth)."""
+    plate = grid_mesh(lambda x, y: 0 * x + 5.0, 10, 10, (0, 0, 20, 20), "plate")
+    for cutter in (Cutter.ball(4.0), Cutter.bull(6.0, 1.0)):
+        tp = run(plate, cutter, params(boundary=(4, 4, 16, 16), stock_to_leave=-0.3))
+        np.testing.assert_allclose(tp.cutting_points()[:, 2], 4.7, atol=1e-12)
+        floored = run(plate, cutter, params(boundary=(4, 4, 16, 16), stock_to_leave=-0.3, floor_z=4.9))
+        np.testing.assert_allclose(floored.cutting_points()[:, 2], 4.9, atol=1e-12)
+    with pytest.raises(TmmError, match="negative stock to leave -0.3 mm exceeds the corner radius 0 mm"):
+        run(plate, Cutter.flat(4.0), params(boundary=(4, 4, 16, 16), stock_to_leave=-0.3))
+
+
 def test_stock_to_leave_on_a_slope_is_a_normal_offset():
     # Plane at 30 degrees: the ball centre must be R + s from the plane, i.e. tip raised by s / cos(30).
     t = np.tan(np.radians(30))

@@ -72,7 +72,9 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
         from tmm_workbench.core.strategies.surface.variable_step import estimate_params
 
         estimate_params(cutter, params)
-    floor_z = float(lo[2]) if params.floor_z is None else float(params.floor_z)
+    # the model's lowest point, as far below it as a negative stock to leave cuts into the model (an explicit floor
+    # is the user's final depth and stays)
+    floor_z = float(lo[2]) + min(params.stock_to_leave, 0.0) if params.floor_z is None else float(params.floor_z)
     diagnostics: dict = {}
     placed, surface = pattern(mesh, cutter, params, floor_z, diagnostics, progress, surface)
     surface = surface or DropSurface(mesh)
