@@ -208,6 +208,14 @@ def new_op(info: dict, doc, job):
     type_into(visible(QtGui.QDoubleSpinBox, "startY"), f"{bb.YMax:.3f}")
     info["percent_enabled"] = visible(QtGui.QDoubleSpinBox, "stepOverPercent").isEnabled()
     info["mm_step_over_enabled"] = visible(QtGui.QWidget, "stepOver").isEnabled()
+    info["cusp_enabled_with_step_over"] = visible(QtGui.QWidget, "cuspHeight").isEnabled()
+    mode = visible(QtGui.QComboBox, "stepOverMode")
+    mode.setCurrentIndex(mode.findText("Cusp"))
+    pump(0.3)
+    info["cusp_mode_enabled"] = [visible(QtGui.QWidget, w).isEnabled() for w in ("cuspHeight", "stepOver",
+                                                                                    "stepOverPercent")]
+    mode.setCurrentIndex(mode.findText("StepOver"))
+    pump(0.3)
     scroll_to(visible(QtGui.QGroupBox, "depthsGroup"))
     info["png_fields"] = screenshot("state_3_depths_fields")
     click(QtGui.QDialogButtonBox.Ok)

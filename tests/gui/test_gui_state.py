@@ -56,6 +56,8 @@ def test_gui_state(tmp_path: Path) -> None:
     assert (unit, percent, passes, step_down, use_start, sample) == ("%", 50.0, 2, 0.5, True, 1.0), info["op_values"]
     assert start == [round(c, 3) for c in info["start_point"]], info["op_values"]
     assert info["percent_enabled"] and not info["mm_step_over_enabled"]
+    # fields that do not apply are disabled: the cusp height with StepOver spacing, the step-over with a cusp one
+    assert not info["cusp_enabled_with_step_over"] and info["cusp_mode_enabled"] == [True, False, False]
     assert info["cycle_time"] and info["cycle_time"] != "00:00:00", info["cycle_time"]
     x, y = info["first_cut_xy"]
     sx, sy = info["start_point"]

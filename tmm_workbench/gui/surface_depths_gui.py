@@ -15,7 +15,7 @@ from tmm_workbench.core.strategies.finish_passes import MAX_PASSES
 
 # widget name -> property, merged into op_surface_gui's tables
 # the properties whose change enables or disables fields
-ENABLING = ("StepOverUnit", "StepOverMode", "UseFinalDepth", "FinishPasses", "UseStartPoint")
+ENABLING = ("StepOverUnit", "StepOverMode", "UseFinalDepth", "FinishPasses", "UseStartPoint", "VerifyCusp", "Pattern")
 
 
 class DepthFields:
@@ -60,15 +60,22 @@ class DepthFields:
                 self.form.startX.editingFinished, self.form.startY.editingFinished]
 
     def enable_depths(self, obj: Any) -> None:
-        """Only the fields that act are enabled: the step-over in its unit, the final depth when used, the
-        step-down with more than one pass, the start point when used."""
+        """Only the fields that act are enabled: the step-over in its unit with StepOver spacing, the cusp height
+        with a cusp spacing, VerifyCusp or the pencil's creases, the cusp slope limit with a cusp spacing, the
+        spiral's direction with the spiral, the final depth when used, the step-down with more than one pass, the
+        start point when used."""
         if not self.has_depths():
             return
         try:
             spacing = obj.StepOverMode == "StepOver"
             percent = obj.StepOverUnit == PERCENT
+            pattern = getattr(obj, "Pattern", "")
             self.form.stepOverPercent.setEnabled(spacing and percent)
-            self.form.stepOver.setEnabled(not (spacing and percent))
+            self.form.stepOver.setEnabled(spacing and not percent)
+            self.form.cuspHeight.setEnabled(not spacing or bool(getattr(obj, "VerifyCusp", False))
+                                            or pattern == "Pencil")
+            self.form.cuspSlopeLimit.setEnabled(not spacing)
+            self.form.spiralDirection.setEnabled(pattern == "Spiral")
             self.form.finalDepth.setEnabled(bool(obj.UseFinalDepth))
             self.form.stepDown.setEnabled(int(obj.FinishPasses) > 1)
             self.form.startX.setEnabled(bool(obj.UseStartPoint))
