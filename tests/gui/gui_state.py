@@ -209,6 +209,7 @@ def new_op(info: dict, doc, job):
     info["percent_enabled"] = visible(QtGui.QDoubleSpinBox, "stepOverPercent").isEnabled()
     info["mm_step_over_enabled"] = visible(QtGui.QWidget, "stepOver").isEnabled()
     info["cusp_enabled_with_step_over"] = visible(QtGui.QWidget, "cuspHeight").isEnabled()
+    info["step_over_tip"] = visible(QtGui.QWidget, "stepOver").toolTip()
     mode = visible(QtGui.QComboBox, "stepOverMode")
     mode.setCurrentIndex(mode.findText("Cusp"))
     pump(0.3)

@@ -58,6 +58,8 @@ def test_gui_state(tmp_path: Path) -> None:
     assert info["percent_enabled"] and not info["mm_step_over_enabled"]
     # fields that do not apply are disabled: the cusp height with StepOver spacing, the step-over with a cusp one
     assert not info["cusp_enabled_with_step_over"] and info["cusp_mode_enabled"] == [True, False, False]
+    # a tooltip says what the value does, then its range and unit
+    assert info["step_over_tip"].startswith("Distance between raster passes\n") and " mm" in info["step_over_tip"]
     assert info["cycle_time"] and info["cycle_time"] != "00:00:00", info["cycle_time"]
     x, y = info["first_cut_xy"]
     sx, sy = info["start_point"]

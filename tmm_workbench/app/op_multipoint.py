@@ -60,7 +60,9 @@ MAX_AREAS_LISTED = 10  # areas where the scallop is not held, one warning line e
 
 PROPERTIES: list[Prop] = [
     Prop("App::PropertyEnumeration", "Method", "Multipoint",
-         "VCRF: vertical cutter, rotate to find the second contact (seed 001); DRD: directional ray distances",
+         "How the tool is put on the face touching it at two points (seed 001): VCRF, vertical and circular ray "
+         "firing (rays shot down and round the tool find the first contact and the tilt to the second; the "
+         "faster); DRD, drop-rotate-drop (drop the tool, tilt it about the first contact until it touches again)",
          "method"),
     Prop("App::PropertyEnumeration", "ToolShape", "Multipoint",
          "RoundInsert: the seed's torus (round-insert cutter, hollow centre); BullNose: the torus plus its flat "
@@ -79,7 +81,9 @@ PROPERTIES: list[Prop] = [
          "scallop"),
     Prop("App::PropertyDistance", "ForwardStep", "Footprint",
          "Distance between tool positions along a pass (at most)", "forward_step"),
-    Prop("App::PropertyAngle", "FeedAngle", "Footprint", "Direction of the passes in XY, from +X", "feed_angle_deg"),
+    Prop("App::PropertyAngle", "FeedAngle", "Footprint",
+         "Direction of the passes seen from above, from +X (the footprint: the grid of XY points the tool is put "
+         "on, pass by pass)", "feed_angle_deg"),
     Prop("App::PropertyDistance", "BoundaryMargin", "Footprint",
          "Grows (positive) or shrinks (negative) the face's XY extent covered by the footprint", "margin"),
     Prop("App::PropertyBool", "ZigZag", "Footprint", "Alternate the direction of the passes", "zigzag"),

@@ -87,7 +87,9 @@ class FieldGuard:
         widget.setProperty("unit", unit)
         widget.setProperty("tmmUnit", unit)
         span = f"{low:g} .. {high:g} {unit}" + (" (0: derived)" if spec is not None and spec.optional else "")
-        widget.setToolTip(f"{spec.label if spec else prop}: {span}; a bare number is in {unit}")
+        what = _documentation(self.obj, prop)   # what the value does, then its range and unit
+        widget.setToolTip((f"{what}\n" if what else "") + f"{spec.label if spec else prop}: {span}; a bare number "
+                          f"is in {unit}")
         line = widget.findChild(QtGui.QLineEdit)
         if line is not None:
             line.textEdited.connect(lambda text, prop=prop, line=line, unit=unit: self.typed(prop, line, unit, text))
@@ -192,3 +194,11 @@ def guard_panel(panel: Any) -> None:
         return clicked(button)
 
     panel.accept, panel.clicked = guarded_accept, guarded_clicked
+
+
+def _documentation(obj: Any, prop: str) -> str:
+    """The property's own description (its tooltip in the property editor), '' when FreeCAD has none."""
+    try:
+        return str(obj.getDocumentationOfProperty(prop) or "")
+    except Exception:  # noqa: BLE001 - an object without it (a plain Python one) has no description to add
+        return ""
