@@ -176,3 +176,24 @@ def test_heat_map_marks_the_collisions(tmp_path):
     b = np.asarray(Image.open(plain).convert("RGB")).astype(int)
     assert a.shape == b.shape and (np.abs(a - b).sum(axis=2) > 0).sum() > 50   # crosses and the legend drawn
     assert COLLISION_LABEL == "holder/shank collision"
+
+
+def test_heat_map_in_a_colour_band(tmp_path):
+    """With a band the colours span +-band and the cells beyond take the map's darkest ends: half the cells 0.004
+    mm above the design read clearly red in a 0.01 band, near white over the whole range (to 1 mm)."""
+    from PIL import Image
+
+    from tmm_workbench.core.preview.deviation_png import render_deviation_png
+    from tmm_workbench.core.sim.compare import compare
+
+    grid, stock, cutter, _ = boss_case(0.5)
+    cmp = compare(simulate(boss_pass(0.0), cutter, grid, stock), np.full_like(stock, -1.0), 0.01)
+    cmp.deviation[:] = np.where(np.arange(cmp.deviation.shape[1]) < cmp.deviation.shape[1] // 2, 0.004, 1.0)
+
+    def red_pixels(path: str) -> int:
+        img = np.asarray(Image.open(path).convert("RGB")).astype(int)
+        return int((img[..., 0] - img[..., 2] > 60).sum())
+
+    banded = red_pixels(render_deviation_png(cmp, grid, str(tmp_path / "band.png"), "t", band=0.01))
+    whole = red_pixels(render_deviation_png(cmp, grid, str(tmp_path / "whole.png"), "t"))
+    assert banded > 1.5 * whole, (banded, whole)

@@ -6,6 +6,7 @@ Tarus post's joint-speed estimate), and bad input refused by name."""
 from __future__ import annotations
 
 import unittest
+from pathlib import Path as Path_
 
 import Path
 
@@ -53,6 +54,12 @@ class Simulate3Axis(FreeCADTestCase):
         self.assertTrue(all(v["max_left"] <= r.max_left + 1e-12 for v in r.regions.values()))
         self.assertAlmostEqual(max(v["max_left"] for v in r.regions.values()), r.max_left, places=12)
         self.assertTrue(png.is_file() and png.stat().st_size > 20_000)
+        banded = simulate(job, cell=0.1, tolerance=0.01, png_path=OUT / "sim3_band.png", png_band=0.01,
+                          progress=False)   # TMM Simulate's colour band in the picture
+        self.assertTrue(Path_(banded.png).is_file() and banded.max_left == r.max_left)
+        with self.assertRaises(TmmError) as ctx:
+            simulate(job, cell=0.1, png_band=0.01, progress=False)
+        self.assertIn("png_band colours the heat map: give png_path as well", str(ctx.exception))
         # the op's CycleTime is TMM's estimate, and the report's
         self.assertAlmostEqual(hms_seconds(op.CycleTime), round(simulation.op_cycle_seconds(op)), delta=1)
         self.assertAlmostEqual(r.cycle_seconds, simulation.op_cycle_seconds(op), places=6)

@@ -417,7 +417,7 @@ class SimulationReport:
 def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
              png_path: Optional[Union[str, os.PathLike]] = None, progress: Union[bool, Callable[[float], bool]] = True,
              fail_on_gouge: bool = False, holder: Optional[str] = None,
-             stick_out: Optional[float] = None) -> SimulationReport:
+             stick_out: Optional[float] = None, png_band: Optional[float] = None) -> SimulationReport:
     """Cuts the stock of a Job with its active ops in order (or with one op), compares it with the Job's model
     and reports: the deviation (vertical, + material left, - gouge) extremes and percentiles, removed and
     remaining volume, rapids through stock, cycle time. `target`: a Job, an op, or a SurfaceResult /
@@ -427,7 +427,9 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     The shank and holder of each op (its Holder; or `holder`, a name of the holder library, with `stick_out` for
     every op: a job computed without one) are checked along its moves against the design: `holder_collisions`,
     and during the cut against the stock as each move finds it (uncut material too): `stock_collisions`, each
-    printed as an error (with fail_on_gouge: raised); png_path's heat map marks the stock collisions."""
+    printed as an error (with fail_on_gouge: raised); png_path's heat map marks the stock collisions. png_band:
+    the heat map's colours span +-png_band mm, the cells beyond in its darkest ends, counted in its title (TMM
+    Simulate's colour band; None: the whole range)."""
     from tmm_workbench.app import simulation
     from tmm_workbench.core.preview.deviation_png import render_deviation_png
 
@@ -437,7 +439,10 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
              max_step=(max_step, Spec(low=1e-3, high=10.0, unit="mm", label="max_step", optional=True)))
     if stick_out is not None and holder is None:
         raise TmmError("stick_out is used with a holder only: give holder= (a name from the holder library) as well")
-    numbers(stick_out=(stick_out, Spec(low=0.0, high=1000.0, unit="mm", label="stick_out", low_open=True)))
+    numbers(stick_out=(stick_out, Spec(low=0.0, high=1000.0, unit="mm", label="stick_out", low_open=True)),
+            png_band=(png_band, Spec(low=0.0, high=1000.0, unit="mm", label="png_band", low_open=True, optional=True)))
+    if png_band is not None and not png_path:
+        raise TmmError("png_band colours the heat map: give png_path as well")
     label = str(getattr(target, "Label", "simulation"))
     factory = (lambda _: CallbackProgress(progress)) if callable(progress) else None
     with progress_mod.using(factory):
@@ -448,7 +453,7 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     png = None
     if png_path:
         png = render_deviation_png(sim.comparison, sim.grid, str(png_path), f"{label}: simulated stock vs design",
-                                   collisions=sim.result.stock_collisions)
+                                   collisions=sim.result.stock_collisions, band=png_band)
     report = SimulationReport(o.max_left, o.min_deviation, dict(o.percentiles), sim.comparison.removed_volume,
                               o.remaining_volume, o.gouge_cells, sim.comparison.gouged, sim.collisions,
                               sim.cycle_seconds,
