@@ -47,7 +47,7 @@ def run() -> dict:
         sys.path.insert(0, str(ROOT))
     FreeCADGui.activateWorkbench("TMMWorkbench")
     pump(0.5)
-    from tmm_workbench.app import model_proxy, registry
+    from tmm_workbench.app import model_proxy, registry, tools
     from tmm_workbench.core.shared_data import benchmark_file
     from tmm_workbench.gui import job_cmd
 
@@ -69,7 +69,7 @@ def run() -> dict:
     info["job_panel_open"] = bool(FreeCADGui.Control.activeDialog())
     info["stock_visible"] = bool(job.Stock.ViewObject.Visibility)
     tc = job.Tools.Group[0]
-    info["tool"] = [tc.Tool.ShapeName if hasattr(tc.Tool, "ShapeName") else tc.Tool.BitShape,
+    info["tool"] = [tools.shape_name(tc.Tool),   # BitShape (0.20, 1.0) or ShapeID / ShapeName (1.1)
                     float(tc.Tool.Diameter.Value), tc.HorizFeed.Value, tc.VertFeed.Value, tc.SpindleSpeed]
     boxes = [o for o in doc.Objects if model_proxy.is_bounds(o)]
     info["bounds"] = [[o.Label, o.Label2, bool(o.ViewObject.Visibility)] for o in boxes]
