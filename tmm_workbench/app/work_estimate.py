@@ -240,24 +240,25 @@ def _mesh_at_hand(proxy: Any, obj: Any, load_stl: bool) -> Any:
     return None
 
 
-_samples: dict[tuple, Any] = {}
+_surface: list[Any] = []           # [mesh, its DropSurface]: the last model's index
+_samples: dict[tuple, Any] = {}   # (cutter, boundary, floor) -> that model's sample
 
 
 def _sample(mesh: Any, cutter: Any, boundary: tuple[float, ...], floor: float) -> Any:
     """The model's coarse height sample for this cutter over `boundary` (the panel asks on every value entered:
-    the last few are kept, and the mesh's index with them)."""
+    the last few are kept with the model's index, and dropped with it when the model changes)."""
     from tmm_workbench.core.query.drop import DropSurface
     from tmm_workbench.core.query.height_sample import sample_heights
 
-    key = (id(mesh), cutter.diameter, cutter.corner_radius, repr(cutter.native), tuple(round(v, 6) for v in boundary),
-           round(floor, 6))
+    if not _surface or _surface[0] is not mesh:
+        _surface[:] = [mesh, DropSurface(mesh)]
+        _samples.clear()
+    key = (cutter, tuple(round(v, 6) for v in boundary), round(floor, 6))   # a Cutter is equal by its values
     if key not in _samples:
-        surfaces = {k[0]: v[1] for k, v in _samples.items()}
-        surface = surfaces.get(id(mesh)) or DropSurface(mesh)
         if len(_samples) >= 4:
             _samples.clear()
-        _samples[key] = (sample_heights(surface, cutter, boundary, floor), surface, mesh)  # the mesh: its id stays its
-    return _samples[key][0]
+        _samples[key] = sample_heights(_surface[1], cutter, boundary, floor)
+    return _samples[key]
 
 
 def waterline(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:

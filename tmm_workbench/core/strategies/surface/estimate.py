@@ -136,11 +136,11 @@ def _step_table(cutter: Cutter, cusp: float, limit_tan: float) -> np.ndarray:
         r = cutter.radius
         chord = 2.0 * math.sqrt(max(2.0 * r * cusp - cusp * cusp, 0.0))
         return chord * np.cos(np.arctan(np.linspace(0.0, limit_tan, 64)))
-    return np.array(_rule_rows(cutter.diameter, cutter.corner_radius, repr(cutter.native), cusp, limit_tan, cutter))
+    return np.array(_rule_rows(cutter, cusp, limit_tan))
 
 
 @functools.lru_cache(maxsize=8)
-def _rule_rows(diameter: float, corner: float, shape: str, cusp: float, limit_tan: float, cutter: Cutter) -> tuple:
+def _rule_rows(cutter: Cutter, cusp: float, limit_tan: float) -> tuple:   # a Cutter is equal by its values
     return tuple(_cusp_step(cutter, cusp, t) for t in np.linspace(0.0, limit_tan, 8))
 
 
