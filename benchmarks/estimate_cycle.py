@@ -53,13 +53,6 @@ def path_seconds(tp: Toolpath) -> float:
     return t
 
 
-def told_seconds(work) -> float:
-    """The estimate's time as app.work_estimate.Estimate tells it."""
-    steep = math.tan(math.radians(PLUNGE_DEG))
-    down = 0.5 * sum(mm for t, mm in work.climbs if t > steep)
-    return (work.cut_length - down) / FEED + down / PLUNGE_FEED
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cache", default="", help="JSON file keeping the computed paths' times")
@@ -91,8 +84,8 @@ def main() -> None:
                     if cache:
                         cache.write_text(json.dumps(real))
                 bounds = (*lo, *hi)
-                told = told_seconds(estimate_work(params, cutter, bounds, sample))
-                boxes = told_seconds(estimate_work(params, cutter, bounds))
+                told = estimate_work(params, cutter, bounds, sample).cutting_seconds(FEED, PLUNGE_FEED, PLUNGE_DEG)
+                boxes = estimate_work(params, cutter, bounds).cutting_seconds(FEED, PLUNGE_FEED, PLUNGE_DEG)
                 ratio = told / real[key]
                 inside += 0.6 <= ratio <= 1.6
                 print(f"{key:44s} {real[key] / 60:7.2f}m {told / 60:7.2f}m {ratio:6.2f} {boxes / 60:9.2f}m "

@@ -8,7 +8,6 @@ panel's minimum and maximum for them, checked here like the params' own.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional
 
@@ -69,19 +68,24 @@ class Estimate:
     feed: Optional[float] = None         # mm/s, the tool controller's horizontal feed
     note: str = ""                       # what the count leaves out (VerifyCusp's partial passes)
     compute_seconds: Optional[float] = None   # the count at the strategy's measured pace (PACE)
-    climbs: tuple[tuple[float, float], ...] = ()   # core.work.Work.climbs
+    work: Optional[Work] = None          # what it was told from (its climbs)
     vert_feed: Optional[float] = None    # mm/s, the tool controller's vertical feed
     plunge_deg: float = 45.0             # moves going down steeper than this are cut at vert_feed (the op's)
 
     @property
+    def climbs(self) -> tuple[tuple[float, float], ...]:
+        """The cut length by the slope the passes climb (core.work.Work.climbs; () when not told)."""
+        return self.work.climbs if self.work is not None else ()
+
+    @property
     def cutting_seconds(self) -> Optional[float]:
-        """The cutting time the estimate implies (cut length at the horizontal feed, the half of it that goes down
-        slopes steeper than the plunge angle at the vertical feed); None without a feed."""
+        """The cutting time the estimate implies (core.work.Work.cutting_seconds: cut length at the horizontal
+        feed, the half of it that goes down slopes steeper than the plunge angle at the vertical feed); None
+        without a feed."""
         if self.cut_length is None or not self.feed or self.feed <= 0:
             return None
-        steep = math.tan(math.radians(self.plunge_deg))
-        down = 0.5 * sum(mm for t, mm in self.climbs if t > steep) if self.vert_feed and self.vert_feed > 0 else 0.0
-        return (self.cut_length - down) / self.feed + (down / self.vert_feed if down else 0.0)
+        work = self.work or Work(self.count, self.what, cut_length=self.cut_length)
+        return work.cutting_seconds(self.feed, self.vert_feed, self.plunge_deg)
 
     def text(self) -> str:
         from tmm_workbench.core.sim.cycle_time import hms
@@ -310,7 +314,7 @@ def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None
     (and `vert_feed` down slopes steeper than `plunge_deg`)."""
     seconds = sum(units * PACE[pace] for pace, units in work.paces)
     return Estimate(work.count, work.what, work.passes, work.cut_length, feed, work.note, compute_seconds=seconds,
-                    climbs=work.climbs, vert_feed=vert_feed, plunge_deg=plunge_deg)
+                    work=work, vert_feed=vert_feed, plunge_deg=plunge_deg)
 
 
 def estimate(obj: Any, overrides: Optional[Mapping[str, float]] = None, load_stl: bool = True) -> Optional[Estimate]:

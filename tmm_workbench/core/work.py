@@ -5,6 +5,7 @@ one signature: `estimate_work(params, cutter, bounds) -> Work`, `bounds` the box
 inputs a caller may have: the Surface's coarse height sample of the model)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Optional
 
@@ -27,3 +28,10 @@ class Work:
         """This work and `count` more of the same kind at `pace` (a verification's dense raster)."""
         return Work(self.count + count, self.what, self.passes, self.cut_length, note,
                     self.paces + ((pace, count),), self.climbs)
+
+    def cutting_seconds(self, feed: float, vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> float:
+        """The cutting time of cut_length at `feed` (mm/s), the half of the climbs steeper than `plunge_deg` (the
+        moves going down them) at `vert_feed` as the ops write them (none without a vertical feed)."""
+        steep = math.tan(math.radians(plunge_deg))
+        down = 0.5 * sum(mm for t, mm in self.climbs if t > steep) if vert_feed and vert_feed > 0 else 0.0
+        return (float(self.cut_length or 0.0) - down) / feed + (down / vert_feed if down else 0.0)
