@@ -126,6 +126,13 @@ def simulate_case(result: Any, png: Path, cell: float) -> dict[str, Any]:
                 collisions=len(rep.collisions), cycle=rep.cycle_seconds, seconds=time.perf_counter() - t0)
 
 
+def print_files(files: list[Path]) -> None:
+    """Each file written with its size (MISSING when it is not there)."""
+    for f in files:
+        size = f.stat().st_size if f.exists() else -1
+        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+
+
 def sim_line(name: str, sim: dict[str, Any]) -> str:
     verdict = "GOUGED" if sim["gouged"] else "no gouge"
     return (f"{name:<16} max left {sim['max_left']:.4f} mm, min {sim['min_dev']:+.4f} mm, p95 {sim['p95']:.4f} mm, "
@@ -296,9 +303,7 @@ def print_rough_finish(r: dict[str, Any], total: float) -> None:
         print("simulated (roughing + waterline; shallow areas keep the roughing's 0.5 mm): "
               + sim_line(r["name"], r["sim"]))
     print("written (stock to part):")
-    for f in r["files"]:
-        size = f.stat().st_size if f.exists() else -1
-        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print_files(r["files"])
     print(f"stock to part {total:.1f} s", flush=True)
 
 
@@ -344,9 +349,7 @@ def print_rest(r: dict[str, Any], total: float) -> None:
     print(f"the rest: {r['report']}")
     print("simulated (D10 finish + D3 rest): " + sim_line(r["name"], r["sim"]))
     print("written (rest):")
-    for f in r["files"]:
-        size = f.stat().st_size if f.exists() else -1
-        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print_files(r["files"])
     print(f"rest {total:.1f} s", flush=True)
 
 
@@ -446,9 +449,7 @@ def print_table5(r: dict[str, Any], total: float) -> None:
     if r.get("sim"):
         print("simulated: " + sim_line(r["name"], r["sim"]))
     print("\nwritten (5-axis):")
-    for f in r["files"]:
-        size = f.stat().st_size if f.exists() else -1
-        print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print_files(r["files"])
     print(f"5-axis part {total:.1f} s", flush=True)
 
 
@@ -468,10 +469,7 @@ def print_table(rows: list[dict[str, Any]], total: float) -> None:
         for r in sims:
             print("  " + sim_line(r["name"], r["sim"]))
     print("\nwritten:")
-    for r in rows:
-        for f in [*r["files"], r["png"]]:
-            size = f.stat().st_size if f.exists() else -1
-            print(f"  {f}  ({size / 1024:.0f} KiB)" if size >= 0 else f"  {f}  (MISSING)")
+    print_files([f for r in rows for f in (*r["files"], r["png"])])
     print(f"total {total:.1f} s", flush=True)
 
 
