@@ -110,3 +110,21 @@ def load_stl(path: str | Path, weld_tolerance: float = WELD_TOLERANCE_MM,
         raise TmmError(str(exc)) from exc
     return TriMesh.from_corners(soup.reshape(-1, 3, 3), name=p.name, weld_tolerance=weld_tolerance,
                                 progress=welding)
+
+
+def save_stl(mesh: TriMesh, path: str | Path) -> Path:
+    """Write `mesh` as a binary STL (its facet normals from the corners' order); the file appears only when whole
+    (written beside it, then renamed)."""
+    p = Path(path)
+    corners = mesh.vertices[mesh.triangles].astype(np.float32)
+    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-30)
+    rows = np.zeros(len(corners), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    rows["n"], rows["v"] = normals, corners
+    part = p.with_name(p.name + ".part")
+    with open(part, "wb") as f:
+        f.write(mesh.name.encode("ascii", "replace")[:80].ljust(80, b" "))
+        f.write(np.uint32(len(rows)).tobytes())
+        f.write(rows.tobytes())
+    part.replace(p)
+    return p
