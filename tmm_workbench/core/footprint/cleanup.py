@@ -46,6 +46,8 @@ LIFT = 1e-3            # mm: the slide starts this far above the flank (a grazin
 ANGLE_BIN = math.radians(1.0)   # slide directions within a degree share one directional index of the mesh
 FLAT = 1e-4          # a slope below this (on either side of a strip point) is a floor: the slide goes both ways
 OFF_MODEL = 1.0        # mm below the model's lowest point: the finishing tool's drop there is off the model
+BRANCH = 3             # cells: a short medial curve this near a longer one is its branch, a shorter one a speck
+FOLD_STEPS = 30         # golden-section steps placing a point in its fold (0.618^30 of the bracket: 1e-7 mm)
 
 
 def jump_limit(cutter: Cutter, tolerance: float) -> float:
@@ -151,14 +153,27 @@ def strips(mesh: TriMesh, surface: DropSurface, finishing: Cutter, grid: Grid, d
 
 
 def medial_curves(mask: np.ndarray, grid: Grid, min_length: float) -> list[np.ndarray]:
-    """The mask's medial curves: the ridges of the distance to its edge (pencil.valley_curves of its negative)."""
+    """The mask's medial curves: the ridges of the distance to its edge (pencil.valley_curves of its negative),
+    those at least `min_length` long and the shorter branches of them (a curve whose end lies within BRANCH cells
+    of a longer one): where a strip ends in a corner (the sloped end of a groove meeting its flanks), its medial
+    axis forks towards the corner in branches shorter than the tool, along the creases only they lead to."""
     if not mask.any():
         return []
     from scipy import ndimage
 
     dist = ndimage.distance_transform_edt(np.pad(mask, 1))[1:-1, 1:-1] * grid.cell
-    return pencil.valley_curves(grid.xs(), grid.ys(), -dist, 0.25 * grid.cell, min_length, within=mask,
-                                strict=True)
+    found = pencil.valley_curves(grid.xs(), grid.ys(), -dist, 0.25 * grid.cell, BRANCH * grid.cell, within=mask,
+                                 strict=True)
+    long = [c for c in found if pencil.curve_length(c) >= min_length]
+    if not long:
+        return []
+    trunk = np.vstack(long)
+    def gap(p: np.ndarray) -> float:
+        return float(np.hypot(*(trunk - p).T).min())
+
+    branches = [c for c in found if pencil.curve_length(c) < min_length
+                and min(gap(c[0]), gap(c[-1])) <= BRANCH * grid.cell]
+    return long + branches
 
 
 def _across(curve: np.ndarray) -> np.ndarray:
@@ -187,7 +202,9 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
     """Each XY point (n, 2) moved across (its unit XY normal `across`) to where `cutter` (vertical axis), slid down
     the flank it stands on, touches the other flank (see the module): the kernel's drop along that vector, from a
     `probe` behind the point (default a twentieth of the diameter), at most `reach` mm. A point already at the
-    fold (both sides higher), a slide blocked before the point or touching nothing within reach keeps its XY."""
+    fold within a probe (both sides higher) is moved to the lowest vertical drop between its probes (_fold_bottom):
+    there a tool a few hundredths off the fold stands on one flank and is lifted off the other by that times their
+    slope. A slide blocked before the point or touching nothing within reach keeps its XY."""
     a = probe if probe is not None else 0.05 * cutter.diameter
     n = len(points)
     offs = np.array([0.0, -1.0, 1.0])
@@ -215,7 +232,38 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
             r, to, d = r[nearer], to[nearer], d[nearer]
             xy[r], moved[r], direction[r] = to, d, v[r]
     moved[~np.isfinite(moved)] = 0.0
+    # each point (slid or not) in a fold within a probe: to the fold's bottom
+    z0, zm, zp = surface.drop(cutter, (xy[:, None, :] + offs[None, :, None] * a * across[:, None, :]).reshape(-1, 2),
+                              floor_z).reshape(n, 3).T
+    fold = np.flatnonzero((zm > z0 + FLAT * a) & (zp > z0 + FLAT * a))
+    t = _fold_bottom(surface, cutter, xy[fold], across[fold], a, floor_z)
+    xy[fold] += t[:, None] * across[fold]
+    moved[fold] = np.linalg.norm(xy[fold] - points[fold], axis=1)
     return Slide(xy, moved, direction)
+
+
+def _fold_bottom(surface: DropSurface, cutter: Cutter, points: np.ndarray, across: np.ndarray, a: float,
+                 floor_z: float) -> np.ndarray:
+    """Offsets t in (-a, a) along `across` of the lowest vertical drop near each point (both probes a away stand
+    higher: the fold is bracketed), by golden-section search (one drop per point and step)."""
+    lo, hi = np.full(len(points), -a), np.full(len(points), a)
+    if not len(points):
+        return lo
+    k = (math.sqrt(5.0) - 1.0) / 2.0
+
+    def z_at(t: np.ndarray) -> np.ndarray:
+        return surface.drop(cutter, points + t[:, None] * across, floor_z)
+
+    c, d = hi - k * (hi - lo), lo + k * (hi - lo)
+    zc, zd = z_at(c), z_at(d)
+    for _ in range(FOLD_STEPS):
+        left = zc <= zd                       # the bottom lies in (lo, d): d becomes hi, c the new d
+        lo, hi = np.where(left, lo, c), np.where(left, d, hi)
+        new = np.where(left, hi - k * (hi - lo), lo + k * (hi - lo))
+        z_new = z_at(new)
+        c, d, zc, zd = (np.where(left, new, d), np.where(left, c, new), np.where(left, z_new, zd),
+                        np.where(left, zc, z_new))
+    return 0.5 * (lo + hi)
 
 
 def _slide_length(mesh: TriMesh, cutter: Cutter) -> Cutter:
@@ -278,25 +326,27 @@ def cleanup_curves(mesh: TriMesh, surface: DropSurface, cutter: Cutter, found: S
 def flank_passes(surface: DropSurface, cutter: Cutter, curves: list[np.ndarray], floor_z: float, step: float,
                  passes: int, inside: Optional[tuple[Grid, np.ndarray]] = None) -> list[np.ndarray]:
     """Passes up each flank of each crease curve (its points at the fold): on each side, `passes` curves whose
-    points walk out across the crease, each XY step `step` cos(a)^1.5 with tan(a) = g the slope of the CL surface
-    (the design's at the contact) the exact drop finds just ahead: the passes step sqrt(cos a) along the surface,
-    which keeps the cusp's height measured vertically (as the rest and the simulation measure it) to the planar
-    step's; close on a steep wall, wide on a floor. Cut where they leave the strip (`inside`: a grid and its mask),
+    points walk out across the crease, each XY step `step` cos(a)^1.5 with tan(a) the steepest slope of the CL
+    surface (the design's at the contact) the exact drop finds just ahead, across and along the curve: the passes
+    step at most sqrt(cos a) along the surface, which keeps the cusp's height measured vertically (as the rest and
+    the simulation measure it) to the planar step's; close on a steep wall, wide on a floor. (The slope across alone
+    under-reads a flank that falls along the curve too, as a groove's sloped end does by its branch.) Cut where they leave the strip (`inside`: a grid and its mask),
     kept as runs of two points or more; innermost first."""
     out: list[np.ndarray] = []
     if not curves or passes < 1:
         return out
     pts = np.vstack(curves)
     across = np.vstack([_across(c) for c in curves])
+    along = np.column_stack([across[:, 1], -across[:, 0]])
     ends = np.cumsum([len(c) for c in curves])[:-1]
     a = 0.05 * cutter.diameter
     for side in (1.0, -1.0):
         pos, alive = pts.copy(), np.ones(len(pts), dtype=bool)
         for _ in range(passes):
-            probes = np.vstack([pos, pos + side * a * across])
-            z = surface.drop(cutter, probes, floor_z).reshape(2, -1)
-            g = (z[1] - z[0]) / a
-            pos = pos + side * (step * (1.0 + g * g) ** -0.75)[:, None] * across
+            probes = np.vstack([pos, pos + side * a * across, pos + a * along])
+            z = surface.drop(cutter, probes, floor_z).reshape(3, -1)
+            slope2 = ((z[1] - z[0]) ** 2 + (z[2] - z[0]) ** 2) / (a * a)   # the steepest slope's, squared
+            pos = pos + side * (step * (1.0 + slope2) ** -0.75)[:, None] * across
             if inside is not None:
                 alive &= _in_mask(pos, *inside)
             for c, ok in zip(np.split(pos, ends), np.split(alive, ends)):
