@@ -85,6 +85,10 @@ class Strips:
                 f"> {math.degrees(self.limit):.1f} deg, {self.rest.sum() * a:.0f} mm2 of rest cells), "
                 f"{len(self.curves)} curve(s)")
 
+    def length(self) -> float:
+        """mm: the curves' total length."""
+        return sum(pencil.curve_length(c) for c in self.curves)
+
 
 def normal_jumps(z: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Per grid point of the CL heights `z`: the largest concave jump (rad) of the section's normal across it over
@@ -195,6 +199,28 @@ class Slide:
     xy: np.ndarray          # (n, 2) the CL points' XY after the slide
     moved: np.ndarray       # (n,) how far in XY each moved (0: kept)
     direction: np.ndarray   # (n, 3) the slide's unit vector (0: none)
+    folded: Optional[np.ndarray] = None   # (n,) placed at the bottom of the fold they stood within a probe of
+
+    def missed(self) -> np.ndarray:
+        """The points that found no crease: neither slid to a far flank nor placed in a fold."""
+        folded = np.zeros(len(self.xy), dtype=bool) if self.folded is None else self.folded
+        return ~folded & ~self.direction.any(axis=1)
+
+
+@dataclass
+class CleanupReport:
+    """What the clean-up found and did, for the op's report: its strips, their curves' slide, the flank passes."""
+    strips: Strips
+    slide: Slide
+    passes: int
+
+    def summary(self) -> str:
+        n, missed = len(self.slide.xy), int(self.slide.missed().sum())
+        text = (f"{self.strips.summary()} {self.strips.length():.0f} mm long; {n - missed} of {n} curve points placed in their "
+                f"crease, {self.passes} flank pass(es)")
+        if missed:
+            text += f"; {missed} found no crease within reach (cut where they stand)"
+        return text
 
 
 def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points: np.ndarray, across: np.ndarray,
@@ -239,7 +265,9 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
     t = _fold_bottom(surface, cutter, xy[fold], across[fold], a, floor_z)
     xy[fold] += t[:, None] * across[fold]
     moved[fold] = np.linalg.norm(xy[fold] - points[fold], axis=1)
-    return Slide(xy, moved, direction)
+    folded = np.zeros(n, dtype=bool)
+    folded[fold] = True
+    return Slide(xy, moved, direction, folded)
 
 
 def _fold_bottom(surface: DropSurface, cutter: Cutter, points: np.ndarray, across: np.ndarray, a: float,
