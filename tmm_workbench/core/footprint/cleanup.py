@@ -240,6 +240,7 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
     at_fold = (zm > z0 + FLAT * a) & (zp > z0 + FLAT * a)      # both sides higher: the tool is in the fold
     xy, moved, direction = points.copy(), np.full(n, np.inf), np.zeros((n, 3))
     length = _slide_length(mesh, cutter)
+    tri = Triangles(mesh)
     for s in (1.0, -1.0):   # downhill; on a floor both ways, the nearer contact kept
         todo = np.flatnonzero(~at_fold & (flat | ((zp < zm) == (s > 0))))
         behind = np.where(s > 0, zm, zp)
@@ -249,7 +250,7 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
         back = a * np.sqrt(1.0 + g * g)
         start = np.column_stack([points, z0 + LIFT]) - back[:, None] * v   # from the probe behind
         for rows in _by_direction(v, todo):
-            travel = _slide(mesh, cutter, start[rows], v[rows], back[rows] + reach, length)
+            travel = _slide(tri, cutter, start[rows], v[rows], back[rows] + reach, length)
             ok = (travel > back[rows] + 1e-9) & (travel < back[rows] + reach)
             r, t = rows[ok], travel[ok]
             to = (start[r] + t[:, None] * v[r])[:, :2]
@@ -314,21 +315,29 @@ def _by_direction(v: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
     return [rows[keys == k] for k in np.unique(keys)]
 
 
-def _slide(mesh: TriMesh, cutter: Cutter, starts: np.ndarray, v: np.ndarray, most: np.ndarray,
+class Triangles:
+    """The mesh's triangles' corners and XY bounds, gathered once for all the slides' groups."""
+
+    def __init__(self, mesh: TriMesh) -> None:
+        self.mesh = mesh
+        self.corners = mesh.vertices[mesh.triangles]               # (m, 3, 3)
+        self.lo, self.hi = self.corners[:, :, :2].min(axis=1), self.corners[:, :, :2].max(axis=1)
+
+
+def _slide(tri: Triangles, cutter: Cutter, starts: np.ndarray, v: np.ndarray, most: np.ndarray,
            cutter_l: Cutter) -> np.ndarray:
     """Travel of each start along the group's common direction (their mean, rounded within ANGLE_BIN) until the
     tool touches; only triangles that can lie ahead of the starts take part (the kernel's drop comes from
     infinitely far behind: what lies behind the start is not in the way of a slide from it)."""
     d = v.mean(axis=0)
     d /= np.linalg.norm(d)
-    tri = mesh.vertices[mesh.triangles]                     # (m, 3, 3)
-    ahead = (tri @ d).max(axis=1) >= (starts @ d).min() - cutter.diameter
     lo = starts[:, :2].min(axis=0) - most.max() - cutter.diameter
     hi = starts[:, :2].max(axis=0) + most.max() + cutter.diameter
-    near = ((tri[:, :, :2].max(axis=1) >= lo) & (tri[:, :, :2].min(axis=1) <= hi)).all(axis=1)
-    keep = ahead & near
-    if not keep.any():
+    near = np.flatnonzero((tri.hi >= lo).all(axis=1) & (tri.lo <= hi).all(axis=1))
+    keep = near[(tri.corners[near] @ d).max(axis=1) >= (starts @ d).min() - cutter.diameter]
+    if not len(keep):
         return np.full(len(starts), np.inf)
+    mesh = tri.mesh
     part = TriMesh(mesh.vertices, mesh.triangles[keep], mesh.name)
     travel, _ = DirectionalDrop(part, d).drop(cutter_l, starts, np.array([0.0, 0.0, 1.0]), float(most.max()))
     return travel

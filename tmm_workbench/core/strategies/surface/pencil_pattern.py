@@ -110,13 +110,20 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceP
 
 def _nearest_first(pieces: list[np.ndarray]) -> list[np.ndarray]:
     """Each next piece the one whose nearer end is nearest the last end (turned to start there)."""
-    pool, out = list(pieces), []
-    at = np.array([-math.inf, -math.inf])
-    while pool:
-        d = [min(np.hypot(*(p[0] - at)), np.hypot(*(p[-1] - at))) if np.isfinite(at).all() else 0.0 for p in pool]
-        p = pool.pop(int(np.argmin(d)))
-        if np.isfinite(at).all() and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
+    if not pieces:
+        return []
+    heads = np.array([p[0] for p in pieces], dtype=float)
+    tails = np.array([p[-1] for p in pieces], dtype=float)
+    left = np.ones(len(pieces), dtype=bool)
+    out, k, at = [], 0, heads[0]             # the first piece as it comes
+    while True:
+        left[k] = False
+        p = pieces[k]
+        if out and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
             p = p[::-1]
         out.append(p)
+        if not left.any():
+            return out
         at = p[-1]
-    return out
+        d = np.minimum(np.hypot(*(heads - at).T), np.hypot(*(tails - at).T))
+        k = int(np.argmin(np.where(left, d, np.inf)))
