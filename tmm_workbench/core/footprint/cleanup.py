@@ -12,7 +12,8 @@ crease whose flanks' normals differ by theta touches both flanks and leaves the 
 jump is larger, the cells between the two contacts (P1, P2 in the seed's Figure 3-31) are the strip; a kink that
 falls between two grid points is caught by the jump of the slopes two steps either side. The strip is joined with
 the rest cells (the cells the finishing tool could not reach: core.footprint.rest), and thinned into its medial
-curves (the ridges of the distance to its edge, core.footprint.pencil.valley_curves).
+curves (the ridges of the distance to its edge, core.footprint.pencil.valley_curves) with their short branches
+(into a strip's corners: a groove's sloped ends).
 
 CL points by translation. At each point of a strip curve, across it, the clean-up tool slides from the point down
 the flank it stands on (a vertical tool: the slope of its CL surface behind the point; 0 on a floor: horizontal)
@@ -23,7 +24,8 @@ without undercuts: what it adds is the place of the fold across the crease to th
 point anywhere on the approach side, instead of a grid cell's. It matters where the CL surface's fold is a cliff:
 a steep wall meeting a floor (a cell's error on the floor side leaves a sliver on the wall's foot, on the wall side
 lifts the tool off the floor by the cell times the wall's slope). In a groove symmetric about the strip curve the
-slide is nil: the vertical drop there already touches both flanks.
+slide is nil: the vertical drop there already touches both flanks; a point within a probe of such a fold is put
+at its bottom (the lowest vertical drop across it).
 """
 from __future__ import annotations
 
