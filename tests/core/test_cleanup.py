@@ -59,17 +59,38 @@ def test_the_strips_lie_between_the_d10_contacts_at_the_wall_and_over_the_groove
 
 def test_the_strip_points_slide_to_the_two_contact_position(case) -> None:
     mesh, surface, grid, found = case
-    pts = np.array([[WALL_X - 2.5, 25.0], [WALL_X - 0.4, 25.0], [18.0, GROOVE_Y + 0.3], [18.0, GROOVE_Y]])
-    across = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.0]])
+    pts = np.array([[WALL_X - 2.5, 25.0], [WALL_X - 0.4, 25.0], [18.0, GROOVE_Y + 0.3], [18.0, GROOVE_Y],
+                    [18.0, GROOVE_Y + 0.03], [5.67, 19.13]])
+    across = np.array([[-1.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.0, 1.0], [0.0, 1.0], [-0.6, 0.8]])
     slide = cleanup.slide_to_crease(mesh, surface, D2, pts, across, -5.0, 10.0)
     assert slide.xy[0, 0] == pytest.approx(fold_x(1.0), abs=1e-3)   # from the floor, horizontally, to the wall
     assert slide.direction[0, 2] == pytest.approx(0.0, abs=1e-9)
     assert slide.xy[1, 0] == pytest.approx(fold_x(1.0), abs=2e-3)   # from the wall's flank, down it
     assert slide.direction[1, 2] < -0.5
     assert slide.xy[2, 1] == pytest.approx(GROOVE_Y, abs=2e-3)      # down the groove's flank to its middle
-    assert slide.moved[3] == 0.0                                     # in the groove's fold already: kept
+    assert slide.moved[3] < 1e-6                                     # in the groove's fold already: kept
+    # within a probe of the fold (both sides higher): moved into it, to the groove's middle and to the crease of
+    # its sloped end with its flank (x - 5 = y - 18.5) whatever the direction across
+    assert slide.xy[4, 1] == pytest.approx(GROOVE_Y, abs=1e-5)
+    assert slide.xy[5, 0] - 5.0 == pytest.approx(slide.xy[5, 1] - 18.5, abs=1e-5)
     z = surface.drop(D2, slide.xy, -5.0)
     assert z[0] == pytest.approx(0.0, abs=1e-3)                      # on the floor, against the wall
+
+
+def test_the_strip_keeps_its_short_branches_into_the_groove_ends(case) -> None:
+    # the groove's sloped ends meet its flanks in creases running to its corners: the strip's medial axis forks
+    # there in branches shorter than the clean-up tool (a D2), kept as branches of the groove's curve
+    found = case[3]
+    groove = [c for c in found.curves if np.median(c[:, 0]) < 35 and np.abs(c[:, 1] - GROOVE_Y).max() < 2]
+    trunk = max(groove, key=len)
+    branches = [c for c in groove if pencil.curve_length(c) < D2.diameter]
+    assert len(branches) == 2
+    assert sorted(np.median(c[:, 0]) < 15 for c in branches) == [False, True]   # one at each end
+    for c in branches:
+        gaps = [np.hypot(*(trunk - p).T).min() for p in (c[0], c[-1])]
+        assert min(gaps) < 1.0                                   # joined to the groove's curve
+        tip = c[int(np.argmax(gaps)) * -1]
+        assert tip[1] > GROOVE_Y + 0.2                           # towards the corners the trunk's ends miss
 
 
 def test_the_cleaned_curves_and_the_flank_passes(case) -> None:
@@ -109,3 +130,34 @@ def test_the_pencil_source_cleanup_needs_its_finishing_tool(case) -> None:
     tips = np.vstack([s.tips for s in res.segments])
     at_foot = tips[np.abs(tips[:, 0] - fold_x(1.0)) < 2e-3]
     assert len(at_foot) >= 2 and np.abs(at_foot[:, 2]).max() < 2e-3
+
+
+def test_the_groove_end_is_cleaned_within_the_tolerance_where_the_d2_reaches() -> None:
+    # seed 000's case at the groove's end (x 30): finished with the D10 (cusp 0.01 mm), cleaned up with the D2;
+    # simulated: every cell the D2 can bring within 0.01 mm of the design is within it, no gouge below -0.005 mm
+    from tmm_workbench.core.footprint import rest
+    from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
+    from tmm_workbench.core.sim.simulate import simulate
+    from tmm_workbench.core.sim.stock import box_heights
+
+    mesh, tol, box = crease_mesh(), 0.01, (24.0, 14.0, 34.0, 26.0)
+    grid = Grid.covering(*box, 0.1)
+    design = mesh_heights(mesh, grid)
+    policy = LinkPolicy(8.0, 10.0)
+    finish = raster_drop.compute_surface_toolpath(
+        mesh, D10, SurfaceParams(boundary=box, stepover=2 * math.sqrt(2 * 5.0 * tol), sample_step=0.25), policy)
+    left = simulate(finish, D10, grid, box_heights(grid, 2.0)).heights
+    envelope = rest.tool_envelope(mesh, D2, grid)
+    area = rest.rest_area(left, design, envelope, grid, tol, D2.radius)
+    params = SurfaceParams(boundary=(25.0, 15.0, 33.0, 25.0), region=area.region, sample_step=0.2,
+                           rest=area.stock(left), pattern="pencil", pencil_passes=0, pencil_source="cleanup",
+                           cleanup_reference=D10, stepover=2 * math.sqrt(2 * 1.0 * 0.8 * tol), cusp=tol)
+    tp = link(raster_drop.compute(mesh, D2, params).segments,
+              LinkPolicy(8.0, 10.0, material_top=StockHeights(grid, left, D2), low_links=True))
+    after = simulate(tp, D2, grid, left).heights
+    inner = np.zeros_like(design, dtype=bool)
+    inner[10:-10, 10:-10] = True                       # a millimetre in from the finish's boundary
+    reach = inner & np.isfinite(design) & (envelope - design <= tol)
+    assert np.nanmax(np.where(reach, left - design, np.nan)) > 0.3      # the D10 left the end's creases
+    assert np.nanmax(np.where(reach, after - design, np.nan)) <= tol
+    assert np.nanmin(after - design) > -0.005

@@ -85,7 +85,7 @@ def test_the_creases_a_ball_finds_in_the_cavity_are_its_floors_feet() -> None:
     near = (np.abs(pocket) < 0.5) | (np.abs(boss) < 0.5)
     corner = np.abs(np.abs(pts[:, 0]) - np.abs(pts[:, 1])) < 0.6   # the walls' corners fold too, on the diagonals
     assert (near | corner).mean() > 0.97
-    assert pencil._length(max(curves, key=len)) > 4 * 60          # the pocket's foot chained around
+    assert pencil.curve_length(max(curves, key=len)) > 4 * 60          # the pocket's foot chained around
 
 
 def test_a_multi_pencil_in_the_cavity_leaves_less_than_one_pencil_and_never_gouges() -> None:

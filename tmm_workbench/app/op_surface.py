@@ -120,7 +120,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                                                              progress.phase(cb, 0.0, progress.KERNEL_SHARE))
             surface_verify.report(obj, notes)
             tool_assembly.report(obj, params)
-            rest_source.report(obj, rest)
+            rest_source.report(obj, rest, notes)
             self.mesh, self.toolpath, self.rest = mesh, toolpath, rest
             self.add_moves(toolpath, obj.PlungeAngle.Value, obj.ClearanceHeight.Value,
                            progress.phase(cb, progress.KERNEL_SHARE, 1.0))

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Any, Optional
+from typing import Any, Optional, Sequence
 
 import FreeCAD
 import numpy as np
@@ -82,9 +82,10 @@ def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tu
     return Rest(area, area.stock(heights), region)
 
 
-def report(obj: Any, rest: Optional[Rest]) -> None:
-    """RestReport (the area and volumes) and RestRegions (the rest cells at the height left, for the view);
-    both emptied when the op is not a rest op."""
+def report(obj: Any, rest: Optional[Rest], notes: Sequence = ()) -> None:
+    """RestReport (the area and volumes, and a clean-up's strips among the strategy's `notes`: how many, how long,
+    the points that found no crease) and RestRegions (the rest cells at the height left, for the view); both
+    emptied when the op is not a rest op."""
     for name, kind, tip in ((REPORT, "App::PropertyString", "The rest area of the last computation: its size "
                              "and the volume above the design before and after this tool"),
                             (MARKS, "App::PropertyVectorList", "The rest cells of the last computation (drawn "
@@ -97,7 +98,9 @@ def report(obj: Any, rest: Optional[Rest]) -> None:
         return
     mask = rest.area.mask
     pts = np.column_stack([rest.area.cells_xy(), rest.stock.heights[mask]])[:: max(1, -(-mask.sum() // MAX_MARKS))]
-    obj.RestReport = rest.area.summary()
+    from tmm_workbench.core.footprint.cleanup import CleanupReport
+
+    obj.RestReport = "; ".join([rest.area.summary()] + [n.summary() for n in notes if isinstance(n, CleanupReport)])
     obj.RestRegions = [FreeCAD.Vector(*map(float, p)) for p in pts]
     FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")
 

@@ -33,11 +33,14 @@ REPORT = "CuspReport"
 
 
 def notes_for(params: Any) -> list:
-    """The list the strategy appends its reports to (empty when neither VerifyCusp nor CheckCusp runs)."""
+    """The list the strategy appends its reports to (empty when neither VerifyCusp, CheckCusp nor the pencil's
+    clean-up runs; the clean-up's report goes with the rest's: app.rest_source.report)."""
     from tmm_workbench.core.strategies.surface import cusp_check
+    from tmm_workbench.core.strategies.surface.params import PENCIL, PENCIL_CLEANUP
 
     notes: list = []
-    if params.verify_cusp or cusp_check.applies(params):
+    cleanup = params.pattern == PENCIL and params.pencil_source == PENCIL_CLEANUP
+    if params.verify_cusp or cusp_check.applies(params) or cleanup:
         params.verify_notes = notes
     return notes
 
@@ -51,10 +54,13 @@ def _report_property(obj: Any, text: str) -> None:
 
 
 def report(obj: Any, notes: list) -> None:
+    from tmm_workbench.core.footprint.cleanup import CleanupReport
     from tmm_workbench.core.strategies.surface.cusp_check import CuspCheck
 
     _report_property(obj, "")
     for note in notes:
+        if isinstance(note, CleanupReport):   # reported with the rest (app.rest_source.report)
+            continue
         if isinstance(note, CuspCheck):
             _report_property(obj, note.summary())
             if note.within or note.verified:   # (VerifyCusp warns itself)

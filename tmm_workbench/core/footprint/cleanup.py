@@ -12,7 +12,8 @@ crease whose flanks' normals differ by theta touches both flanks and leaves the 
 jump is larger, the cells between the two contacts (P1, P2 in the seed's Figure 3-31) are the strip; a kink that
 falls between two grid points is caught by the jump of the slopes two steps either side. The strip is joined with
 the rest cells (the cells the finishing tool could not reach: core.footprint.rest), and thinned into its medial
-curves (the ridges of the distance to its edge, core.footprint.pencil.valley_curves).
+curves (the ridges of the distance to its edge, core.footprint.pencil.valley_curves) with their short branches
+(into a strip's corners: a groove's sloped ends).
 
 CL points by translation. At each point of a strip curve, across it, the clean-up tool slides from the point down
 the flank it stands on (a vertical tool: the slope of its CL surface behind the point; 0 on a floor: horizontal)
@@ -23,7 +24,8 @@ without undercuts: what it adds is the place of the fold across the crease to th
 point anywhere on the approach side, instead of a grid cell's. It matters where the CL surface's fold is a cliff:
 a steep wall meeting a floor (a cell's error on the floor side leaves a sliver on the wall's foot, on the wall side
 lifts the tool off the floor by the cell times the wall's slope). In a groove symmetric about the strip curve the
-slide is nil: the vertical drop there already touches both flanks.
+slide is nil: the vertical drop there already touches both flanks; a point within a probe of such a fold is put
+at its bottom (the lowest vertical drop across it).
 """
 from __future__ import annotations
 
@@ -46,6 +48,8 @@ LIFT = 1e-3            # mm: the slide starts this far above the flank (a grazin
 ANGLE_BIN = math.radians(1.0)   # slide directions within a degree share one directional index of the mesh
 FLAT = 1e-4          # a slope below this (on either side of a strip point) is a floor: the slide goes both ways
 OFF_MODEL = 1.0        # mm below the model's lowest point: the finishing tool's drop there is off the model
+BRANCH = 3             # cells: a short medial curve this near a longer one is its branch, a shorter one a speck
+FOLD_STEPS = 30         # golden-section steps placing a point in its fold (0.618^30 of the bracket: 1e-7 mm)
 
 
 def jump_limit(cutter: Cutter, tolerance: float) -> float:
@@ -82,6 +86,10 @@ class Strips:
         return (f"clean-up strips {self.mask.sum() * a:.0f} mm2 ({self.jumps.sum() * a:.0f} mm2 by the normal jump "
                 f"> {math.degrees(self.limit):.1f} deg, {self.rest.sum() * a:.0f} mm2 of rest cells), "
                 f"{len(self.curves)} curve(s)")
+
+    def length(self) -> float:
+        """mm: the curves' total length."""
+        return sum(pencil.curve_length(c) for c in self.curves)
 
 
 def normal_jumps(z: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -151,14 +159,27 @@ def strips(mesh: TriMesh, surface: DropSurface, finishing: Cutter, grid: Grid, d
 
 
 def medial_curves(mask: np.ndarray, grid: Grid, min_length: float) -> list[np.ndarray]:
-    """The mask's medial curves: the ridges of the distance to its edge (pencil.valley_curves of its negative)."""
+    """The mask's medial curves: the ridges of the distance to its edge (pencil.valley_curves of its negative),
+    those at least `min_length` long and the shorter branches of them (a curve whose end lies within BRANCH cells
+    of a longer one): where a strip ends in a corner (the sloped end of a groove meeting its flanks), its medial
+    axis forks towards the corner in branches shorter than the tool, along the creases only they lead to."""
     if not mask.any():
         return []
     from scipy import ndimage
 
     dist = ndimage.distance_transform_edt(np.pad(mask, 1))[1:-1, 1:-1] * grid.cell
-    return pencil.valley_curves(grid.xs(), grid.ys(), -dist, 0.25 * grid.cell, min_length, within=mask,
-                                strict=True)
+    found = pencil.valley_curves(grid.xs(), grid.ys(), -dist, 0.25 * grid.cell, BRANCH * grid.cell, within=mask,
+                                 strict=True)
+    long = [c for c in found if pencil.curve_length(c) >= min_length]
+    if not long:
+        return []
+    trunk = np.vstack(long)
+    def gap(p: np.ndarray) -> float:
+        return float(np.hypot(*(trunk - p).T).min())
+
+    branches = [c for c in found if pencil.curve_length(c) < min_length
+                and min(gap(c[0]), gap(c[-1])) <= BRANCH * grid.cell]
+    return long + branches
 
 
 def _across(curve: np.ndarray) -> np.ndarray:
@@ -180,6 +201,28 @@ class Slide:
     xy: np.ndarray          # (n, 2) the CL points' XY after the slide
     moved: np.ndarray       # (n,) how far in XY each moved (0: kept)
     direction: np.ndarray   # (n, 3) the slide's unit vector (0: none)
+    folded: Optional[np.ndarray] = None   # (n,) placed at the bottom of the fold they stood within a probe of
+
+    def missed(self) -> np.ndarray:
+        """The points that found no crease: neither slid to a far flank nor placed in a fold."""
+        folded = np.zeros(len(self.xy), dtype=bool) if self.folded is None else self.folded
+        return ~folded & ~self.direction.any(axis=1)
+
+
+@dataclass
+class CleanupReport:
+    """What the clean-up found and did, for the op's report: its strips, their curves' slide, the flank passes."""
+    strips: Strips
+    slide: Slide
+    passes: int
+
+    def summary(self) -> str:
+        n, missed = len(self.slide.xy), int(self.slide.missed().sum())
+        text = (f"{self.strips.summary()} {self.strips.length():.0f} mm long; {n - missed} of {n} curve points placed in their "
+                f"crease, {self.passes} flank pass(es)")
+        if missed:
+            text += f"; {missed} found no crease within reach (cut where they stand)"
+        return text
 
 
 def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points: np.ndarray, across: np.ndarray,
@@ -187,7 +230,9 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
     """Each XY point (n, 2) moved across (its unit XY normal `across`) to where `cutter` (vertical axis), slid down
     the flank it stands on, touches the other flank (see the module): the kernel's drop along that vector, from a
     `probe` behind the point (default a twentieth of the diameter), at most `reach` mm. A point already at the
-    fold (both sides higher), a slide blocked before the point or touching nothing within reach keeps its XY."""
+    fold within a probe (both sides higher) is moved to the lowest vertical drop between its probes (_fold_bottom):
+    there a tool a few hundredths off the fold stands on one flank and is lifted off the other by that times their
+    slope. A slide blocked before the point or touching nothing within reach keeps its XY."""
     a = probe if probe is not None else 0.05 * cutter.diameter
     n = len(points)
     offs = np.array([0.0, -1.0, 1.0])
@@ -197,6 +242,7 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
     at_fold = (zm > z0 + FLAT * a) & (zp > z0 + FLAT * a)      # both sides higher: the tool is in the fold
     xy, moved, direction = points.copy(), np.full(n, np.inf), np.zeros((n, 3))
     length = _slide_length(mesh, cutter)
+    tri = Triangles(mesh)
     for s in (1.0, -1.0):   # downhill; on a floor both ways, the nearer contact kept
         todo = np.flatnonzero(~at_fold & (flat | ((zp < zm) == (s > 0))))
         behind = np.where(s > 0, zm, zp)
@@ -206,7 +252,7 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
         back = a * np.sqrt(1.0 + g * g)
         start = np.column_stack([points, z0 + LIFT]) - back[:, None] * v   # from the probe behind
         for rows in _by_direction(v, todo):
-            travel = _slide(mesh, cutter, start[rows], v[rows], back[rows] + reach, length)
+            travel = _slide(tri, cutter, start[rows], v[rows], back[rows] + reach, length)
             ok = (travel > back[rows] + 1e-9) & (travel < back[rows] + reach)
             r, t = rows[ok], travel[ok]
             to = (start[r] + t[:, None] * v[r])[:, :2]
@@ -215,7 +261,40 @@ def slide_to_crease(mesh: TriMesh, surface: DropSurface, cutter: Cutter, points:
             r, to, d = r[nearer], to[nearer], d[nearer]
             xy[r], moved[r], direction[r] = to, d, v[r]
     moved[~np.isfinite(moved)] = 0.0
-    return Slide(xy, moved, direction)
+    # each point (slid or not) in a fold within a probe: to the fold's bottom
+    z0, zm, zp = surface.drop(cutter, (xy[:, None, :] + offs[None, :, None] * a * across[:, None, :]).reshape(-1, 2),
+                              floor_z).reshape(n, 3).T
+    fold = np.flatnonzero((zm > z0 + FLAT * a) & (zp > z0 + FLAT * a))
+    t = _fold_bottom(surface, cutter, xy[fold], across[fold], a, floor_z)
+    xy[fold] += t[:, None] * across[fold]
+    moved[fold] = np.linalg.norm(xy[fold] - points[fold], axis=1)
+    folded = np.zeros(n, dtype=bool)
+    folded[fold] = True
+    return Slide(xy, moved, direction, folded)
+
+
+def _fold_bottom(surface: DropSurface, cutter: Cutter, points: np.ndarray, across: np.ndarray, a: float,
+                 floor_z: float) -> np.ndarray:
+    """Offsets t in (-a, a) along `across` of the lowest vertical drop near each point (both probes a away stand
+    higher: the fold is bracketed), by golden-section search (one drop per point and step)."""
+    lo, hi = np.full(len(points), -a), np.full(len(points), a)
+    if not len(points):
+        return lo
+    k = (math.sqrt(5.0) - 1.0) / 2.0
+
+    def z_at(t: np.ndarray) -> np.ndarray:
+        return surface.drop(cutter, points + t[:, None] * across, floor_z)
+
+    c, d = hi - k * (hi - lo), lo + k * (hi - lo)
+    zc, zd = z_at(c), z_at(d)
+    for _ in range(FOLD_STEPS):
+        left = zc <= zd                       # the bottom lies in (lo, d): d becomes hi, c the new d
+        lo, hi = np.where(left, lo, c), np.where(left, d, hi)
+        new = np.where(left, hi - k * (hi - lo), lo + k * (hi - lo))
+        z_new = z_at(new)
+        c, d, zc, zd = (np.where(left, new, d), np.where(left, c, new), np.where(left, z_new, zd),
+                        np.where(left, zc, z_new))
+    return 0.5 * (lo + hi)
 
 
 def _slide_length(mesh: TriMesh, cutter: Cutter) -> Cutter:
@@ -238,21 +317,29 @@ def _by_direction(v: np.ndarray, rows: np.ndarray) -> list[np.ndarray]:
     return [rows[keys == k] for k in np.unique(keys)]
 
 
-def _slide(mesh: TriMesh, cutter: Cutter, starts: np.ndarray, v: np.ndarray, most: np.ndarray,
+class Triangles:
+    """The mesh's triangles' corners and XY bounds, gathered once for all the slides' groups."""
+
+    def __init__(self, mesh: TriMesh) -> None:
+        self.mesh = mesh
+        self.corners = mesh.vertices[mesh.triangles]               # (m, 3, 3)
+        self.lo, self.hi = self.corners[:, :, :2].min(axis=1), self.corners[:, :, :2].max(axis=1)
+
+
+def _slide(tri: Triangles, cutter: Cutter, starts: np.ndarray, v: np.ndarray, most: np.ndarray,
            cutter_l: Cutter) -> np.ndarray:
     """Travel of each start along the group's common direction (their mean, rounded within ANGLE_BIN) until the
     tool touches; only triangles that can lie ahead of the starts take part (the kernel's drop comes from
     infinitely far behind: what lies behind the start is not in the way of a slide from it)."""
     d = v.mean(axis=0)
     d /= np.linalg.norm(d)
-    tri = mesh.vertices[mesh.triangles]                     # (m, 3, 3)
-    ahead = (tri @ d).max(axis=1) >= (starts @ d).min() - cutter.diameter
     lo = starts[:, :2].min(axis=0) - most.max() - cutter.diameter
     hi = starts[:, :2].max(axis=0) + most.max() + cutter.diameter
-    near = ((tri[:, :, :2].max(axis=1) >= lo) & (tri[:, :, :2].min(axis=1) <= hi)).all(axis=1)
-    keep = ahead & near
-    if not keep.any():
+    near = np.flatnonzero((tri.hi >= lo).all(axis=1) & (tri.lo <= hi).all(axis=1))
+    keep = near[(tri.corners[near] @ d).max(axis=1) >= (starts @ d).min() - cutter.diameter]
+    if not len(keep):
         return np.full(len(starts), np.inf)
+    mesh = tri.mesh
     part = TriMesh(mesh.vertices, mesh.triangles[keep], mesh.name)
     travel, _ = DirectionalDrop(part, d).drop(cutter_l, starts, np.array([0.0, 0.0, 1.0]), float(most.max()))
     return travel
@@ -278,25 +365,27 @@ def cleanup_curves(mesh: TriMesh, surface: DropSurface, cutter: Cutter, found: S
 def flank_passes(surface: DropSurface, cutter: Cutter, curves: list[np.ndarray], floor_z: float, step: float,
                  passes: int, inside: Optional[tuple[Grid, np.ndarray]] = None) -> list[np.ndarray]:
     """Passes up each flank of each crease curve (its points at the fold): on each side, `passes` curves whose
-    points walk out across the crease, each XY step `step` cos(a)^1.5 with tan(a) = g the slope of the CL surface
-    (the design's at the contact) the exact drop finds just ahead: the passes step sqrt(cos a) along the surface,
-    which keeps the cusp's height measured vertically (as the rest and the simulation measure it) to the planar
-    step's; close on a steep wall, wide on a floor. Cut where they leave the strip (`inside`: a grid and its mask),
+    points walk out across the crease, each XY step `step` cos(a)^1.5 with tan(a) the steepest slope of the CL
+    surface (the design's at the contact) the exact drop finds just ahead, across and along the curve: the passes
+    step at most sqrt(cos a) along the surface, which keeps the cusp's height measured vertically (as the rest and
+    the simulation measure it) to the planar step's; close on a steep wall, wide on a floor. (The slope across alone
+    under-reads a flank that falls along the curve too, as a groove's sloped end does by its branch.) Cut where they leave the strip (`inside`: a grid and its mask),
     kept as runs of two points or more; innermost first."""
     out: list[np.ndarray] = []
     if not curves or passes < 1:
         return out
     pts = np.vstack(curves)
     across = np.vstack([_across(c) for c in curves])
+    along = np.column_stack([across[:, 1], -across[:, 0]])
     ends = np.cumsum([len(c) for c in curves])[:-1]
     a = 0.05 * cutter.diameter
     for side in (1.0, -1.0):
         pos, alive = pts.copy(), np.ones(len(pts), dtype=bool)
         for _ in range(passes):
-            probes = np.vstack([pos, pos + side * a * across])
-            z = surface.drop(cutter, probes, floor_z).reshape(2, -1)
-            g = (z[1] - z[0]) / a
-            pos = pos + side * (step * (1.0 + g * g) ** -0.75)[:, None] * across
+            probes = np.vstack([pos, pos + side * a * across, pos + a * along])
+            z = surface.drop(cutter, probes, floor_z).reshape(3, -1)
+            slope2 = ((z[1] - z[0]) ** 2 + (z[2] - z[0]) ** 2) / (a * a)   # the steepest slope's, squared
+            pos = pos + side * (step * (1.0 + slope2) ** -0.75)[:, None] * across
             if inside is not None:
                 alive &= _in_mask(pos, *inside)
             for c, ok in zip(np.split(pos, ends), np.split(alive, ends)):

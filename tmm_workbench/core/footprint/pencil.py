@@ -128,7 +128,7 @@ def valley_curves(xs: np.ndarray, ys: np.ndarray, z: np.ndarray, depth: float, m
     if within is not None:
         valley &= within
     curves = _joined([np.column_stack([xs[c[:, 1]], ys[c[:, 0]]]) for c in _chains(valley)], 2.5 * cell)
-    return [c for c in (_smoothed(c) for c in curves) if _length(c) >= min_length]
+    return [c for c in (_smoothed(c) for c in curves) if curve_length(c) >= min_length]
 
 
 def neighbours(z: np.ndarray, reach: int = 1):
@@ -228,7 +228,7 @@ def _smoothed(c: np.ndarray) -> np.ndarray:
     return np.column_stack([np.convolve(padded[:, 0], k, "valid"), np.convolve(padded[:, 1], k, "valid")])
 
 
-def _length(c: np.ndarray) -> float:
+def curve_length(c: np.ndarray) -> float:
     return float(np.hypot(*np.diff(c, axis=0).T).sum()) if len(c) > 1 else 0.0
 
 

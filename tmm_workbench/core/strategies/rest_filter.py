@@ -33,7 +33,9 @@ def _offsets(grid: Grid, reach: float) -> np.ndarray:
     """(k, 2) cell offsets (di, dj) whose centres may lie within `reach` of a point in the middle cell."""
     n = int(math.ceil(reach / grid.cell)) + 1
     d = np.arange(-n, n + 1)
-    return np.array(np.meshgrid(d, d)).reshape(2, -1).T
+    square = np.array(np.meshgrid(d, d)).reshape(2, -1).T
+    nearest = np.maximum(np.abs(square) - 0.5, 0.0) * grid.cell   # the point anywhere in the middle cell
+    return square[np.hypot(*nearest.T) <= reach]
 
 
 def cutting(tips: np.ndarray, cutter: Cutter, rest: RestStock) -> np.ndarray:

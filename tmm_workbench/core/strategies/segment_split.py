@@ -40,6 +40,8 @@ def keep_runs(seg: CutSegment, ok_tip: np.ndarray, ok_move: np.ndarray, joined: 
 def move_samples(seg: CutSegment, step: float) -> tuple[np.ndarray, np.ndarray]:
     """(points, move): the segment's tips with samples at most `step` apart along each move (arcs by their
     chords), each point's move (the tip it ends at; a tip is its own move's end)."""
+    if seg.arcs is None or all(a is None for a in seg.arcs[1:]):
+        return _line_samples(seg.tips, step)
     pts, move = [seg.tips[:1]], [np.zeros(1, dtype=np.int64)]
     for i in range(1, len(seg)):
         a, b = seg.tips[i - 1], seg.tips[i]
@@ -52,3 +54,14 @@ def move_samples(seg: CutSegment, step: float) -> tuple[np.ndarray, np.ndarray]:
         pts.append(chord)
         move.append(np.full(len(chord), i, dtype=np.int64))
     return np.vstack(pts), np.concatenate(move)
+
+
+def _line_samples(tips: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """move_samples of a segment of lines, all moves at once."""
+    a, b = tips[:-1], tips[1:]
+    n = np.maximum(1, np.ceil(np.hypot(*(b[:, :2] - a[:, :2]).T) / step).astype(np.int64))
+    move = np.repeat(np.arange(1, len(tips), dtype=np.int64), n)
+    k = np.arange(len(move)) - np.repeat(np.cumsum(n) - n, n) + 1          # 1 .. n within each move
+    f = (k / n[move - 1])[:, None]
+    return (np.vstack([tips[:1], a[move - 1] + f * (b - a)[move - 1]]),
+            np.concatenate([np.zeros(1, dtype=np.int64), move]))

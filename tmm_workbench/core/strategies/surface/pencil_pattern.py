@@ -65,7 +65,8 @@ def cleanup_passes(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: 
     """Seed 000's clean-up (core.footprint.cleanup): the strips the finishing tool (params.cleanup_reference) left,
     by its normal jumps joined with the rest cells (params.rest), on the rest's grid (else one of the crease cell
     over the boundary); their curves with each point slid to its crease, and passes up both flanks `step` apart
-    along the surface (PencilPasses - 1 each side; 0: to the strip's edge, at most 50)."""
+    along the surface (PencilPasses - 1 each side; 0: to the strip's edge, at most 50). What it found is appended
+    to params.verify_notes when given (a cleanup.CleanupReport)."""
     from tmm_workbench.core.footprint import cleanup
     from tmm_workbench.core.sim.grid import Grid
     from tmm_workbench.core.sim.stock import mesh_heights
@@ -78,13 +79,16 @@ def cleanup_passes(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: 
     tolerance = params.cusp if rest is None else rest.tolerance / LEAST_CUT
     found = cleanup.strips(mesh, surface, finishing, grid, mesh_heights(mesh, grid), cells, tolerance,
                            cutter.diameter)
-    curves, _ = cleanup.cleanup_curves(mesh, surface, cutter, found, floor_z, finishing.diameter,
-                                       crease_cell(params))
+    curves, slide = cleanup.cleanup_curves(mesh, surface, cutter, found, floor_z, finishing.diameter,
+                                           crease_cell(params))
     sides = params.pencil_passes - 1 if params.pencil_passes else 50
     from scipy import ndimage
 
     near = ndimage.binary_dilation(found.mask, iterations=2)   # a pass ends a little past the strip's edge
-    return curves + cleanup.flank_passes(surface, cutter, curves, floor_z, step, sides, (grid, near))
+    flanks = cleanup.flank_passes(surface, cutter, curves, floor_z, step, sides, (grid, near))
+    if params.verify_notes is not None:   # the op's report (app.rest_source)
+        params.verify_notes.append(cleanup.CleanupReport(found, slide, len(flanks)))
+    return curves + flanks
 
 
 def _is_closed(c: np.ndarray) -> bool:
@@ -106,13 +110,20 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceP
 
 def _nearest_first(pieces: list[np.ndarray]) -> list[np.ndarray]:
     """Each next piece the one whose nearer end is nearest the last end (turned to start there)."""
-    pool, out = list(pieces), []
-    at = np.array([-math.inf, -math.inf])
-    while pool:
-        d = [min(np.hypot(*(p[0] - at)), np.hypot(*(p[-1] - at))) if np.isfinite(at).all() else 0.0 for p in pool]
-        p = pool.pop(int(np.argmin(d)))
-        if np.isfinite(at).all() and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
+    if not pieces:
+        return []
+    heads = np.array([p[0] for p in pieces], dtype=float)
+    tails = np.array([p[-1] for p in pieces], dtype=float)
+    left = np.ones(len(pieces), dtype=bool)
+    out, k, at = [], 0, heads[0]             # the first piece as it comes
+    while True:
+        left[k] = False
+        p = pieces[k]
+        if out and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
             p = p[::-1]
         out.append(p)
+        if not left.any():
+            return out
         at = p[-1]
-    return out
+        d = np.minimum(np.hypot(*(heads - at).T), np.hypot(*(tails - at).T))
+        k = int(np.argmin(np.where(left, d, np.inf)))
