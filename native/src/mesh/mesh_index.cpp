@@ -180,7 +180,7 @@ struct MeshIndex::BuildState {
 MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const Triangles>& F, int threads,
                      const std::function<bool(double)>& progress) {
   const Eigen::Index nv = V.rows(), nt = F.rows();
-  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: all hardware threads), got " + std::to_string(threads));
+  if (threads < 0) throw std::invalid_argument("threads must be >= 0 (0: the default, TMM_THREADS or all hardware threads), got " + std::to_string(threads));
   if (nt == 0) throw std::invalid_argument("the mesh has no triangles");
   if (nt > (int64_t{1} << 30)) throw std::invalid_argument("the mesh has too many triangles");
   SerialProgress reporter(progress);
@@ -220,7 +220,7 @@ MeshIndex::MeshIndex(const Eigen::Ref<const Vertices>& V, const Eigen::Ref<const
     reporter.step(n, node_count);
     nodes_.resize(std::min(node_count, n + (std::size_t(1) << 18)));
   }
-  if (threads == 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  if (threads == 0) threads = default_threads();
   reporter.part(0.87, 1.0);
   BuildState state{reporter, count};
   build(0, 1, 0, count, threads, state, true);

@@ -154,8 +154,7 @@ void run_levels(const MeshIndex& index, const Cutter& cutter, const Grid& g, con
   BatchOptions level_batch{batch.threads, {}};
   if (batch.progress)
     level_batch.progress = [&](double f) { return batch.progress(grid_share + f * (1.0 - grid_share)); };
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t threads = batch.threads > 0 ? static_cast<std::size_t>(batch.threads) : hardware;
+  const std::size_t threads = static_cast<std::size_t>(batch.threads > 0 ? batch.threads : default_threads());
   if (zs.size() < threads) {
     for (std::size_t k = 0; k < zs.size(); ++k) {
       BatchOptions inner{batch.threads, {}};

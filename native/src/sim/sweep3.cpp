@@ -153,8 +153,7 @@ SimReport cut_3axis(ZMap& stock, const Cutter& cutter, const double* tips, const
   check_inputs(stock, tips, kinds, n);
 
   const std::size_t ny = stock.ny();
-  const int threads = batch.threads > 0 ? batch.threads
-                                        : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = batch.threads > 0 ? batch.threads : default_threads();
   std::size_t band_rows = options.band_rows;
   if (band_rows == 0) band_rows = std::max<std::size_t>(8, (ny + 8 * threads - 1) / (8 * threads));
   // With the body check a band also replays the moves whose bodies reach it (a move that misses the band's

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <condition_variable>
 #include <exception>
 #include <memory>
@@ -94,14 +95,22 @@ bool report(Batch& b, const std::function<bool(double)>& progress) {
 
 }  // namespace
 
+int default_threads() {
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const char* named = std::getenv("TMM_THREADS");
+  if (named == nullptr) return hardware;
+  char* end = nullptr;
+  const long n = std::strtol(named, &end, 10);
+  return (end != named && *end == '\0' && n >= 1) ? static_cast<int>(std::min<long>(n, hardware)) : hardware;
+}
+
 void parallel_chunks(std::size_t n, std::size_t chunk, const BatchOptions& options,
                      const std::function<void(std::size_t, std::size_t, ChunkContext&)>& work) {
   Batch b;
   b.n = n;
   b.chunk = std::max<std::size_t>(chunk, 1);
   b.chunks = (n + b.chunk - 1) / b.chunk;
-  const int threads = options.threads > 0 ? options.threads
-                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0 ? options.threads : default_threads();
   b.threads = static_cast<int>(std::min<std::size_t>(threads, std::max<std::size_t>(b.chunks, 1)));
   b.partial = std::make_unique<std::atomic<double>[]>(static_cast<std::size_t>(b.threads));
   for (int t = 0; t < b.threads; ++t) b.partial[static_cast<std::size_t>(t)].store(0.0);

@@ -40,7 +40,7 @@ struct BvhNode {
 
 class MeshIndex {
  public:
-  // threads: at most this many threads build the tree (0: all hardware threads; subtrees of more than
+  // threads: at most this many threads build the tree (0: default_threads(); subtrees of more than
   // kParallelBuild triangles are split between threads, so small meshes build on one). The tree does not
   // depend on it. Throws std::invalid_argument on out-of-range indices, non-finite coordinates, an empty
   // mesh or threads < 0. progress(fraction) is called now and then from the calling thread

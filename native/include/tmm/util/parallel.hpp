@@ -18,8 +18,12 @@ class Cancelled : public std::runtime_error {
 
 class ChunkContext;
 
+// The threads a batch takes when its caller names none: TMM_THREADS when set to a whole number from 1 up (a batch
+// worker given one core of a shared machine), else every hardware thread.
+int default_threads();
+
 struct BatchOptions {
-  int threads = 0;  // 0: all hardware threads
+  int threads = 0;  // 0: default_threads()
   // Called now and then from the calling thread with the fraction done; return false to cancel. An
   // exception thrown by it (a Python KeyboardInterrupt) stops the batch and propagates.
   std::function<bool(double)> progress;
