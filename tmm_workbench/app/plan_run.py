@@ -1,0 +1,116 @@
+"""The FreeCAD side of the automatic planner: runs a plan made by core.plan (its ops as headless API calls, in
+one Job), posts the whole Job, simulates it and writes what the simulation found. Started by core.plan.launch as
+
+    TMM_PLAN_FILE=<folder>/plan.json freecadcmd tmm_workbench/app/plan_run.py
+
+Everything goes to the plan file's folder (the launcher moves it into place when complete): <name>.FCStd,
+<name>.ngc, <name>_sim.png and verify.json. freecadcmd returns 0 even when a script raises, so the outcome is an
+explicit exit code: 0 the plan ran (verify.json says whether it passed), 3 it failed (the reason on stderr).
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Any
+
+REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
+TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
+FAILED = 3
+
+
+def run_ops(plan: dict, folder: Path) -> list:
+    """The plan's ops in order, the first making the Job around the model and its stock, the others added."""
+    from tmm_workbench.app import api
+
+    calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
+    results: list = []
+    for op in plan["ops"]:
+        kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
+        call = calls[op["api"]]
+        if results:
+            r = call(None, job=results[0], progress=False, **kwargs)
+        else:
+            r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
+        r.op.Label = op["label"]
+        results.append(r)
+    return results
+
+
+def op_rows(results: list, sim: Any) -> list:
+    rows = []
+    for r, s in zip(results, sim.ops):
+        rows.append({"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
+                     "rapids_through_stock": len(s.collisions),
+                     "holder": None if s.holder is None else s.holder.summary()})
+    return rows
+
+
+def verify(results: list, plan: dict, folder: Path) -> dict:
+    from tmm_workbench.app.api import simulate
+
+    png = folder / f"{plan['name']}_sim.png" if plan["heat_map"] else None
+    sim = simulate(results[0].job, cell=plan["sim_cell"], tolerance=plan["tolerance"], png_path=png,
+                   progress=False)
+    problems = []
+    if sim.gouged:
+        problems.append(f"gouged {-sim.min_deviation:.4f} mm below the model (tolerance {plan['tolerance']:g} mm)")
+    if sim.collisions:
+        problems.append(f"{len(sim.collisions)} rapids through stock")
+    problems += [f"{label}: {check.summary()}" for label, check in sim.holder_collisions]
+    problems += [f"{label}: {found.summary()}" for label, found in sim.stock_collisions]
+    return {"passed": not problems, "problems": problems,
+            "deepest_gouge_mm": round(max(0.0, -sim.min_deviation), 4),
+            "most_material_left_mm": round(sim.max_left, 4),
+            "left_percentiles_mm": {str(k): round(v, 4) for k, v in sorted(sim.percentiles.items())},
+            "removed_volume_mm3": round(sim.removed_volume, 1), "remaining_volume_mm3": round(sim.remaining_volume, 1),
+            "cycle_seconds": round(sim.cycle_seconds, 1), "ops": op_rows(results, sim.simulation),
+            "sim_cell_mm": plan["sim_cell"], "tolerance_mm": plan["tolerance"],
+            "regions": rounded(dict(sorted(sim.regions.items())))}
+
+
+def rounded(value: Any) -> Any:
+    """Floats to 4 decimals through dicts and lists (the report's numbers, byte-stable)."""
+    if isinstance(value, float):
+        return round(value, 4)
+    if isinstance(value, dict):
+        return {str(k): rounded(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [rounded(v) for v in value]
+    return value
+
+
+def main() -> int:
+    sys.path.insert(0, str(REPO))
+    plan_file = Path(os.environ["TMM_PLAN_FILE"])
+    folder = plan_file.parent
+    plan = json.loads(plan_file.read_text())
+    from tmm_workbench.app import posts
+
+    results = run_ops(plan, folder)
+    job = results[0].job
+    if plan["gcode"]:
+        objects = [o for r in results for o in (r.op.ToolController, r.op)]
+        posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc")
+    report = verify(results, plan, folder)
+    if plan["fcstd"]:
+        job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
+    (folder / "verify.json").write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
+    return 0
+
+
+def _entry() -> None:
+    try:
+        code = main()
+    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
+        traceback.print_exc()
+        code = FAILED
+    sys.stdout.flush()
+    sys.stderr.flush()
+    raise SystemExit(code)
+
+
+if __name__ in ("__main__", "plan_run"):
+    _entry()
