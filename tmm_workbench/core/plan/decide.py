@@ -29,7 +29,7 @@ ROUGH_LEAVE = 0.3          # mm left by roughing for the finishing tool (radial 
 TRANSITION_DEG = 45.0      # shallow / steep split without a comparison saying otherwise
 TRANSITION_RANGE = (30.0, 60.0)
 MIN_SHARE = 0.005          # of the design cells: a slope class smaller than this gets no op of its own
-MIN_STEPOVER = 0.02        # mm: a finish needing a finer step-over than this is refused as too tight
+MIN_STEPOVER = 0.05        # mm: a finish needing a finer step-over than this is refused as too tight
 MAX_COMPARED = 4           # radiused tools compared (the largest first)
 ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
 
