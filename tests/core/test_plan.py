@@ -185,6 +185,10 @@ def test_decisions_beet(tmp_path: Path) -> None:
     dz = steep.kwargs["step_down"]
     assert plane_cusp(Cutter.ball(6.0), dz / math.tan(math.radians(transition)), transition) <= 0.1 + 1e-6
     assert plane_cusp(Cutter.ball(6.0), (dz + 0.01) / math.tan(math.radians(transition)), transition) > 0.1
+    library = job_from_dict(data, tmp_path / "job.yaml").tools
+    cutter = decide.cutter_of(next(t for t in library if t.name == shallow.tool))
+    step = shallow.kwargs["stepover"]
+    assert plane_cusp(cutter, step, transition) <= 0.1 + 1e-6 < plane_cusp(cutter, step + 0.01, transition)
     # every decision has its reason; the feeds are the material table's
     assert all(d.reason for d in plan.decisions)
     assert plan.cutting["T2 ball D6"]["rpm"] == round(materials.cutting("modelling_foam", 6, 2, 24000, 5000).rpm)

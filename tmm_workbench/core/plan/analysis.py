@@ -17,7 +17,6 @@ from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
-from tmm_workbench.core.tools.cutter import Cutter
 
 SLOPE_EDGES = (0.0, 1.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)   # degrees from the horizontal
 FLAT_DEG = 1.0           # a face sloping less is a flat (a floor, a plateau)

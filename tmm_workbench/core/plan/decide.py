@@ -204,13 +204,17 @@ def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, ste
     common = {"post": job.machine.post}
     if 1.0 - steep_share >= MIN_SHARE:
         sample = round(min(0.5, max(0.1, shallow.diameter / 20.0)), 3)
+        # the steepest slope the raster cuts sets its step-over (the op's own cusp mode measures the crossings
+        # of the whole surface: 40x slower on beet_mm, and its curvature term is not needed on a planned split)
+        step = math.floor(stepover_for_cusp(cutter_of(shallow), cusp, transition) * 1000) / 1000
         kwargs = api_tool(shallow) | feeds(plan, job, shallow) | common | {
-            "stepover_mode": "cusp", "cusp": cusp, "sample_step": sample, "slope_range": [0.0, transition],
+            "stepover": step, "sample_step": sample, "slope_range": [0.0, transition],
             "chord_tolerance": round(min(0.01, tol / 2), 4)}
         plan.ops.append(OpPlan("run_surface", f"Finish shallow {shallow.name}", shallow.name, kwargs))
-        plan.decide("shallow finishing", f"cusp-driven raster 0-{transition:g} deg, cusp {cusp:g} mm",
+        plan.decide("shallow finishing", f"raster 0-{transition:g} deg, step-over {step:g} mm",
                     f"{(1 - steep_share) * 100:.0f} % of the model seen from above slopes less than "
-                    f"{transition:g} deg: a raster's step-over is set by the cusp there")
+                    f"{transition:g} deg; the step-over keeps the cusp {cusp:g} mm on a {transition:g} deg plane "
+                    f"across the passes, the steepest the raster cuts")
     else:
         plan.decide("shallow finishing", "none", f"less than {MIN_SHARE * 100:g} % of the model is shallow")
     if steep_share >= MIN_SHARE:

@@ -1,0 +1,58 @@
+"""The automatic planner's FreeCAD side (app/plan_run.py) on the plan core.plan makes for tests/data/plan_beet.yaml
+(beet_mm.stl, coarse values): one Job with the planned ops, their tool controllers and feeds, the whole Job posted
+(every tool's change in the G-code), simulated and verified (no gouge below the tolerance, no rapid through stock),
+the document saved and reopened with its ops recomputing after a changed value."""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+
+import FreeCAD
+
+from fc_helpers import OUT, FreeCADTestCase, close_all, parse_gcode
+from tmm_workbench.app import plan_run
+from tmm_workbench.core.plan import launch
+from tmm_workbench.core.plan.job_file import read_job
+
+JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
+
+
+class PlanBeet(FreeCADTestCase):
+    def test_plan_runs_verified(self) -> None:
+        job = read_job(JOB)
+        _, moved, an, plan = launch.make_plan(job)
+        self.assertFalse(moved)
+        folder = OUT / "plan_beet"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = launch.plan_document(job, plan, job.model.file)
+        (folder / "plan.json").write_text(json.dumps(doc))
+        os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
+        self.assertEqual(plan_run.main(), 0)
+        verified = json.loads((folder / "verify.json").read_text())
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertLess(verified["deepest_gouge_mm"], job.finish.tolerance)
+        self.assertEqual([o["label"] for o in verified["ops"]], [o.label for o in plan.ops])
+        self.assertTrue(all(o["moves"] > 0 and o["cycle_seconds"] > 0 for o in verified["ops"]))
+        self.assertAlmostEqual(verified["cycle_seconds"], sum(o["cycle_seconds"] for o in verified["ops"]), delta=0.2)
+        self.assertGreater(verified["removed_volume_mm3"], 0)
+        # the whole Job in one G-code file: each planned tool's change and spindle speed, feeds from the table
+        gcode = (folder / "beet_mm.ngc").read_text()
+        for number, op in enumerate(plan.ops, 1):
+            self.assertIn(f"M6 T{number}", gcode)
+            self.assertIn(f"S{op.kwargs['spindle_speed']}", gcode.replace(".0000", "").replace(".000", ""))
+        feeds = {f for *_, f in parse_gcode(gcode) if f is not None}
+        self.assertIn(plan.ops[0].kwargs["horiz_feed"], feeds)
+        self.assertTrue((folder / "beet_mm_sim.png").stat().st_size > 10_000)
+        close_all()
+        # an ordinary Job: opened again, a value changed, recomputed
+        reopened = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
+        ops = {o.Label: o for o in reopened.Objects if o.Label in {p.label for p in plan.ops}}
+        self.assertEqual(sorted(ops), sorted(p.label for p in plan.ops))
+        steep = ops[plan.ops[-1].label]
+        self.assertAlmostEqual(float(steep.StepDown), plan.ops[-1].kwargs["step_down"], places=6)
+        before = len(steep.Path.Commands)
+        steep.StepDown = 2 * float(steep.StepDown)
+        reopened.recompute()
+        self.assertTrue(steep.isValid(), steep.getStatusString())
+        self.assertLess(len(steep.Path.Commands), before)
