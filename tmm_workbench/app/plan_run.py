@@ -27,6 +27,7 @@ def run_ops(plan: dict, folder: Path) -> list:
 
     calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
     results: list = []
+    controllers: dict = {}
     for op in plan["ops"]:
         kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
         call = calls[op["api"]]
@@ -35,8 +36,28 @@ def run_ops(plan: dict, folder: Path) -> list:
         else:
             r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
         r.op.Label = op["label"]
+        share_tool_controller(r.op, op["tool"], controllers)
         results.append(r)
+    results[0].doc.recompute()   # the ops given an earlier tool controller
     return results
+
+
+def share_tool_controller(op: Any, tool: str, controllers: dict) -> None:
+    """One tool controller per library tool: an op of a tool already used takes that tool's controller (the same
+    feeds: they are the tool's) and the one the API made for it is removed, so the G-code changes tools only
+    when the tool changes. The kept controller and its ToolBit are named after the library's tool."""
+    from tmm_workbench.app import compat
+
+    made = op.ToolController
+    if tool not in controllers:
+        made.Label = f"TC: {tool}"
+        made.Tool.Label = tool
+        controllers[tool] = made
+        return
+    op.ToolController = controllers[tool]
+    bit = made.Tool
+    op.Document.removeObject(made.Name)
+    compat.remove_toolbit(bit)
 
 
 def op_rows(results: list, sim: Any) -> list:
@@ -92,8 +113,12 @@ def main() -> int:
     results = run_ops(plan, folder)
     job = results[0].job
     if plan["gcode"]:
-        objects = [o for r in results for o in (r.op.ToolController, r.op)]
-        posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc")
+        objects = []
+        for r in results:   # a tool controller where its tool comes in (once per tool)
+            objects += [r.op] if r.op.ToolController in objects else [r.op.ToolController, r.op]
+        # without the header's export time: the same plan gives the same G-code, byte for byte
+        args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
+        posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
     report = verify(results, plan, folder)
     if plan["fcstd"]:
         job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
