@@ -98,7 +98,10 @@ def run_job(tmp_path: Path, data: dict, freecad: str = "freecadcmd-not-needed") 
     (lambda d: d.update(tools=[d["tools"][0]]), ["tools", "no ball or bull-nose"]),
     (lambda d: d["finish"].update(cusp=0.0001), ["finish.cusp", "0.0001", "tighter than"]),
     (lambda d: d["tools"][1].update(diameter="six"), ["tools[1].diameter", "'six'"]),
-], ids=["travels", "depth", "no radiused", "cusp too tight", "diameter text"])
+    (lambda d: [t.update(flute_length=6) for t in d["tools"][1:]], ["no ball or bull-nose tool reaches the model's "
+                                                                    "height 7.2 mm", "6 mm"]),
+    (lambda d: d.update(tools="missing_tools.yaml"), ["tools file not found", "missing_tools.yaml"]),
+], ids=["travels", "depth", "no radiused", "cusp too tight", "diameter text", "radiused too short", "tools file"])
 def test_bad_input_exit_2_nothing_written(tmp_path: Path, capsys, change, words) -> None:
     data = good(tmp_path)
     data["planner"]["compare_cutters"] = False
@@ -253,3 +256,21 @@ def test_launcher_failed_run_writes_nothing(tmp_path: Path, capsys) -> None:
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".beet_mm.")]
     assert run_job(tmp_path, copy.deepcopy(data), str(tmp_path / "no_such_freecadcmd")) == launch.FAILED
     assert "could not start" in capsys.readouterr().err
+
+
+def test_tools_file_and_candidates(tmp_path: Path) -> None:
+    data = good(tmp_path)
+    library = data["tools"] + [{"name": "T4 ball D2", "type": "ball", "diameter": 2, "flute_length": 10},
+                               {"name": "T5 ball D4 short", "type": "ball", "diameter": 4, "flute_length": 5}]
+    (tmp_path / "shop.yaml").write_text(yaml.safe_dump({"tools": library}))
+    data["tools"] = "shop.yaml"
+    _, _, an, plan = plan_of(tmp_path, data)
+    d = {x.topic: x for x in plan.decisions}
+    # the D2 is smaller than the largest ball (kept for the rest); the short D4 does not reach the 7.2 mm height
+    assert d["finishing candidates"].choice == "T2 ball D6, T3 bull D6 r1"
+    assert d["finishing candidates"].reason.endswith("left for the rest: T4 ball D2")
+    assert d["tools left out"].choice == "T5 ball D4 short (5 mm)"
+    assert "T5 ball D4 short" not in {o.tool for o in plan.ops}
+    (tmp_path / "shop.yaml").write_text(yaml.safe_dump(library))
+    with pytest.raises(PlanInputError, match="tools file shop.yaml: got .*one field, tools"):
+        job_from_dict(data, tmp_path / "job.yaml")

@@ -161,9 +161,41 @@ def transition_from(comparison: Any, winner: str, ball: str) -> Optional[float]:
     return None
 
 
+def reaching(plan: Plan, an: Analysis, radiused: list) -> list:
+    """The radiused tools that reach the model's lowest point from its top (the finishing and rest tools)."""
+    height = an.size[2]
+    out = [t for t in radiused if reach_length(t) >= height]
+    if not out:
+        longest = max(radiused, key=reach_length)
+        raise PlanInputError(f"tools: no ball or bull-nose tool reaches the model's height {height:.1f} mm; the "
+                             f"longest, {longest.name}, reaches {reach_length(longest):g} mm")
+    short = [f"{t.name} ({reach_length(t):g} mm)" for t in radiused if t not in out]
+    if short:
+        plan.decide("tools left out", ", ".join(short), f"they do not reach the model's {height:.1f} mm height "
+                    "(stick-out from the holder, else the flute length)")
+    return out
+
+
+def finishing_candidates(plan: Plan, an: Analysis, radiused: list) -> list:
+    """The tools fit to finish: wide at most ROUGH_WIDTH_SHARE of the model's narrower side (the smallest
+    otherwise) and at least as wide as the largest such ball: a smaller tool would finish the whole part at its
+    small step-over for details the rest op takes with it (seed 003 compares cutters of one size class)."""
+    narrow = min(an.size[0], an.size[1])
+    fitting = [t for t in radiused if t.diameter <= ROUGH_WIDTH_SHARE * narrow] or \
+        [min(radiused, key=lambda t: (t.diameter, radiused.index(t)))]
+    ball = largest_ball(fitting)
+    chosen = [t for t in fitting if t.diameter >= ball.diameter]
+    left_out = [t.name for t in radiused if t not in chosen]
+    plan.decide("finishing candidates", ", ".join(t.name for t in chosen),
+                f"radiused tools reaching the model's {an.size[2]:.1f} mm height, at most "
+                f"{ROUGH_WIDTH_SHARE:g} x its narrower side ({narrow:.1f} mm) and at least as wide as the largest "
+                f"ball {ball.name}" + (f"; left for the rest: {', '.join(left_out)}" if left_out else ""))
+    return chosen
+
+
 def choose_finishing(plan: Plan, job: JobSpec, an: Analysis, mesh: TriMesh, radiused: list,
                      compare: Any) -> tuple[ToolSpec, ToolSpec, float]:
-    """(shallow raster tool, steep waterline tool, transition slope deg)."""
+    """(shallow raster tool, steep waterline tool, transition slope deg) among `radiused`, the candidates."""
     ball = largest_ball(radiused)
     cusp = job.finish.cusp
     step = stepover_for_cusp(cutter_of(ball), cusp)
@@ -175,7 +207,7 @@ def choose_finishing(plan: Plan, job: JobSpec, an: Analysis, mesh: TriMesh, radi
                 "slopes; the largest ball of the library")
     candidates = sorted(radiused, key=lambda t: (-t.diameter, -t.corner_radius, radiused.index(t)))[:MAX_COMPARED]
     if compare is None or len(candidates) < 2:
-        why = "the comparison is off in the job file" if compare is None else "the library has one radiused tool"
+        why = "the comparison is off in the job file" if compare is None else "one finishing candidate"
         plan.decide("shallow finishing tool", ball.describe(), f"{why}: the steep areas' ball")
         plan.decide("transition slope", f"{TRANSITION_DEG:g} deg", "the default split (no comparison)")
         return ball, ball, TRANSITION_DEG
@@ -268,7 +300,9 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> 
                 f"slope shares {an.slope_area}, flat {an.flat_share * 100:.0f} %, facing down "
                 f"{an.down_share * 100:.1f} % (never reached from above)")
     choose_roughing(plan, job, an)
-    shallow, steep, transition = choose_finishing(plan, job, an, mesh, radiused, compare)
+    radiused = reaching(plan, an, radiused)
+    shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
+                                                  compare)
     finishing_ops(plan, job, an, shallow, steep, transition)
     rest_op(plan, job, an, [shallow, steep], radiused)
     return plan

@@ -273,8 +273,11 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
     if data["format"] != FORMAT:
         raise _fail("format", data["format"], f"'{FORMAT}'")
     tools = data["tools"]
+    if isinstance(tools, str):   # a library file shared by several jobs
+        tools = _library_file(base / tools)
     if not isinstance(tools, list) or not tools:
-        raise _fail("tools", tools, "a non-empty list of tools (type, diameter, flute_length, ...)")
+        raise _fail("tools", tools, "a non-empty list of tools (type, diameter, flute_length, ...) or the name "
+                    "of a YAML / JSON file holding one")
     library = tuple(_tool(i, t) for i, t in enumerate(tools))
     names = [t.name for t in library]
     for i, n in enumerate(names):
@@ -287,23 +290,34 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
                    _planner(data.get("planner", {})))
 
 
+def _parsed(p: Path, what: str) -> Any:
+    """The YAML or JSON data of file `p` (by its suffix); PlanInputError naming `what` when it cannot be read."""
+    if not p.is_file():
+        raise PlanInputError(f"{what} not found: {p}")
+    text = p.read_text(encoding="utf-8")
+    suffix = p.suffix.lower()
+    if suffix not in (".json", ".yaml", ".yml"):
+        raise PlanInputError(f"{what} {p.name}: the name must end in .yaml, .yml or .json")
+    try:
+        if suffix == ".json":
+            return json.loads(text)
+        import yaml
+
+        return yaml.safe_load(text)
+    except Exception as exc:  # noqa: BLE001 - json's ValueError, yaml.YAMLError (no common base)
+        raise PlanInputError(f"{what} {p}: not readable as {'JSON' if suffix == '.json' else 'YAML'}: "
+                             f"{exc}") from None
+
+
+def _library_file(p: Path) -> Any:
+    data = _parsed(p, "tools file")
+    if isinstance(data, dict) and set(data) == {"tools"}:
+        return data["tools"]
+    raise _fail(f"tools file {p.name}", data if not isinstance(data, dict) else sorted(data),
+                "a mapping with one field, tools: the list of tools")
+
+
 def read_job(path: Union[str, Path]) -> JobSpec:
     """The job file at `path` (.yaml / .yml / .json), checked."""
     p = Path(path)
-    if not p.is_file():
-        raise PlanInputError(f"job file not found: {p}")
-    text = p.read_text(encoding="utf-8")
-    try:
-        if p.suffix.lower() == ".json":
-            data = json.loads(text)
-        elif p.suffix.lower() in (".yaml", ".yml"):
-            import yaml
-
-            data = yaml.safe_load(text)
-        else:
-            raise PlanInputError(f"job file {p.name}: the name must end in .yaml, .yml or .json")
-    except (ValueError, ImportError) as exc:  # json.JSONDecodeError and yaml.YAMLError's parse errors
-        raise PlanInputError(f"job file {p}: not readable as {p.suffix[1:].upper()}: {exc}") from None
-    except Exception as exc:  # noqa: BLE001 - yaml.YAMLError has no common base with ValueError
-        raise PlanInputError(f"job file {p}: not readable as YAML: {exc}") from None
-    return job_from_dict(data, p)
+    return job_from_dict(_parsed(p, "job file"), p)
