@@ -86,6 +86,13 @@ def test_bad_field_named(tmp_path: Path, change, words) -> None:
         assert w in text, (w, text)
 
 
+def short(tool: dict, flutes: float) -> None:
+    """The tool reaching `flutes` mm: its flute length, no holder."""
+    tool.update(flute_length=flutes)
+    tool.pop("holder", None)
+    tool.pop("stick_out", None)
+
+
 def run_job(tmp_path: Path, data: dict, freecad: str = "freecadcmd-not-needed") -> int:
     path = tmp_path / "job.yaml"
     path.write_text(yaml.safe_dump(data))
@@ -94,12 +101,12 @@ def run_job(tmp_path: Path, data: dict, freecad: str = "freecadcmd-not-needed") 
 
 @pytest.mark.parametrize("change, words", [
     (lambda d: d["machine"].update(travels=[20, 200, 100]), ["machine.travels", "in x", "20 mm travel"]),
-    (lambda d: [t.update(flute_length=5) for t in d["tools"]], ["tools", "reaches the roughing depth", "5 mm"]),
+    (lambda d: [short(t, 5) for t in d["tools"]], ["tools", "reaches the roughing depth", "5 mm"]),
     (lambda d: d.update(tools=[d["tools"][0]]), ["tools", "no ball or bull-nose"]),
     (lambda d: d["finish"].update(cusp=0.0001), ["finish.cusp", "0.0001", "tighter than"]),
     (lambda d: d["tools"][1].update(diameter="six"), ["tools[1].diameter", "'six'"]),
-    (lambda d: [t.update(flute_length=6) for t in d["tools"][1:]], ["no ball or bull-nose tool reaches the model's "
-                                                                    "height 7.2 mm", "6 mm"]),
+    (lambda d: [short(t, 6) for t in d["tools"][1:]], ["no ball or bull-nose tool reaches the model's height "
+                                                       "7.2 mm", "6 mm"]),
     (lambda d: d.update(tools="missing_tools.yaml"), ["tools file not found", "missing_tools.yaml"]),
 ], ids=["travels", "depth", "no radiused", "cusp too tight", "diameter text", "radiused too short", "tools file"])
 def test_bad_input_exit_2_nothing_written(tmp_path: Path, capsys, change, words) -> None:

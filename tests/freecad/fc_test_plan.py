@@ -55,6 +55,12 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual(sorted(ops), sorted(p.label for p in plan.ops))
         self.assertEqual(sorted(o.ToolController.Label for o in ops.values()),
                          sorted(f"TC: {p.tool}" for p in plan.ops))
+        # the library's tool on its controller: flute length, overall length (stick-out + 3 D grip), holder
+        ball = next(o.ToolController for o in ops.values() if o.ToolController.Label == "TC: T2 ball D6")
+        self.assertAlmostEqual(float(ball.Tool.CuttingEdgeHeight), 20.0)
+        self.assertAlmostEqual(float(ball.Tool.Length), 30.0 + 3 * 6.0)
+        self.assertEqual((ball.TmmHolder, float(ball.TmmStickOut)), ("ER16 nut", 30.0))
+        self.assertIsNotNone(next(o for o in verified["ops"] if "T2" in o["label"])["holder"])
         steep = ops[plan.ops[-1].label]
         self.assertAlmostEqual(float(steep.StepDown), plan.ops[-1].kwargs["step_down"], places=6)
         before = len(steep.Path.Commands)

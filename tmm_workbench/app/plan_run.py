@@ -36,22 +36,32 @@ def run_ops(plan: dict, folder: Path) -> list:
         else:
             r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
         r.op.Label = op["label"]
-        share_tool_controller(r.op, op["tool"], controllers)
+        share_tool_controller(r.op, op["tool"], plan["tools"][op["tool"]], controllers)
         results.append(r)
-    results[0].doc.recompute()   # the ops given an earlier tool controller
+    results[0].doc.recompute()   # the ops with the library's tools (lengths, holders) and shared controllers
+    for r in results:
+        if not r.op.isValid():
+            raise RuntimeError(f"{r.op.Label}: {r.op.getStatusString()}")
     return results
 
 
-def share_tool_controller(op: Any, tool: str, controllers: dict) -> None:
+def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> None:
     """One tool controller per library tool: an op of a tool already used takes that tool's controller (the same
     feeds: they are the tool's) and the one the API made for it is removed, so the G-code changes tools only
-    when the tool changes. The kept controller and its ToolBit are named after the library's tool."""
+    when the tool changes. The kept controller and its ToolBit are named after the library's tool and given its
+    flute length, overall length and holder (the API makes a bit of standard proportions; the ops use the
+    controller's holder: their Holder is FromToolController)."""
     from tmm_workbench.app import compat
+    from tmm_workbench.app.api import set_holder
 
     made = op.ToolController
     if tool not in controllers:
         made.Label = f"TC: {tool}"
         made.Tool.Label = tool
+        made.Tool.CuttingEdgeHeight = float(spec["flute_length"])
+        made.Tool.Length = float(spec["length"])
+        if spec["holder"] is not None:
+            set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
         controllers[tool] = made
         return
     op.ToolController = controllers[tool]

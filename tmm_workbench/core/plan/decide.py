@@ -79,6 +79,17 @@ def reach_length(tool: ToolSpec) -> float:
     return tool.stick_out if tool.stick_out is not None else tool.flute_length
 
 
+GRIP_DIAMETERS = 3.0         # shank diameters held in the holder (app.tools' default grip)
+LENGTH_PAST_FLUTES = 4.0     # a tool without a holder: its overall length past the flutes, in diameters
+
+
+def overall_length(tool: ToolSpec) -> float:
+    """The ToolBit's overall length: the stick-out plus the grip in the holder, or the flutes plus a shank."""
+    if tool.stick_out is not None:
+        return tool.stick_out + GRIP_DIAMETERS * tool.diameter
+    return tool.flute_length + LENGTH_PAST_FLUTES * tool.diameter
+
+
 def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
     """The stock around the placed model, checked against the machine's travels."""
     lo, hi = mesh.bounds
@@ -95,16 +106,12 @@ def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
 
 
 def api_tool(tool: ToolSpec) -> dict:
-    """The API's tool arguments of a library tool (its holder when it has one)."""
+    """The API's tool arguments of a library tool."""
     shape = {"flat": "endmill", "ball": "ballend", "bull": "bullnose"}[tool.type]
     out: dict[str, Any] = {"tool": shape, "diameter": tool.diameter}
     if tool.type == "bull":
         out["corner_radius"] = tool.corner_radius
-    if tool.holder is not None:
-        out["holder"] = tool.holder
-        if tool.stick_out is not None:
-            out["stick_out"] = tool.stick_out
-    return out
+    return out   # the flute length, overall length and holder go on the tool controller (app/plan_run.py)
 
 
 def feeds(plan: Plan, job: JobSpec, tool: ToolSpec) -> dict:

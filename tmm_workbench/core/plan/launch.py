@@ -88,7 +88,9 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     o = job.outputs
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
-            "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops]}
+            "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
+            "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
+                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools}}
 
 
 def run_freecad(folder: Path, freecad: str, quiet: bool) -> Optional[str]:
