@@ -70,6 +70,19 @@ def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> 
     compat.remove_toolbit(bit)
 
 
+def drop_op(op: Any, kept: list) -> None:
+    """Removes `op` from its Job, and its tool controller when none of the `kept` results' ops uses it."""
+    from tmm_workbench.app import compat
+
+    doc, tc = op.Document, op.ToolController
+    doc.removeObject(op.Name)
+    if all(r.op.ToolController is not tc for r in kept):
+        bit = tc.Tool
+        doc.removeObject(tc.Name)
+        compat.remove_toolbit(bit)
+    doc.recompute()
+
+
 def op_rows(results: list, sim: Any) -> list:
     rows = []
     for r, s in zip(results, sim.ops):
@@ -92,7 +105,8 @@ def verify(results: list, plan: dict, folder: Path) -> dict:
         problems.append(f"{len(sim.collisions)} rapids through stock")
     problems += [f"{label}: {check.summary()}" for label, check in sim.holder_collisions]
     problems += [f"{label}: {found.summary()}" for label, found in sim.stock_collisions]
-    return {"passed": not problems, "problems": problems,
+    failing = {c[0] for c in sim.collisions} | {label for label, _ in sim.holder_collisions + sim.stock_collisions}
+    return {"passed": not problems, "problems": problems, "gouged": bool(sim.gouged), "failing_ops": sorted(failing),
             "deepest_gouge_mm": round(max(0.0, -sim.min_deviation), 4),
             "most_material_left_mm": round(sim.max_left, 4),
             "left_percentiles_mm": {str(k): round(v, 4) for k, v in sorted(sim.percentiles.items())},
@@ -122,6 +136,22 @@ def main() -> int:
 
     results = run_ops(plan, folder)
     job = results[0].job
+    report = verify(results, plan, folder)
+    optional = {op["label"] for op in plan["ops"] if op.get("optional")}
+    dropping = set(report["failing_ops"])
+    replanned = []
+    if not report["passed"] and not report["gouged"] and dropping and dropping <= optional:
+        # the plan changed once: an optional op (the rest) that fails the verification is left out, its material
+        # reported as left; a failing roughing or finishing op stops the plan with the reason (exit 1)
+        replanned = [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))
+                     for label in sorted(dropping)]
+        kept = [r for r in results if r.op.Label not in dropping]
+        for r in results:
+            if r.op.Label in dropping:
+                drop_op(r.op, kept)
+        results = kept
+        report = verify(results, plan, folder)
+    report["replanned"] = replanned
     if plan["gcode"]:
         objects = []
         for r in results:   # a tool controller where its tool comes in (once per tool)
@@ -129,7 +159,6 @@ def main() -> int:
         # without the header's export time: the same plan gives the same G-code, byte for byte
         args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
         posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
-    report = verify(results, plan, folder)
     if plan["fcstd"]:
         job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
     (folder / "verify.json").write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")

@@ -50,9 +50,11 @@ class OpPlan:
     label: str
     tool: str                 # library name
     kwargs: dict              # the API call's keyword arguments (JSON values)
+    optional: bool = False    # left out (its material reported) when it alone fails the verification
 
     def as_dict(self) -> dict:
-        return {"api": self.api, "label": self.label, "tool": self.tool, "kwargs": self.kwargs}
+        return {"api": self.api, "label": self.label, "tool": self.tool, "kwargs": self.kwargs,
+                "optional": self.optional}
 
 
 @dataclass
@@ -94,8 +96,10 @@ def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
     """The stock around the placed model, checked against the machine's travels."""
     lo, hi = mesh.bounds
     s = job.stock
-    box = (float(lo[0]) - s.margin, float(lo[1]) - s.margin, float(lo[2]) - s.below,
-           float(hi[0]) + s.margin, float(hi[1]) + s.margin, float(hi[2]) + s.above)
+    # rounded outward to 0.1 um: the box holds the model (the roughing op refuses a model outside its stock)
+    low = (float(lo[0]) - s.margin, float(lo[1]) - s.margin, float(lo[2]) - s.below)
+    high = (float(hi[0]) + s.margin, float(hi[1]) + s.margin, float(hi[2]) + s.above)
+    box = tuple(math.floor(v * 1e4) / 1e4 for v in low) + tuple(math.ceil(v * 1e4) / 1e4 for v in high)
     size = [box[3] - box[0], box[4] - box[1], box[5] - box[2]]
     for axis, got, travel in zip("xyz", size, job.machine.travels):
         if got > travel:
@@ -145,7 +149,7 @@ def choose_roughing(plan: Plan, job: JobSpec, an: Analysis) -> ToolSpec:
                 f"{tool.flute_length:g} mm; {ROUGH_LEAVE:g} mm left for the finishing passes")
     kwargs = api_tool(tool) | feeds(plan, job, tool) | {
         "step_down": step_down, "stepover_percent": round(c.stepover_percent, 1), "stock_to_leave": ROUGH_LEAVE,
-        "stock": [round(v, 4) for v in plan.stock_box], "post": job.machine.post}
+        "stock": list(plan.stock_box), "post": job.machine.post}
     plan.ops.append(OpPlan("run_roughing", f"Roughing {tool.name}", tool.name, kwargs))
     return tool
 
@@ -288,7 +292,7 @@ def rest_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list, radiused: l
     kwargs = api_tool(tool) | feeds(plan, job, tool) | {
         "region": "rest", "rest_from": "earlier_ops", "rest_tolerance": job.finish.tolerance, "stepover": step,
         "sample_step": round(min(0.5, max(0.1, tool.diameter / 20.0)), 3), "post": job.machine.post}
-    plan.ops.append(OpPlan("run_surface", f"Rest {tool.name}", tool.name, kwargs))
+    plan.ops.append(OpPlan("run_surface", f"Rest {tool.name}", tool.name, kwargs, optional=True))
     plan.decide("rest", tool.describe(),
                 f"the finishing tools leave {left:.0f} mm2 out of reach (reach test); {tool.name} leaves "
                 f"{an.reach[tool.name].unreached_area:.0f} mm2; raster over what the earlier ops leave, step-over "

@@ -157,6 +157,8 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False) -> int:
         move_into_place(tmp, out.dir)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    for change in verified.get("replanned", []):
+        say(f"plan changed: {change}", quiet)
     state = "verified" if verified["passed"] else "verification FAILED: " + "; ".join(verified["problems"])
     say(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left {verified['most_material_left_mm']:g}"
         f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out.dir} "
