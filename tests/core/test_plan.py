@@ -179,6 +179,7 @@ def test_decisions_beet(tmp_path: Path) -> None:
     assert rough.api == "run_roughing" and rough.tool == "T1 flat D8"
     assert "reaches the" in plan.decisions[1].reason
     assert rough.kwargs["step_down"] == 16.0 and rough.kwargs["stock_to_leave"] == decide.ROUGH_LEAVE
+    assert (rough.kwargs["layer_mode"], rough.kwargs["remaining_height"]) == ("tolerance", decide.ROUGH_STAIR)
     lo, hi = mesh.bounds
     assert rough.kwargs["stock"] == pytest.approx([lo[0] - 2, lo[1] - 2, lo[2], hi[0] + 2, hi[1] + 2, hi[2] + 1],
                                                   abs=1e-4)

@@ -26,6 +26,8 @@ from tmm_workbench.core.plan.job_file import JobSpec, PlanInputError, ToolSpec
 from tmm_workbench.core.tools.cutter import Cutter
 
 ROUGH_LEAVE = 0.3          # mm left by roughing for the finishing tool (radial and axial)
+ROUGH_STAIR = 1.0          # mm, the most the layers' stairs may leave on slopes (seed 000 eq. 3.11): the finishing
+#                            ops' rapids come down to a few mm above the model (16 mm stairs were cut by a rapid)
 TRANSITION_DEG = 45.0      # shallow / steep split without a comparison saying otherwise
 TRANSITION_RANGE = (30.0, 60.0)
 MIN_SHARE = 0.005          # of the design cells: a slope class smaller than this gets no op of its own
@@ -143,12 +145,15 @@ def choose_roughing(plan: Plan, job: JobSpec, an: Analysis) -> ToolSpec:
                 f"the largest {'flat or bull-nose ' if tool.type != 'ball' else ''}tool of the library that "
                 f"reaches the {depth:.1f} mm depth ({reach_length(tool):g} mm) and is at most "
                 f"{ROUGH_WIDTH_SHARE:g} x the model's narrower side ({narrow:.1f} mm)")
-    plan.decide("roughing layers", f"step-down {step_down:g} mm, step-over {c.stepover_percent:g} %, "
-                f"leave {ROUGH_LEAVE:g} mm",
+    plan.decide("roughing layers", f"step-down at most {step_down:g} mm, stairs at most {ROUGH_STAIR:g} mm, "
+                f"step-over {c.stepover_percent:g} %, leave {ROUGH_LEAVE:g} mm",
                 f"{job.material}: {materials.TABLE[job.material][2]:g} x D per layer, at most the flute length "
-                f"{tool.flute_length:g} mm; {ROUGH_LEAVE:g} mm left for the finishing passes")
+                f"{tool.flute_length:g} mm; layers closer where the slopes would keep stairs over {ROUGH_STAIR:g} mm "
+                f"(seed 000 eq. 3.11: the finishing tool takes at most that, its rapids stay out of the stock), a "
+                f"layer on each plateau; {ROUGH_LEAVE:g} mm left for the finishing passes")
     kwargs = api_tool(tool) | feeds(plan, job, tool) | {
-        "step_down": step_down, "stepover_percent": round(c.stepover_percent, 1), "stock_to_leave": ROUGH_LEAVE,
+        "step_down": step_down, "layer_mode": "tolerance", "remaining_height": ROUGH_STAIR,
+        "stepover_percent": round(c.stepover_percent, 1), "stock_to_leave": ROUGH_LEAVE,
         "stock": list(plan.stock_box), "post": job.machine.post}
     plan.ops.append(OpPlan("run_roughing", f"Roughing {tool.name}", tool.name, kwargs))
     return tool
