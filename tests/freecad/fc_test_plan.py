@@ -68,3 +68,41 @@ class PlanBeet(FreeCADTestCase):
         reopened.recompute()
         self.assertTrue(steep.isValid(), steep.getStatusString())
         self.assertLess(len(steep.Path.Commands), before)
+
+    def test_optional_op_left_out(self) -> None:
+        """An optional op (the rest) failing the verification alone is left out and the Job verified again: the
+        first verification is made to name the last op (a real one needs a long run); the second is the real."""
+        job = read_job(JOB)
+        _, _, _, plan = launch.make_plan(job)
+        folder = OUT / "plan_beet_drop"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = launch.plan_document(job, plan, job.model.file)
+        last = doc["ops"][-1]
+        last["optional"] = True
+        (folder / "plan.json").write_text(json.dumps(doc))
+        os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
+        real, calls = plan_run.verify, []
+
+        def first_fails(results, plan_doc, out):
+            report = real(results, plan_doc, out)
+            calls.append([r.op.Label for r in results])
+            if len(calls) == 1:
+                report.update(passed=False, problems=[f"{last['label']}: shank too close"],
+                              failing_ops=[last["label"]])
+            return report
+
+        plan_run.verify = first_fails
+        try:
+            self.assertEqual(plan_run.main(), 0)
+        finally:
+            plan_run.verify = real
+        verified = json.loads((folder / "verify.json").read_text())
+        self.assertEqual(calls[1], calls[0][:-1])
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertEqual(verified["replanned"], [f"left out {last['label']}: {last['label']}: shank too close"])
+        self.assertEqual([o["label"] for o in verified["ops"]], calls[1])
+        gcode = (folder / "beet_mm.ngc").read_text()
+        self.assertFalse(f"(begin operation: {last['label']})" in gcode)
+        self.assertTrue(f"(begin operation: {doc['ops'][0]['label']})" in gcode)
+        saved = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
+        self.assertFalse([o for o in saved.Objects if o.Label == last["label"]])
