@@ -51,7 +51,7 @@ def main() -> None:
             continue
         spec = read_job(job)
         report = spec.outputs.dir / "report.json"
-        if not report.is_file():
+        if not report.is_file() or report.stat().st_mtime < time.time() - wall:   # none, or an earlier run's
             print(f"{job.stem:<16} {proc.returncode:>4}  {proc.stderr.strip().splitlines()[-1][:150]}")
             continue
         v = json.loads(report.read_text())["verification"]
