@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
+import sys
 from pathlib import Path
 
 import FreeCAD
@@ -16,6 +18,17 @@ from tmm_workbench.core.plan import launch
 from tmm_workbench.core.plan.job_file import read_job
 
 JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
+
+
+def freecadcmd() -> str:
+    """The freecadcmd running this test (the command starts one itself)."""
+    home = Path(FreeCAD.getHomePath()) / "bin"
+    for c in (os.environ.get("TMM_FREECADCMD"), sys.executable if "freecad" in Path(sys.executable).name.lower()
+              else None, shutil.which("freecadcmd"), shutil.which("FreeCADCmd"), home / "freecadcmd",
+              home / "FreeCADCmd"):
+        if c and Path(c).is_file():
+            return str(c)
+    raise AssertionError(f"no freecadcmd found (sys.executable {sys.executable}, {home}); set TMM_FREECADCMD")
 
 
 class PlanBeet(FreeCADTestCase):
@@ -106,3 +119,26 @@ class PlanBeet(FreeCADTestCase):
         self.assertTrue(f"(begin operation: {doc['ops'][0]['label']})" in gcode)
         saved = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
         self.assertFalse([o for o in saved.Objects if o.Label == last["label"]])
+
+    def test_command_end_to_end(self) -> None:
+        """`python -m tmm_workbench.plan`'s run(): the core plans, a freecadcmd of its own runs the plan, the files
+        appear in the output folder (and nothing else beside it), exit code 0."""
+        import yaml
+
+        data = yaml.safe_load(JOB.read_text())
+        data["model"]["file"] = str(read_job(JOB).model.file)
+        data["outputs"]["dir"] = str(OUT / "plan_command" / "out")
+        job_file = OUT / "plan_command" / "job.yaml"
+        job_file.parent.mkdir(parents=True, exist_ok=True)
+        job_file.write_text(yaml.safe_dump(data))
+        self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
+        out = OUT / "plan_command" / "out"
+        self.assertEqual(sorted(p.name for p in out.iterdir()),
+                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "report.json"])
+        self.assertEqual(sorted(p.name for p in out.parent.iterdir()), ["job.yaml", "out"])
+        report = json.loads((out / "report.json").read_text())
+        self.assertTrue(report["passed"])
+        self.assertEqual(report["files"], sorted(p.name for p in out.iterdir()))
+        self.assertEqual([o["label"] for o in report["verification"]["ops"]],
+                         [o["label"] for o in report["plan"]["ops"]])
+        self.assertTrue(all(d["reason"] for d in report["plan"]["decisions"]))
