@@ -1,0 +1,67 @@
+"""The automatic planner on every job file of benchmarks/jobs (one per shared STL): runs
+`python3 -m tmm_workbench.plan <job> --quiet` for each and prints a table from its report.json.
+
+    /usr/bin/python3 benchmarks/plan_jobs.py [job.yaml ...]     # default: every job of benchmarks/jobs
+
+Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest gouge and the most material left
+(mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
+planning time (the decisions, core only) and the whole run's wall time (FreeCAD included).
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+
+def jobs(args: list[str]) -> list[Path]:
+    if args:
+        return [Path(a) for a in args]
+    return sorted(p for p in (REPO / "benchmarks" / "jobs").glob("*.yaml") if "format:" in p.read_text())
+
+
+def planning_seconds(job: Path) -> float:
+    from tmm_workbench.core.plan.job_file import read_job
+    from tmm_workbench.core.plan.launch import make_plan
+
+    t0 = time.perf_counter()
+    make_plan(read_job(job))
+    return time.perf_counter() - t0
+
+
+def main() -> None:
+    from tmm_workbench.core.plan.job_file import read_job
+
+    head = (f"{'job':<16} {'exit':>4} {'gouge mm':>9} {'left mm':>8} {'p95 mm':>7} {'cycle min':>9} "
+            f"{'plan s':>6} {'wall s':>7}  ops")
+    print(head)
+    print("-" * len(head))
+    for job in jobs(sys.argv[1:]):
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-m", "tmm_workbench.plan", str(job), "--quiet"], cwd=str(REPO),
+                              capture_output=True, text=True)
+        wall = time.perf_counter() - t0
+        if proc.returncode == 2:
+            print(f"{job.stem:<16} {2:>4}  {proc.stderr.strip()[:150]}")
+            continue
+        spec = read_job(job)
+        report = spec.outputs.dir / "report.json"
+        if not report.is_file() or report.stat().st_mtime < time.time() - wall:   # none, or an earlier run's
+            print(f"{job.stem:<16} {proc.returncode:>4}  {proc.stderr.strip().splitlines()[-1][:150]}")
+            continue
+        v = json.loads(report.read_text())["verification"]
+        ops = ", ".join(f"{o['label']} {o['cycle_seconds'] / 60:.1f}" for o in v["ops"])
+        print(f"{job.stem:<16} {proc.returncode:>4} {v['deepest_gouge_mm']:>9.4f} {v['most_material_left_mm']:>8.3f} "
+              f"{v['left_percentiles_mm']['95']:>7.3f} {v['cycle_seconds'] / 60:>9.1f} {planning_seconds(job):>6.1f} "
+              f"{wall:>7.0f}  {ops}", flush=True)
+        if v["problems"]:
+            print(f"{'':<16} problems: {'; '.join(v['problems'])[:300]}", flush=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,144 @@
+"""The automatic planner's FreeCAD side (app/plan_run.py) on the plan core.plan makes for tests/data/plan_beet.yaml
+(beet_mm.stl, coarse values): one Job with the planned ops, their tool controllers and feeds, the whole Job posted
+(every tool's change in the G-code), simulated and verified (no gouge below the tolerance, no rapid through stock),
+the document saved and reopened with its ops recomputing after a changed value."""
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import sys
+from pathlib import Path
+
+import FreeCAD
+
+from fc_helpers import OUT, FreeCADTestCase, close_all, parse_gcode
+from tmm_workbench.app import plan_run
+from tmm_workbench.core.plan import launch
+from tmm_workbench.core.plan.job_file import read_job
+
+JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
+
+
+def freecadcmd() -> str:
+    """The freecadcmd running this test (the command starts one itself)."""
+    home = Path(FreeCAD.getHomePath()) / "bin"
+    for c in (os.environ.get("TMM_FREECADCMD"), sys.executable if "freecad" in Path(sys.executable).name.lower()
+              else None, shutil.which("freecadcmd"), shutil.which("FreeCADCmd"), home / "freecadcmd",
+              home / "FreeCADCmd"):
+        if c and Path(c).is_file():
+            return str(c)
+    raise AssertionError(f"no freecadcmd found (sys.executable {sys.executable}, {home}); set TMM_FREECADCMD")
+
+
+class PlanBeet(FreeCADTestCase):
+    def test_plan_runs_verified(self) -> None:
+        job = read_job(JOB)
+        _, moved, an, plan = launch.make_plan(job)
+        self.assertFalse(moved)
+        folder = OUT / "plan_beet"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = launch.plan_document(job, plan, job.model.file)
+        (folder / "plan.json").write_text(json.dumps(doc))
+        os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
+        self.assertEqual(plan_run.main(), 0)
+        verified = json.loads((folder / "verify.json").read_text())
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertLess(verified["deepest_gouge_mm"], job.finish.tolerance)
+        self.assertEqual([o["label"] for o in verified["ops"]], [o.label for o in plan.ops])
+        self.assertTrue(all(o["moves"] > 0 and o["cycle_seconds"] > 0 for o in verified["ops"]))
+        self.assertAlmostEqual(verified["cycle_seconds"], sum(o["cycle_seconds"] for o in verified["ops"]), delta=0.2)
+        self.assertGreater(verified["removed_volume_mm3"], 0)
+        # the whole Job in one G-code file: each planned tool's change and spindle speed, feeds from the table
+        gcode = (folder / "beet_mm.ngc").read_text()
+        tools = list(dict.fromkeys(op.tool for op in plan.ops))   # the library's tools in their first use
+        self.assertLess(len(tools), len(plan.ops))                # the ball finishes both shallow and steep
+        self.assertEqual(gcode.count("M6 T"), len(tools))
+        for number, name in enumerate(tools, 1):
+            op = next(o for o in plan.ops if o.tool == name)
+            for line in (f"M6 T{number}", f"(begin operation: TC: {name})", f"M3 S{op.kwargs['spindle_speed']}"):
+                self.assertTrue(line in gcode, line)   # (assertIn would print the whole G-code)
+        feeds = {f for *_, f in parse_gcode(gcode) if f is not None}
+        self.assertIn(plan.ops[0].kwargs["horiz_feed"], feeds)
+        self.assertTrue((folder / "beet_mm_sim.png").stat().st_size > 10_000)
+        close_all()
+        # an ordinary Job: opened again, a value changed, recomputed
+        reopened = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
+        ops = {o.Label: o for o in reopened.Objects if o.Label in {p.label for p in plan.ops}}
+        self.assertEqual(sorted(ops), sorted(p.label for p in plan.ops))
+        self.assertEqual(sorted(o.ToolController.Label for o in ops.values()),
+                         sorted(f"TC: {p.tool}" for p in plan.ops))
+        # the library's tool on its controller: flute length, overall length (stick-out + 3 D grip), holder
+        ball = next(o.ToolController for o in ops.values() if o.ToolController.Label == "TC: T2 ball D6")
+        self.assertAlmostEqual(float(ball.Tool.CuttingEdgeHeight), 20.0)
+        self.assertAlmostEqual(float(ball.Tool.Length), 30.0 + 3 * 6.0)
+        self.assertEqual((ball.TmmHolder, float(ball.TmmStickOut)), ("ER16 nut", 30.0))
+        self.assertIsNotNone(next(o for o in verified["ops"] if "T2" in o["label"])["holder"])
+        steep = ops[plan.ops[-1].label]
+        self.assertAlmostEqual(float(steep.StepDown), plan.ops[-1].kwargs["step_down"], places=6)
+        before = len(steep.Path.Commands)
+        steep.StepDown = 2 * float(steep.StepDown)
+        reopened.recompute()
+        self.assertTrue(steep.isValid(), steep.getStatusString())
+        self.assertLess(len(steep.Path.Commands), before)
+
+    def test_optional_op_left_out(self) -> None:
+        """An optional op (the rest) failing the verification alone is left out and the Job verified again: the
+        first verification is made to name the last op (a real one needs a long run); the second is the real."""
+        job = read_job(JOB)
+        _, _, _, plan = launch.make_plan(job)
+        folder = OUT / "plan_beet_drop"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = launch.plan_document(job, plan, job.model.file)
+        last = doc["ops"][-1]
+        last["optional"] = True
+        (folder / "plan.json").write_text(json.dumps(doc))
+        os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
+        real, calls = plan_run.verify, []
+
+        def first_fails(results, plan_doc, out):
+            report = real(results, plan_doc, out)
+            calls.append([r.op.Label for r in results])
+            if len(calls) == 1:
+                report.update(passed=False, problems=[f"{last['label']}: shank too close"],
+                              failing_ops=[last["label"]])
+            return report
+
+        plan_run.verify = first_fails
+        try:
+            self.assertEqual(plan_run.main(), 0)
+        finally:
+            plan_run.verify = real
+        verified = json.loads((folder / "verify.json").read_text())
+        self.assertEqual(calls[1], calls[0][:-1])
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertEqual(verified["replanned"], [f"left out {last['label']}: {last['label']}: shank too close"])
+        self.assertEqual([o["label"] for o in verified["ops"]], calls[1])
+        gcode = (folder / "beet_mm.ngc").read_text()
+        self.assertFalse(f"(begin operation: {last['label']})" in gcode)
+        self.assertTrue(f"(begin operation: {doc['ops'][0]['label']})" in gcode)
+        saved = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
+        self.assertFalse([o for o in saved.Objects if o.Label == last["label"]])
+
+    def test_command_end_to_end(self) -> None:
+        """`python -m tmm_workbench.plan`'s run(): the core plans, a freecadcmd of its own runs the plan, the files
+        appear in the output folder (and nothing else beside it), exit code 0."""
+        import yaml
+
+        data = yaml.safe_load(JOB.read_text())
+        data["model"]["file"] = str(read_job(JOB).model.file)
+        data["outputs"]["dir"] = str(OUT / "plan_command" / "out")
+        job_file = OUT / "plan_command" / "job.yaml"
+        job_file.parent.mkdir(parents=True, exist_ok=True)
+        job_file.write_text(yaml.safe_dump(data))
+        self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
+        out = OUT / "plan_command" / "out"
+        self.assertEqual(sorted(p.name for p in out.iterdir()),
+                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "report.json"])
+        self.assertEqual(sorted(p.name for p in out.parent.iterdir()), ["job.yaml", "out"])
+        report = json.loads((out / "report.json").read_text())
+        self.assertTrue(report["passed"])
+        self.assertEqual(report["files"], sorted(p.name for p in out.iterdir()))
+        self.assertEqual([o["label"] for o in report["verification"]["ops"]],
+                         [o["label"] for o in report["plan"]["ops"]])
+        self.assertTrue(all(d["reason"] for d in report["plan"]["decisions"]))

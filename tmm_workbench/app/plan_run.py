@@ -1,0 +1,180 @@
+"""The FreeCAD side of the automatic planner: runs a plan made by core.plan (its ops as headless API calls, in
+one Job), posts the whole Job, simulates it and writes what the simulation found. Started by core.plan.launch as
+
+    TMM_PLAN_FILE=<folder>/plan.json freecadcmd tmm_workbench/app/plan_run.py
+
+Everything goes to the plan file's folder (the launcher moves it into place when complete): <name>.FCStd,
+<name>.ngc, <name>_sim.png and verify.json. freecadcmd returns 0 even when a script raises, so the outcome is an
+explicit exit code: 0 the plan ran (verify.json says whether it passed), 3 it failed (the reason on stderr).
+"""
+from __future__ import annotations
+
+import json
+import os
+import sys
+import traceback
+from pathlib import Path
+from typing import Any
+
+REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
+TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
+FAILED = 3
+
+
+def run_ops(plan: dict, folder: Path) -> list:
+    """The plan's ops in order, the first making the Job around the model and its stock, the others added."""
+    from tmm_workbench.app import api
+
+    calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
+    results: list = []
+    controllers: dict = {}
+    for op in plan["ops"]:
+        kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
+        call = calls[op["api"]]
+        if results:
+            r = call(None, job=results[0], progress=False, **kwargs)
+        else:
+            r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
+        r.op.Label = op["label"]
+        share_tool_controller(r.op, op["tool"], plan["tools"][op["tool"]], controllers)
+        results.append(r)
+    results[0].doc.recompute()   # the ops with the library's tools (lengths, holders) and shared controllers
+    for r in results:
+        if not r.op.isValid():
+            raise RuntimeError(f"{r.op.Label}: {r.op.getStatusString()}")
+    return results
+
+
+def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> None:
+    """One tool controller per library tool: an op of a tool already used takes that tool's controller (the same
+    feeds: they are the tool's) and the one the API made for it is removed, so the G-code changes tools only
+    when the tool changes. The kept controller and its ToolBit are named after the library's tool and given its
+    flute length, overall length and holder (the API makes a bit of standard proportions; the ops use the
+    controller's holder: their Holder is FromToolController)."""
+    from tmm_workbench.app import compat
+    from tmm_workbench.app.api import set_holder
+
+    made = op.ToolController
+    if tool not in controllers:
+        made.Label = f"TC: {tool}"
+        made.Tool.Label = tool
+        made.Tool.CuttingEdgeHeight = float(spec["flute_length"])
+        made.Tool.Length = float(spec["length"])
+        if spec["holder"] is not None:
+            set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
+        controllers[tool] = made
+        return
+    op.ToolController = controllers[tool]
+    bit = made.Tool
+    op.Document.removeObject(made.Name)
+    compat.remove_toolbit(bit)
+
+
+def drop_op(op: Any, kept: list) -> None:
+    """Removes `op` from its Job, and its tool controller when none of the `kept` results' ops uses it."""
+    from tmm_workbench.app import compat
+
+    doc, tc = op.Document, op.ToolController
+    doc.removeObject(op.Name)
+    if all(r.op.ToolController is not tc for r in kept):
+        bit = tc.Tool
+        doc.removeObject(tc.Name)
+        compat.remove_toolbit(bit)
+    doc.recompute()
+
+
+def op_rows(results: list, sim: Any) -> list:
+    rows = []
+    for r, s in zip(results, sim.ops):
+        rows.append({"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
+                     "rapids_through_stock": len(s.collisions),
+                     "holder": None if s.holder is None else s.holder.summary()})
+    return rows
+
+
+def verify(results: list, plan: dict, folder: Path) -> dict:
+    from tmm_workbench.app.api import simulate
+
+    png = folder / f"{plan['name']}_sim.png" if plan["heat_map"] else None
+    sim = simulate(results[0].job, cell=plan["sim_cell"], tolerance=plan["tolerance"], png_path=png,
+                   progress=False)
+    problems = []
+    if sim.gouged:
+        problems.append(f"gouged {-sim.min_deviation:.4f} mm below the model (tolerance {plan['tolerance']:g} mm)")
+    if sim.collisions:
+        problems.append(f"{len(sim.collisions)} rapids through stock")
+    problems += [f"{label}: {check.summary()}" for label, check in sim.holder_collisions]
+    problems += [f"{label}: {found.summary()}" for label, found in sim.stock_collisions]
+    failing = {c[0] for c in sim.collisions} | {label for label, _ in sim.holder_collisions + sim.stock_collisions}
+    return {"passed": not problems, "problems": problems, "gouged": bool(sim.gouged), "failing_ops": sorted(failing),
+            "deepest_gouge_mm": round(max(0.0, -sim.min_deviation), 4),
+            "most_material_left_mm": round(sim.max_left, 4),
+            "left_percentiles_mm": {str(k): round(v, 4) for k, v in sorted(sim.percentiles.items())},
+            "removed_volume_mm3": round(sim.removed_volume, 1), "remaining_volume_mm3": round(sim.remaining_volume, 1),
+            "cycle_seconds": round(sim.cycle_seconds, 1), "ops": op_rows(results, sim.simulation),
+            "sim_cell_mm": plan["sim_cell"], "tolerance_mm": plan["tolerance"],
+            "regions": rounded(dict(sorted(sim.regions.items())))}
+
+
+def rounded(value: Any) -> Any:
+    """Floats to 4 decimals through dicts and lists (the report's numbers, byte-stable)."""
+    if isinstance(value, float):
+        return round(value, 4)
+    if isinstance(value, dict):
+        return {str(k): rounded(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [rounded(v) for v in value]
+    return value
+
+
+def main() -> int:
+    sys.path.insert(0, str(REPO))
+    plan_file = Path(os.environ["TMM_PLAN_FILE"])
+    folder = plan_file.parent
+    plan = json.loads(plan_file.read_text())
+    from tmm_workbench.app import posts
+
+    results = run_ops(plan, folder)
+    job = results[0].job
+    report = verify(results, plan, folder)
+    optional = {op["label"] for op in plan["ops"] if op.get("optional")}
+    dropping = set(report["failing_ops"])
+    replanned = []
+    if not report["passed"] and not report["gouged"] and dropping and dropping <= optional:
+        # the plan changed once: an optional op (the rest) that fails the verification is left out, its material
+        # reported as left; a failing roughing or finishing op stops the plan with the reason (exit 1)
+        replanned = [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))
+                     for label in sorted(dropping)]
+        kept = [r for r in results if r.op.Label not in dropping]
+        for r in results:
+            if r.op.Label in dropping:
+                drop_op(r.op, kept)
+        results = kept
+        report = verify(results, plan, folder)
+    report["replanned"] = replanned
+    if plan["gcode"]:
+        objects = []
+        for r in results:   # a tool controller where its tool comes in (once per tool)
+            objects += [r.op] if r.op.ToolController in objects else [r.op.ToolController, r.op]
+        # without the header's export time: the same plan gives the same G-code, byte for byte
+        args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
+        posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
+    if plan["fcstd"]:
+        job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
+    (folder / "verify.json").write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
+    return 0
+
+
+def _entry() -> None:
+    try:
+        code = main()
+    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
+        traceback.print_exc()
+        code = FAILED
+    sys.stdout.flush()
+    sys.stderr.flush()
+    raise SystemExit(code)
+
+
+if __name__ in ("__main__", "plan_run"):
+    _entry()

@@ -1,0 +1,324 @@
+"""The planner's decisions: from a checked job (core.plan.job_file) and its model's analysis (core.plan.analysis)
+to the list of ops the headless API runs (app.api's run_roughing, run_surface, run_waterline keyword arguments),
+each decision written down with its reason for the report. Deterministic: the same job gives the same plan.
+
+- roughing: the largest flat or bull-nose library tool (a ball if there is none) that reaches the depth, layers
+  the material's depth per pass allows (at most the flute length), ROUGH_LEAVE left for the finish;
+- finishing split by slope: shallow by a cusp-driven raster, steep by waterline, the transition where seed 003's
+  comparison (core.plan.optimal_cutter) finds a ball starts to leave less than the shallow cutter;
+- the finishing cutter by that comparison (same step-over and raster for every radiused library tool, ranked by
+  the volume each leaves), or the largest ball without it;
+- rest: a smaller radiused tool where the reach tests say the finishing tool leaves material it reaches.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.plan import materials
+from tmm_workbench.core.plan.analysis import Analysis
+from tmm_workbench.core.plan.job_file import JobSpec, PlanInputError, ToolSpec
+from tmm_workbench.core.tools.cutter import Cutter
+
+ROUGH_LEAVE = 0.3          # mm left by roughing for the finishing tool (radial and axial)
+ROUGH_STAIR = 1.0          # mm, the most the layers' stairs may leave on slopes (seed 000 eq. 3.11): the finishing
+#                            ops' rapids come down to a few mm above the model (16 mm stairs were cut by a rapid)
+TRANSITION_DEG = 45.0      # shallow / steep split without a comparison saying otherwise
+TRANSITION_RANGE = (30.0, 60.0)
+MIN_SHARE = 0.005          # of the design cells: a slope class smaller than this gets no op of its own
+MIN_STEPOVER = 0.05        # mm: a finish needing a finer step-over than this is refused as too tight
+MAX_COMPARED = 4           # radiused tools compared (the largest first)
+ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
+
+
+@dataclass(frozen=True)
+class Decision:
+    topic: str
+    choice: str
+    reason: str
+
+    def as_dict(self) -> dict:
+        return {"topic": self.topic, "choice": self.choice, "reason": self.reason}
+
+
+@dataclass
+class OpPlan:
+    api: str                  # run_roughing | run_surface | run_waterline
+    label: str
+    tool: str                 # library name
+    kwargs: dict              # the API call's keyword arguments (JSON values)
+    optional: bool = False    # left out (its material reported) when it alone fails the verification
+
+    def as_dict(self) -> dict:
+        return {"api": self.api, "label": self.label, "tool": self.tool, "kwargs": self.kwargs,
+                "optional": self.optional}
+
+
+@dataclass
+class Plan:
+    stock_box: tuple          # (xmin, ymin, zmin, xmax, ymax, zmax) mm
+    ops: list = field(default_factory=list)
+    decisions: list = field(default_factory=list)
+    cutting: dict = field(default_factory=dict)   # tool name -> materials.Cutting.as_dict()
+
+    def decide(self, topic: str, choice: str, reason: str) -> None:
+        self.decisions.append(Decision(topic, choice, reason))
+
+    def as_dict(self) -> dict:
+        return {"stock_box_mm": [round(v, 4) for v in self.stock_box], "ops": [o.as_dict() for o in self.ops],
+                "decisions": [d.as_dict() for d in self.decisions], "tools": self.cutting}
+
+
+def cutter_of(tool: ToolSpec) -> Cutter:
+    return Cutter(tool.diameter, tool.corner_radius)
+
+
+def reach_length(tool: ToolSpec) -> float:
+    """How deep the tool goes below the stock's top: its stick-out from the holder, or its flutes without one."""
+    return tool.stick_out if tool.stick_out is not None else tool.flute_length
+
+
+GRIP_DIAMETERS = 3.0         # shank diameters held in the holder (app.tools' default grip)
+LENGTH_PAST_FLUTES = 4.0     # a tool without a holder: its overall length past the flutes, in diameters
+
+
+def overall_length(tool: ToolSpec) -> float:
+    """The ToolBit's overall length: the stick-out plus the grip in the holder, or the flutes plus a shank."""
+    if tool.stick_out is not None:
+        return tool.stick_out + GRIP_DIAMETERS * tool.diameter
+    return tool.flute_length + LENGTH_PAST_FLUTES * tool.diameter
+
+
+def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
+    """The stock around the placed model, checked against the machine's travels."""
+    lo, hi = mesh.bounds
+    s = job.stock
+    # rounded outward to 0.1 um: the box holds the model (the roughing op refuses a model outside its stock)
+    low = (float(lo[0]) - s.margin, float(lo[1]) - s.margin, float(lo[2]) - s.below)
+    high = (float(hi[0]) + s.margin, float(hi[1]) + s.margin, float(hi[2]) + s.above)
+    box = tuple(math.floor(v * 1e4) / 1e4 for v in low) + tuple(math.ceil(v * 1e4) / 1e4 for v in high)
+    size = [box[3] - box[0], box[4] - box[1], box[5] - box[2]]
+    for axis, got, travel in zip("xyz", size, job.machine.travels):
+        if got > travel:
+            raise PlanInputError(f"machine.travels: the stock is {got:.1f} mm in {axis} (model "
+                                 f"{got - (2 * s.margin if axis != 'z' else s.above + s.below):.1f} mm + stock "
+                                 f"margins), larger than the machine's {travel:g} mm travel")
+    return box
+
+
+def api_tool(tool: ToolSpec) -> dict:
+    """The API's tool arguments of a library tool."""
+    shape = {"flat": "endmill", "ball": "ballend", "bull": "bullnose"}[tool.type]
+    out: dict[str, Any] = {"tool": shape, "diameter": tool.diameter}
+    if tool.type == "bull":
+        out["corner_radius"] = tool.corner_radius
+    return out   # the flute length, overall length and holder go on the tool controller (app/plan_run.py)
+
+
+def feeds(plan: Plan, job: JobSpec, tool: ToolSpec) -> dict:
+    c = materials.cutting(job.material, tool.diameter, tool.flutes, job.machine.spindle_max, job.machine.feed_max)
+    plan.cutting[tool.name] = c.as_dict() | {"tool": tool.describe()}
+    return {"horiz_feed": round(c.feed, 1), "vert_feed": round(c.plunge, 1), "spindle_speed": round(c.rpm)}
+
+
+def choose_roughing(plan: Plan, job: JobSpec, an: Analysis) -> ToolSpec:
+    depth = plan.stock_box[5] - an.bounds[0][2]
+    narrow = min(an.size[0], an.size[1])
+    reaching = [t for t in job.tools if reach_length(t) >= depth]
+    if not reaching:
+        longest = max(job.tools, key=reach_length)
+        raise PlanInputError(f"tools: no tool reaches the roughing depth {depth:.1f} mm (stock top to the model's "
+                             f"lowest point); the longest, {longest.name}, reaches {reach_length(longest):g} mm")
+    fitting = [t for t in reaching if t.diameter <= ROUGH_WIDTH_SHARE * narrow] or \
+        [min(reaching, key=lambda t: t.diameter)]
+    # flat and bull-nose tools clear layers; a ball only when there is nothing else
+    fitting.sort(key=lambda t: (t.type != "ball", t.diameter, -job.tools.index(t)), reverse=True)
+    tool = fitting[0]
+    c = materials.cutting(job.material, tool.diameter, tool.flutes, job.machine.spindle_max, job.machine.feed_max)
+    step_down = round(min(c.step_down, tool.flute_length), 3)
+    plan.decide("roughing tool", tool.describe(),
+                f"the largest {'flat or bull-nose ' if tool.type != 'ball' else ''}tool of the library that "
+                f"reaches the {depth:.1f} mm depth ({reach_length(tool):g} mm) and is at most "
+                f"{ROUGH_WIDTH_SHARE:g} x the model's narrower side ({narrow:.1f} mm)")
+    plan.decide("roughing layers", f"step-down at most {step_down:g} mm, stairs at most {ROUGH_STAIR:g} mm, "
+                f"step-over {c.stepover_percent:g} %, leave {ROUGH_LEAVE:g} mm",
+                f"{job.material}: {materials.TABLE[job.material][2]:g} x D per layer, at most the flute length "
+                f"{tool.flute_length:g} mm; layers closer where the slopes would keep stairs over {ROUGH_STAIR:g} mm "
+                f"(seed 000 eq. 3.11: the finishing tool takes at most that, its rapids stay out of the stock), a "
+                f"layer on each plateau; {ROUGH_LEAVE:g} mm left for the finishing passes")
+    kwargs = api_tool(tool) | feeds(plan, job, tool) | {
+        "step_down": step_down, "layer_mode": "tolerance", "remaining_height": ROUGH_STAIR,
+        "stepover_percent": round(c.stepover_percent, 1), "stock_to_leave": ROUGH_LEAVE,
+        "stock": list(plan.stock_box), "post": job.machine.post}
+    plan.ops.append(OpPlan("run_roughing", f"Roughing {tool.name}", tool.name, kwargs))
+    return tool
+
+
+def largest_ball(radiused: list) -> ToolSpec:
+    balls = [t for t in radiused if t.type == "ball"] or radiused
+    return max(balls, key=lambda t: (t.corner_radius, t.diameter, -radiused.index(t)))
+
+
+def transition_from(comparison: Any, winner: str, ball: str) -> Optional[float]:
+    """The lower edge of the first slope band (from the flat up) where the ball leaves less than the winner; None
+    when it never does (or they are the same tool)."""
+    if winner == ball:
+        return None
+    by = {s.label: s.by_slope for s in comparison.scores}
+    for band in sorted(by[winner]):
+        w, b = by[winner][band], by[ball][band]
+        if not (math.isnan(w) or math.isnan(b)) and b < w:
+            return band[0]
+    return None
+
+
+def reaching(plan: Plan, an: Analysis, radiused: list) -> list:
+    """The radiused tools that reach the model's lowest point from its top (the finishing and rest tools)."""
+    height = an.size[2]
+    out = [t for t in radiused if reach_length(t) >= height]
+    if not out:
+        longest = max(radiused, key=reach_length)
+        raise PlanInputError(f"tools: no ball or bull-nose tool reaches the model's height {height:.1f} mm; the "
+                             f"longest, {longest.name}, reaches {reach_length(longest):g} mm")
+    short = [f"{t.name} ({reach_length(t):g} mm)" for t in radiused if t not in out]
+    if short:
+        plan.decide("tools left out", ", ".join(short), f"they do not reach the model's {height:.1f} mm height "
+                    "(stick-out from the holder, else the flute length)")
+    return out
+
+
+def finishing_candidates(plan: Plan, an: Analysis, radiused: list) -> list:
+    """The tools fit to finish: wide at most ROUGH_WIDTH_SHARE of the model's narrower side (the smallest
+    otherwise) and at least as wide as the largest such ball: a smaller tool would finish the whole part at its
+    small step-over for details the rest op takes with it (seed 003 compares cutters of one size class)."""
+    narrow = min(an.size[0], an.size[1])
+    fitting = [t for t in radiused if t.diameter <= ROUGH_WIDTH_SHARE * narrow] or \
+        [min(radiused, key=lambda t: (t.diameter, radiused.index(t)))]
+    ball = largest_ball(fitting)
+    chosen = [t for t in fitting if t.diameter >= ball.diameter]
+    left_out = [t.name for t in radiused if t not in chosen]
+    plan.decide("finishing candidates", ", ".join(t.name for t in chosen),
+                f"radiused tools reaching the model's {an.size[2]:.1f} mm height, at most "
+                f"{ROUGH_WIDTH_SHARE:g} x its narrower side ({narrow:.1f} mm) and at least as wide as the largest "
+                f"ball {ball.name}" + (f"; left for the rest: {', '.join(left_out)}" if left_out else ""))
+    return chosen
+
+
+def choose_finishing(plan: Plan, job: JobSpec, an: Analysis, mesh: TriMesh, radiused: list,
+                     compare: Any) -> tuple[ToolSpec, ToolSpec, float]:
+    """(shallow raster tool, steep waterline tool, transition slope deg) among `radiused`, the candidates."""
+    ball = largest_ball(radiused)
+    cusp = job.finish.cusp
+    step = stepover_for_cusp(cutter_of(ball), cusp)
+    if step < MIN_STEPOVER:
+        raise PlanInputError(f"finish.cusp: {cusp:g} mm needs a step-over of {step:.4f} mm with the largest ball "
+                             f"{ball.name}, finer than {MIN_STEPOVER:g} mm: tighter than the library's tools "
+                             f"leave in a sensible time")
+    plan.decide("steep finishing tool", ball.describe(), "seed 003 (Fig. 4.9): a ball leaves the least on steep "
+                "slopes; the largest ball of the library")
+    candidates = sorted(radiused, key=lambda t: (-t.diameter, -t.corner_radius, radiused.index(t)))[:MAX_COMPARED]
+    if compare is None or len(candidates) < 2:
+        why = "the comparison is off in the job file" if compare is None else "one finishing candidate"
+        plan.decide("shallow finishing tool", ball.describe(), f"{why}: the steep areas' ball")
+        plan.decide("transition slope", f"{TRANSITION_DEG:g} deg", "the default split (no comparison)")
+        return ball, ball, TRANSITION_DEG
+    cmp = compare(mesh, [(t.name, cutter_of(t)) for t in candidates], stepover=round(step, 4))
+    best = next(t for t in candidates if t.name == cmp.scores[0].label)
+    plan.decide("shallow finishing tool", best.describe(),
+                f"seed 003 section 4.2: the same raster (step-over {step:.3f} mm, the ball's for the cusp) with "
+                f"{len(candidates)} radiused tools simulated; ranked: " + " | ".join(cmp.reasons))
+    edge = transition_from(cmp, best.name, ball.name)
+    if edge is None:
+        transition = TRANSITION_DEG
+        why = (f"the ball {ball.name} never leaves less than {best.name} in a slope band: the default split"
+               if best is not ball else "the ball wins everywhere: the default split")
+    else:
+        transition = float(np.clip(edge, *TRANSITION_RANGE))
+        why = (f"the ball {ball.name} leaves less than {best.name} from {edge:g} deg up (mean left per slope band "
+               f"in the comparison), kept within {TRANSITION_RANGE[0]:g}-{TRANSITION_RANGE[1]:g} deg")
+    plan.decide("transition slope", f"{transition:g} deg", why)
+    return best, ball, transition
+
+
+def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, steep: ToolSpec,
+                  transition: float) -> None:
+    cusp, tol = job.finish.cusp, job.finish.tolerance
+    steep_share = an.share_steeper(transition)
+    common = {"post": job.machine.post}
+    if 1.0 - steep_share >= MIN_SHARE:
+        sample = round(min(0.5, max(0.1, shallow.diameter / 20.0)), 3)
+        # the steepest slope the raster cuts sets its step-over (the op's own cusp mode measures the crossings
+        # of the whole surface: 40x slower on beet_mm, and its curvature term is not needed on a planned split)
+        step = math.floor(stepover_for_cusp(cutter_of(shallow), cusp, transition) * 1000) / 1000
+        kwargs = api_tool(shallow) | feeds(plan, job, shallow) | common | {
+            "stepover": step, "sample_step": sample, "slope_range": [0.0, transition],
+            "chord_tolerance": round(min(0.01, tol / 2), 4)}
+        plan.ops.append(OpPlan("run_surface", f"Finish shallow {shallow.name}", shallow.name, kwargs))
+        plan.decide("shallow finishing", f"raster 0-{transition:g} deg, step-over {step:g} mm",
+                    f"{(1 - steep_share) * 100:.0f} % of the model seen from above slopes less than "
+                    f"{transition:g} deg; the step-over keeps the cusp {cusp:g} mm on a {transition:g} deg plane "
+                    f"across the passes, the steepest the raster cuts")
+    else:
+        plan.decide("shallow finishing", "none", f"less than {MIN_SHARE * 100:g} % of the model is shallow")
+    if steep_share >= MIN_SHARE:
+        c = cutter_of(steep)
+        t = math.radians(transition)
+        step_down = min(steep.corner_radius, stepover_for_cusp(c, cusp, transition) * math.tan(t))
+        step_down = math.floor(step_down * 1000) / 1000
+        kwargs = api_tool(steep) | feeds(plan, job, steep) | common | {"step_down": step_down}
+        plan.ops.append(OpPlan("run_waterline", f"Finish steep {steep.name}", steep.name, kwargs))
+        plan.decide("steep finishing", f"waterline, step-down {step_down:g} mm",
+                    f"{steep_share * 100:.0f} % of the model seen from above slopes more than {transition:g} deg; "
+                    f"levels {step_down:g} mm apart keep the cusp {cusp:g} mm from {transition:g} deg up")
+    else:
+        plan.decide("steep finishing", "none", f"less than {MIN_SHARE * 100:g} % of the model is steeper than "
+                    f"{transition:g} deg")
+
+
+def rest_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list, radiused: list) -> None:
+    """A smaller radiused tool where the finishing tools leave material out of their reach that it reaches."""
+    left = min(an.reach[t.name].unreached_area for t in finishing)
+    if left == 0.0:
+        plan.decide("rest", "none", "the reach tests find nothing the finishing tools leave")
+        return
+    smaller = [t for t in radiused if t.diameter < min(f.diameter for f in finishing)
+               and an.reach[t.name].unreached_area < left]
+    if not smaller:
+        plan.decide("rest", "none", f"the finishing tools leave {left:.0f} mm2 out of reach and no smaller library "
+                    "tool reaches more (reported as left)")
+        return
+    tool = max(smaller, key=lambda t: (t.diameter, -radiused.index(t)))
+    step = round(stepover_for_cusp(cutter_of(tool), job.finish.cusp), 4)
+    kwargs = api_tool(tool) | feeds(plan, job, tool) | {
+        "region": "rest", "rest_from": "earlier_ops", "rest_tolerance": job.finish.tolerance, "stepover": step,
+        "sample_step": round(min(0.5, max(0.1, tool.diameter / 20.0)), 3), "post": job.machine.post}
+    plan.ops.append(OpPlan("run_surface", f"Rest {tool.name}", tool.name, kwargs, optional=True))
+    plan.decide("rest", tool.describe(),
+                f"the finishing tools leave {left:.0f} mm2 out of reach (reach test); {tool.name} leaves "
+                f"{an.reach[tool.name].unreached_area:.0f} mm2; raster over what the earlier ops leave, step-over "
+                f"{step:g} mm for the cusp")
+
+
+def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> Plan:
+    """The ops and decisions for `job` on its placed `mesh` with its analysis `an` (reach-tested with every
+    library tool); `compare`: core.plan.optimal_cutter.compare_cutters bound to its cell (None: not compared)."""
+    plan = Plan(stock_box(job, mesh))
+    radiused = [t for t in job.tools if t.corner_radius > 0]
+    if not radiused:
+        raise PlanInputError("tools: no ball or bull-nose tool in the library; a sculptured surface is finished "
+                             "with a radiused tool")
+    plan.decide("model", f"{an.size[0]:.1f} x {an.size[1]:.1f} x {an.size[2]:.1f} mm, {an.triangles} triangles",
+                f"slope shares {an.slope_area}, flat {an.flat_share * 100:.0f} %, facing down "
+                f"{an.down_share * 100:.1f} % (never reached from above)")
+    choose_roughing(plan, job, an)
+    radiused = reaching(plan, an, radiused)
+    shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
+                                                  compare)
+    finishing_ops(plan, job, an, shallow, steep, transition)
+    rest_op(plan, job, an, [shallow, steep], radiused)
+    return plan

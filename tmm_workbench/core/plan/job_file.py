@@ -1,0 +1,323 @@
+"""The planner's job description (docs/planner.md): a YAML or JSON file naming the model, the stock, the machine,
+the tool library, the material, the finish and what to write. Read and checked here, without FreeCAD: every
+field is known, every value in its range, or a PlanInputError names the field, the value and what is allowed.
+Paths in the file are relative to the file's folder."""
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Optional, Union
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.footprint.cusp import MIN_CUSP
+from tmm_workbench.core.plan import materials
+
+FORMAT = "tmm-plan 1"
+UNITS = {"mm": 1.0, "inch": 25.4}
+TOOL_TYPES = ("flat", "ball", "bull")
+MACHINE_TYPES = ("3-axis",)
+STOCK_TYPES = ("box",)
+SHARED = "shared:"   # model.file prefix: a file of the project's shared folder
+POSTS = ("linuxcnc", "grbl", "tmm_linuxcnc", "tmm_grbl")
+
+
+class PlanInputError(TmmError):
+    """Bad input to the planner: the command exits with code 2."""
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    file: Path
+    units: str = "mm"
+    translate: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class StockSpec:
+    type: str = "box"
+    margin: float = 2.0      # mm beyond the model on each side
+    above: float = 1.0       # mm above its top
+    below: float = 0.0       # mm below its lowest point
+
+
+@dataclass(frozen=True)
+class MachineSpec:
+    type: str = "3-axis"
+    post: str = "linuxcnc"
+    travels: tuple[float, float, float] = (300.0, 300.0, 100.0)
+    spindle_max: float = 24000.0   # rpm
+    feed_max: float = 5000.0       # mm/min
+
+
+@dataclass(frozen=True)
+class ToolSpec:
+    name: str
+    type: str
+    diameter: float
+    corner_radius: float
+    flutes: int
+    flute_length: float
+    holder: Optional[str] = None
+    stick_out: Optional[float] = None
+
+    def describe(self) -> str:
+        shape = {"flat": "flat", "ball": "ball", "bull": f"bull-nose r{self.corner_radius:g}"}[self.type]
+        return f"{self.name} ({shape} D{self.diameter:g}, {self.flutes} flutes)"
+
+
+@dataclass(frozen=True)
+class FinishSpec:
+    cusp: float = 0.01        # mm, the scallop height the finishing passes aim at
+    tolerance: float = 0.01   # mm, the deepest cut below the model the verification accepts
+
+
+@dataclass(frozen=True)
+class OutputSpec:
+    dir: Path
+    name: str
+    gcode: bool = True
+    fcstd: bool = True
+    heat_map: bool = True
+
+
+@dataclass(frozen=True)
+class PlannerSpec:
+    """Resolution of the planner's own measurements (coarser: faster, rougher)."""
+    analysis_cell: float = 0.5     # mm, the reach tests' and slope map's grid
+    sim_cell: float = 0.2          # mm, the verification's simulation grid
+    compare_cutters: bool = True   # seed 003's cutter comparison for the finishing tool
+
+
+@dataclass(frozen=True)
+class JobSpec:
+    source: Path
+    model: ModelSpec
+    stock: StockSpec
+    machine: MachineSpec
+    tools: tuple[ToolSpec, ...]
+    material: str
+    finish: FinishSpec
+    outputs: OutputSpec
+    planner: PlannerSpec = field(default_factory=PlannerSpec)
+
+
+# --- field checks -------------------------------------------------------------------------------------------
+
+def _fail(where: str, value: Any, allowed: str) -> PlanInputError:
+    return PlanInputError(f"{where}: got {value!r}; {allowed}")
+
+
+def _mapping(where: str, value: Any, required: tuple[str, ...], optional: tuple[str, ...]) -> dict:
+    if not isinstance(value, dict):
+        raise _fail(where, value, f"a mapping with {', '.join(required + optional)}")
+    unknown = sorted(str(k) for k in value if k not in required + optional)
+    if unknown:
+        raise PlanInputError(f"{where}: unknown field(s) {', '.join(unknown)}; allowed: "
+                             f"{', '.join(required + optional)}")
+    missing = [k for k in required if k not in value]
+    if missing:
+        raise PlanInputError(f"{where}: missing field(s) {', '.join(missing)}")
+    return value
+
+
+def _number(where: str, value: Any, low: float, high: float, low_open: bool = False) -> float:
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) \
+        and (value > low if low_open else value >= low) and value <= high
+    if not ok:
+        raise _fail(where, value, f"a number in {'(' if low_open else '['}{low:g}, {high:g}]")
+    return float(value)
+
+
+def _choice(where: str, value: Any, allowed: tuple[str, ...]) -> str:
+    if value not in allowed:
+        raise _fail(where, value, f"one of {', '.join(allowed)}")
+    return str(value)
+
+
+def _flag(where: str, value: Any) -> bool:
+    if not isinstance(value, bool):
+        raise _fail(where, value, "true or false")
+    return value
+
+
+def _vector(where: str, value: Any, low: float, high: float, low_open: bool = False) -> tuple[float, float, float]:
+    if not isinstance(value, (list, tuple)) or len(value) != 3:
+        raise _fail(where, value, "a list of three numbers [x, y, z]")
+    return tuple(_number(f"{where}[{i}]", v, low, high, low_open) for i, v in enumerate(value))  # type: ignore
+
+
+def _text(where: str, value: Any) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise _fail(where, value, "a non-empty text")
+    return value
+
+
+# --- the sections -------------------------------------------------------------------------------------------
+
+def _model(d: Any, base: Path) -> ModelSpec:
+    d = _mapping("model", d, ("file",), ("units", "translate"))
+    path = _model_path(_text("model.file", d["file"]), base)
+    if path.suffix.lower() != ".stl":
+        raise _fail("model.file", d["file"], "an STL file (.stl); STEP and FreeCAD objects are not planned yet")
+    if not path.is_file():
+        raise _fail("model.file", d["file"], f"an existing STL file (looked for {path})")
+    units = _choice("model.units", d.get("units", "mm"), tuple(UNITS))
+    return ModelSpec(path, units, _vector("model.translate", d.get("translate", [0, 0, 0]), -1e4, 1e4))
+
+
+def _model_path(text: str, base: Path) -> Path:
+    """`shared:<path>`: under the project's shared folder (core.shared_data); otherwise relative to the job file."""
+    if text.startswith(SHARED):
+        from tmm_workbench.core.shared_data import shared_dir
+
+        try:
+            return (shared_dir() / text[len(SHARED):]).resolve()
+        except TmmError as exc:
+            raise _fail("model.file", text, str(exc)) from None
+    return (base / text).resolve()
+
+
+def _stock(d: Any) -> StockSpec:
+    d = _mapping("stock", d, (), ("type", "margin", "above", "below"))
+    kind = _choice("stock.type", d.get("type", "box"), STOCK_TYPES)
+    return StockSpec(kind, *(_number(f"stock.{k}", d.get(k, v), 0.0, 1000.0)
+                             for k, v in (("margin", 2.0), ("above", 1.0), ("below", 0.0))))
+
+
+def _machine(d: Any) -> MachineSpec:
+    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max"))
+    return MachineSpec(_choice("machine.type", d.get("type", "3-axis"), MACHINE_TYPES),
+                       _choice("machine.post", d["post"], POSTS),
+                       _vector("machine.travels", d["travels"], 0.0, 1e4, low_open=True),
+                       _number("machine.spindle_max", d.get("spindle_max", 24000.0), materials.MIN_RPM, 1e5),
+                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5))
+
+
+def _tool(i: int, d: Any) -> ToolSpec:
+    where = f"tools[{i}]"
+    d = _mapping(where, d, ("type", "diameter", "flute_length"),
+                 ("name", "corner_radius", "flutes", "holder", "stick_out"))
+    kind = _choice(f"{where}.type", d["type"], TOOL_TYPES)
+    dia = _number(f"{where}.diameter", d["diameter"], 0.0, 100.0, low_open=True)
+    if kind == "bull":
+        if "corner_radius" not in d:
+            raise PlanInputError(f"{where}.corner_radius: missing; a bull-nose tool needs its corner radius")
+        corner = _number(f"{where}.corner_radius", d["corner_radius"], 0.0, dia / 2, low_open=True)
+    elif "corner_radius" in d:  # a flat or ball tool's corner is its shape's: a value here would be ignored
+        raise _fail(f"{where}.corner_radius", d["corner_radius"], f"only for type bull (a {kind} tool's corner "
+                    f"is {'0' if kind == 'flat' else 'its radius'})")
+    else:
+        corner = 0.0 if kind == "flat" else dia / 2
+    flutes = d.get("flutes", 2)
+    if isinstance(flutes, bool) or not isinstance(flutes, int) or not 1 <= flutes <= 12:
+        raise _fail(f"{where}.flutes", flutes, "a whole number in [1, 12]")
+    length = _number(f"{where}.flute_length", d["flute_length"], 0.0, 500.0, low_open=True)
+    holder, stick_out = d.get("holder"), d.get("stick_out")
+    if holder is not None:
+        holder = _holder(f"{where}.holder", holder, dia)
+    if stick_out is not None:
+        if holder is None:
+            raise _fail(f"{where}.stick_out", stick_out, "given with a holder only (it is measured from the "
+                        "holder's face)")
+        stick_out = _number(f"{where}.stick_out", stick_out, length, 1000.0)
+    name = _text(f"{where}.name", d.get("name", f"T{i + 1}"))
+    return ToolSpec(name, kind, dia, corner, flutes, length, holder, stick_out)
+
+
+def _holder(where: str, name: Any, shank: float) -> str:
+    from tmm_workbench.core.tools import holders
+
+    known = holders.names()
+    if name not in known:
+        raise _fail(where, name, f"a holder of TMM's library: {', '.join(known)}")
+    h = holders.holder(name)
+    if not h.shank_min <= shank <= h.shank_max:
+        raise _fail(where, name, f"a holder clamping a {shank:g} mm shank ({name} takes {h.shank_min:g}-"
+                    f"{h.shank_max:g} mm)")
+    return name
+
+
+def _finish(d: Any) -> FinishSpec:
+    d = _mapping("finish", d, ("cusp",), ("tolerance",))
+    return FinishSpec(_number("finish.cusp", d["cusp"], MIN_CUSP, 5.0),
+                      _number("finish.tolerance", d.get("tolerance", 0.01), MIN_CUSP, 5.0))
+
+
+def _outputs(d: Any, base: Path, default_name: str) -> OutputSpec:
+    d = _mapping("outputs", d, ("dir",), ("name", "gcode", "fcstd", "heat_map"))
+    name = _text("outputs.name", d.get("name", default_name))
+    if any(c in name for c in "/\\") or name.startswith("."):
+        raise _fail("outputs.name", name, "a file name without folders (the files are <dir>/<name>.*)")
+    return OutputSpec((base / _text("outputs.dir", d["dir"])).resolve(), name,
+                      *(_flag(f"outputs.{k}", d.get(k, True)) for k in ("gcode", "fcstd", "heat_map")))
+
+
+def _planner(d: Any) -> PlannerSpec:
+    d = _mapping("planner", d, (), ("analysis_cell", "sim_cell", "compare_cutters"))
+    return PlannerSpec(_number("planner.analysis_cell", d.get("analysis_cell", 0.5), 0.05, 5.0),
+                       _number("planner.sim_cell", d.get("sim_cell", 0.2), 0.02, 5.0),
+                       _flag("planner.compare_cutters", d.get("compare_cutters", True)))
+
+
+TOP_FIELDS = ("format", "model", "stock", "machine", "tools", "material", "finish", "outputs", "planner")
+
+
+def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
+    """The checked job of a parsed file `source` (its folder resolves relative paths)."""
+    source = Path(source).resolve()
+    base = source.parent
+    data = _mapping("job file", data, ("format", "model", "machine", "tools", "material", "finish", "outputs"),
+                    ("stock", "planner"))
+    if data["format"] != FORMAT:
+        raise _fail("format", data["format"], f"'{FORMAT}'")
+    tools = data["tools"]
+    if isinstance(tools, str):   # a library file shared by several jobs
+        tools = _library_file(base / tools)
+    if not isinstance(tools, list) or not tools:
+        raise _fail("tools", tools, "a non-empty list of tools (type, diameter, flute_length, ...) or the name "
+                    "of a YAML / JSON file holding one")
+    library = tuple(_tool(i, t) for i, t in enumerate(tools))
+    names = [t.name for t in library]
+    for i, n in enumerate(names):
+        if names.index(n) != i:
+            raise _fail(f"tools[{i}].name", n, "a name no other tool has")
+    material = _choice("material", data["material"], tuple(materials.names()))
+    model = _model(data["model"], base)
+    return JobSpec(source, model, _stock(data.get("stock", {})), _machine(data["machine"]), library, material,
+                   _finish(data["finish"]), _outputs(data["outputs"], base, model.file.stem),
+                   _planner(data.get("planner", {})))
+
+
+def _parsed(p: Path, what: str) -> Any:
+    """The YAML or JSON data of file `p` (by its suffix); PlanInputError naming `what` when it cannot be read."""
+    if not p.is_file():
+        raise PlanInputError(f"{what} not found: {p}")
+    text = p.read_text(encoding="utf-8")
+    suffix = p.suffix.lower()
+    if suffix not in (".json", ".yaml", ".yml"):
+        raise PlanInputError(f"{what} {p.name}: the name must end in .yaml, .yml or .json")
+    try:
+        if suffix == ".json":
+            return json.loads(text)
+        import yaml
+
+        return yaml.safe_load(text)
+    except Exception as exc:  # noqa: BLE001 - json's ValueError, yaml.YAMLError (no common base)
+        raise PlanInputError(f"{what} {p}: not readable as {'JSON' if suffix == '.json' else 'YAML'}: "
+                             f"{exc}") from None
+
+
+def _library_file(p: Path) -> Any:
+    data = _parsed(p, "tools file")
+    if isinstance(data, dict) and set(data) == {"tools"}:
+        return data["tools"]
+    raise _fail(f"tools file {p.name}", data if not isinstance(data, dict) else sorted(data),
+                "a mapping with one field, tools: the list of tools")
+
+
+def read_job(path: Union[str, Path]) -> JobSpec:
+    """The job file at `path` (.yaml / .yml / .json), checked."""
+    p = Path(path)
+    return job_from_dict(_parsed(p, "job file"), p)

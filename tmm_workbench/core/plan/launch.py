@@ -1,0 +1,177 @@
+"""`python3 -m tmm_workbench.plan job.yaml`: the automatic planner's command (docs/planner.md).
+
+Reads and checks the job file, places and analyses the model, decides the ops (all without FreeCAD), then starts
+`freecadcmd` on app/plan_run.py to run the plan as one FreeCAD Job, post it and simulate it. Everything is made
+in a temporary folder beside the output folder and moved into place only when complete (the document, the
+G-code, the heat map and report.json); on bad input or a failure nothing is written.
+
+Exit codes: 0 verified, 1 verification failed (or the Job could not be made: the reason on stderr), 2 bad input.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from functools import partial
+from pathlib import Path
+from typing import Optional, Sequence
+
+import numpy as np
+
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl
+from tmm_workbench.core.plan import analysis, decide
+from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, read_job
+
+VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
+APP_SCRIPT = Path(__file__).resolve().parents[2] / "app" / "plan_run.py"
+REPORT_FORMAT = "tmm-plan-report 1"
+
+
+def say(text: str, quiet: bool) -> None:
+    if not quiet:
+        print(text, file=sys.stderr, flush=True)
+
+
+def placed_mesh(job: JobSpec) -> tuple[TriMesh, bool]:
+    """The model in mm at its place; True when it differs from the file (it is then written for FreeCAD)."""
+    try:
+        mesh = load_stl(job.model.file)
+    except TmmError as exc:
+        raise PlanInputError(f"model.file: {exc}") from None
+    if len(mesh.triangles) == 0:
+        raise PlanInputError(f"model.file: {job.model.file} has no triangles")
+    scale = UNITS[job.model.units]
+    moved = scale != 1.0 or any(job.model.translate)
+    if not moved:
+        return mesh, False
+    vertices = mesh.vertices * scale + np.asarray(job.model.translate, dtype=float)
+    return TriMesh(vertices, mesh.triangles, name=mesh.name), True
+
+
+def write_binary_stl(mesh: TriMesh, path: Path) -> None:
+    """A binary STL of `mesh` (facet normals from the corners)."""
+    c = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.triangles)]
+    n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    rec = np.zeros(len(c), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
+    rec["n"], rec["v"] = n, c
+    with open(path, "wb") as fh:
+        fh.write(b"TMM planner: the model placed, mm".ljust(80, b" "))
+        fh.write(np.uint32(len(rec)).tobytes())
+        fh.write(rec.tobytes())
+
+
+def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis.Analysis, decide.Plan]:
+    """The placed model, whether it was moved, its analysis and the plan (core only; PlanInputError on bad input)."""
+    mesh, moved = placed_mesh(job)
+    say(f"model {job.model.file.name}: {len(mesh.triangles)} triangles; analysing", quiet)
+    tools = [(t.name, decide.cutter_of(t)) for t in job.tools]
+    an = analysis.analyse(mesh, job.planner.analysis_cell, tools, job.finish.tolerance)
+    compare = None
+    if job.planner.compare_cutters:
+        from tmm_workbench.core.plan.optimal_cutter import compare_cutters
+
+        compare = partial(compare_cutters, sample_step=0.5, cell=job.planner.sim_cell,
+                          tolerance=job.finish.tolerance)
+        say("comparing the finishing cutters (seed 003)", quiet)
+    return mesh, moved, an, decide.plan_job(job, mesh, an, compare)
+
+
+def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
+    """What app/plan_run.py needs to run the plan."""
+    o = job.outputs
+    return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
+            "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
+            "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
+            "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
+                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools}}
+
+
+def run_freecad(folder: Path, freecad: str, quiet: bool) -> Optional[str]:
+    """Runs the plan in `folder` under freecadcmd; None when it ran, else the reason it did not."""
+    env = dict(os.environ, TMM_PLAN_FILE=str(folder / "plan.json"))
+    try:
+        proc = subprocess.run([freecad, str(APP_SCRIPT)], env=env, cwd=str(folder), capture_output=True, text=True)
+    except OSError as exc:
+        return f"could not start {freecad}: {exc}"
+    if proc.returncode != 0 or not (folder / "verify.json").is_file():
+        tail = "\n".join((proc.stderr or proc.stdout or "").strip().splitlines()[-12:])
+        return f"the FreeCAD run failed (exit {proc.returncode}):\n{tail}"
+    say("FreeCAD run done", quiet)
+    return None
+
+
+def report(job: JobSpec, an: analysis.Analysis, plan: decide.Plan, verified: dict, files: list) -> dict:
+    return {"format": REPORT_FORMAT, "job_file": job.source.name, "passed": verified["passed"],
+            "problems": verified["problems"], "verification": verified, "analysis": an.as_dict(),
+            "plan": plan.as_dict(), "finish": {"cusp_mm": job.finish.cusp, "tolerance_mm": job.finish.tolerance},
+            "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels)},
+            "files": sorted(files)}
+
+
+def move_into_place(tmp: Path, target: Path) -> list:
+    """The finished files from `tmp` into `target` (created), replacing files of the same name."""
+    target.mkdir(parents=True, exist_ok=True)
+    names = []
+    for f in sorted(tmp.iterdir()):
+        os.replace(f, target / f.name)
+        names.append(f.name)
+    return names
+
+
+def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False) -> int:
+    t0 = time.perf_counter()
+    try:
+        job = read_job(job_path)
+        mesh, moved, an, plan = make_plan(job, quiet)
+    except PlanInputError as exc:
+        print(f"tmm plan: bad input: {exc}", file=sys.stderr)
+        return BAD_INPUT
+    say(f"planned {len(plan.ops)} ops in {time.perf_counter() - t0:.1f} s: "
+        + ", ".join(op.label for op in plan.ops), quiet)
+    out = job.outputs
+    out.dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=str(out.dir.parent)))
+    try:
+        model_file = job.model.file
+        if moved:
+            model_file = tmp / f"{out.name}_model.stl"
+            write_binary_stl(mesh, model_file)
+        (tmp / "plan.json").write_text(json.dumps(plan_document(job, plan, model_file), indent=1, sort_keys=True))
+        failure = run_freecad(tmp, freecad, quiet)
+        if failure is not None:
+            print(f"tmm plan: {failure}", file=sys.stderr)
+            return FAILED
+        verified = json.loads((tmp / "verify.json").read_text())
+        for name in ("plan.json", "verify.json"):
+            (tmp / name).unlink()
+        files = sorted(f.name for f in tmp.iterdir()) + ["report.json"]
+        doc = report(job, an, plan, verified, files)
+        (tmp / "report.json").write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
+        move_into_place(tmp, out.dir)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    for change in verified.get("replanned", []):
+        say(f"plan changed: {change}", quiet)
+    state = "verified" if verified["passed"] else "verification FAILED: " + "; ".join(verified["problems"])
+    say(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left {verified['most_material_left_mm']:g}"
+        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out.dir} "
+        f"({time.perf_counter() - t0:.0f} s)", quiet)
+    return VERIFIED if verified["passed"] else FAILED
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    ap = argparse.ArgumentParser(prog="python3 -m tmm_workbench.plan",
+                                 description="Plans, runs and verifies a Job from a job file (docs/planner.md).")
+    ap.add_argument("job", help="the job file (.yaml, .yml or .json)")
+    ap.add_argument("--freecad", default=os.environ.get("TMM_FREECADCMD", "freecadcmd"),
+                    help="the freecadcmd to run (default: $TMM_FREECADCMD or freecadcmd)")
+    ap.add_argument("--quiet", action="store_true", help="no progress lines (errors only)")
+    args = ap.parse_args(argv)
+    return run(args.job, args.freecad, args.quiet)
