@@ -40,7 +40,8 @@ def addon_version() -> str:
 
 
 def input_key(job: Path) -> str:
-    """sha256 of the job file, the model file it names (and a tools file it names) and the add-on version."""
+    """sha256 of the job file, the model file it names, its tools (a shared tools file's too) and the add-on's
+    version."""
     from tmm_workbench.core.plan.job_file import read_job   # the planner's own reading of the job file
 
     h = hashlib.sha256()
@@ -48,13 +49,11 @@ def input_key(job: Path) -> str:
     h.update(job.read_bytes())
     try:
         spec = read_job(str(job))
-        inputs = [spec.model.file] + ([spec.tools_file] if getattr(spec, "tools_file", None) else [])
     except Exception:   # a job the planner refuses still gets a key: its own bytes (the refusal is its result)
-        inputs = []
-    for f in inputs:
-        p = Path(f)
-        if p.is_file():
-            h.update(p.read_bytes())
+        return h.hexdigest()
+    h.update(repr(spec.tools).encode())
+    if Path(spec.model.file).is_file():
+        h.update(Path(spec.model.file).read_bytes())
     return h.hexdigest()
 
 
@@ -80,6 +79,8 @@ def run_part(job: str, out_root: str, timeout_s: float = 3600.0, python: Optiona
            "worker": os.uname().nodename + f":{os.getpid()}"}
     if (folder / REPORT).is_file():
         return {**row, **_figures(folder), "state": "done before (skipped)", "exit_code": 0, "seconds": 0.0}
+    for stale in folder.parent.glob(f".{folder.name}.*"):   # a killed worker's attempt (its planner died with it)
+        shutil.rmtree(stale, ignore_errors=True)
     tmp = folder.with_name(f".{folder.name}.{uuid.uuid4().hex[:8]}")
     tmp.mkdir(parents=True)
     env = dict(os.environ, TMM_THREADS="1", OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",

@@ -17,6 +17,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from dataclasses import replace
 from functools import partial
 from pathlib import Path
 from typing import Optional, Sequence
@@ -125,10 +126,13 @@ def move_into_place(tmp: Path, target: Path) -> list:
     return names
 
 
-def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False) -> int:
+def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None) -> int:
+    """Plans, runs and verifies the job; `out_dir` in place of the job file's outputs.dir (a batch's part folder)."""
     t0 = time.perf_counter()
     try:
         job = read_job(job_path)
+        if out_dir is not None:
+            job = replace(job, outputs=replace(job.outputs, dir=Path(out_dir).resolve()))
         mesh, moved, an, plan = make_plan(job, quiet)
     except PlanInputError as exc:
         print(f"tmm plan: bad input: {exc}", file=sys.stderr)
@@ -173,5 +177,6 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--freecad", default=os.environ.get("TMM_FREECADCMD", "freecadcmd"),
                     help="the freecadcmd to run (default: $TMM_FREECADCMD or freecadcmd)")
     ap.add_argument("--quiet", action="store_true", help="no progress lines (errors only)")
+    ap.add_argument("--out", default=None, help="the folder for the outputs, in place of the job file's outputs.dir")
     args = ap.parse_args(argv)
-    return run(args.job, args.freecad, args.quiet)
+    return run(args.job, args.freecad, args.quiet, args.out)
