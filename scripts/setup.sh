@@ -42,4 +42,6 @@ cmake --build build -j"$(nproc)"
 MOD="${HOME}/.local/share/FreeCAD/Mod"
 mkdir -p "$MOD"
 ln -sfn "$ROOT" "$MOD/TMM"
+# The `tmm` command (tmm plan, tmm batch) on the PATH.
+if [ -w /usr/local/bin ]; then ln -sfn "$ROOT/scripts/tmm" /usr/local/bin/tmm; fi
 echo "[setup] ready: kernel built, add-on linked at $MOD/TMM"
