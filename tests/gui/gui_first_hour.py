@@ -85,19 +85,11 @@ def status_text() -> str:
 
 
 def job_from_stl(info: dict, stl: str):
-    from tmm_workbench.gui import job_cmd
-
     doc = FreeCAD.newDocument("TmmFirstHour")
-    mesh = job_cmd.import_stl(stl)
-    doc.recompute()
-    FreeCADGui.Selection.clearSelection()
-    FreeCADGui.Selection.addSelection(mesh)
-    FreeCADGui.runCommand(job_cmd.COMMAND_NAME)
-    pump(1.0)
+    mesh, job = gui_runner.job_from_stl(doc, stl)
     info["job_panel"] = bool(FreeCADGui.Control.activeDialog())
     click(QtGui.QDialogButtonBox.Ok)
     wait_closed()
-    job = next(o for o in doc.Objects if hasattr(o, "Operations") and hasattr(o, "Stock"))
     FreeCADGui.activeDocument().activeView().viewIsometric()
     FreeCADGui.SendMsgToActiveView("ViewFit")
     return doc, mesh, job
@@ -161,6 +153,8 @@ def cusp_finish(info: dict, doc, mesh, job):
     flat = flat_end_mill(job)
     op = new_op(job, "TMM_Surface", {"region": "Sketch", "regionSketch": sketch.Label, "sampleStep": "0.5 mm"})
     info["surface_label"] = op.Label
+    info["surface_page_title"] = [w.text() for w in FreeCADGui.getMainWindow().findChildren(QtGui.QLabel)
+                                  if w.isVisible() and w.text().startswith("TMM")]
     probe(info, op, 'new op')
     refusals(info, op, flat)
     est = work_estimate.estimate(op)   # what the status line tells (asserted there)
@@ -188,6 +182,8 @@ def simulate(info: dict, job, key: str, cell: float) -> None:
     page = find_panel(simulate_cmd.PANEL_NAME)
     page.findChild(QtGui.QDoubleSpinBox, "cell").setValue(cell)
     page.findChild(QtGui.QPushButton, "simulate").click()   # returns when done
+    FreeCADGui.activeDocument().activeView().viewIsometric()
+    FreeCADGui.SendMsgToActiveView("ViewFit")
     pump(1.0)
     info[key] = {"status": page.findChild(QtGui.QLabel, "status").text(),
                  "max_left": page.findChild(QtGui.QLabel, "maxLeft").property("value"),

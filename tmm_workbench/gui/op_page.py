@@ -197,10 +197,15 @@ class OpViewProvider(PathOpGui.ViewProvider):
         return self.ICON
 
     def setEdit(self, vobj: Any = None, mode: int = 0) -> bool:
+        from tmm_workbench.app import registry
         from tmm_workbench.gui import panel_state
 
-        with panel_state.first_step_named(self.Object, PathOpGui):   # the op's name, not "AreaOp Operation"
-            return super().setEdit(vobj, mode)
+        type_name, self.OpName = self.OpName, registry.user_name(self.OpName)   # the page's title: "TMM Surface"
+        try:
+            with panel_state.first_step_named(self.Object, PathOpGui):   # the op's name, not "AreaOp Operation"
+                return super().setEdit(vobj, mode)
+        finally:
+            self.OpName = type_name   # FreeCAD saves it with the view provider
 
     def setupTaskPanel(self, panel: Any) -> None:
         from tmm_workbench.gui import panel_state
