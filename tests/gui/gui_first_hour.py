@@ -29,7 +29,8 @@ gui_runner.helpers_of("gui_user_input")
 from gui_user_input import take_box  # noqa: E402
 
 gui_runner.helpers_of("gui_state")
-from gui_state import click, screenshot, type_into, visible, wait_closed, watch_message_boxes  # noqa: E402
+from gui_state import click, screenshot, type_into, visible, wait_closed  # noqa: E402
+from gui_state import watch_message_boxes, widen_panel  # noqa: E402
 
 RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_first_hour.json")
 SHOT_WIDTH = 800   # small pictures for docs/gui
@@ -37,7 +38,10 @@ TIMES: list = []   # (step, monotonic time): where the session's time goes (repo
 
 
 def shot(name: str) -> str:
-    """The main window (gui_state.screenshot) scaled to SHOT_WIDTH px."""
+    """The main window (gui_state.screenshot, the task panel widened to show its labels) scaled to SHOT_WIDTH px."""
+    if FreeCADGui.Control.activeDialog():
+        widen_panel(visible(QtGui.QLabel, "status"))
+        pump(0.3)
     png = screenshot(name)
     image = QtGui.QImage(png).scaledToWidth(SHOT_WIDTH, QtCore.Qt.SmoothTransformation)
     assert image.save(png), png
@@ -153,8 +157,6 @@ def cusp_finish(info: dict, doc, mesh, job):
     flat = flat_end_mill(job)
     op = new_op(job, "TMM_Surface", {"region": "Sketch", "regionSketch": sketch.Label, "sampleStep": "0.5 mm"})
     info["surface_label"] = op.Label
-    info["surface_page_title"] = [w.text() for w in FreeCADGui.getMainWindow().findChildren(QtGui.QLabel)
-                                  if w.isVisible() and w.text().startswith("TMM")]
     probe(info, op, 'new op')
     refusals(info, op, flat)
     est = work_estimate.estimate(op)   # what the status line tells (asserted there)
