@@ -44,6 +44,7 @@ def shot(name: str) -> str:
         pump(0.3)
     png = screenshot(name)
     image = QtGui.QImage(png).scaledToWidth(SHOT_WIDTH, QtCore.Qt.SmoothTransformation)
+    image = image.convertToFormat(QtGui.QImage.Format_Indexed8)   # 256 colours: a third of the bytes
     assert image.save(png), png
     return png
 
