@@ -221,14 +221,14 @@ class Api(FreeCADTestCase):
                 self.assertIn(text, str(ctx.exception))
 
     def test_a_flat_end_mill_in_a_cusp_mode_is_warned(self) -> None:
-        from tmm_workbench.app.op_surface import check_tool_fit
+        from tmm_workbench.core.strategies.surface.estimate import tool_fit
         from tmm_workbench.core.strategies.raster_drop import SurfaceParams
         from tmm_workbench.core.tools.cutter import Cutter
 
         params = SurfaceParams(stepover_mode="cusp", cusp=0.01)
-        self.assertIn("a ball or bull-nose end mill", check_tool_fit(params, Cutter.flat(6.0)))
-        self.assertEqual(check_tool_fit(params, Cutter.ball(6.0)), "")
-        self.assertEqual(check_tool_fit(SurfaceParams(stepover=6.0), Cutter.flat(6.0)), "")
+        self.assertIn("a ball or bull-nose end mill", tool_fit(params, Cutter.flat(6.0)))
+        self.assertEqual(tool_fit(params, Cutter.ball(6.0)), "")
+        self.assertEqual(tool_fit(SurfaceParams(stepover=6.0), Cutter.flat(6.0)), "")
         # a cusp with the verification is read in the step-over mode too
         r = run_surface(bump_stl(), cusp=0.05, verify_cusp=True, progress=False, doc_name="TmmVerifyStep")
         self.assertAlmostEqual(r.op.CuspHeight.Value, 0.05)

@@ -49,7 +49,6 @@ def run() -> dict:
     pump(0.5)
     from tmm_workbench.app import model_proxy, registry, tools
     from tmm_workbench.core.shared_data import benchmark_file
-    from tmm_workbench.gui import job_cmd
 
     doc = FreeCAD.newDocument("TmmGuiFirstSteps")
     pump(0.5)
@@ -59,13 +58,7 @@ def run() -> dict:
     info["path_toolbar"] = toolbar_texts("TMM Path")
     assert info["path_toolbar"] and "Job" not in info["path_toolbar"], info["path_toolbar"]
     stl = os.environ.get("TMM_GUI_STL") or str(benchmark_file("stl", "sphere_on_plate.stl"))
-    mesh = job_cmd.import_stl(stl)
-    doc.recompute()
-    FreeCADGui.Selection.clearSelection()
-    FreeCADGui.Selection.addSelection(mesh)
-    FreeCADGui.runCommand(job_cmd.COMMAND_NAME)
-    pump(1.0)
-    job = next(o for o in doc.Objects if hasattr(o, "Operations") and hasattr(o, "Stock"))
+    mesh, job = gui_runner.job_from_stl(doc, stl)
     info["job_panel_open"] = bool(FreeCADGui.Control.activeDialog())
     info["stock_visible"] = bool(job.Stock.ViewObject.Visibility)
     tc = job.Tools.Group[0]

@@ -83,6 +83,21 @@ def close_document(doc) -> None:
     forget_found_widgets()
 
 
+def job_from_stl(doc, stl: str) -> tuple:
+    """`stl` read into a Mesh object of `doc`, selected, and TMM's *Job from mesh / STL* run on it as a user does:
+    (the mesh, the Job); the Job's panel is left open."""
+    import FreeCADGui
+    from tmm_workbench.gui import job_cmd
+
+    mesh = job_cmd.import_stl(stl)
+    doc.recompute()
+    FreeCADGui.Selection.clearSelection()
+    FreeCADGui.Selection.addSelection(mesh)
+    FreeCADGui.runCommand(job_cmd.COMMAND_NAME)
+    pump(1.0)
+    return mesh, next(o for o in doc.Objects if hasattr(o, "Operations") and hasattr(o, "Stock"))
+
+
 def run(session: Callable[[dict], None], result: Path) -> None:
     """Schedules `session(info)`; `info` (filled step by step, so a failure keeps what was seen before it),
     with "ok" and any "error" traceback, goes to `result`; then FreeCAD quits at once (no save-changes

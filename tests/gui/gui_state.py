@@ -149,17 +149,9 @@ def job_from_mesh(info: dict, stl: str):
     """Step 1: the STL as a mesh object, selected; the TMM command makes the Job."""
     from tmm_workbench.app import job as jobs
     from tmm_workbench.app import tools
-    from tmm_workbench.gui import job_cmd
-
     doc = FreeCAD.newDocument("TmmGuiState")
-    mesh = job_cmd.import_stl(stl)
-    doc.recompute()
-    FreeCADGui.Selection.clearSelection()
-    FreeCADGui.Selection.addSelection(mesh)
-    FreeCADGui.runCommand(job_cmd.COMMAND_NAME)
-    pump(1.0)
+    _, job = gui_runner.job_from_stl(doc, stl)
     click(QtGui.QDialogButtonBox.Ok)  # the Job's panel the command opens: the user accepts the stock
-    job = next(o for o in doc.Objects if o.TypeId == "Path::FeaturePython" and hasattr(o, "Operations"))
     info["job_post"] = job.PostProcessor
     info["job_post_first_offered"] = job.getEnumerationsOfProperty("PostProcessor")[0]
     info["bounds_visible_new"] = [o.ViewObject.Visibility for o in bounds_objects(doc)]

@@ -8,12 +8,12 @@ from pathlib import Path
 
 from tests.conftest import SHARED_STL
 from tests.freecad import fc_process
+from tests.gui.launch import FREECAD, XVFB_RUN
+from tests.gui.launch import blank as _blank
 
 HERE = Path(__file__).resolve().parent
 PNG = fc_process.ROOT / "out" / "gui_smoke.png"
 SIM_PNG = PNG.with_name("gui_simulate.png")  # gui_smoke.py writes it beside PNG
-FREECAD = fc_process.find("freecad", "FreeCAD")
-XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 120
 STL = str(SHARED_STL / "sphere_on_plate.stl")  # where the test finds it, also inside a chroot
 
@@ -56,13 +56,3 @@ def test_gui_smoke(tmp_path: Path) -> None:
     assert SIM_PNG.is_file() and SIM_PNG.stat().st_size > 10_000
     assert not _blank(SIM_PNG), "the simulation screenshot is blank"
 
-
-def _blank(png: Path) -> bool:
-    """A blank grab has (almost) one colour; a window with a panel and a 3D view has many."""
-    try:
-        from PIL import Image
-    except ImportError:  # no Pillow: the size check above has to do
-        return False
-    with Image.open(png) as im:
-        colours = im.convert("RGB").resize((320, 256)).getcolors(maxcolors=1 << 16)
-    return colours is not None and len(colours) < 16

@@ -449,7 +449,10 @@ def create(proxy_class: type, view_kind: str, name: str, obj: Any = None, parent
     GUI it gets the view provider `view_kind` (hooks.attach_view)."""
     if obj is None:
         doc = parentJob.Document if parentJob is not None else FreeCAD.ActiveDocument
+        from tmm_workbench.app import registry
+
         obj = doc.addObject("Path::FeaturePython", name)
+        obj.Label = registry.user_name(name)   # the user's words, not the type name
     obj.Proxy = proxy_class(obj, name, parentJob, values)
     if obj.Proxy is not None:  # not for the SetupSheet's prototypes
         hooks.attach_view(view_kind, obj)

@@ -29,7 +29,8 @@ from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.stage import Field, Stage
 from tmm_workbench.core.strategies import finish_passes, raster_drop
 from tmm_workbench.core.strategies.surface import forward_step, pattern, positioning
-from tmm_workbench.core.strategies.surface.params import OFFSET3D, SAMPLED, STEPOVER, SurfaceParams
+from tmm_workbench.core.strategies.surface.estimate import tool_fit
+from tmm_workbench.core.strategies.surface.params import OFFSET3D, SAMPLED, SurfaceParams
 
 OP_NAME = "TMM_Surface"
 BOUNDARIES = ("Stock", "Model")
@@ -100,7 +101,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         params.rest = None if rest is None else rest.stock
         params.pencil_curves = pencil_source.curves_of(obj)   # an outline's or a footprint file's (pattern Pencil)
         params.cleanup_reference = pencil_source.finishing_cutter(obj, cutter)   # the clean-up's finishing tool
-        flat_cusp = check_tool_fit(params, cutter)
+        flat_cusp = tool_fit(params, cutter)
         if flat_cusp:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")
         if params.arcs and self.post_without_k(obj):
@@ -147,20 +148,6 @@ def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,
 
 # Lets the Job's SetupSheet hold defaults for this op, headless too (the GUI's SetupOperation repeats it).
 PathSetupSheet.RegisterOperation(OP_NAME, Create, SetupProperties)
-
-
-def check_tool_fit(params: SurfaceParams, cutter: Any) -> str:
-    """A step-over wider than the tool leaves strips no pass touches: refused by name. A cusp spacing with a flat
-    end mill (its cusps come from the bottom's edge on every slope, so the passes crowd): the warning to show."""
-    if params.stepover_mode == STEPOVER and params.stepover > cutter.diameter:
-        raise TmmError(f"StepOver {params.stepover:g} mm is wider than the tool (diameter {cutter.diameter:g} mm): "
-                       f"strips between the passes would stay uncut; set it to at most {cutter.diameter:g} mm")
-    if params.stepover_mode != STEPOVER and cutter.corner_radius <= 0:
-        return (f"{params.stepover_mode} spacing with a flat end mill: its cusps come from the edge of its flat "
-                "bottom on every slope, so the passes fall very close together (many more than with a rounded "
-                f"tool); a ball or bull-nose end mill of the same diameter holds CuspHeight {params.cusp:g} mm "
-                "with far fewer passes")
-    return ""
 
 
 def check_final_depth(obj: Any, final_depth: Optional[float]) -> None:

@@ -70,6 +70,11 @@ def entry(name: str) -> OpEntry:
     raise KeyError(f"no TMM operation '{name}' (known: {', '.join(e.name for e in OPS)})")
 
 
+def user_name(name: str) -> str:
+    """An op type's name in the user's words, for new ops' labels and undo steps ("TMM Surface")."""
+    return name.replace("_", " ")
+
+
 def create(name: str, job: Any, values: Optional[dict[str, Any]] = None) -> Any:
     """A new op of type `name` in `job` with property `values` (headless API, macros)."""
     module = entry(name).app()

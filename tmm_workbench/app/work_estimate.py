@@ -234,14 +234,49 @@ def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> In
 
 
 def _mesh_at_hand(proxy: Any, obj: Any, load_stl: bool) -> Any:
-    """The op's model as a mesh without tessellating anything: its last computation's, or its STL file's (read
-    anyway for the bounds when `load_stl`); None for a Part model not computed yet."""
+    """The op's model as a mesh without tessellating anything: its last computation's, its STL file's (read
+    anyway for the bounds when `load_stl`) or the Job's mesh models' (_model_meshes); None for a Part model not
+    computed yet."""
     mesh = getattr(proxy, "mesh", None)
     if mesh is not None:
         return mesh
-    if getattr(obj, "StlFile", "") and load_stl:
-        return geometry.mesh_from_stl(obj.StlFile)
-    return None
+    if getattr(obj, "StlFile", ""):
+        return geometry.mesh_from_stl(obj.StlFile) if load_stl else None
+    return _model_meshes(obj)
+
+
+_feature_mesh: dict[tuple, Any] = {}   # the last Mesh object read: (document, name, counts, box) -> its TriMesh
+
+
+def _model_meshes(obj: Any) -> Any:
+    """The op's Model or the Job's models when all are meshes (Mesh objects, or TMM's stand-ins for a Mesh object
+    or an STL file), as one mesh; None when one is a Part model (tessellating it is the computation's work)."""
+    from tmm_workbench.app import model_proxy
+    from tmm_workbench.app.compat import PathUtils
+
+    models = [obj.Model] if getattr(obj, "Model", None) is not None else []
+    if not models:
+        job = PathUtils.findParentJob(obj)
+        models = list(job.Model.Group) if job is not None else []
+    sources = [model_proxy.source_of(m) or m for m in models]
+    if not sources or not all(isinstance(s, str) or (hasattr(s, "Mesh") and not hasattr(s, "Shape"))
+                              for s in sources):
+        return None
+    meshes = [geometry.mesh_from_stl(s) if isinstance(s, str) else _mesh_feature(s) for s in sources]
+    return meshes[0] if len(meshes) == 1 else geometry.combine(meshes)
+
+
+def _mesh_feature(obj: Any) -> Any:
+    """A Mesh object's TriMesh, kept while the object's mesh keeps its counts and box (the panel asks on every
+    value entered, and _sample keeps its index for the same TriMesh)."""
+    m = obj.Mesh
+    bb = m.BoundBox
+    key = (obj.Document.Name, obj.Name, m.CountPoints, m.CountFacets, bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax,
+           bb.ZMax)
+    if key not in _feature_mesh:
+        _feature_mesh.clear()
+        _feature_mesh[key] = geometry.mesh_from_mesh_feature(obj)
+    return _feature_mesh[key]
 
 
 _surface: list[Any] = []           # [mesh, its DropSurface]: the last model's index

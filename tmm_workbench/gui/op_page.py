@@ -69,6 +69,8 @@ class OpPage(PathOpGui.TaskPanelPage):
         self.get_extra(obj)
         self.updateToolController(obj, self.form.toolController)
         self.updateCoolant(obj, self.form.coolantController)
+        if getattr(self, "guard", None) and not held:  # told again with the choices just written (tool, mode)
+            self.guard.estimate_text = self.guard.estimate(obj, {})
         self.showStatus(obj)
 
     def setFields(self, obj: Any) -> None:
@@ -194,6 +196,17 @@ class OpViewProvider(PathOpGui.ViewProvider):
             return f":/icons/{command_prefix()}OpActive.svg"
         return self.ICON
 
+    def setEdit(self, vobj: Any = None, mode: int = 0) -> bool:
+        from tmm_workbench.app import registry
+        from tmm_workbench.gui import panel_state
+
+        type_name, self.OpName = self.OpName, registry.user_name(self.OpName)   # the page's title: "TMM Surface"
+        try:
+            with panel_state.first_step_named(self.Object, PathOpGui):   # the op's name, not "AreaOp Operation"
+                return super().setEdit(vobj, mode)
+        finally:
+            self.OpName = type_name   # FreeCAD saves it with the view provider
+
     def setupTaskPanel(self, panel: Any) -> None:
         from tmm_workbench.gui import panel_state
 
@@ -214,8 +227,10 @@ def attach_view_provider(obj: Any, view_provider: type, res: Any) -> None:
 
 def create(res: Any, view_provider: type, no_tool_text: str) -> Any:
     """PathOpGui.Create with our view provider: the new op in one undo step, its task panel open."""
+    from tmm_workbench.app import registry
+
     doc = FreeCAD.ActiveDocument
-    doc.openTransaction(f"Create {res.name}")
+    doc.openTransaction(f"Create {registry.user_name(res.name)}")
     try:
         obj = res.objFactory(res.name, obj=None, parentJob=res.job)
         if obj.Proxy:

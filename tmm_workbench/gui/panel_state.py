@@ -14,17 +14,34 @@ from __future__ import annotations
 
 import gc
 import sys
-from typing import Any
+from contextlib import contextmanager
+from typing import Any, Iterator
 
 from PySide import QtCore, QtGui
 
 
 
 def transaction_name(obj: Any) -> str:
-    """The undo step of an op panel's edits after a good Apply: the action and the op's label (as the user named
-    it). (The panel's first step keeps FreeCAD's name, "AreaOp Operation": its pages write the op while FreeCAD's
-    panel builds them, and opening another transaction then would split that step in two.)"""
+    """The undo step of an op panel's edits: the action and the op's label (as the user named it)."""
     return f"Edit {obj.Label}"
+
+
+FREECAD_STEP = "AreaOp Operation"   # the name FreeCAD's op panel gives the undo step it opens
+
+
+@contextmanager
+def first_step_named(obj: Any, op_gui: Any) -> Iterator[None]:
+    """While FreeCAD's op panel is built (`op_gui`: its module, PathOpGui), the undo step it opens is named as the
+    panel's later steps are, not FreeCAD's FREECAD_STEP. It opens the step before building its pages, which write
+    the op: a step opened afterwards would split them in two, so the name is given as it asks for its
+    translation."""
+    translate = op_gui.translate
+    name = transaction_name(obj)
+    op_gui.translate = lambda context, text, *args: name if text == FREECAD_STEP else translate(context, text, *args)
+    try:
+        yield
+    finally:
+        op_gui.translate = translate
 
 
 def commit_on_apply(panel: Any) -> None:

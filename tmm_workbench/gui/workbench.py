@@ -10,9 +10,12 @@ from tmm_workbench.app.compat import command_prefix
 
 # FreeCAD's own commands, without their prefix (Path_ on 0.20, CAM_ from 1.0)
 JOB_TOOLS = ["Job", "Post", "Inspect", "Simulator"]
-# the toolbar offers what works with a mesh: FreeCAD's Job offers only solids as its model (an empty list for an
-# imported STL), so it stays in the menu only; TMM's Job from mesh / STL is the toolbar's first button
-JOB_TOOLBAR = [t for t in JOB_TOOLS if t != "Job"]
+# the toolbar offers what works with a mesh Job (post, inspect, the tool bits); in the menu only: FreeCAD's Job
+# (it offers only solids as its model: an empty list for an imported STL; TMM's Job from mesh / STL is the toolbar's
+# first button) and FreeCAD's Simulator (it cuts the stock with X, Y, Z alone, so a 5-axis op's moves show wrong,
+# and measures nothing against the mesh: TMM Simulate does both)
+MENU_ONLY = ("Job", "Simulator")
+JOB_TOOLBAR = [t for t in JOB_TOOLS if t not in MENU_ONLY]
 TOOL_TOOLS = ["ToolBitLibraryOpen", "ToolBitDock", "ToolBitCreate", "ToolBitLoad", "ToolController"]
 
 

@@ -16,7 +16,7 @@ from typing import Optional
 import numpy as np
 
 from tmm_workbench.core import polygons
-from tmm_workbench.core.errors import WorkLimitError
+from tmm_workbench.core.errors import TmmError, WorkLimitError
 from tmm_workbench.core.footprint import offset_field, region
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.raster import pass_count
@@ -35,10 +35,31 @@ _LEAST_BEND = 0.25                    # a convex section widens the step at most
 _WORST_PERCENT = 3.0                  # the cusp mode's worst crossing: this percentile of the places' steps
 
 
+def tool_fit(params: SurfaceParams, cutter: Cutter) -> str:
+    """A step-over wider than the tool leaves strips no pass touches: refused by name. A cusp spacing with a flat
+    end mill (its cusps come from the bottom's edge on every slope, so the passes crowd): the warning to show."""
+    if params.stepover_mode == STEPOVER and params.stepover > cutter.diameter:
+        raise TmmError(f"StepOver {params.stepover:g} mm is wider than the tool (diameter {cutter.diameter:g} mm): "
+                       f"strips between the passes would stay uncut; set it to at most {cutter.diameter:g} mm")
+    if params.stepover_mode != STEPOVER and cutter.corner_radius <= 0:
+        return (f"{params.stepover_mode} spacing with a flat end mill: its cusps come from the edge of its flat "
+                "bottom on every slope, so the passes fall very close together (many more than with a rounded "
+                f"tool); a ball or bull-nose end mill of the same diameter holds CuspHeight {params.cusp:g} mm "
+                "with far fewer passes")
+    return ""
+
+
 def estimate_work(params: SurfaceParams, cutter: Cutter, bounds: Box, sample: Optional[HeightSample] = None) -> Work:
     """The Surface's work over `params.boundary` and its region (`bounds`: the model's box, unused: the boundary is
-    the params'); `sample`: the model's heights over the boundary, for the passes and length told."""
+    the params'); `sample`: the model's heights over the boundary, for the passes and length told. A step-over
+    wider than the tool is refused (TmmError); a cusp spacing with a flat end mill is told in the work's note."""
     params.validate()
+    flat_cusp = tool_fit(params, cutter) if params.pattern != PENCIL else ""
+    work = _estimate(params, cutter, sample)
+    return replace(work, note=f"{work.note} WARNING: {flat_cusp}".strip()) if flat_cusp else work
+
+
+def _estimate(params: SurfaceParams, cutter: Cutter, sample: Optional[HeightSample]) -> Work:
     if params.pattern == PENCIL:  # the creases' grid of drops and the curves' points (count_points' bound)
         count = count_points(params)
         x0, y0, x1, y1 = params.boundary
