@@ -1,6 +1,6 @@
-"""`tmm batch` on 1 and on 2 local Dask workers, the same 8 parts (the planner's coarse test job,
-tests/data/plan_beet.yaml, on each shared STL and on a sign of seed 003 made by core.geometry.sign), each run
-from an empty output folder: wall time, speed-up, per-part planning time and the peak memory of a part's
+"""`tmm batch` on 1 and on 2 local Dask workers, the same 8 parts (the planner's job files of benchmarks/jobs at a
+coarser finish, two of them twice, and a sign of seed 003 made by core.geometry.sign), each run from an empty
+output folder: wall time, speed-up, per-part planning time and the peak memory of a part's
 planner and FreeCAD (what one worker holds at a time). Prints a table.
 
     python3 benchmarks/batch_speedup.py [--workers 1 2] [--keep DIR]
@@ -22,21 +22,26 @@ sys.path.insert(0, str(ROOT))
 from tmm_workbench.batch import run as batch  # noqa: E402
 from tmm_workbench.core.geometry.mesh import save_stl  # noqa: E402
 from tmm_workbench.core.geometry.sign import SignSpec, make_sign  # noqa: E402
-from tmm_workbench.core.shared_data import benchmark_file  # noqa: E402
+from tmm_workbench.core.plan.job_file import read_job  # noqa: E402
 
-JOB = ROOT / "tests" / "data" / "plan_beet.yaml"
-MODELS = ("beet_mm.stl", "demo.stl", "ktoolcav.stl", "mount_rush.stl", "pycam-textbox.stl", "sphere_on_plate.stl",
-          "wheel_in_box.stl")
+JOBS = ROOT / "benchmarks" / "jobs"
+COARSE = {"finish": {"cusp": 0.05, "tolerance": 0.01}, "planner": {"analysis_cell": 0.5, "sim_cell": 0.4}}
+# 8 parts: the shared models the planner verifies (benchmarks/jobs), two of them twice at another finish, a sign
+PARTS = [("beet", {}), ("demo", {}), ("mount_rush", {}), ("pycam_textbox", {}), ("sphere_on_plate", {}),
+         ("beet", {"finish": {"cusp": 0.02, "tolerance": 0.01}}), ("demo", {"finish": {"cusp": 0.1, "tolerance": 0.01}})]
 
 
 def make_jobs(folder: Path) -> Path:
+    """The 8 job files in `folder` (models and tools files by absolute path, the coarse planner values)."""
     folder.mkdir(parents=True)
     sign = save_stl(make_sign(SignSpec("TMM 2026", width=100, height=50, cell=0.4)).mesh, folder / "sign.stl")
-    base = yaml.safe_load(JOB.read_text())
-    for model in [benchmark_file("stl", m) for m in MODELS] + [sign]:
-        data = dict(base, model=dict(base["model"], file=str(model)))
-        data["machine"] = dict(data["machine"], travels=[600, 400, 200])
-        (folder / f"{Path(model).stem.replace('-', '_')}.yaml").write_text(yaml.safe_dump(data))
+    for k, (name, change) in enumerate(PARTS + [("beet", {"model": {"file": str(sign), "units": "mm"}})]):
+        data = yaml.safe_load((JOBS / f"{name}.yaml").read_text())
+        data["model"]["file"] = str(read_job(JOBS / f"{name}.yaml").model.file)
+        data["tools"] = str((JOBS / data["tools"]).resolve())
+        data.update(COARSE, **change)
+        (folder / f"part{k + 1}_{Path(data['model']['file']).stem.replace('-', '_')}.yaml").write_text(
+            yaml.safe_dump(data))
     return folder
 
 

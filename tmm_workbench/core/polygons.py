@@ -194,6 +194,23 @@ def grid_inside(shape: Shape, xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
     return out
 
 
+def points_inside(shape: Shape, xy: np.ndarray) -> np.ndarray:
+    """(n,) bool: the points (n, 2) inside the shape (even-odd rule, as grid_inside), vectorised over the
+    points, one edge at a time."""
+    xy = np.asarray(xy, float).reshape(-1, 2)
+    x, y = xy[:, 0], xy[:, 1]
+    out = np.zeros(len(xy), dtype=bool)
+    for p in shape:
+        a = np.asarray(p, float)
+        b = np.roll(a, -1, axis=0)
+        for (xa, ya), (xb, yb) in zip(a, b):
+            if ya == yb:
+                continue
+            crosses = (ya > y) != (yb > y)
+            out ^= crosses & (x < xa + (y - ya) * (xb - xa) / (yb - ya))
+    return out
+
+
 def covers(outer: Shape, inner: Shape, tol_area: float = 1e-6) -> bool:
     """`inner` lies in `outer` (what sticks out is below `tol_area` mm^2)."""
     return area(difference(inner, outer)) <= tol_area

@@ -44,7 +44,7 @@ from typing import Optional
 
 import numpy as np
 
-from tmm_workbench.core import cancel
+from tmm_workbench.core import cancel, polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.cusp import check_cusp, profile_height, stepover_for_cusp
 from tmm_workbench.core.footprint.raster import Rect
@@ -90,10 +90,11 @@ def _section_frame(angle_deg: float) -> tuple[np.ndarray, np.ndarray]:
 
 def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: float, cusp: float, floor_z: float,
                      stock_to_leave: float = 0.0, max_slope_deg: float = 75.0, planar: Optional[float] = None,
-                     surface: Optional[DropSurface] = None) -> SectionStep:
+                     surface: Optional[DropSurface] = None, region: Optional[list] = None) -> SectionStep:
     """The constant step-over over `boundary` (passes at `angle_deg` from +X) that keeps the cusp at most `cusp`
     mm at every sampled crossing (see the module). `planar`: the planar rule's step at the steepest crossing,
-    reported beside it."""
+    reported beside it. `region`: the polygons the passes are clipped to (`boundary` their box): crossings
+    counted inside them only, clear of their edge by the tool radius (as the box's edges)."""
     check_cusp(cutter, cusp)
     if not (math.isfinite(max_slope_deg) and 0 < max_slope_deg < 90):
         raise TmmError(f"cusp slope limit must be in (0, 90) deg, got {max_slope_deg!r}")
@@ -110,7 +111,7 @@ def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: f
     surface = surface or DropSurface(mesh)
     while True:  # samples half a step apart at most: coarser ones misplace b between them (a bull's flat)
         step, spots = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar,
-                                    surface, d, n, along, across, s_min, s_max, spacing)
+                                    surface, d, n, along, across, s_min, s_max, spacing, region=region)
         if step.stepover >= 2 * spacing or spacing <= _MIN_SPACING:
             break
         spacing = max(_MIN_SPACING, step.stepover / _SAMPLES_PER_STEP)
@@ -123,7 +124,7 @@ def section_stepover(mesh: TriMesh, cutter: Cutter, boundary: Rect, angle_deg: f
     for x_lo, x_hi, y_at in spots:
         fine, _ = _section_step(mesh, cutter, boundary, cusp, floor_z, stock_to_leave, max_slope_deg, planar,
                                 surface, d, n, along, across, s_min, min(s_max, step.stepover), spacing,
-                                np.linspace(x_lo, x_hi, _REFINE_SECTIONS), (y_at - half, y_at + half))
+                                np.linspace(x_lo, x_hi, _REFINE_SECTIONS), (y_at - half, y_at + half), region)
         if fine.stepover < step.stepover:
             step = SectionStep(fine.stepover, fine.cusp, step.planar, step.sections + fine.sections, spacing,
                                fine.limited, step.unreachable, step.creases)
@@ -136,7 +137,8 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
                   max_slope_deg: float, planar: Optional[float], surface: Optional[DropSurface], d: np.ndarray,
                   n: np.ndarray, along: np.ndarray, across: np.ndarray, s_min: float, s_max: float,
                   spacing: float, at_xs: Optional[np.ndarray] = None,
-                  window: Optional[tuple[float, float]] = None) -> tuple[SectionStep, list[tuple[float, float, float]]]:
+                  window: Optional[tuple[float, float]] = None,
+                  region: Optional[list] = None) -> tuple[SectionStep, list[tuple[float, float, float]]]:
     """section_stepover with samples `spacing` apart across the sections (at `at_xs` along the passes if given,
     else spread over the region; only pairs whose a lies in `window` across if given), and the places to look
     at again: (x_lo, x_hi, y) around each of the worst sections (its neighbours' x, its worst pair's a)."""
@@ -207,10 +209,19 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     grad = np.gradient(envelope, spacing, axis=1)
     cos = 1.0 / np.sqrt(1.0 + grad * grad)
     on_model = np.isfinite(design)
-    reach = (envelope - design) * cos <= cusp + stock_to_leave
     # steep as the measured cells are: the full slope, along the passes too (between sections); the cusp itself
     # stays along the across-normal (a ball on a plane sloped along the passes: the section's vertical cusp)
     steep_along = np.gradient(envelope, xs[1] - xs[0], axis=0) if count > 1 else np.zeros(c.shape)
+    # out of reach where E stays above the design by more than the cusp, less what a slope along the passes lifts a
+    # section's E by (the tool touches ahead of or behind its section there): without it a sphere's flank read as
+    # out of reach at a small cusp, its worst crossing was left out and the step widened (ball D6, cusp 0.04 mm on
+    # sphere_on_plate: 0.96 mm, 0.064 mm measured; 0.79 mm at a cusp of 0.05)
+    # (the design's slope: at the foot of a wall the CL surface climbs along the passes over a flat floor the tool
+    # does not reach)
+    with np.errstate(invalid="ignore"):
+        design_along = np.gradient(design, xs[1] - xs[0], axis=0) if count > 1 else np.zeros(c.shape)
+    lift = _along_lift(cutter, np.nan_to_num(design_along, nan=0.0, posinf=0.0, neginf=0.0))
+    reach = (envelope - design - lift) * cos <= cusp + stock_to_leave
     full_cos = 1.0 / np.sqrt(1.0 + grad * grad + steep_along * steep_along)
     counted = (inside & on_model & reach & (full_cos >= math.cos(math.radians(max_slope_deg)))
                & (envelope > floor_z + 1e-6))
@@ -218,6 +229,9 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     # a ridge counts where the measured cells would lie: inside the boundary, clear of its edges by the radius
     core = inside & (Y >= y_lo + cutter.radius) & (Y <= y_hi - cutter.radius)
     counted &= core if core.any() else inside
+    if region is not None:
+        inner = polygons.offset(region, -cutter.radius)
+        counted &= polygons.points_inside(inner, world.reshape(-1, 2)).reshape(c.shape) if inner else False
 
     def at(field: np.ndarray, y: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """`field` (sections, samples) linearly between samples at y (the rows' sections)."""
@@ -375,6 +389,14 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
     return SectionStep(stepover=s, cusp=worst_cusp, planar=float(planar) if planar is not None else math.nan,
                        sections=count, spacing=spacing, limited=worst_cusp > cusp, unreachable=unreachable,
                        creases=int(turn.sum())), spots
+
+
+def _along_lift(cutter: Cutter, slope: np.ndarray) -> np.ndarray:
+    """How far the tip stands above a plane sloped by `slope` (tan) when the tool rests on it: its flat part's
+    radius times the slope and its corner's rise (a ball: R (sec - 1); a flat end: r tan)."""
+    flat, corner = cutter.radius - cutter.corner_radius, cutter.corner_radius
+    t = np.abs(slope)
+    return flat * t + corner * (np.sqrt(1.0 + t * t) - 1.0)
 
 
 def _largest_step(cusps, s_min: float, s_max: float, target: float) -> float:

@@ -20,7 +20,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from tmm_workbench.core import cancel
+from tmm_workbench.core import cancel, polygons
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
@@ -130,7 +130,7 @@ def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], pa
     path = link(segments, LinkPolicy(stock_top + 1.0, stock_top + 5.0))
     heights = simulate(path, cutter, grid, box_heights(grid, stock_top), progress=cancel.asker()).heights
     cancel.poll()
-    on_model = np.isfinite(design)
+    on_model = np.isfinite(design) & _in_region(params, grid, cutter.radius)
     over = CuspField(grid, design, design + s, np.ones(design.shape), on_model, on_model & False, on_model & False,
                      stock_top, tol, np.zeros(design.shape + (2,))).ridge_cusp(heights)
     screen = np.nan_to_num(over, nan=0.0) > _SCREEN * tol
@@ -149,6 +149,17 @@ def check_segments(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], pa
     if grid.cell > measure_cell(cutter, tol) * (1 + 1e-9):   # CheckCusp Auto's coarser cells: say what they miss
         out.reads_low = reads_low(cutter, grid.cell)
     return out
+
+
+def _in_region(params: Any, grid: Grid, reach: float) -> np.ndarray:
+    """The cells the passes are for: in the region, clear of its edge by the tool radius (as the box's cells are
+    clear of the box's edges: measure_grid); everywhere for the box."""
+    if params.region is None:
+        return np.ones((grid.ny, grid.nx), dtype=bool)
+    inner = polygons.offset(params.region, -reach)
+    if not inner:
+        return np.zeros((grid.ny, grid.nx), dtype=bool)
+    return polygons.grid_inside(inner, grid.xs(), grid.ys())
 
 
 def _report(grid: Grid, cusp: np.ndarray, measured: np.ndarray, unreachable: np.ndarray, steep: np.ndarray,

@@ -109,7 +109,8 @@ def pass_lines(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, floor_z: fl
         from tmm_workbench.core.footprint.cusp_section import section_stepover
 
         step = section_stepover(mesh, cutter, b, params.angle_deg, params.cusp, floor_z, params.stock_to_leave,
-                                params.max_slope_deg, stepover_for_cusp(cutter, params.cusp, slope))
+                                params.max_slope_deg, stepover_for_cusp(cutter, params.cusp, slope),
+                                region=params.region)
         stepover = step.stepover
         diagnostics.update(cusp_slope_deg=slope, cusp_planar_stepover=step.planar, cusp_section=step.cusp,
                            cusp_limited=int(step.limited), cusp_creases=step.creases)
