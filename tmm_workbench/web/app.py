@@ -42,6 +42,7 @@ class BodyLimit:
             if not length.isdigit():
                 return await _send_error(send, 400, f"Content-Length: got {length[:40]!r}; a whole number")
             if int(length) > self.limit:
+                await _drain(receive, 0, self.limit)
                 return await _send_error(send, 413, _too_large(self.limit, int(length)))
         seen = 0
 
@@ -50,10 +51,23 @@ class BodyLimit:
             message = await receive()
             seen += len(message.get("body", b""))
             if seen > self.limit:
+                if message.get("more_body"):
+                    seen = await _drain(receive, seen, self.limit)
                 raise BodyTooLarge(_too_large(self.limit, seen))
             return message
 
         await self.app(scope, limited, send)
+
+
+async def _drain(receive: Any, seen: int, limit: int) -> int:
+    """Reads and drops the rest of a refused body, up to twice the limit, so that the client, still sending, reads
+    the 413 rather than a reset connection."""
+    while seen <= 2 * limit:
+        message = await receive()
+        seen += len(message.get("body", b""))
+        if message.get("type") != "http.request" or not message.get("more_body"):
+            break
+    return seen
 
 
 def _too_large(limit: int, size: int) -> str:
