@@ -31,7 +31,7 @@ def test_a_sign_made_through_the_api_plans_to_gcode(server):
     assert code == 200 and json.loads(data)["state"] in ("queued", "planning", "verified")
     st = server.wait(job["id"])
     assert st["state"] == "verified" and st["report"]["passed"], st
-    assert {"part.ngc", "part.FCStd", "part_sim.png", "report.json"} <= set(st["files"])
+    assert {"part.ngc", "part.FCStd", "part_sim.png", "toolpath.png", "report.json"} <= set(st["files"])
     code, gcode = server.call("GET", f"/api/jobs/{job['id']}/files/part.ngc")
     folder = next((server.jobs / job["id"] / "out").glob("job-*"))
     assert code == 200 and gcode == (folder / "part.ngc").read_bytes()

@@ -4,7 +4,6 @@ own file in the job's folder; and a sign made on the page."""
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import pytest
 
@@ -87,9 +86,10 @@ def test_upload_to_download_in_the_browser(server, browser):
     assert any("queued" in s or "planning" in s for s in shown) and "verified" in shown[-1], shown
     figures = browser.find_element(By.ID, "figures").text
     assert "cycle time" in figures and "deepest gouge" in figures and "verified yes" in figures, figures
-    assert browser.execute_script("const i = document.getElementById('heatmap'); return i.complete && i.naturalWidth") > 100
+    for img in ("heatmap", "toolpath"):
+        assert browser.execute_script(f"const i = document.getElementById('{img}'); return i.complete && i.naturalWidth") > 100
     links = {a.text: a for a in browser.find_elements(By.CSS_SELECTOR, "a.download")}
-    assert {"part.ngc", "part.FCStd", "part_sim.png", "report.json"} <= set(links), links
+    assert {"part.ngc", "part.FCStd", "part_sim.png", "toolpath.png", "report.json"} <= set(links), links
     links["part.ngc"].click()
     got = _wait(lambda: [p for p in browser.downloads.iterdir() if p.name == "part.ngc"], 30, "no download")[0]
     planner_own = next((server.jobs / job_id / "out").glob("job-*")) / "part.ngc"

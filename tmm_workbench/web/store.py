@@ -15,7 +15,7 @@ import uuid
 from pathlib import Path
 from typing import Any, Callable, Optional
 
-from tmm_workbench.web.recipe import JOB_FILE, MODEL_FILE, Recipe, RequestError, job_data
+from tmm_workbench.web.recipe import JOB_FILE, MODEL_FILE, PART_NAME, Recipe, RequestError, job_data
 
 STATE_FILE = "state.json"
 OUT_DIR = "out"
@@ -85,12 +85,13 @@ class JobStore:
     # --- planning ------------------------------------------------------------------------------------------
 
     def submit(self, job_id: str) -> None:
-        """The job's part on the cluster; its end written to its state file by the future's callback."""
-        from tmm_workbench.batch.part import run_part
+        """The job's part on the cluster (planned, then its tool path drawn); its end written to its state file by
+        the future's callback."""
+        from tmm_workbench.web.picture import plan_part
 
         folder = self.root / job_id
-        fut = self.client.submit(run_part, str(folder / JOB_FILE), str(folder / OUT_DIR), self.timeout_s,
-                                 pure=False, retries=1, key=f"tmm-web-{job_id}-{uuid.uuid4().hex[:6]}")
+        fut = self.client.submit(plan_part, str(folder / JOB_FILE), str(folder / OUT_DIR), self.timeout_s,
+                                 str(folder / MODEL_FILE), f"{PART_NAME}.ngc", pure=False, retries=1, key=f"tmm-web-{job_id}-{uuid.uuid4().hex[:6]}")
         self.futures[job_id] = fut
         fut.add_done_callback(self._ended(job_id))
 
@@ -174,6 +175,8 @@ class JobStore:
         out.update(state=row.get("state", record["state"]), files=self.files(record))
         if record["state"] == FAILED or row.get("reason"):
             out["reason"] = row.get("reason", "")
+        if row.get("picture"):
+            out["picture"] = row["picture"]
         report = self._report(record)
         if report:
             ver = report.get("verification", {})
