@@ -165,15 +165,15 @@ def create_app(jobs_dir: Path, scheduler: Optional[str] = None, workers: int = 1
             record = await _accept(store, form)
         finally:
             await form.close()
-        return JSONResponse(store.status(record["id"]), status_code=202)
+        return JSONResponse(await asyncio.to_thread(store.status, record["id"]), status_code=202)
 
     @app.get("/api/jobs/{job_id}")
     async def status(job_id: str) -> dict:
-        return store.status(job_id)
+        return await asyncio.to_thread(store.status, job_id)   # reads the report from disk
 
     @app.get("/api/jobs/{job_id}/files/{name}")
     async def file(job_id: str, name: str) -> Response:
-        path = store.file_path(job_id, name)
+        path = await asyncio.to_thread(store.file_path, job_id, name)
         return FileResponse(path, filename=name)
 
     return BodyLimit(app, max_upload + 256 * 1024)

@@ -44,8 +44,12 @@ class JobStore:
 
     # --- accepting -----------------------------------------------------------------------------------------
 
+    def _records(self) -> list[tuple[str, dict]]:   # a copy: threads add and end jobs meanwhile
+        with self._lock:
+            return list(self.jobs.items())
+
     def waiting(self) -> int:
-        return sum(1 for j in self.jobs.values() if j["state"] == ACCEPTED)
+        return sum(1 for _, j in self._records() if j["state"] == ACCEPTED)
 
     def new_folder(self) -> Path:
         """A hidden folder for a job being accepted (made whole, then renamed to its id)."""
@@ -127,7 +131,8 @@ class JobStore:
                 record = json.loads((folder / STATE_FILE).read_text())
             except (OSError, ValueError):
                 continue
-            self.jobs[folder.name] = record
+            with self._lock:
+                self.jobs[folder.name] = record
             if record.get("state") == ACCEPTED:
                 again.append(folder.name)
         for job_id in again:
@@ -199,4 +204,4 @@ class JobStore:
 
     def listing(self) -> list[dict]:
         return [{"id": k, "state": v["state"], "created": v["created"], "source": v["source"]}
-                for k, v in sorted(self.jobs.items(), key=lambda kv: kv[1]["created"])]
+                for k, v in sorted(self._records(), key=lambda kv: kv[1]["created"])]
