@@ -4,13 +4,16 @@ reason, the server answering afterwards; a model larger than the machine refused
 the job's failure; a restart keeping the accepted jobs and planning the one not ended."""
 from __future__ import annotations
 
+import http.client
 import io
 import json
+import random
+import time
 import zipfile
 
 import pytest
 
-from tests.web.conftest import RECIPE, start_server
+from tests.web.conftest import RECIPE, multipart, start_server
 from tmm_workbench.core.shared_data import benchmark_file
 
 pytestmark = pytest.mark.xdist_group("web")   # servers with clusters of their own: one such test at a time
@@ -101,6 +104,33 @@ def test_malformed_requests_refused_and_the_server_answers_after(server):
     assert server.proc.poll() is None
 
 
+def test_a_streamed_upload_over_the_limit_is_refused_as_it_comes(server):
+    """Chunked, without a Content-Length: the bytes counted as they arrive."""
+    body, kind = multipart(RECIPE, {"model": ("big.stl", b"\0" * (3 * 2 ** 20))})
+    conn = http.client.HTTPConnection("127.0.0.1", server.port, timeout=60)
+    try:
+        conn.request("POST", "/api/jobs", body=(body[i:i + 65536] for i in range(0, len(body), 65536)),
+                     headers={"Content-Type": kind}, encode_chunked=True)
+        r = conn.getresponse()
+        assert r.status == 413 and "limit" in json.loads(r.read())["error"]
+    finally:
+        conn.close()
+    assert server.call("GET", "/api/jobs")[0] == 200
+
+
+def test_random_bodies_never_crash_the_server(server):
+    rng = random.Random(3)
+    pieces = [b"--b\r\n", b"Content-Disposition: form-data; name=\"model\"; filename=\"a.stl\"\r\n\r\n", b"\r\n",
+              b"solid x\n facet normal 0 0 1\n", b"--b--\r\n", b"name=\"material\"\r\n\r\nmdf", b"\0\xff", b"=&%"]
+    for _ in range(40):
+        body = b"".join(rng.choice(pieces) for _ in range(rng.randint(0, 12)))
+        kind = rng.choice(["multipart/form-data; boundary=b", "multipart/form-data", "application/x-www-form-urlencoded",
+                           "text/plain", "multipart/form-data; boundary="])
+        code, data = server.call("POST", "/api/jobs", body, {"Content-Type": kind})
+        assert 400 <= code < 500 and json.loads(data)["error"], (body, kind, code, data)
+    assert server.proc.poll() is None and server.call("GET", "/api/choices")[0] == 200
+
+
 def test_a_model_larger_than_the_machine_fails_with_the_planners_reason(server):
     code, job = server.post_job({**SIGN, "text": "WIDE", "width": "400", "height": "20", "border": "0", **RECIPE})
     assert code == 202, job
@@ -118,6 +148,11 @@ def test_a_restarted_server_keeps_its_jobs_and_plans_the_unfinished(tmp_path):
         assert code == 202 and first.wait(refused["id"])["state"] == "bad input"
         code, job = first.post_job({"sample": "beet_mm.stl", **RECIPE})
         assert code == 202, job
+        seen = []   # the server answers while its worker plans; stopped in the middle of the plan
+        while not seen or seen[-1] == "queued":
+            seen.append(first.status(job["id"])["state"])
+            time.sleep(0.2)
+        assert seen[-1] == "planning", seen
     finally:
         assert first.stop() == 0, log.read_text()[-2000:]
     assert json.loads((jobs / job["id"] / "state.json").read_text())["state"] == "accepted"
