@@ -61,9 +61,6 @@ class Recipe:
     finish: str
     machine: str
 
-    def as_dict(self) -> dict:
-        return {"material": self.material, "finish": self.finish, "machine": self.machine}
-
 
 def choices() -> dict:
     """What the page offers."""

@@ -12,6 +12,7 @@ import shutil
 import threading
 import time
 import uuid
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable, Optional
 
@@ -75,7 +76,7 @@ class JobStore:
         (folder / JOB_FILE).write_text(yaml.safe_dump(data, sort_keys=False))
         job_id = uuid.uuid4().hex
         record = {"id": job_id, "state": ACCEPTED, "created": time.time(), "source": source,
-                  "recipe": recipe.as_dict(), "row": None}
+                  "recipe": asdict(recipe), "row": None}
         _write_json(folder / STATE_FILE, record)
         os.rename(folder, self.root / job_id)
         with self._lock:
