@@ -1,7 +1,8 @@
 """The web front's HTTP API on the real server and a real local Dask cluster: a sign made through the API planned
 to G-code; bad uploads (not an STL, truncated, oversized, a zip) and malformed requests refused with a 4xx and the
 reason, the server answering afterwards; a model larger than the machine refused by the planner's own check as
-the job's failure; a restart keeping the accepted jobs and planning the one not ended."""
+the job's failure; a restart keeping the accepted jobs and planning the one not ended (the second server on an existing Dask
+cluster, --scheduler)."""
 from __future__ import annotations
 
 import http.client
@@ -156,7 +157,15 @@ def test_a_restarted_server_keeps_its_jobs_and_plans_the_unfinished(tmp_path):
     finally:
         assert first.stop() == 0, log.read_text()[-2000:]
     assert json.loads((jobs / job["id"] / "state.json").read_text())["state"] == "accepted"
-    second = start_server(jobs, log, "--workers", "1")
+    from dask.distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster:
+        _after_restart(start_server(jobs, log, "--scheduler", cluster.scheduler_address), refused, job)
+
+
+def _after_restart(second, refused: dict, job: dict) -> None:
+    """The restarted server (on an existing cluster: --scheduler) lists both jobs and plans the one not ended."""
+    jobs = second.jobs
     try:
         code, data = second.call("GET", "/api/jobs")
         listed = {j["id"]: j for j in json.loads(data)["jobs"]}
@@ -167,4 +176,4 @@ def test_a_restarted_server_keeps_its_jobs_and_plans_the_unfinished(tmp_path):
         assert st["state"] == "verified" and st["report"]["passed"], st
         assert not [p for p in (jobs / job["id"] / "out").iterdir() if p.name.startswith(".")]
     finally:
-        assert second.stop() == 0, log.read_text()[-2000:]
+        assert second.stop() == 0, second.log.read_text()[-2000:]

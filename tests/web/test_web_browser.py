@@ -1,6 +1,6 @@
 """The page in Debian's Chromium, headless, through Selenium: an STL uploaded with the coarse recipe, the progress,
 the heat map and the report's figures shown, the G-code downloaded by its link and compared with the planner's
-own file in the job's folder; and a sign made on the page."""
+own file in the job's folder; a sign made on the page; a refusal shown."""
 from __future__ import annotations
 
 import time
@@ -98,6 +98,8 @@ def test_upload_to_download_in_the_browser(server, browser):
 
 
 def test_a_sign_made_on_the_page(server, browser):
+    """The sign's fields reach the server as a sign job whose progress the page follows (its planning to G-code is
+    test_web_api's, through the API: not twice here)."""
     from selenium.webdriver.common.by import By
 
     _open(browser, server)
@@ -107,10 +109,17 @@ def test_a_sign_made_on_the_page(server, browser):
     text.send_keys("OK")
     _choose(browser, "shape", "ellipse")
     _choose(browser, "background", "waves")
-    job_id, _ = _plan_on_page(browser, server)
+    for field, value in (("material", "mdf"), ("finish", "draft"), ("machine", "3-axis grbl")):
+        _choose(browser, field, value)
+    browser.find_element(By.ID, "submit").click()
+    job_id = _wait(lambda: browser.execute_script("return document.body.dataset.job"), 20, "no job accepted")
+    _wait(lambda: job_id in browser.find_element(By.ID, "status").text, 10, "no progress shown")
     st = server.status(job_id)
-    assert st["source"] == "sign 'OK'" and st["state"] == "verified", st
-    assert "part.ngc" in [a.text for a in browser.find_elements(By.CSS_SELECTOR, "a.download")]
+    assert st["source"] == "sign 'OK'" and st["recipe"] == {"material": "mdf", "finish": "draft",
+                                                           "machine": "3-axis grbl"}, st
+    spec = (server.jobs / job_id / "job.yaml").read_text()
+    assert "post: grbl" in spec and "material: mdf" in spec
+    assert b"OK" in (server.jobs / job_id / "model.stl").read_bytes()[:80]   # the sign's mesh, named after it
 
 
 def test_a_refusal_is_shown_on_the_page(server, browser, tmp_path):
