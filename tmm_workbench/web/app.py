@@ -155,9 +155,7 @@ def create_app(jobs_dir: Path, scheduler: Optional[str] = None, workers: int = 1
                                        "STL as the field model) or application/x-www-form-urlencoded")
         try:
             form = await request.form(max_files=2, max_fields=40)
-        except BodyTooLarge:
-            raise
-        except (StarletteHTTPException, rc.RequestError):
+        except (BodyTooLarge, StarletteHTTPException, rc.RequestError):
             raise
         except Exception as exc:   # a malformed body: the parser's reason
             raise rc.RequestError(400, f"the form could not be read: {type(exc).__name__}: {exc}") from None
@@ -181,7 +179,7 @@ def create_app(jobs_dir: Path, scheduler: Optional[str] = None, workers: int = 1
 
 async def _accept(store: JobStore, form: Any) -> dict:
     """The form's model (upload, sample or sign) in a new job folder, checked; the job accepted."""
-    keys = list(form.keys())
+    keys = [k for k, _ in form.multi_items()]
     unknown = sorted(set(keys) - FORM_FIELDS)
     if unknown:
         raise rc.RequestError(400, f"unknown field(s) {', '.join(k[:40] for k in unknown)}; allowed: "
