@@ -9,11 +9,12 @@ cd "$ROOT"
 
 # contourpy: the 3D offset's passes (core.footprint.offset_field); scipy: the verification's buckets on them
 # (core.footprint.variable_step); pytest-xdist: the tests two at a time (scripts/test.sh); ccache: the compiled
-# objects kept between test runs (scripts/test.sh sets CCACHE_DIR); distributed: `tmm batch` (Dask)
+# objects kept between test runs (scripts/test.sh sets CCACHE_DIR); distributed: `tmm batch` (Dask); fastapi, uvicorn,
+# multipart: the web front (tmm_workbench/web); selenium, chromium, chromium-driver: its browser test (tests/web)
 DEBS=(freecad-python3 libeigen3-dev pybind11-dev python3-dev python3-numpy python3-pytest python3-venv
       python3-pip python3-matplotlib python3-pyclipper xvfb xauth cmake g++ make ninja-build libgtest-dev
       python3-contourpy python3-scipy clang-14 libclang-rt-14-dev python3-pytest-xdist ccache
-      python3-distributed)
+      python3-distributed python3-fastapi python3-uvicorn python3-multipart python3-selenium chromium chromium-driver)
 missing=()
 for p in "${DEBS[@]}"; do dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p"); done
 if [ ${#missing[@]} -gt 0 ]; then
