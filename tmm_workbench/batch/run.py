@@ -59,7 +59,7 @@ def open_client(scheduler: Optional[str], workers: int, dashboard: bool):
     if scheduler:
         return Client(scheduler, timeout="30s"), None
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                           dashboard_address=":8787" if dashboard else None, silence_logs=logging.ERROR)
+                           dashboard_address=":8787" if dashboard else ":0", silence_logs=logging.ERROR)
     return Client(cluster), cluster
 
 
