@@ -62,28 +62,14 @@ def cases(out: Path) -> list[Case]:
     ]
 
 
-def write_binary_stl(vertices, triangles, path: Path, name: str = "tmm") -> None:
-    """A binary STL (facet normals from the corners) - enough for FreeCAD and any CAM reader."""
-    import numpy as np
-
-    c = np.asarray(vertices, dtype=np.float64)[np.asarray(triangles)]
-    n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-    rec = np.zeros(len(c), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
-    rec["n"], rec["v"] = n, c
-    with open(path, "wb") as fh:
-        fh.write(name.encode("ascii", "replace")[:80].ljust(80, b" "))
-        fh.write(np.uint32(len(rec)).tobytes())
-        fh.write(rec.tobytes())
-
-
 def bezier_stl(out: Path) -> Path:
     from tmm_workbench.core.geometry import bezier
+    from tmm_workbench.core.geometry.mesh import save_stl
 
     net = bezier.load_seed_patch(bench() / "seed_surfaces.json", "convex")
     mesh = bezier.tessellate_to_tolerance(net, BEZIER_TOLERANCE_MM, name="bezier_convex")
     path = out / "bezier_convex.stl"
-    write_binary_stl(mesh.vertices, mesh.triangles, path, "TMM seed 001 convex Bezier patch (mm)")
+    save_stl(mesh, path)
     return path
 
 

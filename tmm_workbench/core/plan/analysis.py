@@ -21,6 +21,7 @@ from tmm_workbench.core.sim.stock import mesh_heights
 SLOPE_EDGES = (0.0, 1.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)   # degrees from the horizontal
 FLAT_DEG = 1.0           # a face sloping less is a flat (a floor, a plateau)
 STEEP_DEG = 60.0         # a face sloping more is a wall for the report's count
+FAR_MM = 1.0             # a tool staying this far above the design leaves it to the next (a roughing tool's reach)
 SPECK_SHARE = 0.001      # unreached area below this share of the design's is the grid's noise
 
 
@@ -31,10 +32,12 @@ class Reach:
     unreached_area: float    # mm^2 of design cells it stays above by more than the threshold
     deepest_left: float      # mm, the most it stays above the design
     threshold: float         # mm: the tolerance + the grid's own cusp (cell^2 / 8 r)
+    far_area: float = 0.0    # mm^2 of design cells it stays above by more than FAR_MM (out of a roughing's reach)
 
     def as_dict(self) -> dict:
         return {"tool": self.tool, "unreached_mm2": round(self.unreached_area, 1),
-                "deepest_left_mm": round(self.deepest_left, 3), "threshold_mm": round(self.threshold, 4)}
+                "deepest_left_mm": round(self.deepest_left, 3), "threshold_mm": round(self.threshold, 4),
+                f"farther_than_{FAR_MM:g}_mm_mm2": round(self.far_area, 1)}
 
 
 @dataclass
@@ -116,7 +119,8 @@ def analyse(mesh: TriMesh, cell: float, tools: Optional[list] = None, tolerance:
         unreached = float(np.sum(left > threshold)) * grid.cell_area
         if unreached < SPECK_SHARE * design_area:
             unreached = 0.0
-        out.reach[name] = Reach(name, unreached, float(left.max()) if finite.any() else 0.0, threshold)
+        out.reach[name] = Reach(name, unreached, float(left.max()) if finite.any() else 0.0, threshold,
+                                float(np.sum(left > FAR_MM)) * grid.cell_area)
     out.concave_radius = concave_bracket(out.reach, dict(tools or []))
     return out
 

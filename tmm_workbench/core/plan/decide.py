@@ -21,7 +21,7 @@ import numpy as np
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.plan import materials
-from tmm_workbench.core.plan.analysis import Analysis
+from tmm_workbench.core.plan.analysis import FAR_MM, Analysis
 from tmm_workbench.core.plan.job_file import JobSpec, PlanInputError, ToolSpec
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -34,6 +34,7 @@ MIN_SHARE = 0.005          # of the design cells: a slope class smaller than thi
 MIN_STEPOVER = 0.05        # mm: a finish needing a finer step-over than this is refused as too tight
 MAX_COMPARED = 4           # radiused tools compared (the largest first)
 ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
+ROUGH_FAR_SHARE = 0.5      # nor one staying more than FAR_MM above over more than this share of the model's area
 
 
 @dataclass(frozen=True)
@@ -138,13 +139,18 @@ def choose_roughing(plan: Plan, job: JobSpec, an: Analysis) -> ToolSpec:
         [min(reaching, key=lambda t: t.diameter)]
     # flat and bull-nose tools clear layers; a ball only when there is nothing else
     fitting.sort(key=lambda t: (t.type != "ball", t.diameter, -job.tools.index(t)), reverse=True)
-    tool = fitting[0]
+    # and one that gets down into most of the model: a tool wider than the gaps between its features (a sign's
+    # letters) removes nothing (the roughing op then refuses: no material to remove)
+    xy_area = float(np.isfinite(an.design).sum()) * an.grid.cell_area
+    into = [t for t in fitting if t.name not in an.reach or an.reach[t.name].far_area <= ROUGH_FAR_SHARE * xy_area]
+    tool = into[0] if into else min(fitting, key=lambda t: an.reach[t.name].far_area)
     c = materials.cutting(job.material, tool.diameter, tool.flutes, job.machine.spindle_max, job.machine.feed_max)
     step_down = round(min(c.step_down, tool.flute_length), 3)
     plan.decide("roughing tool", tool.describe(),
                 f"the largest {'flat or bull-nose ' if tool.type != 'ball' else ''}tool of the library that "
-                f"reaches the {depth:.1f} mm depth ({reach_length(tool):g} mm) and is at most "
-                f"{ROUGH_WIDTH_SHARE:g} x the model's narrower side ({narrow:.1f} mm)")
+                f"reaches the {depth:.1f} mm depth ({reach_length(tool):g} mm), is at most "
+                f"{ROUGH_WIDTH_SHARE:g} x the model's narrower side ({narrow:.1f} mm) and gets within {FAR_MM:g} mm of "
+                f"at least {1 - ROUGH_FAR_SHARE:g} of its area from above (the reach test)")
     plan.decide("roughing layers", f"step-down at most {step_down:g} mm, stairs at most {ROUGH_STAIR:g} mm, "
                 f"step-over {c.stepover_percent:g} %, leave {ROUGH_LEAVE:g} mm",
                 f"{job.material}: {materials.TABLE[job.material][2]:g} x D per layer, at most the flute length "

@@ -25,7 +25,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.geometry.mesh import TriMesh, load_stl
+from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
 from tmm_workbench.core.plan import analysis, decide
 from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, read_job
 
@@ -53,19 +53,6 @@ def placed_mesh(job: JobSpec) -> tuple[TriMesh, bool]:
         return mesh, False
     vertices = mesh.vertices * scale + np.asarray(job.model.translate, dtype=float)
     return TriMesh(vertices, mesh.triangles, name=mesh.name), True
-
-
-def write_binary_stl(mesh: TriMesh, path: Path) -> None:
-    """A binary STL of `mesh` (facet normals from the corners)."""
-    c = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.triangles)]
-    n = np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-    rec = np.zeros(len(c), dtype=np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")]))
-    rec["n"], rec["v"] = n, c
-    with open(path, "wb") as fh:
-        fh.write(b"TMM planner: the model placed, mm".ljust(80, b" "))
-        fh.write(np.uint32(len(rec)).tobytes())
-        fh.write(rec.tobytes())
 
 
 def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis.Analysis, decide.Plan]:
@@ -146,7 +133,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         model_file = job.model.file
         if moved:
             model_file = tmp / f"{out.name}_model.stl"
-            write_binary_stl(mesh, model_file)
+            save_stl(mesh, model_file)
         (tmp / "plan.json").write_text(json.dumps(plan_document(job, plan, model_file), indent=1, sort_keys=True))
         failure = run_freecad(tmp, freecad, quiet)
         if failure is not None:
