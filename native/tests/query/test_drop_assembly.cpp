@@ -337,6 +337,30 @@ TEST(DropAssembly, ThreadsAgreeAndBatchEqualsPoints) {
   EXPECT_GT(lifted, 500);
 }
 
+// A raster dense enough that the bodies go with the cutter's tiles (a list per tile and piece, scanned per
+// point with the walk's own per-triangle values): the batch equals the point query, which walks each piece.
+TEST(DropAssembly, TiledBodiesEqualPoints) {
+  const auto index = bumpy(12, 16);
+  std::vector<double> xy;
+  for (double y = 1.0; y <= 11.0; y += 0.2)
+    for (double x = 1.0; x <= 11.0; x += 0.2) xy.insert(xy.end(), {x, y});
+  const std::size_t n = xy.size() / 2;
+  const std::vector<ToolBody> thin = {{1.0, 2.0, 0.6, 0.6, 0.2}, {2.0, 30.0, 4.0, 4.0, 0.5}};
+  for (const tmm::ToolAssembly& tool : {tmm::ToolAssembly(Cutter(1.0, 1.0), short_assembly()),
+                                        tmm::ToolAssembly(Cutter(0.5, 0.2), thin, 0.1)}) {
+    std::vector<double> z(n);
+    std::vector<int32_t> by(n);
+    tmm::drop_assembly_batch(index, tool, xy.data(), n, -20.0, z.data(), by.data(), tmm::BatchOptions{});
+    int lifted = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int32_t point_by = 0;
+      ASSERT_NEAR(tmm::drop_assembly_point(index, tool, xy[2 * i], xy[2 * i + 1], -20.0, &point_by), z[i], 1e-9) << i;
+      lifted += by[i] >= 0;
+    }
+    EXPECT_GT(lifted, 100);
+  }
+}
+
 // A pocket 6 x 6 mm, 10 deep, in a plate: a ball on a 3 mm stick-out cannot reach its floor, the holder
 // (radius 8, clearance 1, from 8 above the tip) rests on the plate: tip = 10 - (8 - 1) = 3.
 TEST(DropAssembly, HolderSetsTheHeightInADeepPocket) {
