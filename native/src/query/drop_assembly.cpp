@@ -366,7 +366,10 @@ void drop_assembly_follow(const MeshIndex& index, const std::vector<AssemblyPiec
   std::vector<std::size_t> open;  // every point left open for some piece
   for (std::size_t i = 0; i < n; ++i)
     if (first_open[i] < m) open.push_back(i);
-  if (open.empty()) return;
+  if (open.empty()) {
+    if (options.progress && !options.progress(1.0)) throw Cancelled();
+    return;
+  }
   std::vector<double> oxy, rows, bound;
   for (std::size_t i : open) oxy.insert(oxy.end(), {xy[2 * i], xy[2 * i + 1]});
   double reach = 0.0;  // of the bodies' pieces

@@ -203,7 +203,7 @@ class RunSolver {
       lowest = std::min(lowest, base[k]);
     }
     TileCandidates& fc = scratch.follower;
-    const std::size_t most = kMaxCandidatesPerPoint * (b - a);
+    const std::size_t most = kMaxFollowerCandidatesPerPoint * (b - a);
     fc.sorted.clear();
     bool crowded = false;
     index_.near_rect(scratch.x0, scratch.y0, scratch.x1, scratch.y1, p.profile.max_radius(), lowest,

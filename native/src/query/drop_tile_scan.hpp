@@ -300,6 +300,10 @@ inline double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, c
   return best;
 }
 
+// Followers' lists are bounded tighter than the cutter's: a holder over a dense plateau would gather thousands
+// of triangles there that the height cells' bound (drop_assembly.cpp) settles at once.
+constexpr std::size_t kMaxFollowerCandidatesPerPoint = 10;
+
 // The bodies of a tool assembly dropped in the cutter's own tiles right after it, one piece after another,
 // each from the height so far (as drop_assembly_point). A tile gathers per piece the triangles within its reach
 // above the lowest of its points' floors (the index prunes all below: a holder high above the part gathers
