@@ -354,7 +354,6 @@ void drop_assembly_follow(const MeshIndex& index, const std::vector<AssemblyPiec
                           std::size_t n, const double* floors, double floor_z, double* z_out, int32_t* set_by,
                           const BatchOptions& options, DropStats* stats) {
   const std::size_t m = pieces.size();
-  std::vector<double> top(n);
   std::vector<int32_t> owner(set_by ? 0 : n);
   int32_t* by = set_by ? set_by : owner.data();
   std::vector<std::uint8_t> first_open(n);
@@ -362,7 +361,7 @@ void drop_assembly_follow(const MeshIndex& index, const std::vector<AssemblyPiec
   BatchOptions pass = options;
   if (options.progress) pass.progress = [&options](double f) { return options.progress(0.8 * f); };
   drop_detail::drop_batch_follow(index, {pieces.data(), m, floors, floor_z, z_out, by, first_open.data()}, xy, n,
-                                 top.data(), pass, stats);
+                                 z_out, pass, stats);
   std::vector<std::size_t> open;  // every point left open for some piece
   for (std::size_t i = 0; i < n; ++i)
     if (first_open[i] < m) open.push_back(i);

@@ -327,8 +327,9 @@ struct FollowPieces {
   }
 };
 
-// drop_batch of pieces[0] from the floors floors[i] + lift (or floor_z + lift) into `top` (scratch), its
-// followers (see FollowPieces) in the same pass. Needs each follower's lift at or above the cutter's (their
+// drop_batch of pieces[0] from the floors floors[i] + lift (or floor_z + lift) into `top` (scratch; may be
+// follow.height: a point's cutter height is read before its height is written), its followers (see
+// FollowPieces) in the same pass. Needs each follower's lift at or above the cutter's (their
 // floors then lie above the cutter's tile floor) and at most 255 pieces.
 void drop_batch_follow(const MeshIndex& index, const FollowPieces& follow, const double* xy, std::size_t n,
                        double* top, const BatchOptions& options, DropStats* stats);
