@@ -63,6 +63,49 @@ inline double drop_on_owned(const Cutter& c, double x, double y, const IndexedTr
   return owned_edges_drop(c, x, y, t, above);
 }
 
+// A bound of any contact of a profile reaching r from its axis at (x, y) on the segment p-q: the segment's
+// highest point within r of the axis in XY (the profile's height above its tip is >= 0), -inf when none lies
+// there; widened by a margin against the rounding of the clip.
+inline double segment_top_within(double x, double y, double r, const double* p, const double* q) {
+  const double dx = q[0] - p[0], dy = q[1] - p[1], fx = p[0] - x, fy = p[1] - y;
+  const double reach = r * (1.0 + 1e-12) + 1e-12;
+  const double a = dx * dx + dy * dy, b = fx * dx + fy * dy, c = fx * fx + fy * fy - reach * reach;
+  double t0 = 0.0, t1 = 1.0;
+  if (a > 0.0) {
+    const double disc = b * b - a * c;
+    if (disc < 0.0) return -INFINITY;
+    const double root = std::sqrt(disc);
+    t0 = std::max(0.0, (-b - root) / a - 1e-9);
+    t1 = std::min(1.0, (-b + root) / a + 1e-9);
+    if (t0 > t1) return -INFINITY;
+  } else if (c > 0.0) {
+    return -INFINITY;
+  }
+  const double top = std::max(p[2] + t0 * (q[2] - p[2]), p[2] + t1 * (q[2] - p[2]));
+  return top + 1e-9 * (1.0 + std::fabs(top));
+}
+
+// drop_on_owned with each owned edge first bounded by its part within the profile's reach: the same value, the
+// contact solve skipped for an edge that only rises above `above` out of reach (a long wall facet's diagonal
+// beside a shank).
+inline double drop_on_owned_clipped(const Cutter& c, double x, double y, const IndexedTriangle& t, double above) {
+  bool inside = false;
+  const double zp = plane_drop(c, x, y, t.p[0], t.p[1], t.p[2], t.n, inside);
+  if (zp != kNoContact) {
+    if (zp <= above) return kNoContact;
+    if (inside) return zp;
+  }
+  const double r = c.max_radius();
+  double z = above;
+  for (int k = 0; k < 3; ++k) {
+    if (!(t.owned_edges & (1u << k))) continue;
+    const double* p = t.p[k];
+    const double* q = t.p[(k + 1) % 3];
+    if (segment_top_within(x, y, r, p, q) > z) z = std::max(z, edge_drop(c, x, y, p, q, z));
+  }
+  return z > above ? z : kNoContact;
+}
+
 // Does `profile`'s flat bottom rest at height h at (x, y) on triangle t: a corner or an edge of t at h (both
 // ends) within the flat bottom's radius? Then the drop is at least h (the flat bottom cannot pass below that
 // edge), and exactly h when nothing within reach is higher (h a bound of the heights around). A holder over a
@@ -231,7 +274,7 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
 }
 
 // drop_on_owned for candidate q of a tile: raises best (and winner, the position in the list) when its
-// contact is higher. kExact: drop_on_owned itself, the very value drop_point gets; else with the tile's
+// contact is higher. kExact: drop_on_owned's value, the very value drop_point gets; else with the tile's
 // precomputed plane drop (the same value up to rounding, fewer operations).
 template <bool kExact>
 inline void test_candidate(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, std::size_t q,
@@ -240,7 +283,7 @@ inline void test_candidate(const MeshIndex& index, const Cutter& cutter, const T
   const IndexedTriangle& t = index.triangles()[c.id[q]];
   double z;
   if (kExact) {
-    z = drop_on_owned(cutter, x, y, t, best);
+    z = drop_on_owned_clipped(cutter, x, y, t, best);
   } else {
     const double zp = c.plane_a[q] * x + c.plane_b[q] * y + c.plane_c[q];
     if (zp <= best) return;  // the plane bounds the triangle (+inf for a plane not facing up: edges only)
