@@ -1,5 +1,6 @@
 // The tool assembly's drop: the grown cutter and bodies as shifted APT cutters (drop_assembly.hpp), dropped
-// one after another, each from the height so far.
+// one after another, each from the height so far. A batch drops the bodies in the cutter's own tiles
+// (drop_detail::drop_batch_follow); the points a tile cannot list go piece by piece (drop_piece).
 #include "tmm/query/drop_assembly.hpp"
 
 #include <algorithm>
@@ -249,26 +250,6 @@ class HeightCells {
   std::vector<double> top_;
 };
 
-// Does `profile`'s flat bottom rest at height h at (x, y) on triangle t: a corner or an edge of t at h (both
-// ends) within the flat bottom's radius? With h the cells' bound at (x, y) (nothing within reach is higher),
-// the drop is then h exactly: the flat bottom cannot pass below that edge, nothing lifts it above. (A holder
-// over a plateau: the common case, answered without a walk.)
-bool rests_flat(const Cutter& profile, const IndexedTriangle& t, double x, double y, double h) {
-  const double e = profile.flat_radius();
-  if (!(t.zmax == h && e > 0.0 && profile.beta1() == 0.0)) return false;
-  for (int k = 0; k < 3; ++k) {
-    const double* p = t.p[k];
-    const double* q = t.p[(k + 1) % 3];
-    if (p[2] != h) continue;
-    double s = 0.0;  // the closest point of the edge p-q (of p alone when q is lower)
-    const double ex = q[0] - p[0], ey = q[1] - p[1], l2 = ex * ex + ey * ey;
-    if (q[2] == h && l2 > 0.0) s = std::clamp(((x - p[0]) * ex + (y - p[1]) * ey) / l2, 0.0, 1.0);
-    const double dx = p[0] + s * ex - x, dy = p[1] + s * ey - y;
-    if (dx * dx + dy * dy <= e * e) return true;
-  }
-  return false;
-}
-
 // One body's piece over the batch, each point from its own floor `base` (the height so far + the lift). Points
 // whose cells' bound is not above the floor keep it (top = base); points where the previous winner holds the
 // flat bottom at the bound get the bound (rests_flat). The others are dropped with `tiles` as a batch
@@ -313,7 +294,7 @@ void drop_piece(const MeshIndex& index, const Cutter& profile, const double* xy,
       const double x = xy[2 * i], y = xy[2 * i + 1], ub = bound_at(i);
       if (ub <= base[i]) {
         top[i] = base[i];
-      } else if (hint >= 0 && rests_flat(profile, tris[static_cast<std::size_t>(hint)], x, y, ub)) {
+      } else if (hint >= 0 && drop_detail::rests_flat(profile, tris[static_cast<std::size_t>(hint)], x, y, ub)) {
         top[i] = ub;
       } else {
         top[i] = drop_point(index, profile, x, y, base[i], &local, &hint);
@@ -367,11 +348,74 @@ double drop_assembly_point(const MeshIndex& index, const ToolAssembly& tool, dou
 
 namespace {
 
-// drop_assembly_batch with the floor of point i = floors ? floors[i] : floor_z.
+// drop_assembly_floors with the bodies dropped in the cutter's tiles (FollowPieces); the points those leave open
+// from some piece on are dropped from there piece after piece (drop_piece over them alone).
+void drop_assembly_follow(const MeshIndex& index, const std::vector<AssemblyPiece>& pieces, const double* xy,
+                          std::size_t n, const double* floors, double floor_z, double* z_out, int32_t* set_by,
+                          const BatchOptions& options, DropStats* stats) {
+  const std::size_t m = pieces.size();
+  std::vector<int32_t> owner(set_by ? 0 : n);
+  int32_t* by = set_by ? set_by : owner.data();
+  std::vector<std::uint8_t> first_open(n);
+  // Progress: the cutter's pass with its followers up to 0.8, the open points' passes the rest.
+  BatchOptions pass = options;
+  if (options.progress) pass.progress = [&options](double f) { return options.progress(0.8 * f); };
+  drop_detail::drop_batch_follow(index, {pieces.data(), m, floors, floor_z, z_out, by, first_open.data()}, xy, n,
+                                 z_out, pass, stats);
+  std::vector<std::size_t> open;  // every point left open for some piece
+  for (std::size_t i = 0; i < n; ++i)
+    if (first_open[i] < m) open.push_back(i);
+  if (open.empty()) {
+    if (options.progress && !options.progress(1.0)) throw Cancelled();
+    return;
+  }
+  std::vector<double> oxy, rows, bound;
+  for (std::size_t i : open) oxy.insert(oxy.end(), {xy[2 * i], xy[2 * i + 1]});
+  double reach = 0.0;  // of the bodies' pieces
+  for (std::size_t k = 1; k < m; ++k) reach = std::max(reach, pieces[k].profile.max_radius());
+  const HeightCells cells(index, oxy.data(), open.size() >= kCellsFromPoints ? open.size() : 0, reach);
+  for (std::size_t k = 1; k < m; ++k) {
+    const AssemblyPiece& p = pieces[k];
+    // The points open for piece k lead the list as the pieces go (open ones stay open).
+    std::vector<double> kxy, kbase;
+    std::vector<std::size_t> at;
+    for (std::size_t o = 0; o < open.size(); ++o) {
+      const std::size_t i = open[o];
+      if (first_open[i] > k) continue;
+      at.push_back(i);
+      kxy.insert(kxy.end(), {xy[2 * i], xy[2 * i + 1]});
+      kbase.push_back(z_out[i] + p.lift);
+    }
+    if (at.empty()) continue;
+    std::vector<double> ktop(at.size());
+    if (options.progress)
+      pass.progress = [&options, k, m](double f) {
+        return options.progress(0.8 + 0.2 * (static_cast<double>(k - 1) + f) / static_cast<double>(m - 1));
+      };
+    drop_piece(index, p.profile, kxy.data(), at.size(), kbase.data(), ktop.data(), cells, rows, bound,
+               p.profile.max_radius() <= kTilesUpTo * pieces[0].profile.max_radius(), pass, stats);
+    for (std::size_t q = 0; q < at.size(); ++q) drop_detail::FollowPieces::raise(z_out[at[q]], by[at[q]], ktop[q], p);
+  }
+}
+
+// drop_assembly_batch with the floor of point i = floors ? floors[i] : floor_z: the bodies in the cutter's tiles
+// where each starts at or above the cutter's lift, else piece after piece over the batch.
 void drop_assembly_floors(const MeshIndex& index, const ToolAssembly& tool, const double* xy, std::size_t n,
                           const double* floors, double floor_z, double* z_out, int32_t* set_by,
                           const BatchOptions& options, DropStats* stats) {
   const std::vector<AssemblyPiece>& pieces = tool.pieces();
+  // Bodies in the cutter's tiles when those hold points enough for lists (a raster finer than a tile, not
+  // scattered points: there every tile would leave its points open).
+  const auto box = drop_detail::finite_box(xy, n);
+  const double tile = drop_detail::kTileFactor * pieces[0].profile.max_radius();
+  const double tiles = (std::floor((box.x1 - box.x0) / tile) + 1.0) * (std::floor((box.y1 - box.y0) / tile) + 1.0);
+  bool follow = pieces.size() > 1 && pieces.size() <= 255 && box.x0 <= box.x1 &&
+                static_cast<double>(n) >= static_cast<double>(drop_detail::kMinTilePoints) * tiles;
+  for (std::size_t k = 1; k < pieces.size(); ++k) follow = follow && pieces[k].lift >= pieces[0].lift;
+  if (follow) {
+    drop_assembly_follow(index, pieces, xy, n, floors, floor_z, z_out, set_by, options, stats);
+    return;
+  }
   const double passes = static_cast<double>(pieces.size());
   std::vector<double> base(n), top(n), rows, bound;  // rows, bound: the cells' scratch, kept from piece to piece
   double reach = 0.0;  // of the bodies' pieces

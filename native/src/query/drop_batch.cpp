@@ -94,20 +94,32 @@ TileRuns tile_runs(const Cutter& cutter, const double* xy, std::size_t n) {
 // One batch's runs solved one at a time (each thread its own candidate list): the floor of point i is
 // floors ? floors[i] : floor_z; with a finite ceiling each point's scan stops at its first contact above it
 // and reports min(h, ceiling).
+// A thread's lists, kept from run to run: the cutter's and a follower's; the tile's box, the heights so far.
+struct RunScratch {
+  TileCandidates cutter, follower;
+  double x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+  std::vector<double> height, base;
+  std::vector<int32_t> owner;
+};
+
 class RunSolver {
  public:
-  RunSolver(const MeshIndex& index, const Cutter& cutter, const double* xy, const double* floors, double floor_z,
-            double* z_out, double ceiling)
-      : index_(index), cutter_(cutter), xy_(xy), floors_(floors), floor_z_(floor_z), z_out_(z_out),
-        ceiling_(ceiling), capped_(ceiling < INFINITY),
-        // The tile scan specialised for the cutter's reach test, chosen once.
-        drop_in_tile_(cutter.kind() == CutterKind::Flat   ? &drop_point_in_tile<Reach::Flat>
-                      : cutter.kind() == CutterKind::Ball ? &drop_point_in_tile<Reach::Ball>
-                      : cutter.kind() == CutterKind::Bull ? &drop_point_in_tile<Reach::Bull>
-                                                          : &drop_point_in_tile<Reach::Scalar>) {}
+  using TileDrop = double (*)(const MeshIndex&, const Cutter&, const TileCandidates&, double, double, double,
+                              std::size_t&, int32_t&, double);
 
-  // The heights of run r's points; adds the triangles tested to `tested`.
-  void solve(const TileRuns& t, std::size_t r, TileCandidates& cands, std::size_t& tested) const {
+  // with `follow`, ceiling must be +inf
+  RunSolver(const MeshIndex& index, const Cutter& cutter, const double* xy, const double* floors, double floor_z,
+            double* z_out, double ceiling, const FollowPieces* follow = nullptr)
+      : index_(index), cutter_(cutter), xy_(xy), floors_(floors), floor_z_(floor_z), z_out_(z_out),
+        ceiling_(ceiling), capped_(ceiling < INFINITY), follow_(follow),
+        drop_in_tile_(tile_drop<false>(cutter)) {
+    for (std::size_t j = 1; follow && j < follow->count; ++j)
+      follow_in_tile_.push_back(tile_drop<true>(follow->pieces[j].profile));
+  }
+
+  // The heights of run r's points (and the follower's); adds the triangles tested to `tested`.
+  void solve(const TileRuns& t, std::size_t r, RunScratch& scratch, std::size_t& tested) const {
+    TileCandidates& cands = scratch.cutter;
     const std::size_t a = t.start[r], b = t.start[r + 1];
     const std::vector<std::size_t>& order = t.order;
     bool listed = b - a >= kMinTilePoints && t.key[order[a]] != kUntiled;
@@ -116,7 +128,24 @@ class RunSolver {
       k = above_ceiling(order, a, b, tested);
       if (k == b) return;
     }
-    if (listed) listed = gather(order, a, b, cands);
+    const bool boxed = listed;  // the tile's box is in scratch
+    if (listed) listed = gather(order, a, b, scratch);
+    solve_cutter(order, k, b, listed, cands, tested);
+    if (follow_) solve_followers(order, a, b, boxed, scratch, tested);
+  }
+
+ private:
+  // The tile scan specialised for the profile's reach test, chosen once.
+  template <bool kExact>
+  static TileDrop tile_drop(const Cutter& c) {
+    return c.kind() == CutterKind::Flat   ? &drop_point_in_tile<Reach::Flat, kExact>
+           : c.kind() == CutterKind::Ball ? &drop_point_in_tile<Reach::Ball, kExact>
+           : c.kind() == CutterKind::Bull ? &drop_point_in_tile<Reach::Bull, kExact>
+                                          : &drop_point_in_tile<Reach::Scalar, kExact>;
+  }
+
+  void solve_cutter(const std::vector<std::size_t>& order, std::size_t k, std::size_t b, bool listed,
+                    const TileCandidates& cands, std::size_t& tested) const {
     int32_t hint = -1;
     if (!listed) {
       DropStats s;
@@ -136,7 +165,82 @@ class RunSolver {
     }
   }
 
- private:
+  // The followers over run [a, b) once the cutter's heights are in (see FollowPieces); the tile's heights,
+  // owners and floors kept in scratch, written out once.
+  void solve_followers(const std::vector<std::size_t>& order, std::size_t a, std::size_t b, bool boxed,
+                       RunScratch& scratch, std::size_t& tested) const {
+    const FollowPieces& f = *follow_;
+    std::vector<double>& height = scratch.height;
+    std::vector<double>& base = scratch.base;
+    std::vector<int32_t>& owner = scratch.owner;
+    height.resize(b - a);
+    base.resize(b - a);
+    owner.assign(b - a, kSetByFloor);
+    for (std::size_t k = a; k < b; ++k) {
+      const std::size_t i = order[k];
+      height[k - a] = f.floors ? f.floors[i] : f.floor_z;
+      FollowPieces::raise(height[k - a], owner[k - a], z_out_[i], f.pieces[0]);
+    }
+    std::size_t open = boxed ? f.count : 1;  // the first piece left open
+    for (std::size_t j = 1; j < open; ++j)
+      if (!follow_piece(order, a, b, f.pieces[j], j - 1, scratch, tested)) open = j;
+    for (std::size_t k = a; k < b; ++k) {
+      const std::size_t i = order[k];
+      f.height[i] = height[k - a];
+      f.owner[i] = owner[k - a];
+      f.first_open[i] = static_cast<std::uint8_t>(open);
+    }
+  }
+
+  // One follower over the tile (its scan at position `scan`); false when its list would be too long.
+  bool follow_piece(const std::vector<std::size_t>& order, std::size_t a, std::size_t b, const AssemblyPiece& p,
+                    std::size_t scan, RunScratch& scratch, std::size_t& tested) const {
+    std::vector<double>& height = scratch.height;
+    std::vector<double>& base = scratch.base;
+    double lowest = INFINITY;
+    for (std::size_t k = 0; k < b - a; ++k) {
+      base[k] = height[k] + p.lift;
+      lowest = std::min(lowest, base[k]);
+    }
+    TileCandidates& fc = scratch.follower;
+    const std::size_t most = kMaxFollowerCandidatesPerPoint * (b - a);
+    fc.sorted.clear();
+    bool crowded = false;
+    index_.near_rect(scratch.x0, scratch.y0, scratch.x1, scratch.y1, p.profile.max_radius(), lowest,
+                     [&](const IndexedTriangle& t, int32_t id) {
+                       crowded = fc.sorted.size() == most;
+                       if (!crowded) fc.sorted.emplace_back(t.zmax, id);
+                       return !crowded;
+                     });
+    if (crowded) return false;
+    if (fc.sorted.empty()) return true;  // nothing rises above any floor
+    fc.prepare(index_, p.profile, most);
+    const double highest = fc.zmax[0];
+    const auto& tris = index_.triangles();
+    int32_t hint = -1;
+    for (std::size_t k = a; k < b; ++k) {
+      const double floor_k = base[k - a];
+      if (!(highest > floor_k)) continue;
+      // A holder over a plateau: the last winner holding the flat bottom at its top is a lower bound without a
+      // contact solve (the scan then only looks above it).
+      const std::size_t i = order[k];
+      const double x = xy_[2 * i], y = xy_[2 * i + 1];
+      double from = floor_k;
+      int32_t h = hint;
+      if (h >= 0) {
+        const IndexedTriangle& t = tris[static_cast<std::size_t>(fc.id[static_cast<std::size_t>(h)])];
+        if (t.zmax > floor_k && rests_flat(p.profile, t, x, y, t.zmax)) {
+          from = t.zmax;
+          h = -1;
+        }
+      }
+      const double top = follow_in_tile_[scan](index_, p.profile, fc, x, y, from, tested, h, INFINITY);
+      hint = h < 0 && from > floor_k ? hint : h;
+      FollowPieces::raise(height[k - a], scratch.owner[k - a], top, p);
+    }
+    return true;
+  }
+
   double floor_of(std::size_t i) const { return floors_ ? floors_[i] : floor_z_; }
 
   // Capped heights (a waterline's grid): while the tile's points stand above the ceiling (over the top of a
@@ -174,7 +278,7 @@ class RunSolver {
 
   // The tile's candidate list over its points' box and below their lowest floor; false when the tile is too
   // crowded for a list (then drop_point serves its points).
-  bool gather(const std::vector<std::size_t>& order, std::size_t a, std::size_t b, TileCandidates& cands) const {
+  bool gather(const std::vector<std::size_t>& order, std::size_t a, std::size_t b, RunScratch& scratch) const {
     double tx0 = INFINITY, ty0 = INFINITY, tx1 = -INFINITY, ty1 = -INFINITY;
     for (std::size_t j = a; j < b; ++j) {
       const std::size_t i = order[j];
@@ -185,11 +289,12 @@ class RunSolver {
     }
     double tile_floor = INFINITY;  // the lowest floor of the tile's points bounds the list
     for (std::size_t j = a; j < b; ++j) tile_floor = std::min(tile_floor, floor_of(order[j]));
-    return cands.gather(index_, cutter_, tx0, ty0, tx1, ty1, tile_floor, kMaxCandidatesPerPoint * (b - a));
+    scratch.x0 = tx0;
+    scratch.y0 = ty0;
+    scratch.x1 = tx1;
+    scratch.y1 = ty1;
+    return scratch.cutter.gather(index_, cutter_, tx0, ty0, tx1, ty1, tile_floor, kMaxCandidatesPerPoint * (b - a));
   }
-
-  using TileDrop = double (*)(const MeshIndex&, const Cutter&, const TileCandidates&, double, double, double,
-                              std::size_t&, int32_t&, double);
   const MeshIndex& index_;
   const Cutter& cutter_;
   const double* xy_;
@@ -198,27 +303,46 @@ class RunSolver {
   double* z_out_;
   const double ceiling_;
   const bool capped_;
+  const FollowPieces* follow_;
   const TileDrop drop_in_tile_;
+  std::vector<TileDrop> follow_in_tile_;  // piece j's scan at j - 1
 };
 
 // drop_batch with the floor of point i = floors ? floors[i] : floor_z.
 // ceiling: each point's scan stops at its first contact above it and reports min(h, ceiling).
 void drop_batch_floors(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                        const double* floors, double floor_z, double* z_out, const BatchOptions& options,
-                       DropStats* stats, double ceiling = INFINITY) {
+                       DropStats* stats, double ceiling = INFINITY, const FollowPieces* follow = nullptr) {
   const TileRuns t = tile_runs(cutter, xy, n);
-  const RunSolver solver(index, cutter, xy, floors, floor_z, z_out, ceiling);
+  const RunSolver solver(index, cutter, xy, floors, floor_z, z_out, ceiling, follow);
   std::atomic<std::size_t> tested{0};
   parallel_chunks(t.runs(), 16, options, [&](std::size_t begin, std::size_t end) {
     std::size_t local = 0;
-    TileCandidates cands;
-    for (std::size_t r = begin; r < end; ++r) solver.solve(t, r, cands, local);
+    RunScratch scratch;
+    for (std::size_t r = begin; r < end; ++r) solver.solve(t, r, scratch, local);
     tested.fetch_add(local);
   });
   if (stats) stats->triangles_tested += tested.load();
 }
 
 }  // namespace
+
+void drop_detail::drop_batch_follow(const MeshIndex& index, const FollowPieces& follow, const double* xy,
+                                    std::size_t n, double* top, const BatchOptions& options, DropStats* stats) {
+  const AssemblyPiece& cutter = follow.pieces[0];
+  if (follow.count > 255) throw std::invalid_argument("drop_batch_follow: more than 255 pieces");
+  for (std::size_t j = 1; j < follow.count; ++j)
+    if (!(follow.pieces[j].lift >= cutter.lift))
+      throw std::invalid_argument("drop_batch_follow: a follower's lift below the cutter's");
+  if (!follow.floors) {
+    drop_batch_floors(index, cutter.profile, xy, n, nullptr, follow.floor_z + cutter.lift, top, options, stats,
+                      INFINITY, &follow);
+    return;
+  }
+  std::vector<double> base(n);
+  for (std::size_t i = 0; i < n; ++i) base[i] = follow.floors[i] + cutter.lift;
+  drop_batch_floors(index, cutter.profile, xy, n, base.data(), 0.0, top, options, stats, INFINITY, &follow);
+}
 
 void drop_batch(const MeshIndex& index, const Cutter& cutter, const double* xy, std::size_t n,
                 double floor_z, double* z_out, const BatchOptions& options, DropStats* stats) {

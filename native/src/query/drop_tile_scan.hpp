@@ -15,6 +15,7 @@
 #include <emmintrin.h>
 #endif
 
+#include "tmm/query/drop_assembly.hpp"
 #include "tmm/query/drop_contacts.hpp"
 #include "tmm/query/drop_cutter.hpp"
 
@@ -62,6 +63,69 @@ inline double drop_on_owned(const Cutter& c, double x, double y, const IndexedTr
   return owned_edges_drop(c, x, y, t, above);
 }
 
+// A bound of any contact of a profile reaching r from its axis at (x, y) on the segment p-q: the segment's
+// highest point within r of the axis in XY (the profile's height above its tip is >= 0), -inf when none lies
+// there; widened by a margin against the rounding of the clip.
+inline double segment_top_within(double x, double y, double r, const double* p, const double* q) {
+  const double dx = q[0] - p[0], dy = q[1] - p[1], fx = p[0] - x, fy = p[1] - y;
+  const double reach = r * (1.0 + 1e-12) + 1e-12;
+  const double a = dx * dx + dy * dy, b = fx * dx + fy * dy, c = fx * fx + fy * fy - reach * reach;
+  double t0 = 0.0, t1 = 1.0;
+  if (a > 0.0) {
+    const double disc = b * b - a * c;
+    if (disc < 0.0) return -INFINITY;
+    const double root = std::sqrt(disc);
+    t0 = std::max(0.0, (-b - root) / a - 1e-9);
+    t1 = std::min(1.0, (-b + root) / a + 1e-9);
+    if (t0 > t1) return -INFINITY;
+  } else if (c > 0.0) {
+    return -INFINITY;
+  }
+  const double top = std::max(p[2] + t0 * (q[2] - p[2]), p[2] + t1 * (q[2] - p[2]));
+  return top + 1e-9 * (1.0 + std::fabs(top));
+}
+
+// drop_on_owned with each owned edge first bounded by its part within the profile's reach: the same value, the
+// contact solve skipped for an edge that only rises above `above` out of reach (a long wall facet's diagonal
+// beside a shank).
+inline double drop_on_owned_clipped(const Cutter& c, double x, double y, const IndexedTriangle& t, double above) {
+  bool inside = false;
+  const double zp = plane_drop(c, x, y, t.p[0], t.p[1], t.p[2], t.n, inside);
+  if (zp != kNoContact) {
+    if (zp <= above) return kNoContact;
+    if (inside) return zp;
+  }
+  const double r = c.max_radius();
+  double z = above;
+  for (int k = 0; k < 3; ++k) {
+    if (!(t.owned_edges & (1u << k))) continue;
+    const double* p = t.p[k];
+    const double* q = t.p[(k + 1) % 3];
+    if (segment_top_within(x, y, r, p, q) > z) z = std::max(z, edge_drop(c, x, y, p, q, z));
+  }
+  return z > above ? z : kNoContact;
+}
+
+// Does `profile`'s flat bottom rest at height h at (x, y) on triangle t: a corner or an edge of t at h (both
+// ends) within the flat bottom's radius? Then the drop is at least h (the flat bottom cannot pass below that
+// edge), and exactly h when nothing within reach is higher (h a bound of the heights around). A holder over a
+// plateau: the common case, answered without a contact solve.
+inline bool rests_flat(const Cutter& profile, const IndexedTriangle& t, double x, double y, double h) {
+  const double e = profile.flat_radius();
+  if (!(t.zmax == h && e > 0.0 && profile.beta1() == 0.0)) return false;
+  for (int k = 0; k < 3; ++k) {
+    const double* p = t.p[k];
+    const double* q = t.p[(k + 1) % 3];
+    if (p[2] != h) continue;
+    double s = 0.0;  // the closest point of the edge p-q (of p alone when q is lower)
+    const double ex = q[0] - p[0], ey = q[1] - p[1], l2 = ex * ex + ey * ey;
+    if (q[2] == h && l2 > 0.0) s = std::clamp(((x - p[0]) * ex + (y - p[1]) * ey) / l2, 0.0, 1.0);
+    const double dx = p[0] + s * ex - x, dy = p[1] + s * ey - y;
+    if (dx * dx + dy * dy <= e * e) return true;
+  }
+  return false;
+}
+
 // Batches are solved tile by tile: points are grouped into square tiles, each tile gathers once the
 // triangles any of its points can rest on, sorted by decreasing height, and each point scans that list
 // only until a triangle's top is no higher than its best contact (no later one can raise the cutter).
@@ -94,10 +158,15 @@ struct TileCandidates {
   // Collects the tile's candidates; false (and nothing prepared) when there are more than `most` of them.
   bool gather(const MeshIndex& index, const Cutter& cutter, double x0, double y0, double x1, double y1,
               double floor, std::size_t most) {
-    const double radius = cutter.max_radius();
     sorted.clear();
-    index.near_rect(x0, y0, x1, y1, radius, floor,
+    index.near_rect(x0, y0, x1, y1, cutter.max_radius(), floor,
                     [&](const IndexedTriangle& t, int32_t i) { sorted.emplace_back(t.zmax, i); });
+    return prepare(index, cutter, most);
+  }
+
+  // The list from the (top, triangle) pairs in `sorted`, in any order; false (and nothing prepared) when there
+  // are more than `most` of them.
+  bool prepare(const MeshIndex& index, const Cutter& cutter, std::size_t most) {
     if (sorted.size() > most) return false;
     std::sort(sorted.begin(), sorted.end(),
               [](const auto& a, const auto& b) { return a.first > b.first; });
@@ -205,7 +274,7 @@ inline unsigned block_mask(const TileCandidates& c, std::size_t k, double x, dou
 }
 
 // drop_on_owned for candidate q of a tile: raises best (and winner, the position in the list) when its
-// contact is higher. kExact: drop_on_owned itself, the very value drop_point gets; else with the tile's
+// contact is higher. kExact: drop_on_owned's value, the very value drop_point gets; else with the tile's
 // precomputed plane drop (the same value up to rounding, fewer operations).
 template <bool kExact>
 inline void test_candidate(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, std::size_t q,
@@ -214,7 +283,7 @@ inline void test_candidate(const MeshIndex& index, const Cutter& cutter, const T
   const IndexedTriangle& t = index.triangles()[c.id[q]];
   double z;
   if (kExact) {
-    z = drop_on_owned(cutter, x, y, t, best);
+    z = drop_on_owned_clipped(cutter, x, y, t, best);
   } else {
     const double zp = c.plane_a[q] * x + c.plane_b[q] * y + c.plane_c[q];
     if (zp <= best) return;  // the plane bounds the triangle (+inf for a plane not facing up: edges only)
@@ -261,17 +330,52 @@ inline double scan_tile(const MeshIndex& index, const Cutter& cutter, const Tile
 }
 
 // drop_point over a tile's candidate list; same result as the walk (the same bounds, a different order).
-template <Reach kReach>
+// kExact: each candidate by drop_on_owned, the very values of drop_point's walk.
+template <Reach kReach, bool kExact = false>
 inline double drop_point_in_tile(const MeshIndex& index, const Cutter& cutter, const TileCandidates& c, double x,
                           double y, double floor_z, std::size_t& tested, int32_t& hint, double ceiling) {
   double best = floor_z;
   int32_t winner = -1;  // position in the tile's list
   // Warm start: the previous point's winner (a position in this list) gives a true lower bound at once.
-  if (hint >= 0) test_candidate<false>(index, cutter, c, static_cast<std::size_t>(hint), x, y, best, winner, tested);
-  best = scan_tile<kReach>(index, cutter, c, x, y, best, winner, static_cast<std::size_t>(hint), tested, ceiling);
+  if (hint >= 0) test_candidate<kExact>(index, cutter, c, static_cast<std::size_t>(hint), x, y, best, winner, tested);
+  best = scan_tile<kReach, kExact>(index, cutter, c, x, y, best, winner, static_cast<std::size_t>(hint), tested, ceiling);
   hint = winner;
   return best;
 }
+
+// Followers' lists are bounded tighter than the cutter's: a holder over a dense plateau would gather thousands
+// of triangles there that the height cells' bound (drop_assembly.cpp) settles at once.
+constexpr std::size_t kMaxFollowerCandidatesPerPoint = 10;
+
+// The bodies of a tool assembly dropped in the cutter's own tiles right after it, one piece after another,
+// each from the height so far (as drop_assembly_point). A tile gathers per piece the triangles within its reach
+// above the lowest of its points' floors (the index prunes all below: a holder high above the part gathers
+// nothing) and scans them per point with drop_point's own per-triangle values. Where a piece has no list (a
+// tile too sparse, or its list too long) the tile's points are left open from that piece on, for the caller.
+struct FollowPieces {
+  const AssemblyPiece* pieces;  // [0] the cutter, [1, count) its followers
+  std::size_t count;
+  const double* floors;  // per point, or null: floor_z
+  double floor_z;
+  double* height;            // per point: the height after the pieces before first_open
+  int32_t* owner;            // per point: the piece that set it (kSetByFloor when none)
+  std::uint8_t* first_open;  // per point: the first piece left open (count when none)
+
+  // Piece p's drop from z + p.lift reached `top`: the height after it, and who set it (as drop_assembly_batch).
+  static void raise(double& z, int32_t& by, double top, const AssemblyPiece& p) {
+    if (top > z + p.lift && top - p.lift > z) {
+      z = top - p.lift;
+      by = p.owner;
+    }
+  }
+};
+
+// drop_batch of pieces[0] from the floors floors[i] + lift (or floor_z + lift) into `top` (scratch; may be
+// follow.height: a point's cutter height is read before its height is written), its followers (see
+// FollowPieces) in the same pass. Needs each follower's lift at or above the cutter's (their
+// floors then lie above the cutter's tile floor) and at most 255 pieces.
+void drop_batch_follow(const MeshIndex& index, const FollowPieces& follow, const double* xy, std::size_t n,
+                       double* top, const BatchOptions& options, DropStats* stats);
 
 }  // namespace drop_detail
 }  // namespace tmm

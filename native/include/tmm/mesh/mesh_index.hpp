@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -71,7 +72,7 @@ class MeshIndex {
 
   // Visits the triangles whose XY bounds come within `radius` of the rectangle [x0, x1] x [y0, y1] and whose
   // highest point is above `floor`: every triangle a cutter of that radius centred in the rectangle can
-  // rest on. visit(triangle, position) as for walk.
+  // rest on. visit(triangle, position) as for walk; a visit returning bool stops the walk with false.
   template <class Visit>
   void near_rect(double x0, double y0, double x1, double y1, double radius, double floor, Visit&& visit) const;
 
@@ -138,7 +139,12 @@ void MeshIndex::near_rect(double x0, double y0, double x1, double y1, double rad
     if (node.count > 0) {
       for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
         const IndexedTriangle& t = tris_[i];
-        if (near(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax)) visit(t, i);
+        if (!near(t.xmin, t.ymin, t.xmax, t.ymax, t.zmax)) continue;
+        if constexpr (std::is_same_v<decltype(visit(t, i)), bool>) {
+          if (!visit(t, i)) return;  // the visitor has seen enough
+        } else {
+          visit(t, i);
+        }
       }
     } else {
       stack[top++] = node.first + 1;
