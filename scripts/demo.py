@@ -204,6 +204,10 @@ def main() -> None:
         t_rest = time.perf_counter()
         print_rest(run_rest_case(out), time.perf_counter() - t_rest)
 
+    # planned with no operator: seed 003's sign, made from its text, planned from its job file (tmm plan)
+    t_p = time.perf_counter()
+    print_planned(run_planned_case(out), time.perf_counter() - t_p)
+
     # 5-axis part: seed 001's convex patch, multipoint positioning (the 3-axis part above is unchanged)
     t5 = time.perf_counter()
     row5 = run_multipoint_case(out, with_freecad)
@@ -291,6 +295,50 @@ def print_rough_finish(r: dict[str, Any], total: float) -> None:
     print("written (stock to part):")
     print_files(r["files"])
     print(f"stock to part {total:.1f} s", flush=True)
+
+
+# --- planned by the automatic planner ---------------------------------------------------------------------
+PLAN_NAME = "sign_planned"
+
+
+def run_planned_case(out: Path) -> dict[str, Any]:
+    """A sign of seed 003 (core.geometry.sign) planned, run and verified by `python3 -m tmm_workbench.plan` from a
+    job file naming only the model, the stock margin, the machine, the library, the material and the finish."""
+    import json
+    import subprocess
+
+    import yaml
+    from tmm_workbench.core.geometry.mesh import save_stl
+    from tmm_workbench.core.geometry.sign import SignSpec, make_sign
+
+    folder = out / PLAN_NAME
+    folder.mkdir(parents=True, exist_ok=True)
+    model = save_stl(make_sign(SignSpec("TMM 2026", width=100, height=50, cell=0.4)).mesh, folder / "sign.stl")
+    job = yaml.safe_load((REPO / "benchmarks" / "jobs" / "beet.yaml").read_text())
+    job.update(model={"file": str(model), "units": "mm"}, tools=str(REPO / "benchmarks" / "jobs" / "shop_tools.yaml"),
+               finish={"cusp": 0.05, "tolerance": 0.01}, outputs={"dir": str(folder), "name": PLAN_NAME})
+    job_file = folder / "job.yaml"
+    job_file.write_text(yaml.safe_dump(job))
+    proc = subprocess.run(["/usr/bin/python3", "-m", "tmm_workbench.plan", str(job_file), "--quiet"], cwd=REPO,
+                          capture_output=True, text=True, env=dict(os.environ, PYTHONPATH=str(REPO)))
+    report = folder / "report.json"
+    if proc.returncode not in (0, 1) or not report.is_file():
+        raise RuntimeError(f"tmm plan failed (exit {proc.returncode}): {proc.stderr.strip()[-800:]}")
+    rep = json.loads(report.read_text())
+    return dict(name=PLAN_NAME, exit=proc.returncode, report=rep,
+                files=[job_file, model] + [folder / f for f in rep["files"]])
+
+
+def print_planned(r: dict[str, Any], total: float) -> None:
+    rep, v = r["report"], r["report"]["verification"]
+    print(f"\n--- {r['name']}: seed 003's sign planned with no operator (tmm plan, exit {r['exit']}): "
+          f"{'verified' if rep['passed'] else 'NOT verified: ' + '; '.join(rep['problems'])}")
+    for d in rep["plan"]["decisions"]:
+        print(f"  {d['topic']}: {d['choice']}")
+    print(f"  deepest gouge {v['deepest_gouge_mm']:g} mm, cycle {v['cycle_seconds'] / 60:.1f} min")
+    print("written (planned):")
+    print_files(r["files"])
+    print(f"planned part {total:.1f} s", flush=True)
 
 
 # --- rest -----------------------------------------------------------------------------------------------
