@@ -11,6 +11,7 @@ import pytest
 from tests.conftest import grid_mesh
 from tests.core.scallop5_reference import remaining, surface_samples, swept_positions
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths
@@ -82,3 +83,13 @@ def test_bad_tolerance_and_tool_are_refused_by_name():
         adaptive_passes(plane, Cutter.flat(6.0), 0)
     with pytest.raises(TmmError, match="ball, flat or bull-nose"):
         adaptive_passes(plane, Cutter.vbit(6.0, 90.0), 0.01)
+
+
+def test_interior_points_catch_a_groove_between_the_cc_point_and_the_side_step():
+    # a groove 0.2 mm deep halfway to the side step: the ends of the step pass, the tool leaves the groove's
+    # depth of material above it
+    groove = grid_mesh(lambda x, y: -0.2 * np.exp(-((y - 1.5) / 0.3) ** 2), 16, 200, (-8, -5, 8, 5), "groove")
+    grid = PostureGrid.degrees((0, 6), (-6, 6))
+    args = (groove, Cutter.flat(10.0), np.zeros((1, 3)), np.eye(3)[None], grid, TOL, 3.0)
+    assert build_cspace(*args).available.any()
+    assert build_cspace(*args, interior=3).empty.all()

@@ -47,6 +47,9 @@ Progress = Callable[[float], bool]
 WIDTH_SAMPLES = 97      # lateral samples per side out to 2 R (the section is linear between them)
 SHRINK = 0.8            # gap factor when a pass must be rebuilt
 MAX_TRIES = 12
+# points checked inside each side step by the C-space's top bound: where the section curves up between the
+# CC point and the side step, the ends alone pass postures that leave more there
+INTERIOR = 3
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -143,7 +146,7 @@ def _plan_pass(mesh: TriMesh, reach: MeshReach, cutter: Cutter, tolerance: float
         raise TmmError(f"drive plane at {offset:.4f} mm does not cut the mesh")
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, min(side, 2 * cutter.radius))
+    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, min(side, 2 * cutter.radius), interior=INTERIOR)
     if cs.empty.any():
         return None
     postures, start = [], 0

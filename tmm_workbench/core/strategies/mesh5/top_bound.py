@@ -140,10 +140,12 @@ def half_steps(side_step, n: int, radius: float) -> np.ndarray:
 
 
 def top_bounds(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
-               omg: np.ndarray, tolerance: float, side_step, arcs: Optional[tuple] = None) -> np.ndarray:
+               omg: np.ndarray, tolerance: float, side_step, arcs: Optional[tuple] = None,
+               interior: int = 0) -> np.ndarray:
     """delta_1 (n, P) of the P postures (lam, omg radians) at the n CC points for the remaining height
-    `tolerance` at the half side steps (see half_steps): -inf where no lift meets it, inf where the mesh
-    ends on both sides."""
+    `tolerance` at the half side steps (see half_steps), and with `interior` > 0 also at that many evenly
+    spaced points inside each side (where the section curves up between the CC point and the side step):
+    -inf where no lift meets it, inf where the mesh ends on both sides."""
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"tolerance must be a positive number of mm, got {tolerance!r}")
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -151,14 +153,15 @@ def top_bounds(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.
     w = half_steps(side_step, len(pts), cutter.radius)
     # LY of the CC point itself (the lift leaves material there too: the seed's delta < tau, eq. 3.20) and of
     # the two sides
-    lateral = np.stack([np.zeros(len(w)), w[:, 0], -w[:, 1]], axis=1)
+    frac = np.arange(1, int(interior) + 2) / (int(interior) + 1)
+    lateral = np.concatenate([np.zeros((len(w), 1)), w[:, :1] * frac, -w[:, 1:] * frac], axis=1)
     S = surface_heights(reach, pts, frm, lateral, 2 * cutter.radius + 4 * float(w.max()))
     a2, across, along = profile_arcs(cutter, lam, omg) if arcs is None else arcs
     norm2 = np.linalg.norm(a2, axis=1)
     au = a2 / norm2[:, None]
     bu = np.stack([au[:, 1], -au[:, 0]], axis=1)
     out = np.full((len(pts), len(a2)), np.inf)
-    for side in range(3):
+    for side in range(lateral.shape[1]):
         qy, qz = lateral[:, side], S[:, side] + tolerance                  # (n,)
         has = np.isfinite(qz)
         for p in range(len(a2)):
