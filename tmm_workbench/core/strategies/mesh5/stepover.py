@@ -121,12 +121,15 @@ class PlannedPass:
 class AdaptivePlan:
     passes: List[PlannedPass] = field(default_factory=list)
     builds: int = 0                 # C-spaces built (passes + rebuilds)
+    short: int = 0                  # rebuilt nearer: the right side fell short of the band covered
+    shrunk: int = 0                 # rebuilt with a smaller gap: no posture, or nothing gained
     seconds: float = 0.0
     extent: tuple[float, float] = (0.0, 0.0)   # the mesh along the plane normal
 
     def report(self) -> str:
         return (f"{len(self.passes)} passes over {self.extent[1] - self.extent[0]:.1f} mm, "
-                f"{self.builds} C-spaces built, {self.seconds:.1f} s")
+                f"{self.builds} C-spaces built ({self.short} moved nearer, {self.shrunk} with a smaller gap), "
+                f"{self.seconds:.1f} s")
 
 
 def _band(m: np.ndarray, ends: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
@@ -137,16 +140,17 @@ def _band(m: np.ndarray, ends: np.ndarray, lo: float, hi: float) -> tuple[float,
 
 
 def _plan_pass(mesh: TriMesh, reach: MeshReach, cutter: Cutter, tolerance: float, direction, offset: float,
-               side: float, grid: PostureGrid, machine: TarusMachine, forward_step: float,
+               side: tuple[float, float], grid: PostureGrid, machine: TarusMachine, forward_step: float,
                chord_tolerance: float, ideal_weight: float):
-    """The pass on the plane at `offset` with side step `side` each side, or None where some CC point has
-    no posture for it."""
+    """The pass on the plane at `offset` with the side steps `side` (left, right), or None where some CC
+    point has no posture for them."""
     paths = cc_paths(mesh, direction, np.array([offset]), forward_step, chord_tolerance)
     if not paths:
         raise TmmError(f"drive plane at {offset:.4f} mm does not cut the mesh")
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, min(side, 2 * cutter.radius), interior=INTERIOR)
+    steps = np.tile(np.minimum(side, 2 * cutter.radius), (len(pts), 1))
+    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, steps, interior=INTERIOR)
     if cs.empty.any():
         return None
     postures, start = [], 0
@@ -188,23 +192,24 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         for _ in range(MAX_TRIES):
             offset = min(offset, hi - edge)
             plan.builds += 1
-            got = _plan_pass(mesh, reach, cutter, tolerance, direction, offset, gap, grid, machine,
+            got = _plan_pass(mesh, reach, cutter, tolerance, direction, offset, (gap, gap), grid, machine,
                              forward_step, chord_tolerance, ideal_weight)
-            if got is None:                                                 # no posture for this side step
-                gap *= SHRINK
-                offset = covered + gap if plan.passes else offset
-                continue
-            band = _band(m, got[3], lo, hi)
-            if band[0] <= covered + 1e-9:
+            band = None if got is None else _band(m, got[3], lo, hi)
+            if band is not None and band[0] <= covered + 1e-9 and band[1] > covered + 1e-9:
                 break
-            offset -= 1.05 * (band[0] - covered) + 1e-6                     # the right side falls short
+            if band is not None and band[0] > covered + 1e-9 and \
+                    offset - 1.05 * (band[0] - covered) > covered + 0.25 * gap:
+                plan.short += 1
+                offset -= 1.05 * (band[0] - covered) + 1e-6                 # the right side falls short
+                continue
+            plan.shrunk += 1                                                # no posture, or nothing gained
+            gap *= SHRINK
+            offset = covered + gap if plan.passes else offset
         else:
             raise TmmError(f"no pass can be placed beyond {covered:.4f} mm on the plane-normal axis within the "
                            f"tolerance {tolerance:g} mm (gap down to {gap:.4g} mm)")
         paths, postures, widths, _ = got
         plan.passes.append(PlannedPass(offset, paths, postures, widths, band, gap))
-        if band[1] <= covered + 1e-9:
-            raise TmmError(f"the pass at {offset:.4f} mm covers nothing beyond {covered:.4f} mm")
         gap = max(band[1] - offset, 1e-3)                                   # the next right side: this left one
         covered = band[1]
         offset = covered + gap
