@@ -68,6 +68,12 @@ def main() -> None:
     print(f"slow check, {hit.sum()} surface points x {a.check_x[0]:g}..{a.check_x[1]:g} mm (every 0.25 mm across): "
           f"remaining height max {h.max():.4f} mm (tolerance {tol:.4f}), min {h.min():.4f} mm, above the "
           f"tolerance + 0.002: {(h > tol + 0.002).sum()} points; {time.perf_counter() - t0:.1f} s")
+    over = np.flatnonzero(h > tol + 0.002)
+    for i in over[:20]:
+        k = int(np.searchsorted([p.offset for p in plan.passes], q[hit][i, 1]))
+        near = [plan.passes[j] for j in (k - 1, k) if 0 <= j < len(plan.passes)]
+        print(f"  ({q[hit][i, 0]:.2f}, {q[hit][i, 1]:.2f}) left {h[i]:.4f} mm; planes "
+              + ", ".join(f"{p.offset:.2f} band {p.band[0]:.2f}..{p.band[1]:.2f}" for p in near))
 
 
 if __name__ == "__main__":

@@ -11,6 +11,7 @@ import pytest
 from tests.conftest import grid_mesh
 from tests.core.scallop5_reference import remaining, surface_samples, swept_positions
 from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
@@ -49,28 +50,36 @@ def test_a_yawed_tool_is_wider_on_the_side_of_its_body():
     assert plane_widths(Cutter.flat(12.0), 9.0, -30.0) == pytest.approx(w[::-1], abs=1e-6)
 
 
-@pytest.fixture(scope="module")
-def cylinder_plan():
-    """A convex cylinder patch (radius 60 mm, axis along the feed) cut by a flat D 10 at tolerance 0.05."""
+def cylinder(shear: float):
+    """A convex cylinder patch (radius 60 mm, axis along the feed), its ends slanted by `shear` (x += shear y)."""
     mesh = grid_mesh(lambda x, y: np.sqrt(60.0 ** 2 - y * y), 8, 80, (-12, -20, 12, 20), "cylinder")
+    v = mesh.vertices.copy()
+    v[:, 0] += shear * v[:, 1]
+    return TriMesh(v, mesh.triangles, "cylinder")
+
+
+@pytest.fixture(scope="module", params=[0.0, 0.8], ids=["square", "slanted"])
+def cylinder_plan(request):
+    """The cylinder cut by a flat D 10 at tolerance 0.05 mm; slanted, the planes' paths end at different x."""
+    mesh = cylinder(request.param)
     plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), grid=PostureGrid.degrees((0, 24), (-30, 30)),
                            forward_step=3.0)
-    return mesh, plan
+    return mesh, plan, request.param
 
 
 def test_passes_cover_the_surface_in_order_with_the_scallop_at_the_tolerance(cylinder_plan):
-    mesh, plan = cylinder_plan
+    mesh, plan, shear = cylinder_plan
     offsets = [p.offset for p in plan.passes]
-    assert offsets == sorted(offsets) and 3 <= len(offsets) <= 12
+    assert offsets == sorted(offsets) and 3 <= len(offsets) <= 16
     assert plan.passes[0].band[0] == pytest.approx(-20.0) and plan.passes[-1].band[1] == pytest.approx(20.0)
-    for a, b in zip(plan.passes[:-1], plan.passes[1:]):
-        assert b.band[0] <= a.band[1] + 1e-9                                # bands meet or overlap
-    # the slow check: every surface point in the middle of the feed, the tools of all passes swept over it
-    tips = np.concatenate([swept_positions(q.tips, q.axes)[0] for p in plan.passes for q in p.postures])
-    axes = np.concatenate([swept_positions(q.tips, q.axes)[1] for p in plan.passes for q in p.postures])
+    # the slow check: surface points a cutter radius and more from the ends of the feed (nearer, the tool
+    # leaving the path narrows its track: the ends need an overrun), the tools of all passes swept over them
+    sw = [swept_positions(q.tips, q.axes) for p in plan.passes for q in p.postures]
+    tips, axes = np.concatenate([s[0] for s in sw]), np.concatenate([s[1] for s in sw])
     xs, ys = np.meshgrid(np.linspace(-6, 6, 7), np.linspace(-19.5, 19.5, 391), indexing="ij")
-    q, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
-    h = remaining(q[hit], nrm[hit], tips, axes, 5.0, 20.0).reshape(7, -1)
+    q, nrm, hit = surface_samples(mesh, np.column_stack([(xs + shear * ys).ravel(), ys.ravel()]))
+    assert hit.all()
+    h = remaining(q, nrm, tips, axes, 5.0, 20.0)
     assert np.isfinite(h).all()
     assert h.min() >= -2e-3                                                 # no gouge
     assert h.max() <= TOL + 2e-3                                            # the scallop within the tolerance

@@ -132,11 +132,58 @@ class AdaptivePlan:
                 f"{self.seconds:.1f} s")
 
 
-def _band(m: np.ndarray, ends: np.ndarray, lo: float, hi: float) -> tuple[float, float]:
-    """(right, left) boundary of the covered band along m; the mesh's edge where a side ran off it."""
-    left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
-    right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
-    return float(right.max()), float(left.min())
+class _Coverage:
+    """How far across (along the plane normal m) the surface is finished, per bin of the feed coordinate:
+    passes end where the mesh's boundary runs slanted across the planes, so one level for the whole width
+    would take a pass's band for places its path never reaches."""
+
+    def __init__(self, mesh: TriMesh, m: np.ndarray, feed: np.ndarray, width: float, edge: float) -> None:
+        self.m, self.feed, self.width, self.edge = m, feed, width, edge
+        f, s = mesh.vertices @ feed, mesh.vertices @ m
+        self.f0 = float(f.min())
+        nb = int((float(f.max()) - self.f0) // width) + 1
+        self.lo, self.hi = np.full(nb, np.inf), np.full(nb, -np.inf)
+        b = self.bin(f)
+        np.minimum.at(self.lo, b, s)
+        np.maximum.at(self.hi, b, s)
+        self.level = self.lo.copy()                                         # finished up to here
+
+    def bin(self, f: np.ndarray) -> np.ndarray:
+        return np.clip(((f - self.f0) // self.width).astype(np.int64), 0, len(self.lo) - 1)
+
+    @property
+    def open(self) -> np.ndarray:
+        return self.level < self.hi - self.edge
+
+    @property
+    def covered(self) -> float:
+        """The least level over the bins not finished (inf when all are)."""
+        return float(self.level[self.open].min(initial=np.inf))
+
+    def shortfall(self, points: np.ndarray, ends: np.ndarray) -> float:
+        """How far (m) the right boundaries of a pass's CC points stay short of the level at their bins."""
+        right = np.where(np.isnan(ends[:, 1, 0]), -np.inf, ends[:, 1] @ self.m)
+        return float(np.max(right - self.level[self.bin(points @ self.feed)], initial=0.0))
+
+    def advanced(self, paths: List[CCPath], ends: np.ndarray) -> np.ndarray:
+        """The level after a pass (its right side meeting the level): per bin its paths span, the least left
+        boundary of the CC points in or next to the bin (inf where the left side ran off the mesh)."""
+        left = np.where(np.isnan(ends[:, 0, 0]), np.inf, ends[:, 0] @ self.m)
+        level, start = self.level.copy(), 0
+        for p in paths:
+            lp, fp = left[start:start + len(p)], p.points @ self.feed
+            start += len(p)
+            b = self.bin(fp)
+            new = np.full(len(level), np.inf)
+            np.minimum.at(new, b, lp)
+            # the bins between two CC points: the lesser of the two
+            for i in range(len(b) - 1):
+                lo, hi = sorted((int(b[i]), int(b[i + 1])))
+                new[lo:hi + 1] = np.minimum(new[lo:hi + 1], min(lp[i], lp[i + 1]))
+            span = np.zeros(len(level), dtype=bool)
+            span[int(b.min()):int(b.max()) + 1] = True
+            level = np.where(span, np.maximum(level, new), level)
+        return level
 
 
 def _plan_pass(mesh: TriMesh, reach: MeshReach, cutter: Cutter, tolerance: float, direction, offset: float,
@@ -185,35 +232,42 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     s = mesh.vertices @ m
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi))
-    covered, gap = lo, 0.25 * cutter.diameter                              # eq. 3.22: the seed's d = 0.25 D
-    offset = lo + 0.125 * cutter.diameter
     edge = 1e-3 * cutter.radius
-    while covered < hi:
+    cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, edge)
+    gap = 0.25 * cutter.diameter                                            # eq. 3.22: the seed's d = 0.25 D
+    offset = lo + 0.125 * cutter.diameter
+    while cover.open.any():
+        covered = cover.covered
         for _ in range(MAX_TRIES):
             offset = min(offset, hi - edge)
             plan.builds += 1
             got = _plan_pass(mesh, reach, cutter, tolerance, direction, offset, (gap, gap), grid, machine,
                              forward_step, chord_tolerance, ideal_weight)
-            band = None if got is None else _band(m, got[3], lo, hi)
-            if band is not None and band[0] <= covered + 1e-9 and band[1] > covered + 1e-9:
-                break
-            if band is not None and band[0] > covered + 1e-9 and \
-                    offset - 1.05 * (band[0] - covered) > covered + 0.25 * gap:
-                plan.short += 1
-                offset -= 1.05 * (band[0] - covered) + 1e-6                 # the right side falls short
-                continue
+            if got is not None:
+                pts = np.concatenate([p.points for p in got[0]])
+                short = cover.shortfall(pts, got[3])
+                level = cover.advanced(got[0], got[3])
+                if short <= 1e-9 and (level > cover.level + 1e-9)[cover.open].any():
+                    break
+                if short > 1e-9 and offset - 1.05 * short > covered + 0.25 * gap:
+                    plan.short += 1
+                    offset -= 1.05 * short + 1e-6                           # the right side falls short
+                    continue
             plan.shrunk += 1                                                # no posture, or nothing gained
             gap *= SHRINK
             offset = covered + gap if plan.passes else offset
         else:
             raise TmmError(f"no pass can be placed beyond {covered:.4f} mm on the plane-normal axis within the "
                            f"tolerance {tolerance:g} mm (gap down to {gap:.4g} mm)")
-        paths, postures, widths, _ = got
+        paths, postures, widths, ends = got
+        left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
+        right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
+        band = (float(right.max()), float(left.min()))
         plan.passes.append(PlannedPass(offset, paths, postures, widths, band, gap))
+        cover.level = level
         gap = max(band[1] - offset, 1e-3)                                   # the next right side: this left one
-        covered = band[1]
-        offset = covered + gap
-        if progress is not None and progress(min(1.0, (covered - lo) / (hi - lo))):
+        offset = min(cover.covered, hi) + gap
+        if progress is not None and progress(min(1.0, (min(cover.covered, hi) - lo) / (hi - lo))):
             break
     plan.seconds = time.perf_counter() - t0
     return plan
