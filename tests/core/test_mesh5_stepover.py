@@ -102,3 +102,16 @@ def test_interior_points_catch_a_groove_between_the_cc_point_and_the_side_step()
     args = (groove, Cutter.flat(10.0), np.zeros((1, 3)), np.eye(3)[None], grid, TOL, 3.0)
     assert build_cspace(*args).available.any()
     assert build_cspace(*args, interior=3).empty.all()
+
+
+def test_a_groove_no_pass_can_finish_is_reported_and_the_passes_go_on_beyond_it():
+    # a V groove 2 mm wide and 1 mm deep along the feed: no posture of a flat D 10 finishes it
+    mesh = grid_mesh(lambda x, y: -np.clip(1.0 - np.abs(y), 0, None), 10, 120, (-10, -15, 10, 15), "groove")
+    plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), grid=PostureGrid.degrees((0, 12), (-12, 12)),
+                           forward_step=4.0)
+    assert len(plan.unfinished) >= 1
+    f0, f1, a, b = plan.unfinished[0]
+    assert f0 <= -9.0 and f1 >= 9.0                                         # all along the feed
+    assert a < 1.0 and b > -1.0                                             # across: over the groove
+    assert any(p.offset > 1.0 for p in plan.passes) and plan.passes[-1].band[1] == pytest.approx(15.0)
+    assert "left unfinished" in plan.report()

@@ -123,13 +123,16 @@ class AdaptivePlan:
     builds: int = 0                 # C-spaces built (passes + rebuilds)
     short: int = 0                  # rebuilt nearer: the right side fell short of the band covered
     shrunk: int = 0                 # rebuilt with a smaller gap: no posture, or nothing gained
+    # (feed from, feed to, across from, across to) of the strips no pass could finish: for clean-up
+    unfinished: List[tuple[float, float, float, float]] = field(default_factory=list)
     seconds: float = 0.0
     extent: tuple[float, float] = (0.0, 0.0)   # the mesh along the plane normal
 
     def report(self) -> str:
         return (f"{len(self.passes)} passes over {self.extent[1] - self.extent[0]:.1f} mm, "
                 f"{self.builds} C-spaces built ({self.short} moved nearer, {self.shrunk} with a smaller gap), "
-                f"{self.seconds:.1f} s")
+                f"{self.seconds:.1f} s" + ("; left unfinished (feed from, to, across from, to; mm): " + ", ".join(
+                    f"({a:.1f}, {b:.1f}, {c:.2f}, {d:.2f})" for a, b, c, d in self.unfinished) if self.unfinished else ""))
 
 
 class _Coverage:
@@ -219,8 +222,9 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
                     forward_step: float = 2.0, chord_tolerance: float = 0.01, ideal_weight: float = 0.1,
                     progress: Optional[Progress] = None) -> AdaptivePlan:
     """Passes across the mesh, each placed so that the scallop with the previous one stays within
-    `tolerance` (module doc), their postures chosen for the Tarus motion time. TmmError when a pass cannot
-    be placed (no posture for any gap) or the tolerance is not a positive number."""
+    `tolerance` (module doc), their postures chosen for the Tarus motion time. Where no pass can advance the
+    finished level (no posture for any gap), those places are listed in `AdaptivePlan.unfinished` for
+    clean-up and the passes go on beside them. TmmError for a tolerance that is not a positive number."""
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"tolerance must be a positive number of mm, got {tolerance!r}")
     require_plain(cutter)
@@ -257,8 +261,15 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             gap *= SHRINK
             offset = covered + gap if plan.passes else offset
         else:
-            raise TmmError(f"no pass can be placed beyond {covered:.4f} mm on the plane-normal axis within the "
-                           f"tolerance {tolerance:g} mm (gap down to {gap:.4g} mm)")
+            # no pass advances the least finished bins: a strip a quarter diameter wide beyond them is left
+            # (reported for clean-up) and the passes go on past it
+            stuck = cover.open & (cover.level <= covered + 1e-9)
+            f = cover.f0 + cover.width * np.flatnonzero(stuck)
+            skip = 0.25 * cutter.diameter
+            plan.unfinished.append((float(f.min()), float(f.max() + cover.width), covered, covered + skip))
+            cover.level[stuck] = covered + skip
+            gap, offset = skip, cover.covered + skip
+            continue
         paths, postures, widths, ends = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
