@@ -59,12 +59,14 @@ class CSpace:
 def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray,
                  grid: PostureGrid, tolerance: float, side_step, lift_limit: Optional[float] = None,
                  tool_length: Optional[float] = None, all_lifts: bool = False,
-                 progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None) -> CSpace:
+                 progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None,
+                 interior: int = 0) -> CSpace:
     """The C-spaces at the n CC points (points (n, 3), frames (n, 3, 3) rows LX, LY, LZ, as cc_paths gives
     them). `side_step`: the half step-over on each side (number, (n,) or (n, 2): left +LY, right -LY).
     `lift_limit`: lifts above it count as unavailable (default: the largest finite top bound, at least the
     tolerance; with `all_lifts` the cutter radius). `assembly`: the cutter's ToolAssembly, whose shank and
-    holder (with their clearances) then bound S2 too."""
+    holder (with their clearances) then bound S2 too. `interior`: points checked inside each side step too
+    (top_bounds)."""
     require_plain(cutter)
     reach = mesh if isinstance(mesh, MeshReach) else MeshReach(mesh)
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -75,7 +77,8 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
     if len(pts) == 0:
         return CSpace(grid, np.zeros(shape), np.zeros(shape))
     lam, omg = (g.ravel() for g in grid.mesh())
-    top = top_bounds(reach, cutter, pts, frm, lam, omg, tolerance, side_step, profile_arcs(cutter, lam, omg))
+    top = top_bounds(reach, cutter, pts, frm, lam, omg, tolerance, side_step, profile_arcs(cutter, lam, omg),
+                     interior)
     finite = top[np.isfinite(top)]
     if lift_limit is None:
         lift_limit = cutter.radius if all_lifts else max(float(tolerance), float(finite.max()) if finite.size else 0.0)

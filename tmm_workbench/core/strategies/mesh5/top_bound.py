@@ -48,22 +48,14 @@ def profile_arcs(cutter: Cutter, lam: np.ndarray, omg: np.ndarray,
     return _profile_arcs(cutter, lam.tobytes(), omg.tobytes(), int(samples))
 
 
-@lru_cache(maxsize=4)
-def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: int):
-    lam, omg = np.frombuffer(lam_bytes), np.frombuffer(omg_bytes)
-    rot = tool_rotation(lam, omg)                                          # (P, 3, 3)
-    tip = touch_tip(cutter, rot)
+def _support(cutter: Cutter, rot: np.ndarray, ny: np.ndarray, nz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(LY, LZ) (P, S) of the profile's support points for the unit normals (ny, nz) (P, S), at delta = 0:
+    the ellipse (the disc of radius R - r seen along LX) grown by a disc of radius r."""
     r = cutter.corner_radius
     rp = cutter.radius - r
+    tip = touch_tip(cutter, rot)
     c2 = (tip + r * rot[:, 2, :])[:, 1:]                                  # disc centre (LY, LZ)
     M = rp * np.stack([rot[:, 0, 1:], rot[:, 1, 1:]], axis=-1)            # (P, 2, 2): columns TX, TY seen
-    a2 = rot[:, 2, 1:]                                                     # lift direction in (LY, LZ)
-    au = a2 / np.linalg.norm(a2, axis=1, keepdims=True)
-    bu = np.stack([au[:, 1], -au[:, 0]], axis=1)                           # across the lift, towards +LY
-    th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
-    # outward normals of the arc that faces against the lift: n = -cos(th) a + sin(th) b, (P, S) components
-    ny = -np.cos(th) * au[:, :1] + np.sin(th) * bu[:, :1]
-    nz = -np.cos(th) * au[:, 1:] + np.sin(th) * bu[:, 1:]
     m = [[M[:, i, j][:, None] for j in range(2)] for i in range(2)]
     s0 = m[0][0] * ny + m[1][0] * nz                                       # M^T n
     s1 = m[0][1] * ny + m[1][1] * nz
@@ -71,14 +63,40 @@ def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: i
     inv = np.where(norm > 1e-15, 1.0 / np.where(norm > 1e-15, norm, 1.0), 0.0)
     s0 *= inv
     s1 *= inv
-    py = c2[:, :1] + m[0][0] * s0 + m[0][1] * s1 + r * ny                  # support points of E + disc_r
+    py = c2[:, :1] + m[0][0] * s0 + m[0][1] * s1 + r * ny
     pz = c2[:, 1:] + m[1][0] * s0 + m[1][1] * s1 + r * nz
+    return py, pz
+
+
+@lru_cache(maxsize=4)
+def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: int):
+    lam, omg = np.frombuffer(lam_bytes), np.frombuffer(omg_bytes)
+    rot = tool_rotation(lam, omg)                                          # (P, 3, 3)
+    a2 = rot[:, 2, 1:]                                                     # lift direction in (LY, LZ)
+    au = a2 / np.linalg.norm(a2, axis=1, keepdims=True)
+    bu = np.stack([au[:, 1], -au[:, 0]], axis=1)                           # across the lift, towards +LY
+    th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
+    # outward normals of the arc that faces against the lift: n = -cos(th) a + sin(th) b
+    py, pz = _support(cutter, rot, -np.cos(th) * au[:, :1] + np.sin(th) * bu[:, :1],
+                      -np.cos(th) * au[:, 1:] + np.sin(th) * bu[:, 1:])
     across = py * bu[:, :1] + pz * bu[:, 1:]
     along = py * au[:, :1] + pz * au[:, 1:]
     arcs = (a2, np.maximum.accumulate(across, axis=1), along)
     for a in arcs:
         a.flags.writeable = False                                          # shared by the cache
     return arcs
+
+
+def lower_profile(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, samples: int = PROFILE_SAMPLES
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The effective cutting profile's lower boundary along LZ for P postures (lam, omg radians) at delta =
+    0: LY (P, samples, increasing) and LZ (P, samples) in the CC point's LCS."""
+    lam = np.asarray(lam, dtype=float).reshape(-1)
+    rot = tool_rotation(lam, np.asarray(omg, dtype=float).reshape(-1))
+    th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
+    ny = np.repeat(np.sin(th), len(lam), axis=0)
+    py, pz = _support(cutter, rot, ny, -np.cos(th) + 0 * ny)
+    return np.maximum.accumulate(py, axis=1), pz
 
 
 def surface_heights(reach: MeshReach, points: np.ndarray, frames: np.ndarray, lateral: np.ndarray,
@@ -94,15 +112,14 @@ def surface_heights(reach: MeshReach, points: np.ndarray, frames: np.ndarray, la
         det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
         ok = np.abs(det) > 1e-300
         a, b, c, det = a[ok], b[ok], c[ok], det[ok]
-        for j, y in enumerate(lat[i]):
-            px, py = -a[:, 0], y - a[:, 1]
-            u = (px * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * py) / det
-            v = ((b[:, 0] - a[:, 0]) * py - px * (b[:, 1] - a[:, 1])) / det
-            tol = 1e-12
-            inside = (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol)
-            if inside.any():
-                z = a[inside, 2] + u[inside] * (b[inside, 2] - a[inside, 2]) + v[inside] * (c[inside, 2] - a[inside, 2])
-                out[i, j] = z.max()
+        px, py = -a[:, 0][:, None], lat[i][None, :] - a[:, 1][:, None]                 # (k, L)
+        u = (px * (c[:, 1] - a[:, 1])[:, None] - (c[:, 0] - a[:, 0])[:, None] * py) / det[:, None]
+        v = ((b[:, 0] - a[:, 0])[:, None] * py - px * (b[:, 1] - a[:, 1])[:, None]) / det[:, None]
+        tol = 1e-12
+        inside = (u >= -tol) & (v >= -tol) & (u + v <= 1 + tol)
+        z = a[:, 2][:, None] + u * (b[:, 2] - a[:, 2])[:, None] + v * (c[:, 2] - a[:, 2])[:, None]
+        z = np.where(inside, z, -np.inf).max(axis=0, initial=-np.inf)
+        out[i] = np.where(np.isfinite(z), z, np.nan)
     return out
 
 
@@ -123,10 +140,12 @@ def half_steps(side_step, n: int, radius: float) -> np.ndarray:
 
 
 def top_bounds(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
-               omg: np.ndarray, tolerance: float, side_step, arcs: Optional[tuple] = None) -> np.ndarray:
+               omg: np.ndarray, tolerance: float, side_step, arcs: Optional[tuple] = None,
+               interior: int = 0) -> np.ndarray:
     """delta_1 (n, P) of the P postures (lam, omg radians) at the n CC points for the remaining height
-    `tolerance` at the half side steps (see half_steps): -inf where no lift meets it, inf where the mesh
-    ends on both sides."""
+    `tolerance` at the half side steps (see half_steps), and with `interior` > 0 also at that many evenly
+    spaced points inside each side (where the section curves up between the CC point and the side step):
+    -inf where no lift meets it, inf where the mesh ends on both sides."""
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"tolerance must be a positive number of mm, got {tolerance!r}")
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -134,14 +153,15 @@ def top_bounds(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.
     w = half_steps(side_step, len(pts), cutter.radius)
     # LY of the CC point itself (the lift leaves material there too: the seed's delta < tau, eq. 3.20) and of
     # the two sides
-    lateral = np.stack([np.zeros(len(w)), w[:, 0], -w[:, 1]], axis=1)
+    frac = np.arange(1, int(interior) + 2) / (int(interior) + 1)
+    lateral = np.concatenate([np.zeros((len(w), 1)), w[:, :1] * frac, -w[:, 1:] * frac], axis=1)
     S = surface_heights(reach, pts, frm, lateral, 2 * cutter.radius + 4 * float(w.max()))
     a2, across, along = profile_arcs(cutter, lam, omg) if arcs is None else arcs
     norm2 = np.linalg.norm(a2, axis=1)
     au = a2 / norm2[:, None]
     bu = np.stack([au[:, 1], -au[:, 0]], axis=1)
     out = np.full((len(pts), len(a2)), np.inf)
-    for side in range(3):
+    for side in range(lateral.shape[1]):
         qy, qz = lateral[:, side], S[:, side] + tolerance                  # (n,)
         has = np.isfinite(qz)
         for p in range(len(a2)):

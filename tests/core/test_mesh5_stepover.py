@@ -1,0 +1,117 @@
+"""Adaptive 5-axis step-over (core.strategies.mesh5.stepover): the half-widths of the tilted cutter's effective
+profile against closed forms on a plane, and the passes' scallop checked on the real tool positions by the
+slow reference (the solid cylinder swept between the CL points, material measured along the normals)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tests.conftest import grid_mesh
+from tests.core.scallop5_reference import remaining, surface_samples, swept_positions
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
+from tmm_workbench.core.strategies.mesh5.lift import MeshReach
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
+from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths
+from tmm_workbench.core.tools.cutter import Cutter
+
+TOL = 0.05
+
+
+def plane_widths(cutter: Cutter, lam_deg: float, omg_deg: float = 0.0) -> np.ndarray:
+    plane = grid_mesh(lambda x, y: 0.0 * x, 20, 20, (-20, -20, 20, 20), "plane")
+    w, _ = half_widths(MeshReach(plane), cutter, np.zeros((1, 3)), np.eye(3)[None], np.radians([lam_deg]),
+                       np.radians([omg_deg]), np.zeros(1), TOL)
+    return w[0]
+
+
+@pytest.mark.parametrize("lam", [3.0, 9.0, 30.0])
+def test_tilted_flat_end_half_width_on_a_plane_is_the_ellipse(lam):
+    # the rim seen along the feed: R sin(lambda) (1 - sqrt(1 - y^2 / R^2)) above the plane (seed Fig. 3-12)
+    R = 6.0
+    k = 1.0 - TOL / (R * math.sin(math.radians(lam)))
+    expect = R * math.sqrt(1.0 - k * k)
+    assert plane_widths(Cutter.flat(2 * R), lam) == pytest.approx([expect, expect], abs=2e-3)
+
+
+def test_bull_nose_half_width_on_a_plane_is_the_flat_plus_the_corner():
+    R, r = 6.0, 2.0
+    expect = (R - r) + math.sqrt(r * r - (r - TOL) ** 2)
+    assert plane_widths(Cutter.bull(2 * R, r), 0.0) == pytest.approx([expect, expect], abs=2e-3)
+
+
+def test_a_yawed_tool_is_wider_on_the_side_of_its_body():
+    # yawed towards +LY, the lowest rim point moves to +LY and the body (behind it along -TX) to -LY
+    w = plane_widths(Cutter.flat(12.0), 9.0, 30.0)
+    assert w[1] > w[0] + 0.1
+    assert plane_widths(Cutter.flat(12.0), 9.0, -30.0) == pytest.approx(w[::-1], abs=1e-6)
+
+
+def cylinder(shear: float):
+    """A convex cylinder patch (radius 60 mm, axis along the feed), its ends slanted by `shear` (x += shear y)."""
+    mesh = grid_mesh(lambda x, y: np.sqrt(60.0 ** 2 - y * y), 8, 80, (-12, -20, 12, 20), "cylinder")
+    v = mesh.vertices.copy()
+    v[:, 0] += shear * v[:, 1]
+    return TriMesh(v, mesh.triangles, "cylinder")
+
+
+@pytest.fixture(scope="module", params=[0.0, 0.8], ids=["square", "slanted"])
+def cylinder_plan(request):
+    """The cylinder cut by a flat D 10 at tolerance 0.05 mm; slanted, the planes' paths end at different x."""
+    mesh = cylinder(request.param)
+    plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), grid=PostureGrid.degrees((0, 24), (-30, 30)),
+                           forward_step=3.0)
+    return mesh, plan, request.param
+
+
+def test_passes_cover_the_surface_in_order_with_the_scallop_at_the_tolerance(cylinder_plan):
+    mesh, plan, shear = cylinder_plan
+    offsets = [p.offset for p in plan.passes]
+    assert offsets == sorted(offsets) and 3 <= len(offsets) <= 16
+    assert plan.passes[0].band[0] == pytest.approx(-20.0) and plan.passes[-1].band[1] == pytest.approx(20.0)
+    # the slow check: surface points a cutter radius and more from the ends of the feed (nearer, the tool
+    # leaving the path narrows its track: the ends need an overrun), the tools of all passes swept over them
+    sw = [swept_positions(q.tips, q.axes) for p in plan.passes for q in p.postures]
+    tips, axes = np.concatenate([s[0] for s in sw]), np.concatenate([s[1] for s in sw])
+    xs, ys = np.meshgrid(np.linspace(-6, 6, 7), np.linspace(-19.5, 19.5, 391), indexing="ij")
+    q, nrm, hit = surface_samples(mesh, np.column_stack([(xs + shear * ys).ravel(), ys.ravel()]))
+    assert hit.all()
+    h = remaining(q, nrm, tips, axes, 5.0, 20.0)
+    assert np.isfinite(h).all()
+    assert h.min() >= -2e-3                                                 # no gouge
+    assert h.max() <= TOL + 2e-3                                            # the scallop within the tolerance
+    assert h.max() >= 0.7 * TOL                                             # and not far below it: adaptive
+
+
+def test_bad_tolerance_and_tool_are_refused_by_name():
+    plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 10, 10), "plane")
+    with pytest.raises(TmmError, match="tolerance must be a positive number of mm, got 0"):
+        adaptive_passes(plane, Cutter.flat(6.0), 0)
+    with pytest.raises(TmmError, match="ball, flat or bull-nose"):
+        adaptive_passes(plane, Cutter.vbit(6.0, 90.0), 0.01)
+
+
+def test_interior_points_catch_a_groove_between_the_cc_point_and_the_side_step():
+    # a groove 0.2 mm deep halfway to the side step: the ends of the step pass, the tool leaves the groove's
+    # depth of material above it
+    groove = grid_mesh(lambda x, y: -0.2 * np.exp(-((y - 1.5) / 0.3) ** 2), 16, 200, (-8, -5, 8, 5), "groove")
+    grid = PostureGrid.degrees((0, 6), (-6, 6))
+    args = (groove, Cutter.flat(10.0), np.zeros((1, 3)), np.eye(3)[None], grid, TOL, 3.0)
+    assert build_cspace(*args).available.any()
+    assert build_cspace(*args, interior=3).empty.all()
+
+
+def test_a_groove_no_pass_can_finish_is_reported_and_the_passes_go_on_beyond_it():
+    # a V groove 2 mm wide and 1 mm deep along the feed: no posture of a flat D 10 finishes it
+    mesh = grid_mesh(lambda x, y: -np.clip(1.0 - np.abs(y), 0, None), 10, 120, (-10, -15, 10, 15), "groove")
+    plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), grid=PostureGrid.degrees((0, 12), (-12, 12)),
+                           forward_step=4.0)
+    assert len(plan.unfinished) >= 1
+    f0, f1, a, b = plan.unfinished[0]
+    assert f0 <= -9.0 and f1 >= 9.0                                         # all along the feed
+    assert a < 1.0 and b > -1.0                                             # across: over the groove
+    assert any(p.offset > 1.0 for p in plan.passes) and plan.passes[-1].band[1] == pytest.approx(15.0)
+    assert "left unfinished" in plan.report()
