@@ -81,7 +81,7 @@ def run_batch(jobs: Sequence[Path], out_root: Path, scheduler: Optional[str] = N
         if client.dashboard_link and has_dashboard() and not quiet:
             print(f"Dask dashboard: {client.dashboard_link}", file=sys.stderr)
         futures = {client.submit(run_part, str(j), str(out_root), timeout_s, pure=False, retries=1,
-                                 key=f"tmm-part-{j.stem}-{int(t0)}"): j for j in jobs}
+                                 priority=_size(j), key=f"tmm-part-{j.stem}-{int(t0)}"): j for j in jobs}
         rows: dict[Path, dict] = {}
         for fut in as_completed(futures):
             job = futures[fut]
@@ -102,6 +102,17 @@ def run_batch(jobs: Sequence[Path], out_root: Path, scheduler: Optional[str] = N
 
 
 _GOOD = ("verified", "done before (skipped)")
+
+
+def _size(job: Path) -> int:
+    """The part's model file size in KB: the larger first (the longest parts first keep the last worker from
+    finishing alone); 0 when the job does not read."""
+    from tmm_workbench.core.plan.job_file import read_job
+
+    try:
+        return Path(read_job(str(job)).model.file).stat().st_size // 1024
+    except Exception:   # the part's own run reports why
+        return 0
 
 
 def _progress(done: int, total: int, failed: int, elapsed: float, quiet: bool) -> None:
