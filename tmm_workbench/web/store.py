@@ -178,7 +178,10 @@ class JobStore:
             running = any((self.root / job_id / OUT_DIR).glob(".job-*"))   # run_part's folder while it plans
             return {**out, "state": "planning" if running else "queued"}
         row = record.get("row") or {}
-        out.update(state=row.get("state", record["state"]), files=self.files(record))
+        state = row.get("state", record["state"])
+        if state == "done before (skipped)":   # planned by a worker while the server restarted: its report says
+            state = "verified" if row.get("passed") else "verification failed"
+        out.update(state=state, files=self.files(record))
         if record["state"] == FAILED or row.get("reason"):
             out["reason"] = row.get("reason", "")
         if row.get("picture"):
