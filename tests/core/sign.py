@@ -31,22 +31,7 @@ def outlines() -> list[np.ndarray]:
 def raised(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Whether each point lies on a raised part (a letter or the border)."""
     out = (x < BORDER) | (x > WIDTH - BORDER) | (y < BORDER) | (y > HEIGHT - BORDER)
-    for loop in _letters():
-        out |= _inside(loop, x, y)
-    return out
-
-
-def _inside(loop: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Even-odd point in polygon, vectorised."""
-    inside = np.zeros(x.shape, dtype=bool)
-    n = len(loop)
-    for k in range(n):
-        (xa, ya), (xb, yb) = loop[k], loop[(k + 1) % n]
-        crosses = (ya > y) != (yb > y)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xc = xa + (y - ya) * (xb - xa) / (yb - ya)
-        inside ^= crosses & (x < xc)
-    return inside
+    return out | polygons.points_inside(_letters(), np.column_stack([x.ravel(), y.ravel()])).reshape(x.shape)
 
 
 def sign_mesh(cell: float = CELL) -> TriMesh:
