@@ -24,13 +24,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y --no-install-recommends "${missing[@]}"
 fi
 
-# Test-only Python packages (OpenCAMLib as the peer) go into a venv on top of Debian's python3.
+# Python packages Debian 12 lacks go into a venv on top of Debian's python3: OpenCAMLib (the test peer) and bokeh
+# (Dask's dashboard for `tmm batch`, which runs this venv's python: below 3 for Debian 12's distributed 2022.12).
 if [ ! -x .venv/bin/python ]; then
   /usr/bin/python3 -m venv --system-site-packages .venv
 fi
 if ! .venv/bin/python -c "import opencamlib" >/dev/null 2>&1; then
   echo "[setup] pip install opencamlib (test peer)"
   .venv/bin/python -m pip install -q opencamlib
+fi
+if ! .venv/bin/python -c "import bokeh" >/dev/null 2>&1; then
+  echo "[setup] pip install bokeh (Dask's dashboard)"
+  .venv/bin/python -m pip install -q "bokeh>=2.4.2,<3"
 fi
 
 # Native kernel for /usr/bin/python3 (FreeCAD's interpreter). Through ccache when CCACHE_DIR names its cache

@@ -8,8 +8,10 @@ import csv
 import json
 import os
 import signal
+import socket
 import threading
 import time
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -39,12 +41,47 @@ def _rows(out: Path) -> dict[str, dict]:
         return {r["part"]: r for r in csv.DictReader(f)}
 
 
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _dashboard_while(run: threading.Thread, port: int) -> dict:
+    """What Dask's dashboard at `port` says while `run` plans: its page served, and the batch's tasks counted."""
+    seen: dict = {"status": None, "tasks": 0, "processing": 0, "progress": None}
+    base = f"http://127.0.0.1:{port}"
+    while run.is_alive():
+        try:
+            with urllib.request.urlopen(base + "/json/counts.json", timeout=5) as r:
+                counts = json.loads(r.read())
+            if counts["processing"] and seen["status"] is None:
+                with urllib.request.urlopen(base + "/status", timeout=5) as r:
+                    seen["status"] = (r.status, b"Dask" in r.read())
+                with urllib.request.urlopen(base + "/individual-progress", timeout=5) as r:
+                    seen["progress"] = r.status
+            seen["tasks"] = max(seen["tasks"], counts["tasks"])
+            seen["processing"] = max(seen["processing"], counts["processing"])
+        except OSError:   # the cluster is still starting, or already gone
+            pass
+        time.sleep(0.3)
+    return seen
+
+
 def test_parts_on_two_workers_a_broken_one_reported_and_a_rerun_skips(tmp_path):
     jobs = _jobs(tmp_path / "jobs", a={}, b={"finish": {"cusp": 0.12, "tolerance": 0.01}},
                  broken={"material": "cheese"})
     (jobs / "tools.yaml").write_text("- {name: T, type: ball, diameter: 6, flutes: 2, flute_length: 20}\n")
     out = tmp_path / "out"
-    assert batch.main([str(jobs), "--out", str(out), "--workers", "2", "--quiet"]) == 1   # one part not verified
+    port, code = _free_port(), []
+    run = threading.Thread(target=lambda: code.append(batch.main(
+        [str(jobs), "--out", str(out), "--workers", "2", "--quiet", "--dashboard", f"127.0.0.1:{port}"])))
+    run.start()
+    seen = _dashboard_while(run, port)
+    run.join()
+    assert code == [1]                                                   # one part not verified
+    assert seen["status"] == (200, True) and seen["progress"] == 200 and seen["tasks"] == 3, seen
+    assert seen["processing"] >= 2, seen                                # parts on both workers
     rows = _rows(out)
     assert sorted(rows) == ["a", "b", "broken"]                                           # the tools file is no job
     for name in ("a", "b"):
@@ -100,6 +137,7 @@ def test_a_worker_killed_in_the_middle_of_a_part(tmp_path):
     (["{jobs}", "--workers", "-1"], "--workers must be >= 1"),
     (["{jobs}", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "not taken with --scheduler"),
     (["{jobs}", "--timeout", "0"], "--timeout must be > 0 s, got 0.0"),
+    (["{jobs}", "--scheduler", "tcp://127.0.0.1:1", "--dashboard", ":9999"], "--dashboard is not taken with"),
 ])
 def test_bad_arguments_exit_2_naming_them(tmp_path, capsys, args, words):
     (tmp_path / "empty").mkdir()

@@ -99,9 +99,9 @@ def create_app(jobs_dir: Path, scheduler: Optional[str] = None, workers: int = 1
 
     @app.on_event("startup")
     async def start() -> None:
-        from tmm_workbench.batch.run import open_client
+        from tmm_workbench.batch.run import NO_DASHBOARD, open_client
 
-        client, local = await asyncio.to_thread(open_client, scheduler, workers, False)
+        client, local = await asyncio.to_thread(open_client, scheduler, workers, NO_DASHBOARD)
         store.client = client
         cluster.append(local)
         await asyncio.to_thread(store.recover)
