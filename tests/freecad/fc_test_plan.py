@@ -14,7 +14,7 @@ import FreeCAD
 
 from fc_helpers import OUT, FreeCADTestCase, close_all, parse_gcode
 from tmm_workbench.app import plan_run
-from tmm_workbench.core.plan import launch
+from tmm_workbench.core.plan import launch, progress_note
 from tmm_workbench.core.plan.job_file import read_job
 
 JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
@@ -41,9 +41,15 @@ class PlanBeet(FreeCADTestCase):
         doc = launch.plan_document(job, plan, job.model.file)
         (folder / "plan.json").write_text(json.dumps(doc))
         os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
-        self.assertEqual(plan_run.main(), 0)
+        os.environ[progress_note.ENV] = str(folder / "progress.json")
+        try:
+            self.assertEqual(plan_run.main(), 0)
+        finally:
+            del os.environ[progress_note.ENV]
         verified = json.loads((folder / "verify.json").read_text())
         self.assertTrue(verified["passed"], verified["problems"])
+        last = progress_note.read(folder / "progress.json")   # the run's last progress note: its last step
+        self.assertEqual(last, {"step": len(plan.ops) + 4, "steps": len(plan.ops) + 4, "doing": "saving the document"})
         self.assertLess(verified["deepest_gouge_mm"], job.finish.tolerance)
         self.assertEqual([o["label"] for o in verified["ops"]], [o.label for o in plan.ops])
         self.assertTrue(all(o["moves"] > 0 and o["cycle_seconds"] > 0 for o in verified["ops"]))

@@ -162,6 +162,11 @@ def test_a_restarted_server_keeps_its_jobs_and_plans_the_unfinished(tmp_path):
             seen.append(first.status(job["id"])["state"])
             time.sleep(0.2)
         assert seen[-1] == "planning", seen
+        doing, end = None, time.monotonic() + 60   # what the planner says it does (its progress note)
+        while doing is None and time.monotonic() < end:
+            doing = first.status(job["id"]).get("doing")
+            time.sleep(0.1)
+        assert doing and ("the model" in doing or "step" in doing), doing
     finally:
         assert first.stop() == 0, log.read_text()[-2000:]
     assert json.loads((jobs / job["id"] / "state.json").read_text())["state"] == "accepted"

@@ -24,11 +24,13 @@ FAILED = 3
 def run_ops(plan: dict, folder: Path) -> list:
     """The plan's ops in order, the first making the Job around the model and its stock, the others added."""
     from tmm_workbench.app import api
+    from tmm_workbench.core.plan import progress_note
 
     calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
     results: list = []
     controllers: dict = {}
-    for op in plan["ops"]:
+    for i, op in enumerate(plan["ops"]):
+        progress_note.note(2 + i, steps(plan), f"computing {op['label']}")
         kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
         call = calls[op["api"]]
         if results:
@@ -92,8 +94,17 @@ def op_rows(results: list, sim: Any) -> list:
     return rows
 
 
+def steps(plan: dict) -> int:
+    """The run's steps for its progress notes: the analysis and plan (the launcher's), each op, the simulation, the
+    G-code and the document when asked."""
+    return 1 + len(plan["ops"]) + 1 + bool(plan["gcode"]) + bool(plan["fcstd"])
+
+
 def verify(results: list, plan: dict, folder: Path) -> dict:
     from tmm_workbench.app.api import simulate
+    from tmm_workbench.core.plan import progress_note
+
+    progress_note.note(2 + len(plan["ops"]), steps(plan), "simulating the Job")
 
     png = folder / f"{plan['name']}_sim.png" if plan["heat_map"] else None
     sim = simulate(results[0].job, cell=plan["sim_cell"], tolerance=plan["tolerance"], png_path=png,
@@ -133,6 +144,7 @@ def main() -> int:
     folder = plan_file.parent
     plan = json.loads(plan_file.read_text())
     from tmm_workbench.app import posts
+    from tmm_workbench.core.plan import progress_note
 
     results = run_ops(plan, folder)
     job = results[0].job
@@ -153,6 +165,7 @@ def main() -> int:
         report = verify(results, plan, folder)
     report["replanned"] = replanned
     if plan["gcode"]:
+        progress_note.note(3 + len(plan["ops"]), steps(plan), f"writing the G-code ({plan['post']})")
         objects = []
         for r in results:   # a tool controller where its tool comes in (once per tool)
             objects += [r.op] if r.op.ToolController in objects else [r.op.ToolController, r.op]
@@ -160,6 +173,7 @@ def main() -> int:
         args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
         posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
     if plan["fcstd"]:
+        progress_note.note(steps(plan), steps(plan), "saving the document")
         job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
     (folder / "verify.json").write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return 0

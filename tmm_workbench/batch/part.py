@@ -21,6 +21,7 @@ ROOT = Path(__file__).resolve().parents[2]
 REPORT = "report.json"
 FAILURE = "failure.json"
 LOG = "plan.log"
+PROGRESS = "progress.json"   # the planner's last progress note (core.plan.progress_note), in the attempt's folder
 JOB_SUFFIXES = (".yaml", ".yml", ".json")
 EXIT_STATES = {0: "verified", 1: "verification failed", 2: "bad input"}
 TIMED_OUT = -1000
@@ -84,7 +85,7 @@ def run_part(job: str, out_root: str, timeout_s: float = 3600.0, python: Optiona
     tmp = folder.with_name(f".{folder.name}.{uuid.uuid4().hex[:8]}")
     tmp.mkdir(parents=True)
     env = dict(os.environ, TMM_THREADS="1", OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
-               PYTHONPATH=os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
+               TMM_PROGRESS_FILE=str(tmp / PROGRESS), PYTHONPATH=os.pathsep.join([str(ROOT)] + [p for p in [os.environ.get("PYTHONPATH")] if p]))
     t0 = time.monotonic()
     with open(tmp / LOG, "wb") as log:
         proc = subprocess.Popen([python or sys.executable, "-m", "tmm_workbench.plan", str(job_path), "--out",

@@ -16,6 +16,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any, Callable, Optional
 
+from tmm_workbench.batch.part import PROGRESS
+from tmm_workbench.core.plan import progress_note
 from tmm_workbench.web.recipe import JOB_FILE, MODEL_FILE, PART_NAME, Recipe, RequestError, job_data
 
 STATE_FILE = "state.json"
@@ -175,8 +177,11 @@ class JobStore:
         out = {"id": job_id, "source": record["source"], "recipe": record["recipe"],
                "seconds": round(record.get("ended", time.time()) - record["created"], 1)}
         if record["state"] == ACCEPTED:
-            running = any((self.root / job_id / OUT_DIR).glob(".job-*"))   # run_part's folder while it plans
-            return {**out, "state": "planning" if running else "queued"}
+            running = sorted((self.root / job_id / OUT_DIR).glob(".job-*"))   # run_part's folder while it plans
+            if not running:
+                return {**out, "state": "queued"}
+            notes = [n for n in (progress_note.read(f / PROGRESS) for f in running) if n]
+            return {**out, "state": "planning", **({"doing": progress_note.words(notes[-1])} if notes else {})}
         row = record.get("row") or {}
         state = row.get("state", record["state"])
         if state == "done before (skipped)":   # planned by a worker while the server restarted: its report says

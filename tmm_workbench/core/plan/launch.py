@@ -26,7 +26,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
-from tmm_workbench.core.plan import analysis, decide
+from tmm_workbench.core.plan import analysis, decide, progress_note
 from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, read_job
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
@@ -120,6 +120,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         job = read_job(job_path)
         if out_dir is not None:
             job = replace(job, outputs=replace(job.outputs, dir=Path(out_dir).resolve()))
+        progress_note.note(1, 0, "analysing the model and planning")
         mesh, moved, an, plan = make_plan(job, quiet)
     except PlanInputError as exc:
         print(f"tmm plan: bad input: {exc}", file=sys.stderr)
