@@ -39,13 +39,22 @@ def dome():
 
 
 def _distances(points: np.ndarray, loops: list[np.ndarray]) -> np.ndarray:
-    """Brute force: each point's distance to the nearest segment of the closed polylines."""
+    """Each point's exact distance to the nearest segment of the polylines. A segment within the distance d0 to
+    the nearest vertex has an end within d0 + its length of the point, so only those segments are measured."""
+    from scipy.spatial import cKDTree
+
     a = np.vstack([p[:-1] for p in loops])
     b = np.vstack([p[1:] for p in loops])
     ab = b - a
-    t = np.clip(((points[:, None, :] - a[None]) * ab[None]).sum(-1) / (ab * ab).sum(-1)[None], 0, 1)
-    q = a[None] + t[..., None] * ab[None]
-    return np.hypot(*(q - points[:, None, :]).transpose(2, 0, 1)).min(axis=1)
+    tree = cKDTree(a)
+    d0 = np.minimum(tree.query(points)[0], cKDTree(b).query(points)[0])
+    reach = d0 + np.hypot(*ab.T).max() + 1e-9
+    out = np.empty(len(points))
+    for i, (p, near) in enumerate(zip(points, tree.query_ball_point(points, reach))):
+        sa, sab = a[near], ab[near]
+        t = np.clip(((p - sa) * sab).sum(-1) / np.maximum((sab * sab).sum(-1), 1e-300), 0, 1)
+        out[i] = np.hypot(*(sa + t[:, None] * sab - p).T).min()
+    return out
 
 
 def _heights(mesh, cutter=BALL):
