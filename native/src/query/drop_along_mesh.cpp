@@ -9,7 +9,6 @@
 #include <stdexcept>
 #include <vector>
 
-#include "drop_along_walk.hpp"
 #include "tmm/query/drop_direction.hpp"
 #include "tmm/query/swept_clearance.hpp"
 #include "tmm/util/range.hpp"
@@ -20,11 +19,71 @@ using Eigen::Vector3d;
 using direction_detail::kParallelAxisTol;
 using direction_detail::require_finite_length;
 using direction_detail::require_unit;
-using direction_detail::walk_lowest;
 
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// Best-first walk of the index's hierarchy for a cutter whose lowest point is `floor` high at best: visits
+// the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point, lowered by
+// rise(d, x0, x1, y0, y1, enough) (d: the box's XY' distance from (x, y), [x0, x1] x [y0, y1] the box less
+// (x, y); it may stop at `enough`, which prunes the box), is above `floor`; `floor` may rise during the walk.
+// Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
+template <class Rise, class Visit>
+void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Rise&& rise,
+                 Visit&& visit) {
+  const auto& nodes = mi.nodes();
+  const auto& tris = mi.triangles();
+  const double r2 = radius * radius;
+  auto bound = [&](double xmin, double ymin, double xmax, double ymax, double zmax) {
+    const double dx = std::max(std::max(xmin - x, x - xmax), 0.0);
+    const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
+    const double d2 = dx * dx + dy * dy;
+    if (d2 > r2 || zmax <= floor) return -kInfinity;
+    return zmax - rise(std::sqrt(d2), xmin - x, xmax - x, ymin - y, ymax - y, zmax - floor);
+  };
+  struct Entry {
+    int32_t node;
+    double bound;
+  };
+  std::vector<Entry> stack;  // depth-first: at most ~2 entries per level
+  stack.reserve(128);
+  stack.push_back({0, kInfinity});
+  while (!stack.empty()) {
+    const Entry e = stack.back();
+    stack.pop_back();
+    if (e.bound <= floor) continue;
+    const BvhNode& node = nodes[e.node];
+    if (node.count > 0) {
+      for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
+        const IndexedTriangle& t = tris[i];
+        if (t.zmax <= floor) continue;
+        const double b = bound(std::min({t.p[0][0], t.p[1][0], t.p[2][0]}), std::min({t.p[0][1], t.p[1][1], t.p[2][1]}),
+                               std::max({t.p[0][0], t.p[1][0], t.p[2][0]}), std::max({t.p[0][1], t.p[1][1], t.p[2][1]}),
+                               t.zmax);
+        if (b > floor) visit(t, i);
+      }
+    } else {
+      const BvhNode& l = nodes[node.first];
+      const BvhNode& r = nodes[node.first + 1];
+      const double bl = bound(l.xmin, l.ymin, l.xmax, l.ymax, l.zmax);
+      const double br = bound(r.xmin, r.ymin, r.xmax, r.ymax, r.zmax);
+      // The more promising child last, so it is popped first: its contacts prune more of the other.
+      if (bl > br) {
+        if (br > floor) stack.push_back({node.first + 1, br});
+        if (bl > floor) stack.push_back({node.first, bl});
+      } else {
+        if (bl > floor) stack.push_back({node.first, bl});
+        if (br > floor) stack.push_back({node.first + 1, br});
+      }
+    }
+  }
+}
+
+// Planes under K, as directions in the tool frame at these angles from the axis (8 around it, one at 0 and 180
+// degrees); those facing down in the index's frame are kept. Along the axis: the tip's end (a flat bottom);
+// across it: the side, which a tilted tool leans on.
+constexpr double kPlaneAngles[] = {0.0, 60.0, 90.0, 120.0, 180.0};
 
 }  // namespace
 
@@ -37,28 +96,45 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   require_finite_length(cutter);
   W_ = frame_.to_tool(Vector3d(0, 0, -1));
   ahead_ = direction_detail::support(cutter, W_).value;
-  // Lowest point of K along Z' below the tip (under_): no triangle whose highest point is below the cutter's
-  // lowest point can touch it, so the index walks on that height in place of the tip's. An edge shared by several
+  // Lowest point of K along Z' below the tip: no triangle whose highest point is below the cutter's lowest
+  // point can touch it, so the index walks on that height in place of the tip's. An edge shared by several
   // triangles is solved by its owner only (IndexedTriangle::owned_edges): the owner's bound covers the edge
   // (the edge lies in its box and below its highest point), so when the owner is pruned so is the edge.
-  under_ = direction_detail::UnderBounds(
-      frame_, [&](const Vector3d& d) { return direction_detail::support(cutter, d); }, cutter.max_radius(), 0.0);
+  lowest_ = -direction_detail::support(cutter, -frame_.to_tool(Vector3d::UnitZ())).value;
   // K's shadow on the XY' plane lies within this distance of the tip.
-  reach_ = (cutter.max_radius() + cutter.cutting_length() * under_.axis_xy()) * (1 + 1e-12) + 1e-12;
+  axis_xy_ = std::hypot(a_.x(), a_.y());
+  reach_ = (cutter.max_radius() + cutter.cutting_length() * axis_xy_) * (1 + 1e-12) + 1e-12;
+  // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
+  for (const double deg : kPlaneAngles) {
+    const double th = deg * M_PI / 180.0;
+    const int around = (deg == 0.0 || deg == 180.0) ? 1 : 8;
+    for (int k = 0; k < around; ++k) {
+      const double ph = 2.0 * M_PI * k / around;
+      const Vector3d n = frame_.to_world(
+          Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+      if (!(n.z() > 1e-3)) continue;
+      const double h = direction_detail::support(cutter, frame_.to_tool(-n)).value;
+      planes_.push_back({-h / n.z(), n.x() / n.z(), n.y() / n.z()});
+    }
+  }
 }
 
-double AlongCutter::triangle(const Vector3d& s, const IndexedTriangle& t, double best) const {
-  const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
-                 q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
-  if (best < kNoTravel) {
-    // Most candidates are not touched before the best contact so far: a separating plane proves it for the
-    // whole triangle (its edges included) at a fraction of the cost of its pieces.
-    const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
-    if (t0 >= best) return kNoTravel;
-    if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best))
-      return kNoTravel;
+double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
+  const double margin = 1e-9 * (1.0 + std::fabs(lowest_));  // against rounding
+  enough += margin;
+  double r = 0.0;
+  // A point X = z a + r of K (|r| <= rmax, r perpendicular to a, z >= 0) at horizontal distance >= d from the
+  // tip has z >= (d - rmax) / ah, so its height is at least a.z (d - rmax) / ah - rmax ah (axis leaning up):
+  // boxes far from the tip can only meet the cutter's higher parts.
+  const double rmax = cutter_.max_radius(), ah = axis_xy_;
+  if (a_.z() > 0 && ah > 0 && d > rmax) r = a_.z() * (d - rmax) / ah - rmax * ah - lowest_;
+  // Over the box K is no lower than any plane under it at the box's corner where that plane is lowest.
+  for (std::size_t k = 0; k < planes_.size() && r < enough; ++k) {
+    const Plane& p = planes_[k];
+    const double low = p.c - std::max(p.gx * x0, p.gx * x1) - std::max(p.gy * y0, p.gy * y1);
+    r = std::max(r, low - lowest_ - 1e-9 * std::fabs(low));
   }
-  return direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, best, t.owned_edges);
+  return std::max(0.0, r - margin);
 }
 
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
@@ -67,11 +143,20 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   double best = max_travel;
   int32_t winner = -1;
   std::size_t tested = 0;
-  auto floor_of = [&](double t) { return s.z() - t + under_.lowest() - 1e-9; };  // margin against rounding
+  auto floor_of = [&](double t) { return s.z() - t + lowest_ - 1e-9; };  // margin against rounding
   double floor_ref = floor_of(best);
   auto test = [&](const IndexedTriangle& t, int32_t i) {
     ++tested;
-    const double tr = triangle(s, t, best);
+    const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
+                   q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
+    if (best < kNoTravel) {
+      // Most candidates are not touched before the best contact so far: a separating plane proves it for the
+      // whole triangle (its edges included) at a fraction of the cost of its pieces.
+      const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
+      if (t0 >= best) return;
+      if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best)) return;
+    }
+    const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, best, t.owned_edges);
     if (tr < best) {
       best = tr;
       winner = i;
@@ -84,7 +169,7 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   walk_lowest(
       mi, s.x(), s.y(), reach_, floor_ref,
       [&](double d, double x0, double x1, double y0, double y1, double enough) {
-        return under_.rise(d, x0, x1, y0, y1, enough);
+        return rise(d, x0, x1, y0, y1, enough);
       },
       [&](const IndexedTriangle& t, int32_t i) {
         if (i != skip) test(t, i);

@@ -1,18 +1,14 @@
 // The tool assembly dropped along any direction: its grown pieces as convex drop_direction solids (see
 // drop_assembly_direction.hpp), each set up once per axis and dropped with the travel so far as its cap (the
-// owner that stopped the previous start first; a body's solids in one walk bounded by the whole grown body), or
-// along the tool's own axis the vertical assembly drop in the rotated frame.
+// solid that stopped the previous start first), or along the tool's own axis the vertical assembly drop in the
+// rotated frame.
 #include "tmm/query/drop_assembly_direction.hpp"
 
-#include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <memory>
 #include <stdexcept>
 #include <string>
 
-#include "drop_along_walk.hpp"
-#include "tmm/query/swept_clearance.hpp"
 #include "tmm/util/range.hpp"
 
 namespace tmm {
@@ -92,152 +88,31 @@ std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std:
   return out;
 }
 
-// The solids of one owner (the cutter or a body: consecutive in the list) dropped together. A body's solids
-// share one walk of the index and one clearance certificate per candidate, both from the grown body as one
-// convex solid (direction_detail::GrownFrustum, its support in closed form): most candidates of a wide holder
-// are cleared once for its two or three solids; the rest go to each solid (its own certificate, then the
-// exact solve). A lone solid (the cutter, a body with no clearance) walks by itself.
-class AlongOwner {
- public:
-  AlongOwner(const DirectionalIndex& index, const ToolAssembly& tool, const std::vector<AssemblySolid>& solids,
-             std::size_t first, std::size_t end, const Vector3d& axis)
-      : index_(&index), first_(first), end_(end), a_(index.rotation() * axis), frame_(a_) {
-    const int32_t owner = solids[first].owner;
-    if (owner < 0 || end - first < 2 || end - first > kMostSolids) return;
-    const ToolBody& b = tool.bodies()[static_cast<std::size_t>(owner)];
-    body_ = {b.z0, b.z1, b.r0, b.r1, b.clearance};
-    grouped_ = true;
-    W_ = frame_.to_tool(Vector3d(0, 0, -1));
-    ahead_ = body_.support(W_).value;
-    const double rmax = std::max(b.r0, b.r1) + b.clearance, zmin = b.z0 - b.clearance;
-    under_ = direction_detail::UnderBounds(frame_, [this](const Vector3d& d) { return body_.support(d); }, rmax, zmin);
-    // The body's XY' shadow lies within this distance of the tip.
-    const double along = std::max(std::fabs(zmin), std::fabs(b.z1 + b.clearance));
-    reach_ = (rmax + along * under_.axis_xy()) * (1 + 1e-12) + 1e-12;
-  }
-
-  std::size_t first() const { return first_; }
-
-  // The earliest contact of the owner's solids before cap (cap if none), the tool's tip at `start` (model
-  // frame); `hints`: per solid of the owner (a group uses the first), the triangle that stopped it last (tested
-  // first), updated.
-  double drop(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
-              const Vector3d& start, const Vector3d& axis, double cap, DropStats* stats, int32_t* hints) const {
-    if (!grouped_) {
-      double best = cap;
-      for (std::size_t k = first_; k < end_; ++k)
-        best = std::min(best, cutters[k].drop(start + solids[k].lift * axis, best, stats,
-                                              hints ? hints + (k - first_) : nullptr));
-      return best;
-    }
-    int32_t* hint = hints;
-    const Vector3d s = index_->rotation() * start;
-    Vector3d tips[kMostSolids];  // each solid's tip in the index's frame
-    for (std::size_t k = first_; k < end_; ++k)
-      tips[k - first_] = index_->rotation() * (start + solids[k].lift * axis);
-    double best = cap;
-    int32_t winner = -1;
-    std::size_t tested = 0;
-    auto floor_of = [&](double t) { return s.z() - t + under_.lowest() - 1e-9; };  // margin against rounding
-    double floor_ref = floor_of(best);
-    auto test = [&](const IndexedTriangle& t, int32_t i) {
-      ++tested;
-      if (best < kNoTravel) {
-        const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
-                       q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
-        const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
-        if (t0 >= best) return;
-        if (direction_detail::triangle_clear(body_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best)) return;
-      }
-      for (std::size_t k = first_; k < end_; ++k) {
-        // With no contact yet nothing caps a solid's solve: first its own reach.
-        if (!(best < kNoTravel) && !cutters[k].within_reach(tips[k - first_], t)) continue;
-        const double tr = cutters[k].triangle(tips[k - first_], t, best);
-        if (tr < best) {
-          best = tr;
-          winner = i;
-          floor_ref = floor_of(best);
-        }
-      }
-    };
-    const auto& tris = index_->index().triangles();
-    const int32_t skip = hint ? *hint : -1;
-    if (skip >= 0 && static_cast<std::size_t>(skip) < tris.size()) test(tris[static_cast<std::size_t>(skip)], skip);
-    direction_detail::walk_lowest(
-        index_->index(), s.x(), s.y(), reach_, floor_ref,
-        [&](double d, double x0, double x1, double y0, double y1, double enough) {
-          return under_.rise(d, x0, x1, y0, y1, enough);
-        },
-        [&](const IndexedTriangle& t, int32_t i) {
-          if (i != skip) test(t, i);
-        });
-    if (stats) stats->triangles_tested += tested;
-    if (hint) *hint = winner;
-    return best;
-  }
-
- private:
-  static constexpr std::size_t kMostSolids = 3;  // of a body (add_grown_frustum)
-  const DirectionalIndex* index_;
-  std::size_t first_, end_;
-  Vector3d a_;  // the axis in the index's frame
-  ToolFrame frame_;
-  bool grouped_ = false;
-  direction_detail::GrownFrustum body_;
-  Vector3d W_ = Vector3d::Zero();
-  double ahead_ = 0, reach_ = 0;
-  direction_detail::UnderBounds under_;
-};
-
-// The owners of the solids (set up by along_cutters) for the axis (model frame).
-std::vector<AlongOwner> along_owners(const DirectionalIndex& index, const ToolAssembly& tool,
-                                     const std::vector<AssemblySolid>& solids, const Vector3d& axis) {
-  std::vector<AlongOwner> out;
-  for (std::size_t k = 0; k < solids.size();) {
-    std::size_t end = k + 1;
-    while (end < solids.size() && solids[end].owner == solids[k].owner) ++end;
-    out.emplace_back(index, tool, solids, k, end, axis);
-    k = end;
-  }
-  return out;
-}
-
-// The solids of one axis set up once: each solid's AlongCutter and the owners that drop them.
-struct AlongTool {
-  std::vector<AlongCutter> cutters;
-  std::vector<AlongOwner> owners;
-  AlongTool(const DirectionalIndex& index, const ToolAssembly& tool, const std::vector<AssemblySolid>& solids,
-            const Vector3d& axis)
-      : cutters(along_cutters(index, solids, axis)), owners(along_owners(index, tool, solids, axis)) {}
-};
-
-// The earliest contact of the owners' solids from `start` (hints: one per solid, or null), capped at
-// max_travel. `lead` (or null): the owner dropped first, then set to the one that set the travel. The next
-// start is likely stopped by the same owner: its travel, found first, caps the others' searches (a holder that
-// holds the tool well above the part leaves the cutter little to test). An owner earlier in the list than the
-// one that stopped the tool so far wins a tie, as in the list's order.
-double along_solids(const std::vector<AssemblySolid>& solids, const AlongTool& along, const Vector3d& start,
-                    const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats, int32_t* hints,
-                    std::size_t* lead) {
+// The earliest contact of the solids (set up by along_cutters) from `start` (hints: one per solid, or null),
+// capped at max_travel. `lead` (or null): the solid dropped first, then set to the one that set the travel. The
+// next start is likely stopped by the same solid: its travel, found first, caps the others' searches (a holder
+// that holds the tool well above the part leaves the cutter little to test). A solid earlier in the list than
+// the one that stopped the tool so far wins a tie, as in the list's order.
+double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
+                    const Vector3d& start, const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats,
+                    int32_t* hints, std::size_t* lead) {
   constexpr std::size_t kNone = ~std::size_t{0};
-  const std::vector<AlongOwner>& owners = along.owners;
   double best = max_travel;
   std::size_t winner = kNone;
   auto drop = [&](std::size_t k) {
     const double cap = winner != kNone && k < winner ? std::nextafter(best, INFINITY) : best;
-    const double t =
-        owners[k].drop(solids, along.cutters, start, axis, cap, stats, hints ? hints + owners[k].first() : nullptr);
+    const double t = cutters[k].drop(start + solids[k].lift * axis, cap, stats, hints ? &hints[k] : nullptr);
     if (t < best || (t == best && winner != kNone && k < winner)) {
       best = t;
       winner = k;
     }
   };
-  const std::size_t first = lead && *lead < owners.size() ? *lead : 0;
+  const std::size_t first = lead && *lead < solids.size() ? *lead : 0;
   drop(first);
-  for (std::size_t k = 0; k < owners.size(); ++k)
+  for (std::size_t k = 0; k < solids.size(); ++k)
     if (k != first) drop(k);
   if (lead) *lead = winner == kNone ? 0 : winner;
-  if (set_by) *set_by = winner == kNone ? kSetByFloor : solids[owners[winner].first()].owner;
+  if (set_by) *set_by = winner == kNone ? kSetByFloor : solids[winner].owner;
   return best;
 }
 
@@ -270,8 +145,7 @@ double drop_assembly_along_point(const DirectionalIndex& index, const ToolAssemb
   if (along_axis(index, axis)) return axial_drop(index, tool, start, max_travel, set_by, stats);
   const Vector3d a = axis.normalized();
   const std::vector<AssemblySolid> solids = assembly_solids(tool);
-  return along_solids(solids, AlongTool(index, tool, solids, a), start, a, max_travel, set_by, stats, nullptr,
-                      nullptr);
+  return along_solids(solids, along_cutters(index, solids, a), start, a, max_travel, set_by, stats, nullptr, nullptr);
 }
 
 void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly& tool, const double* starts,
@@ -300,9 +174,8 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
-  std::unique_ptr<AlongTool> shared;  // one tilted axis for all: the solids set up once
-  if (any_tilted && !axes_per_point)
-    shared = std::make_unique<AlongTool>(index, tool, solids, Vector3d(axes[0], axes[1], axes[2]).normalized());
+  std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
+  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized());
   std::atomic<std::size_t> tested{0};
   // Hints and the solid dropped first start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
@@ -317,7 +190,7 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
         travel_out[i] = axial_drop(index, tool, start, max_travel, by, &local);
       } else {
         const Vector3d a = axis.normalized();
-        travel_out[i] = along_solids(solids, axes_per_point ? AlongTool(index, tool, solids, a) : *shared, start, a,
+        travel_out[i] = along_solids(solids, axes_per_point ? along_cutters(index, solids, a) : shared, start, a,
                                      max_travel, by, &local, hints.data(), &lead);
       }
     }

@@ -122,17 +122,16 @@ bool closest_on_tetrahedron(Simplex& s, Vector3d& v) {
   return true;
 }
 
-// triangle_clear with the solid's support function `support` (d -> Support); `bounded`: the solid and the
-// sweep are bounded.
-template <class SupportFn>
-bool clear_of(const SupportFn& support_of, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-              const Vector3d& W, double t0, double cap, bool bounded) {
-  if (!(std::isfinite(t0) && std::isfinite(cap) && t0 <= cap && bounded)) return false;
+}  // namespace
+
+bool triangle_clear(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
+                    const Vector3d& W, double t0, double cap) {
+  if (!(std::isfinite(t0) && std::isfinite(cap) && t0 <= cap && std::isfinite(c.cutting_length()))) return false;
   // The point of D lowest along d: the triangle's corner lowest along d minus S's point highest along it.
   auto lowest = [&](const Vector3d& d) {
     const double a0 = d.dot(q0), a1 = d.dot(q1), a2 = d.dot(q2);
     const Vector3d& q = a0 <= a1 ? (a0 <= a2 ? q0 : q2) : (a1 <= a2 ? q1 : q2);
-    return Vector3d(q - support_of(d).point - (d.dot(W) >= 0 ? cap : t0) * W);
+    return Vector3d(q - support(c, d).point - (d.dot(W) >= 0 ? cap : t0) * W);
   };
   Simplex s;
   Vector3d v = lowest(W);
@@ -153,29 +152,6 @@ bool clear_of(const SupportFn& support_of, const Vector3d& q0, const Vector3d& q
     if (!ok) return false;
   }
   return false;
-}
-
-}  // namespace
-
-bool triangle_clear(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                    const Vector3d& W, double t0, double cap) {
-  return clear_of([&c](const Vector3d& d) { return support(c, d); }, q0, q1, q2, W, t0, cap,
-                  std::isfinite(c.cutting_length()));
-}
-
-Support GrownFrustum::support(const Vector3d& d) const {
-  const double rho = std::sqrt(d.x() * d.x() + d.y() * d.y()), len = std::sqrt(rho * rho + d.z() * d.z());
-  const double ux = rho > 0 ? d.x() / rho : 1.0, uy = rho > 0 ? d.y() / rho : 0.0;
-  // The rim farther along d (the top rim when it ties), then out by the clearance along d.
-  const bool top = r1 * rho + z1 * d.z() >= r0 * rho + z0 * d.z();
-  const double r = top ? r1 : r0, g = len > 0 ? clearance / len : 0.0;
-  const Vector3d X(r * ux + g * d.x(), r * uy + g * d.y(), (top ? z1 : z0) + g * d.z());
-  return {X, d.dot(X)};
-}
-
-bool triangle_clear(const GrownFrustum& body, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                    const Vector3d& W, double t0, double cap) {
-  return clear_of([&body](const Vector3d& d) { return body.support(d); }, q0, q1, q2, W, t0, cap, true);
 }
 
 }  // namespace tmm::direction_detail

@@ -5,9 +5,7 @@
 //    past it), for every cutter shape and random axes, motions and triangles;
 //  - it is not vacuous: with the cap well before the contact (or a triangle never touched) it clears nearly all;
 //  - a triangle touched exactly at the cap is not cleared (the plane must clear it by 1e-9 mm);
-//  - an endless cutter or an unbounded sweep is never cleared;
-//  - a grown tool body as one solid (GrownFrustum): its support is the highest of its drop solids' (their union
-//    is the grown body), and it never clears a triangle one of those solids touches before the cap.
+//  - an endless cutter or an unbounded sweep is never cleared.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -16,7 +14,6 @@
 #include <random>
 #include <vector>
 
-#include "tmm/query/drop_assembly_direction.hpp"
 #include "tmm/query/drop_direction.hpp"
 #include "tmm/query/swept_clearance.hpp"
 
@@ -115,71 +112,6 @@ TEST(SweptClearance, AMissedTriangleIsClearedAndATouchedOneIsNot) {
   EXPECT_FALSE(triangle_clear(Cutter(3, 0), q0, q1, q2, W, t0, 6.0));
   EXPECT_FALSE(triangle_clear(flat, q0, q1, q2, W, t0, kInf));
   EXPECT_FALSE(triangle_clear(flat, q0, q1, q2, W, -kInf, 6.0));
-}
-
-// A solid of drop_assembly_direction's in its own frame: a point (or direction) of the tool frame seen from the
-// solid's tip, pointing along the axis or, flipped, against it (a half turn about x).
-Vector3d solid_frame(const tmm::AssemblySolid& s, const Vector3d& p, bool point) {
-  const double lift = point ? s.lift : 0.0;
-  return s.flipped ? Vector3d(p.x(), -p.y(), lift - p.z()) : Vector3d(p.x(), p.y(), p.z() - lift);
-}
-
-TEST(SweptClearance, GrownBodyIsItsSolidsAndNeverClearsATouchedTriangle) {
-  using tmm::ToolBody;
-  // A cylinder, a widening and a narrowing cone, a pointed cone, a disc with no radius of its own.
-  const std::vector<ToolBody> bodies = {{10, 25, 3, 3, 0.5},  {8, 14, 2, 6, 1.0}, {8, 14, 6, 2, 0.7},
-                                        {5, 9, 0, 3, 0.4},    {20, 21, 0, 0, 2.0}, {25, 85, 15, 15, 2.0}};
-  std::mt19937_64 rng(43);
-  std::uniform_real_distribution<double> pos(-1.0, 1.0), size(0.05, 1.0);
-  int touched = 0, early = 0, cleared_early = 0, never = 0, cleared_never = 0;
-  for (const ToolBody& b : bodies) {
-    const tmm::ToolAssembly tool(Cutter(1.0, 1.0), {b});
-    std::vector<tmm::AssemblySolid> solids;
-    for (const auto& s : tmm::assembly_solids(tool))
-      if (s.owner == 0) solids.push_back(s);
-    ASSERT_GE(solids.size(), 2u);
-    const tmm::direction_detail::GrownFrustum body{b.z0, b.z1, b.r0, b.r1, b.clearance};
-    for (int k = 0; k < 400; ++k) {
-      const Vector3d d = random_unit(rng);
-      double highest = -kInf;
-      for (const auto& s : solids)
-        highest = std::max(highest, support(s.profile, solid_frame(s, d, false)).value + s.lift * d.z());
-      ASSERT_NEAR(body.support(d).value, highest, 1e-9) << k;
-    }
-    const double reach = std::max(b.r0, b.r1) + b.clearance + b.z1;
-    for (int k = 0; k < 1500; ++k) {
-      const Vector3d W = random_unit(rng);
-      const Vector3d centre = Vector3d(reach * pos(rng), reach * pos(rng), b.z0 + (b.z1 - b.z0) * (0.5 + pos(rng))) +
-                              reach * (1 + pos(rng)) * W;
-      const double sz = size(rng) * (k % 4 == 0 ? reach : 3.0);
-      const Vector3d q0 = centre + sz * random_unit(rng), q1 = centre + sz * random_unit(rng),
-                     q2 = centre + sz * random_unit(rng);
-      double t = kInf;
-      for (const auto& s : solids)
-        t = std::min(t, triangle_travel(s.profile, solid_frame(s, q0, true), solid_frame(s, q1, true),
-                                        solid_frame(s, q2, true), solid_frame(s, W, false)));
-      double t0 = std::min({q0.dot(W), q1.dot(W), q2.dot(W)}) - body.support(W).value;
-      t0 -= 1e-9 * (1 + std::fabs(t0));
-      if (t < kInf) {
-        ++touched;
-        ASSERT_GE(t, t0) << k;
-        for (const double past : {0.0, 1e-7, 1e-3, 1.0, 100.0})
-          ASSERT_FALSE(triangle_clear(body, q0, q1, q2, W, t0, t + past)) << k << " " << past;
-        if (t - 0.01 > t0) {
-          ++early;
-          cleared_early += triangle_clear(body, q0, q1, q2, W, t0, t - 0.01);
-        }
-      } else {
-        ++never;
-        cleared_never += triangle_clear(body, q0, q1, q2, W, t0, t0 + 2 * reach);
-      }
-    }
-  }
-  EXPECT_GT(touched, 1000);
-  EXPECT_GT(early, 500);
-  EXPECT_GT(never, 1500);
-  EXPECT_GT(cleared_early, 0.9 * early);
-  EXPECT_GT(cleared_never, 0.95 * never);
 }
 
 }  // namespace

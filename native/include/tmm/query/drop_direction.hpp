@@ -12,7 +12,6 @@
 // See docs/drop_direction.md for the method and the tolerances.
 #pragma once
 
-#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -77,68 +76,6 @@ double triangle_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::
                        unsigned edges = 7u);
 // std::invalid_argument for an endless cutter (L_C = inf): the general method needs a bounded solid.
 void require_finite_length(const Cutter& c);
-
-// How far a convex solid of revolution about the axis `a` (index frame), moving along -Z', stays above its
-// lowest point over a box of the index: set up once per solid and axis from its support function (in the tool
-// frame `frame`), the solid lying within `rmax` of the axis and at or above `zmin` along it.
-class UnderBounds {
- public:
-  UnderBounds() = default;
-  template <class SupportFn>
-  UnderBounds(const ToolFrame& frame, const SupportFn& support, double rmax, double zmin)
-      : a_(frame.a), rmax_(rmax), zmin_(zmin), axis_xy_(std::hypot(frame.a.x(), frame.a.y())) {
-    lowest_ = -support(frame.to_tool(-Eigen::Vector3d::UnitZ())).value;
-    // A plane under the solid with normal n (n.z > 0, index frame): n . X >= -h(-n) for X in it about the tip.
-    for (const double deg : kPlaneAngles) {
-      const double th = deg * M_PI / 180.0;
-      const int around = (deg == 0.0 || deg == 180.0) ? 1 : 8;
-      for (int k = 0; k < around; ++k) {
-        const double ph = 2.0 * M_PI * k / around;
-        const Eigen::Vector3d n = frame.to_world(
-            Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
-        if (!(n.z() > 1e-3)) continue;
-        const double h = support(frame.to_tool(-n)).value;
-        planes_.push_back({-h / n.z(), n.x() / n.z(), n.y() / n.z()});
-      }
-    }
-  }
-
-  double lowest() const { return lowest_; }  // the solid's lowest Z' about its tip
-  double axis_xy() const { return axis_xy_; }
-
-  // How much higher than its lowest point the solid is over the box [x0, x1] x [y0, y1] (about the tip), d
-  // the box's distance from the tip; may stop once it reaches `enough`.
-  double rise(double d, double x0, double x1, double y0, double y1, double enough) const {
-    const double margin = 1e-9 * (1.0 + std::fabs(lowest_));  // against rounding
-    enough += margin;
-    double r = 0.0;
-    // A point X = z a + r of the solid (|r| <= rmax, r perpendicular to a, z >= zmin >= 0) at horizontal distance
-    // >= d from the tip has z >= (d - rmax) / ah, so its height is at least a.z (d - rmax) / ah - rmax ah (axis
-    // leaning up): boxes far from the tip can only meet the solid's higher parts.
-    const double ah = axis_xy_;
-    if (zmin_ >= 0.0 && a_.z() > 0 && ah > 0 && d > rmax_) r = a_.z() * (d - rmax_) / ah - rmax_ * ah - lowest_;
-    // Over the box the solid is no lower than any plane under it at the box's corner where that plane is lowest.
-    for (std::size_t k = 0; k < planes_.size() && r < enough; ++k) {
-      const Plane& p = planes_[k];
-      const double low = p.c - std::max(p.gx * x0, p.gx * x1) - std::max(p.gy * y0, p.gy * y1);
-      r = std::max(r, low - lowest_ - 1e-9 * std::fabs(low));
-    }
-    return std::max(0.0, r - margin);
-  }
-
- private:
-  // Planes under the solid, as directions in the tool frame at these angles from the axis (8 around it, one at 0
-  // and 180 degrees); those facing down in the index's frame are kept. Along the axis: the tip's end (a flat
-  // bottom); across it: the side, which a tilted tool leans on.
-  static constexpr double kPlaneAngles[] = {0.0, 60.0, 90.0, 120.0, 180.0};
-  // Below the XY' offset p from the tip, the solid is no lower than c - g . p.
-  struct Plane {
-    double c, gx, gy;
-  };
-  Eigen::Vector3d a_ = Eigen::Vector3d::UnitZ();
-  double rmax_ = 0, zmin_ = 0, axis_xy_ = 0, lowest_ = 0;
-  std::vector<Plane> planes_;
-};
 }  // namespace direction_detail
 
 class DirectionalIndex;
@@ -191,26 +128,22 @@ class AlongCutter {
   // drop_along_point with this cutter and axis.
   double drop(const Eigen::Vector3d& start, double max_travel = kNoTravel, DropStats* stats = nullptr,
               int32_t* hint = nullptr) const;
-  // The first contact with triangle t of the cutter with its tip at s (in the index's frame) if before `best`,
-  // else kNoTravel: with a finite best the clearance certificate first, then the exact solve (drop's test of
-  // each candidate, for a caller walking the index itself).
-  double triangle(const Eigen::Vector3d& s, const IndexedTriangle& t, double best) const;
-  // Does t's XY' box come within the solid's XY' reach of its tip at s (index frame)? Else it is never touched.
-  bool within_reach(const Eigen::Vector3d& s, const IndexedTriangle& t) const {
-    const double dx = std::max({t.xmin - s.x(), s.x() - t.xmax, 0.0});
-    const double dy = std::max({t.ymin - s.y(), s.y() - t.ymax, 0.0});
-    return dx * dx + dy * dy <= reach_ * reach_;
-  }
 
  private:
+  // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
+  struct Plane {
+    double c, gx, gy;
+  };
+  double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
+
   const DirectionalIndex* index_;
   Cutter cutter_;
   Eigen::Vector3d a_;   // the axis in the index's frame
   ToolFrame frame_;
   Eigen::Vector3d W_;   // the motion in tool coordinates
-  double reach_ = 0;
+  double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
-  direction_detail::UnderBounds under_;  // K's lowest point and the planes under it
+  std::vector<Plane> planes_;
 };
 
 // starts: n points (x, y, z, ...); axes: one unit axis (axes_per_point = false) or n of them; travel_out: n.

@@ -7,7 +7,6 @@
 #include <Eigen/Core>
 
 #include "tmm/cutter/cutter.hpp"
-#include "tmm/query/drop_direction.hpp"
 
 namespace tmm::direction_detail {
 
@@ -19,18 +18,6 @@ namespace tmm::direction_detail {
 // always for an unbounded K or sweep: the caller then solves the contact. Every true answer is checked on
 // the separating plane itself, so it never depends on the search converging.
 bool triangle_clear(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
-                    const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double t0, double cap);
-
-// A frustum about the tool axis (radius r0 at z0 along it from the tip, r1 at z1) grown by `clearance`: a tool
-// body of drop_assembly.hpp as one convex solid, its support in closed form (the rim farther along d, moved out
-// by the clearance along d).
-struct GrownFrustum {
-  double z0 = 0, z1 = 0, r0 = 0, r1 = 0, clearance = 0;
-  Support support(const Eigen::Vector3d& d) const;
-};
-
-// triangle_clear for a grown frustum in the tool frame.
-bool triangle_clear(const GrownFrustum& body, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
                     const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double t0, double cap);
 
 }  // namespace tmm::direction_detail
