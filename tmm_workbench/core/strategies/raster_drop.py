@@ -27,7 +27,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import StrategyResult
-from tmm_workbench.core.strategies import holder_guard, rest_filter
+from tmm_workbench.core.strategies import holder_guard, rest_filter, rest_steep
 from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - the Surface's names, used from here
     _BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY, OUTWARD, SAMPLED,
     SPIRAL, STEPOVER, TOLERANCE, ZIGZAG, SurfaceParams, raster_points)
@@ -100,9 +100,13 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             segments = segments[:n] + extra
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
-    segments = rest_filter.apply(params, cutter, segments, diagnostics)   # rest machining: only what is left
+    # rest machining: only what is left; its steep part by waterline loops (the passes cannot hold the cusp there)
+    params, steep = rest_steep.of_params(params, cutter)
+    segments = rest_filter.apply(params, cutter, segments, diagnostics)
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
+    if steep is not None:
+        segments = segments + rest_steep.passes(mesh, cutter, params, steep, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

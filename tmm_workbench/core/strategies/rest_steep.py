@@ -1,0 +1,142 @@
+"""The steep part of a rest, cut by waterline passes: a raster (or 3D offset) whose passes are s apart in XY
+leaves, on a slope a crossed by them, a cusp whose vertical height (what the rest and the simulation judge) is
+about c / cos^3 a, c = s^2 / 8 r its cusp on a flat; above the slope where that exceeds the rest tolerance the
+passes cannot hold it. The rest's cells (core.footprint.rest's RestStock, with the design's heights) are split
+there: the shallow ones stay with the Surface's pattern, the steep ones are cut by waterline loops
+(core.strategies.waterline, kept only where they cut steep rest material), at levels spaced by the cusp on the
+wall: two loops dz apart on a slope a leave, for a corner radius r, a vertical cusp dz^2 / (8 r sin^2 a cos a),
+so dz = sin a sqrt(8 r c cos a) under the steep cells of each height band (a capped at STEEPEST_DEG: a vertical
+wall's vertical cusp has no bound)."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.core.footprint.rest import RestStock
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.tools.cutter import Cutter
+
+FLATTEST_DEG = 15.0    # never steeper than this: a step too coarse for the tolerance on a flat is the user's
+STEEPEST_DEG = 85.0    # the levels' spacing is that of this slope on anything steeper
+WALL_CUSP = 0.8        # of the rest tolerance: the waterline's vertical cusp on the wall
+CHORD_TOL = 0.002      # the loops' chord tolerance, mm: their growth off the wall times tan a is left on it
+
+
+def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
+    """(ny, nx) the design's slope on the grid, degrees (NaN where a neighbour has no design)."""
+    gy, gx = np.gradient(design, cell)
+    return np.degrees(np.arctan(np.hypot(gx, gy)))
+
+
+def vertical_cusp(design: np.ndarray, cell: float, cusp: float, across_deg: Optional[float]) -> np.ndarray:
+    """(ny, nx) the vertical cusp of passes leaving `cusp` on a flat: the step along the surface across them is
+    1 / cos a_n of the XY step (a_n the slope across the passes, whose direction is `across_deg` from +X; None:
+    any direction, the slope itself), so the cusp c / cos^2 a_n along the normal, divided by cos a vertically."""
+    gy, gx = np.gradient(design, cell)
+    g = np.hypot(gx, gy)
+    if across_deg is None:
+        gn = g
+    else:
+        t = math.radians(across_deg)
+        gn = np.abs(gx * math.cos(t) + gy * math.sin(t))
+    return cusp * (1 + gn ** 2) * np.sqrt(1 + g ** 2)
+
+
+def flat_cusp(cutter: Cutter, params: Any) -> float:
+    """The cusp on a flat of the Surface's passes: its cusp height in the cusp modes, else that of its step-over
+    for the corner radius."""
+    if params.stepover_mode != "stepover":
+        return float(params.cusp)
+    return params.stepover ** 2 / (8 * cutter.corner_radius)
+
+
+def across_deg(params: Any) -> Optional[float]:
+    """The direction the raster's passes are spaced in (None: loops and spirals, every direction)."""
+    if params.pattern in ("zigzag", "oneway") and params.stepover_mode != "offset3d":
+        return float(params.angle_deg) + 90.0
+    return None
+
+
+def split(rest: RestStock, cusp: float, across: Optional[float]) -> tuple[RestStock, Optional[RestStock]]:
+    """(shallow, steep) parts of the rest: steep where passes leaving `cusp` on a flat, spaced in the direction
+    `across` (degrees from +X; None: any), leave more than the rest tolerance vertically (slopes under
+    FLATTEST_DEG never); steep None when no cell is."""
+    if rest.design is None:
+        return rest, None
+    cells = np.isfinite(rest.heights)
+    cell = rest.grid.cell
+    over = np.nan_to_num(vertical_cusp(rest.design, cell, cusp, across)) > rest.within
+    steep = cells & over & (np.nan_to_num(slope_deg(rest.design, cell)) > FLATTEST_DEG)
+    if not steep.any():
+        return rest, None
+    return (replace(rest, heights=np.where(steep, -np.inf, rest.heights)),
+            replace(rest, heights=np.where(steep, rest.heights, -np.inf)))
+
+
+def level_step(radius: float, cusp: float, slope: np.ndarray) -> np.ndarray:
+    """The z-step between loops that leaves `cusp` (vertical) on slopes `slope` (radians) for a corner radius."""
+    a = np.minimum(slope, math.radians(STEEPEST_DEG))
+    return np.sin(a) * np.sqrt(8 * radius * cusp * np.cos(a))
+
+
+def levels(steep: RestStock, radius: float, cusp: float) -> list[float]:
+    """Tip heights top-down for the steep rest cells: a cell at height h on a slope a is touched by the corner
+    from the level h - r (1 - cos a); each level the step of the steepest cells within a step below it, a gap
+    without steep cells jumped to the next one's level."""
+    cells = np.isfinite(steep.heights)
+    a = np.radians(np.nan_to_num(slope_deg(steep.design, steep.grid.cell)[cells]))
+    z = steep.design[cells] - radius * (1 - np.cos(a))
+    dz = level_step(radius, cusp, a)
+    order = np.argsort(-z)
+    z, dz = z[order], dz[order]
+    big = float(dz.max())
+    out = [float(z[0])]
+    while True:
+        below = z < out[-1] - 1e-9
+        if not below.any():
+            return out
+        near = (z <= out[-1] + 1e-9) & (z >= out[-1] - big)
+        step = float(dz[near].min()) if near.any() else big
+        # a gap without steep cells: the next level at the next cell's
+        out.append(min(out[-1] - step, float(z[below].max())) if not near.any() else out[-1] - step)
+
+
+def of_params(params: Any, cutter: Cutter) -> tuple[Any, Optional[RestStock]]:
+    """The Surface params with the shallow part of their rest, and the steep part (None: no split: no rest, a
+    pencil, a flat end mill or nothing steep)."""
+    rest = getattr(params, "rest", None)
+    if rest is None or rest.design is None or params.pattern == "pencil" or cutter.corner_radius <= 0:
+        return params, None
+    shallow, steep = split(rest, flat_cusp(cutter, params), across_deg(params))
+    return (params, None) if steep is None else (replace(params, rest=shallow), steep)
+
+
+def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
+           diagnostics: dict) -> list[CutSegment]:
+    """Waterline loops over the steep rest cells, within the Surface params' boundary, kept where they cut steep
+    rest material (diagnostics "steep": levels, the slope limit, the segments)."""
+    r = cutter.corner_radius
+    cusp = WALL_CUSP * steep.within
+    zs = levels(steep, r, cusp)
+    lo = float(mesh.bounds[0][2])
+    zs = [z for z in zs if z >= lo]
+    if not zs:
+        return []
+    wp = waterline.WaterlineParams(boundary=tuple(params.boundary), step_down=1.0, top_z=zs[0] + 1e-6,
+                                   bottom_z=min(zs[-1], zs[0] - 1e-5), chord_tol=CHORD_TOL, z_levels=zs,
+                                   stock_to_leave=max(params.stock_to_leave, 0.0), empty_ok=True,
+                                   assembly=params.assembly, holder_collision=params.holder_collision,
+                                   holder_notes=params.holder_notes)
+    wp.rest = steep
+    result = waterline.compute(mesh, cutter, wp, surface=surface)
+    diagnostics["steep"] = {"levels": len(zs), "segments": len(result.segments)}
+    if result.segments:
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(s.tips[:, 2].max())
+                                                                         for s in result.segments))
+    return result.segments
