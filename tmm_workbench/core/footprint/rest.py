@@ -47,6 +47,7 @@ class RestStock:
     # the rest (core.strategies.rest_steep) is told by the design's slope; None: not split
     design: Optional[np.ndarray] = None
     within: float = 0.0
+    envelope: Optional[np.ndarray] = None   # the rest tool's envelope (what it can reach)
 
     def __post_init__(self) -> None:
         if np.shape(self.heights) != (self.grid.ny, self.grid.nx):
@@ -67,6 +68,7 @@ class RestArea:
     volume_after: float         # and after it (what it cannot reach)
     out_of_reach: float         # mm^2 still above the tolerance after it
     design: Optional[np.ndarray] = None   # the design's heights (NaN: none)
+    envelope: Optional[np.ndarray] = None   # the tool's envelope (tool_envelope)
 
     @property
     def empty(self) -> bool:
@@ -86,7 +88,7 @@ class RestArea:
         """What the rest filter cuts against: `left` on the rest cells only, a cut being LEAST_CUT of the
         tolerance."""
         return RestStock(self.grid, np.where(self.mask, left, -np.inf), LEAST_CUT * self.tolerance, self.design,
-                         self.tolerance)
+                         self.tolerance, self.envelope)
 
     def cells_xy(self) -> np.ndarray:
         """(n, 2) centres of the rest cells (what the view marks)."""
@@ -146,7 +148,8 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
     a = grid.cell_area
     region = mask_region(mask, grid, radius) if mask.any() else []
     return RestArea(grid, mask, region, tolerance, float(mask.sum() * a), float(above.sum() * a),
-                    float(above_after.sum() * a), float(np.sum(above_after > tolerance) * a), design)
+                    float(above_after.sum() * a), float(np.sum(above_after > tolerance) * a), design,
+                    envelope)
 
 
 def without_specks(mask: np.ndarray) -> np.ndarray:

@@ -1,12 +1,14 @@
-"""The steep part of a rest, cut by waterline passes: a raster (or 3D offset) whose passes are s apart in XY
-leaves, on a slope a crossed by them, a cusp whose vertical height (what the rest and the simulation judge) is
-about c / cos^3 a, c = s^2 / 8 r its cusp on a flat; above the slope where that exceeds the rest tolerance the
-passes cannot hold it. The rest's cells (core.footprint.rest's RestStock, with the design's heights) are split
-there: the shallow ones stay with the Surface's pattern, the steep ones are cut by waterline loops
-(core.strategies.waterline, kept only where they cut steep rest material), at levels spaced by the cusp on the
-wall: two loops dz apart on a slope a leave, for a corner radius r, a vertical cusp dz^2 / (8 r sin^2 a cos a),
-so dz = sin a sqrt(8 r c cos a) under the steep cells of each height band (a capped at STEEPEST_DEG: a vertical
-wall's vertical cusp has no bound)."""
+"""The steep part of a rest, cut by waterline loops. Passes s apart in XY leave on a flat a cusp c = s^2 / 8 r
+(r the corner radius); across a slope a_n the step along the surface is s / cos a_n, so the cusp along the
+normal c / cos^2 a_n, and its vertical height (what the rest and the simulation judge) that over cos a, a the
+slope. Where that exceeds the rest tolerance the passes cannot hold it: the rest's cells (RestStock with the
+design's heights) are split there; the shallow ones stay with the Surface's pattern, the steep ones (where the
+tool's envelope comes within the tolerance: elsewhere no spacing holds it) are cut by waterline loops
+(core.strategies.waterline, kept only where they cut steep rest material, linked with the other passes), at
+levels spaced by the cusp on the wall: two loops dz apart on a slope a leave dz^2 / (8 r sin^2 a cos a)
+vertically, so dz = sin a sqrt(8 r c cos a) under the steep cells of each height band (a capped at
+STEEPEST_DEG: a vertical wall's vertical cusp has no bound).
+"""
 from __future__ import annotations
 
 import math
@@ -73,6 +75,8 @@ def split(rest: RestStock, cusp: float, across: Optional[float]) -> tuple[RestSt
     cell = rest.grid.cell
     over = np.nan_to_num(vertical_cusp(rest.design, cell, cusp, across)) > rest.within
     steep = cells & over & (np.nan_to_num(slope_deg(rest.design, cell)) > FLATTEST_DEG)
+    if rest.envelope is not None:   # where the tool can come within the tolerance: elsewhere no spacing holds it
+        steep &= rest.envelope - rest.design <= rest.within
     if not steep.any():
         return rest, None
     return (replace(rest, heights=np.where(steep, -np.inf, rest.heights)),
@@ -87,24 +91,23 @@ def level_step(radius: float, cusp: float, slope: np.ndarray) -> np.ndarray:
 
 def levels(steep: RestStock, radius: float, cusp: float) -> list[float]:
     """Tip heights top-down for the steep rest cells: a cell at height h on a slope a is touched by the corner
-    from the level h - r (1 - cos a); each level the step of the steepest cells within a step below it, a gap
-    without steep cells jumped to the next one's level."""
+    from the level h - r (1 - cos a), and spans the wall's rise across it (cell tan a, a capped at STEEPEST_DEG);
+    each level a step below the last, the step of the steepest cells within one of it, a gap without steep
+    cells jumped to the next one's top."""
     cells = np.isfinite(steep.heights)
-    a = np.radians(np.nan_to_num(slope_deg(steep.design, steep.grid.cell)[cells]))
+    a = np.minimum(np.radians(np.nan_to_num(slope_deg(steep.design, steep.grid.cell)[cells])),
+                   math.radians(STEEPEST_DEG))
     z = steep.design[cells] - radius * (1 - np.cos(a))
-    dz = level_step(radius, cusp, a)
-    order = np.argsort(-z)
-    z, dz = z[order], dz[order]
+    half = 0.5 * steep.grid.cell * np.tan(a)
+    top, bottom, dz = z + half, z - half, level_step(radius, cusp, a)
     big = float(dz.max())
-    out = [float(z[0])]
+    out = [float(top.max())]
     while True:
-        below = z < out[-1] - 1e-9
+        below = bottom < out[-1] - 1e-9
         if not below.any():
             return out
-        near = (z <= out[-1] + 1e-9) & (z >= out[-1] - big)
-        step = float(dz[near].min()) if near.any() else big
-        # a gap without steep cells: the next level at the next cell's
-        out.append(min(out[-1] - step, float(z[below].max())) if not near.any() else out[-1] - step)
+        near = below & (top >= out[-1] - big)
+        out.append(out[-1] - float(dz[near].min()) if near.any() else float(top[below].max()))
 
 
 def of_params(params: Any, cutter: Cutter) -> tuple[Any, Optional[RestStock]]:

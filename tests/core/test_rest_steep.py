@@ -1,0 +1,120 @@
+"""The steep part of a rest (core.strategies.rest_steep): the split by the passes' vertical cusp, the waterline
+levels spaced by the cusp on the wall, and a 75 deg wall finished with a ball D10 then rested with a ball D3:
+where the D3 reaches the wall, what is left is within the tolerance with the waterline, not with the raster
+alone."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tmm_workbench.core import polygons
+from tmm_workbench.core.footprint import rest
+from tmm_workbench.core.footprint.rest import RestStock
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.sim.stock import box_heights, mesh_heights
+from tmm_workbench.core.strategies import raster_drop, rest_steep
+from tmm_workbench.core.strategies.surface.params import SurfaceParams
+from tmm_workbench.core.tools.cutter import Cutter
+
+TOL = 0.01
+D10, D3 = Cutter.ball(10), Cutter.ball(3)
+
+
+WALL_DEG, WALL_X, WALL_H = 60.0, 10.0, 6.0
+
+
+def wall_mesh() -> TriMesh:
+    """A floor meeting a 60 deg wall along y (from x = 10) up to a plateau 6 mm high: a height field on 0.25 mm."""
+    xs = np.unique(np.concatenate([np.arange(0.0, 20.01, 0.25),
+                                   [WALL_X, WALL_X + WALL_H / math.tan(math.radians(WALL_DEG))]]))
+    ys = np.arange(0.0, 10.01, 0.25)
+    X, Y = np.meshgrid(xs, ys)
+    Z = np.clip((X - WALL_X) * math.tan(math.radians(WALL_DEG)), 0.0, WALL_H)
+    nx, ny = len(xs), len(ys)
+    idx = np.arange(nx * ny).reshape(ny, nx)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    return TriMesh(np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]),
+                   np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])]), "wall")
+
+
+def ramp(slope_deg: float, along_y: bool = False) -> tuple[Grid, np.ndarray]:
+    grid = Grid.covering(0.0, 0.0, 10.0, 10.0, 0.25)
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    return grid, (Y if along_y else X) * math.tan(math.radians(slope_deg))
+
+
+def test_the_vertical_cusp_grows_with_the_slope_across_the_passes() -> None:
+    grid, design = ramp(60.0)
+    a = math.radians(60.0)
+    across_x = rest_steep.vertical_cusp(design, grid.cell, 0.008, 0.0)[5:-5, 5:-5]
+    across_y = rest_steep.vertical_cusp(design, grid.cell, 0.008, 90.0)[5:-5, 5:-5]
+    # passes spaced along the slope: the surface step 1 / cos a of the XY step, its cusp 1 / cos^2 a, vertically
+    # 1 / cos a more; spaced along the level: only the last
+    assert across_x == pytest.approx(0.008 / math.cos(a) ** 3, rel=1e-9)
+    assert across_y == pytest.approx(0.008 / math.cos(a), rel=1e-9)
+
+
+def test_the_split_sends_the_cells_the_passes_cannot_hold_to_the_waterline() -> None:
+    for slope, steep_expected in ((10.0, False), (25.0, True), (70.0, True)):
+        grid, design = ramp(slope)
+        stock = RestStock(grid, design + 0.05, TOL * rest.LEAST_CUT, design, TOL)
+        shallow, steep = rest_steep.split(stock, 0.008, 0.0)   # passes along Y, spaced along X: across the slope
+        assert (steep is not None) == steep_expected, slope
+        if steep is not None:
+            both = np.isfinite(shallow.heights) & np.isfinite(steep.heights)
+            assert not both.any()
+            assert np.isfinite(steep.heights).sum() > 0.9 * design.size
+    grid, design = ramp(25.0)      # passes along the slope: 0.008 / cos 25 deg < 0.01 holds it
+    assert rest_steep.split(RestStock(grid, design + 0.05, 0.002, design, TOL), 0.008, 90.0)[1] is None
+
+
+def test_the_levels_leave_the_cusp_on_the_wall() -> None:
+    grid, design = ramp(60.0)
+    stock = RestStock(grid, design + 0.05, 0.002, design, TOL)
+    zs = np.array(rest_steep.levels(stock, 1.5, 0.008))
+    a = math.radians(60.0)
+    dz = math.sin(a) * math.sqrt(8 * 1.5 * 0.008 * math.cos(a))
+    steps = -np.diff(zs)
+    assert np.all(steps > 0)
+    assert np.median(steps) == pytest.approx(dz, rel=0.02)
+    assert (np.median(steps) / math.sin(a)) ** 2 / (8 * 1.5 * math.cos(a)) == pytest.approx(0.008, rel=0.05)
+    inner = design[1:-1, 1:-1]
+    assert zs[0] >= inner.max() - 1.5 * (1 - math.cos(a)) - 1e-6   # the top cell's contact level
+    assert zs[-1] <= inner.min()
+
+
+def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> None:
+    mesh = wall_mesh()
+    box = (WALL_X - 4.0, 0.0, WALL_X + 8.0, 10.0)
+    grid = Grid.covering(*box, 0.25)
+    design = mesh_heights(mesh, grid)
+    policy = LinkPolicy(10.0, 12.0)
+    finish = raster_drop.compute_surface_toolpath(
+        mesh, D10, SurfaceParams(boundary=box, stepover=2 * math.sqrt(2 * 5.0 * TOL), sample_step=0.25), policy)
+    left = simulate(finish, D10, grid, box_heights(grid, 7.0)).heights
+    envelope = rest.tool_envelope(mesh, D3, grid)
+    area = rest.rest_area(left, design, envelope, grid, TOL, D3.radius)
+    inner = np.zeros_like(design, dtype=bool)
+    inner[8:-8, 8:-8] = True                     # two millimetres in from the finish's boundary
+    reach = inner & np.isfinite(design) & (envelope - design <= TOL)
+    on_wall = reach & (np.nan_to_num(rest_steep.slope_deg(design, grid.cell)) > 55.0)
+    assert on_wall.sum() > 100 and np.nanmax(np.where(on_wall, left - design, np.nan)) > 1.5 * TOL
+    params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, sample_step=0.25,
+                           rest=area.stock(left), stepover=2 * math.sqrt(2 * D3.radius * 0.8 * TOL))
+    rest_policy = LinkPolicy(10.0, 12.0, material_top=StockHeights(grid, left, D3), low_links=True)
+    worst = {}
+    for name, p in (("raster alone", replace(params, rest=replace(params.rest, design=None))), ("split", params)):
+        result = raster_drop.compute(mesh, D3, p)
+        after = simulate(link(result.segments, rest_policy), D3, grid, left).heights
+        worst[name] = float(np.nanmax(np.where(on_wall, after - design, np.nan)))
+        assert np.nanmin(after - design) > -0.005
+        if name == "split":
+            assert result.diagnostics["steep"]["levels"] > 10 and result.diagnostics["steep"]["segments"] > 0
+    assert worst["raster alone"] > 1.3 * TOL        # the passes cannot hold the cusp on the 60 deg wall
+    assert worst["split"] <= TOL, worst
