@@ -114,7 +114,9 @@ def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> N
         after = simulate(link(result.segments, rest_policy), D3, grid, left).heights
         worst[name] = float(np.nanmax(np.where(on_wall, after - design, np.nan)))
         assert np.nanmin(after - design) > -0.005
-        if name == "split":
-            assert result.diagnostics["steep"]["levels"] > 10 and result.diagnostics["steep"]["segments"] > 0
+        if name == "split":   # the loops go over the steep cells the raster's passes leave above the tolerance
+            steep = result.diagnostics["steep"]
+            assert steep["levels"] >= 2 and steep["segments"] > 0
+            assert 0 < steep["cells"] < np.sum(on_wall & area.mask)
     assert worst["raster alone"] > 1.3 * TOL        # the passes cannot hold the cusp on the 60 deg wall
     assert worst["split"] <= TOL, worst

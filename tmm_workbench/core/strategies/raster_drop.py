@@ -101,10 +101,11 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
     # rest machining: only what is left; its steep part by waterline loops (the passes cannot hold the cusp there)
-    params, steep = rest_steep.of_params(params, cutter)
+    _, steep = rest_steep.of_params(params, cutter)
     segments = rest_filter.apply(params, cutter, segments, diagnostics)
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
+    steep = None if steep is None else rest_steep.residue(steep, segments, cutter)   # what the passes leave there
     if steep is not None:
         segments = segments + rest_steep.passes(mesh, cutter, params, steep, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
