@@ -60,18 +60,20 @@ def test_the_vertical_cusp_grows_with_the_slope_across_the_passes() -> None:
     assert across_y == pytest.approx(0.008 / math.cos(a), rel=1e-9)
 
 
-def test_the_split_sends_the_cells_the_passes_cannot_hold_to_the_waterline() -> None:
+def test_the_steep_cells_are_those_the_passes_cannot_hold() -> None:
     for slope, steep_expected in ((10.0, False), (25.0, True), (70.0, True)):
         grid, design = ramp(slope)
         stock = RestStock(grid, design + 0.05, TOL * rest.LEAST_CUT, design, TOL)
-        shallow, steep = rest_steep.split(stock, 0.008, 0.0)   # passes along Y, spaced along X: across the slope
+        steep = rest_steep.steep_cells(stock, 0.008, 0.0)   # passes along Y, spaced along X: across the slope
         assert (steep is not None) == steep_expected, slope
         if steep is not None:
-            both = np.isfinite(shallow.heights) & np.isfinite(steep.heights)
-            assert not both.any()
             assert np.isfinite(steep.heights).sum() > 0.9 * design.size
     grid, design = ramp(25.0)      # passes along the slope: 0.008 / cos 25 deg < 0.01 holds it
-    assert rest_steep.split(RestStock(grid, design + 0.05, 0.002, design, TOL), 0.008, 90.0)[1] is None
+    assert rest_steep.steep_cells(RestStock(grid, design + 0.05, 0.002, design, TOL), 0.008, 90.0) is None
+    # nor where the tool's envelope stays more than the tolerance above the design (no spacing holds it there)
+    grid, design = ramp(70.0)
+    away = RestStock(grid, design + 0.05, 0.002, design, TOL, envelope=design + 0.02)
+    assert rest_steep.steep_cells(away, 0.008, 0.0) is None
 
 
 def test_the_levels_leave_the_cusp_on_the_wall() -> None:

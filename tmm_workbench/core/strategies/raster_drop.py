@@ -101,7 +101,7 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
     # rest machining: only what is left; its steep part by waterline loops (the passes cannot hold the cusp there)
-    _, steep = rest_steep.of_params(params, cutter)
+    steep = rest_steep.of_params(params, cutter)
     segments = rest_filter.apply(params, cutter, segments, diagnostics)
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)

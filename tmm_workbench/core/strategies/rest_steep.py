@@ -72,22 +72,19 @@ def across_deg(params: Any) -> Optional[float]:
     return None
 
 
-def split(rest: RestStock, cusp: float, across: Optional[float]) -> tuple[RestStock, Optional[RestStock]]:
-    """(shallow, steep) parts of the rest: steep where passes leaving `cusp` on a flat, spaced in the direction
-    `across` (degrees from +X; None: any), leave more than the rest tolerance vertically (slopes under
-    FLATTEST_DEG never); steep None when no cell is."""
+def steep_cells(rest: RestStock, cusp: float, across: Optional[float]) -> Optional[RestStock]:
+    """The rest's steep part: where passes leaving `cusp` on a flat, spaced in the direction `across` (degrees
+    from +X; None: any), leave more than the rest tolerance vertically (slopes under FLATTEST_DEG never) and the
+    tool's envelope comes within it; None when no cell is."""
     if rest.design is None:
-        return rest, None
+        return None
     cells = np.isfinite(rest.heights)
     cell = rest.grid.cell
     over = np.nan_to_num(vertical_cusp(rest.design, cell, cusp, across)) > rest.within
     steep = cells & over & (np.nan_to_num(slope_deg(rest.design, cell)) > FLATTEST_DEG)
     if rest.envelope is not None:   # where the tool can come within the tolerance: elsewhere no spacing holds it
         steep &= rest.envelope - rest.design <= rest.within
-    if not steep.any():
-        return rest, None
-    return (replace(rest, heights=np.where(steep, -np.inf, rest.heights)),
-            replace(rest, heights=np.where(steep, rest.heights, -np.inf)))
+    return replace(rest, heights=np.where(steep, rest.heights, -np.inf)) if steep.any() else None
 
 
 def level_step(radius: float, cusp: float, slope: np.ndarray) -> np.ndarray:
@@ -141,14 +138,12 @@ def residue(steep: RestStock, segments: list[CutSegment], cutter: Cutter) -> Opt
     return replace(steep, heights=np.where(left, after, -np.inf)) if left.any() else None
 
 
-def of_params(params: Any, cutter: Cutter) -> tuple[Any, Optional[RestStock]]:
-    """The Surface params with the shallow part of their rest, and the steep part (None: no split: no rest, a
-    pencil, a flat end mill or nothing steep)."""
+def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
+    """The steep part of the Surface params' rest (None: no rest, a pencil, a flat end mill or nothing steep)."""
     rest = getattr(params, "rest", None)
-    if rest is None or rest.design is None or params.pattern == "pencil" or cutter.corner_radius <= 0:
-        return params, None
-    shallow, steep = split(rest, flat_cusp(cutter, params), across_deg(params))
-    return (params, None) if steep is None else (replace(params, rest=shallow), steep)
+    if rest is None or params.pattern == "pencil" or cutter.corner_radius <= 0:
+        return None
+    return steep_cells(rest, flat_cusp(cutter, params), across_deg(params))
 
 
 def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
