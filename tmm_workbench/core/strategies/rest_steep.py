@@ -146,27 +146,66 @@ def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
     return steep_cells(rest, flat_cusp(cutter, params), across_deg(params))
 
 
+def patches(steep: RestStock, reach: float) -> list[RestStock]:
+    """The steep cells in groups (cells within about `reach` of one another together), each a RestStock, in the
+    order a tool going from one to the nearest next would take."""
+    from scipy import ndimage
+
+    cells = np.isfinite(steep.heights)
+    grown = ndimage.binary_dilation(cells, iterations=max(1, int(math.ceil(0.5 * reach / steep.grid.cell))))
+    labels, n = ndimage.label(grown, structure=np.ones((3, 3), dtype=bool))
+    labels = np.where(cells, labels, 0)
+    centres = steep.grid.centres().reshape(steep.grid.ny, steep.grid.nx, 2)
+    groups = [k for k in range(1, n + 1) if (labels == k).any()]
+    middle = {k: centres[labels == k].mean(axis=0) for k in groups}
+    order, at = [], None
+    while groups:
+        k = groups[0] if at is None else min(groups, key=lambda g: float(np.hypot(*(middle[g] - at))))
+        groups.remove(k)
+        order.append(k)
+        at = middle[k]
+    return [replace(steep, heights=np.where(labels == k, steep.heights, -np.inf)) for k in order]
+
+
 def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
-    """Waterline loops over the steep rest cells, within the Surface params' boundary, kept where they cut steep
-    rest material (diagnostics "steep": levels, segments, the cells)."""
-    r = cutter.corner_radius
-    cusp = WALL_CUSP * steep.within
-    zs = levels(steep, r, cusp)
+    """Waterline loops over the steep rest cells, group by group (each group's levels top-down, the loops of
+    the next level reached with the tool down where they start near), within the Surface params' boundary, kept
+    where they cut that material (diagnostics "steep": levels, segments, cells, groups)."""
+    surface = surface or DropSurface(mesh)
+    segments: list[CutSegment] = []
+    count = 0
+    groups = patches(steep, cutter.diameter)
+    for group in groups:
+        found = _group_passes(mesh, cutter, params, group, surface)
+        count += len(found[1])
+        segments += found[0]
+    diagnostics["steep"] = {"levels": count, "segments": len(segments), "groups": len(groups),
+                            "cells": int(np.isfinite(steep.heights).sum())}
+    if segments:
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(s.tips[:, 2].max())
+                                                                         for s in segments))
+    return segments
+
+
+def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,
+                  surface: DropSurface) -> tuple[list[CutSegment], list[float]]:
+    """(segments, levels) of one group of steep cells: its box grown by the tool radius, within the boundary."""
+    zs = levels(group, cutter.corner_radius, WALL_CUSP * group.within)
     lo = float(mesh.bounds[0][2])
     zs = [z for z in zs if z >= lo]
-    if not zs:
-        return []
-    wp = waterline.WaterlineParams(boundary=tuple(params.boundary), step_down=1.0, top_z=zs[0] + 1e-6,
+    g, cells = group.grid, np.isfinite(group.heights)
+    xy = g.centres().reshape(g.ny, g.nx, 2)[cells]
+    grow = cutter.diameter   # the tool centre is within a radius of its contact: the loop well inside the box
+    b = params.boundary
+    box = (max(b[0], float(xy[:, 0].min()) - grow), max(b[1], float(xy[:, 1].min()) - grow),
+           min(b[2], float(xy[:, 0].max()) + grow), min(b[3], float(xy[:, 1].max()) + grow))
+    if not zs or not (box[2] > box[0] and box[3] > box[1]):
+        return [], []
+    wp = waterline.WaterlineParams(boundary=box, step_down=1.0, top_z=zs[0] + 1e-6,
                                    bottom_z=min(zs[-1], zs[0] - 1e-5), chord_tol=CHORD_TOL, z_levels=zs,
                                    stock_to_leave=max(params.stock_to_leave, 0.0), empty_ok=True,
                                    assembly=params.assembly, holder_collision=params.holder_collision,
                                    holder_notes=params.holder_notes)
-    wp.rest, wp.rest_bridge = steep, BRIDGE
-    result = waterline.compute(mesh, cutter, wp, surface=surface)
-    diagnostics["steep"] = {"levels": len(zs), "segments": len(result.segments),
-                            "cells": int(np.isfinite(steep.heights).sum())}
-    if result.segments:
-        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(s.tips[:, 2].max())
-                                                                         for s in result.segments))
-    return result.segments
+    wp.rest, wp.rest_bridge = group, BRIDGE
+    return waterline.compute(mesh, cutter, wp, surface=surface).segments, zs
