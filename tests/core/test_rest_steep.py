@@ -49,31 +49,16 @@ def ramp(slope_deg: float, along_y: bool = False) -> tuple[Grid, np.ndarray]:
     return grid, (Y if along_y else X) * math.tan(math.radians(slope_deg))
 
 
-def test_the_vertical_cusp_grows_with_the_slope_across_the_passes() -> None:
-    grid, design = ramp(60.0)
-    a = math.radians(60.0)
-    across_x = rest_steep.vertical_cusp(design, grid.cell, 0.008, 0.0)[5:-5, 5:-5]
-    across_y = rest_steep.vertical_cusp(design, grid.cell, 0.008, 90.0)[5:-5, 5:-5]
-    # passes spaced along the slope: the surface step 1 / cos a of the XY step, its cusp 1 / cos^2 a, vertically
-    # 1 / cos a more; spaced along the level: only the last
-    assert across_x == pytest.approx(0.008 / math.cos(a) ** 3, rel=1e-9)
-    assert across_y == pytest.approx(0.008 / math.cos(a), rel=1e-9)
-
-
-def test_the_steep_cells_are_those_the_passes_cannot_hold() -> None:
+def test_the_steep_cells_are_the_sloped_ones_the_tool_reaches() -> None:
     for slope, steep_expected in ((10.0, False), (25.0, True), (70.0, True)):
         grid, design = ramp(slope)
-        stock = RestStock(grid, design + 0.05, TOL * rest.LEAST_CUT, design, TOL)
-        steep = rest_steep.steep_cells(stock, 0.008, 0.0)   # passes along Y, spaced along X: across the slope
+        steep = rest_steep.steep_cells(RestStock(grid, design + 0.05, TOL * rest.LEAST_CUT, design, TOL))
         assert (steep is not None) == steep_expected, slope
         if steep is not None:
-            assert np.isfinite(steep.heights).sum() > 0.9 * design.size
-    grid, design = ramp(25.0)      # passes along the slope: 0.008 / cos 25 deg < 0.01 holds it
-    assert rest_steep.steep_cells(RestStock(grid, design + 0.05, 0.002, design, TOL), 0.008, 90.0) is None
-    # nor where the tool's envelope stays more than the tolerance above the design (no spacing holds it there)
+            assert np.isfinite(steep.heights).all()   # the edges' slopes read one-sided
+    # not where the tool's envelope stays more than the tolerance above the design (no spacing holds it there)
     grid, design = ramp(70.0)
-    away = RestStock(grid, design + 0.05, 0.002, design, TOL, envelope=design + 0.02)
-    assert rest_steep.steep_cells(away, 0.008, 0.0) is None
+    assert rest_steep.steep_cells(RestStock(grid, design + 0.05, 0.002, design, TOL, envelope=design + 0.02)) is None
 
 
 def test_the_levels_leave_the_cusp_on_the_wall() -> None:
@@ -108,7 +93,7 @@ def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> N
     on_wall = reach & (np.nan_to_num(rest_steep.slope_deg(design, grid.cell)) > 55.0)
     assert on_wall.sum() > 100 and np.nanmax(np.where(on_wall, left - design, np.nan)) > 1.5 * TOL
     params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, sample_step=0.25,
-                           rest=area.stock(left), stepover=2 * math.sqrt(2 * D3.radius * 0.8 * TOL))
+                           rest=area.stock(left), stepover=2 * math.sqrt(2 * D3.radius * 0.8 * TOL), verify_notes=[])
     rest_policy = LinkPolicy(10.0, 12.0, material_top=StockHeights(grid, left, D3), low_links=True)
     worst = {}
     for name, p in (("raster alone", replace(params, rest=replace(params.rest, design=None))), ("split", params)):
@@ -120,5 +105,10 @@ def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> N
             steep = result.diagnostics["steep"]
             assert steep["levels"] >= 2 and steep["segments"] > 0
             assert 0 < steep["cells"] < np.sum(on_wall & area.mask)
+            note = p.verify_notes[-1]   # what the op reports: the loops' cells, what stays (the wall's ends)
+            assert isinstance(note, rest_steep.SteepReport)
+            assert note.sloped == pytest.approx(steep["cells"] * grid.cell_area)
+            assert note.sloped_after < 0.5 * note.sloped
+            assert note.summary().startswith(f"the passes left {note.sloped:.1f} mm2 of sloped rest above 0.01 mm")
     assert worst["raster alone"] > 1.3 * TOL        # the passes cannot hold the cusp on the 60 deg wall
     assert worst["split"] <= TOL, worst

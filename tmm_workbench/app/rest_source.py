@@ -99,8 +99,10 @@ def report(obj: Any, rest: Optional[Rest], notes: Sequence = ()) -> None:
     mask = rest.area.mask
     pts = np.column_stack([rest.area.cells_xy(), rest.stock.heights[mask]])[:: max(1, -(-mask.sum() // MAX_MARKS))]
     from tmm_workbench.core.footprint.cleanup import CleanupReport
+    from tmm_workbench.core.strategies.rest_steep import SteepReport
 
-    obj.RestReport = "; ".join([rest.area.summary()] + [n.summary() for n in notes if isinstance(n, CleanupReport)])
+    obj.RestReport = "; ".join([rest.area.summary()] + [n.summary() for n in notes
+                                                        if isinstance(n, (CleanupReport, SteepReport))])
     obj.RestRegions = [FreeCAD.Vector(*map(float, p)) for p in pts]
     FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")
 

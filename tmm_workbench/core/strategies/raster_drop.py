@@ -105,9 +105,8 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
     segments = rest_filter.apply(params, cutter, segments, diagnostics)
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
-    steep = None if steep is None else rest_steep.residue(steep, segments, cutter)   # what the passes leave there
-    if steep is not None:
-        segments = segments + rest_steep.passes(mesh, cutter, params, steep, surface, diagnostics)
+    if steep is not None:   # waterline loops over what the passes leave there
+        segments = rest_steep.finish(mesh, cutter, params, steep, segments, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

@@ -1,21 +1,24 @@
 """The steep part of a rest, cut by waterline loops. Passes s apart in XY leave on a flat a cusp c = s^2 / 8 r
 (r the corner radius); across a slope a_n the step along the surface is s / cos a_n, so the cusp along the
 normal c / cos^2 a_n, and its vertical height (what the rest and the simulation judge) that over cos a, a the
-slope. Where that exceeds the rest tolerance the passes cannot hold it: those rest cells (RestStock with the
-design's heights; only where the tool's envelope comes within the tolerance: elsewhere no spacing holds it) are
-the steep part. The Surface's passes run over the whole rest as before; the steep cells they leave above the
-tolerance (their cut in a z-map of the steep cells) are cut by waterline loops (core.strategies.waterline, kept
-only where they cut that material, linked with the other passes), at levels spaced by the cusp on the wall: two
-loops dz apart on a slope a leave dz^2 / (8 r sin^2 a cos a) vertically, so dz = sin a sqrt(8 r c cos a) under
-the steep cells of each height band (a capped at STEEPEST_DEG: a vertical wall's vertical cusp has no bound).
-Loops over all the steep cells instead (the passes only over the shallow ones) made the rest 1.4 times longer on
-sphere_on_plate and 2.6 times on mount_rush: a large tool's cusps on a slope lie scattered along its passes, and a
-loop crossing them cuts little.
+slope: on the steep parts of a rest the passes cannot hold the tolerance (and on curved ones they leave more
+than that). So the Surface's passes run over the whole rest as before, and the sloped rest cells (steeper than
+FLATTEST_DEG, where the tool's envelope comes within the tolerance: elsewhere no spacing holds it) they leave
+above the tolerance, found by cutting their z-map with the passes, are cut by waterline loops
+(core.strategies.waterline), group by group of nearby cells, kept only where they cut that material and linked
+with the other passes. The loops' levels are spaced by the cusp on the wall: two loops dz apart on a slope a
+leave dz^2 / (8 r sin^2 a cos a) vertically, so dz = sin a sqrt(8 r c cos a) under the cells of each height band
+(a capped at STEEPEST_DEG: a vertical wall's vertical cusp has no bound).
+
+Measured (docs/rest_pencil.md): loops over every cell the passes cannot hold by the formula, the passes only over
+the others, made the rest 1.4 times longer on sphere_on_plate and 2.3 times on mount_rush than this (a large
+tool's cusps on a slope lie scattered along its passes, and a loop crossing them cuts little); loops only over the
+cells the formula calls steep left twice the cells above the tolerance on mount_rush.
 """
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any, Optional
 
 import numpy as np
@@ -29,7 +32,7 @@ from tmm_workbench.core.sim.simulate import CUT, RAPID
 from tmm_workbench.core.strategies import waterline
 from tmm_workbench.core.tools.cutter import Cutter
 
-FLATTEST_DEG = 15.0    # never steeper than this: a step too coarse for the tolerance on a flat is the user's
+FLATTEST_DEG = 15.0    # the waterline's levels on flatter cells would be too close: what passes leave there stays
 STEEPEST_DEG = 85.0    # the levels' spacing is that of this slope on anything steeper
 WALL_CUSP = 0.8        # of the rest tolerance: the waterline's vertical cusp on the wall
 CHORD_TOL = 0.002      # the loops' chord tolerance, mm: their growth off the wall times tan a is left on it
@@ -37,52 +40,51 @@ BRIDGE = 1.0           # tool diameters of a loop's gap cut through (the raster'
 #                        along a large tool's passes, a loop crossing many of them; the hop over a gap is 1 mm
 
 
-def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
-    """(ny, nx) the design's slope on the grid, degrees (NaN where a neighbour has no design)."""
+@dataclass
+class SteepReport:
+    """What the rest's passes and loops leave (their cut of the rest cells' z-map), for the op's RestReport."""
+    tolerance: float
+    sloped: float         # mm^2 of sloped rest the passes left above the tolerance (the loops' cells)
+    groups: int
+    levels: int
+    sloped_after: float   # mm^2 of sloped rest the tool reaches still above it after the loops
+    flat_after: float     # mm^2 flatter than FLATTEST_DEG it reaches the passes leave above it (no loops there)
+
+    def summary(self) -> str:
+        text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline "
+                f"loops over it ({self.groups} group(s), {self.levels} levels)")
+        if self.sloped_after > 0 or self.flat_after > 0:
+            text += (f"; {self.sloped_after:.1f} mm2 of it stay above (the loops' cusp on near-vertical walls and "
+                     f"in creases), {self.flat_after:.1f} mm2 flatter than {FLATTEST_DEG:g} deg left by the passes")
+        return text
+
+
+def gradient(design: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
+    """(gy, gx) of the design's heights, a cell without design taking its nearest neighbour's height (at the
+    model's edge the slope is read one-sided, not lost)."""
+    missing = ~np.isfinite(design)
+    if missing.any() and not missing.all():
+        from scipy import ndimage
+
+        idx = ndimage.distance_transform_edt(missing, return_distances=False, return_indices=True)
+        design = design[tuple(idx)]
     gy, gx = np.gradient(design, cell)
+    return gy, gx
+
+
+def slope_deg(design: np.ndarray, cell: float) -> np.ndarray:
+    """(ny, nx) the design's slope on the grid, degrees."""
+    gy, gx = gradient(design, cell)
     return np.degrees(np.arctan(np.hypot(gx, gy)))
 
 
-def vertical_cusp(design: np.ndarray, cell: float, cusp: float, across_deg: Optional[float]) -> np.ndarray:
-    """(ny, nx) the vertical cusp of passes leaving `cusp` on a flat: the step along the surface across them is
-    1 / cos a_n of the XY step (a_n the slope across the passes, whose direction is `across_deg` from +X; None:
-    any direction, the slope itself), so the cusp c / cos^2 a_n along the normal, divided by cos a vertically."""
-    gy, gx = np.gradient(design, cell)
-    g = np.hypot(gx, gy)
-    if across_deg is None:
-        gn = g
-    else:
-        t = math.radians(across_deg)
-        gn = np.abs(gx * math.cos(t) + gy * math.sin(t))
-    return cusp * (1 + gn ** 2) * np.sqrt(1 + g ** 2)
-
-
-def flat_cusp(cutter: Cutter, params: Any) -> float:
-    """The cusp on a flat of the Surface's passes: its cusp height in the cusp modes, else that of its step-over
-    for the corner radius."""
-    if params.stepover_mode != "stepover":
-        return float(params.cusp)
-    return params.stepover ** 2 / (8 * cutter.corner_radius)
-
-
-def across_deg(params: Any) -> Optional[float]:
-    """The direction the raster's passes are spaced in (None: loops and spirals, every direction)."""
-    if params.pattern in ("zigzag", "oneway") and params.stepover_mode != "offset3d":
-        return float(params.angle_deg) + 90.0
-    return None
-
-
-def steep_cells(rest: RestStock, cusp: float, across: Optional[float]) -> Optional[RestStock]:
-    """The rest's steep part: where passes leaving `cusp` on a flat, spaced in the direction `across` (degrees
-    from +X; None: any), leave more than the rest tolerance vertically (slopes under FLATTEST_DEG never) and the
-    tool's envelope comes within it; None when no cell is."""
+def steep_cells(rest: RestStock) -> Optional[RestStock]:
+    """The rest's sloped part: steeper than FLATTEST_DEG, where the tool's envelope comes within the rest
+    tolerance (elsewhere no spacing holds it); None when no cell is."""
     if rest.design is None:
         return None
-    cells = np.isfinite(rest.heights)
-    cell = rest.grid.cell
-    over = np.nan_to_num(vertical_cusp(rest.design, cell, cusp, across)) > rest.within
-    steep = cells & over & (np.nan_to_num(slope_deg(rest.design, cell)) > FLATTEST_DEG)
-    if rest.envelope is not None:   # where the tool can come within the tolerance: elsewhere no spacing holds it
+    steep = np.isfinite(rest.heights) & (slope_deg(rest.design, rest.grid.cell) > FLATTEST_DEG)
+    if rest.envelope is not None:
         steep &= rest.envelope - rest.design <= rest.within
     return replace(rest, heights=np.where(steep, rest.heights, -np.inf)) if steep.any() else None
 
@@ -114,36 +116,62 @@ def levels(steep: RestStock, radius: float, cusp: float) -> list[float]:
         out.append(out[-1] - float(dz[near].min()) if near.any() else float(top[below].max()))
 
 
-def residue(steep: RestStock, segments: list[CutSegment], cutter: Cutter) -> Optional[RestStock]:
-    """The steep cells `segments` (cut in order, a rapid between two) leave more than the rest tolerance above
-    the design, at the heights they leave; None when none is."""
-    cells = np.isfinite(steep.heights)
-    if segments:
-        g = steep.grid
-        floor = float(np.nanmin(steep.design)) - 1.0
-        zmap = native.ZMap(g.x0, g.y0, g.cell, g.nx, g.ny, 0.0)
-        zmap.heights[:] = np.where(cells, steep.heights, floor)
-        top = max(float(np.max(np.where(cells, steep.heights, floor))), max(float(seg.tips[:, 2].max())
-                                                                            for seg in segments)) + cutter.diameter
-        # each segment entered straight down from above all and left straight up (a rapid cuts in the z-map too)
-        tips = np.vstack([np.vstack([[*seg.tips[0, :2], top], seg.tips, [*seg.tips[-1, :2], top]])
-                          for seg in segments])
-        kinds = np.concatenate([[CUT] * len(seg.tips) + [RAPID, RAPID] for seg in segments])[:-1]
-        native.cut_3axis(zmap, cutter.native, np.ascontiguousarray(tips, dtype=float), kinds.astype(np.uint8),
-                         1e-3, 0, None)
-        after = np.array(zmap.heights)
-    else:
-        after = steep.heights
-    left = cells & (after - steep.design > steep.within)
-    return replace(steep, heights=np.where(left, after, -np.inf)) if left.any() else None
+def after_cut(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> np.ndarray:
+    """(ny, nx) the rest cells' heights after `segments` (cut in order, each entered straight down from above all
+    and left straight up: a rapid cuts in the z-map too); -inf off the rest."""
+    cells = np.isfinite(rest.heights)
+    if not segments or not cells.any():
+        return rest.heights
+    g = rest.grid
+    floor = float(np.nanmin(rest.design)) - 1.0
+    zmap = native.ZMap(g.x0, g.y0, g.cell, g.nx, g.ny, 0.0)
+    zmap.heights[:] = np.where(cells, rest.heights, floor)
+    top = max(float(rest.heights[cells].max()), max(float(seg.tips[:, 2].max()) for seg in segments)) + 1.0
+    tips = np.vstack([np.vstack([[*seg.tips[0, :2], top], seg.tips, [*seg.tips[-1, :2], top]])
+                      for seg in segments])
+    kinds = np.concatenate([[CUT] * len(seg.tips) + [RAPID, RAPID] for seg in segments])[:-1]
+    native.cut_3axis(zmap, cutter.native, np.ascontiguousarray(tips, dtype=float), kinds.astype(np.uint8), 1e-3, 0,
+                     None)
+    return np.where(cells, np.array(zmap.heights), -np.inf)
+
+
+def residue(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> Optional[RestStock]:
+    """The cells of `rest` (with the design) that `segments` leave more than the rest tolerance above the design,
+    at the heights they leave; None when none is."""
+    after = after_cut(rest, segments, cutter)
+    left = np.isfinite(after) & (after - rest.design > rest.within)
+    return replace(rest, heights=np.where(left, after, -np.inf)) if left.any() else None
+
+
+def finish(mesh: TriMesh, cutter: Cutter, params: Any, sloped: RestStock, segments: list[CutSegment],
+           surface: Optional[DropSurface], diagnostics: dict) -> list[CutSegment]:
+    """The passes' `segments` and after them the waterline loops over the `sloped` cells they leave above the
+    tolerance; what both leave of the rest (params.rest) as a SteepReport appended to params.verify_notes (the
+    op's RestReport) when it is a list."""
+    left = residue(sloped, segments, cutter)
+    loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
+    if params.verify_notes is not None:
+        rest, a = params.rest, sloped.grid.cell_area
+        after = residue(rest, segments + loops, cutter)
+        still = np.zeros(rest.heights.shape, dtype=bool) if after is None else np.isfinite(after.heights)
+        if rest.envelope is not None:   # (beyond the tool's reach: the rest's own report)
+            still &= rest.envelope - rest.design <= rest.within
+        flat = slope_deg(rest.design, rest.grid.cell) <= FLATTEST_DEG
+        steep = diagnostics.get("steep", {})
+        params.verify_notes.append(SteepReport(
+            rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
+            int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
+            float(np.sum(still & flat) * a)))
+    return segments + loops
 
 
 def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
-    """The steep part of the Surface params' rest (None: no rest, a pencil, a flat end mill or nothing steep)."""
+    """The sloped part of the Surface params' rest (None: no rest, a pencil, a flat end mill or nothing
+    sloped)."""
     rest = getattr(params, "rest", None)
     if rest is None or params.pattern == "pencil" or cutter.corner_radius <= 0:
         return None
-    return steep_cells(rest, flat_cusp(cutter, params), across_deg(params))
+    return steep_cells(rest)
 
 
 def patches(steep: RestStock, reach: float) -> list[RestStock]:
