@@ -208,12 +208,47 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
         found = _group_passes(mesh, cutter, params, group, surface)
         count += len(found[1])
         segments += found[0]
+    segments = ordered(segments)
+    for seg in segments:   # joined again in the new order: down to the next piece where it starts near
+        seg.joined = False
+    s = max(params.stock_to_leave, 0.0)
+    waterline.join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     diagnostics["steep"] = {"levels": count, "segments": len(segments), "groups": len(groups),
                             "cells": int(np.isfinite(steep.heights).sum())}
     if segments:
         diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(s.tips[:, 2].max())
                                                                          for s in segments))
     return segments
+
+
+UPHILL = 3.0   # a move up counts this many times its height in choosing the next piece: the levels top-down
+
+
+def ordered(segments: list[CutSegment]) -> list[CutSegment]:
+    """The loops' pieces in the order a tool going from each to the nearest next (rising counted UPHILL times)
+    takes, a piece joined to the one before it (reached with the tool down) kept after it: level by level over a
+    large group the tool would cross the group at every level."""
+    chains: list[list[CutSegment]] = []
+    for seg in segments:
+        if seg.joined and chains:
+            chains[-1].append(seg)
+        else:
+            chains.append([seg])
+    if len(chains) < 3:
+        return segments
+    starts = np.array([c[0].tips[0] for c in chains])
+    ends = np.array([c[-1].tips[-1] for c in chains])
+    left = np.ones(len(chains), dtype=bool)
+    order, k = [0], 0
+    left[0] = False
+    while left.any():
+        d = starts - ends[k]
+        cost = np.hypot(d[:, 0], d[:, 1]) + UPHILL * np.maximum(d[:, 2], 0.0) + np.abs(d[:, 2])
+        cost[~left] = np.inf
+        k = int(np.argmin(cost))
+        left[k] = False
+        order.append(k)
+    return [seg for i in order for seg in chains[i]]
 
 
 def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,

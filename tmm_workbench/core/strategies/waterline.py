@@ -164,12 +164,12 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                 xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
             tips = np.column_stack([xy, np.full(len(xy), z)])
             # The linker enters each segment from above onto its first tip (gouge-free, since every loop
-            # point is free: its drop height is at most z), unless _join_levels reaches it with the tool down.
+            # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
             extra = {"closed": closed} if _HAS_CLOSED else {}
             segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
             points += len(tips)
             where = xy[-1]
-    joined = _join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
+    joined = join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     if not segments and params.empty_ok:
         return StrategyResult([], {"levels": len(zs), "loops": loops, "points": 0, "joined": 0, "top": zs[0]})
     if not segments:
@@ -186,7 +186,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 
-def _join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
+def join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
     """Pieces that start within a tool radius of where the previous one ended, no higher, reached with the tool
     down (`joined`: a straight fed move, the next level's loop from the one above) where that move is clear of
     the model plus stock to leave (sampled as core.verify.linear_moves checks moves); the count. A lift, a rapid
