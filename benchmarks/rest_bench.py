@@ -73,7 +73,7 @@ def run(path: Path, offset3d: bool) -> None:
     step = step_for(d3, 0.8 * TOL)
     mode = dict(stepover_mode="offset3d", cusp=0.8 * TOL) if offset3d else dict(stepover=step)
     params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, sample_step=0.25,
-                           rest=area.stock(left), **mode)
+                           rest=area.stock(left), verify_notes=[], **mode)
     rest_policy = LinkPolicy(policy.safe_height, policy.clearance_height, material_top=StockHeights(grid, left, d3),
                              low_links=True)
     result = raster_drop.compute(mesh, d3, params)
@@ -97,6 +97,8 @@ def run(path: Path, offset3d: bool) -> None:
     if steep:
         print(f"the sloped rest the passes leave above {TOL} mm: {steep['cells']} cells, waterline loops in "
               f"{steep['groups']} group(s), {steep['levels']} levels, {steep['segments']} pieces")
+    for note in params.verify_notes:   # what the op reports (a z-map of the rest cells cut by the pieces)
+        print(f"op's report: {note.summary()}")
     print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s}")
     for name, length, seconds, above, worst, low in rows:
         print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f}")

@@ -11,9 +11,9 @@ leave dz^2 / (8 r sin^2 a cos a) vertically, so dz = sin a sqrt(8 r c cos a) und
 (a capped at STEEPEST_DEG: a vertical wall's vertical cusp has no bound).
 
 Measured (docs/rest_pencil.md): loops over every cell the passes cannot hold by the formula, the passes only over
-the others, made the rest 1.4 times longer on sphere_on_plate and 2.3 times on mount_rush than this (a large
+the others, made the rest 1.4 times longer on sphere_on_plate and 2.2 times on mount_rush than this (a large
 tool's cusps on a slope lie scattered along its passes, and a loop crossing them cuts little); loops only over the
-cells the formula calls steep left twice the cells above the tolerance on mount_rush.
+cells the formula calls steep left 2.3 times the cells above the tolerance on mount_rush.
 """
 from __future__ import annotations
 
@@ -221,7 +221,7 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
     return segments
 
 
-UPHILL = 3.0   # a move up counts this many times its height in choosing the next piece: the levels top-down
+UPHILL = 3.0   # a move up counts this many times its height more than a move down in choosing the next piece
 
 
 def ordered(segments: list[CutSegment]) -> list[CutSegment]:
