@@ -10,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from tests.core.rest_case import after_d10
 from tmm_workbench.core import polygons
 from tmm_workbench.core.footprint import rest
 from tmm_workbench.core.footprint.rest import RestStock
@@ -17,13 +18,12 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
-from tmm_workbench.core.sim.stock import box_heights, mesh_heights
 from tmm_workbench.core.strategies import raster_drop, rest_steep
 from tmm_workbench.core.strategies.surface.params import SurfaceParams
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.01
-D10, D3 = Cutter.ball(10), Cutter.ball(3)
+D3 = Cutter.ball(3)
 
 
 WALL_DEG, WALL_X, WALL_H = 60.0, 10.0, 6.0
@@ -78,15 +78,8 @@ def test_the_levels_leave_the_cusp_on_the_wall() -> None:
 
 def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> None:
     mesh = wall_mesh()
-    box = (WALL_X - 4.0, 0.0, WALL_X + 8.0, 10.0)
-    grid = Grid.covering(*box, 0.25)
-    design = mesh_heights(mesh, grid)
-    policy = LinkPolicy(10.0, 12.0)
-    finish = raster_drop.compute_surface_toolpath(
-        mesh, D10, SurfaceParams(boundary=box, stepover=2 * math.sqrt(2 * 5.0 * TOL), sample_step=0.25), policy)
-    left = simulate(finish, D10, grid, box_heights(grid, 7.0)).heights
-    envelope = rest.tool_envelope(mesh, D3, grid)
-    area = rest.rest_area(left, design, envelope, grid, TOL, D3.radius)
+    case = after_d10(mesh, (WALL_X - 4.0, 0.0, WALL_X + 8.0, 10.0), 0.25, D3, 7.0, 10.0)
+    grid, design, left, envelope, area = case.grid, case.design, case.left, case.envelope, case.area
     inner = np.zeros_like(design, dtype=bool)
     inner[8:-8, 8:-8] = True                     # two millimetres in from the finish's boundary
     reach = inner & np.isfinite(design) & (envelope - design <= TOL)

@@ -100,13 +100,11 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
             segments = segments[:n] + extra
             for key, value in stats.items():
                 diagnostics["lean"][key] = diagnostics["lean"].get(key, 0) + value
-    # rest machining: only what is left; its steep part by waterline loops (the passes cannot hold the cusp there)
-    steep = rest_steep.of_params(params, cutter)
-    segments = rest_filter.apply(params, cutter, segments, diagnostics)
+    segments = rest_filter.apply(params, cutter, segments, diagnostics)   # rest machining: only what is left
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
-    if steep is not None:   # waterline loops over what the passes leave there
-        segments = rest_steep.finish(mesh, cutter, params, steep, segments, surface, diagnostics)
+    # a rest's slopes: waterline loops where the passes cannot hold the tolerance
+    segments = rest_steep.finish(mesh, cutter, params, segments, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

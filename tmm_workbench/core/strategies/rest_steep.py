@@ -51,8 +51,9 @@ class SteepReport:
     flat_after: float     # mm^2 flatter than FLATTEST_DEG it reaches the passes leave above it (no loops there)
 
     def summary(self) -> str:
-        text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline "
-                f"loops over it ({self.groups} group(s), {self.levels} levels)")
+        text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline loops "
+                f"over it ({self.groups} group(s), {self.levels} levels)" if self.sloped else
+                f"the passes left no sloped rest above {self.tolerance:g} mm")
         if self.sloped_after > 0 or self.flat_after > 0:
             text += (f"; {self.sloped_after:.1f} mm2 of it stay above (the loops' cusp on near-vertical walls and "
                      f"in creases), {self.flat_after:.1f} mm2 flatter than {FLATTEST_DEG:g} deg left by the passes")
@@ -143,15 +144,19 @@ def residue(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> Opti
     return replace(rest, heights=np.where(left, after, -np.inf)) if left.any() else None
 
 
-def finish(mesh: TriMesh, cutter: Cutter, params: Any, sloped: RestStock, segments: list[CutSegment],
-           surface: Optional[DropSurface], diagnostics: dict) -> list[CutSegment]:
-    """The passes' `segments` and after them the waterline loops over the `sloped` cells they leave above the
-    tolerance; what both leave of the rest (params.rest) as a SteepReport appended to params.verify_notes (the
-    op's RestReport) when it is a list."""
-    left = residue(sloped, segments, cutter)
+def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment], surface: Optional[DropSurface],
+           diagnostics: dict) -> list[CutSegment]:
+    """A rest's passes (`segments`, the Surface's pattern but the pencil) and after them the waterline loops over
+    the sloped rest cells they leave above the tolerance; what both leave (params.rest) as a SteepReport appended
+    to params.verify_notes (the op's RestReport) when it is a list."""
+    rest = getattr(params, "rest", None)
+    if rest is None or rest.design is None or params.pattern == "pencil":
+        return segments
+    sloped = of_params(params, cutter)
+    left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
     if params.verify_notes is not None:
-        rest, a = params.rest, sloped.grid.cell_area
+        a = rest.grid.cell_area
         after = residue(rest, segments + loops, cutter)
         still = np.zeros(rest.heights.shape, dtype=bool) if after is None else np.isfinite(after.heights)
         if rest.envelope is not None:   # (beyond the tool's reach: the rest's own report)
