@@ -49,14 +49,16 @@ class SteepReport:
     levels: int
     sloped_after: float   # mm^2 of sloped rest the tool reaches still above it after the loops
     flat_after: float     # mm^2 flatter than FLATTEST_DEG it reaches the passes leave above it (no loops there)
+    edge: float = 0.0     # mm^2 of both where its envelope stands more than half the tolerance above the design
 
     def summary(self) -> str:
         text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline loops "
                 f"over it ({self.groups} group(s), {self.levels} levels)" if self.sloped else
                 f"the passes left no sloped rest above {self.tolerance:g} mm")
         if self.sloped_after > 0 or self.flat_after > 0:
-            text += (f"; {self.sloped_after:.1f} mm2 of it stay above (the loops' cusp on near-vertical walls and "
-                     f"in creases), {self.flat_after:.1f} mm2 flatter than {FLATTEST_DEG:g} deg left by the passes")
+            text += (f"; where this tool reaches, {self.sloped_after:.1f} mm2 sloped and {self.flat_after:.1f} mm2 "
+                     f"flatter than {FLATTEST_DEG:g} deg (no loops there) stay above it, {self.edge:.1f} mm2 of them "
+                     f"at the edge of its reach (its envelope more than half the tolerance above the design)")
         return text
 
 
@@ -162,11 +164,12 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
         if rest.envelope is not None:   # (beyond the tool's reach: the rest's own report)
             still &= rest.envelope - rest.design <= rest.within
         flat = slope_deg(rest.design, rest.grid.cell) <= FLATTEST_DEG
+        edge = np.zeros_like(flat) if rest.envelope is None else rest.envelope - rest.design > 0.5 * rest.within
         steep = diagnostics.get("steep", {})
         params.verify_notes.append(SteepReport(
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
-            float(np.sum(still & flat) * a)))
+            float(np.sum(still & flat) * a), float(np.sum(still & edge) * a)))
     return segments + loops
 
 
