@@ -87,10 +87,11 @@ def run(path: Path, offset3d: bool) -> None:
     reach = np.isfinite(design) & (envelope - design <= TOL)
     rows = []
     for name, tp in (("rest D3", rest_path), ("full D3", full)):
-        after = simulate(tp, d3, grid, left).heights
+        sim = simulate(tp, d3, grid, left)
+        after = sim.heights
         length, seconds = cycle(tp)
         above, worst = left_where_reached(after, design, reach)
-        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design))))
+        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design)), len(sim.collisions)))
     print(f"\n{path.name}: {area.summary()}; D10 finish {t_finish:.1f} s, rest {t_rest:.1f} s, full D3 {t_full:.1f} s "
           f"to compute ({'offset3d' if offset3d else 'raster'} rest)")
     steep = result.diagnostics.get("steep")
@@ -99,9 +100,10 @@ def run(path: Path, offset3d: bool) -> None:
               f"{steep['groups']} group(s), {steep['levels']} levels, {steep['segments']} pieces")
     for note in params.verify_notes:   # what the op reports (a z-map of the rest cells cut by the pieces)
         print(f"op's report: {note.summary()}")
-    print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s}")
-    for name, length, seconds, above, worst, low in rows:
-        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f}")
+    print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s} "
+          f"{'rapids in stock':>16s}")
+    for name, length, seconds, above, worst, low, rapids in rows:
+        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f} {rapids:16d}")
     (_, lr, sr, *_), (_, lf, sf, *_) = rows
     print(f"{'ratio':10s} {lr / lf:10.2f} {sr / sf:9.2f}   (target <= 0.25 both, leaving the same)")
     # a path that leaves the full finish's cusp over the rest cells passes over them at most `step` apart: its
