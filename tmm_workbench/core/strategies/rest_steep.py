@@ -23,6 +23,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from tmm_workbench.core import cancel
 from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.kernel import native
@@ -213,6 +214,7 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
     count = 0
     groups = patches(steep, cutter.diameter)
     for group in groups:
+        cancel.poll()
         found = _group_passes(mesh, cutter, params, group, surface)
         count += len(found[1])
         segments += found[0]
@@ -279,4 +281,4 @@ def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,
                                    assembly=params.assembly, holder_collision=params.holder_collision,
                                    holder_notes=params.holder_notes)
     wp.rest, wp.rest_bridge = group, BRIDGE
-    return waterline.compute(mesh, cutter, wp, surface=surface).segments, zs
+    return waterline.compute(mesh, cutter, wp, cancel.asker(), surface).segments, zs
