@@ -105,3 +105,15 @@ def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> N
             assert note.summary().startswith(f"the passes left {note.sloped:.1f} mm2 of sloped rest above 0.01 mm")
     assert worst["raster alone"] > 1.3 * TOL        # the passes cannot hold the cusp on the 60 deg wall
     assert worst["split"] <= TOL, worst
+
+
+def test_the_pieces_go_nearest_first_and_downhill_keeping_joined_ones_together() -> None:
+    from tmm_workbench.core.segments import CutSegment, SegmentKind
+
+    def piece(x0: float, z: float, joined: bool = False) -> CutSegment:
+        tips = np.array([[x0, 0.0, z], [x0 + 1.0, 0.0, z]])
+        return CutSegment(tips, SegmentKind.PASS, joined=joined)
+
+    a, far, b, b2, up = piece(0.0, 5.0), piece(50.0, 5.0), piece(1.5, 4.8), piece(2.6, 4.7, True), piece(2.0, 6.0)
+    # from a's end (1, 0, 5): b 0.5 away and 0.2 down; the piece 1 mm away but 1 mm up costs 1 + 4; far last
+    assert rest_steep.ordered([a, far, up, b, b2]) == [a, b, b2, up, far]

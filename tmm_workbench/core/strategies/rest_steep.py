@@ -184,24 +184,15 @@ def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
 
 
 def patches(steep: RestStock, reach: float) -> list[RestStock]:
-    """The steep cells in groups (cells within about `reach` of one another together), each a RestStock, in the
-    order a tool going from one to the nearest next would take."""
+    """The steep cells in groups (cells within about `reach` of one another together), each a RestStock."""
     from scipy import ndimage
 
     cells = np.isfinite(steep.heights)
     grown = ndimage.binary_dilation(cells, iterations=max(1, int(math.ceil(0.5 * reach / steep.grid.cell))))
     labels, n = ndimage.label(grown, structure=np.ones((3, 3), dtype=bool))
     labels = np.where(cells, labels, 0)
-    centres = steep.grid.centres().reshape(steep.grid.ny, steep.grid.nx, 2)
-    groups = [k for k in range(1, n + 1) if (labels == k).any()]
-    middle = {k: centres[labels == k].mean(axis=0) for k in groups}
-    order, at = [], None
-    while groups:
-        k = groups[0] if at is None else min(groups, key=lambda g: float(np.hypot(*(middle[g] - at))))
-        groups.remove(k)
-        order.append(k)
-        at = middle[k]
-    return [replace(steep, heights=np.where(labels == k, steep.heights, -np.inf)) for k in order]
+    return [replace(steep, heights=np.where(labels == k, steep.heights, -np.inf)) for k in range(1, n + 1)
+            if (labels == k).any()]
 
 
 def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
@@ -226,8 +217,8 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
     diagnostics["steep"] = {"levels": count, "segments": len(segments), "groups": len(groups),
                             "cells": int(np.isfinite(steep.heights).sum())}
     if segments:
-        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(s.tips[:, 2].max())
-                                                                         for s in segments))
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max())
+                                                                         for seg in segments))
     return segments
 
 
@@ -235,8 +226,8 @@ UPHILL = 3.0   # a move up counts this many times its height more than a move do
 
 
 def ordered(segments: list[CutSegment]) -> list[CutSegment]:
-    """The loops' pieces in the order a tool going from each to the nearest next (rising counted UPHILL times)
-    takes, a piece joined to the one before it (reached with the tool down) kept after it: level by level over a
+    """The loops' pieces in the order a tool going from each to the nearest next (a rise counted UPHILL + 1
+    times its height, a descent once) takes, a piece joined to the one before it (reached with the tool down) kept after it: level by level over a
     large group the tool would cross the group at every level."""
     chains: list[list[CutSegment]] = []
     for seg in segments:
@@ -263,7 +254,7 @@ def ordered(segments: list[CutSegment]) -> list[CutSegment]:
 
 def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,
                   surface: DropSurface) -> tuple[list[CutSegment], list[float]]:
-    """(segments, levels) of one group of steep cells: its box grown by the tool radius, within the boundary."""
+    """(segments, levels) of one group of steep cells: its box grown by the tool diameter, within the boundary."""
     zs = levels(group, cutter.corner_radius, WALL_CUSP * group.within)
     lo = float(mesh.bounds[0][2])
     zs = [z for z in zs if z >= lo]
