@@ -2,7 +2,8 @@
 ball D10 finish at most 25 % of the length and of the time of a full D3 finish that leaves the same).
 
 For each model: a D10 raster finish (cusp 0.01 mm), simulated on the stock's top (cells 0.25 mm); a D3 rest path
-(core.footprint.rest's region and core.strategies.rest_filter, raster or 3D offset, cusp 0.008 mm between passes)
+(core.footprint.rest's region and core.strategies.rest_filter, raster or 3D offset, cusp 0.008 mm between passes;
+waterline loops over the sloped cells they leave above the tolerance: core.strategies.rest_steep)
 and a full D3 raster with the same step-over, both simulated from what the D10 left; printed side by side: feed
 length, cycle time (feed 1000 mm/min, plunge 300, rapid 5000), and what each leaves where the D3 reaches the model
 (cells above 0.01 mm, the largest), with the ratios.
@@ -72,10 +73,11 @@ def run(path: Path, offset3d: bool) -> None:
     step = step_for(d3, 0.8 * TOL)
     mode = dict(stepover_mode="offset3d", cusp=0.8 * TOL) if offset3d else dict(stepover=step)
     params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, sample_step=0.25,
-                           rest=area.stock(left), **mode)
+                           rest=area.stock(left), verify_notes=[], **mode)
     rest_policy = LinkPolicy(policy.safe_height, policy.clearance_height, material_top=StockHeights(grid, left, d3),
                              low_links=True)
-    rest_path = link(raster_drop.compute(mesh, d3, params).segments, rest_policy)
+    result = raster_drop.compute(mesh, d3, params)
+    rest_path = link(result.segments, rest_policy)
     t_rest = time.perf_counter() - t0
     t0 = time.perf_counter()
     full = raster_drop.compute_surface_toolpath(mesh, d3, SurfaceParams(boundary=box, stepover=step, sample_step=0.25),
@@ -85,15 +87,23 @@ def run(path: Path, offset3d: bool) -> None:
     reach = np.isfinite(design) & (envelope - design <= TOL)
     rows = []
     for name, tp in (("rest D3", rest_path), ("full D3", full)):
-        after = simulate(tp, d3, grid, left).heights
+        sim = simulate(tp, d3, grid, left)
+        after = sim.heights
         length, seconds = cycle(tp)
         above, worst = left_where_reached(after, design, reach)
-        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design))))
+        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design)), len(sim.collisions)))
     print(f"\n{path.name}: {area.summary()}; D10 finish {t_finish:.1f} s, rest {t_rest:.1f} s, full D3 {t_full:.1f} s "
           f"to compute ({'offset3d' if offset3d else 'raster'} rest)")
-    print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s}")
-    for name, length, seconds, above, worst, low in rows:
-        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f}")
+    steep = result.diagnostics.get("steep")
+    if steep:
+        print(f"the sloped rest the passes leave above {TOL} mm: {steep['cells']} cells, waterline loops in "
+              f"{steep['groups']} group(s), {steep['levels']} levels, {steep['segments']} pieces")
+    for note in params.verify_notes:   # what the op reports (a z-map of the rest cells cut by the pieces)
+        print(f"op's report: {note.summary()}")
+    print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s} "
+          f"{'rapids in stock':>16s}")
+    for name, length, seconds, above, worst, low, rapids in rows:
+        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f} {rapids:16d}")
     (_, lr, sr, *_), (_, lf, sf, *_) = rows
     print(f"{'ratio':10s} {lr / lf:10.2f} {sr / sf:9.2f}   (target <= 0.25 both, leaving the same)")
     # a path that leaves the full finish's cusp over the rest cells passes over them at most `step` apart: its

@@ -135,20 +135,13 @@ def test_the_pencil_source_cleanup_needs_its_finishing_tool(case) -> None:
 def test_the_groove_end_is_cleaned_within_the_tolerance_where_the_d2_reaches() -> None:
     # seed 000's case at the groove's end (x 30): finished with the D10 (cusp 0.01 mm), cleaned up with the D2;
     # simulated: every cell the D2 can bring within 0.01 mm of the design is within it, no gouge below -0.005 mm
-    from tmm_workbench.core.footprint import rest
     from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
     from tmm_workbench.core.sim.simulate import simulate
-    from tmm_workbench.core.sim.stock import box_heights
+    from tests.core.rest_case import after_d10
 
-    mesh, tol, box = crease_mesh(), 0.01, (24.0, 14.0, 34.0, 26.0)
-    grid = Grid.covering(*box, 0.1)
-    design = mesh_heights(mesh, grid)
-    policy = LinkPolicy(8.0, 10.0)
-    finish = raster_drop.compute_surface_toolpath(
-        mesh, D10, SurfaceParams(boundary=box, stepover=2 * math.sqrt(2 * 5.0 * tol), sample_step=0.25), policy)
-    left = simulate(finish, D10, grid, box_heights(grid, 2.0)).heights
-    envelope = rest.tool_envelope(mesh, D2, grid)
-    area = rest.rest_area(left, design, envelope, grid, tol, D2.radius)
+    mesh, tol = crease_mesh(), 0.01
+    case = after_d10(mesh, (24.0, 14.0, 34.0, 26.0), 0.1, D2, 2.0, 8.0)
+    grid, design, left, envelope, area = case.grid, case.design, case.left, case.envelope, case.area
     params = SurfaceParams(boundary=(25.0, 15.0, 33.0, 25.0), region=area.region, sample_step=0.2,
                            rest=area.stock(left), pattern="pencil", pencil_passes=0, pencil_source="cleanup",
                            cleanup_reference=D10, stepover=2 * math.sqrt(2 * 1.0 * 0.8 * tol), cusp=tol)

@@ -42,12 +42,13 @@ class CleanUpInTheSurface(FreeCADTestCase):
         sim = after.simulation
         design = mesh_heights(op.Proxy.mesh, sim.grid)
         reach = np.isfinite(design) & (tool_envelope(op.Proxy.mesh, op.Proxy.cutter(), sim.grid) - design <= 0.01)
-        left_before = np.sum(reach & (before.simulation.comparison.deviation > 0.012))
-        left_after = np.sum(reach & (sim.comparison.deviation > 0.012))
+        left_before = np.sum(reach & (before.simulation.comparison.deviation > 0.01))
+        left_after = np.sum(reach & (sim.comparison.deviation > 0.01))
         self.assertGreater(left_before, 5000)
-        # within 0.012 mm wherever the D2 reaches, the groove's ends too (at 0.01 mm: 3 cells of up to 0.0113 mm
-        # where the groove's bottom meets its sloped ends, on this finish of 0.6 mm step-over)
-        self.assertEqual(left_after, 0)
+        # within the tolerance wherever the D2 reaches, the groove's ends too (the rest found on cells of an
+        # eighth of the D2's radius: on a quarter, 3 cells of up to 0.0113 mm stayed where the groove's bottom
+        # meets its sloped ends)
+        self.assertEqual(left_after, 0, float(np.nanmax(np.where(reach, sim.comparison.deviation, np.nan))))
         # the pass along the wall's foot: on the floor, where the D2 touches the floor and the wall at once (moves
         # both of whose ends lie there, most of the wall's 40 mm long)
         pts = op.Proxy.toolpath.points()
@@ -65,7 +66,7 @@ class CleanUpInTheSurface(FreeCADTestCase):
         self.assertGreater(length, 40 + 25)
         self.assertGreater(placed, 0.8 * points)
         self.assertGreater(passes, 0)
-        print(f"TMM-FC-NOTE cleanup: {op.RestReport}; cells > 0.012: {left_before} -> {left_after}")
+        print(f"TMM-FC-NOTE cleanup: {op.RestReport}; cells > 0.01: {left_before} -> {left_after}")
 
     def test_bad_values_are_refused_by_name(self) -> None:
         big = finished("TmmCleanUpBad")

@@ -18,7 +18,7 @@ from typing import Any, Optional
 
 import FreeCAD
 
-from tmm_workbench.app import offset_start, op_base, op_mesh, pencil_source, progress, region_source, simulation
+from tmm_workbench.app import offset_start, op_base, op_mesh, pencil_source, progress, region_source
 from tmm_workbench.app import stages
 from tmm_workbench.app import rest_source, surface_passes, surface_verify, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet, PathUtils
@@ -85,7 +85,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         mesh = self.model_mesh(obj)
         cutter = self.cutter()
         job = PathUtils.findParentJob(obj)
-        left = simulation.material_left(obj, cutter)   # what the Job's earlier ops left (None: not known)
+        left = rest_source.material_left(obj, cutter)   # what the Job's earlier ops left (None: not known)
         rest = None
         if getattr(obj, "Region", "") == region_source.REST:   # only where they (or a larger tool) left material
             rest = rest_source.rest_of(obj, job, mesh, cutter, left, self.boundary(obj, mesh))

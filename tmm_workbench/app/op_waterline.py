@@ -96,7 +96,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, retract=VERTICAL)
         policy.validate()
-        policy.material_top = simulation.material_left(obj, cutter)
+        policy.material_top = rest_source.material_left(obj, cutter)
         rest = rest_source.rest_of_op(obj, simulation.job_of(obj), mesh, cutter, policy.material_top,
                                       extra["boundary"])
         params.rest = None if rest is None else rest.stock

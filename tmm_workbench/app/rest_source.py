@@ -69,7 +69,7 @@ def rest_of(op: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tu
         grid, heights = left.grid, np.array(left.heights)   # a copy: the linker cuts the material top as it links
     else:
         reference = reference_cutter(op, cutter)
-        grid = simulation.simulation_grid(job, simulation.known_cell(job, cutter))   # as the earlier ops' stock
+        grid = simulation.simulation_grid(job, simulation.known_cell(job, cutter, simulation.REST_SHARE))
         heights = np.minimum(simulation.stock_heights(job, grid), tool_envelope(mesh, reference, grid))
     area = rest_area(heights, mesh_heights(mesh, grid), tool_envelope(mesh, cutter, grid), grid, tolerance,
                      cutter.radius)
@@ -99,8 +99,10 @@ def report(obj: Any, rest: Optional[Rest], notes: Sequence = ()) -> None:
     mask = rest.area.mask
     pts = np.column_stack([rest.area.cells_xy(), rest.stock.heights[mask]])[:: max(1, -(-mask.sum() // MAX_MARKS))]
     from tmm_workbench.core.footprint.cleanup import CleanupReport
+    from tmm_workbench.core.strategies.rest_steep import SteepReport
 
-    obj.RestReport = "; ".join([rest.area.summary()] + [n.summary() for n in notes if isinstance(n, CleanupReport)])
+    obj.RestReport = "; ".join([rest.area.summary()] + [n.summary() for n in notes
+                                                        if isinstance(n, (CleanupReport, SteepReport))])
     obj.RestRegions = [FreeCAD.Vector(*map(float, p)) for p in pts]
     FreeCAD.Console.PrintMessage(f"{obj.Label}: {obj.RestReport}\n")
 
@@ -135,9 +137,19 @@ STAGE = Stage("rest", (
 ), ignored=ignored)
 
 
+def is_rest(obj: Any) -> bool:
+    """Whether the op machines only the rest (Region 'Rest', or the waterline's RestOnly)."""
+    return getattr(obj, "Region", "") == REST or bool(getattr(obj, "RestOnly", False))
+
+
+def material_left(obj: Any, cutter: Cutter) -> Any:
+    """What the Job's earlier ops left (app.simulation.material_left), on a rest op's finer cells."""
+    return simulation.material_left(obj, cutter, simulation.REST_SHARE if is_rest(obj) else 4.0)
+
+
 def rest_of_op(obj: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tuple) -> Optional[Rest]:
     """The op's rest when it machines only the rest (Region 'Rest', or the waterline's RestOnly), else None."""
-    if getattr(obj, "Region", "") == REST or bool(getattr(obj, "RestOnly", False)):
+    if is_rest(obj):
         return rest_of(obj, job, mesh, cutter, left, box)
     return None
 

@@ -40,7 +40,7 @@ def notes_for(params: Any) -> list:
 
     notes: list = []
     cleanup = params.pattern == PENCIL and params.pencil_source == PENCIL_CLEANUP
-    if params.verify_cusp or cusp_check.applies(params) or cleanup:
+    if params.verify_cusp or cusp_check.applies(params) or cleanup or params.rest is not None:
         params.verify_notes = notes
     return notes
 
@@ -55,11 +55,12 @@ def _report_property(obj: Any, text: str) -> None:
 
 def report(obj: Any, notes: list) -> None:
     from tmm_workbench.core.footprint.cleanup import CleanupReport
+    from tmm_workbench.core.strategies.rest_steep import SteepReport
     from tmm_workbench.core.strategies.surface.cusp_check import CuspCheck
 
     _report_property(obj, "")
     for note in notes:
-        if isinstance(note, CleanupReport):   # reported with the rest (app.rest_source.report)
+        if isinstance(note, (CleanupReport, SteepReport)):   # reported with the rest (app.rest_source.report)
             continue
         if isinstance(note, CuspCheck):
             _report_property(obj, note.summary())

@@ -31,7 +31,7 @@ from tmm_workbench.core.sim.simulate import CUT, RAPID
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
-MIN_CELLS = 3          # a rest patch of fewer cells is the grid's noise, not material
+MIN_CELLS = 3          # a clean-up strip's patch of fewer cells is the grid's noise (core.footprint.cleanup)
 LEAST_CUT = 0.2        # of the tolerance: a rest cell is one the tool lowers by at least this much
 MAX_RUNS = 400_000     # row runs of rest cells turned into rectangles: a finer grid is refused above this
 
@@ -43,6 +43,11 @@ class RestStock:
     grid: Grid
     heights: np.ndarray
     tolerance: float
+    # the design's heights on the grid (NaN: none) and the rest tolerance they are judged by: the steep part of
+    # the rest (core.strategies.rest_steep) is told by the design's slope; None: not split
+    design: Optional[np.ndarray] = None
+    within: float = 0.0
+    envelope: Optional[np.ndarray] = None   # the rest tool's envelope (what it can reach)
 
     def __post_init__(self) -> None:
         if np.shape(self.heights) != (self.grid.ny, self.grid.nx):
@@ -62,6 +67,8 @@ class RestArea:
     volume_before: float        # mm^3 above the design before the rest tool
     volume_after: float         # and after it (what it cannot reach)
     out_of_reach: float         # mm^2 still above the tolerance after it
+    design: Optional[np.ndarray] = None   # the design's heights (NaN: none)
+    envelope: Optional[np.ndarray] = None   # the tool's envelope (tool_envelope)
 
     @property
     def empty(self) -> bool:
@@ -80,7 +87,8 @@ class RestArea:
     def stock(self, left: np.ndarray) -> "RestStock":
         """What the rest filter cuts against: `left` on the rest cells only, a cut being LEAST_CUT of the
         tolerance."""
-        return RestStock(self.grid, np.where(self.mask, left, -np.inf), LEAST_CUT * self.tolerance)
+        return RestStock(self.grid, np.where(self.mask, left, -np.inf), LEAST_CUT * self.tolerance, self.design,
+                         self.tolerance, self.envelope)
 
     def cells_xy(self) -> np.ndarray:
         """(n, 2) centres of the rest cells (what the view marks)."""
@@ -122,8 +130,8 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
               radius: float) -> RestArea:
     """The rest of `left` ((ny, nx) heights on `grid`) for a tool whose envelope is `envelope`, over the design
     heights (NaN where there is no design: never rest): the cells more than the tolerance above the design that
-    the tool lowers by LEAST_CUT of it or more. The region bounds the tool centre: the rest cells (patches of
-    fewer than MIN_CELLS dropped) grown by `radius`."""
+    the tool lowers by LEAST_CUT of it or more. The region bounds the tool centre: the rest cells grown by
+    `radius`."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"rest tolerance must be a length > 0 mm, got {tolerance!r}")
     for name, a in (("left", left), ("design", design), ("envelope", envelope)):
@@ -131,15 +139,17 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
             raise TmmError(f"rest {name} heights have shape {np.shape(a)}, the grid {grid.ny} x {grid.nx}")
     has_design = np.isfinite(design)
     # above the tolerance, and the tool takes some of it off (to within the tolerance where it reaches)
+    # every such cell, a single one too: a large tool's raster on a steep slope leaves its cusps above the
+    # tolerance in cells one or two wide along its passes
     mask = has_design & (left - design > tolerance) & (left - envelope > LEAST_CUT * tolerance)
-    mask = without_specks(mask)
     after = np.minimum(left, envelope)
     above = np.where(has_design, np.clip(left - design, 0, None), 0.0)
     above_after = np.where(has_design, np.clip(after - design, 0, None), 0.0)
     a = grid.cell_area
     region = mask_region(mask, grid, radius) if mask.any() else []
     return RestArea(grid, mask, region, tolerance, float(mask.sum() * a), float(above.sum() * a),
-                    float(above_after.sum() * a), float(np.sum(above_after > tolerance) * a))
+                    float(above_after.sum() * a), float(np.sum(above_after > tolerance) * a), design,
+                    envelope)
 
 
 def without_specks(mask: np.ndarray) -> np.ndarray:

@@ -27,7 +27,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import StrategyResult
-from tmm_workbench.core.strategies import holder_guard, rest_filter
+from tmm_workbench.core.strategies import holder_guard, rest_filter, rest_steep
 from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - the Surface's names, used from here
     _BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY, OUTWARD, SAMPLED,
     SPIRAL, STEPOVER, TOLERANCE, ZIGZAG, SurfaceParams, raster_points)
@@ -103,6 +103,8 @@ def _compute(mesh: TriMesh, cutter: Cutter, params: SurfaceParams, progress: Opt
     segments = rest_filter.apply(params, cutter, segments, diagnostics)   # rest machining: only what is left
     # the whole tool: the shank and holder kept clear of the model
     segments = holder_guard.apply(mesh, params, segments, params.sample_step, surface, diagnostics)
+    # a rest's slopes: waterline loops where the passes cannot hold the tolerance
+    segments = rest_steep.finish(mesh, cutter, params, segments, surface, diagnostics)
     from tmm_workbench.core.strategies.surface import cusp_check
 
     if cusp_check.applies(params):  # (skipped, and said, when its work is above the limits)

@@ -25,8 +25,10 @@ BRIDGE_DIAMETERS = 3.0   # a gap in a pass shorter than this many tool diameters
 
 @dataclass
 class RestParams:
-    """The field a 3-axis strategy's params carry for the rest filter (None: cut everywhere)."""
+    """The fields a 3-axis strategy's params carry for the rest filter (None: cut everywhere; a gap in a pass up
+    to `rest_bridge` tool diameters is cut through)."""
     rest: Optional[RestStock] = None
+    rest_bridge: float = BRIDGE_DIAMETERS
 
 
 def _offsets(grid: Grid, reach: float) -> np.ndarray:
@@ -75,7 +77,7 @@ def apply(params: Any, cutter: Cutter, segments: list[CutSegment], diagnostics: 
         pts, move = move_samples(seg, rest.grid.cell)
         ok_move = np.zeros(len(seg), dtype=bool)
         ok_move[np.unique(move[cutting(pts, cutter, rest)])] = True   # move 0: the first tip itself
-        _bridge(seg, ok_move, BRIDGE_DIAMETERS * cutter.diameter)
+        _bridge(seg, ok_move, getattr(params, "rest_bridge", BRIDGE_DIAMETERS) * cutter.diameter)
         ok_tip = ok_move.copy()
         ok_tip[:-1] |= ok_move[1:]    # a kept move's start
         moves += len(seg)

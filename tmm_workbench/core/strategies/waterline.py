@@ -60,6 +60,8 @@ class WaterlineParams(StrategyParams, WholeToolParams, RestParams):  # + the who
     chord_tol: float = param(0.01, "chord tolerance", "mm", low=FINEST_MM, high=1.0)
     direction: str = param(CLIMB, "direction", choices=(CLIMB, CONVENTIONAL))
     stock_z: Optional[tuple[float, float]] = None  # the stock's bottom and top, mm: the levels stay within it
+    z_levels: Optional[list] = None   # the tip heights themselves, top-down (a rest's steep part); None: step-down
+    empty_ok: bool = False            # no loop (or none cutting rest material): no segments rather than an error
 
     def validate(self) -> None:
         super().validate()
@@ -111,7 +113,7 @@ def count_work(params: WaterlineParams, cutter: Cutter, top: float, bottom: floa
     params.validate()
     b = params.boundary
     step = wl.default_sample_step(cutter, b) if params.sample_step is None else params.sample_step
-    count = level_count(top, bottom, params.step_down)
+    count = len(params.z_levels) if params.z_levels else level_count(top, bottom, params.step_down)
     return wl.estimate_work(b, count, step, f"step-down {params.step_down:g} mm from {top:g} to {bottom:g} mm")
 
 
@@ -141,7 +143,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                        f"(x {lo[0]:g}..{hi[0]:g}, y {lo[1]:g}..{hi[1]:g})")
     top, bottom = _range(mesh, params)
     count_work(params, cutter, top, bottom)
-    zs = levels(top, bottom, params.step_down)
+    zs = list(params.z_levels) if params.z_levels else levels(top, bottom, params.step_down)
     s = params.stock_to_leave
     surface = surface or DropSurface(mesh)
     # Stock to leave: the cutter grown by s at tip heights z - s is exactly this cutter at z on the mesh
@@ -162,12 +164,14 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                 xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
             tips = np.column_stack([xy, np.full(len(xy), z)])
             # The linker enters each segment from above onto its first tip (gouge-free, since every loop
-            # point is free: its drop height is at most z), unless _join_levels reaches it with the tool down.
+            # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
             extra = {"closed": closed} if _HAS_CLOSED else {}
             segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
             points += len(tips)
             where = xy[-1]
-    joined = _join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
+    joined = join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
+    if not segments and params.empty_ok:
+        return StrategyResult([], {"levels": len(zs), "loops": loops, "points": 0, "joined": 0, "top": zs[0]})
     if not segments:
         raise TmmError(f"no waterline loop within the boundary x {b[0]:g}..{b[2]:g}, y {b[1]:g}..{b[3]:g} "
                        f"between {bottom:g} and {top:g} mm: the model lies outside it or below the levels")
@@ -175,12 +179,14 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                    "top": max(float(seg.tips[0, 2]) for seg in segments)}
     step = params.sample_step or wl.default_sample_step(cutter, b)
     segments = rest_filter.apply(params, cutter, segments, diagnostics)   # a rest: only where material is left
+    if not segments and params.empty_ok:
+        return StrategyResult([], diagnostics)
     if not segments:
         raise TmmError("no waterline loop takes off rest material: nothing is left for this tool on the walls")
     return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 
-def _join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
+def join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
     """Pieces that start within a tool radius of where the previous one ended, no higher, reached with the tool
     down (`joined`: a straight fed move, the next level's loop from the one above) where that move is clear of
     the model plus stock to leave (sampled as core.verify.linear_moves checks moves); the count. A lift, a rapid

@@ -89,7 +89,8 @@ class SurfaceParams(StrategyParams, WholeToolParams, RestParams):  # + the whole
     arcs: bool = param(False, "arc fitting", choices=(True, False))  # G2/G3 in XZ/YZ (TOLERANCE only)
     # --- verification pass (core.strategies.surface.variable_step): the pass set cut in the simulation,
     # extra partial passes where its cusp exceeds `cusp`; each pass set's VerifyReport is appended to verify_notes
-    # (and the pencil source 'cleanup''s CleanupReport: core.footprint.cleanup)
+    # (and the pencil source 'cleanup''s CleanupReport: core.footprint.cleanup; a rest's SteepReport:
+    # core.strategies.rest_steep)
     verify_cusp: bool = param(False, "verify cusp", choices=(True, False))
     verify_notes: Optional[list] = None
     # the cusp modes' pass set measured as the verification measures it, no passes added: cells left above the
