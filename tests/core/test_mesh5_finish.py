@@ -113,3 +113,14 @@ def test_work_is_estimated_from_the_box_alone():
     assert work.what == "CC points" and work.passes == 11 and work.count == pytest.approx(11 * (24 / 3 + 2))
     with pytest.raises(TmmError, match="CC points"):
         finish.estimate_work(Mesh5Params(forward_step=0.01), Cutter.flat(1.0), (0, 0, 0, 1e5, 1e5, 1))
+
+
+def test_progress_is_told_and_a_cancel_stops_the_passes():
+    from tmm_workbench.core.errors import Cancelled
+
+    mesh = grid_mesh(lambda x, y: np.sqrt(60.0 ** 2 - y * y), 8, 48, (-12, -12, 12, 12), "cylinder")
+    told = []
+    result = finish.compute(mesh, Cutter.flat(10.0), Mesh5Params(**PARAMS), lambda f: told.append(f) or True)
+    assert told and told == sorted(told) and result.diagnostics["passes"] >= 4   # every pass, not the first only
+    with pytest.raises(Cancelled):
+        finish.compute(mesh, Cutter.flat(10.0), Mesh5Params(**PARAMS), lambda f: False)
