@@ -131,7 +131,7 @@ class Mesh5Op(FreeCADTestCase):
         dev = sim.comparison.deviation
         self.assertGreaterEqual(float(np.nanmin(dev)), -0.01)
         self.assertEqual(report.collisions, [])
-        X, Y = np.meshgrid(sim.grid.xs, sim.grid.ys)
+        X, Y = np.meshgrid(sim.grid.xs(), sim.grid.ys())
         # inside the machined area: a cutter radius and more from the passes' ends, away from the side edges
         inside = (np.abs(X) < HALF - D / 2 - 1.0) & (np.abs(Y) < HALF - 3.0)
         slope = np.cos(np.arcsin(np.abs(Y[inside]) / R_CYL))   # vertical deviation = normal / cos(slope)
