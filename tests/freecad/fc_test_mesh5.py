@@ -125,6 +125,16 @@ class Mesh5Op(FreeCADTestCase):
             self.assertTrue((turn[tilted] < math.pi / 2).all(), (a, b))
             self.assertLess(turn[tilted].sum(), 2 * math.pi)
 
+    def test_apt_cl_carries_every_cut_point_with_its_axis(self) -> None:
+        text = load_post("apt_cl").export([self.tc, self.op], str(OUT / "mesh5.apt"), "--no-show-editor")
+        goto = np.array([[float(v) for v in ln[5:].split(",")] for ln in text.splitlines()
+                         if ln.startswith("GOTO/")]).reshape(-1, 6)
+        for seg in self.op.Proxy.segments:
+            for t, a in zip(seg.tips, seg.axes):
+                k = int(np.argmin(np.linalg.norm(goto[:, :3] - t, axis=1)))
+                self.assertLess(np.linalg.norm(goto[k, :3] - t), 1e-3)
+                self.assertLess(np.linalg.norm(goto[k, 3:] - a), 1e-5)
+
     def test_simulated_stock_has_no_gouge_and_the_scallop_within_the_tolerance(self) -> None:
         report = simulate(self.job, cell=0.2, tolerance=TOL, progress=False)
         sim = report.simulation
