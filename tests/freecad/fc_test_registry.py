@@ -15,7 +15,7 @@ from tmm_workbench.core.params import StrategyParams
 class Registry(FreeCADTestCase):
     def test_every_entry_is_a_complete_room(self) -> None:
         self.assertEqual([e.name for e in registry.OPS],
-                         ["TMM_Surface", "TMM_Multipoint", "TMM_Roughing", "TMM_Waterline"])
+                         ["TMM_Surface", "TMM_Multipoint", "TMM_Roughing", "TMM_Waterline", "TMM_Mesh5"])
         self.assertEqual(len({e.view_kind for e in registry.OPS}), len(registry.OPS))  # one view hook each
         for entry in registry.OPS:
             with self.subTest(op=entry.name):

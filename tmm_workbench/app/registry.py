@@ -60,6 +60,11 @@ OPS: tuple[OpEntry, ...] = (
             "TMM_Waterline",
             "tmm_workbench.app.op_waterline", "tmm_workbench.gui.op_waterline_gui", "waterline_op",
             "tmm_workbench.core.strategies.waterline"),
+    OpEntry("TMM_Mesh5", "TMM 5-axis Mesh",
+            "5-axis finishing of a mesh or a Part model with a tilted flat end mill or bull-nose by the 3D C-space "
+            "(seed 000): adaptive passes within the tolerance, postures for the Tarus motion time", "TMM_Mesh5",
+            "tmm_workbench.app.op_mesh5", "tmm_workbench.gui.op_mesh5_gui", "mesh5_op",
+            "tmm_workbench.core.strategies.mesh5.finish"),
 )
 
 

@@ -33,7 +33,8 @@ EXTRA_SPECS: dict[str, Spec] = {
 # compute seconds per counted unit on this project's reference machine (2 cores, loaded by other work: the upper
 # of the runs that benchmarks/compute_estimate.py measured; a machine to itself computes up to ~2x faster)
 PACE = {"surface": 2e-5, "adaptive": 7e-5, "surface_flat_cusp": 4e-5, "offset3d": 5e-4, "verify": 4e-6,
-        "waterline": 2e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025}
+        "waterline": 2e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025,
+        "mesh5": 0.1}   # a CC point's C-space and its rebuilds (docs/mesh5.md, the cylinder of its tests)
 TELL_COMPUTE_S = 5.0    # the panel's estimate names the compute time from here
 LONG_COMPUTE_S = 30.0   # the op says so before it starts (console), with how to cancel
 # a side of a range the params leave open, for the panel's minimum / maximum
@@ -342,6 +343,12 @@ def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
     base, subs = obj.Base[0]
     bb = base.Shape.getElement(subs[0]).BoundBox
     return _params(proxy, obj, ov), None, (bb.XMin, bb.YMin, bb.ZMin, bb.XMax, bb.YMax, bb.ZMax)
+
+
+def mesh5(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
+    """5-axis mesh finishing's params over the model's box (its CC points: passes a quarter diameter apart)."""
+    b = model_bounds(proxy, obj, load_stl)
+    return None if b is None else (_params(proxy, obj, ov), _cutter(obj), b)
 
 
 def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> Estimate:

@@ -32,7 +32,7 @@ tmm::TorusTool tool_from(double Ro, double Ri, const std::string& shape) {
   if (shape == "round_insert") t.shape = tmm::ToolShape::RoundInsert;
   else if (shape == "bull_nose") t.shape = tmm::ToolShape::BullNose;
   else throw std::invalid_argument("tool_shape must be 'round_insert' or 'bull_nose', got '" + shape + "'");
-  t.validate();
+  t.validate_solid();
   return t;
 }
 

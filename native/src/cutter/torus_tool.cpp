@@ -47,7 +47,10 @@ double circle_distance(double R, double rho, double h, const Vector3d& e, const 
 
 }  // namespace
 
-void TorusTool::validate() const {
+namespace {
+
+// Finite radii, Ro >= 0, Ri > 0 (or >= 0 with flat_ok), within the kernel's length range.
+void require_radii(double Ro, double Ri, bool flat_ok) {
   for (const auto& [name, value] : {std::pair<const char*, double>{"major radius Ro", Ro}, {"minor radius Ri", Ri}}) {
     if (!std::isfinite(value)) {
       std::ostringstream msg;
@@ -56,13 +59,25 @@ void TorusTool::validate() const {
     }
   }
   if (Ro < 0.0) throw std::invalid_argument("major radius Ro must be >= 0 (0 is a ball end mill)");
-  if (Ri <= 0.0) {
+  if (flat_ok && Ri < 0.0) throw std::invalid_argument("minor radius Ri must be >= 0 (0 is a flat end mill)");
+  if (!flat_ok && Ri <= 0.0) {
     throw std::invalid_argument(
         "minor radius Ri must be > 0: a flat end mill (Ri = 0) has no pseudo-insert to tilt about, "
         "multipoint positioning needs a toroidal (or ball) cutter");
   }
   require_length(Ro, "major radius Ro");
-  require_length(Ri, "minor radius Ri");
+  if (Ri > 0.0) require_length(Ri, "minor radius Ri");
+}
+
+}  // namespace
+
+void TorusTool::validate() const { require_radii(Ro, Ri, false); }
+
+void TorusTool::validate_solid() const {
+  require_radii(Ro, Ri, true);
+  if (Ri == 0.0 && !(shape == ToolShape::BullNose && Ro > 0.0)) {
+    throw std::invalid_argument("a tool with minor radius Ri = 0 must be a bull-nose (flat end mill) with Ro > 0");
+  }
 }
 
 double TorusTool::profile(double rho) const {

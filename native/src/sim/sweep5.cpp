@@ -138,7 +138,7 @@ namespace {
 // The options and the path (tips, axes normalised, kinds), refused by name when not usable.
 void read_path(const TorusTool& tool, const double* tips, const double* axes_in, const MoveKind* kinds,
                std::size_t n, const Sweep5Options& options, std::vector<Vector3d>& tip, std::vector<Vector3d>& axis) {
-  tool.validate();
+  tool.validate_solid();
   if (!(std::isfinite(options.max_step) && options.max_step > 0.0)) {
     std::ostringstream msg;
     msg << "cut_5axis: max_step must be > 0 mm and finite, got " << options.max_step;
@@ -359,8 +359,8 @@ class Stamper {
     // The quartic decides most lines at the price of one evaluation; the bounds decide the rest.
     const Line l{qa, qq, az};
     const Quartic quartic = ball_ ? Quartic{} : torus_quartic(l, Ro, Ri);
-    const Verdict verdict = ball_ ? Verdict::Unknown : torus_below(quartic, dz);
-    bool torus = verdict == Verdict::Yes;
+    const Verdict verdict = Ri <= 0.0 ? Verdict::No : ball_ ? Verdict::Unknown : torus_below(quartic, dz);
+    bool torus = verdict == Verdict::Yes;  // a flat end mill (Ri = 0): the rim is the core's edge
     if (verdict == Verdict::Unknown && qq <= Rt2_hit_) {
       const double w = std::sqrt(Rt2_hit_ - qq);
       const double lo = std::max({0.0, (hp - Ri) / az, dz - w}), hi = std::min((hp + Ri) / az, dz + w);

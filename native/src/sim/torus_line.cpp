@@ -229,7 +229,8 @@ double torus_lowest(const Line& l, double Ro, double Ri, std::size_t* fallback) 
 
 // Lowest t of the whole solid (torus, bull-nose core, shank) on the line.
 double solid_lowest(const TorusTool& tool, const Line& l) {
-  double t = std::min(torus_lowest(l, tool.Ro, tool.Ri, nullptr), half_cylinder_lowest(l, tool.radius(), 0.0));
+  double t = half_cylinder_lowest(l, tool.radius(), 0.0);
+  if (tool.Ri > 0.0) t = std::min(t, torus_lowest(l, tool.Ro, tool.Ri, nullptr));  // Ri = 0: the rim, the core's edge
   if (tool.shape == ToolShape::BullNose && tool.Ro > 0.0) t = std::min(t, half_cylinder_lowest(l, tool.Ro, -tool.Ri));
   return t;
 }

@@ -163,6 +163,23 @@ TEST(Sweep5Lowest, ClosedFormsOfTheVerticalTool) {
               10.0 + 4.0 * std::cos(30 * kDeg) - 4.0, 1e-12);
 }
 
+TEST(Sweep5Lowest, FlatEndMillIsTheBullNoseWithoutCorner) {
+  // Ri = 0: the flat bottom disc of radius R, the cylinder above; tilted by b about Y its bottom is the plane
+  // z = tip_z - (x - tip_x) tan(b), out to R cos(b) each side; beyond the low rim nothing
+  const TorusTool flat = make_tool(5.0, 0.0, ToolShape::BullNose);
+  EXPECT_NO_THROW(flat.validate_solid());
+  EXPECT_THROW(flat.validate(), std::invalid_argument);  // multipoint positioning still needs a corner
+  EXPECT_THROW(make_tool(5.0, 0.0, ToolShape::RoundInsert).validate_solid(), std::invalid_argument);
+  EXPECT_THROW(make_tool(0.0, 0.0, ToolShape::BullNose).validate_solid(), std::invalid_argument);
+  const Vector3d tip(1.0, 2.0, 3.0), a = tilted(12, 0);
+  for (double u : {-4.8, -2.0, 0.0, 1.5, 4.8}) {
+    EXPECT_NEAR(tmm::lowest_on_vertical(flat, tip, a, 1.0 + u, 2.0), 3.0 - u * std::tan(12 * kDeg), 1e-12) << u;
+    EXPECT_NEAR(tmm::lowest_on_vertical(flat, tip, a, 1.0 + u, 2.0),
+                brute_lowest(flat, tip, a, 1.0 + u, 2.0, -5.0, 20.0), 2e-4) << u;
+  }
+  EXPECT_TRUE(std::isinf(tmm::lowest_on_vertical(flat, tip, a, 1.0 - 5.0 * std::cos(12 * kDeg) - 0.01, 2.0)));
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Sweeps.
 // ---------------------------------------------------------------------------------------------------------

@@ -1,8 +1,9 @@
 """What a tool path leaves in the stock: the kernel cuts the z-map along every move (3-axis: the APT cutter's
 swept envelope, exact per cell; 5-axis: the torus sub-stepped along the move, tip straight and axis by slerp,
-bound in the kernel's sweep5.hpp). Rapids cut too; one that removes material is a collision (a crash on the
-machine), reported with its move. With a tool assembly, its neck, shank and holder are checked against the stock
-as it is at each move (core.sim.stock_collisions)."""
+bound in the kernel's sweep5.hpp; a flat end mill is the bull-nose solid with corner radius 0, exactly).
+Rapids cut too; one that removes material is a collision (a crash on the machine), reported with its move.
+With a tool assembly, its neck, shank and holder are checked against the stock as it is at each move
+(core.sim.stock_collisions)."""
 from __future__ import annotations
 
 import math
@@ -48,11 +49,27 @@ def move_kinds(toolpath: Toolpath) -> np.ndarray:
     return np.array([RAPID if m.kind is MoveKind.RAPID else CUT for m in toolpath.moves[1:]], dtype=np.uint8)
 
 
-def sub_step(tool: Cutter, tolerance: float) -> float:
-    """The 5-axis sub-step whose cusp between instances, s^2 / (8 Ri) (the kernel's sweep5.hpp bound), is a
-    tenth of `tolerance`: sqrt(0.8 Ri tol), at most 0.5 mm."""
-    _, Ri = tool.torus_radii
+def solid_radii(tool: Cutter) -> tuple[float, float]:
+    """(Ro, Ri) of the 5-axis simulated solid: the toroidal view, a flat end mill (R, 0) (the bull-nose solid
+    with corner radius 0: flat bottom, rim, cylinder)."""
+    return (tool.radius, 0.0) if tool.kind == "flat" else tool.torus_radii
+
+
+def sub_step(tool: Cutter, tolerance: float, max_tilt: float = math.pi / 4) -> float:
+    """The 5-axis sub-step whose error between instances is a tenth of `tolerance`, at most 0.5 mm: the cusp
+    s^2 / (8 Ri) of the torus (the kernel's sweep5.hpp bound), sqrt(0.8 Ri tol); a flat end mill's tilted
+    bottom leaves a sawtooth s tan(tilt) instead (its rim has no radius), so s = 0.1 tol / tan(`max_tilt`)."""
+    _, Ri = solid_radii(tool)
+    if Ri == 0.0:
+        return min(0.5, 0.1 * tolerance / max(math.tan(min(max_tilt, 1.5)), 1e-3))
     return min(0.5, math.sqrt(0.8 * Ri * tolerance))
+
+
+def max_tilt(toolpath: Toolpath) -> float:
+    """The largest angle (rad) of a cutting move's tool axis from the vertical."""
+    cut = move_kinds(toolpath) == CUT
+    axes = toolpath.axes()[1:][cut]
+    return float(np.arccos(np.clip(axes[:, 2], -1.0, 1.0)).max(initial=0.0))
 
 
 def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *, shape: str = "bull_nose",
@@ -60,9 +77,9 @@ def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *,
              progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None,
              body_tolerance: float = 1e-3) -> SimResult:
     """Cuts `stock` ((ny, nx) heights on `grid`, copied) along `toolpath` with `tool`. A 5-axis path (any
-    axis off vertical) needs a toroidal or ball tool (`tool.torus_radii`); `shape` is its solid
+    axis off vertical) needs a toroidal, ball or flat tool (`solid_radii`); `shape` is its solid
     ('bull_nose': a solid end mill; 'round_insert': the seed's insert cutter with its hollow); its moves are
-    sub-stepped `max_step` mm apart (default: sub_step(tool, tolerance)). `assembly`: the tool's neck, shank and
+    sub-stepped `max_step` mm apart (default: sub_step(tool, tolerance, the path's largest cutting tilt)). `assembly`: the tool's neck, shank and
     holder are checked against the stock as each move finds it (`stock_collisions`; deeper than `body_tolerance`
     mm into a clearance counts); its cutter is `tool`'s, so only what stands above the flutes is taken."""
     if len(toolpath) < 2:
@@ -89,8 +106,8 @@ def simulate(toolpath: Toolpath, tool: Cutter, grid: Grid, stock: np.ndarray, *,
     t0 = time.perf_counter()
     try:
         if five:
-            Ro, Ri = tool.torus_radii
-            max_step = sub_step(tool, tolerance) if max_step is None else max_step
+            Ro, Ri = solid_radii(tool)
+            max_step = sub_step(tool, tolerance, max_tilt(toolpath)) if max_step is None else max_step
             rep = native.cut_5axis(zmap, Ro, Ri, shape, tips, np.ascontiguousarray(toolpath.axes()), kinds,
                                    max_step, collision_tol, threads, progress, **check)
         else:
