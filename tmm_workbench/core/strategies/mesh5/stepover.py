@@ -304,21 +304,26 @@ class _Planes:
     the top of any open bin (a plane beyond it never comes back to finish that bin)."""
 
     def __init__(self, mesh: TriMesh, direction, cover: _Coverage, forward_step: float, chord_tolerance: float,
-                 inset: float):
-        self.mesh, self.direction, self.cover, self.inset = mesh, direction, cover, inset
+                 radius: float):
+        self.mesh, self.direction, self.cover, self.radius = mesh, direction, cover, radius
         self.forward_step, self.chord_tolerance = forward_step, chord_tolerance
 
     def paths(self, offset: float) -> List[CCPath]:
-        """The plane's CC paths, their end points moved a hair inside along the feed: on the mesh's boundary
-        the sections' rays graze it, and a side that reads "off the mesh" is neither bounded by the C-space
-        nor measured by the half-widths (the overrun covers the hair)."""
+        """The plane's CC paths, their end points moved inside along the feed: on the mesh's boundary the
+        sections' rays graze it, and a side that reads "off the mesh" is neither bounded by the C-space nor
+        measured by the half-widths. The section (LX = 0) drifts along the feed by LY's and LZ's share of it
+        as it goes out to the side, so the end points go in by that drift over a diameter across (at most a
+        radius; the overrun covers it)."""
         out = []
         for p in cc_paths(self.mesh, self.direction, np.array([offset]), self.forward_step,
                           self.chord_tolerance):
             pts = p.points.copy()
             if len(pts) > 1:
-                pts[0] += self.inset * p.frames[0, 0]
-                pts[-1] -= self.inset * p.frames[-1, 0]
+                most = min(self.radius, float(np.linalg.norm(pts[-1] - pts[0])) / 3)
+                for k, sgn in ((0, 1.0), (-1, -1.0)):
+                    f, feed = p.frames[k], self.cover.feed
+                    drift = 2 * self.radius * abs(f[1] @ feed) + self.radius * abs(f[2] @ feed)
+                    pts[k] += sgn * min(0.02 * self.radius + drift, most) * f[0]
             out.append(replace(p, points=pts))
         return out
 
@@ -395,7 +400,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
     cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
-    planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, 0.02 * cutter.radius)
+    planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius)
     gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
     ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
     guess = lo + gap
