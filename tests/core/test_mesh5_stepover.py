@@ -15,7 +15,8 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
-from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths
+from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath
+from tmm_workbench.core.strategies.mesh5.stepover import _Coverage, adaptive_passes, half_widths
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -127,3 +128,26 @@ def test_a_groove_no_pass_can_finish_is_reported_and_the_passes_go_on_beyond_it(
     assert (strips[:, 2] < 1.0).all() and (strips[:, 3] > -1.0).all()      # across: over the groove
     assert any(p.offset > 1.0 for p in plan.passes) and plan.passes[-1].band[1] == pytest.approx(15.0)
     assert "left unfinished" in plan.report()
+
+
+def test_the_finished_level_moves_only_in_the_bins_a_pass_runs_through():
+    # a plane with vertices 10 mm apart along the feed (2 mm bins): every bin still knows the mesh's extent
+    # across, and a pass along part of the feed leaves the other bins as they were
+    plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 40, 20), "plane")
+    m, feed = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    cover = _Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
+    assert np.allclose(cover.lo, 0.0) and np.allclose(cover.hi, 20.0) and cover.open.all()
+    xs = np.arange(0.0, 16.1, 2.0)
+    frames = np.tile(np.eye(3), (len(xs), 1, 1))
+    path = CCPath(0, 4.0, np.column_stack([xs, np.full(len(xs), 4.0), np.zeros(len(xs))]), frames[:, 2], frames)
+    ends = np.stack([path.points + [0.0, 5.0, 0.0], path.points - [0.0, 5.0, 0.0]], axis=1)
+    level, short = cover.advanced([path], ends)
+    reached = cover.bin(np.array([0.0, 16.0 + 3.0]))                        # the path and its overrun
+    assert short == 0
+    assert np.allclose(level[reached[0]:reached[1] + 1], 9.0)
+    assert np.allclose(level[reached[1] + 1:], 0.0)
+    # a CC point whose right side falls short keeps the bins of its segments for the next pass
+    ends[4, 1, 1] = 1.0
+    level, short = cover.advanced([path], ends)
+    assert short == 3 and np.allclose(level[cover.bin(np.array([6.0, 10.0]))], 0.0)
+    assert np.allclose(level[cover.bin(np.array([2.0, 14.0]))], 9.0)
