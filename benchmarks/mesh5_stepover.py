@@ -2,10 +2,12 @@
 D 0.5 in, tolerance 0.004 in, postures chosen for the Tarus motion time; the scallop checked by the slow
 reference on the real tool positions; and one pass's motion time against the seed's nearest-to-ideal choice.
 
-    .venv/bin/python benchmarks/mesh5_stepover.py [--surface convex|concave] [--check-x 100 150]
+    .venv/bin/python benchmarks/mesh5_stepover.py [--surface convex|concave|complex] [--tolerance-in 0.004]
+        [--x-lines 11] [--step 0.25] [--no-pass-times]
 
-Prints the passes (seed: 49 adaptive, 84 at constant step-over), the compute time, the C-spaces built, the
-step between planes, and the remaining height at surface samples between x0 and x1 (all y) under all passes.
+Prints the passes (seed: 49 adaptive, 84 at constant step-over), the compute time (wall and CPU: the machine is
+shared), the C-spaces built, the step between planes, and the slow check: the material left at surface samples
+on lines across the whole surface (every 0.25 mm) under all passes' tools with their overruns; then a table.
 """
 from __future__ import annotations
 
@@ -42,38 +44,73 @@ def one_pass_times(mesh, cutter, tol: float, machine: TarusMachine) -> None:
           f"({t1 - t0:.2f} s to choose), shortest path {b:.2f} s ({t2 - t1:.2f} s to choose), ratio {a / b:.2f}")
 
 
+def slow_check(mesh, plan, cutter, x_lines: int, step: float, sub: int = 16) -> tuple[np.ndarray, np.ndarray, float]:
+    """The material left (mm, along the facet normals) at surface samples on `x_lines` lines across the whole
+    feed width, every `step` mm across, under all passes' tools with their overruns, `sub` - 1 positions
+    between each two CL points (a flat end tilted by lambda sits up to sin(lambda) x the spacing above the
+    surface between two sampled positions: 0.026 mm at 3 deg with 4 positions on a 2 mm step); and the
+    seconds."""
+    t0 = time.perf_counter()
+    sw = [swept_positions(t, a, sub) for t, a in plan.tool_positions()]
+    tips, axes = np.concatenate([s[0] for s in sw]), np.concatenate([s[1] for s in sw])
+    lo, hi = mesh.bounds
+    reach = cutter.radius + 2 * cutter.diameter
+    qs, hs = [], []
+    for x in np.linspace(lo[0] + 0.05, hi[0] - 0.05, x_lines):          # the edge itself: no facet normal
+        ys = np.arange(lo[1] + step / 2, hi[1], step)
+        q, nrm, hit = surface_samples(mesh, np.column_stack([np.full(len(ys), x), ys]))
+        near = np.abs(tips[:, 0] - x) <= reach
+        qs.append(q[hit])
+        hs.append(remaining(q[hit], nrm[hit], tips[near], axes[near], cutter.radius, 2 * cutter.diameter))
+    return np.concatenate(qs), np.concatenate(hs), time.perf_counter() - t0
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
-    ap.add_argument("--surface", default="convex", choices=("convex", "concave"))
-    ap.add_argument("--check-x", type=float, nargs=2, default=(100.0, 150.0))
+    ap.add_argument("--surface", default="convex", choices=("convex", "concave", "complex"))
+    ap.add_argument("--tolerance-in", type=float, default=0.004, help="the tolerance in inches (seed: 0.004; "
+                    "the complex surface also at 0.03)")
+    ap.add_argument("--x-lines", type=int, default=11, help="lines across the feed for the slow check")
+    ap.add_argument("--step", type=float, default=0.25, help="mm between the slow check's samples across")
+    ap.add_argument("--no-pass-times", action="store_true")
     a = ap.parse_args()
     mesh, _ = seed000_mesh(a.surface)
     cutter = Cutter.flat(0.5 * INCH)
-    tol = 0.004 * INCH
+    tol = a.tolerance_in * INCH
     machine = TarusMachine()
-    one_pass_times(mesh, cutter, tol, machine)
+    if not a.no_pass_times:
+        one_pass_times(mesh, cutter, tol, machine)
+    cpu = time.process_time()
     plan = adaptive_passes(mesh, cutter, tol, (1, 0), machine)
+    cpu = time.process_time() - cpu
     steps = np.diff([p.offset for p in plan.passes])
-    print(f"seed 000 {a.surface}: {plan.report()}; seed: 49 adaptive, 84 constant")
+    print(f"seed 000 {a.surface}: {plan.report()}")
     print(f"step between planes (mm): min {steps.min():.2f}, median {np.median(steps):.2f}, max {steps.max():.2f}")
     lam = np.degrees(np.concatenate([q.lam for p in plan.passes for q in p.postures]))
     print(f"CC points {lam.size}; lambda (deg) median {np.median(lam):.0f}, max {lam.max():.0f}")
-    t0 = time.perf_counter()
-    sw = [swept_positions(q.tips, q.axes) for p in plan.passes for q in p.postures]
-    tips, axes = np.concatenate([s[0] for s in sw]), np.concatenate([s[1] for s in sw])
-    lo, hi = mesh.bounds
-    xs, ys = np.meshgrid(np.linspace(*a.check_x, 6), np.arange(lo[1] + 0.25, hi[1], 0.25), indexing="ij")
-    q, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
-    h = remaining(q[hit], nrm[hit], tips, axes, cutter.radius, 2 * cutter.diameter)
-    print(f"slow check, {hit.sum()} surface points x {a.check_x[0]:g}..{a.check_x[1]:g} mm (every 0.25 mm across): "
-          f"remaining height max {h.max():.4f} mm (tolerance {tol:.4f}), min {h.min():.4f} mm, above the "
-          f"tolerance + 0.002: {(h > tol + 0.002).sum()} points; {time.perf_counter() - t0:.1f} s")
+    q, h, secs = slow_check(mesh, plan, cutter, a.x_lines, a.step)
     over = np.flatnonzero(h > tol + 0.002)
-    for i in over[:20]:
-        k = int(np.searchsorted([p.offset for p in plan.passes], q[hit][i, 1]))
-        near = [plan.passes[j] for j in (k - 1, k) if 0 <= j < len(plan.passes)]
-        print(f"  ({q[hit][i, 0]:.2f}, {q[hit][i, 1]:.2f}) left {h[i]:.4f} mm; planes "
-              + ", ".join(f"{p.offset:.2f} band {p.band[0]:.2f}..{p.band[1]:.2f}" for p in near))
+    print(f"slow check: {len(h)} surface points on {a.x_lines} lines x {mesh.bounds[0][0]:g}..{mesh.bounds[1][0]:g} "
+          f"mm, every {a.step:g} mm across, tools with a {plan.overrun:.2f} mm overrun; {secs:.1f} s")
+    for x in np.unique(q[:, 0]):
+        on = q[:, 0] == x
+        print(f"  x = {x:6.1f} mm: {on.sum()} points, max {h[on].max():.4f} mm, above tau + 0.002 mm: "
+              f"{(h[on] > tol + 0.002).sum()}, uncut {(~np.isfinite(h[on])).sum()}, least {h[on].min():.4f} mm")
+    for i in over[:: max(1, len(over) // 20)]:
+        print(f"  ({q[i, 0]:.2f}, {q[i, 1]:.2f}) left {h[i]:.4f} mm")
+    print()
+    print("| | passes | max scallop (mm) | points above tau + 0.002 mm | uncut points | least (gouge < 0) (mm) | "
+          "seconds (wall / CPU) |")
+    print("|---|---|---|---|---|---|---|")
+    print(f"| TMM, {a.surface}, tau {tol:.4f} mm | {len(plan.passes)} | {h[np.isfinite(h)].max():.4f} | "
+          f"{len(over)} | {int((~np.isfinite(h)).sum())} | {h.min():.4f} | {plan.seconds:.1f} / {cpu:.1f} |")
+    if a.surface == "convex" and a.tolerance_in == 0.004:
+        print("| seed 000 (Fig. 5-5), adaptive | 49 | | | | | |")
+        print("| seed 000 (Fig. 5-5), constant step-over | 84 | | | | | |")
+    if a.surface == "complex" and a.tolerance_in == 0.03:
+        print("| seed 000 (Fig. 5-6 (e)), adaptive | 30 | | | | | |")
+        print("| seed 000's CAD application A, constant 0.25 in (cusp not verifiable) | 40 | | | | | |")
+        print("| seed 000's CAD application B | 182 | | | | | |")
 
 
 if __name__ == "__main__":

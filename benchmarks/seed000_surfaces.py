@@ -14,6 +14,7 @@ below the seed's tessellation tolerance of 0.002 in.
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -61,6 +62,37 @@ def ruled_points(sections: list[np.ndarray], t: np.ndarray, s: np.ndarray) -> np
     return (1.0 - s)[:, None] * c0 + s[:, None] * c1
 
 
+def through_points(sections: list[np.ndarray], t: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """Points (n, 3) of the surface through the section curves at the parameter pairs (t[k], s[k]): ruled
+    between two sections; through more, at equal curve parameter t, the polynomial in s through the sections'
+    points at s = 0, 1/(m-1), ..., 1 (the complex surface's four sections lie at X = 0, 3, 6, 9 in, evenly
+    spaced: a cubic through the four, X linear in s)."""
+    if len(sections) == 2:
+        return ruled_points(sections, t, s)
+    pts = [bspline_curve(np.asarray(p, dtype=float), t) for p in sections]
+    nodes = np.linspace(0.0, 1.0, len(pts))
+    out = np.zeros_like(pts[0])
+    for k, pk in enumerate(pts):
+        w = np.ones_like(s)
+        for j in range(len(pts)):
+            if j != k:
+                w = w * (s - nodes[j]) / (nodes[k] - nodes[j])
+        out += w[:, None] * pk
+    return out
+
+
+def complex_sections() -> list[np.ndarray]:
+    """The complex surface's four section curves' poles (inches), read from seed 000's Appendix A (they are
+    not in seed_surfaces.json): the X, Y, Z columns of every pole of Spline 1..4."""
+    text = (shared_dir() / "seeds" / "000_644051502d90cb70.txt").read_text()
+    text = text[text.index("Complex surface:"):text.index("APPENDIX B")]
+    out = []
+    for body in re.split(r"Control points of Spline \d:", text)[1:]:
+        xyz = [re.findall(rf"\b{c} =\s+(-?\d+\.\d+)", body) for c in "XYZ"]
+        out.append(np.array(xyz, dtype=float).T)
+    return out
+
+
 def _grid_triangles(nt: int, ns: int) -> np.ndarray:
     i, j = np.meshgrid(np.arange(nt - 1), np.arange(ns - 1), indexing="ij")
     a = (i * ns + j).ravel()
@@ -68,12 +100,17 @@ def _grid_triangles(nt: int, ns: int) -> np.ndarray:
     return np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
 
 
-def seed000_mesh(name: str, nt: int = 401, ns: int = 41) -> tuple[TriMesh, float]:
-    """The surface `name` ("convex" or "concave") in mm and the mesh's largest deviation from it (mm)."""
-    data = json.loads((shared_dir() / "benchmarks" / "seed_surfaces.json").read_text())
-    sections = [np.asarray(p) * INCH for p in data["lu2007_bspline_sections"]["surfaces"][name]]
+def seed000_mesh(name: str, nt: int = 401, ns: int | None = None) -> tuple[TriMesh, float]:
+    """The surface `name` ("convex", "concave" or "complex") in mm and the mesh's largest deviation from it (mm)."""
+    if name == "complex":
+        sections = [p * INCH for p in complex_sections()]
+        ns = 81 if ns is None else ns                   # it bends along X too: 41 columns left 0.106 mm
+    else:
+        data = json.loads((shared_dir() / "benchmarks" / "seed_surfaces.json").read_text())
+        sections = [np.asarray(p) * INCH for p in data["lu2007_bspline_sections"]["surfaces"][name]]
+        ns = 41 if ns is None else ns
     tt, ss = (g.ravel() for g in np.meshgrid(np.linspace(0, 1, nt), np.linspace(0, 1, ns), indexing="ij"))
-    pts = ruled_points(sections, tt, ss)
+    pts = through_points(sections, tt, ss)
     tri = _grid_triangles(nt, ns)
     # a height field faces up: wind every triangle so (its normal).z >= 0 (the grid's (t, s) may map onto (x, y)
     # either way round; down-facing triangles made core.footprint.cusp's steepest crossing read 0 deg)
@@ -82,13 +119,13 @@ def seed000_mesh(name: str, nt: int = 401, ns: int = 41) -> tuple[TriMesh, float
     tri[down] = tri[down][:, ::-1]
     # the deviation at each triangle's centroid: the surface at the centroid's parameters against the plane
     uv = np.stack([tt, ss], 1)[tri].mean(axis=1)
-    deviation = float(np.linalg.norm(ruled_points(sections, uv[:, 0], uv[:, 1]) - pts[tri].mean(axis=1),
+    deviation = float(np.linalg.norm(through_points(sections, uv[:, 0], uv[:, 1]) - pts[tri].mean(axis=1),
                                      axis=1).max())
     return TriMesh(pts, tri, f"seed000_{name}"), deviation
 
 
 if __name__ == "__main__":
-    for n in ("convex", "concave"):
+    for n in ("convex", "concave", "complex"):
         mesh, dev = seed000_mesh(n)
         lo, hi = mesh.bounds
         print(f"{n}: {len(mesh.triangles)} triangles, box {np.round(lo, 2)} .. {np.round(hi, 2)} mm, "

@@ -15,7 +15,8 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
-from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths
+from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath
+from tmm_workbench.core.strategies.mesh5.stepover import _Coverage, adaptive_passes, half_widths
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -72,11 +73,11 @@ def test_passes_cover_the_surface_in_order_with_the_scallop_at_the_tolerance(cyl
     offsets = [p.offset for p in plan.passes]
     assert offsets == sorted(offsets) and 3 <= len(offsets) <= 16
     assert plan.passes[0].band[0] == pytest.approx(-20.0) and plan.passes[-1].band[1] == pytest.approx(20.0)
-    # the slow check: surface points a cutter radius and more from the ends of the feed (nearer, the tool
-    # leaving the path narrows its track: the ends need an overrun), the tools of all passes swept over them
-    sw = [swept_positions(q.tips, q.axes) for p in plan.passes for q in p.postures]
+    # the slow check: surface points 5 mm and more from the ends of the feed (at the ends themselves the
+    # overrun covers the surface, measured up to 0.054 mm), the tools of all passes swept over them
+    sw = [swept_positions(t, a, 8) for t, a in plan.tool_positions()]
     tips, axes = np.concatenate([s[0] for s in sw]), np.concatenate([s[1] for s in sw])
-    xs, ys = np.meshgrid(np.linspace(-6, 6, 7), np.linspace(-19.5, 19.5, 391), indexing="ij")
+    xs, ys = np.meshgrid(np.linspace(-7, 7, 8), np.linspace(-19.5, 19.5, 391), indexing="ij")
     q, nrm, hit = surface_samples(mesh, np.column_stack([(xs + shear * ys).ravel(), ys.ravel()]))
     assert hit.all()
     h = remaining(q, nrm, tips, axes, 5.0, 20.0)
@@ -84,6 +85,17 @@ def test_passes_cover_the_surface_in_order_with_the_scallop_at_the_tolerance(cyl
     assert h.min() >= -2e-3                                                 # no gouge
     assert h.max() <= TOL + 2e-3                                            # the scallop within the tolerance
     assert h.max() >= 0.7 * TOL                                             # and not far below it: adaptive
+
+
+def test_the_tools_go_on_an_overrun_beyond_the_ends_along_the_feed(cylinder_plan):
+    _, plan, _ = cylinder_plan
+    assert plan.overrun == pytest.approx(5.0)                               # the cutter's radius
+    for p in plan.passes:
+        for path, q, (tips, axes) in zip(p.paths, p.postures, p.tool_positions(plan.overrun)):
+            assert len(tips) == len(q.tips) + 2 and np.array_equal(tips[1:-1], q.tips)
+            assert tips[0] == pytest.approx(q.tips[0] - 5.0 * path.frames[0, 0])
+            assert tips[-1] == pytest.approx(q.tips[-1] + 5.0 * path.frames[-1, 0])
+            assert np.array_equal(axes[[0, -1]], q.axes[[0, -1]])
 
 
 def test_bad_tolerance_and_tool_are_refused_by_name():
@@ -110,8 +122,32 @@ def test_a_groove_no_pass_can_finish_is_reported_and_the_passes_go_on_beyond_it(
     plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), grid=PostureGrid.degrees((0, 12), (-12, 12)),
                            forward_step=4.0)
     assert len(plan.unfinished) >= 1
-    f0, f1, a, b = plan.unfinished[0]
-    assert f0 <= -9.0 and f1 >= 9.0                                         # all along the feed
-    assert a < 1.0 and b > -1.0                                             # across: over the groove
+    strips = np.array(plan.unfinished)
+    # all along the feed (the bins get stuck where the passes before left them, not all at once)
+    assert strips[:, 0].min() <= -9.0 and strips[:, 1].max() >= 9.0
+    assert (strips[:, 2] < 1.0).all() and (strips[:, 3] > -1.0).all()      # across: over the groove
     assert any(p.offset > 1.0 for p in plan.passes) and plan.passes[-1].band[1] == pytest.approx(15.0)
     assert "left unfinished" in plan.report()
+
+
+def test_the_finished_level_moves_only_in_the_bins_a_pass_runs_through():
+    # a plane with vertices 10 mm apart along the feed (2 mm bins): every bin still knows the mesh's extent
+    # across, and a pass along part of the feed leaves the other bins as they were
+    plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 40, 20), "plane")
+    m, feed = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    cover = _Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
+    assert np.allclose(cover.lo, 0.0) and np.allclose(cover.hi, 20.0) and cover.open.all()
+    xs = np.arange(0.0, 16.1, 2.0)
+    frames = np.tile(np.eye(3), (len(xs), 1, 1))
+    path = CCPath(0, 4.0, np.column_stack([xs, np.full(len(xs), 4.0), np.zeros(len(xs))]), frames[:, 2], frames)
+    ends = np.stack([path.points + [0.0, 5.0, 0.0], path.points - [0.0, 5.0, 0.0]], axis=1)
+    level, short = cover.advanced([path], ends)
+    reached = cover.bin(np.array([0.0, 16.0 + 3.0]))                        # the path and its overrun
+    assert short == 0
+    assert np.allclose(level[reached[0]:reached[1] + 1], 9.0)
+    assert np.allclose(level[reached[1] + 1:], 0.0)
+    # a CC point whose right side falls short keeps the bins of its segments for the next pass
+    ends[4, 1, 1] = 1.0
+    level, short = cover.advanced([path], ends)
+    assert short == 3 and np.allclose(level[cover.bin(np.array([6.0, 10.0]))], 0.0)
+    assert np.allclose(level[cover.bin(np.array([2.0, 14.0]))], 9.0)

@@ -10,24 +10,24 @@ flat end mill (alpha); here it is the whole profile, for any posture and the bul
 that will be cut (the seed estimates it by CM2 first, and takes 0.9 of the result, eq. 3.33). Where the mesh
 ends first, that side is covered to the edge (inf).
 
-Passes. The drive planes are placed one after another across the mesh (along their normal m). A pass covers,
-on the plane-normal axis, the band between its left and right boundaries: the section points at the
-half-widths, the least of its CC points on the left (the seed's maximum remaining material height point,
-eq. 3.23) and the greatest on the right. The first plane lies 0.125 D inside the mesh (eq. 3.22). Each next
-plane is put a guessed gap beyond the band covered so far (the previous pass's own left width: eq. 3.21's
-d_step_{i+1,R} = d_step_{i,L} guess) and its C-space is built with that side step on both sides, so that
-every posture it may choose reaches back over the gap within the tolerance (and as far ahead); the postures
-are chosen for the motion time (optimal.smooth_postures) and the real half-widths measured. Where a CC point
-has no posture for that side step, or the real right boundary does not reach the band (the frames of the
-new pass differ from the guess), the gap is shrunk and the pass rebuilt. Between two passes the scallop is
-then at most the tolerance at every CC point's section (each pass's own profile leaves at most the
-tolerance up to its boundary), and about equal to it where the binding CC points meet.
+Passes. The drive planes are placed one after another across the mesh (along their normal m); how far
+across the surface is finished is kept per 2 mm bin of the feed coordinate (passes end where the mesh's
+boundary runs slanted across the planes). The first plane lies 0.125 D inside the mesh (eq. 3.22). Each next
+plane goes a gap beyond the least finished level of the open bins its own path runs through, and no higher
+than the top of any open bin. Its C-space is built with, per CC point, the right side step reaching back to
+the level of its bins and the left one the gap asked of the next pass (eq. 3.21's d_step_{i+1,R} =
+d_step_{i,L}, asked 10 % more after a pass that met it everywhere); a CC point with no posture for its left
+step gets a smaller one, a CC point with none for its right step moves the plane nearer. The postures are
+chosen for the motion time (optimal.smooth_postures) and the real half-widths measured; a bin advances to the
+least left boundary of its CC points where their right boundaries reach its level, and keeps its level
+(for the next pass) where they do not. The passes are planned at MARGIN of the tolerance. The tools go on an
+overrun of a radius beyond the ends of each path (PlannedPass.tool_positions), which the bins count.
 """
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, List, Optional, Sequence
 
 import numpy as np
@@ -36,7 +36,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths, plane_normal
-from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
+from tmm_workbench.core.strategies.mesh5.cspace import CSpace, build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_postures
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
@@ -47,6 +47,10 @@ Progress = Callable[[float], bool]
 WIDTH_SAMPLES = 97      # lateral samples per side out to 2 R (the section is linear between them)
 SHRINK = 0.8            # gap factor when a pass must be rebuilt
 MAX_TRIES = 12
+# the passes are planned for this share of the tolerance: the profile is swept straight along LX with the
+# posture of its CC point, while the path curves along the feed and the posture turns between CC points (the
+# slow check on seed 000's convex surface found up to 1.26 tau where the full tolerance was planned)
+MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
@@ -98,7 +102,8 @@ def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn:
     the section's samples) reaches the tolerance, by bisection (the profile curves between samples)."""
     for _ in range(30):
         mid = 0.5 * (a + b)
-        if np.interp(sgn * mid, py, pz) - np.interp(mid, y, s) <= tolerance:
+        # beyond the profile's ends the tool is not there (its side wall): never within the tolerance
+        if np.interp(sgn * mid, py, pz, left=np.inf, right=np.inf) - np.interp(mid, y, s) <= tolerance:
             a = mid
         else:
             b = mid
@@ -116,23 +121,54 @@ class PlannedPass:
     band: tuple[float, float]
     side_step: float
 
+    def tool_positions(self, overrun: float) -> List[tuple[np.ndarray, np.ndarray]]:
+        """(tips, axes) of each path with the overrun: the tool goes on `overrun` mm beyond both ends along
+        the path's end tangents at the end postures (at the ends the CC point lies on the mesh's boundary,
+        and a tool stopping there would narrow its track within a radius of it)."""
+        out = []
+        for p, q in zip(self.paths, self.postures):
+            # the feed direction LX at the end CC points (not the tips' steps: a yaw turning between the last
+            # two postures moves the tip sideways)
+            tips, t0, t1 = q.tips, p.frames[0, 0], p.frames[-1, 0]
+            out.append((np.concatenate([tips[:1] - overrun * t0, tips, tips[-1:] + overrun * t1]),
+                        np.concatenate([q.axes[:1], q.axes, q.axes[-1:]])))
+        return out
+
 
 @dataclass
 class AdaptivePlan:
     passes: List[PlannedPass] = field(default_factory=list)
     builds: int = 0                 # C-spaces built (passes + rebuilds)
-    short: int = 0                  # rebuilt nearer: the right side fell short of the band covered
     shrunk: int = 0                 # rebuilt with a smaller gap: no posture, or nothing gained
+    partial: int = 0                # passes accepted with some CC points short of the finished level
     # (feed from, feed to, across from, across to) of the strips no pass could finish: for clean-up
     unfinished: List[tuple[float, float, float, float]] = field(default_factory=list)
     seconds: float = 0.0
     extent: tuple[float, float] = (0.0, 0.0)   # the mesh along the plane normal
+    overrun: float = 0.0            # mm the tool goes on beyond the ends of each path (PlannedPass.tool_positions)
+
+    def tool_positions(self) -> List[tuple[np.ndarray, np.ndarray]]:
+        """(tips, axes) of every path of every pass, with the overrun."""
+        return [tp for p in self.passes for tp in p.tool_positions(self.overrun)]
 
     def report(self) -> str:
         return (f"{len(self.passes)} passes over {self.extent[1] - self.extent[0]:.1f} mm, "
-                f"{self.builds} C-spaces built ({self.short} moved nearer, {self.shrunk} with a smaller gap), "
-                f"{self.seconds:.1f} s" + ("; left unfinished (feed from, to, across from, to; mm): " + ", ".join(
-                    f"({a:.1f}, {b:.1f}, {c:.2f}, {d:.2f})" for a, b, c, d in self.unfinished) if self.unfinished else ""))
+                f"{self.builds} C-spaces built ({self.shrunk} with a smaller gap, {self.partial} passes left "
+                f"some bins to the next), {self.seconds:.1f} s" + (
+                    "; left unfinished (feed from, to, across from, to; mm): " + ", ".join(
+                        f"({a:.1f}, {b:.1f}, {c:.2f}, {d:.2f})" for a, b, c, d in self.unfinished)
+                    if self.unfinished else ""))
+
+
+def _edge_samples(mesh: TriMesh, feed: np.ndarray, spacing: float) -> np.ndarray:
+    """Points along every edge of the mesh, at most `spacing` apart along the feed, so that every feed bin
+    sees the mesh's extent across (its vertices alone may lie several bins apart)."""
+    e = np.unique(np.sort(mesh.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    a, b = mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]]
+    k = np.minimum(np.ceil(np.abs((b - a) @ feed) / spacing).astype(np.int64), 1000) + 2
+    idx = np.repeat(np.arange(len(e)), k)
+    frac = (np.arange(len(idx)) - np.repeat(np.cumsum(k) - k, k)) / np.repeat(k - 1, k)
+    return a[idx] + frac[:, None] * (b[idx] - a[idx])
 
 
 class _Coverage:
@@ -140,9 +176,11 @@ class _Coverage:
     passes end where the mesh's boundary runs slanted across the planes, so one level for the whole width
     would take a pass's band for places its path never reaches."""
 
-    def __init__(self, mesh: TriMesh, m: np.ndarray, feed: np.ndarray, width: float, edge: float) -> None:
-        self.m, self.feed, self.width, self.edge = m, feed, width, edge
-        f, s = mesh.vertices @ feed, mesh.vertices @ m
+    def __init__(self, mesh: TriMesh, m: np.ndarray, feed: np.ndarray, width: float, edge: float,
+                 overrun: float) -> None:
+        self.m, self.feed, self.width, self.edge, self.overrun = m, feed, width, edge, overrun
+        pts = _edge_samples(mesh, feed, 0.5 * width)
+        f, s = pts @ feed, pts @ m
         self.f0 = float(f.min())
         nb = int((float(f.max()) - self.f0) // width) + 1
         self.lo, self.hi = np.full(nb, np.inf), np.full(nb, -np.inf)
@@ -158,55 +196,98 @@ class _Coverage:
     def open(self) -> np.ndarray:
         return self.level < self.hi - self.edge
 
-    @property
-    def covered(self) -> float:
-        """The least level over the bins not finished (inf when all are)."""
-        return float(self.level[self.open].min(initial=np.inf))
+    def _segments(self, path: CCPath) -> tuple[np.ndarray, np.ndarray]:
+        """Per segment of the path, its CC points' two indices and the bins it spans (lo, hi); the overrun
+        adds a segment at each end from the end point to overrun mm beyond it."""
+        b = self.bin(path.points @ self.feed)
+        ext = self.bin(np.array([path.points[0] @ self.feed - self.overrun,
+                                 path.points[-1] @ self.feed + self.overrun]))
+        n = len(b)
+        ij = np.array([[0, 0]] + [[i, i + 1] for i in range(n - 1)] + [[n - 1, n - 1]])
+        bins = np.column_stack([np.r_[ext[0], b[:-1], b[-1]], np.r_[b[0], b[1:], ext[1]]])
+        return ij, np.sort(bins, axis=1)
 
-    def shortfall(self, points: np.ndarray, ends: np.ndarray) -> float:
-        """How far (m) the right boundaries of a pass's CC points stay short of the level at their bins."""
-        right = np.where(np.isnan(ends[:, 1, 0]), -np.inf, ends[:, 1] @ self.m)
-        return float(np.max(right - self.level[self.bin(points @ self.feed)], initial=0.0))
-
-    def advanced(self, paths: List[CCPath], ends: np.ndarray) -> np.ndarray:
-        """The level after a pass (its right side meeting the level): per bin its paths span, the least left
-        boundary of the CC points in or next to the bin (inf where the left side ran off the mesh)."""
-        left = np.where(np.isnan(ends[:, 0, 0]), np.inf, ends[:, 0] @ self.m)
-        level, start = self.level.copy(), 0
+    def spanned(self, paths: List[CCPath]) -> np.ndarray:
+        """The bins the paths (with their overruns) run through."""
+        span = np.zeros(len(self.lo), dtype=bool)
         for p in paths:
-            lp, fp = left[start:start + len(p)], p.points @ self.feed
+            _, bins = self._segments(p)
+            span[int(bins.min()):int(bins.max()) + 1] = True
+        return span
+
+    def needed(self, paths: List[CCPath]) -> tuple[np.ndarray, np.ndarray]:
+        """Per CC point, the least level of the bins of its two segments (how far back its right side must
+        reach), and whether one of them is still at the mesh's own edge (no pass finished it yet)."""
+        need, edge = [], []
+        for p in paths:
+            ij, bins = self._segments(p)
+            low = np.array([self.level[a:b + 1].min() for a, b in bins])
+            fresh = np.array([(self.level[a:b + 1] <= self.lo[a:b + 1]).any() for a, b in bins])
+            n, e = np.full(len(p), np.inf), np.zeros(len(p), dtype=bool)
+            for k in (0, 1):
+                np.minimum.at(n, ij[:, k], low)
+                np.logical_or.at(e, ij[:, k], fresh)
+            need.append(n)
+            edge.append(e)
+        return np.concatenate(need), np.concatenate(edge)
+
+    def advanced(self, paths: List[CCPath], ends: np.ndarray) -> tuple[np.ndarray, int]:
+        """The level after a pass and how many of its CC points fall short of the level: a segment whose
+        right boundaries reach the level of every bin it spans raises them to the lesser of its left
+        boundaries (inf where the left side ran off the mesh); a bin that any short segment spans keeps its
+        level, for the next pass."""
+        left = np.where(np.isnan(ends[:, 0, 0]), np.inf, ends[:, 0] @ self.m)
+        right = np.where(np.isnan(ends[:, 1, 0]), -np.inf, ends[:, 1] @ self.m)
+        cand = np.full(len(self.level), np.inf)
+        touched, failed = np.zeros(len(cand), dtype=bool), np.zeros(len(cand), dtype=bool)
+        short, start = np.zeros(len(left), dtype=bool), 0
+        for p in paths:
+            ij, bins = self._segments(p)
+            lp, rp = left[start:start + len(p)], right[start:start + len(p)]
+            for (i, j), (a, b) in zip(ij, bins):
+                touched[a:b + 1] = True
+                if max(rp[i], rp[j]) <= self.level[a:b + 1].min() + 1e-9:
+                    cand[a:b + 1] = np.minimum(cand[a:b + 1], min(lp[i], lp[j]))
+                else:
+                    failed[a:b + 1] = True
+                    short[start + i] = short[start + j] = True
             start += len(p)
-            b = self.bin(fp)
-            new = np.full(len(level), np.inf)
-            np.minimum.at(new, b, lp)
-            # the bins between two CC points: the lesser of the two
-            for i in range(len(b) - 1):
-                lo, hi = sorted((int(b[i]), int(b[i + 1])))
-                new[lo:hi + 1] = np.minimum(new[lo:hi + 1], min(lp[i], lp[i + 1]))
-            span = np.zeros(len(level), dtype=bool)
-            span[int(b.min()):int(b.max()) + 1] = True
-            level = np.where(span, np.maximum(level, new), level)
-        return level
+        return np.where(touched & ~failed, np.maximum(self.level, cand), self.level), int(short.sum())
 
 
-def _plan_pass(mesh: TriMesh, reach: MeshReach, cutter: Cutter, tolerance: float, direction, offset: float,
-               side: tuple[float, float], grid: PostureGrid, machine: TarusMachine, forward_step: float,
-               chord_tolerance: float, ideal_weight: float):
-    """The pass on the plane at `offset` with the side steps `side` (left, right), or None where some CC
-    point has no posture for them."""
-    paths = cc_paths(mesh, direction, np.array([offset]), forward_step, chord_tolerance)
-    if not paths:
-        raise TmmError(f"drive plane at {offset:.4f} mm does not cut the mesh")
+def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray, frm: np.ndarray,
+            side: np.ndarray, grid: PostureGrid) -> tuple[CSpace, np.ndarray]:
+    """The C-space of the CC points for the side steps `side` (n, 2) (left, right), and the side steps used:
+    where a CC point has no posture, its left step (the guess for the next pass) is halved, down to a
+    quarter of what was asked, and only those CC points rebuilt."""
+    side = np.minimum(side, 2 * cutter.radius)
+    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR)
+    floor = 0.25 * side[:, 0]
+    for _ in range(2):
+        redo = np.flatnonzero(cs.empty & (side[:, 0] > floor + 1e-9))
+        if redo.size == 0:
+            break
+        side[redo, 0] = np.maximum(0.5 * side[redo, 0], floor[redo])
+        sub = build_cspace(reach, cutter, pts[redo], frm[redo], grid, tolerance, side[redo], interior=INTERIOR)
+        lift, top = cs.lift.copy(), cs.top.copy()
+        lift[redo], top[redo] = sub.lift, sub.top
+        cs = CSpace(cs.grid, lift, top)
+    return cs, side
+
+
+def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float):
+    """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
+    ones relaxed where no posture meets them), or None where some CC point still has no posture."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    steps = np.tile(np.minimum(side, 2 * cutter.radius), (len(pts), 1))
-    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, steps, interior=INTERIOR)
+    cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid)
     if cs.empty.any():
         return None
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
-        sub = type(cs)(cs.grid, cs.lift[part], cs.top[part])
+        sub = CSpace(cs.grid, cs.lift[part], cs.top[part])
         try:
             postures.append(smooth_postures(sub, cutter, p.points, p.frames, machine, ideal_weight))
         except TmmError:
@@ -214,7 +295,89 @@ def _plan_pass(mesh: TriMesh, reach: MeshReach, cutter: Cutter, tolerance: float
         start += len(p)
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance)
-    return paths, postures, widths, ends
+    return postures, widths, ends, side
+
+
+class _Planes:
+    """Where the next drive plane goes: a gap beyond the least finished level of the open bins its own path
+    runs through (not of all bins: the passes end where the mesh's boundary runs slanted), and no higher than
+    the top of any open bin (a plane beyond it never comes back to finish that bin)."""
+
+    def __init__(self, mesh: TriMesh, direction, cover: _Coverage, forward_step: float, chord_tolerance: float,
+                 radius: float):
+        self.mesh, self.direction, self.cover, self.radius = mesh, direction, cover, radius
+        self.forward_step, self.chord_tolerance = forward_step, chord_tolerance
+
+    def paths(self, offset: float) -> List[CCPath]:
+        """The plane's CC paths, their end points moved inside along the feed: on the mesh's boundary the
+        sections' rays graze it, and a side that reads "off the mesh" is neither bounded by the C-space nor
+        measured by the half-widths. The section (LX = 0) drifts along the feed by LY's and LZ's share of it
+        as it goes out to the side, so the end points go in by that drift over a diameter across (at most a
+        radius; the overrun covers it)."""
+        out = []
+        for p in cc_paths(self.mesh, self.direction, np.array([offset]), self.forward_step,
+                          self.chord_tolerance):
+            pts = p.points.copy()
+            if len(pts) > 1:
+                most = min(self.radius, float(np.linalg.norm(pts[-1] - pts[0])) / 3)
+                for k, sgn in ((0, 1.0), (-1, -1.0)):
+                    f, feed = p.frames[k], self.cover.feed
+                    drift = 2 * self.radius * abs(f[1] @ feed) + self.radius * abs(f[2] @ feed)
+                    pts[k] += sgn * min(0.02 * self.radius + drift, most) * f[0]
+            out.append(replace(p, points=pts))
+        return out
+
+    def place(self, guess: float, gap: float) -> tuple[float, List[CCPath], float]:
+        """(offset, its paths, the least level it starts from) for a plane `gap` beyond the level its path
+        runs through, starting the search at `guess`."""
+        cover = self.cover
+        top = float(cover.hi[cover.open].min()) - cover.edge
+        offset = min(guess, top)
+        for _ in range(4):
+            paths = self.paths(offset)
+            span = cover.spanned(paths) & cover.open if paths else cover.open
+            base = float(cover.level[span].min()) if span.any() else float(cover.level[cover.open].min())
+            nxt = min(base + gap, top)
+            if abs(nxt - offset) < 1e-3 * gap and paths:
+                break
+            offset = nxt
+        else:
+            paths = self.paths(offset)
+        if not paths:
+            raise TmmError(f"drive plane at {offset:.4f} mm does not cut the mesh")
+        return offset, paths, base
+
+
+def _side_steps(reach: MeshReach, paths: List[CCPath], need: tuple[np.ndarray, np.ndarray], offset: float,
+                m: np.ndarray, gap: float, limit: float) -> np.ndarray:
+    """(n, 2) side steps of the CC points: the left one the gap guessed for the next pass, the right one the
+    distance along LY back to the level its bins are finished to (a little beyond), at most `limit`; where
+    that level is the mesh's own edge, at most the distance to where the CC point's section leaves the mesh
+    (the top bound checks nothing beyond it, and would pass a posture that stops short of the edge)."""
+    level, edge = need
+    frm = np.concatenate([p.frames for p in paths])
+    across = np.maximum(frm[:, 1] @ m, 0.2)                                 # LY's share of m
+    right = np.clip(1.01 * (offset - level) / across + 1e-3, 1e-3, limit)
+    k = np.flatnonzero(edge)
+    if k.size:
+        pts = np.concatenate([p.points for p in paths])
+        right[k] = np.maximum(_on_mesh(reach, pts[k], frm[k], right[k]), 1e-3)
+    return np.column_stack([np.full(len(right), min(gap, limit)), right])
+
+
+def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, samples: int = 8) -> np.ndarray:
+    """(n,) how far (<= d) along -LY each CC point's section stays on the mesh, to d / samples^2."""
+    lo, hi = np.zeros(len(pts)), d.copy()
+    for _ in range(2):
+        t = lo[:, None] + (hi - lo)[:, None] * np.arange(1, samples + 1) / samples
+        S = surface_heights(reach, pts, frm, -t, 3.0 * float(d.max()) + 1.0)
+        off = np.isnan(S)
+        first = np.where(off.any(axis=1), off.argmax(axis=1), samples)
+        rows = np.arange(len(pts))
+        last_on = np.where(first > 0, t[rows, np.maximum(first - 1, 0)], lo)
+        hi = np.where(first < samples, t[rows, np.minimum(first, samples - 1)], hi)
+        lo = last_on
+    return lo
 
 
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
@@ -235,50 +398,51 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     m = plane_normal(direction)
     s = mesh.vertices @ m
     lo, hi = float(s.min()), float(s.max())
-    plan = AdaptivePlan(extent=(lo, hi))
-    edge = 1e-3 * cutter.radius
-    cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, edge)
-    gap = 0.25 * cutter.diameter                                            # eq. 3.22: the seed's d = 0.25 D
-    offset = lo + 0.125 * cutter.diameter
+    plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
+    cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
+    planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius)
+    gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
+    ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
+    guess = lo + gap
     while cover.open.any():
-        covered = cover.covered
         for _ in range(MAX_TRIES):
-            offset = min(offset, hi - edge)
+            offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
-            got = _plan_pass(mesh, reach, cutter, tolerance, direction, offset, (gap, gap), grid, machine,
-                             forward_step, chord_tolerance, ideal_weight)
+            side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
+            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight)
             if got is not None:
-                pts = np.concatenate([p.points for p in got[0]])
-                short = cover.shortfall(pts, got[3])
-                level = cover.advanced(got[0], got[3])
-                if short <= 1e-9 and (level > cover.level + 1e-9)[cover.open].any():
+                level, short = cover.advanced(paths, got[2])
+                if (level > cover.level + 1e-9)[cover.open].any():
                     break
-                if short > 1e-9 and offset - 1.05 * short > covered + 0.25 * gap:
-                    plan.short += 1
-                    offset -= 1.05 * short + 1e-6                           # the right side falls short
-                    continue
             plan.shrunk += 1                                                # no posture, or nothing gained
             gap *= SHRINK
-            offset = covered + gap if plan.passes else offset
+            ahead = min(ahead, gap)
+            guess = base + gap
         else:
             # no pass advances the least finished bins: a strip a quarter diameter wide beyond them is left
             # (reported for clean-up) and the passes go on past it
-            stuck = cover.open & (cover.level <= covered + 1e-9)
+            stuck = cover.open & (cover.level <= base + 1e-9)
             f = cover.f0 + cover.width * np.flatnonzero(stuck)
             skip = 0.25 * cutter.diameter
-            plan.unfinished.append((float(f.min()), float(f.max() + cover.width), covered, covered + skip))
-            cover.level[stuck] = covered + skip
-            gap, offset = skip, cover.covered + skip
+            plan.unfinished.append((float(f.min()), float(f.max() + cover.width), base, base + skip))
+            cover.level[stuck] = base + skip
+            gap = skip
+            guess = base + 2 * skip
             continue
-        paths, postures, widths, ends = got
+        postures, widths, ends, used = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
-        band = (float(right.max()), float(left.min()))
-        plan.passes.append(PlannedPass(offset, paths, postures, widths, band, gap))
+        plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
+                                       gap))
+        plan.partial += short > 0
         cover.level = level
-        gap = max(band[1] - offset, 1e-3)                                   # the next right side: this left one
-        offset = min(cover.covered, hi) + gap
-        if progress is not None and progress(min(1.0, (min(cover.covered, hi) - lo) / (hi - lo))):
+        # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
+        # asked a little more while every CC point meets them
+        relaxed = bool((used[:, 0] < ahead - 1e-9).any())
+        ahead = float(np.clip(ahead * (0.95 if relaxed else 1.1), 0.05 * cutter.radius, 2 * cutter.radius))
+        gap = ahead
+        guess = offset + 2 * gap
+        if progress is not None and progress(1.0 - float(np.mean(cover.open))):
             break
     plan.seconds = time.perf_counter() - t0
     return plan
