@@ -134,7 +134,8 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
         out = OUT / "plan_command" / "out"
         self.assertEqual(sorted(p.name for p in out.iterdir()),
-                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "report.json"])
+                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "beet_mm_toolpath.png", "report.html",
+                          "report.json"])
         self.assertEqual(sorted(p.name for p in out.parent.iterdir()), ["job.yaml", "out"])
         report = json.loads((out / "report.json").read_text())
         self.assertTrue(report["passed"])
@@ -142,3 +143,10 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual([o["label"] for o in report["verification"]["ops"]],
                          [o["label"] for o in report["plan"]["ops"]])
         self.assertTrue(all(d["reason"] for d in report["plan"]["decisions"]))
+        # the page for people: the verdict, each op (in the setup sheet's op list), both pictures inside
+        page = (out / "report.html").read_text()
+        self.assertTrue("VERIFIED" in page)
+        for op in report["plan"]["ops"]:
+            self.assertTrue(f"<td>{op['label']}</td>" in page, op["label"])
+        self.assertEqual(page.count("data:image/png;base64,"), 2)
+        self.assertGreater((out / "beet_mm_toolpath.png").stat().st_size, 10_000)
