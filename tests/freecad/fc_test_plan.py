@@ -96,8 +96,8 @@ class PlanBeet(FreeCADTestCase):
         os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
         real, calls = plan_run.verify, []
 
-        def first_fails(results, plan_doc, out):
-            report = real(results, plan_doc, out)
+        def first_fails(results, plan_doc, out, progress=False):
+            report = real(results, plan_doc, out, progress)
             calls.append([r.op.Label for r in results])
             if len(calls) == 1:
                 report.update(passed=False, problems=[f"{last['label']}: shank too close"],

@@ -132,6 +132,28 @@ def write_pages(tmp: Path, job: JobSpec, mesh: TriMesh, doc: dict) -> None:
     (tmp / "report.html").write_text(html, encoding="utf-8")
 
 
+def finish_outputs(tmp: Path, job: JobSpec, mesh: TriMesh, an: analysis.Analysis, plan: decide.Plan,
+                   verified: dict, quiet: bool = True) -> dict:
+    """After the FreeCAD side wrote its files into `tmp`: the tool path picture, report.json and report.html, all
+    moved into the job's outputs.dir. Returns the report."""
+    out = job.outputs
+    gcode = tmp / f"{out.name}.ngc"
+    if gcode.is_file():
+        say("drawing the tool path", quiet)
+        draw_toolpath(mesh, gcode, tmp / f"{out.name}_toolpath.png")
+    files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
+    doc = report(job, an, plan, verified, files)
+    write_pages(tmp, job, mesh, doc)
+    move_into_place(tmp, out.dir)
+    return doc
+
+
+def temporary_folder(out_dir: Path, name: str) -> Path:
+    """Where a run's files are made: a new hidden folder beside `out_dir` (the same file system: moved whole)."""
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=f".{name}.", dir=str(out_dir.parent)))
+
+
 def move_into_place(tmp: Path, target: Path) -> list:
     """The finished files from `tmp` into `target` (created), replacing files of the same name."""
     target.mkdir(parents=True, exist_ok=True)
@@ -156,8 +178,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
     say(f"planned {len(plan.ops)} ops in {time.perf_counter() - t0:.1f} s: "
         + ", ".join(op.label for op in plan.ops), quiet)
     out = job.outputs
-    out.dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=str(out.dir.parent)))
+    tmp = temporary_folder(out.dir, out.name)
     try:
         model_file = job.model.file
         if moved:
@@ -171,13 +192,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         verified = json.loads((tmp / "verify.json").read_text())
         for name in ("plan.json", "verify.json"):
             (tmp / name).unlink()
-        gcode = tmp / f"{out.name}.ngc"
-        if gcode.is_file():
-            say("drawing the tool path", quiet)
-            draw_toolpath(mesh, gcode, tmp / f"{out.name}_toolpath.png")
-        files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
-        write_pages(tmp, job, mesh, report(job, an, plan, verified, files))
-        move_into_place(tmp, out.dir)
+        finish_outputs(tmp, job, mesh, an, plan, verified, quiet)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     for change in verified.get("replanned", []):
