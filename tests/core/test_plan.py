@@ -288,3 +288,21 @@ def test_tools_file_and_candidates(tmp_path: Path) -> None:
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump(library))
     with pytest.raises(PlanInputError, match="tools file shop.yaml: got .*one field, tools"):
         job_from_dict(data, tmp_path / "job.yaml")
+
+
+def test_roughing_stops_where_its_flutes_end(tmp_path: Path) -> None:
+    """A roughing tool reaching the depth by its stick-out but with shorter flutes roughs down only as far as
+    its flutes keep the shank clear of the walls (ktoolcav: the shank rubbed the walls below the flutes)."""
+    data = good(tmp_path)
+    data["planner"]["compare_cutters"] = False
+    data["tools"][0].update(flute_length=5, holder="ER16 nut", stick_out=30)
+    _, _, _, plan = plan_of(tmp_path, data)
+    rough = plan.ops[0]
+    top = plan.stock_box[5]
+    assert rough.tool == "T1 flat D8"
+    assert rough.kwargs["final_z"] == pytest.approx(top - 5 + decide.ROUGH_SHANK_CLEAR)
+    assert "shank" in next(d.reason for d in plan.decisions if d.topic == "roughing depth")
+    # flutes long enough: down to the model
+    _, _, _, plan = plan_of(tmp_path, good(tmp_path))
+    assert "final_z" not in plan.ops[0].kwargs
+    assert "roughing depth" not in [d.topic for d in plan.decisions]
