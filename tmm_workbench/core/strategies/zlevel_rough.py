@@ -15,8 +15,9 @@ Per layer (tip height z, descending; zlevel_layers):
   region    the tool-centre positions that touch material: the stock's XY grown by the tool radius less a
             step-over (so the first loop around the stock takes no more than a step-over; not grown at all
             for step-overs past the radius), minus blocked; and, where the model stands closer to the stock's
-            edge than that (a thin margin), the positions within a step-over of blocked that still touch
-            material (the loop round the model then takes what the margin holds, less than a step-over).
+            edge than that (a thin margin; a box stock only), the positions within a step-over of blocked that
+            still touch material (the loop round the model then takes what the margin holds, less than a
+            step-over).
             Every position in it is gouge-free at z and above (the blocked region only shrinks upwards);
   clearing  contour-parallel offsets (or zig-zag lines) of each region at the step-over (zlevel_clearing),
             climb or conventional;
@@ -517,12 +518,14 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
         # the first loop round the material takes a step-over of it (or the tool's radius, for step-overs
         # past half the diameter: an erosion by s - R would cut the stock's corners off)
         touching = P.offset(material, max(ctx.R - ctx.s, 0.0), ctx.arc_tol)
-        # and round the model where it stands closer to the material's edge than that (a thin margin, a block
-        # in a box): the positions within a step-over of the model's offset that still touch material (the last
-        # loop round the model takes less than a step-over)
-        hugging = P.intersection(P.offset(material, ctx.R - _TOUCH, ctx.arc_tol),
-                                 P.offset(blocked, ctx.s, ctx.arc_tol))
-        cut_shape = P.intersection(tool_centres, P.union(touching, hugging))
+        if params.stock_heights is None:
+            # and round the model where it stands closer to the box stock's edge than that (a thin margin, a
+            # block in a box): the positions within a step-over of the model's offset that still touch material
+            # (the last loop round the model takes less than a step-over). Not on a stock of heights: its
+            # cells' edges stand past what an earlier op left on the walls, which this would trace again
+            touching = P.union(touching, P.intersection(P.offset(material, ctx.R - _TOUCH, ctx.arc_tol),
+                                                        P.offset(blocked, ctx.s, ctx.arc_tol)))
+        cut_shape = P.intersection(tool_centres, touching)
         regions = [r for r in P.regions(cut_shape) if r.area > _MIN_REGION_AREA]
         for region in regions:
             segments += _clear_region(ctx, float(z), region, tool_centres, material_reach, steps)
