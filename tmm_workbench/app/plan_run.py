@@ -198,9 +198,9 @@ def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict
 
 def remove_added(doc: Any, before: set) -> None:
     """The objects a failed run added to `doc`, removed (the newest first: an op before its Job)."""
-    for obj in reversed([o for o in doc.Objects if o.Name not in before]):
-        if doc.getObject(obj.Name) is not None:
-            doc.removeObject(obj.Name)
+    for name in reversed([o.Name for o in doc.Objects if o.Name not in before]):
+        if doc.getObject(name) is not None:   # by name: removing a Job removes its children too (1.1)
+            doc.removeObject(name)
     doc.recompute()
 
 
