@@ -2,8 +2,8 @@
 
 An STL (env TMM_GUI_STL) read into a Mesh object and selected; the TMM toolbar offers TMM Auto; its panel with a
 recipe (modelling foam, the draft finish, an output folder: env TMM_GUI_OUT): a tool library file that does not
-exist is refused on the status line with the panel open and nothing added; a run cancelled at its first progress
-dialog leaves the document as it was, the panel open; then OK plans: the Job with its ops stays in the document,
+exist is refused on the status line with the panel open and nothing added; a run cancelled in its progress dialog
+(shown at once) leaves the document as it was, the panel open; then OK plans: the Job with its ops stays in the document,
 selected, the result box names the ops and the report, the output folder holds report.html naming them.
 Screenshots into env TMM_GUI_SHOTS; the outcome to env TMM_GUI_RESULT (JSON) and the exit code."""
 import os
@@ -46,11 +46,11 @@ def names(doc) -> list:
     return sorted(o.Name for o in doc.Objects)
 
 
-def cancel_first_progress(seen: list) -> QtCore.QTimer:
-    """Clicks Cancel on the first progress dialog that shows (as a user does)."""
+def cancel_progress(seen: list) -> QtCore.QTimer:
+    """Clicks Cancel on each progress dialog that shows (as a user does); their labels into `seen`."""
     def look() -> None:
         for w in QtGui.QApplication.topLevelWidgets():
-            if isinstance(w, QtGui.QProgressDialog) and w.isVisible() and not seen:
+            if isinstance(w, QtGui.QProgressDialog) and w.isVisible() and not w.wasCanceled():
                 seen.append(w.labelText())
                 w.cancel()
     timer = QtCore.QTimer()
@@ -99,9 +99,13 @@ def session(info: dict) -> None:
     info["refused_unchanged"] = names(doc) == before
     type_text("library", "")
     # cancelled at the first progress dialog: the document as it was, the panel open
+    from tmm_workbench.gui import progress_dialog
+
     seen: list = []
-    timer = cancel_first_progress(seen)
+    timer = cancel_progress(seen)
+    shown_after, progress_dialog.SHOW_AFTER_S = progress_dialog.SHOW_AFTER_S, 0.0   # shown at once: a fast op too
     click(QtGui.QDialogButtonBox.Ok)
+    progress_dialog.SHOW_AFTER_S = shown_after
     timer.stop()
     info["cancelled_at"] = seen
     info["cancelled_status"] = visible(QtGui.QLabel, "status").text()
