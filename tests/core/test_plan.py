@@ -230,12 +230,16 @@ def stand_in(tmp_path: Path, passed: bool, fail: bool = False) -> str:
     """An executable playing freecadcmd: writes what app/plan_run.py writes (or fails)."""
     script = tmp_path / "fake_freecadcmd"
     verified = {"passed": passed, "problems": [] if passed else ["gouged 0.0500 mm"], "deepest_gouge_mm": 0.0,
-                "most_material_left_mm": 0.1, "cycle_seconds": 60.0, "ops": []}
+                "most_material_left_mm": 0.1, "cycle_seconds": 60.0, "removed_volume_mm3": 5000.0,
+                "remaining_volume_mm3": 100.0, "left_percentiles_mm": {"50": 0.05}, "sim_cell_mm": 0.4}
     body = "raise SystemExit(3)" if fail else (
         "import json, os\nfrom pathlib import Path\nf = Path(os.environ['TMM_PLAN_FILE']).parent\n"
         "plan = json.loads((f / 'plan.json').read_text())\n"
-        "(f / (plan['name'] + '.ngc')).write_text('G0 X0\\n')\n"
-        f"(f / 'verify.json').write_text(json.dumps({verified!r}))\n")
+        "(f / (plan['name'] + '.ngc')).write_text('G0 X0 Y0 Z5\\nG1 Z-1\\nG1 X10\\n')\n"
+        f"verified = {verified!r}\n"
+        "verified['ops'] = [{'label': o['label'], 'moves': 3, 'cycle_seconds': 20.0, 'rapids_through_stock': 0,"
+        " 'holder': None} for o in plan['ops']]\n"
+        "(f / 'verify.json').write_text(json.dumps(verified))\n")
     script.write_text(f"#!{sys.executable}\n{body}\n")
     script.chmod(script.stat().st_mode | stat.S_IEXEC)
     return str(script)
@@ -247,9 +251,11 @@ def test_launcher_moves_complete_outputs(tmp_path: Path, passed: bool, code: int
     data["planner"]["compare_cutters"] = False
     assert run_job(tmp_path, data, stand_in(tmp_path, passed)) == code
     out = tmp_path / "out"
-    assert sorted(p.name for p in out.iterdir()) == ["beet_mm.ngc", "report.json"]
+    files = ["beet_mm.ngc", "beet_mm_toolpath.png", "report.html", "report.json"]
+    assert sorted(p.name for p in out.iterdir()) == files
     rep = json.loads((out / "report.json").read_text())
-    assert rep["passed"] is passed and rep["files"] == ["beet_mm.ngc", "report.json"]
+    assert rep["passed"] is passed and rep["files"] == files
+    assert ("VERIFIED" if passed else "VERIFICATION FAILED") in (out / "report.html").read_text()
     assert [d["topic"] for d in rep["plan"]["decisions"]][:2] == ["model", "roughing tool"]
     assert rep["analysis"]["triangles"] > 1000
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".beet_mm.")]   # no temporary folder left
@@ -282,3 +288,21 @@ def test_tools_file_and_candidates(tmp_path: Path) -> None:
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump(library))
     with pytest.raises(PlanInputError, match="tools file shop.yaml: got .*one field, tools"):
         job_from_dict(data, tmp_path / "job.yaml")
+
+
+def test_roughing_stops_where_its_flutes_end(tmp_path: Path) -> None:
+    """A roughing tool reaching the depth by its stick-out but with shorter flutes roughs down only as far as
+    its flutes keep the shank clear of the walls (ktoolcav: the shank rubbed the walls below the flutes)."""
+    data = good(tmp_path)
+    data["planner"]["compare_cutters"] = False
+    data["tools"][0].update(flute_length=5, holder="ER16 nut", stick_out=30)
+    _, _, _, plan = plan_of(tmp_path, data)
+    rough = plan.ops[0]
+    top = plan.stock_box[5]
+    assert rough.tool == "T1 flat D8"
+    assert rough.kwargs["final_z"] == pytest.approx(top - 5 + decide.ROUGH_SHANK_CLEAR)
+    assert "shank" in next(d.reason for d in plan.decisions if d.topic == "roughing depth")
+    # flutes long enough: down to the model
+    _, _, _, plan = plan_of(tmp_path, good(tmp_path))
+    assert "final_z" not in plan.ops[0].kwargs
+    assert "roughing depth" not in [d.topic for d in plan.decisions]

@@ -191,6 +191,23 @@ def test_sphere_on_plate_with_a_ball():
     assert np.nanpercentile(out["dev"], 50) < 1.0
 
 
+def test_block_in_a_thin_margin():
+    """A block filling its stock but for a 2 mm margin, a flat D16 at a 50 % step-over: no tool-centre position
+    inside the stock clears the model, so the walls are cut from beside the stock, taking what the margin holds
+    (ktoolcav of the shared benchmarks: "no material to remove")."""
+    mesh = blocks_mesh([0.0, 40.0], [0.0, 20.0], [[30.0]])
+    s = 0.3
+    params = RoughingParams(stock_box=(-2.0, -2.0, 0.0, 42.0, 22.0, 31.0), step_down=10.0, stock_to_leave=s,
+                            stepover_percent=50.0)
+    out = check_roughing(mesh, Cutter.flat(16), params, cell=0.2, safe=40.0, clear=45.0)
+    grid, h = out["grid"], out["sim"].heights
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    gap = np.maximum(np.maximum(-X, X - 40.0), np.maximum(-Y, Y - 20.0))   # outside the block by this much
+    ring = gap > s + zr.wall_margin(params) + grid.cell
+    assert ring.any() and h[ring].max() <= min(out["result"].diagnostics["layer_z"]) + 1e-3
+    assert h[gap < 0].min() >= 30.0 - 1e-3                                 # the block untouched
+
+
 def test_tolerance_layers_on_the_sphere():
     mesh = load_stl(SHARED_STL / "sphere_on_plate.stl")
     lo, hi = mesh.bounds

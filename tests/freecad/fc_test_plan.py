@@ -102,8 +102,8 @@ class PlanBeet(FreeCADTestCase):
         os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
         real, calls = plan_run.verify, []
 
-        def first_fails(results, plan_doc, out):
-            report = real(results, plan_doc, out)
+        def first_fails(results, plan_doc, out, progress=False):
+            report = real(results, plan_doc, out, progress)
             calls.append([r.op.Label for r in results])
             if len(calls) == 1:
                 report.update(passed=False, problems=[f"{last['label']}: shank too close"],
@@ -140,7 +140,8 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
         out = OUT / "plan_command" / "out"
         self.assertEqual(sorted(p.name for p in out.iterdir()),
-                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "report.json"])
+                         ["beet_mm.FCStd", "beet_mm.ngc", "beet_mm_sim.png", "beet_mm_toolpath.png", "report.html",
+                          "report.json"])
         self.assertEqual(sorted(p.name for p in out.parent.iterdir()), ["job.yaml", "out"])
         report = json.loads((out / "report.json").read_text())
         self.assertTrue(report["passed"])
@@ -148,3 +149,10 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual([o["label"] for o in report["verification"]["ops"]],
                          [o["label"] for o in report["plan"]["ops"]])
         self.assertTrue(all(d["reason"] for d in report["plan"]["decisions"]))
+        # the page for people: the verdict, each op (in the setup sheet's op list), both pictures inside
+        page = (out / "report.html").read_text()
+        self.assertTrue("VERIFIED" in page)
+        for op in report["plan"]["ops"]:
+            self.assertTrue(f"<td>{op['label']}</td>" in page, op["label"])
+        self.assertEqual(page.count("data:image/png;base64,"), 2)
+        self.assertGreater((out / "beet_mm_toolpath.png").stat().st_size, 10_000)

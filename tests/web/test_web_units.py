@@ -6,7 +6,7 @@ import pytest
 
 from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.web.__main__ import main as web_main
-from tmm_workbench.web.picture import toolpath_of_gcode
+from tmm_workbench.core.preview.toolpath_png import toolpath_of_gcode
 
 
 def test_gcode_read_back_as_moves():

@@ -132,11 +132,22 @@ def stock_box_checked(stock: Any) -> StockBox:
     return box  # type: ignore[return-value]
 
 
+def base_bounds(base: Any) -> Any:
+    """The bounds of a stock's Base: its shape's, or (the Job's Model group: it has no shape of its own in a GUI
+    session) those of the shapes in it, as FreeCAD's stock from the base takes them."""
+    if hasattr(base, "Shape"):
+        return base.Shape.BoundBox
+    bb = FreeCAD.BoundBox()
+    for o in getattr(base, "Group", []):
+        bb.add(o.Shape.BoundBox)
+    return bb if bb.isValid() else None
+
+
 def set_stock(job: Any, stock: Optional[StockBox], margin: float, above: float) -> None:
     """The Job's box stock (FreeCAD's stock from the base, its extents set): `stock` exactly, or the model's box
     grown by `margin` on the sides and `above` on top."""
     s = job.Stock
-    bb = s.Base.Shape.BoundBox if getattr(s, "Base", None) is not None else None
+    bb = base_bounds(s.Base) if getattr(s, "Base", None) is not None else None
     if bb is None or not hasattr(s, "ExtXneg"):
         raise TmmError(f"Job '{job.Label}': its stock is not FreeCAD's stock from the base; set it in the Job")
     if stock is None:

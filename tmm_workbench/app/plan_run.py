@@ -21,8 +21,9 @@ TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
 FAILED = 3
 
 
-def run_ops(plan: dict, folder: Path) -> list:
-    """The plan's ops in order, the first making the Job around the model and its stock, the others added."""
+def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
+    """The plan's ops in order, the first making the Job around the model and its stock (`model`, a Mesh or Part
+    object: its Job in the object's document; None: the plan's STL in a new document), the others added."""
     from tmm_workbench.app import api
     from tmm_workbench.core.plan import progress_note
 
@@ -34,7 +35,9 @@ def run_ops(plan: dict, folder: Path) -> list:
         kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
         call = calls[op["api"]]
         if results:
-            r = call(None, job=results[0], progress=False, **kwargs)
+            r = call(None, job=results[0], progress=progress, **kwargs)
+        elif model is not None:
+            r = call(model, progress=progress, **kwargs)
         else:
             r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
         r.op.Label = op["label"]
@@ -100,7 +103,7 @@ def steps(plan: dict) -> int:
     return 1 + len(plan["ops"]) + 1 + bool(plan["gcode"]) + bool(plan["fcstd"])
 
 
-def verify(results: list, plan: dict, folder: Path) -> dict:
+def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> dict:
     from tmm_workbench.app.api import simulate
     from tmm_workbench.core.plan import progress_note
 
@@ -108,7 +111,7 @@ def verify(results: list, plan: dict, folder: Path) -> dict:
 
     png = folder / f"{plan['name']}_sim.png" if plan["heat_map"] else None
     sim = simulate(results[0].job, cell=plan["sim_cell"], tolerance=plan["tolerance"], png_path=png,
-                   progress=False)
+                   progress=progress)
     problems = []
     if sim.gouged:
         problems.append(f"gouged {-sim.min_deviation:.4f} mm below the model (tolerance {plan['tolerance']:g} mm)")
@@ -138,17 +141,14 @@ def rounded(value: Any) -> Any:
     return value
 
 
-def main() -> int:
-    sys.path.insert(0, str(REPO))
-    plan_file = Path(os.environ["TMM_PLAN_FILE"])
-    folder = plan_file.parent
-    plan = json.loads(plan_file.read_text())
+def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False) -> tuple[list, dict]:
+    """The plan run as one Job (run_ops), verified, its optional ops left out when they alone fail, the whole Job
+    posted into `folder`: (the API results of the ops kept, the verification)."""
     from tmm_workbench.app import posts
     from tmm_workbench.core.plan import progress_note
 
-    results = run_ops(plan, folder)
-    job = results[0].job
-    report = verify(results, plan, folder)
+    results = run_ops(plan, model, progress)
+    report = verify(results, plan, folder, progress)
     optional = {op["label"] for op in plan["ops"] if op.get("optional")}
     dropping = set(report["failing_ops"])
     replanned = []
@@ -162,7 +162,7 @@ def main() -> int:
             if r.op.Label in dropping:
                 drop_op(r.op, kept)
         results = kept
-        report = verify(results, plan, folder)
+        report = verify(results, plan, folder, progress)
     report["replanned"] = replanned
     if plan["gcode"]:
         progress_note.note(3 + len(plan["ops"]), steps(plan), f"writing the G-code ({plan['post']})")
@@ -172,9 +172,62 @@ def main() -> int:
         # without the header's export time: the same plan gives the same G-code, byte for byte
         args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
         posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
+    return results, report
+
+
+def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict]:
+    """The automatic planner on a Mesh or Part object of an open document (the GUI's TMM Auto). `data`: a job
+    file's data (core.plan.recipes.job_data) with absolute paths; its model is the object's mesh, written as
+    <name>_model.stl beside the outputs (with job.json, the job file that plans it again with `tmm plan`). The
+    Job is made in the object's document and left there for review; the G-code, pictures and reports go to
+    outputs.dir, moved in whole. A failed or cancelled run removes what it added and writes nothing.
+    Returns (the Job, the report). PlanInputError: the recipe refused (its message names the field)."""
+    import shutil
+
+    from tmm_workbench.app.geometry import mesh_from_object
+    from tmm_workbench.core.geometry.mesh import save_stl
+    from tmm_workbench.core.plan import launch
+    from tmm_workbench.core.plan.job_file import job_from_dict
+
+    name, out_dir = data["outputs"]["name"], Path(data["outputs"]["dir"])
+    tmp = launch.temporary_folder(out_dir, name)
+    doc, before = model.Document, {o.Name for o in model.Document.Objects}
+    try:
+        stl = save_stl(mesh_from_object(model), tmp / f"{name}_model.stl")
+        again = dict(data, model=dict(data["model"], file=stl.name), outputs=dict(data["outputs"], dir="."))
+        (tmp / "job.json").write_text(json.dumps(again, indent=1, sort_keys=True) + "\n")
+        job = job_from_dict(dict(data, model=dict(data["model"], file=str(stl))), tmp / "job.json")
+        mesh, _, an, plan = launch.make_plan(job)
+        plan_doc = dict(launch.plan_document(job, plan, stl), fcstd=False)
+        try:
+            results, verified = run_plan(plan_doc, tmp, model, progress)
+        except BaseException:
+            remove_added(doc, before)
+            raise
+        return results[0].job, launch.finish_outputs(tmp, job, mesh, an, plan, verified)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def remove_added(doc: Any, before: set) -> None:
+    """The objects a failed run added to `doc`, removed (the newest first: an op before its Job)."""
+    for name in reversed([o.Name for o in doc.Objects if o.Name not in before]):
+        if doc.getObject(name) is not None:   # by name: removing a Job removes its children too (1.1)
+            doc.removeObject(name)
+    doc.recompute()
+
+
+def main() -> int:
+    sys.path.insert(0, str(REPO))
+    plan_file = Path(os.environ["TMM_PLAN_FILE"])
+    folder = plan_file.parent
+    plan = json.loads(plan_file.read_text())
+    from tmm_workbench.core.plan import progress_note
+
+    results, report = run_plan(plan, folder)
     if plan["fcstd"]:
         progress_note.note(steps(plan), steps(plan), "saving the document")
-        job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
+        results[0].job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))
     (folder / "verify.json").write_text(json.dumps(report, indent=1, sort_keys=True) + "\n")
     return 0
 

@@ -40,7 +40,7 @@ class TMMWorkbench(FreeCADGui.Workbench):
         import_gui("tool_bit_library_cmd")
         import_gui("commands")
         from tmm_workbench.app import registry
-        from tmm_workbench.gui import job_cmd, simulate_cmd, stick_out_cmd
+        from tmm_workbench.gui import auto_cmd, job_cmd, simulate_cmd, stick_out_cmd
 
         posts.install_post_dir()
         from tmm_workbench.core import kernel
@@ -54,7 +54,7 @@ class TMMWorkbench(FreeCADGui.Workbench):
         for entry in registry.OPS:
             entry.gui()  # registers the op's command
         tmm = ([job_cmd.COMMAND_NAME] + [entry.command_name for entry in registry.OPS]
-               + [simulate_cmd.COMMAND_NAME, stick_out_cmd.COMMAND_NAME])
+               + [simulate_cmd.COMMAND_NAME, stick_out_cmd.COMMAND_NAME, auto_cmd.COMMAND_NAME])
         self.appendToolbar("TMM", tmm)
         job_tools, tool_tools = path_commands(JOB_TOOLS), path_commands(TOOL_TOOLS)
         self.appendToolbar("TMM Path", path_commands(JOB_TOOLBAR))

@@ -6,46 +6,28 @@ as it is and says why in the row."""
 from __future__ import annotations
 
 import os
-import re
+import shutil
 import uuid
 from pathlib import Path
 
-from tmm_workbench.core.toolpath import MoveKind, Toolpath
+from tmm_workbench.core.preview.toolpath_png import toolpath_of_gcode
 
 PICTURE = "toolpath.png"
-_WORD = re.compile(r"([GXYZ])\s*([-+]?\d*\.?\d+)")
-
-
-def toolpath_of_gcode(text: str) -> Toolpath:
-    """The G0 / G1 (and G2 / G3, as lines to their end: for drawing) moves of a 3-axis program in absolute mm,
-    coordinates modal (a move before all three are known is not drawn: its start is the machine's); comments in
-    parentheses or after ';' skipped."""
-    path = Toolpath()
-    pos: dict[str, float] = {}
-    mode = None
-    for line in text.splitlines():
-        line = re.sub(r"\([^)]*\)", "", line).split(";")[0].upper()
-        words = _WORD.findall(line)
-        moved = False
-        for letter, value in words:
-            if letter == "G" and value in ("0", "00", "1", "01", "2", "02", "3", "03"):
-                mode = int(value)
-            elif letter in "XYZ":
-                pos[letter] = float(value)
-                moved = True
-        if moved and mode is not None and len(pos) == 3:
-            path.add(MoveKind.RAPID if mode == 0 else MoveKind.FEED, pos["X"], pos["Y"], pos["Z"])
-    return path
 
 
 def draw(folder: Path, model: Path, gcode_name: str) -> Path:
-    """`folder`/toolpath.png: the G-code `gcode_name` of the folder over `model`."""
+    """`folder`/toolpath.png: the G-code `gcode_name` of the folder over `model`; the planner's own picture of it
+    (`<name>_toolpath.png`, drawn the same way) when it wrote one."""
     from tmm_workbench.core.geometry.mesh import load_stl
     from tmm_workbench.core.preview.toolpath_png import render_toolpath_png
 
-    toolpath = toolpath_of_gcode((folder / gcode_name).read_text(errors="replace"))
     tmp = folder / f".{PICTURE}.{uuid.uuid4().hex[:8]}.png"
-    render_toolpath_png(load_stl(model), toolpath, str(tmp), title="the tool path", size_px=(1400, 650))
+    planned = folder / f"{Path(gcode_name).stem}_toolpath.png"
+    if planned.is_file():
+        shutil.copyfile(planned, tmp)
+    else:
+        toolpath = toolpath_of_gcode((folder / gcode_name).read_text(errors="replace"))
+        render_toolpath_png(load_stl(model), toolpath, str(tmp), title="the tool path", size_px=(1400, 650))
     os.replace(tmp, folder / PICTURE)
     return folder / PICTURE
 

@@ -11,7 +11,8 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.plan import materials
+from tmm_workbench.core.plan import materials, recipes
+from tmm_workbench.core.plan.recipes import FINISHES, MACHINES
 
 MAX_UPLOAD_BYTES = 50 * 1024 * 1024
 MAX_TRIANGLES = 1_000_000          # a model's work: the planner's reach tests and simulation grow with it
@@ -20,28 +21,6 @@ MODEL_FILE = "model.stl"
 JOB_FILE = "job.yaml"
 PART_NAME = "part"                  # the planner's outputs: part.ngc, part.FCStd, part_sim.png, report.json
 
-# the shop's machines: the planner's machine section
-MACHINES: dict[str, dict] = {
-    "3-axis linuxcnc": {"type": "3-axis", "post": "linuxcnc", "travels": [300, 200, 100]},
-    "3-axis grbl": {"type": "3-axis", "post": "grbl", "travels": [300, 300, 80]},
-}
-# finish presets: the cusp kept, the verification's tolerance and the planner's grids (coarser: faster);
-# `draft` is tests/data/plan_beet.yaml's coarse values
-FINISHES: dict[str, dict] = {
-    "draft": {"finish": {"cusp": 0.1, "tolerance": 0.01}, "planner": {"analysis_cell": 0.5, "sim_cell": 0.4},
-              "sign_cell": 0.5},
-    "standard": {"finish": {"cusp": 0.05, "tolerance": 0.01}, "planner": {"analysis_cell": 0.5, "sim_cell": 0.2},
-                 "sign_cell": 0.35},
-    "fine": {"finish": {"cusp": 0.02, "tolerance": 0.01}, "planner": {"analysis_cell": 0.4, "sim_cell": 0.15},
-             "sign_cell": 0.25},
-}
-# the shop's library (the planner's test job's)
-TOOLS = [
-    {"name": "T1 flat D8", "type": "flat", "diameter": 8, "flutes": 2, "flute_length": 20},
-    {"name": "T2 ball D6", "type": "ball", "diameter": 6, "flutes": 2, "flute_length": 20, "holder": "ER16 nut",
-     "stick_out": 30},
-    {"name": "T3 bull D6 r1", "type": "bull", "diameter": 6, "corner_radius": 1, "flutes": 2, "flute_length": 20},
-]
 SIGN_FIELDS = {"text": str, "width": float, "height": float, "shape": str, "border": float, "relief": float,
                "background": str, "thickness": float}
 
@@ -174,8 +153,4 @@ def check_stl_file(path: Path) -> int:
 
 def job_data(recipe: Recipe) -> dict:
     """The planner's job file for the model beside it (MODEL_FILE) and `recipe`."""
-    finish = FINISHES[recipe.finish]
-    return {"format": "tmm-plan 1", "model": {"file": MODEL_FILE, "units": "mm"},
-            "stock": {"type": "box", "margin": 2, "above": 1}, "machine": dict(MACHINES[recipe.machine]),
-            "tools": [dict(t) for t in TOOLS], "material": recipe.material, "finish": dict(finish["finish"]),
-            "outputs": {"dir": "out", "name": PART_NAME}, "planner": dict(finish["planner"])}
+    return recipes.job_data(recipe.material, recipe.finish, recipe.machine, MODEL_FILE, "out", PART_NAME)

@@ -33,6 +33,7 @@ TRANSITION_RANGE = (30.0, 60.0)
 MIN_SHARE = 0.005          # of the design cells: a slope class smaller than this gets no op of its own
 MIN_STEPOVER = 0.05        # mm: a finish needing a finer step-over than this is refused as too tight
 MAX_COMPARED = 4           # radiused tools compared (the largest first)
+ROUGH_SHANK_CLEAR = 1.5    # mm: the roughing's flutes end this far above the stock (the API's shank clearance 1 mm)
 ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
 ROUGH_FAR_SHARE = 0.5      # nor one staying more than FAR_MM above over more than this share of the model's area
 
@@ -161,6 +162,13 @@ def choose_roughing(plan: Plan, job: JobSpec, an: Analysis) -> ToolSpec:
         "step_down": step_down, "layer_mode": "tolerance", "remaining_height": ROUGH_STAIR,
         "stepover_percent": round(c.stepover_percent, 1), "stock_to_leave": ROUGH_LEAVE,
         "stock": list(plan.stock_box), "post": job.machine.post}
+    if tool.flute_length - ROUGH_SHANK_CLEAR < depth:
+        # below its flutes the shank (as wide as the cut) would rub the walls the layers leave ROUGH_LEAVE from
+        kwargs["final_z"] = round(plan.stock_box[5] - tool.flute_length + ROUGH_SHANK_CLEAR, 4)
+        plan.decide("roughing depth", f"down to Z{kwargs['final_z']:g}",
+                    f"{tool.name}'s flutes are {tool.flute_length:g} mm long, the depth {depth:.1f} mm: deeper, its "
+                    f"shank would rub the walls {ROUGH_LEAVE:g} mm away (the flutes' top kept {ROUGH_SHANK_CLEAR:g} "
+                    "mm above the stock: the shank's clearance); the finishing ops take what is below")
     plan.ops.append(OpPlan("run_roughing", f"Roughing {tool.name}", tool.name, kwargs))
     return tool
 

@@ -3,7 +3,7 @@
 Reads and checks the job file, places and analyses the model, decides the ops (all without FreeCAD), then starts
 `freecadcmd` on app/plan_run.py to run the plan as one FreeCAD Job, post it and simulate it. Everything is made
 in a temporary folder beside the output folder and moved into place only when complete (the document, the
-G-code, the heat map and report.json); on bad input or a failure nothing is written.
+G-code, the heat map, the tool path picture, report.json and report.html); on bad input or a failure nothing is written.
 
 Exit codes: 0 verified, 1 verification failed (or the Job could not be made: the reason on stderr), 2 bad input.
 """
@@ -27,7 +27,7 @@ import numpy as np
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
 from tmm_workbench.core.plan import analysis, decide, progress_note
-from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, read_job
+from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, ToolSpec, read_job
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
 APP_SCRIPT = Path(__file__).resolve().parents[2] / "app" / "plan_run.py"
@@ -100,7 +100,58 @@ def report(job: JobSpec, an: analysis.Analysis, plan: decide.Plan, verified: dic
             "problems": verified["problems"], "verification": verified, "analysis": an.as_dict(),
             "plan": plan.as_dict(), "finish": {"cusp_mm": job.finish.cusp, "tolerance_mm": job.finish.tolerance},
             "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels)},
-            "files": sorted(files)}
+            "tools": [tool_row(t) for t in job.tools], "files": sorted(files)}
+
+
+def tool_row(tool: ToolSpec) -> dict:
+    """A library tool for the setup sheet; its stick-out the job's, or the API's (the ToolBit's length less the
+    grip) when the job gives none."""
+    stick = tool.stick_out if tool.stick_out is not None else \
+        decide.overall_length(tool) - decide.GRIP_DIAMETERS * tool.diameter
+    return {"name": tool.name, "type": tool.type, "diameter": tool.diameter, "corner_radius": tool.corner_radius,
+            "flutes": tool.flutes, "flute_length": tool.flute_length, "holder": tool.holder,
+            "stick_out_mm": round(stick, 4)}
+
+
+def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path) -> None:
+    """The whole Job's G-code read back and drawn over the model (core.preview.toolpath_png)."""
+    from tmm_workbench.core.preview.toolpath_png import render_toolpath_png, toolpath_of_gcode
+
+    toolpath = toolpath_of_gcode(gcode.read_text(errors="replace"))
+    render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {gcode.name}", size_px=(1400, 650))
+
+
+def write_pages(tmp: Path, job: JobSpec, mesh: TriMesh, doc: dict) -> None:
+    """report.json and report.html (with the heat map and the tool path picture, drawn here) into `tmp`."""
+    from tmm_workbench.core.plan.report_html import report_html
+
+    name = job.outputs.name
+    pictures = {kind: tmp / f"{name}_{kind}.png" for kind in ("sim", "toolpath")}
+    (tmp / "report.json").write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
+    html = report_html(doc, name, *(p.read_bytes() if p.is_file() else None for p in pictures.values()))
+    (tmp / "report.html").write_text(html, encoding="utf-8")
+
+
+def finish_outputs(tmp: Path, job: JobSpec, mesh: TriMesh, an: analysis.Analysis, plan: decide.Plan,
+                   verified: dict, quiet: bool = True) -> dict:
+    """After the FreeCAD side wrote its files into `tmp`: the tool path picture, report.json and report.html, all
+    moved into the job's outputs.dir. Returns the report."""
+    out = job.outputs
+    gcode = tmp / f"{out.name}.ngc"
+    if gcode.is_file():
+        say("drawing the tool path", quiet)
+        draw_toolpath(mesh, gcode, tmp / f"{out.name}_toolpath.png")
+    files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
+    doc = report(job, an, plan, verified, files)
+    write_pages(tmp, job, mesh, doc)
+    move_into_place(tmp, out.dir)
+    return doc
+
+
+def temporary_folder(out_dir: Path, name: str) -> Path:
+    """Where a run's files are made: a new hidden folder beside `out_dir` (the same file system: moved whole)."""
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    return Path(tempfile.mkdtemp(prefix=f".{name}.", dir=str(out_dir.parent)))
 
 
 def move_into_place(tmp: Path, target: Path) -> list:
@@ -128,8 +179,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
     say(f"planned {len(plan.ops)} ops in {time.perf_counter() - t0:.1f} s: "
         + ", ".join(op.label for op in plan.ops), quiet)
     out = job.outputs
-    out.dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=str(out.dir.parent)))
+    tmp = temporary_folder(out.dir, out.name)
     try:
         model_file = job.model.file
         if moved:
@@ -143,10 +193,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         verified = json.loads((tmp / "verify.json").read_text())
         for name in ("plan.json", "verify.json"):
             (tmp / name).unlink()
-        files = sorted(f.name for f in tmp.iterdir()) + ["report.json"]
-        doc = report(job, an, plan, verified, files)
-        (tmp / "report.json").write_text(json.dumps(doc, indent=1, sort_keys=True) + "\n")
-        move_into_place(tmp, out.dir)
+        finish_outputs(tmp, job, mesh, an, plan, verified, quiet)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     for change in verified.get("replanned", []):

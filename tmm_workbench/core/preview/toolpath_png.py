@@ -5,6 +5,7 @@ matplotlib is imported inside the functions so importing this module never start
 """
 from __future__ import annotations
 
+import re
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,6 +22,29 @@ MAX_PASSES_TOP = 110
 CUT_COLOUR = "#d62728"
 RAPID_COLOUR = "#000000"  # black dashed: stands out on the grey model and on viridis
 MODEL_COLOUR = np.array([0.72, 0.75, 0.80])
+_GCODE_WORD = re.compile(r"([GXYZ])\s*([-+]?\d*\.?\d+)")
+
+
+def toolpath_of_gcode(text: str) -> Toolpath:
+    """The G0 / G1 (and G2 / G3, as lines to their end: for drawing) moves of a 3-axis program in absolute mm,
+    coordinates modal (a move before all three are known is not drawn: its start is the machine's); comments in
+    parentheses or after ';' skipped."""
+    path = Toolpath()
+    pos: dict[str, float] = {}
+    mode = None
+    for line in text.splitlines():
+        line = re.sub(r"\([^)]*\)", "", line).split(";")[0].upper()
+        words = _GCODE_WORD.findall(line)
+        moved = False
+        for letter, value in words:
+            if letter == "G" and value in ("0", "00", "1", "01", "2", "02", "3", "03"):
+                mode = int(value)
+            elif letter in "XYZ":
+                pos[letter] = float(value)
+                moved = True
+        if moved and mode is not None and len(pos) == 3:
+            path.add(MoveKind.RAPID if mode == 0 else MoveKind.FEED, pos["X"], pos["Y"], pos["Z"])
+    return path
 
 
 def decimate_for_drawing(vertices: np.ndarray, triangles: np.ndarray,

@@ -14,7 +14,10 @@ Per layer (tip height z, descending; zlevel_layers):
             the level z - s_a keeps s_a on flats (on slopes a mix of the two);
   region    the tool-centre positions that touch material: the stock's XY grown by the tool radius less a
             step-over (so the first loop around the stock takes no more than a step-over; not grown at all
-            for step-overs past the radius), minus blocked.
+            for step-overs past the radius), minus blocked; and, where the model stands closer to the stock's
+            edge than that so no position is left in a layer (a thin margin; a box stock only), the positions
+            within a step-over of blocked that take more than the stock to leave of the material (the loop
+            round the model then takes what the margin holds, less than a step-over).
             Every position in it is gouge-free at z and above (the blocked region only shrinks upwards);
   clearing  contour-parallel offsets (or zig-zag lines) of each region at the step-over (zlevel_clearing),
             climb or conventional;
@@ -68,6 +71,7 @@ _AIR_MARGIN = 1.0           # mm: the tool-centre box reaches this far past the 
 _ENTRY_CLEARANCE = 0.5      # mm: helices and ramps start this far above the material
 _FLOOR_NOISE = 1e-4        # mm: stock heights this close above a layer are the floor an earlier layer cut
 _MIN_REGION_AREA = 1e-6     # mm^2: tool-centre regions smaller than this are rounding, not room
+_TOUCH = 0.05               # mm: a loop beside the model takes at least this more than the stock to leave
 _SLIVER = 0.02              # mm: unreachable material thinner than this is the offsets' rounding
 _MIN_RAMP = 0.25            # a ramp follows a pass at least this many tool diameters long; a region whose
                             # whole outline is shorter (its tool centre fits in a spot) is not entered
@@ -466,6 +470,10 @@ def _clear_region(ctx: _Context, z: float, region: P.Region, tool_centres: P.Sha
     return out
 
 
+def _has_room(shape: P.Shape) -> bool:
+    return any(r.area > _MIN_REGION_AREA for r in P.regions(shape))
+
+
 def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Optional[Progress] = None,
             surface: Optional[DropSurface] = None) -> StrategyResult:
     """Z-level roughing of the stock down to `mesh` plus stock to leave with `cutter`, as cut segments with
@@ -515,6 +523,15 @@ def compute(mesh: TriMesh, cutter: Cutter, params: RoughingParams, progress: Opt
         # past half the diameter: an erosion by s - R would cut the stock's corners off)
         touching = P.offset(material, max(ctx.R - ctx.s, 0.0), ctx.arc_tol)
         cut_shape = P.intersection(tool_centres, touching)
+        if params.stock_heights is None and not _has_room(cut_shape):
+            # no room there, the model standing closer to the box stock's edge than that (a thin margin, a
+            # block in a box): the positions within a step-over of the model's offset that take more than the
+            # stock to leave of the material (the loop round the model takes what the margin holds, less than a
+            # step-over; a thinner strip is left to the finishing as the stock to leave is). Not on a stock of
+            # heights: its cells' edges stand past what an earlier op left on the walls
+            hugging = P.intersection(P.offset(material, ctx.R - s_r - _TOUCH, ctx.arc_tol),
+                                     P.offset(blocked, ctx.s, ctx.arc_tol))
+            cut_shape = P.intersection(tool_centres, hugging)
         regions = [r for r in P.regions(cut_shape) if r.area > _MIN_REGION_AREA]
         for region in regions:
             segments += _clear_region(ctx, float(z), region, tool_centres, material_reach, steps)
