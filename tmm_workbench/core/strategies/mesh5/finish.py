@@ -22,7 +22,7 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from tmm_workbench.core.errors import Cancelled, TmmError
+from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.machine.tarus import TarusMachine
@@ -140,19 +140,6 @@ def empty_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params) -> np.n
     return np.vstack(found) if found else np.zeros((0, 3))
 
 
-def _passes_progress(progress: Optional[Progress]) -> Optional[Progress]:
-    """`progress` (False cancels: Cancelled raised) as adaptive_passes calls it: it stops planning on a true
-    answer, so the passes are told False to go on."""
-    if progress is None:
-        return None
-
-    def report(fraction: float) -> bool:
-        if progress(fraction) is False:
-            raise Cancelled("5-axis mesh finishing cancelled")
-        return False
-    return report
-
-
 def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
             progress: Optional[Progress] = None) -> StrategyResult:
     """The strategy (module doc): cut segments and diagnostics "plan" (the AdaptivePlan), "unfinished",
@@ -165,7 +152,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
     lo, hi = mesh.bounds
     count_points(*_extents(lo, hi, params), params, cutter)
     plan = adaptive_passes(mesh, cutter, params.tolerance, params.direction(), params.the_machine(), grid,
-                           params.forward_step, params.chord_tol, progress=_passes_progress(progress))
+                           params.forward_step, params.chord_tol, progress=progress)
     segments = _segments(plan, params.zigzag)
     if not segments:
         raise TmmError(f"no pass could be placed on the mesh ({plan.report()})")

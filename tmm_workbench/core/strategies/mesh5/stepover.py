@@ -32,7 +32,7 @@ from typing import Callable, List, Optional, Sequence
 
 import numpy as np
 
-from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths, plane_normal
@@ -387,7 +387,8 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     """Passes across the mesh, each placed so that the scallop with the previous one stays within
     `tolerance` (module doc), their postures chosen for the Tarus motion time. Where no pass can advance the
     finished level (no posture for any gap), those places are listed in `AdaptivePlan.unfinished` for
-    clean-up and the passes go on beside them. TmmError for a tolerance that is not a positive number."""
+    clean-up and the passes go on beside them. `progress(fraction done)` after each pass, False cancels
+    (Cancelled), as everywhere in the core. TmmError for a tolerance that is not a positive number."""
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"tolerance must be a positive number of mm, got {tolerance!r}")
     require_plain(cutter)
@@ -442,7 +443,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         ahead = float(np.clip(ahead * (0.95 if relaxed else 1.1), 0.05 * cutter.radius, 2 * cutter.radius))
         gap = ahead
         guess = offset + 2 * gap
-        if progress is not None and progress(1.0 - float(np.mean(cover.open))):
-            break
+        if progress is not None and progress(1.0 - float(np.mean(cover.open))) is False:
+            raise Cancelled("5-axis mesh step-over cancelled")   # never a partial plan passed on as whole
     plan.seconds = time.perf_counter() - t0
     return plan
