@@ -121,7 +121,7 @@ def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path) -> None:
     render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {gcode.name}", size_px=(1400, 650))
 
 
-def write_pages(tmp: Path, job: JobSpec, mesh: TriMesh, doc: dict) -> None:
+def write_pages(tmp: Path, job: JobSpec, doc: dict) -> None:
     """report.json and report.html (with the heat map and the tool path picture, drawn here) into `tmp`."""
     from tmm_workbench.core.plan.report_html import report_html
 
@@ -143,7 +143,7 @@ def finish_outputs(tmp: Path, job: JobSpec, mesh: TriMesh, an: analysis.Analysis
         draw_toolpath(mesh, gcode, tmp / f"{out.name}_toolpath.png")
     files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
     doc = report(job, an, plan, verified, files)
-    write_pages(tmp, job, mesh, doc)
+    write_pages(tmp, job, doc)
     move_into_place(tmp, out.dir)
     return doc
 
