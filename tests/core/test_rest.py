@@ -15,6 +15,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint import rest
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.segments import SegmentKind
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import box_heights, mesh_heights
@@ -106,6 +107,39 @@ def test_cutting_is_the_tool_coming_more_than_the_tolerance_below_what_is_left()
         want.append(bool(np.any(left.ravel()[near] - surface > 0.01)))
     assert rest_filter.cutting(tips, ball, stock).tolist() == want
     assert 50 < sum(want) < 350   # both kinds present
+
+
+def moves(segments) -> set:
+    """The straight moves (from, to) the tool makes with the tool down: within each segment and into a joined one
+    from the end of the segment before it."""
+    key = lambda p: tuple(np.round(p, 9))   # noqa: E731
+    out = set()
+    for k, seg in enumerate(segments):
+        if seg.joined and k:
+            out.add((key(segments[k - 1].tips[-1]), key(seg.tips[0])))
+        out |= {(key(a), key(b)) for a, b in zip(seg.tips[:-1], seg.tips[1:])}
+    return out
+
+
+def test_a_pass_joined_across_a_left_out_link_of_one_point_is_entered_anew() -> None:
+    # pass A (y 2) cuts only near its start, the zig-zag link's one point (15, 3) and pass B (y 4) cut material
+    # beyond A's end: the link's run of one tip is dropped, so B reached from A's kept piece would be a straight
+    # 12 mm move across what the filter left out (the 3D offset rest's -0.79 mm gouge on sphere_on_plate)
+    grid = Grid.covering(-2.0, -1.0, 18.0, 8.0, 0.25)
+    left = np.full((grid.ny, grid.nx), -np.inf)
+    c = grid.centres().reshape(grid.ny, grid.nx, 2)
+    left[np.hypot(c[..., 0], c[..., 1] - 2.0) < 0.5] = 0.5
+    left[np.hypot(c[..., 0] - 15.5, c[..., 1] - 4.2) < 0.3] = 1.2
+    stock = rest_filter.RestStock(grid, left, 0.01)
+    x = np.arange(0.0, 15.0 + 1e-9, 0.25)
+    a = rest_filter.CutSegment(np.column_stack([x, np.full_like(x, 2.0), np.zeros_like(x)]))
+    link_point = rest_filter.CutSegment(np.array([[15.0, 3.0, 0.0]]), SegmentKind.LINK, joined=True)
+    b = rest_filter.CutSegment(np.column_stack([x[::-1], np.full_like(x, 4.0), np.zeros_like(x)]), joined=True)
+    params = SurfaceParams(boundary=(-2.0, -1.0, 18.0, 8.0), stepover=1.0, rest=stock)
+    kept = rest_filter.apply(params, Cutter.ball(3), [a, link_point, b], {})
+    assert len(kept) == 2 and kept[0].tips[-1, 0] < 5.0 and kept[1].tips[0, 0] == 15.0   # A's start, B's start
+    assert not kept[1].joined
+    assert moves(kept) <= moves([a, link_point, b])    # no move the input did not make
 
 
 def path_length(tp) -> float:

@@ -22,7 +22,7 @@ from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.segments import CutSegment
-from tmm_workbench.core.strategies.segment_split import keep_runs, move_samples
+from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.verify.holder_clearance import StickOut, minimum_stick_out
 
@@ -122,14 +122,15 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
         seg_hit, seg_z = hit[start:end], zb[start:end]
         start = end
         if not seg_hit.any():
-            out.append(seg if end_kept else replace(seg, joined=False))
+            pieces = [seg if end_kept else replace(seg, joined=False)]
         elif mode == LIFT:
             tips = pts.copy()
             tips[:, 2] = np.maximum(tips[:, 2], seg_z)
-            out.append(replace(seg, tips=_refined(drop, tips), arcs=None, joined=seg.joined and end_kept))
+            pieces = [replace(seg, tips=_refined(drop, tips), arcs=None, joined=seg.joined and end_kept)]
         else:
-            out += _leave_out(seg, seg_hit, move, end_kept)
-        end_kept = mode == LIFT or not seg_hit[-1]
+            pieces = _leave_out(seg, seg_hit, move, end_kept)
+        out += pieces
+        end_kept = mode == LIFT or keeps_end(seg, pieces)
     try:
         report.stick_out = minimum_stick_out(mesh, assembly, allpts[:, :2], surface=drop.surface)  # along the moves
     except TmmError as exc:  # a holder narrower than the shank somewhere: no stick-out is monotone

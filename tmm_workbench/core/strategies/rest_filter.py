@@ -15,7 +15,7 @@ import numpy as np
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.sim.grid import Grid
-from tmm_workbench.core.strategies.segment_split import keep_runs, move_samples
+from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.cutter import Cutter
 
 CHUNK = 20_000   # tips per vectorised block (x the cells under the tool: ~200 for a D3 on 0.25 mm cells)
@@ -72,7 +72,7 @@ def apply(params: Any, cutter: Cutter, segments: list[CutSegment], diagnostics: 
         return segments
     out: list[CutSegment] = []
     moves = kept = 0
-    end_kept = False   # the previous segment's last tip: a segment joined to it stays joined only then
+    end_kept = False   # the previous segment's last tip was kept: one joined to it stays joined only then
     for seg in segments:
         pts, move = move_samples(seg, rest.grid.cell)
         ok_move = np.zeros(len(seg), dtype=bool)
@@ -83,8 +83,9 @@ def apply(params: Any, cutter: Cutter, segments: list[CutSegment], diagnostics: 
         moves += len(seg)
         kept += int(ok_move.sum())
         whole = ok_tip.all() and ok_move[1:].all() and (end_kept or not seg.joined)
-        out += [seg] if whole else keep_runs(seg, ok_tip, ok_move | ~ok_tip, end_kept)
-        end_kept = bool(ok_tip[-1])
+        pieces = [seg] if whole else keep_runs(seg, ok_tip, ok_move | ~ok_tip, end_kept)
+        out += pieces
+        end_kept = keeps_end(seg, pieces)
     diagnostics["rest"] = {"moves": moves, "kept": kept}
     return out
 

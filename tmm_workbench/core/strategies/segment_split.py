@@ -37,6 +37,14 @@ def keep_runs(seg: CutSegment, ok_tip: np.ndarray, ok_move: np.ndarray, joined: 
     return pieces
 
 
+def keeps_end(seg: CutSegment, pieces: list[CutSegment]) -> bool:
+    """Whether `pieces` (what is kept of `seg`, in order) end at its last tip: a segment joined to `seg` stays
+    joined only then. A kept last tip is not enough: keep_runs drops a run of one tip (a zig-zag link of one point,
+    a last move left out), and the next segment joined to an earlier piece's end would be reached by a straight
+    move across what was left out."""
+    return bool(pieces) and len(pieces[-1]) > 0 and bool(np.array_equal(pieces[-1].tips[-1], seg.tips[-1]))
+
+
 def move_samples(seg: CutSegment, step: float) -> tuple[np.ndarray, np.ndarray]:
     """(points, move): the segment's tips with samples at most `step` apart along each move (arcs by their
     chords), each point's move (the tip it ends at; a tip is its own move's end)."""
