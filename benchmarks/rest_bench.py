@@ -6,7 +6,7 @@ For each model: a D10 raster finish (cusp 0.01 mm), simulated on the stock's top
 waterline loops over the sloped cells they leave above the tolerance: core.strategies.rest_steep)
 and a full D3 raster with the same step-over, both simulated from what the D10 left; printed side by side: feed
 length, cycle time (feed 1000 mm/min, plunge 300, rapid 5000), and what each leaves where the D3 reaches the model
-(cells above 0.01 mm, the largest), with the ratios.
+(cells above 0.01 mm, the largest), the plunges (entries), with the ratios.
 
 Run: OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/rest_bench.py [model.stl ...] [--offset3d]
 """
@@ -33,6 +33,7 @@ from tmm_workbench.core.sim.simulate import simulate  # noqa: E402
 from tmm_workbench.core.sim.stock import box_heights, mesh_heights  # noqa: E402
 from tmm_workbench.core.strategies import raster_drop  # noqa: E402
 from tmm_workbench.core.strategies.surface.params import SurfaceParams  # noqa: E402
+from tmm_workbench.core.toolpath import MoveKind  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 CELL, TOL = 0.25, 0.01
@@ -91,19 +92,23 @@ def run(path: Path, offset3d: bool) -> None:
         after = sim.heights
         length, seconds = cycle(tp)
         above, worst = left_where_reached(after, design, reach)
-        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design)), len(sim.collisions)))
+        plunges = sum(m.kind is MoveKind.PLUNGE for m in tp.moves)
+        rows.append((name, length, seconds, above, worst, float(np.nanmin(after - design)), len(sim.collisions),
+                     plunges))
     print(f"\n{path.name}: {area.summary()}; D10 finish {t_finish:.1f} s, rest {t_rest:.1f} s, full D3 {t_full:.1f} s "
           f"to compute ({'offset3d' if offset3d else 'raster'} rest)")
     steep = result.diagnostics.get("steep")
     if steep:
         print(f"the sloped rest the passes leave above {TOL} mm: {steep['cells']} cells, waterline loops in "
               f"{steep['groups']} group(s), {steep['levels']} levels, {steep['segments']} pieces")
+    print(f"pieces of passes and loops reached by a join with the tool down: {result.diagnostics.get('joins', 0)}")
     for note in params.verify_notes:   # what the op reports (a z-map of the rest cells cut by the pieces)
         print(f"op's report: {note.summary()}")
     print(f"{'path':10s} {'feed mm':>10s} {'cycle s':>9s} {'cells > tol':>12s} {'max left':>9s} {'min dev':>9s} "
-          f"{'rapids in stock':>16s}")
-    for name, length, seconds, above, worst, low, rapids in rows:
-        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f} {rapids:16d}")
+          f"{'rapids in stock':>16s} {'plunges':>8s}")
+    for name, length, seconds, above, worst, low, rapids, plunges in rows:
+        print(f"{name:10s} {length:10.0f} {seconds:9.0f} {above:12d} {worst:9.4f} {low:9.4f} {rapids:16d} "
+              f"{plunges:8d}")
     (_, lr, sr, *_), (_, lf, sf, *_) = rows
     print(f"{'ratio':10s} {lr / lf:10.2f} {sr / sf:9.2f}   (target <= 0.25 both, leaving the same)")
     # a path that leaves the full finish's cusp over the rest cells passes over them at most `step` apart: its

@@ -97,6 +97,7 @@ def test_a_steep_wall_rested_with_waterline_loops_is_within_the_tolerance() -> N
         if name == "split":   # the loops go over the steep cells the raster's passes leave above the tolerance
             steep = result.diagnostics["steep"]
             assert steep["levels"] >= 2 and steep["segments"] > 0
+            assert result.diagnostics["joins"] > 0   # pieces reached with the tool down (no gouge: above)
             assert 0 < steep["cells"] < np.sum(on_wall & area.mask)
             note = p.verify_notes[-1]   # what the op reports: the loops' cells, what stays (the wall's ends)
             assert isinstance(note, rest_steep.SteepReport)

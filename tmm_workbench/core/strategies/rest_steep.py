@@ -14,6 +14,10 @@ Measured (docs/rest_pencil.md): loops over every cell the passes cannot hold by 
 the others, made the rest 1.4 times longer on sphere_on_plate and 2.2 times on mount_rush than this (a large
 tool's cusps on a slope lie scattered along its passes, and a loop crossing them cuts little); loops only over the
 cells the formula calls steep left 2.3 times the cells above the tolerance on mount_rush.
+
+The pieces of passes and loops are then reached with the tool down from the one before where a join passes its
+checks (core.strategies.rest_joins): each entered by a hop and a plunge, the loops' short pieces took a third of
+the rest's time on mount_rush.
 """
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ from tmm_workbench.core.kernel import native
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.simulate import CUT, RAPID
-from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.strategies import rest_joins, waterline
 from tmm_workbench.core.tools.cutter import Cutter
 
 FLATTEST_DEG = 15.0    # the waterline's levels on flatter cells would be too close: what passes leave there stays
@@ -150,17 +154,22 @@ def residue(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> Opti
 def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment], surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
     """A rest's passes (`segments`, the Surface's pattern but the pencil) and after them the waterline loops over
-    the sloped rest cells they leave above the tolerance; what both leave (params.rest) as a SteepReport appended
-    to params.verify_notes (the op's RestReport) when it is a list."""
+    the sloped rest cells they leave above the tolerance, joined (rest_joins; diagnostics "joins"); what they leave
+    (params.rest) as a SteepReport appended to params.verify_notes (the op's RestReport) when it is a list."""
     rest = getattr(params, "rest", None)
     if rest is None or rest.design is None or params.pattern == "pencil":
         return segments
     sloped = of_params(params, cutter)
     left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
+    # the pieces of passes and loops reached with the tool down where a join from the one before passes its checks
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops,
+                                                       surface or DropSurface(mesh))
+    if cut:   # a join lifted over a ridge between two pieces may stand above both
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     if params.verify_notes is not None:
         a = rest.grid.cell_area
-        after = residue(rest, segments + loops, cutter)
+        after = residue(rest, cut, cutter)
         still = np.zeros(rest.heights.shape, dtype=bool) if after is None else np.isfinite(after.heights)
         if rest.envelope is not None:   # (beyond the tool's reach: the rest's own report)
             still &= rest.envelope - rest.design <= rest.within
@@ -171,7 +180,7 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
             float(np.sum(still & flat) * a), float(np.sum(still & edge) * a)))
-    return segments + loops
+    return cut
 
 
 def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
@@ -197,9 +206,9 @@ def patches(steep: RestStock, reach: float) -> list[RestStock]:
 
 def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
-    """Waterline loops over the steep rest cells, group by group (each group's levels top-down, the loops of
-    the next level reached with the tool down where they start near), within the Surface params' boundary, kept
-    where they cut that material (diagnostics "steep": levels, segments, cells, groups)."""
+    """Waterline loops over the steep rest cells, group by group (each group's levels top-down), within the
+    Surface params' boundary, kept where they cut that material, in the order `ordered` takes them, none joined
+    (finish joins them) (diagnostics "steep": levels, segments, cells, groups)."""
     surface = surface or DropSurface(mesh)
     segments: list[CutSegment] = []
     count = 0
@@ -210,10 +219,8 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
         count += len(found[1])
         segments += found[0]
     segments = ordered(segments)
-    for seg in segments:   # joined again in the new order: down to the next piece where it starts near
+    for seg in segments:   # joined again in the new order (rest_joins: finish)
         seg.joined = False
-    s = max(params.stock_to_leave, 0.0)
-    waterline.join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     diagnostics["steep"] = {"levels": count, "segments": len(segments), "groups": len(groups),
                             "cells": int(np.isfinite(steep.heights).sum())}
     if segments:

@@ -1,0 +1,101 @@
+"""Joins between the pieces of a rest's waterline loops (core.strategies.rest_steep): the next piece reached with
+the tool down, by a fed move, instead of a lift, a hop and a plunge at the plunge feed.
+
+A large tool's rest on a slope is a scatter of short loop pieces (mount_rush: 1,467 pieces, median 0.4 mm, each
+entered by a hop and a 1.6 mm plunge at the plunge feed: a third of the rest's time). The move from one piece's
+end a to the next one's start b, at most JOIN_DIAMETERS tool diameters apart and a level up or down, is the
+straight line a -> b lifted where the surface stands above it: sampled SAMPLE_MM apart along it, each sample at
+the higher of the line and the tool's drop there (plus the stock to leave), then thinned by chords that pass no
+lower than any sample (surface.segments.reduce_chords). It stays on or above the surface: it cuts the rest
+material it crosses, never the model. Before it is kept, its cut is checked: the moves against the model
+(core.verify.linear_moves, DEEPEST_MM) and, with a tool assembly and a join longer than the tool radius (a
+shorter one stays within the pieces' own reach), the neck, shank and holder against it along every sample
+(core.query.drop_assembly, the holder guard's clearance). A join that fails is not made: the linker enters the
+piece as before.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.segments import CutSegment, SegmentKind
+from tmm_workbench.core.strategies.surface.segments import reduce_chords
+from tmm_workbench.core.tools.cutter import Cutter
+
+JOIN_DIAMETERS = 2.0   # the longest join (XY and rise), in tool diameters: a 2 mm plunge at 300 mm/min and the hop
+#                        take as long as about 6 mm at 1000 mm/min
+SAMPLE_MM = 0.05       # the join's samples along the line (linear_moves' step)
+CHORD_MM = 0.002       # a thinned join passes at most this far above its samples
+DEEPEST_MM = 1e-3      # a join whose moves come this far below the model's drop between samples is not made
+
+
+def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
+                surface: DropSurface) -> tuple[list[CutSegment], int]:
+    """`segments` (the loops' pieces in cutting order) with each piece that is not joined reached from the one
+    before by a join where one passes the checks (see the module): a LINK segment of its interior points, joined,
+    and the piece joined; the segments and the number of joins made."""
+    s = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0)
+    grown = cutter.offset(s)
+    longest = JOIN_DIAMETERS * cutter.diameter
+    candidates = [k for k in range(1, len(segments)) if not segments[k].joined
+                  and _near(segments[k - 1].tips[-1], segments[k].tips[0], longest)]
+    if not candidates:
+        return segments, 0
+    joins = {k: _lifted(segments[k - 1].tips[-1], segments[k].tips[0], surface, grown, s) for k in candidates}
+    joins = {k: p for k, p in joins.items() if _clear_of_model(p, surface, grown, s)}
+    assembly = getattr(params, "assembly", None)
+    if assembly is not None:
+        from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+
+        bodies = AssemblyDrop(mesh, assembly, surface)
+        joins = {k: p for k, p in joins.items() if _length(p) <= cutter.radius or _clear_of_bodies(bodies, p)}
+    out: list[CutSegment] = []
+    for k, seg in enumerate(segments):
+        path = joins.get(k)
+        if path is not None:
+            if len(path) > 2:
+                out.append(CutSegment(path[1:-1], SegmentKind.LINK, joined=True, pass_index=seg.pass_index))
+            seg.joined = True
+        out.append(seg)
+    return out, len(joins)
+
+
+def _near(a: np.ndarray, b: np.ndarray, longest: float) -> bool:
+    return float(np.hypot(*(b[:2] - a[:2]))) <= longest and abs(float(b[2] - a[2])) <= longest
+
+
+def _length(p: np.ndarray) -> float:
+    return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
+
+
+def _lifted(a: np.ndarray, b: np.ndarray, surface: DropSurface, grown: Cutter, s: float) -> np.ndarray:
+    """(k, 3) the join a -> b: the line lifted onto the surface where it stands above it, thinned."""
+    n = max(1, int(math.ceil(float(np.hypot(*(b[:2] - a[:2]))) / SAMPLE_MM)))
+    f = np.linspace(0.0, 1.0, n + 1)[:, None]
+    pts = a + f * (b - a)
+    if n > 1:
+        inner = pts[1:-1]
+        floor = float(min(a[2], b[2])) - s - 1e3
+        inner[:, 2] = np.maximum(inner[:, 2], surface.drop(grown, inner[:, :2], floor) + s)
+    return reduce_chords(pts, CHORD_MM)
+
+
+def _clear_of_model(path: np.ndarray, surface: DropSurface, grown: Cutter, s: float) -> bool:
+    from tmm_workbench.core.verify.linear_moves import deepest_cut
+
+    moves = path - np.array([0.0, 0.0, s])   # the grown cutter's tips lie s lower
+    return deepest_cut(surface, grown, moves, np.ones(len(moves), dtype=bool), SAMPLE_MM / 2)[0] <= DEEPEST_MM
+
+
+def _clear_of_bodies(bodies: Any, path: np.ndarray) -> bool:
+    """Whether the neck, shank and holder (an AssemblyDrop) keep their clearance along the join's samples."""
+    from tmm_workbench.core.strategies.holder_guard import BODIES, TOLERANCE_MM
+    from tmm_workbench.core.strategies.segment_split import move_samples
+
+    pts, _ = move_samples(CutSegment(path), SAMPLE_MM)
+    zb, owner = bodies.heights_of(BODIES, pts[:, :2])
+    return not bool(np.any((zb - pts[:, 2] > TOLERANCE_MM) & (owner >= 0)))
