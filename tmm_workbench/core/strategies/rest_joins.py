@@ -5,8 +5,8 @@ A large tool's rest on a slope is a scatter of short loop pieces (mount_rush: 1,
 entered by a hop and a 1.6 mm plunge at the plunge feed: a third of the rest's time). The move from one piece's
 end a to the next one's start b, at most JOIN_DIAMETERS tool diameters apart and a level up or down, is the
 straight line a -> b lifted where the surface stands above it: sampled SAMPLE_MM apart along it, each sample at
-the higher of the line and the tool's drop there (plus the stock to leave), then thinned by chords that pass no
-lower than any sample (surface.segments.reduce_chords). It stays on or above the surface: it cuts the rest
+the higher of the line and the tool's drop there (plus the stock to leave), midpoints inserted where a steep wall
+rises between two, then thinned by chords that pass no lower than any sample (surface.segments.reduce_chords). It stays on or above the surface: it cuts the rest
 material it crosses, never the model. Before it is kept, its cut is checked: the moves against the model
 (core.verify.linear_moves, DEEPEST_MM) and, with a tool assembly and a join longer than the tool radius (a
 shorter one stays within the pieces' own reach), the neck, shank and holder against it along every sample
@@ -31,6 +31,8 @@ JOIN_DIAMETERS = 2.0   # the longest join (XY and rise), in tool diameters: a 2 
 SAMPLE_MM = 0.05       # the join's samples along the line (linear_moves' step)
 CHORD_MM = 0.002       # a thinned join passes at most this far above its samples
 DEEPEST_MM = 1e-3      # a join whose moves come this far below the model's drop between samples is not made
+REFINE_ROUNDS = 8      # halvings of a move between samples where the midpoint's drop stands above it
+MIN_GAP_MM = 1e-3      # down to this far apart
 
 
 def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
@@ -77,10 +79,21 @@ def _lifted(a: np.ndarray, b: np.ndarray, surface: DropSurface, grown: Cutter, s
     n = max(1, int(math.ceil(float(np.hypot(*(b[:2] - a[:2]))) / SAMPLE_MM)))
     f = np.linspace(0.0, 1.0, n + 1)[:, None]
     pts = a + f * (b - a)
+    floor = float(min(a[2], b[2])) - s - 1e3
+
+    def lift(p: np.ndarray) -> None:
+        p[:, 2] = np.maximum(p[:, 2], surface.drop(grown, p[:, :2], floor) + s)
+
     if n > 1:
-        inner = pts[1:-1]
-        floor = float(min(a[2], b[2])) - s - 1e3
-        inner[:, 2] = np.maximum(inner[:, 2], surface.drop(grown, inner[:, :2], floor) + s)
+        lift(pts[1:-1])
+    for _ in range(REFINE_ROUNDS):   # a steep wall rises between two samples: its midpoints lifted too
+        mid = 0.5 * (pts[1:] + pts[:-1])
+        z = mid[:, 2].copy()
+        lift(mid)
+        low = (mid[:, 2] - z > DEEPEST_MM / 10) & (np.hypot(*np.diff(pts[:, :2], axis=0).T) > MIN_GAP_MM)
+        if not low.any():
+            break
+        pts = np.insert(pts, np.flatnonzero(low) + 1, mid[low], axis=0)
     return reduce_chords(pts, CHORD_MM)
 
 
