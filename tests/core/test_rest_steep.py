@@ -10,6 +10,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from tests.conftest import grid_mesh
 from tests.core.rest_case import after_d10
 from tmm_workbench.core import polygons
 from tmm_workbench.core.footprint import rest
@@ -118,3 +119,29 @@ def test_the_pieces_go_nearest_first_and_downhill_keeping_joined_ones_together()
     a, far, b, b2, up = piece(0.0, 5.0), piece(50.0, 5.0), piece(1.5, 4.8), piece(2.6, 4.7, True), piece(2.0, 6.0)
     # from a's end (1, 0, 5): b 0.5 away and 0.2 down; the piece 1 mm away but 1 mm up costs 1 + 4; far last
     assert rest_steep.ordered([a, far, up, b, b2]) == [a, b, b2, up, far]
+
+
+def test_the_work_estimate_counts_the_loops_over_the_rest_slopes() -> None:
+    # a 60 deg cone, its ring between radii 2 and 4.5 mm left 0.05 mm above it
+    tan = math.tan(math.radians(60.0))
+    cone = lambda x, y: np.maximum(0.0, (6.0 - np.hypot(x, y)) * tan)   # noqa: E731
+    mesh = grid_mesh(cone, 96, 96, (-8.0, -8.0, 8.0, 8.0))
+    grid = Grid.covering(-8.0, -8.0, 8.0, 8.0, 0.25)
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    design = cone(X, Y)
+    ring = (np.hypot(X, Y) > 2.0) & (np.hypot(X, Y) < 4.5)
+    stock = RestStock(grid, np.where(ring, design + 0.05, -np.inf), 0.002, design, TOL)
+    plain = SurfaceParams(boundary=(-8.0, -8.0, 8.0, 8.0), stepover=0.3)
+    bounds = (-8.0, -8.0, 0.0, 8.0, 8.0, 6.0 * tan)
+    without = raster_drop.estimate_work(plain, D3, bounds)
+    work = raster_drop.estimate_work(replace(plain, rest=stock), D3, bounds)
+    count, length, n = rest_steep.estimate(replace(plain, rest=stock), D3)
+    assert n == len(rest_steep.levels(rest_steep.of_params(replace(plain, rest=stock), D3), D3.radius, 0.008))
+    assert count > 0 and work.count == pytest.approx(without.count + count)
+    assert work.cut_length == pytest.approx(without.cut_length + length)
+    assert dict(work.paces)["waterline"] == count and "waterline loops" in work.note
+    # the loops made: the tip runs r sin a outside the contacts around the cone (radius 2 to 4.5): 1.3 to 1.6 times
+    made = rest_steep.passes(mesh, D3, replace(plain, rest=stock), rest_steep.of_params(replace(plain, rest=stock),
+                                                                                       D3), None, {})
+    real = sum(float(np.linalg.norm(np.diff(seg.tips, axis=0), axis=1).sum()) for seg in made)
+    assert 1.2 * length < real < 1.7 * length

@@ -259,19 +259,55 @@ def ordered(segments: list[CutSegment]) -> list[CutSegment]:
     return [seg for i in order for seg in chains[i]]
 
 
+def estimate(params: Any, cutter: Cutter) -> Optional[tuple[float, float, int]]:
+    """The waterline loops a rest's slopes may get, before any is made (None: no rest, a pencil, a flat end mill
+    or nothing sloped): (drops and loop points, loop length mm, levels) as if the passes left every sloped rest
+    cell above the tolerance (they leave a part of them: an upper bound). Each group's levels and box as passes
+    makes them, its drops and points as the waterline counts them (core.query.waterline.estimate_work: refused
+    above the limits, as the waterline would refuse it); the length: each cell's area times tan a over its
+    levels' step, the contacts' length (the tip runs a corner radius times sin a off them: around a convex slope
+    of plan radius rho longer by r sin a / rho, in a concave corner shorter)."""
+    from tmm_workbench.core.query import waterline as wl
+
+    steep = of_params(params, cutter)
+    if steep is None:
+        return None
+    cusp = WALL_CUSP * steep.within
+    count, n = 0.0, 0
+    for group in patches(steep, cutter.diameter):
+        zs = levels(group, cutter.corner_radius, cusp)
+        box = _group_box(group, cutter, params.boundary)
+        if box is None:
+            continue
+        count += wl.estimate_work(box, len(zs), wl.default_sample_step(cutter, box),
+                                  f"the rest's sloped cells: {len(zs)} levels spaced by the cusp on the wall")
+        n += len(zs)
+    cells = np.isfinite(steep.heights)
+    a = np.radians(np.clip(np.nan_to_num(slope_deg(steep.design, steep.grid.cell)[cells]), FLATTEST_DEG,
+                           STEEPEST_DEG))
+    length = float(np.sum(steep.grid.cell_area * np.tan(a) / level_step(cutter.corner_radius, cusp, a)))
+    return count, length, n
+
+
+def _group_box(group: RestStock, cutter: Cutter, boundary: tuple) -> Optional[tuple[float, float, float, float]]:
+    """The box of a group's loops: its cells' grown by the tool diameter (the tool centre is within a radius of
+    its contact: the loop well inside it), within the boundary; None when nothing is left of it."""
+    g, cells = group.grid, np.isfinite(group.heights)
+    xy = g.centres().reshape(g.ny, g.nx, 2)[cells]
+    grow, b = cutter.diameter, boundary
+    box = (max(b[0], float(xy[:, 0].min()) - grow), max(b[1], float(xy[:, 1].min()) - grow),
+           min(b[2], float(xy[:, 0].max()) + grow), min(b[3], float(xy[:, 1].max()) + grow))
+    return box if box[2] > box[0] and box[3] > box[1] else None
+
+
 def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,
                   surface: DropSurface) -> tuple[list[CutSegment], list[float]]:
-    """(segments, levels) of one group of steep cells: its box grown by the tool diameter, within the boundary."""
+    """(segments, levels) of one group of steep cells, in its box (_group_box)."""
     zs = levels(group, cutter.corner_radius, WALL_CUSP * group.within)
     lo = float(mesh.bounds[0][2])
     zs = [z for z in zs if z >= lo]
-    g, cells = group.grid, np.isfinite(group.heights)
-    xy = g.centres().reshape(g.ny, g.nx, 2)[cells]
-    grow = cutter.diameter   # the tool centre is within a radius of its contact: the loop well inside the box
-    b = params.boundary
-    box = (max(b[0], float(xy[:, 0].min()) - grow), max(b[1], float(xy[:, 1].min()) - grow),
-           min(b[2], float(xy[:, 0].max()) + grow), min(b[3], float(xy[:, 1].max()) + grow))
-    if not zs or not (box[2] > box[0] and box[3] > box[1]):
+    box = _group_box(group, cutter, params.boundary)
+    if not zs or box is None:
         return [], []
     wp = waterline.WaterlineParams(boundary=box, step_down=1.0, top_z=zs[0] + 1e-6,
                                    bottom_z=min(zs[-1], zs[0] - 1e-5), chord_tol=CHORD_TOL, z_levels=zs,

@@ -55,8 +55,23 @@ def estimate_work(params: SurfaceParams, cutter: Cutter, bounds: Box, sample: Op
     wider than the tool is refused (TmmError); a cusp spacing with a flat end mill is told in the work's note."""
     params.validate()
     flat_cusp = tool_fit(params, cutter) if params.pattern != PENCIL else ""
-    work = _estimate(params, cutter, sample)
+    work = _with_loops(_estimate(params, cutter, sample), params, cutter)
     return replace(work, note=f"{work.note} WARNING: {flat_cusp}".strip()) if flat_cusp else work
+
+
+def _with_loops(work: Work, params: SurfaceParams, cutter: Cutter) -> Work:
+    """A rest's `work` with the waterline loops over its slopes (core.strategies.rest_steep.estimate), when its
+    rest is known (the op's after it has found it)."""
+    if getattr(params, "rest", None) is None or params.pattern == PENCIL:
+        return work
+    from tmm_workbench.core.strategies import rest_steep
+
+    loops = rest_steep.estimate(params, cutter)
+    if loops is None:
+        return work
+    count, length, levels = loops
+    note = f"{work.note} (with the waterline loops over the rest's slopes: {levels} levels, at most)".strip()
+    return replace(work.plus(count, "waterline", note), cut_length=float(work.cut_length or 0.0) + length)
 
 
 def _estimate(params: SurfaceParams, cutter: Cutter, sample: Optional[HeightSample]) -> Work:
