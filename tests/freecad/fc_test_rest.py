@@ -12,6 +12,7 @@ import numpy as np
 
 from fc_helpers import FreeCADTestCase, reopened
 from fc_test_holder import cavity_stl
+from tmm_workbench.app import work_estimate
 from tmm_workbench.app.api import run_surface, simulate
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.rest import tool_envelope
@@ -54,6 +55,11 @@ class RestInTheSurface(FreeCADTestCase):
         self.assertGreater(np.sum(reach & (before.simulation.comparison.deviation > 0.012)), 1000)
         full = run_surface(job=big.job, tool="ballend", diameter=3.0, stepover=STEP_D3, **HALF)
         self.assertLess(feed_length(op.Proxy.toolpath), 0.5 * feed_length(full.op.Proxy.toolpath))
+        told = work_estimate.estimate(op)   # after a run: over the rest it found (and its slopes' loops: none here)
+        found, op.Proxy.rest = op.Proxy.rest, None
+        boxed = work_estimate.estimate(op)  # before: over the box
+        op.Proxy.rest = found
+        self.assertLess(told.cut_length, 0.7 * boxed.cut_length)   # (0.58: the region grown by the radius)
         op = reopened(rest.doc, op, "rest.FCStd")   # the report and marks are saved with the op
         self.assertEqual((op.Region, op.RestFrom, len(op.RestRegions) > 100), ("Rest", "EarlierOps", True))
 

@@ -101,6 +101,9 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         params.rest = None if rest is None else rest.stock
         params.pencil_curves = pencil_source.curves_of(obj)   # an outline's or a footprint file's (pattern Pencil)
         params.cleanup_reference = pencil_source.finishing_cutter(obj, cutter)   # the clean-up's finishing tool
+        if rest is not None:   # its slopes' loops are told only now: refused above the limits before any is made
+            lo, hi = mesh.bounds
+            self.STRATEGY.estimate_work(params, cutter, (*map(float, lo), *map(float, hi)))
         flat_cusp = tool_fit(params, cutter)
         if flat_cusp:
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {flat_cusp}\n")

@@ -208,7 +208,8 @@ Inputs = Optional[tuple[Any, Any, tuple[float, ...]]]   # (params, cutter, bound
 
 def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
     """The Surface's params over its region (a sketch's or faces' polygons and their box; Rest is known only when
-    it computes: its box) or its boundary box (the stock's or the model's, with the margin), and a coarse sample
+    it computes: the last run's, its region and rest (the loops over its slopes counted), else the box) or its
+    boundary box (the stock's or the model's, with the margin), and a coarse sample
     of the model's heights when the model is at hand (core.query.height_sample: the passes and time told)."""
     from tmm_workbench.app import region_source
     from tmm_workbench.app.compat import PathUtils
@@ -222,10 +223,16 @@ def surface(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> In
             return None
     m = _value(obj, "BoundaryMargin", ov)
     region = None
-    if getattr(obj, "Region", region_source.BOX) not in (region_source.BOX, region_source.REST):
+    kind = getattr(obj, "Region", region_source.BOX)
+    rest = getattr(proxy, "rest", None) if kind == region_source.REST else None   # the last run's (app.rest_source)
+    if rest is not None:   # its region, and its slopes' waterline loops counted
+        region = rest.region
+    elif kind not in (region_source.BOX, region_source.REST):
         region = region_source.region_of(obj, PathUtils.findParentJob(obj))
     boundary = (box[0] - m, box[1] - m, box[3] + m, box[4] + m) if region is None else polygons.bounds(region)
     params = _params(proxy, obj, ov, boundary=boundary, region=region)
+    if rest is not None:
+        params.rest = rest.stock
     cutter = _cutter(obj)
     mesh = _mesh_at_hand(proxy, obj, load_stl)
     if mesh is None:
