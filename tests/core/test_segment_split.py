@@ -9,7 +9,7 @@ from tmm_workbench.core.linking import RAMP
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.strategies import rest_filter
-from tmm_workbench.core.strategies.segment_split import keep_runs, move_samples
+from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.cutter import Cutter
 
 
@@ -48,3 +48,14 @@ def test_the_rest_filter_unjoins_a_pass_after_a_cut_off_end() -> None:
     assert [p.tips[[0, -1], 0].tolist() for p in out] == [[0, 3], [3, 0]]   # the ball D1 reaches x < 2 from x = 3
     assert not out[1].joined                 # its start was cut off: entered from above, not fed across
     assert diags["rest"]["kept"] < diags["rest"]["moves"]
+
+
+def test_the_end_is_kept_only_by_a_piece_that_ends_there() -> None:
+    seg = line(10, joined=True)
+    ok_move = np.ones(10, dtype=bool)
+    ok_tip = np.ones(10, dtype=bool)
+    ok_tip[8] = False                       # tip 9 alone: a run of one tip, no piece
+    pieces = keep_runs(seg, ok_tip, ok_move)
+    assert ok_tip[-1] and pieces[-1].tips[-1, 0] == 7.0
+    assert not keeps_end(seg, pieces) and keeps_end(seg, keep_runs(seg, np.ones(10, dtype=bool), ok_move))
+    assert not keeps_end(seg, [])
