@@ -1,5 +1,5 @@
-"""Joins between the pieces of a rest's waterline loops (core.strategies.rest_steep): the next piece reached with
-the tool down, by a fed move, instead of a lift, a hop and a plunge at the plunge feed.
+"""Joins between the pieces of a rest's passes and waterline loops (core.strategies.rest_steep): the next piece
+reached with the tool down, by a fed move, instead of a lift, a hop and a plunge at the plunge feed.
 
 A large tool's rest on a slope is a scatter of short loop pieces (mount_rush: 1,467 pieces, median 0.4 mm, each
 entered by a hop and a 1.6 mm plunge at the plunge feed: a third of the rest's time). The move from one piece's
@@ -37,9 +37,10 @@ MIN_GAP_MM = 1e-3      # down to this far apart
 
 def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment],
                 surface: DropSurface) -> tuple[list[CutSegment], int]:
-    """`segments` (the loops' pieces in cutting order) with each piece that is not joined reached from the one
-    before by a join where one passes the checks (see the module): a LINK segment of its interior points, joined,
-    and the piece joined; the segments and the number of joins made."""
+    """`segments` (the rest's pieces of passes and loops, in cutting order) with each piece that is not joined
+    reached from the one before by a join where one passes the checks (see the module): a LINK segment of its
+    interior points, joined, before it, and the piece marked joined (in place); the segments and the number of
+    joins made."""
     s = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0)
     grown = cutter.offset(s)
     longest = JOIN_DIAMETERS * cutter.diameter
