@@ -124,7 +124,7 @@ def moves(segments) -> set:
 def test_a_pass_joined_across_a_left_out_link_of_one_point_is_entered_anew() -> None:
     # pass A (y 2) cuts only near its start, the zig-zag link's one point (15, 3) and pass B (y 4) cut material
     # beyond A's end: the link's run of one tip is dropped, so B reached from A's kept piece would be a straight
-    # 12 mm move across what the filter left out (the 3D offset rest's -0.79 mm gouge on sphere_on_plate)
+    # 14 mm move across what the filter left out (the 3D offset rest's -0.79 mm gouge on sphere_on_plate)
     grid = Grid.covering(-2.0, -1.0, 18.0, 8.0, 0.25)
     left = np.full((grid.ny, grid.nx), -np.inf)
     c = grid.centres().reshape(grid.ny, grid.nx, 2)
