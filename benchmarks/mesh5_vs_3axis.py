@@ -1,8 +1,8 @@
 """5-axis on a mesh against TMM's best 3-axis ball finish at equal scallop (seed 000's convex surface, Fig. 5-5's
 case): a flat end mill D 0.5 in tilted by the 3D C-space (core.strategies.mesh5.finish, the op's strategy),
 posted by the Tarus post (its estimate plans A and C at the joint speeds), against a ball D 0.5 in with the
-Surface's cusp-driven modes (cusp and adaptive, raster along X and along Y, and the 3D offset; the fastest counts), both at the
-same feed and the same scallop height (the seed's 0.004 in).
+Surface's cusp-driven modes (cusp and adaptive, raster along X and along Y, and the 3D offset; the fastest
+counts), both at the same feed and the same scallop height (the seed's 0.004 in).
 
     .venv/bin/python benchmarks/mesh5_vs_3axis.py [--surface convex] [--tolerance-in 0.004] [--feed 1000]
 
