@@ -34,7 +34,7 @@ from tmm_workbench.core.kernel import native
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.simulate import CUT, RAPID
-from tmm_workbench.core.strategies import rest_joins, waterline
+from tmm_workbench.core.strategies import rest_joins, rest_touchup, waterline
 from tmm_workbench.core.tools.cutter import Cutter
 
 FLATTEST_DEG = 15.0    # the waterline's levels on flatter cells would be too close: what passes leave there stays
@@ -162,9 +162,15 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     sloped = of_params(params, cutter)
     left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
+    # where passes and loops leave the rest above the tolerance, the tool put where it reaches it
+    surface = surface or DropSurface(mesh)
+    touch = rest_touchup.pieces(_reached(residue(rest, segments + loops, cutter)), cutter, surface,
+                                float(getattr(params, "stock_to_leave", 0.0)))
+    diagnostics["touch_ups"] = len(touch)
+    if touch:
+        loops = ordered(loops + touch)
     # the pieces of passes and loops reached with the tool down where a join from the one before passes its checks
-    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops,
-                                                       surface or DropSurface(mesh))
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops, surface)
     if cut:   # a join lifted over a ridge between two pieces may stand above both
         diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     if params.verify_notes is not None:
@@ -181,6 +187,15 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
             float(np.sum(still & flat) * a), float(np.sum(still & edge) * a)))
     return cut
+
+
+def _reached(left: Optional[RestStock]) -> Optional[RestStock]:
+    """`left` on the cells where the tool's envelope comes within the tolerance (all of it without an
+    envelope); None when none is."""
+    if left is None or left.envelope is None:
+        return left
+    cells = np.isfinite(left.heights) & (left.envelope - left.design <= left.within)
+    return replace(left, heights=np.where(cells, left.heights, -np.inf)) if cells.any() else None
 
 
 def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
