@@ -39,6 +39,9 @@ def test_the_foot_of_a_wall_the_passes_and_loops_leave_is_touched_up_within_the_
     touched = raster_drop.compute(mesh, D3, params)
     assert touched.diagnostics["touch_ups"] > 0
     assert np.nanmax(left_over(touched)) <= TOL
+    note = params.verify_notes[-1]   # the op's RestReport: the touch-ups, nothing left within reach
+    assert note.touch_ups == touched.diagnostics["touch_ups"] and "touch-up(s) where" in note.summary()
+    assert note.sloped_after == 0 and note.flat_after == 0
     monkeypatch.setattr(rest_touchup, "pieces", lambda *args, **kwargs: [])
     plain = left_over(raster_drop.compute(mesh, D3, params))
     feet = np.argwhere(plain > TOL)   # the passes and loops alone leave cells at the wall's foot

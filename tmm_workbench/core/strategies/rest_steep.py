@@ -55,11 +55,14 @@ class SteepReport:
     sloped_after: float   # mm^2 of sloped rest the tool reaches still above it after the loops
     flat_after: float     # mm^2 flatter than FLATTEST_DEG it reaches the passes leave above it (no loops there)
     edge: float = 0.0     # mm^2 of both where its envelope stands more than half the tolerance above the design
+    touch_ups: int = 0    # pieces put where the tool reaches what passes and loops left (core.strategies.rest_touchup)
 
     def summary(self) -> str:
         text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline loops "
                 f"over it ({self.groups} group(s), {self.levels} levels)" if self.sloped else
                 f"the passes left no sloped rest above {self.tolerance:g} mm")
+        if self.touch_ups:
+            text += f"; {self.touch_ups} touch-up(s) where the tool reaches what passes and loops left above it"
         if self.sloped_after > 0 or self.flat_after > 0:
             text += (f"; where this tool reaches, {self.sloped_after:.1f} mm2 sloped and {self.flat_after:.1f} mm2 "
                      f"flatter than {FLATTEST_DEG:g} deg (no loops there) stay above it, {self.edge:.1f} mm2 of them "
@@ -185,7 +188,7 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
         params.verify_notes.append(SteepReport(
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
-            float(np.sum(still & flat) * a), float(np.sum(still & edge) * a)))
+            float(np.sum(still & flat) * a), float(np.sum(still & edge) * a), len(touch)))
     return cut
 
 
