@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 
+from tests.conftest import grid_mesh
 from tests.core.rest_case import after_d10
 from tests.core.test_rest_steep import D3, TOL, WALL_X, wall_mesh
 from tmm_workbench.core import polygons
@@ -16,8 +17,13 @@ from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.strategies import raster_drop, rest_touchup
 from tmm_workbench.core.strategies.surface.params import SurfaceParams
+from tmm_workbench.core.tools.assembly import ToolAssembly
+from tmm_workbench.core.tools.cutter import Cutter
+
+PARAMS = SurfaceParams(boundary=(0.0, 0.0, 30.0, 10.0), stepover=0.3)
 
 
 def test_the_foot_of_a_wall_the_passes_and_loops_leave_is_touched_up_within_the_tolerance(monkeypatch) -> None:
@@ -59,7 +65,8 @@ def test_a_touch_up_goes_where_the_tool_reaches_the_cell_and_neighbours_are_one_
     heights = np.full_like(design, -np.inf)
     heights[20, 20] = heights[20, 21] = heights[30, 5] = 0.05
     left = RestStock(grid, heights, 0.002, design, TOL, envelope=design.copy())
-    pieces = rest_touchup.pieces(left, D3, DropSurface(flat_mesh()))
+    mesh = flat_mesh()
+    pieces = rest_touchup.pieces(mesh, D3, PARAMS, left, DropSurface(mesh))
     assert len(pieces) == 2
     one, two = sorted(pieces, key=lambda seg: float(np.ptp(seg.tips[:, 0])))
     assert np.allclose(one.tips, [[grid.xs()[5], grid.ys()[30], 0.0]] * 2)   # down there and up
@@ -72,7 +79,25 @@ def test_a_touch_up_goes_where_the_tool_reaches_the_cell_and_neighbours_are_one_
     heights = np.full_like(design, -np.inf)
     heights[10, 10] = 0.05
     left = RestStock(grid, heights, 0.002, pit, TOL)
-    assert rest_touchup.pieces(left, D3, DropSurface(flat_mesh())) == []
+    assert rest_touchup.pieces(mesh, D3, PARAMS, left, DropSurface(mesh)) == []
+
+
+def test_touch_ups_keep_the_holder_clear_of_a_wall() -> None:
+    # a floor beside a wall 40 mm high; a ball D4 on a 20 mm stick-out: its holder reaches over the wall
+    mesh = grid_mesh(lambda x, y: np.clip((x - 10.0) * 10.0, 0.0, 40.0), 120, 40, (0.0, 0.0, 30.0, 10.0), "wall")
+    surface = DropSurface(mesh)
+    ball = Cutter.ball(4)
+    grid = Grid.covering(0.0, 0.0, 30.0, 10.0, 0.25)
+    design = mesh_heights(mesh, grid)
+    heights = np.full_like(design, -np.inf)
+    heights[20, 31] = 0.05                      # on the floor at x 7.9, y 5.1, the ball D4 reaches it
+    left = RestStock(grid, heights, 0.002, design, TOL)
+    free = rest_touchup.pieces(mesh, ball, PARAMS, left, surface)
+    assert len(free) == 1 and np.allclose(free[0].tips[:, 2], 0.0, atol=1e-6)
+    holder = ToolAssembly(ball, 4, 20.0, flute_length=12, holder="SK40 ER32x70")
+    params = SurfaceParams(boundary=PARAMS.boundary, stepover=0.3, assembly=holder, holder_collision="leave_out",
+                           holder_notes=[])
+    assert rest_touchup.pieces(mesh, ball, params, left, surface) == [] and params.holder_notes[-1].affected > 0
 
 
 def test_a_cell_the_tool_brings_within_the_tolerance_is_rest_however_little_it_takes_off() -> None:

@@ -167,8 +167,7 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
     # where passes and loops leave the rest above the tolerance, the tool put where it reaches it
     surface = surface or DropSurface(mesh)
-    touch = rest_touchup.pieces(_reached(residue(rest, segments + loops, cutter)), cutter, surface,
-                                float(getattr(params, "stock_to_leave", 0.0)))
+    touch = rest_touchup.pieces(mesh, cutter, params, _reached(residue(rest, segments + loops, cutter)), surface)
     diagnostics["touch_ups"] = len(touch)
     if touch:
         loops = ordered(loops + touch)
