@@ -30,13 +30,13 @@ D3 = Cutter.ball(3)
 WALL_DEG, WALL_X, WALL_H = 60.0, 10.0, 6.0
 
 
-def wall_mesh() -> TriMesh:
-    """A floor meeting a 60 deg wall along y (from x = 10) up to a plateau 6 mm high: a height field on 0.25 mm."""
+def wall_mesh(deg: float = WALL_DEG) -> TriMesh:
+    """A floor meeting a `deg` wall along y (from x = 10) up to a plateau 6 mm high: a height field on 0.25 mm."""
     xs = np.unique(np.concatenate([np.arange(0.0, 20.01, 0.25),
-                                   [WALL_X, WALL_X + WALL_H / math.tan(math.radians(WALL_DEG))]]))
+                                   [WALL_X, WALL_X + WALL_H / math.tan(math.radians(deg))]]))
     ys = np.arange(0.0, 10.01, 0.25)
     X, Y = np.meshgrid(xs, ys)
-    Z = np.clip((X - WALL_X) * math.tan(math.radians(WALL_DEG)), 0.0, WALL_H)
+    Z = np.clip((X - WALL_X) * math.tan(math.radians(deg)), 0.0, WALL_H)
     nx, ny = len(xs), len(ys)
     idx = np.arange(nx * ny).reshape(ny, nx)
     a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()

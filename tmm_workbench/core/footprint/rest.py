@@ -141,7 +141,10 @@ def rest_area(left: np.ndarray, design: np.ndarray, envelope: np.ndarray, grid: 
     # above the tolerance, and the tool takes some of it off (to within the tolerance where it reaches)
     # every such cell, a single one too: a large tool's raster on a steep slope leaves its cusps above the
     # tolerance in cells one or two wide along its passes
-    mask = has_design & (left - design > tolerance) & (left - envelope > LEAST_CUT * tolerance)
+    # (and every cell it brings within the tolerance, however little it takes off: a cell 0.0105 mm above the
+    # design with the envelope at 0.009 is rest too)
+    mask = has_design & (left - design > tolerance) & ((left - envelope > LEAST_CUT * tolerance)
+                                                        | (envelope - design <= tolerance))
     after = np.minimum(left, envelope)
     above = np.where(has_design, np.clip(left - design, 0, None), 0.0)
     above_after = np.where(has_design, np.clip(after - design, 0, None), 0.0)

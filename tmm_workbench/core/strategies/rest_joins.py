@@ -48,7 +48,7 @@ def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSe
                   and _near(segments[k - 1].tips[-1], segments[k].tips[0], longest)]
     if not candidates:
         return segments, 0
-    joins = {k: _lifted(segments[k - 1].tips[-1], segments[k].tips[0], surface, grown, s) for k in candidates}
+    joins = {k: lifted(segments[k - 1].tips[-1], segments[k].tips[0], surface, grown, s) for k in candidates}
     joins = {k: p for k, p in joins.items() if _clear_of_model(p, surface, grown, s)}
     assembly = getattr(params, "assembly", None)
     if assembly is not None:
@@ -75,7 +75,7 @@ def _length(p: np.ndarray) -> float:
     return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
 
 
-def _lifted(a: np.ndarray, b: np.ndarray, surface: DropSurface, grown: Cutter, s: float) -> np.ndarray:
+def lifted(a: np.ndarray, b: np.ndarray, surface: DropSurface, grown: Cutter, s: float) -> np.ndarray:
     """(k, 3) the join a -> b: the line lifted onto the surface where it stands above it, thinned."""
     n = max(1, int(math.ceil(float(np.hypot(*(b[:2] - a[:2]))) / SAMPLE_MM)))
     f = np.linspace(0.0, 1.0, n + 1)[:, None]

@@ -34,7 +34,7 @@ from tmm_workbench.core.kernel import native
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.simulate import CUT, RAPID
-from tmm_workbench.core.strategies import rest_joins, waterline
+from tmm_workbench.core.strategies import rest_joins, rest_touchup, waterline
 from tmm_workbench.core.tools.cutter import Cutter
 
 FLATTEST_DEG = 15.0    # the waterline's levels on flatter cells would be too close: what passes leave there stays
@@ -55,11 +55,14 @@ class SteepReport:
     sloped_after: float   # mm^2 of sloped rest the tool reaches still above it after the loops
     flat_after: float     # mm^2 flatter than FLATTEST_DEG it reaches the passes leave above it (no loops there)
     edge: float = 0.0     # mm^2 of both where its envelope stands more than half the tolerance above the design
+    touch_ups: int = 0    # pieces put where the tool reaches what passes and loops left (core.strategies.rest_touchup)
 
     def summary(self) -> str:
         text = (f"the passes left {self.sloped:.1f} mm2 of sloped rest above {self.tolerance:g} mm: waterline loops "
                 f"over it ({self.groups} group(s), {self.levels} levels)" if self.sloped else
                 f"the passes left no sloped rest above {self.tolerance:g} mm")
+        if self.touch_ups:
+            text += f"; {self.touch_ups} touch-up(s) where the tool reaches what passes and loops left above it"
         if self.sloped_after > 0 or self.flat_after > 0:
             text += (f"; where this tool reaches, {self.sloped_after:.1f} mm2 sloped and {self.flat_after:.1f} mm2 "
                      f"flatter than {FLATTEST_DEG:g} deg (no loops there) stay above it, {self.edge:.1f} mm2 of them "
@@ -162,9 +165,14 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     sloped = of_params(params, cutter)
     left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
+    # where passes and loops leave the rest above the tolerance, the tool put where it reaches it
+    surface = surface or DropSurface(mesh)
+    touch = rest_touchup.pieces(mesh, cutter, params, _reached(residue(rest, segments + loops, cutter)), surface)
+    diagnostics["touch_ups"] = len(touch)
+    if touch:
+        loops = ordered(loops + touch)
     # the pieces of passes and loops reached with the tool down where a join from the one before passes its checks
-    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops,
-                                                       surface or DropSurface(mesh))
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops, surface)
     if cut:   # a join lifted over a ridge between two pieces may stand above both
         diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     if params.verify_notes is not None:
@@ -179,8 +187,17 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
         params.verify_notes.append(SteepReport(
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
-            float(np.sum(still & flat) * a), float(np.sum(still & edge) * a)))
+            float(np.sum(still & flat) * a), float(np.sum(still & edge) * a), len(touch)))
     return cut
+
+
+def _reached(left: Optional[RestStock]) -> Optional[RestStock]:
+    """`left` on the cells where the tool's envelope comes within the tolerance (all of it without an
+    envelope); None when none is."""
+    if left is None or left.envelope is None:
+        return left
+    cells = np.isfinite(left.heights) & (left.envelope - left.design <= left.within)
+    return replace(left, heights=np.where(cells, left.heights, -np.inf)) if cells.any() else None
 
 
 def of_params(params: Any, cutter: Cutter) -> Optional[RestStock]:
