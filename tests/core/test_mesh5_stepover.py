@@ -18,7 +18,8 @@ from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
-from tmm_workbench.core.strategies.mesh5.stepover import (OVERRUN_STEPS, _Coverage, adaptive_passes, half_widths,
+from tmm_workbench.core.strategies.mesh5.stepover import (BETWEEN_TOL, OVERRUN_STEPS, _Coverage, adaptive_passes,
+                                                         between_positions, clear_lifts, half_widths,
                                                          overrun_positions)
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -118,7 +119,7 @@ def test_the_overrun_clears_a_surface_that_rises_beyond_the_end_of_the_path():
     path = replace(full, points=full.points[keep], normals=full.normals[keep], frames=full.frames[keep])
     cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 24), (-30, 30)), TOL, 1.0)
     q = smooth_postures(cs, cutter, path.points, path.frames)
-    tips, axes = overrun_positions(MeshReach(mesh), cutter, path, q, 5.0)
+    tips, axes, _ = overrun_positions(MeshReach(mesh), cutter, path, q, 5.0)
     n = OVERRUN_STEPS
     assert len(tips) == len(q.tips) + 2 * n and np.array_equal(tips[n:-n], q.tips)
     xs, ys = np.meshgrid(np.arange(-4.0, 14.0, 0.25), np.arange(-9.5, 9.6, 0.5), indexing="ij")
@@ -133,6 +134,36 @@ def test_the_overrun_clears_a_surface_that_rises_beyond_the_end_of_the_path():
     assert least(straight, axes[end]) < -0.1                                # the gouge the lift prevents
     assert -2e-3 <= least(tips[end], axes[end]) <= 0.02                     # clear, and in contact: not lifted more
     assert tips[-1] @ path.frames[-1, 2] > q.tips[-1] @ path.frames[-1, 2] + 0.1
+
+
+def test_a_move_that_would_cut_in_between_two_cl_points_gets_a_position_lifted_clear():
+    # a saddle z = x y / 60: along a pass the least lift curves, and the straight move between two CL points 3 mm
+    # apart sags into the surface (up to about 3^2 / (8 x 60) = 0.019 mm; here, with the tilt held to 6 deg, 0.01)
+    mesh = grid_mesh(lambda x, y: x * y / 60.0, 40, 40, (-20, -20, 20, 20), "saddle")
+    cutter = Cutter.flat(10.0)
+    path = cc_paths(mesh, (1, 0), np.array([-4.0]), 3.0, 0.01)[0]
+    keep = np.abs(path.points[:, 0]) <= 9.0
+    path = replace(path, points=path.points[keep], normals=path.normals[keep], frames=path.frames[keep])
+    cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 6), (-30, 30)), TOL, 1.0)
+    q = smooth_postures(cs, cutter, path.points, path.frames)
+    reach = MeshReach(mesh)
+    tips, axes = between_positions(reach, cutter, q.tips, q.axes, path.frames)
+    assert len(tips) > len(q.tips)
+    # the CL points stay, in order; every inserted one is clear of the mesh (its lift 0 now)
+    at = [int(np.flatnonzero(np.all(tips == t, axis=1))[0]) for t in q.tips]
+    assert at == sorted(at)
+    new = np.setdiff1d(np.arange(len(tips)), at)
+    frames = path.frames[np.searchsorted(at, new) - 1]
+    assert np.allclose(clear_lifts(reach, cutter, tips[new], axes[new], frames), 0.0, atol=1e-6)
+    xs, ys = np.meshgrid(np.arange(-8.0, 8.0, 0.25), np.arange(-12.0, 4.0, 0.25), indexing="ij")
+    pts, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
+
+    def least(t: np.ndarray, a: np.ndarray) -> float:
+        st, sa = swept_positions(t, a, 8)
+        return float(remaining(pts[hit], nrm[hit], st, sa, 5.0, 20.0).min())
+
+    assert least(q.tips, q.axes) < -0.006                                    # the straight moves cut in
+    assert least(tips, axes) >= -BETWEEN_TOL
 
 
 def test_bad_tolerance_and_tool_are_refused_by_name():
