@@ -27,7 +27,7 @@ from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.optimal import nearest_ideal, pass_motion_time, smooth_postures  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid  # noqa: E402
-from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.stepover import OVERRUN_STEPS, adaptive_passes  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 
@@ -88,6 +88,9 @@ def main() -> None:
     print(f"step between planes (mm): min {steps.min():.2f}, median {np.median(steps):.2f}, max {steps.max():.2f}")
     lam = np.degrees(np.concatenate([q.lam for p in plan.passes for q in p.postures]))
     print(f"CC points {lam.size}; lambda (deg) median {np.median(lam):.0f}, max {lam.max():.0f}")
+    runs = plan.tool_positions()
+    print(f"tool positions {sum(len(t) for t, _ in runs)}: the CC points' {lam.size}, on the overruns and between "
+          f"{sum(len(t) for t, _ in runs) - lam.size} ({len(runs)} paths, up to {2 * OVERRUN_STEPS} overrun each)")
     q, h, secs = slow_check(mesh, plan, cutter, a.x_lines, a.step)
     over = np.flatnonzero(h > tol + 0.002)
     print(f"slow check: {len(h)} surface points on {a.x_lines} lines x {mesh.bounds[0][0]:g}..{mesh.bounds[1][0]:g} "

@@ -10,6 +10,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import link
 from tmm_workbench.core.strategies.mesh5 import finish
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
+from tmm_workbench.core.strategies.mesh5.stepover import OVERRUN_STEPS
 from tmm_workbench.core.strategies.multipoint import link_policy
 from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.core.tools.cutter import Cutter
@@ -33,18 +34,21 @@ def test_the_cuts_are_the_plans_postures_in_pass_order_zig_zag(linked):
     assert result.diagnostics["passes"] == len(plan.passes) >= 2
     expect_tips, expect_axes = [], []
     for k, p in enumerate(plan.passes):
-        tips = np.vstack([q.tips for q in p.postures])
-        axes = np.vstack([q.axes for q in p.postures])
+        tips = np.vstack([t for t, _ in p.tool_positions()])
+        axes = np.vstack([a for _, a in p.tool_positions()])
         expect_tips.append(tips[::-1] if k % 2 else tips)
         expect_axes.append(axes[::-1] if k % 2 else axes)
     got = np.array([(m.x, m.y, m.z) for m in path.moves if m.kind is not MoveKind.RAPID])
-    # every CC point's CL point is reached, in order (the first of each segment by the entry along the axis)
+    # every CC point's CL point and the overruns beyond the ends are reached, in order (the first of each
+    # segment by the entry along the axis)
     cut = np.vstack(expect_tips)
     i = 0
     for p in got:
         if i < len(cut) and np.allclose(p, cut[i], atol=1e-9):
             i += 1
-    assert i == len(cut) == result.diagnostics["cc_points"]
+    assert i == len(cut)
+    cc = sum(len(q.tips) for p in plan.passes for q in p.postures)
+    assert result.diagnostics["cc_points"] == cc and len(cut) == cc + 2 * OVERRUN_STEPS * len(result.segments)
     assert all(np.linalg.norm(np.array(m.axis)) == pytest.approx(1.0) for m in path.moves)
     # the tool is tilted (a flat end mill upright would gouge the convex cylinder's sides)
     assert max(np.degrees(np.arccos(np.vstack(expect_axes)[:, 2]))) > 1.0

@@ -4,6 +4,7 @@ slow reference (the solid cylinder swept between the CL points, material measure
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -15,8 +16,11 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
-from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath
-from tmm_workbench.core.strategies.mesh5.stepover import _Coverage, adaptive_passes, half_widths
+from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
+from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
+from tmm_workbench.core.strategies.mesh5.stepover import (BETWEEN_TOL, OVERRUN_STEPS, _Coverage, adaptive_passes,
+                                                         between_positions, clear_lifts, half_widths,
+                                                         overrun_positions)
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -90,12 +94,76 @@ def test_passes_cover_the_surface_in_order_with_the_scallop_at_the_tolerance(cyl
 def test_the_tools_go_on_an_overrun_beyond_the_ends_along_the_feed(cylinder_plan):
     _, plan, _ = cylinder_plan
     assert plan.overrun == pytest.approx(5.0)                               # the cutter's radius
+    n = OVERRUN_STEPS
     for p in plan.passes:
-        for path, q, (tips, axes) in zip(p.paths, p.postures, p.tool_positions(plan.overrun)):
-            assert len(tips) == len(q.tips) + 2 and np.array_equal(tips[1:-1], q.tips)
-            assert tips[0] == pytest.approx(q.tips[0] - 5.0 * path.frames[0, 0])
-            assert tips[-1] == pytest.approx(q.tips[-1] + 5.0 * path.frames[-1, 0])
-            assert np.array_equal(axes[[0, -1]], q.axes[[0, -1]])
+        for path, q, (tips, axes) in zip(p.paths, p.postures, p.tool_positions()):
+            assert len(tips) == len(q.tips) + 2 * n and np.array_equal(tips[n:-n], q.tips)
+            # on this convex patch nothing rises beyond the ends: straight on along the end tangents
+            for end, cc, lx in ((tips[:n][::-1], q.tips[0], -path.frames[0, 0]),
+                                (tips[-n:], q.tips[-1], path.frames[-1, 0])):
+                along = (end - cc) @ lx
+                assert along == pytest.approx(5.0 * np.arange(1, n + 1) / n, abs=0.05)
+                assert np.linalg.norm(end - cc - along[:, None] * lx, axis=1).max() <= 0.05
+            assert np.array_equal(axes[:n + 1], np.repeat(q.axes[:1], n + 1, 0))
+            assert np.array_equal(axes[-n - 1:], np.repeat(q.axes[-1:], n + 1, 0))
+
+
+def test_the_overrun_clears_a_surface_that_rises_beyond_the_end_of_the_path():
+    # a trough curving up along the feed (radius 80 mm) and a path along its floor that ends at x = 0 while the
+    # mesh goes on, as where the mesh's boundary runs slanted across the planes (seed 000's concave surface):
+    # straight on along the end's tangent at its lift, the tool runs into the rise
+    mesh = grid_mesh(lambda x, y: x * x / 160.0, 40, 20, (-20, -10, 20, 10), "trough")
+    cutter = Cutter.flat(10.0)
+    full = cc_paths(mesh, (1, 0), np.array([0.0]), 2.0, 0.01)[0]
+    keep = (full.points[:, 0] >= -10.0) & (full.points[:, 0] <= 1e-9)
+    path = replace(full, points=full.points[keep], normals=full.normals[keep], frames=full.frames[keep])
+    cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 24), (-30, 30)), TOL, 1.0)
+    q = smooth_postures(cs, cutter, path.points, path.frames)
+    tips, axes, _ = overrun_positions(MeshReach(mesh), cutter, path, q, 5.0)
+    n = OVERRUN_STEPS
+    assert len(tips) == len(q.tips) + 2 * n and np.array_equal(tips[n:-n], q.tips)
+    xs, ys = np.meshgrid(np.arange(-4.0, 14.0, 0.25), np.arange(-9.5, 9.6, 0.5), indexing="ij")
+    pts, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
+    end = np.arange(len(tips) - n - 1, len(tips))                          # from the last CL point on
+
+    def least(t: np.ndarray, a: np.ndarray) -> float:
+        st, sa = swept_positions(t, a, 8)
+        return float(remaining(pts[hit], nrm[hit], st, sa, 5.0, 20.0).min())
+
+    straight = q.tips[-1] + np.linspace(0.0, 5.0, n + 1)[:, None] * path.frames[-1, 0]
+    assert least(straight, axes[end]) < -0.1                                # the gouge the lift prevents
+    assert -2e-3 <= least(tips[end], axes[end]) <= 0.02                     # clear, and in contact: not lifted more
+    assert tips[-1] @ path.frames[-1, 2] > q.tips[-1] @ path.frames[-1, 2] + 0.1
+
+
+def test_a_move_that_would_cut_in_between_two_cl_points_gets_a_position_lifted_clear():
+    # a saddle z = x y / 60: along a pass the least lift curves, and the straight move between two CL points 3 mm
+    # apart sags into the surface (up to about 3^2 / (8 x 60) = 0.019 mm; here, with the tilt held to 6 deg, 0.01)
+    mesh = grid_mesh(lambda x, y: x * y / 60.0, 40, 40, (-20, -20, 20, 20), "saddle")
+    cutter = Cutter.flat(10.0)
+    path = cc_paths(mesh, (1, 0), np.array([-4.0]), 3.0, 0.01)[0]
+    keep = np.abs(path.points[:, 0]) <= 9.0
+    path = replace(path, points=path.points[keep], normals=path.normals[keep], frames=path.frames[keep])
+    cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 6), (-30, 30)), TOL, 1.0)
+    q = smooth_postures(cs, cutter, path.points, path.frames)
+    reach = MeshReach(mesh)
+    tips, axes = between_positions(reach, cutter, q.tips, q.axes, path.frames)
+    assert len(tips) > len(q.tips)
+    # the CL points stay, in order; every inserted one is clear of the mesh (its lift 0 now)
+    at = [int(np.flatnonzero(np.all(tips == t, axis=1))[0]) for t in q.tips]
+    assert at == sorted(at)
+    new = np.setdiff1d(np.arange(len(tips)), at)
+    frames = path.frames[np.searchsorted(at, new) - 1]
+    assert np.allclose(clear_lifts(reach, cutter, tips[new], axes[new], frames), 0.0, atol=1e-6)
+    xs, ys = np.meshgrid(np.arange(-8.0, 8.0, 0.25), np.arange(-12.0, 4.0, 0.25), indexing="ij")
+    pts, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
+
+    def least(t: np.ndarray, a: np.ndarray) -> float:
+        st, sa = swept_positions(t, a, 8)
+        return float(remaining(pts[hit], nrm[hit], st, sa, 5.0, 20.0).min())
+
+    assert least(q.tips, q.axes) < -0.006                                    # the straight moves cut in
+    assert least(tips, axes) >= -BETWEEN_TOL
 
 
 def test_bad_tolerance_and_tool_are_refused_by_name():

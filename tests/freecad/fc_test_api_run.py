@@ -56,7 +56,7 @@ class RunByName(FreeCADTestCase):
         self.assertIn("stock_margin is not used by TMM_Multipoint", str(ctx.exception))
         with self.assertRaises(TmmError) as ctx:
             run("TMM_Drill", str(SPHERE_ON_PLATE))
-        self.assertIn("TMM_Surface, TMM_Roughing, TMM_Waterline, TMM_Multipoint", str(ctx.exception))
+        self.assertIn("TMM_Surface, TMM_Roughing, TMM_Waterline, TMM_Mesh5, TMM_Multipoint", str(ctx.exception))
         self.assertEqual(set(FreeCAD.listDocuments()), before)
 
 

@@ -266,6 +266,57 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
                doc_name=doc_name, progress=progress, **values)
 
 
+@plain_numbers
+def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[str, Cutter] = "endmill",
+              diameter: float = 6.0, corner_radius: float = 0.0, tolerance: Optional[float] = None,
+              feed_angle_deg: float = 0.0, forward_step: Optional[float] = None,
+              chord_tolerance: Optional[float] = None, least_tilt_deg: Optional[float] = None,
+              tilt_limit_deg: Optional[float] = None, yaw_limit_deg: Optional[float] = None,
+              grid_step_deg: Optional[float] = None, zigzag: bool = True, axis_retract: float = 5.0,
+              stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
+              job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
+              horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
+              post: Optional[str] = "tarus", gcode_path: Optional[Union[str, os.PathLike]] = None,
+              fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
+              progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+    """5-axis finishing of `model` (STL path, Mesh::Feature or Part::Feature) by seed 000's 3D C-space (a 'TMM
+    5-axis Mesh' op in a new Job, or in `job`): adaptive passes within `tolerance` (the scallop, mm), the
+    posture at every CC point chosen for the Tarus motion time (docs/mesh5.md).
+
+    tool: 'endmill' | 'bullnose' (corner_radius) or a core flat / bull-nose Cutter; a ball or a V-bit is
+    refused. feed_angle_deg: the passes' direction seen from above, from +X. least_tilt_deg, tilt_limit_deg:
+    the tool axis's inclination from the surface normal, both within the machine's C range; yaw_limit_deg,
+    grid_step_deg: the posture grid; None keeps the op's defaults (the seed's 0..45 deg, +-45 deg, 3 deg).
+    post 'tarus' | 'apt_cl' | None (a 3-axis post would drop the tool axes: refused). The stock of a new Job
+    as run_roughing's (the simulation cuts it). Heights, feeds (mm/min), files and progress as run_surface; the
+    result is a SurfaceResult (op: the 5-axis mesh op; what was left for clean-up: its Mesh5Summary).
+    """
+    from tmm_workbench.app import op_mesh5
+    from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
+
+    spec = lambda field: spec_of(Mesh5Params, field)  # noqa: E731
+    numbers(tolerance=(tolerance, spec("tolerance")), feed_angle_deg=(feed_angle_deg, spec("feed_angle_deg")),
+            forward_step=(forward_step, spec("forward_step")), chord_tolerance=(chord_tolerance, spec("chord_tol")),
+            least_tilt_deg=(least_tilt_deg, spec("tilt_min_deg")), tilt_limit_deg=(tilt_limit_deg, spec("tilt_max_deg")),
+            yaw_limit_deg=(yaw_limit_deg, spec("yaw_limit_deg")), grid_step_deg=(grid_step_deg, spec("grid_step_deg")),
+            axis_retract=(axis_retract, NON_NEGATIVE))  # the tool, stock, heights and feeds: run's
+    given = {"tolerance": tolerance, "forward_step": forward_step, "chord_tol": chord_tolerance,
+             "tilt_min_deg": least_tilt_deg, "tilt_max_deg": tilt_limit_deg, "yaw_limit_deg": yaw_limit_deg,
+             "grid_step_deg": grid_step_deg}
+    Mesh5Params(**{k: v for k, v in given.items() if v is not None}).grid()  # the tilts within the machine's range
+    values: dict[str, Any] = {"FeedAngle": feed_angle_deg, "ZigZag": bool(zigzag), "AxisRetract": axis_retract}
+    for prop, value in (("Tolerance", tolerance), ("ForwardStep", forward_step), ("ChordTolerance", chord_tolerance),
+                        ("LeastTilt", least_tilt_deg), ("TiltLimit", tilt_limit_deg), ("YawLimit", yaw_limit_deg),
+                        ("GridStep", grid_step_deg)):
+        if value is not None:
+            values[prop] = value
+    return run(op_mesh5.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
+               stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
+               clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
+               spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
+               doc_name=doc_name, progress=progress, **values)
+
+
 def _specs(params_class: type, **values: Any) -> dict[str, tuple[Any, Spec]]:
     """API arguments named as the params fields, each with its field's spec."""
     return {name: (value, spec_of(params_class, name)) for name, value in values.items()}

@@ -6,7 +6,7 @@ them (checked against the op's own declarations: the names, their ranges, their 
     r = run("TMM_Surface", "part.stl", tool="ballend", diameter=6, StepOverMode="Cusp", CuspHeight=0.01,
             gcode_path="part.ngc")
 
-`run_surface`, `run_roughing` and `run_waterline` (app.api) are the same with the API's argument names.
+`run_surface`, `run_roughing`, `run_waterline` and `run_mesh5` (app.api) are the same with the API's argument names.
 """
 from __future__ import annotations
 
@@ -30,8 +30,9 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
 
-MESH_OPS = ("TMM_Surface", "TMM_Roughing", "TMM_Waterline")
+MESH_OPS = ("TMM_Surface", "TMM_Roughing", "TMM_Waterline", "TMM_Mesh5")
 FACE_OPS = ("TMM_Multipoint",)   # a Bézier / B-spline face (app.face_source), a new document and Job for it
+AUTO_POST = "auto"   # run's default post: linuxcnc for a 3-axis op, tarus for a 5-axis one (job.FIVE_AXIS_OPS)
 
 
 StockBox = tuple[float, float, float, float, float, float]
@@ -254,15 +255,40 @@ def check_properties(op: str, properties: dict[str, Any]) -> None:
             work_estimate.check_value(cls, name, value if isinstance(value, int) else float(value))
 
 
+def checked_post(op: str, post: Optional[str]) -> Optional[str]:
+    """The post for `op`: AUTO_POST gives linuxcnc for a 3-axis op, tarus for a 5-axis one; a 5-axis op with a
+    3-axis post is refused (it would drop the tool axes)."""
+    five = op in jobs.FIVE_AXIS_OPS
+    if post == AUTO_POST:
+        return jobs.FIVE_AXIS_POSTS[0] if five else jobs.DEFAULT_POST
+    if five and post is not None and post not in jobs.FIVE_AXIS_POSTS:
+        raise TmmError(f"post {post!r} cannot write the tool axes of {op}: it must be one of "
+                       f"{', '.join(jobs.FIVE_AXIS_POSTS)} (or None: not posted)")
+    return post
+
+
+def check_tool_taken(op: str, shape: Union[str, Cutter], diameter: float, corner_radius: float) -> None:
+    """The op's strategy's own tool check (core check_tool, where it has one), before a document is made."""
+    check = getattr(registry.entry(op).core(), "check_tool", None)
+    if check is None:
+        return
+    if not isinstance(shape, Cutter):
+        shape = (Cutter.ball(diameter) if shape == "ballend" else
+                 Cutter.bull(diameter, corner_radius) if shape == "bullnose" and corner_radius > 0 else
+                 Cutter.flat(diameter))
+    check(shape)
+
+
 def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter] = "ballend", diameter: float = 6.0,
         corner_radius: float = 0.0, stock: Optional[StockBox] = None, stock_margin: Optional[float] = None,
         stock_above: Optional[float] = None, safe_height: Optional[float] = None,
         clearance_height: Optional[float] = None, horiz_feed: float = 1000.0, vert_feed: float = 300.0,
-        spindle_speed: float = 10000.0, post: Optional[str] = "linuxcnc", gcode_path: Any = None,
+        spindle_speed: float = 10000.0, post: Optional[str] = AUTO_POST, gcode_path: Any = None,
         fcstd_path: Any = None, doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
         **properties: Any) -> SurfaceResult:
     """The op registered as `op` on `model` with `properties` (the op's property names and values: StepOver=0.5,
-    Pattern="OneWay"), computed, posted (`post` None: not posted), saved (as app.api.run_surface).
+    Pattern="OneWay"), computed, posted (`post` None: not posted; AUTO_POST: linuxcnc, or tarus for a 5-axis op,
+    which takes only tarus or apt_cl), saved (as app.api.run_surface).
     A mesh op (MESH_OPS): `model` an STL path, a Mesh or a Part object (None with `job`: the Job's model), in a new
     Job or added to `job` with its own tool controller; the Job's stock: FreeCAD's default for a new Job unless
     `stock` (a box) or `stock_margin` / `stock_above` (mm around the model) is given.
@@ -283,6 +309,8 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
     check_properties(op, properties)
     shape = tool if isinstance(tool, Cutter) else option("tool", tool, tools.SHAPE_ALIASES,
                                                           sorted(set(tools.SHAPE_ALIASES.values())))
+    post = checked_post(op, post)
+    check_tool_taken(op, shape, diameter, corner_radius)
     if stock is not None:
         stock_box_checked(stock)
     given = stock is not None or stock_margin is not None or stock_above is not None

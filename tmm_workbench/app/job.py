@@ -76,7 +76,7 @@ def start_tool(job: Any, diameter: float = START_BALL_MM) -> Any:
 # --- the Job's post: a working one, not FreeCAD's first in the list -------------------------------------
 DEFAULT_POST = "linuxcnc"
 FIVE_AXIS_POSTS = ("tarus", "apt_cl")  # the first is the default for a Job whose first op is 5-axis
-FIVE_AXIS_OPS = ("TMM_Multipoint",)
+FIVE_AXIS_OPS = ("TMM_Multipoint", "TMM_Mesh5")
 
 
 def user_default_post() -> str:

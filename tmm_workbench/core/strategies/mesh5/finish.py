@@ -2,7 +2,8 @@
 
 The adaptive passes (stepover.adaptive_passes: drive planes across the mesh, the C-space at every CC point,
 the posture chosen for the Tarus motion time, each pass placed so that the scallop stays within the
-tolerance) become cut segments, one per CC path (the tool's tips and axes of its chosen postures), in pass
+tolerance) become cut segments, one per CC path (the tool's tips and axes of its chosen postures, and the
+overruns beyond its ends, each lifted clear of the mesh), in pass
 order, every other pass reversed when zig-zag. The one linker joins them (multipoint.link_policy: out and in
 along the tool axis, transit above the tilted tool's lowest point), as the 5-axis multipoint op does.
 
@@ -117,10 +118,11 @@ def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box) -> Work:
 
 
 def _segments(plan: AdaptivePlan, zigzag: bool) -> list[CutSegment]:
-    """One segment per CC path (tips and axes of its postures), passes in order, odd ones reversed."""
+    """One segment per CC path (its tool positions with the overruns the plan counted on), passes in order,
+    odd ones reversed."""
     out = []
     for k, p in enumerate(plan.passes):
-        runs = [CutSegment(q.tips, axes=q.axes, pass_index=k) for q in p.postures if len(q.tips)]
+        runs = [CutSegment(tips, axes=axes, pass_index=k) for tips, axes in p.tool_positions() if len(tips)]
         if zigzag and k % 2 == 1:
             runs = [CutSegment(s.tips[::-1], axes=s.axes[::-1], pass_index=k) for s in runs[::-1]]
         out.extend(runs)
@@ -158,7 +160,8 @@ def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
         raise TmmError(f"no pass could be placed on the mesh ({plan.report()})")
     empty = empty_points(mesh, plan, params)
     diagnostics = {"plan": plan, "unfinished": list(plan.unfinished), "empty_points": empty,
-                   "passes": len(plan.passes), "cc_points": int(sum(len(s.tips) for s in segments))}
+                   "passes": len(plan.passes), "cc_points": int(sum(len(q.tips) for p in plan.passes
+                                                                    for q in p.postures))}
     return StrategyResult(segments, diagnostics)
 
 

@@ -21,7 +21,8 @@ step gets a smaller one, a CC point with none for its right step moves the plane
 chosen for the motion time (optimal.smooth_postures) and the real half-widths measured; a bin advances to the
 least left boundary of its CC points where their right boundaries reach its level, and keeps its level
 (for the next pass) where they do not. The passes are planned at MARGIN of the tolerance. The tools go on an
-overrun of a radius beyond the ends of each path (PlannedPass.tool_positions), which the bins count.
+overrun of a radius beyond the ends of each path, each position lifted clear of the mesh
+(overrun_positions), which the bins count.
 """
 from __future__ import annotations
 
@@ -37,9 +38,10 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths, plane_normal
 from tmm_workbench.core.strategies.mesh5.cspace import CSpace, build_cspace
-from tmm_workbench.core.strategies.mesh5.lift import MeshReach
+from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_postures
-from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
+from tmm_workbench.core.strategies.mesh5.posture import (PostureGrid, require_plain, tool_rotation, touch_tip,
+                                                        world_placement)
 from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile, surface_heights
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -54,6 +56,12 @@ MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
+# positions along each overrun, each lifted clear of the mesh (a radius in 4: about the CC points' spacing)
+OVERRUN_STEPS = 4
+# the deepest a straight move between two tool positions may cut into the mesh (mm), and how many times a move
+# is halved to keep it there (between_positions)
+BETWEEN_TOL = 0.002
+BETWEEN_ROUNDS = 2
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -113,26 +121,83 @@ def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn:
 @dataclass(frozen=True)
 class PlannedPass:
     """One drive plane's pass: its CC paths with their chosen postures, the half-widths (n, 2) of its CC
-    points (all paths in order) and the band it covers on the plane-normal axis (right, left), mm."""
+    points (all paths in order), the band it covers on the plane-normal axis (right, left), mm, and the
+    tool positions (tips, axes) of each path with its overruns (overrun_positions)."""
     offset: float
     paths: List[CCPath]
     postures: List[PassPostures]
     widths: np.ndarray
     band: tuple[float, float]
     side_step: float
+    runs: List[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
 
-    def tool_positions(self, overrun: float) -> List[tuple[np.ndarray, np.ndarray]]:
-        """(tips, axes) of each path with the overrun: the tool goes on `overrun` mm beyond both ends along
-        the path's end tangents at the end postures (at the ends the CC point lies on the mesh's boundary,
-        and a tool stopping there would narrow its track within a radius of it)."""
-        out = []
-        for p, q in zip(self.paths, self.postures):
-            # the feed direction LX at the end CC points (not the tips' steps: a yaw turning between the last
-            # two postures moves the tip sideways)
-            tips, t0, t1 = q.tips, p.frames[0, 0], p.frames[-1, 0]
-            out.append((np.concatenate([tips[:1] - overrun * t0, tips, tips[-1:] + overrun * t1]),
-                        np.concatenate([q.axes[:1], q.axes, q.axes[-1:]])))
-        return out
+    def tool_positions(self) -> List[tuple[np.ndarray, np.ndarray]]:
+        """(tips, axes) of each path with its overruns: every CL point, beyond both ends the overrun's positions
+        and between two where the straight move would cut in, each clear of the mesh."""
+        return self.runs
+
+
+def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: PassPostures, overrun: float,
+                      steps: int = OVERRUN_STEPS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(tips, axes, LCS frames) of the path's tool with its overruns: `overrun` mm beyond both end CC points along their
+    feed LX at the end postures (at the ends the CC point lies on the mesh's boundary, and a tool stopping
+    there would narrow its track within a radius of it), in `steps` positions each, every one lifted along
+    the axis by the least lift that clears the mesh there (the C-space's S2 at that place). Straight along
+    LX at the end's own lift, the tool ran into the mesh where it goes on beyond the path's end (a boundary
+    slanted across the planes, the tool's body yawed over the surface beside the path: 0.07 mm deep on seed
+    000's concave surface). An overrun stops before a position no lift within the tool's radius clears."""
+    s = overrun * np.arange(1, steps + 1) / steps
+    ends = []
+    for k, sgn in ((0, -1.0), (-1, 1.0)):
+        frame = path.frames[k]
+        pts = path.points[k] + sgn * s[:, None] * frame[0]
+        frm = np.repeat(frame[None], steps, 0)
+        lam, omg = np.array([postures.lam[k]]), np.array([postures.omg[k]])
+        lift = lifts(reach, cutter, pts, frm, lam, omg, cutter.radius)[:, 0]
+        blocked = np.flatnonzero(~np.isfinite(lift))
+        keep = int(blocked[0]) if blocked.size else steps
+        tips, axes = world_placement(cutter, pts[:keep], frm[:keep], np.repeat(lam, keep),
+                                     np.repeat(omg, keep), lift[:keep])
+        ends.append((tips, axes, frm[:keep]))
+    (t0, a0, f0), (t1, a1, f1) = ends
+    return (np.concatenate([t0[::-1], postures.tips, t1]), np.concatenate([a0[::-1], postures.axes, a1]),
+            np.concatenate([f0, path.frames, f1]))
+
+
+def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray,
+                frames: np.ndarray) -> np.ndarray:
+    """(n,) the least lift along its axis that clears the mesh for the tool at each (tip, axis) (0 where it is
+    clear already; inf above a radius), by the C-space's S2 (lift.lifts): the posture read in the LCS
+    `frames` (n, 3, 3) of a CC point nearby, the tip's touching point as the CC point."""
+    a = np.einsum("nij,nj->ni", frames, axes)                              # the axis in each LCS
+    lam, omg = np.arccos(np.clip(a[:, 2], -1.0, 1.0)), np.arctan2(a[:, 1], a[:, 0])
+    pts = tips - np.einsum("nji,nj->ni", frames, touch_tip(cutter, tool_rotation(lam, omg)))
+    n = len(tips)
+    return np.diagonal(lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, np.eye(n, dtype=bool))).copy()
+
+
+def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray, frames: np.ndarray,
+                      tol: float = BETWEEN_TOL, rounds: int = BETWEEN_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
+    """The run's positions (tips, axes, their LCS frames (n, 3, 3)) with a position inserted in the middle of
+    each move whose midpoint (tip halfway, axis halfway) cuts into the mesh deeper than `tol`, lifted clear
+    along its axis; `rounds` times. The C-space clears the tool at the CL points; between two, the move is a
+    straight line, and where the least lift curves along the pass (a surface concave along the feed, a saddle)
+    the line sags into the surface by about step^2 / (8 radius)."""
+    for _ in range(rounds):
+        if len(tips) < 2:
+            break
+        mid_t = 0.5 * (tips[:-1] + tips[1:])
+        mid_a = axes[:-1] + axes[1:]
+        mid_a /= np.linalg.norm(mid_a, axis=1, keepdims=True)               # slerp at one half
+        lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1])
+        deep = np.flatnonzero(np.isfinite(lift) & (lift > tol))
+        if deep.size == 0:
+            break
+        at = deep + 1
+        tips = np.insert(tips, at, mid_t[deep] + lift[deep, None] * mid_a[deep], axis=0)
+        axes = np.insert(axes, at, mid_a[deep], axis=0)
+        frames = np.insert(frames, at, frames[deep], axis=0)
+    return tips, axes
 
 
 @dataclass
@@ -145,11 +210,11 @@ class AdaptivePlan:
     unfinished: List[tuple[float, float, float, float]] = field(default_factory=list)
     seconds: float = 0.0
     extent: tuple[float, float] = (0.0, 0.0)   # the mesh along the plane normal
-    overrun: float = 0.0            # mm the tool goes on beyond the ends of each path (PlannedPass.tool_positions)
+    overrun: float = 0.0            # mm the tool goes on beyond the ends of each path (overrun_positions)
 
     def tool_positions(self) -> List[tuple[np.ndarray, np.ndarray]]:
         """(tips, axes) of every path of every pass, with the overrun."""
-        return [tp for p in self.passes for tp in p.tool_positions(self.overrun)]
+        return [tp for p in self.passes for tp in p.tool_positions()]
 
     def report(self) -> str:
         return (f"{len(self.passes)} passes over {self.extent[1] - self.extent[0]:.1f} mm, "
@@ -433,8 +498,10 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         postures, widths, ends, used = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
+        runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun))
+                for p, q in zip(paths, postures)]
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
-                                       gap))
+                                       gap, runs))
         plan.partial += short > 0
         cover.level = level
         # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
