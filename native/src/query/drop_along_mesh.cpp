@@ -28,7 +28,7 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point is above `floor`, in
 // the nodes whose highest point, lowered by rise(d, x0, x1, y0, y1, enough) (d: the box's XY' distance from
 // (x, y), [x0, x1] x [y0, y1] the box less (x, y); it may stop at `enough`, which prunes the box), is above
-// `floor` (boxes about (x, y) or wider than `radius` by their highest point alone); `floor` may rise during
+// `floor` (boxes about (x, y) or wider than 2 `radius` by their highest point alone); `floor` may rise during
 // the walk. Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
 template <class Rise, class Visit>
 void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Rise&& rise,
@@ -41,9 +41,9 @@ void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const d
     const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
     if (d2 > r2 || zmax <= floor) return -kInfinity;
-    // Over a box about the tip, or wider than the reach, the planes' lowest corner bounds little and the
+    // Over a box about the tip, or wider than twice the reach, the planes' lowest corner bounds little and the
     // children are bounded again: the planes are kept for the boxes where they prune.
-    if (d2 == 0.0 || (xmax - xmin) + (ymax - ymin) > radius) return zmax;
+    if (d2 == 0.0 || (xmax - xmin) + (ymax - ymin) > 2.0 * radius) return zmax;
     return zmax - rise(std::sqrt(d2), xmin - x, xmax - x, ymin - y, ymax - y, zmax - floor);
   };
   struct Entry {
