@@ -25,10 +25,11 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
 // Best-first walk of the index's hierarchy for a cutter whose lowest point is `floor` high at best: visits
-// the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point, lowered by
-// rise(d, x0, x1, y0, y1, enough) (d: the box's XY' distance from (x, y), [x0, x1] x [y0, y1] the box less
-// (x, y); it may stop at `enough`, which prunes the box), is above `floor`; `floor` may rise during the walk.
-// Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
+// the triangles whose XY' bounds come within `radius` of (x, y) and whose highest point is above `floor`, in
+// the nodes whose highest point, lowered by rise(d, x0, x1, y0, y1, enough) (d: the box's XY' distance from
+// (x, y), [x0, x1] x [y0, y1] the box less (x, y); it may stop at `enough`, which prunes the box), is above
+// `floor` (boxes about (x, y) or wider than 2 `radius` by their highest point alone); `floor` may rise during
+// the walk. Written over nodes() and triangles() rather than MeshIndex::walk, whose pruning is tied to the -Z profile.
 template <class Rise, class Visit>
 void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const double& floor, Rise&& rise,
                  Visit&& visit) {
@@ -40,6 +41,9 @@ void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const d
     const double dy = std::max(std::max(ymin - y, y - ymax), 0.0);
     const double d2 = dx * dx + dy * dy;
     if (d2 > r2 || zmax <= floor) return -kInfinity;
+    // Over a box about the tip, or wider than twice the reach, the planes' lowest corner bounds little and the
+    // children are bounded again: the planes are kept for the boxes where they prune.
+    if (d2 == 0.0 || (xmax - xmin) + (ymax - ymin) > 2.0 * radius) return zmax;
     return zmax - rise(std::sqrt(d2), xmin - x, xmax - x, ymin - y, ymax - y, zmax - floor);
   };
   struct Entry {
@@ -58,10 +62,11 @@ void walk_lowest(const MeshIndex& mi, double x, double y, double radius, const d
       for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
         const IndexedTriangle& t = tris[i];
         if (t.zmax <= floor) continue;
-        const double b = bound(std::min({t.p[0][0], t.p[1][0], t.p[2][0]}), std::min({t.p[0][1], t.p[1][1], t.p[2][1]}),
-                               std::max({t.p[0][0], t.p[1][0], t.p[2][0]}), std::max({t.p[0][1], t.p[1][1], t.p[2][1]}),
-                               t.zmax);
-        if (b > floor) visit(t, i);
+        const double xmin = std::min({t.p[0][0], t.p[1][0], t.p[2][0]}), ymin = std::min({t.p[0][1], t.p[1][1], t.p[2][1]});
+        const double xmax = std::max({t.p[0][0], t.p[1][0], t.p[2][0]}), ymax = std::max({t.p[0][1], t.p[1][1], t.p[2][1]});
+        const double dx = std::max(std::max(xmin - x, x - xmax), 0.0), dy = std::max(std::max(ymin - y, y - ymax), 0.0);
+        // The planes under K are tested on the corners themselves by `visit`, which is tighter than on the box.
+        if (dx * dx + dy * dy <= r2) visit(t, i);
       }
     } else {
       const BvhNode& l = nodes[node.first];
@@ -87,7 +92,8 @@ constexpr double kPlaneAngles[] = {0.0, 60.0, 90.0, 120.0, 180.0};
 
 }  // namespace
 
-AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& axis)
+AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& axis,
+                         bool fine_planes)
     : index_(&index), cutter_(cutter), a_(index.rotation() * axis.normalized()), frame_(a_) {
   require_unit(axis, "cutter axis");
   if ((a_ - Vector3d::UnitZ()).norm() <= kParallelAxisTol)
@@ -113,10 +119,25 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
       const Vector3d n = frame_.to_world(
           Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
       if (!(n.z() > 1e-3)) continue;
-      const double h = direction_detail::support(cutter, frame_.to_tool(-n)).value;
-      planes_.push_back({-h / n.z(), n.x() / n.z(), n.y() / n.z()});
+      planes_.push_back(plane_under(n));
     }
   }
+  if (!fine_planes) return;
+  for (const Vector3d& n : {a_, Vector3d(-a_)})
+    if (n.z() > 1e-3) axial_.push_back(plane_under(n));
+  fine_.resize(kFineAzimuths * kFineTilts);
+  for (int k = 0; k < kFineAzimuths; ++k)
+    for (int j = 0; j < kFineTilts; ++j) {
+      const double th = M_PI * (j + 1) / (kFineTilts + 1), ph = 2.0 * M_PI * k / kFineAzimuths;
+      const Vector3d n = frame_.to_world(
+          Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
+      fine_[k * kFineTilts + j] = n.z() > 1e-3 ? plane_under(n) : Plane{-kInfinity, 0.0, 0.0};
+    }
+}
+
+AlongCutter::Plane AlongCutter::plane_under(const Vector3d& n) const {
+  const double h = direction_detail::support(cutter_, frame_.to_tool(-n)).value;
+  return {-h / n.z(), n.x() / n.z(), n.y() / n.z()};
 }
 
 double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
@@ -137,6 +158,31 @@ double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, d
   return std::max(0.0, r - margin);
 }
 
+bool AlongCutter::below(const Plane& p, const IndexedTriangle& t, double x, double y, double top) {
+  for (int k = 0; k < 3; ++k) {
+    const double lim = top + p.c - p.gx * (t.p[k][0] - x) - p.gy * (t.p[k][1] - y);
+    if (!(t.p[k][2] < lim - 1e-9 * (1.0 + std::fabs(lim)))) return false;  // margin against rounding
+  }
+  return true;
+}
+
+bool AlongCutter::below_a_plane(const IndexedTriangle& t, double x, double y, double top) const {
+  if (fine_.empty()) {
+    for (const Plane& p : planes_)
+      if (below(p, t, x, y, top)) return true;
+    return false;
+  }
+  for (const Plane& p : axial_)
+    if (below(p, t, x, y, top)) return true;
+  // The planes leaning away from the triangle's centre, seen from the axis (K lies beyond each plane).
+  const Vector3d c = Vector3d(x, y, top) - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
+  const double ph = std::atan2(frame_.e2.dot(c), frame_.e1.dot(c));
+  const int k = static_cast<int>(std::lround(ph * (kFineAzimuths / (2.0 * M_PI)))) & (kFineAzimuths - 1);
+  for (int j = 0; j < kFineTilts; ++j)
+    if (below(fine_[k * kFineTilts + j], t, x, y, top)) return true;
+  return false;
+}
+
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
   const Vector3d s = index_->rotation() * start;
   const MeshIndex& mi = index_->index();
@@ -146,12 +192,14 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   auto floor_of = [&](double t) { return s.z() - t + lowest_ - 1e-9; };  // margin against rounding
   double floor_ref = floor_of(best);
   auto test = [&](const IndexedTriangle& t, int32_t i) {
+    // Most candidates are not touched before the best contact so far: a plane under K that has the whole
+    // triangle below it proves it in a few products; else a separating plane found by the clearance
+    // certificate, at a fraction of the cost of the triangle's pieces.
+    if (best < kNoTravel && below_a_plane(t, s.x(), s.y(), s.z() - best)) return;
     ++tested;
     const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
                    q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
     if (best < kNoTravel) {
-      // Most candidates are not touched before the best contact so far: a separating plane proves it for the
-      // whole triangle (its edges included) at a fraction of the cost of its pieces.
       const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
       if (t0 >= best) return;
       if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best)) return;
@@ -218,7 +266,7 @@ void drop_along_batch(const DirectionalIndex& index, const Cutter& cutter, const
     }
   }
   std::unique_ptr<AlongCutter> shared;  // one axis for all: its set-up once
-  if (!axes_per_point && n > 0) shared = std::make_unique<AlongCutter>(index, cutter, Vector3d(axes[0], axes[1], axes[2]));
+  if (!axes_per_point && n > 0) shared = std::make_unique<AlongCutter>(index, cutter, Vector3d(axes[0], axes[1], axes[2]), true);
   std::atomic<std::size_t> tested{0};
   // The hint starts afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 128, options, [&](std::size_t begin, std::size_t end) {

@@ -81,10 +81,11 @@ double axial_drop(const DirectionalIndex& index, const ToolAssembly& tool, const
 
 // The solids set up for drops along the index's direction with the tool axis `axis` (once per axis).
 std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std::vector<AssemblySolid>& solids,
-                                       const Vector3d& axis) {
+                                       const Vector3d& axis, bool fine_planes = false) {
   std::vector<AlongCutter> out;
   out.reserve(solids.size());
-  for (const AssemblySolid& s : solids) out.emplace_back(index, s.profile, s.flipped ? Vector3d(-axis) : axis);
+  for (const AssemblySolid& s : solids)
+    out.emplace_back(index, s.profile, s.flipped ? Vector3d(-axis) : axis, fine_planes);
   return out;
 }
 
@@ -175,7 +176,7 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
   std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
-  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized());
+  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized(), true);
   std::atomic<std::size_t> tested{0};
   // Hints and the solid dropped first start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {

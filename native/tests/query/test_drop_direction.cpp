@@ -453,6 +453,42 @@ TEST(DropDirection, AxisAlongVBatchIsPointByPoint) {
   }
 }
 
+// One tilted axis for a whole raster: the batch sets the solid up with planes every few degrees around the
+// axis and tests each candidate's corners against those facing it; the travels equal the minimum over every
+// triangle of the per-triangle contact (no index, no planes) at every start, for a wide thin disc (a holder's
+// rim: the planes there are far from its edge unless they face it) and a bull-nose.
+TEST(DropDirection, TiltedRasterBatchEqualsEveryTriangle) {
+  const Grid g = bumpy_grid(24);
+  const Vector3d V = Vector3d(0.25, -0.1, -1).normalized();
+  const tmm::DirectionalIndex index(g.V, g.F, V);
+  const Vector3d axis = Vector3d(-0.2, 0.35, 1).normalized();  // about 28 deg off -V
+  const int side = 14, n = side * side;
+  std::vector<double> starts;
+  for (int i = 0; i < n; ++i)  // a zig-zag raster, as a path visits it
+    starts.insert(starts.end(), {-2 + 2.0 * (i / side % 2 ? side - 1 - i % side : i % side), -2 + 2.0 * (i / side), 14});
+  for (const Cutter& cut : {Cutter::apt(9, 2, 2, 0, 0), Cutter::apt(3, 1, 8, 0, 0)}) {
+    std::vector<double> t(n);
+    tmm::BatchOptions one;
+    one.threads = 1;
+    tmm::drop_along_batch(index, cut, starts.data(), axis.data(), false, n, tmm::kNoTravel, t.data(), one);
+    int contacts = 0;
+    for (int i = 0; i < n; ++i) {
+      const Vector3d start(&starts[3 * i]);
+      double brute = tmm::kNoTravel;
+      for (int f = 0; f < g.F.rows(); ++f)
+        brute = std::min(brute, tmm::drop_along(cut, start, axis, V, g.V.row(g.F(f, 0)).transpose(),
+                                                g.V.row(g.F(f, 1)).transpose(), g.V.row(g.F(f, 2)).transpose()));
+      if (brute == tmm::kNoTravel) {
+        EXPECT_EQ(t[i], brute) << i;
+      } else {
+        EXPECT_NEAR(t[i], brute, 1e-9) << i;
+        ++contacts;
+      }
+    }
+    EXPECT_GT(contacts, n / 2);
+  }
+}
+
 TEST(DropDirection, BatchThreadsAgreeAndCancel) {
   const Grid g = bumpy_grid(30);
   const Vector3d V = Vector3d(0.3, -0.2, -1).normalized();

@@ -124,7 +124,10 @@ double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, con
 class AlongCutter {
  public:
   // axis: a unit vector in the model's frame, not -V; std::invalid_argument otherwise or for an endless cutter.
-  AlongCutter(const DirectionalIndex& index, const Cutter& cutter, const Eigen::Vector3d& axis);
+  // fine_planes: also set up planes under K every few degrees around the axis (some 700 support values,
+  // worth it when many starts share the set-up), so that each candidate triangle meets the few facing it.
+  AlongCutter(const DirectionalIndex& index, const Cutter& cutter, const Eigen::Vector3d& axis,
+              bool fine_planes = false);
   // drop_along_point with this cutter and axis.
   double drop(const Eigen::Vector3d& start, double max_travel = kNoTravel, DropStats* stats = nullptr,
               int32_t* hint = nullptr) const;
@@ -135,6 +138,13 @@ class AlongCutter {
     double c, gx, gy;
   };
   double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
+  Plane plane_under(const Eigen::Vector3d& n) const;  // n: unit, index frame, n.z > 0
+  // True when one of the planes, with the tip `top` high over the XY' point (x, y), has all of t's corners
+  // below it: then K, which lies above that plane and only rises as the travel shrinks, misses t before it.
+  bool below_a_plane(const IndexedTriangle& t, double x, double y, double top) const;
+  static bool below(const Plane& p, const IndexedTriangle& t, double x, double y, double top);
+  // The fine planes' azimuth (0 to kFineAzimuths - 1) nearest to the direction c (index frame) around the axis.
+  int azimuth(const Eigen::Vector3d& c) const;
 
   const DirectionalIndex* index_;
   Cutter cutter_;
@@ -144,6 +154,10 @@ class AlongCutter {
   double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
+  // With fine planes: those along the axis (facing down), then kFineAzimuths per tilt from the axis
+  // (kFineTilts of them), azimuth-major; a plane facing up has c = -inf (nothing lies below it).
+  static constexpr int kFineAzimuths = 64, kFineTilts = 11;
+  std::vector<Plane> axial_, fine_;
 };
 
 // starts: n points (x, y, z, ...); axes: one unit axis (axes_per_point = false) or n of them; travel_out: n.
