@@ -3,6 +3,8 @@
 
     /usr/bin/python3 benchmarks/plan_jobs.py [job.yaml ...]     # default: every job of benchmarks/jobs
 
+benchmarks/jobs/sign.yaml plans seed 003's wooden sign: its model is made here first (core.geometry.sign, SIGN).
+
 Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest gouge and the most material left
 (mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
 planning time (the decisions, core only) and the whole run's wall time (FreeCAD included).
@@ -17,6 +19,20 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+
+
+SIGN_STL = REPO / "out" / "plan" / "sign_model" / "sign.stl"   # benchmarks/jobs/sign.yaml's model
+
+
+def make_sign_model() -> None:
+    """Seed 003's sign (section 1.4: a border, raised text) for sign.yaml, written once."""
+    if SIGN_STL.is_file():
+        return
+    from tmm_workbench.core.geometry.mesh import save_stl
+    from tmm_workbench.core.geometry.sign import SignSpec, make_sign
+
+    SIGN_STL.parent.mkdir(parents=True, exist_ok=True)
+    save_stl(make_sign(SignSpec("TMM 2026", width=120, height=60, relief=3, cell=0.25)).mesh, SIGN_STL)
 
 
 def jobs(args: list[str]) -> list[Path]:
@@ -37,6 +53,7 @@ def planning_seconds(job: Path) -> float:
 def main() -> None:
     from tmm_workbench.core.plan.job_file import read_job
 
+    make_sign_model()
     head = (f"{'job':<16} {'exit':>4} {'gouge mm':>9} {'left mm':>8} {'p95 mm':>7} {'cycle min':>9} "
             f"{'plan s':>6} {'wall s':>7}  ops")
     print(head)

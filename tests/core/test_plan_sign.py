@@ -9,7 +9,7 @@ import yaml
 
 from tmm_workbench.core.geometry.mesh import save_stl
 from tmm_workbench.core.geometry.sign import SignSpec, make_sign
-from tmm_workbench.core.plan import launch
+from tmm_workbench.core.plan import decide, launch
 from tmm_workbench.core.plan.job_file import job_from_dict
 
 JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
@@ -31,3 +31,52 @@ def test_sign_roughed_by_a_tool_that_gets_between_the_letters(tmp_path):
     area = 100 * 50
     assert an.reach["T16"].far_area > 0.5 * area > an.reach["T12"].far_area
     assert any("1 mm of at least 0.5 of its area" in d["reason"] for d in plan.as_dict()["decisions"])
+
+
+def sign_job(tmp_path, tools: list):
+    """Seed 003's wooden sign of tests/core/sign.py (block letters and a border raised 2.5 mm, walls at 85 deg:
+    sharp concave corners at their feet) with `tools` after a flat D8 roughing tool, comparison off (fast)."""
+    from tests.core.sign import sign_mesh
+
+    stl = save_stl(sign_mesh(0.4), tmp_path / "sign.stl")
+    data = yaml.safe_load(JOB.read_text())
+    data["model"]["file"] = str(stl)
+    data["planner"]["compare_cutters"] = False
+    data["finish"]["cusp"] = 0.02
+    data["tools"] = [{"name": "F8", "type": "flat", "diameter": 8, "flutes": 2, "flute_length": 20}] + tools
+    return job_from_dict(data, tmp_path / "sign.yaml")
+
+
+BALLS = [{"name": f"B{d:g}", "type": "ball", "diameter": d, "flutes": 2, "flute_length": 10} for d in (6, 3, 1)]
+
+
+def test_cleanup_after_the_rest_in_the_corners(tmp_path):
+    """The ball D6 finishes, the D3 takes the rest, and the D1, which the reach tests say leaves far less in the
+    letters' corners, cleans up along the creases the D3 leaves (pencil pattern, clean-up strips, only where
+    material is left; optional: left out if it alone fails the verification)."""
+    _, _, an, plan = launch.make_plan(sign_job(tmp_path, BALLS))
+    labels = [o.label for o in plan.ops]
+    assert labels[-2:] == ["Rest B3", "Clean-up B1"], labels
+    rest, clean = plan.ops[-2:]
+    assert rest.kwargs["region"] == "rest" and "pattern" not in rest.kwargs
+    wanted = {"region": "rest", "rest_from": "earlier_ops", "pattern": "pencil", "pencil_source": "cleanup",
+              "pencil_passes": 0, "rest_tolerance": 0.01}
+    assert {k: clean.kwargs.get(k) for k in wanted} == wanted
+    assert clean.optional and rest.optional
+    left = {t: an.reach[t].unreached_area for t in ("B6", "B3", "B1")}
+    assert left["B6"] > left["B3"] > left["B1"] / decide.CLEANUP_GAIN > 0, left
+    why = next(d for d in plan.decisions if d.topic == "clean-up")
+    assert why.choice.startswith("B1 (ball D1") and f"{left['B3']:.0f} mm2" in why.reason, why
+
+
+def test_no_cleanup_without_a_smaller_tool_that_reaches_more(tmp_path):
+    """Without the D1 the rest is the last op and the clean-up decision says why there is none; a D2.5 that the
+    reach tests find hardly better than the D3 is not worth its op either."""
+    _, _, _, plan = launch.make_plan(sign_job(tmp_path, BALLS[:2]))
+    assert [o.label for o in plan.ops][-1] == "Rest B3"
+    why = next(d for d in plan.decisions if d.topic == "clean-up")
+    assert why.choice == "none" and "no smaller library tool" in why.reason
+    near = BALLS[:2] + [{"name": "B2.8", "type": "ball", "diameter": 2.8, "flutes": 2, "flute_length": 10}]
+    _, an, plan = launch.make_plan(sign_job(tmp_path, near))[1:]
+    assert an.reach["B2.8"].unreached_area > decide.CLEANUP_GAIN * an.reach["B3"].unreached_area
+    assert not any(o.label.startswith("Clean-up") for o in plan.ops)
