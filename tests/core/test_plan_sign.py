@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+import pytest
 import yaml
 
 from tmm_workbench.core.geometry.mesh import save_stl
@@ -80,3 +82,31 @@ def test_no_cleanup_without_a_smaller_tool_that_reaches_more(tmp_path):
     _, an, plan = launch.make_plan(sign_job(tmp_path, near))[1:]
     assert an.reach["B2.8"].unreached_area > decide.CLEANUP_GAIN * an.reach["B3"].unreached_area
     assert not any(o.label.startswith("Clean-up") for o in plan.ops)
+
+
+def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():
+    """The Job's deviation judged where the smallest library tool reaches: a patch left 0.05 mm on the open
+    background counts (its area, its depth), 1 mm left in the sharp corner at the border's foot (out of any
+    ball's reach) does not; a larger ball reaches less."""
+    from tests.core.sign import BORDER, sign_mesh
+    from tmm_workbench.core.plan.left_check import left_in_reach
+    from tmm_workbench.core.sim.grid import Grid
+    from tmm_workbench.core.sim.stock import mesh_heights
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    mesh = sign_mesh(0.4)
+    grid = Grid.covering(0, 0, 84, 44, 0.4)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    deviation = np.zeros_like(design)
+    patch = (x > 5) & (x < 7) & (y > 5) & (y < 7)
+    corner = (x > BORDER) & (x < BORDER + 0.4) & (y > 10) & (y < 30)
+    deviation[patch], deviation[corner] = 0.05, 1.0
+    small = left_in_reach(mesh, grid, design, deviation, "B1", Cutter.ball(1.0), 0.01)
+    assert small["left_above_tolerance_mm2"] == pytest.approx(patch.sum() * 0.16)
+    assert small["most_left_mm"] == pytest.approx(0.05)
+    assert small["out_of_reach_mm2"] >= corner.sum() * 0.16
+    large = left_in_reach(mesh, grid, design, deviation, "B6", Cutter.ball(6.0), 0.01)
+    assert large["out_of_reach_mm2"] > small["out_of_reach_mm2"]
+    assert large["reached_mm2"] + large["out_of_reach_mm2"] == pytest.approx(small["reached_mm2"] +
+                                                                              small["out_of_reach_mm2"])

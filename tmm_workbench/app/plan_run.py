@@ -91,9 +91,11 @@ def drop_op(op: Any, kept: list) -> None:
 def op_rows(results: list, sim: Any) -> list:
     rows = []
     for r, s in zip(results, sim.ops):
-        rows.append({"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
-                     "rapids_through_stock": len(s.collisions),
-                     "holder": None if s.holder is None else s.holder.summary()})
+        row = {"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
+               "rapids_through_stock": len(s.collisions), "holder": None if s.holder is None else s.holder.summary()}
+        if getattr(r.op, "RestReport", ""):   # a rest or clean-up op: its rest area, the volume before and after
+            row["rest"] = r.op.RestReport
+        rows.append(row)
     return rows
 
 
@@ -127,7 +129,20 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
             "removed_volume_mm3": round(sim.removed_volume, 1), "remaining_volume_mm3": round(sim.remaining_volume, 1),
             "cycle_seconds": round(sim.cycle_seconds, 1), "ops": op_rows(results, sim.simulation),
             "sim_cell_mm": plan["sim_cell"], "tolerance_mm": plan["tolerance"],
-            "regions": rounded(dict(sorted(sim.regions.items())))}
+            "regions": rounded(dict(sorted(sim.regions.items()))), "left_in_reach": left_in_reach(sim, plan)}
+
+
+def left_in_reach(sim: Any, plan: dict) -> dict:
+    """The simulated Job's material left judged where the library's most reaching tool reaches
+    (core.plan.left_check)."""
+    from tmm_workbench.core.geometry.mesh import load_stl
+    from tmm_workbench.core.plan import left_check
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    js, tool = sim.simulation, plan["reach_tool"]
+    return left_check.left_in_reach(load_stl(plan["model_file"]), js.grid, js.design, js.comparison.deviation,
+                                    tool["name"], Cutter(tool["diameter"], tool["corner_radius"]),
+                                    plan["tolerance"])
 
 
 def rounded(value: Any) -> Any:

@@ -70,13 +70,15 @@ class Plan:
     ops: list = field(default_factory=list)
     decisions: list = field(default_factory=list)
     cutting: dict = field(default_factory=dict)   # tool name -> materials.Cutting.as_dict()
+    reach_tool: str = ""      # the library tool reaching the most: what is left is judged where it reaches
 
     def decide(self, topic: str, choice: str, reason: str) -> None:
         self.decisions.append(Decision(topic, choice, reason))
 
     def as_dict(self) -> dict:
         return {"stock_box_mm": [round(v, 4) for v in self.stock_box], "ops": [o.as_dict() for o in self.ops],
-                "decisions": [d.as_dict() for d in self.decisions], "tools": self.cutting}
+                "decisions": [d.as_dict() for d in self.decisions], "tools": self.cutting,
+                "left_judged_where_reaches": self.reach_tool}
 
 
 def cutter_of(tool: ToolSpec) -> Cutter:
@@ -364,6 +366,8 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> 
                 f"{an.down_share * 100:.1f} % (never reached from above)")
     choose_roughing(plan, job, an)
     radiused = reaching(plan, an, radiused)
+    plan.reach_tool = min(radiused, key=lambda t: (an.reach[t.name].unreached_area, t.corner_radius,
+                                                   radiused.index(t))).name
     shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
                                                   compare)
     finishing_ops(plan, job, an, shallow, steep, transition)

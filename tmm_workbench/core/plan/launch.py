@@ -74,11 +74,13 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
 def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     """What app/plan_run.py needs to run the plan."""
     o = job.outputs
+    reach = next(t for t in job.tools if t.name == plan.reach_tool)
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
             "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
-                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools}}
+                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools},
+            "reach_tool": {"name": plan.reach_tool, "diameter": reach.diameter, "corner_radius": reach.corner_radius}}
 
 
 def run_freecad(folder: Path, freecad: str, quiet: bool) -> Optional[str]:
