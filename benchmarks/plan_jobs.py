@@ -7,7 +7,9 @@ benchmarks/jobs/sign.yaml plans seed 003's wooden sign: its model is made here f
 
 Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest gouge and the most material left
 (mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
-planning time (the decisions, core only) and the whole run's wall time (FreeCAD included).
+planning time (the decisions, core only) and the whole run's wall time (FreeCAD included). Then what is left
+where the library's most reaching tool reaches (core.plan.left_check, along the normal): the area above the
+tolerance, the most, and the area out of that tool's reach from above; each rest and clean-up op's own report.
 """
 from __future__ import annotations
 
@@ -76,6 +78,17 @@ def main() -> None:
         print(f"{job.stem:<16} {proc.returncode:>4} {v['deepest_gouge_mm']:>9.4f} {v['most_material_left_mm']:>8.3f} "
               f"{v['left_percentiles_mm']['95']:>7.3f} {v['cycle_seconds'] / 60:>9.1f} {planning_seconds(job):>6.1f} "
               f"{wall:>7.0f}  {ops}", flush=True)
+        reach = v.get("left_in_reach")
+        if reach:
+            print(f"{'':<16} where {reach['tool']} reaches: {reach['left_above_tolerance_mm2']:g} mm2 left above the "
+                  f"tolerance, most {reach['most_left_mm']:g} mm (99 %: {reach['left_99_percentile_mm']:g} mm); out "
+                  f"of its reach {reach['out_of_reach_mm2']:g} of {reach['reached_mm2'] + reach['out_of_reach_mm2']:g}"
+                  " mm2", flush=True)
+        for op in v["ops"]:
+            if op.get("rest"):
+                print(f"{'':<16} {op['label']}: {op['rest'][:200]}", flush=True)
+        for change in v.get("replanned", []):
+            print(f"{'':<16} plan changed: {change[:200]}", flush=True)
         if v["problems"]:
             print(f"{'':<16} problems: {'; '.join(v['problems'])[:300]}", flush=True)
 

@@ -217,3 +217,45 @@ class PlanCleanup(FreeCADTestCase):
         self.assertEqual(with_it["tool"], "B1")
         self.assertGreater(left["left_above_tolerance_mm2"], 2 * with_it["left_above_tolerance_mm2"] + 1.0)
         self.assertGreater(without["remaining_volume_mm3"], verified["remaining_volume_mm3"])
+
+
+class PlanStep(FreeCADTestCase):
+    def test_step_model_planned(self) -> None:
+        """A STEP made here from a Part solid (a 30 x 20 x 4 mm plate with a boss r 6 h 3): app/step_mesh.py
+        tessellates it within half the tolerance (every triangle's centre that close to the solid's surface, the
+        boss's rim in facets as fine as that needs), a file that is no STEP is refused; `tmm plan` on it runs
+        verified and leaves the tessellation beside the G-code."""
+        import Part
+        import yaml
+
+        from tmm_workbench.app.step_mesh import step_mesh
+        from tmm_workbench.core.geometry.mesh import load_stl
+
+        folder = OUT / "plan_step"
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        solid = Part.makeBox(30, 20, 4).fuse(Part.makeCylinder(6, 3, FreeCAD.Vector(15, 10, 4)))
+        solid.exportStep(str(folder / "part.step"))
+        self.assertEqual(step_mesh(folder / "part.step", folder / "mesh.stl", 0.005), len(
+            load_stl(folder / "mesh.stl").triangles))
+        mesh = load_stl(folder / "mesh.stl")
+        centres = mesh.vertices[mesh.triangles].mean(axis=1)
+        far = max(solid.distToShape(Part.Vertex(FreeCAD.Vector(*map(float, c))))[0] for c in centres[::7])
+        self.assertLess(far, 0.005 + 1e-6)
+        rim = np.hypot(mesh.vertices[:, 0] - 15, mesh.vertices[:, 1] - 10)
+        on_rim = (np.abs(rim - 6) < 1e-3) & (np.abs(mesh.vertices[:, 2] - 7) < 1e-6)
+        self.assertGreater(on_rim.sum(), np.pi / np.arccos(1 - 0.005 / 6) * 0.9)   # facets for a 5 um chord
+        (folder / "not.step").write_text("solid not a step\n")
+        with self.assertRaises(ValueError):
+            step_mesh(folder / "not.step", folder / "not.stl", 0.005)
+        data = yaml.safe_load(JOB.read_text())
+        data["model"]["file"] = str(folder / "part.step")
+        data["outputs"]["dir"] = str(folder / "out")
+        data["planner"]["compare_cutters"] = False
+        (folder / "job.yaml").write_text(yaml.safe_dump(data))
+        self.assertEqual(launch.run(str(folder / "job.yaml"), freecadcmd(), quiet=True), launch.VERIFIED)
+        out = sorted(p.name for p in (folder / "out").iterdir())
+        self.assertEqual(out, ["part.FCStd", "part.ngc", "part_model.stl", "part_sim.png", "part_toolpath.png",
+                               "report.html", "report.json"])
+        report = json.loads((folder / "out" / "report.json").read_text())
+        self.assertEqual(report["analysis"]["size_mm"], [30.0, 20.0, 7.0])
