@@ -9,7 +9,7 @@ Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest
 (mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
 planning time (the decisions, core only) and the whole run's wall time (FreeCAD included). Then what is left
 where the library's most reaching tool reaches (core.plan.left_check, along the normal): the area above the
-tolerance, the most, and the area out of that tool's reach from above; each rest and clean-up op's own report.
+tolerance, the most, and the area out of that tool's reach from above; each rest and pencil op's own report.
 """
 from __future__ import annotations
 

@@ -3,6 +3,7 @@ letters (a flat D16 stays more than 1 mm above most of the sign: the roughing op
 remove), the rest as for any model."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -52,36 +53,37 @@ def sign_job(tmp_path, tools: list):
 BALLS = [{"name": f"B{d:g}", "type": "ball", "diameter": d, "flutes": 2, "flute_length": 10} for d in (6, 3, 1)]
 
 
-def test_cleanup_after_the_rest_in_the_corners(tmp_path):
+def test_pencil_after_the_rest_in_the_corners(tmp_path):
     """The ball D6 finishes, the D3 takes the rest, and the D1, which the reach tests say leaves far less in the
-    letters' corners, cleans up along the creases the D3 leaves (pencil pattern, clean-up strips, only where
-    material is left; optional: left out if it alone fails the verification)."""
+    letters' corners, pencils the creases with passes outward over the band between the D3's radius and its own
+    (only where material is left; optional: left out if it alone fails the verification)."""
     _, _, an, plan = launch.make_plan(sign_job(tmp_path, BALLS))
     labels = [o.label for o in plan.ops]
-    assert labels[-2:] == ["Rest B3", "Clean-up B1"], labels
-    rest, clean = plan.ops[-2:]
+    assert labels[-2:] == ["Rest B3", "Pencil B1"], labels
+    rest, pencil = plan.ops[-2:]
     assert rest.kwargs["region"] == "rest" and "pattern" not in rest.kwargs
-    wanted = {"region": "rest", "rest_from": "earlier_ops", "pattern": "pencil", "pencil_source": "cleanup",
-              "pencil_passes": 0, "rest_tolerance": 0.01}
-    assert {k: clean.kwargs.get(k) for k in wanted} == wanted
-    assert clean.optional and rest.optional
+    step = pencil.kwargs["stepover"]   # the cusp's step-over of the D1: (1.5 - 0.5) mm covered outward
+    wanted = {"region": "rest", "rest_from": "earlier_ops", "pattern": "pencil", "pencil_source": "creases",
+              "pencil_passes": 1 + math.ceil(1.0 / step), "rest_tolerance": 0.01}
+    assert {k: pencil.kwargs.get(k) for k in wanted} == wanted
+    assert pencil.optional and rest.optional
     left = {t: an.reach[t].unreached_area for t in ("B6", "B3", "B1")}
-    assert left["B6"] > left["B3"] > left["B1"] / decide.CLEANUP_GAIN > 0, left
-    why = next(d for d in plan.decisions if d.topic == "clean-up")
+    assert left["B6"] > left["B3"] > left["B1"] / decide.PENCIL_GAIN > 0, left
+    why = next(d for d in plan.decisions if d.topic == "pencil")
     assert why.choice.startswith("B1 (ball D1") and f"{left['B3']:.0f} mm2" in why.reason, why
 
 
-def test_no_cleanup_without_a_smaller_tool_that_reaches_more(tmp_path):
-    """Without the D1 the rest is the last op and the clean-up decision says why there is none; a D2.5 that the
+def test_no_pencil_without_a_smaller_tool_that_reaches_more(tmp_path):
+    """Without the D1 the rest is the last op and the pencil decision says why there is none; a D2.8 that the
     reach tests find hardly better than the D3 is not worth its op either."""
     _, _, _, plan = launch.make_plan(sign_job(tmp_path, BALLS[:2]))
     assert [o.label for o in plan.ops][-1] == "Rest B3"
-    why = next(d for d in plan.decisions if d.topic == "clean-up")
+    why = next(d for d in plan.decisions if d.topic == "pencil")
     assert why.choice == "none" and "no smaller library tool" in why.reason
     near = BALLS[:2] + [{"name": "B2.8", "type": "ball", "diameter": 2.8, "flutes": 2, "flute_length": 10}]
     _, an, plan = launch.make_plan(sign_job(tmp_path, near))[1:]
-    assert an.reach["B2.8"].unreached_area > decide.CLEANUP_GAIN * an.reach["B3"].unreached_area
-    assert not any(o.label.startswith("Clean-up") for o in plan.ops)
+    assert an.reach["B2.8"].unreached_area > decide.PENCIL_GAIN * an.reach["B3"].unreached_area
+    assert not any(o.label.startswith("Pencil") for o in plan.ops)
 
 
 def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():

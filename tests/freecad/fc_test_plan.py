@@ -2,7 +2,8 @@
 (beet_mm.stl, coarse values): one Job with the planned ops, their tool controllers and feeds, the whole Job posted
 (every tool's change in the G-code), simulated and verified (no gouge below the tolerance, no rapid through stock),
 the document saved and reopened with its ops recomputing after a changed value. On a block raised from a plate
-(sharp concave corners at its foot): the rest and the clean-up planned, run, and what they take off verified."""
+(sharp concave corners at its foot): the rest and the pencil planned, run, and what they take off verified. A STEP
+model tessellated and planned."""
 from __future__ import annotations
 
 import json
@@ -180,17 +181,17 @@ def block_on_plate() -> Any:
     return TriMesh(np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]), faces, "block")
 
 
-class PlanCleanup(FreeCADTestCase):
-    def test_rest_and_cleanup_take_the_corners(self) -> None:
-        """Ball D6 finishing, D3 rest, D1 clean-up along the creases the D3 leaves: each rest op reports less
-        volume after than before, and the simulation of the Job without the clean-up leaves more above the
+class PlanPencil(FreeCADTestCase):
+    def test_rest_and_pencil_take_the_corners(self) -> None:
+        """Ball D6 finishing, D3 rest, D1 pencil along the creases the D3 leaves: each rest op reports less
+        volume after than before, and the simulation of the Job without the pencil leaves more above the
         tolerance where the D1 reaches (and more volume) than with it."""
         import yaml
 
         from tmm_workbench.core.geometry.mesh import save_stl
         from tmm_workbench.core.plan.job_file import job_from_dict
 
-        folder = OUT / "plan_cleanup"
+        folder = OUT / "plan_pencil"
         folder.mkdir(parents=True, exist_ok=True)
         data = yaml.safe_load(JOB.read_text())
         data["model"]["file"] = str(save_stl(block_on_plate(), folder / "block.stl"))
@@ -200,18 +201,17 @@ class PlanCleanup(FreeCADTestCase):
             {"name": f"B{d}", "type": "ball", "diameter": d, "flute_length": 10} for d in (6, 3, 1)]
         job = job_from_dict(data, folder / "job.yaml")
         _, _, an, plan = launch.make_plan(job)
-        self.assertEqual([o.label for o in plan.ops][-2:], ["Rest B3", "Clean-up B1"])
+        self.assertEqual([o.label for o in plan.ops][-2:], ["Rest B3", "Pencil B1"])
         doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
         results, verified = plan_run.run_plan(doc, folder)
         self.assertTrue(verified["passed"], verified["problems"])
         self.assertEqual(verified["replanned"], [])
         rows = {o["label"]: o for o in verified["ops"]}
-        for label in ("Rest B3", "Clean-up B1"):
+        for label in ("Rest B3", "Pencil B1"):
             before, after = (float(v) for v in re.search(r"([\d.]+) mm3 above the design before, ([\d.]+) mm3 "
                                                           r"after", rows[label]["rest"]).groups())
             self.assertLess(after, 0.5 * before, rows[label]["rest"])
-        clean = results[-1]
-        plan_run.drop_op(clean.op, results[:-1])
+        plan_run.drop_op(results[-1].op, results[:-1])
         without = plan_run.verify(results[:-1], doc, folder)
         with_it, left = verified["left_in_reach"], without["left_in_reach"]
         self.assertEqual(with_it["tool"], "B1")

@@ -93,7 +93,7 @@ def op_rows(results: list, sim: Any) -> list:
     for r, s in zip(results, sim.ops):
         row = {"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
                "rapids_through_stock": len(s.collisions), "holder": None if s.holder is None else s.holder.summary()}
-        if getattr(r.op, "RestReport", ""):   # a rest or clean-up op: its rest area, the volume before and after
+        if getattr(r.op, "RestReport", ""):   # a rest or pencil op: its rest area, the volume before and after
             row["rest"] = r.op.RestReport
         rows.append(row)
     return rows
@@ -208,7 +208,9 @@ def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict
     tmp = launch.temporary_folder(out_dir, name)
     doc, before = model.Document, {o.Name for o in model.Document.Objects}
     try:
-        stl = save_stl(mesh_from_object(model), tmp / f"{name}_model.stl")
+        # a Part object tessellated as a STEP model is (core.plan.launch): within a share of the tolerance
+        deflection = launch.STEP_DEFLECTION_SHARE * float(data["finish"]["tolerance"])
+        stl = save_stl(mesh_from_object(model, deflection), tmp / f"{name}_model.stl")
         again = dict(data, model=dict(data["model"], file=stl.name), outputs=dict(data["outputs"], dir="."))
         (tmp / "job.json").write_text(json.dumps(again, indent=1, sort_keys=True) + "\n")
         job = job_from_dict(dict(data, model=dict(data["model"], file=str(stl))), tmp / "job.json")

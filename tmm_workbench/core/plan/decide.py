@@ -9,8 +9,8 @@ each decision written down with its reason for the report. Deterministic: the sa
 - the finishing cutter by that comparison (same step-over and raster for every radiused library tool, ranked by
   the volume each leaves), or the largest ball without it;
 - rest: a smaller radiused tool where the reach tests say the finishing tool leaves material it reaches;
-- clean-up: a still smaller one along the concave creases the rest tool leaves (seed 000's clean-up strips, the
-  pencil of seed 003 section 4.5) where the reach tests say it reaches clearly more.
+- pencil: a still smaller one along the concave creases (seed 003 section 4.5's pencil, passes outward over the
+  band the rest tool's radius leaves) where the reach tests say it reaches clearly more.
 """
 from __future__ import annotations
 
@@ -38,7 +38,7 @@ MAX_COMPARED = 4           # radiused tools compared (the largest first)
 ROUGH_SHANK_CLEAR = 1.5    # mm: the roughing's flutes end this far above the stock (the API's shank clearance 1 mm)
 ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
 ROUGH_FAR_SHARE = 0.5      # nor one staying more than FAR_MM above over more than this share of the model's area
-CLEANUP_GAIN = 0.8         # a clean-up tool must leave at most this share of the rest tool's unreached area
+PENCIL_GAIN = 0.8          # a pencil tool must leave at most this share of the rest tool's unreached area
 
 
 @dataclass(frozen=True)
@@ -329,28 +329,31 @@ def rest_args(job: JobSpec, tool: ToolSpec) -> dict:
             "sample_step": round(min(0.5, max(0.1, tool.diameter / 20.0)), 3), "post": job.machine.post}
 
 
-def cleanup_op(plan: Plan, job: JobSpec, an: Analysis, rest: ToolSpec, radiused: list) -> None:
+def pencil_op(plan: Plan, job: JobSpec, an: Analysis, rest: ToolSpec, radiused: list) -> None:
     """After the rest: the smaller radiused tool that reaches the most of what the rest tool leaves, along the
-    concave creases where it leaves it (seed 000's clean-up strips: where the rest tool's contact normals jump,
-    joined with the cells it leaves; passes up each flank to the strip's edge), when the reach tests say it
-    leaves at most CLEANUP_GAIN of the rest tool's unreached area."""
+    concave creases (where it touches the model on two sides), with passes outward the cusp's step-over apart
+    across the band between its radius and the rest tool's, only where more than the tolerance is left; when the
+    reach tests say it leaves at most PENCIL_GAIN of the rest tool's unreached area. (Seed 000's clean-up strips
+    were tried: on beet_mm they joined the rest tool's out-of-reach undercuts into 92,805 flank passes, minutes
+    of computing; this pencil took 13 s and the same corners, 48.2 -> 11.2 mm3.)"""
     left = an.reach[rest.name].unreached_area
     smaller = [t for t in radiused if t.diameter < rest.diameter
-               and an.reach[t.name].unreached_area <= CLEANUP_GAIN * left]
+               and an.reach[t.name].unreached_area <= PENCIL_GAIN * left]
     if left == 0.0 or not smaller:
-        plan.decide("clean-up", "none", f"the rest tool {rest.name} leaves {left:.0f} mm2 out of reach and no "
-                    f"smaller library tool leaves at most {CLEANUP_GAIN:g} of it (reported as left)")
+        plan.decide("pencil", "none", f"the rest tool {rest.name} leaves {left:.0f} mm2 out of reach and no "
+                    f"smaller library tool leaves at most {PENCIL_GAIN:g} of it (reported as left)")
         return
     tool = min(smaller, key=lambda t: (an.reach[t.name].unreached_area, -t.diameter, radiused.index(t)))
     step = round(stepover_for_cusp(cutter_of(tool), job.finish.cusp), 4)
+    passes = min(50, 1 + math.ceil((rest.corner_radius - tool.corner_radius) / step))
     kwargs = api_tool(tool) | feeds(plan, job, tool) | rest_args(job, tool) | {
-        "pattern": "pencil", "pencil_source": "cleanup", "pencil_passes": 0, "stepover": step}
-    plan.ops.append(OpPlan("run_surface", f"Clean-up {tool.name}", tool.name, kwargs, optional=True))
-    plan.decide("clean-up", tool.describe(),
+        "pattern": "pencil", "pencil_source": "creases", "pencil_passes": passes, "stepover": step}
+    plan.ops.append(OpPlan("run_surface", f"Pencil {tool.name}", tool.name, kwargs, optional=True))
+    plan.decide("pencil", tool.describe(),
                 f"the rest tool {rest.name} leaves {left:.0f} mm2 out of reach (reach test), {tool.name} "
-                f"{an.reach[tool.name].unreached_area:.0f} mm2: along the concave creases {rest.name} leaves (seed "
-                f"000's clean-up strips, seed 003's pencil), passes {step:g} mm apart up each flank to the strip's "
-                f"edge, only where more than {job.finish.tolerance:g} mm is left")
+                f"{an.reach[tool.name].unreached_area:.0f} mm2: along the concave creases (seed 003 section 4.5), "
+                f"{passes} passes {step:g} mm apart outward over the band between the two tools' radii, only where "
+                f"more than {job.finish.tolerance:g} mm is left")
 
 
 def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> Plan:
@@ -373,5 +376,5 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> 
     finishing_ops(plan, job, an, shallow, steep, transition)
     rest = rest_op(plan, job, an, [shallow, steep], radiused)
     if rest is not None:
-        cleanup_op(plan, job, an, rest, radiused)
+        pencil_op(plan, job, an, rest, radiused)
     return plan
