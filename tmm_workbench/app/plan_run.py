@@ -14,7 +14,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
 TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
@@ -249,10 +249,12 @@ def main() -> int:
     return 0
 
 
-def _entry() -> None:
+def exit_with(run: Callable[[], int]) -> None:
+    """A freecadcmd script's end: `run`'s exit code, FAILED with the traceback when it raises (freecadcmd would
+    swallow the exception and exit 0)."""
     try:
-        code = main()
-    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
+        code = run()
+    except BaseException:  # noqa: BLE001
         traceback.print_exc()
         code = FAILED
     sys.stdout.flush()
@@ -261,4 +263,4 @@ def _entry() -> None:
 
 
 if __name__ in ("__main__", "plan_run"):
-    _entry()
+    exit_with(main)

@@ -12,11 +12,10 @@ from __future__ import annotations
 
 import os
 import sys
-import traceback
 from pathlib import Path
 
 REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
-UNREADABLE, FAILED = 2, 3
+UNREADABLE = 2   # app.plan_run.exit_with: 3 for any other failure
 
 
 def step_mesh(step: Path, stl: Path, deflection: float) -> int:
@@ -25,34 +24,29 @@ def step_mesh(step: Path, stl: Path, deflection: float) -> int:
     import Part
 
     from tmm_workbench.app.geometry import mesh_from_shape
-    from tmm_workbench.core.errors import TmmError
     from tmm_workbench.core.geometry.mesh import save_stl
 
     try:
         shape = Part.read(str(step))
         mesh = mesh_from_shape(shape, deflection, step.stem)
-    except (TmmError, Exception) as exc:  # noqa: BLE001 - OCC's reader raises its own kinds
+    except Exception as exc:  # noqa: BLE001 - OCC's reader raises its own kinds, TMM a TmmError without faces
         raise ValueError(f"FreeCAD could not read {step.name} as a STEP model: {exc}") from None
     save_stl(mesh, stl)
     return len(mesh.triangles)
 
 
-def _entry() -> None:
-    sys.path.insert(0, str(REPO))
+def main() -> int:
     try:
         step_mesh(Path(os.environ["TMM_STEP_FILE"]), Path(os.environ["TMM_STEP_STL"]),
                   float(os.environ["TMM_STEP_DEFLECTION"]))
-        code = 0
     except ValueError as exc:
         print(exc, file=sys.stderr)
-        code = UNREADABLE
-    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
-        traceback.print_exc()
-        code = FAILED
-    sys.stdout.flush()
-    sys.stderr.flush()
-    raise SystemExit(code)
+        return UNREADABLE
+    return 0
 
 
 if __name__ in ("__main__", "step_mesh"):
-    _entry()
+    sys.path.insert(0, str(REPO))
+    from tmm_workbench.app.plan_run import exit_with
+
+    exit_with(main)
