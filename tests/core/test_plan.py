@@ -307,17 +307,3 @@ def test_roughing_stops_where_its_flutes_end(tmp_path: Path) -> None:
     assert "final_z" not in plan.ops[0].kwargs
     assert "roughing depth" not in [d.topic for d in plan.decisions]
 
-
-def test_steep_first_where_the_flutes_are_short(tmp_path: Path) -> None:
-    """A finishing ball whose flutes are shorter than the model is high finishes the walls first (its shank would
-    run along the roughing's stock on them under the shallow raster); with long flutes the raster comes first."""
-    data = good(tmp_path)
-    data["planner"]["compare_cutters"] = False
-    labels = [o.label for o in plan_of(tmp_path, data)[3].ops]
-    assert labels.index("Finish shallow T2 ball D6") < labels.index("Finish steep T2 ball D6")
-    data["tools"][1]["flute_length"] = 5       # the beet is 7.2 mm high; the stick-out (30 mm) still reaches
-    plan = plan_of(tmp_path, data)[3]
-    labels = [o.label for o in plan.ops]
-    assert labels.index("Finish steep T2 ball D6") < labels.index("Finish shallow T2 ball D6")
-    why = next(d for d in plan.decisions if d.topic == "finishing order")
-    assert "T2 ball D6 has 5 mm flutes" in why.reason and "7.2 mm high" in why.reason

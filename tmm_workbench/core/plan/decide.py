@@ -299,23 +299,6 @@ def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, ste
                     f"{transition:g} deg")
 
 
-def finishing_order(plan: Plan, an: Analysis, shallow: ToolSpec, steep: ToolSpec) -> None:
-    """The steep walls first where a finishing tool's flutes are shorter than the model is high: below its flutes
-    its shank (as wide as the cut) would run along walls still carrying the roughing's stock (wheel_in_box: the
-    raster's shank in that stock on 12,657 moves); the waterline clears them from the top down first."""
-    labels = [o.label for o in plan.ops]
-    shallow_at = next((i for i, x in enumerate(labels) if x.startswith("Finish shallow")), None)
-    steep_at = next((i for i, x in enumerate(labels) if x.startswith("Finish steep")), None)
-    short = [t for t in dict.fromkeys([shallow, steep]) if t.flute_length < an.size[2]]
-    if shallow_at is None or steep_at is None or not short:
-        return
-    plan.ops[shallow_at], plan.ops[steep_at] = plan.ops[steep_at], plan.ops[shallow_at]
-    plan.decide("finishing order", "steep first, then shallow",
-                f"{', '.join(f'{t.name} has {t.flute_length:g} mm flutes' for t in short)} for a model "
-                f"{an.size[2]:.1f} mm high: deeper its shank, as wide as the cut, would run along walls still carrying "
-                f"the roughing's {ROUGH_LEAVE:g} mm; the waterline takes the walls from the top down first")
-
-
 def rest_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list, radiused: list) -> Optional[ToolSpec]:
     """A smaller radiused tool where the finishing tools leave material out of their reach that it reaches (the
     rest tool, None without one)."""
@@ -391,7 +374,6 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> 
     shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
                                                   compare)
     finishing_ops(plan, job, an, shallow, steep, transition)
-    finishing_order(plan, an, shallow, steep)
     rest = rest_op(plan, job, an, [shallow, steep], radiused)
     if rest is not None:
         pencil_op(plan, job, an, rest, radiused)
