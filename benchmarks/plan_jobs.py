@@ -3,9 +3,13 @@
 
     /usr/bin/python3 benchmarks/plan_jobs.py [job.yaml ...]     # default: every job of benchmarks/jobs
 
+benchmarks/jobs/sign.yaml plans seed 003's wooden sign: its model is made here first (core.geometry.sign, SIGN).
+
 Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest gouge and the most material left
 (mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
-planning time (the decisions, core only) and the whole run's wall time (FreeCAD included).
+planning time (the decisions, core only) and the whole run's wall time (FreeCAD included). Then what is left
+where the library's most reaching tool reaches (core.plan.left_check, along the normal): the area above the
+tolerance, the most, and the area out of that tool's reach from above; each rest and pencil op's own report.
 """
 from __future__ import annotations
 
@@ -17,6 +21,20 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+
+
+SIGN_STL = REPO / "out" / "plan" / "sign_model" / "sign.stl"   # benchmarks/jobs/sign.yaml's model
+
+
+def make_sign_model() -> None:
+    """Seed 003's sign (section 1.4: a border, raised text) for sign.yaml, written once."""
+    if SIGN_STL.is_file():
+        return
+    from tmm_workbench.core.geometry.mesh import save_stl
+    from tmm_workbench.core.geometry.sign import SignSpec, make_sign
+
+    SIGN_STL.parent.mkdir(parents=True, exist_ok=True)
+    save_stl(make_sign(SignSpec("TMM 2026", width=120, height=60, relief=3, cell=0.25)).mesh, SIGN_STL)
 
 
 def jobs(args: list[str]) -> list[Path]:
@@ -37,6 +55,7 @@ def planning_seconds(job: Path) -> float:
 def main() -> None:
     from tmm_workbench.core.plan.job_file import read_job
 
+    make_sign_model()
     head = (f"{'job':<16} {'exit':>4} {'gouge mm':>9} {'left mm':>8} {'p95 mm':>7} {'cycle min':>9} "
             f"{'plan s':>6} {'wall s':>7}  ops")
     print(head)
@@ -59,6 +78,17 @@ def main() -> None:
         print(f"{job.stem:<16} {proc.returncode:>4} {v['deepest_gouge_mm']:>9.4f} {v['most_material_left_mm']:>8.3f} "
               f"{v['left_percentiles_mm']['95']:>7.3f} {v['cycle_seconds'] / 60:>9.1f} {planning_seconds(job):>6.1f} "
               f"{wall:>7.0f}  {ops}", flush=True)
+        reach = v.get("left_in_reach")
+        if reach:
+            print(f"{'':<16} where {reach['tool']} reaches: {reach['left_above_tolerance_mm2']:g} mm2 left above the "
+                  f"tolerance, most {reach['most_left_mm']:g} mm (99 %: {reach['left_99_percentile_mm']:g} mm); out "
+                  f"of its reach {reach['out_of_reach_mm2']:g} of {reach['reached_mm2'] + reach['out_of_reach_mm2']:g}"
+                  " mm2", flush=True)
+        for op in v["ops"]:
+            if op.get("rest"):
+                print(f"{'':<16} {op['label']}: {op['rest'][:200]}", flush=True)
+        for change in v.get("replanned", []):
+            print(f"{'':<16} plan changed: {change[:200]}", flush=True)
         if v["problems"]:
             print(f"{'':<16} problems: {'; '.join(v['problems'])[:300]}", flush=True)
 

@@ -63,8 +63,8 @@ BAD = [  # (change, words the message must hold: the field, the value, what is a
     (lambda d: d["finish"].update(cusp=0), ["finish.cusp", "0", "[0.0001, 5]"]),
     (lambda d: d["finish"].update(cusp="fine"), ["finish.cusp", "'fine'"]),
     (lambda d: d["model"].update(units="cm"), ["model.units", "'cm'", "mm, inch"]),
-    (lambda d: d["model"].update(file="nowhere.stl"), ["model.file", "nowhere.stl", "existing STL"]),
-    (lambda d: d["model"].update(file="part.step"), ["model.file", "part.step", "STL"]),
+    (lambda d: d["model"].update(file="nowhere.stl"), ["model.file", "nowhere.stl", "existing model file"]),
+    (lambda d: d["model"].update(file="part.iges"), ["model.file", "part.iges", "STL (.stl) or STEP"]),
     (lambda d: d["machine"].update(post="fanuc"), ["machine.post", "'fanuc'", "linuxcnc"]),
     (lambda d: d["machine"].update(type="5-axis"), ["machine.type", "'5-axis'", "3-axis"]),
     (lambda d: d["machine"].update(travels=[300, 200]), ["machine.travels", "[x, y, z]"]),
@@ -306,3 +306,4 @@ def test_roughing_stops_where_its_flutes_end(tmp_path: Path) -> None:
     _, _, _, plan = plan_of(tmp_path, good(tmp_path))
     assert "final_z" not in plan.ops[0].kwargs
     assert "roughing depth" not in [d.topic for d in plan.decisions]
+

@@ -3,13 +3,16 @@ letters (a flat D16 stays more than 1 mm above most of the sign: the roughing op
 remove), the rest as for any model."""
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+import numpy as np
+import pytest
 import yaml
 
 from tmm_workbench.core.geometry.mesh import save_stl
 from tmm_workbench.core.geometry.sign import SignSpec, make_sign
-from tmm_workbench.core.plan import launch
+from tmm_workbench.core.plan import decide, launch
 from tmm_workbench.core.plan.job_file import job_from_dict
 
 JOB = Path(__file__).resolve().parents[1] / "data" / "plan_beet.yaml"
@@ -31,3 +34,81 @@ def test_sign_roughed_by_a_tool_that_gets_between_the_letters(tmp_path):
     area = 100 * 50
     assert an.reach["T16"].far_area > 0.5 * area > an.reach["T12"].far_area
     assert any("1 mm of at least 0.5 of its area" in d["reason"] for d in plan.as_dict()["decisions"])
+
+
+def sign_job(tmp_path, tools: list):
+    """Seed 003's wooden sign of tests/core/sign.py (block letters and a border raised 2.5 mm, walls at 85 deg:
+    sharp concave corners at their feet) with `tools` after a flat D8 roughing tool, comparison off (fast)."""
+    from tests.core.sign import sign_mesh
+
+    stl = save_stl(sign_mesh(0.4), tmp_path / "sign.stl")
+    data = yaml.safe_load(JOB.read_text())
+    data["model"]["file"] = str(stl)
+    data["planner"]["compare_cutters"] = False
+    data["finish"]["cusp"] = 0.02
+    data["tools"] = [{"name": "F8", "type": "flat", "diameter": 8, "flutes": 2, "flute_length": 20}] + tools
+    return job_from_dict(data, tmp_path / "sign.yaml")
+
+
+BALLS = [{"name": f"B{d:g}", "type": "ball", "diameter": d, "flutes": 2, "flute_length": 10} for d in (6, 3, 1)]
+
+
+def test_pencil_after_the_rest_in_the_corners(tmp_path):
+    """The ball D6 finishes, the D3 takes the rest, and the D1, which the reach tests say leaves far less in the
+    letters' corners, pencils the creases with passes outward over the band between the D3's radius and its own
+    (only where material is left; optional: left out if it alone fails the verification)."""
+    _, _, an, plan = launch.make_plan(sign_job(tmp_path, BALLS))
+    labels = [o.label for o in plan.ops]
+    assert labels[-2:] == ["Rest B3", "Pencil B1"], labels
+    rest, pencil = plan.ops[-2:]
+    assert rest.kwargs["region"] == "rest" and "pattern" not in rest.kwargs
+    step = pencil.kwargs["stepover"]   # the cusp's step-over of the D1: (1.5 - 0.5) mm covered outward
+    wanted = {"region": "rest", "rest_from": "earlier_ops", "pattern": "pencil", "pencil_source": "creases",
+              "pencil_passes": 1 + math.ceil(1.0 / step), "rest_tolerance": 0.01}
+    assert {k: pencil.kwargs.get(k) for k in wanted} == wanted
+    assert pencil.optional and rest.optional
+    left = {t: an.reach[t].unreached_area for t in ("B6", "B3", "B1")}
+    assert left["B6"] > left["B3"] > left["B1"] / decide.PENCIL_GAIN > 0, left
+    why = next(d for d in plan.decisions if d.topic == "pencil")
+    assert why.choice.startswith("B1 (ball D1") and f"{left['B3']:.0f} mm2" in why.reason, why
+
+
+def test_no_pencil_without_a_smaller_tool_that_reaches_more(tmp_path):
+    """Without the D1 the rest is the last op and the pencil decision says why there is none; a D2.8 that the
+    reach tests find hardly better than the D3 is not worth its op either."""
+    _, _, _, plan = launch.make_plan(sign_job(tmp_path, BALLS[:2]))
+    assert [o.label for o in plan.ops][-1] == "Rest B3"
+    why = next(d for d in plan.decisions if d.topic == "pencil")
+    assert why.choice == "none" and "no smaller library tool" in why.reason
+    near = BALLS[:2] + [{"name": "B2.8", "type": "ball", "diameter": 2.8, "flutes": 2, "flute_length": 10}]
+    _, an, plan = launch.make_plan(sign_job(tmp_path, near))[1:]
+    assert an.reach["B2.8"].unreached_area > decide.PENCIL_GAIN * an.reach["B3"].unreached_area
+    assert not any(o.label.startswith("Pencil") for o in plan.ops)
+
+
+def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():
+    """The Job's deviation judged where the smallest library tool reaches: a patch left 0.05 mm on the open
+    background counts (its area, its depth), 1 mm left in the sharp corner at the border's foot (out of any
+    ball's reach) does not; a larger ball reaches less."""
+    from tests.core.sign import BORDER, sign_mesh
+    from tmm_workbench.core.plan.left_check import left_in_reach
+    from tmm_workbench.core.sim.grid import Grid
+    from tmm_workbench.core.sim.stock import mesh_heights
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    mesh = sign_mesh(0.4)
+    grid = Grid.covering(0, 0, 84, 44, 0.4)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    deviation = np.zeros_like(design)
+    patch = (x > 5) & (x < 7) & (y > 5) & (y < 7)
+    corner = (x > BORDER) & (x < BORDER + 0.4) & (y > 10) & (y < 30)
+    deviation[patch], deviation[corner] = 0.05, 1.0
+    small = left_in_reach(mesh, grid, design, deviation, "B1", Cutter.ball(1.0), 0.01)
+    assert small["left_above_tolerance_mm2"] == pytest.approx(patch.sum() * 0.16)
+    assert small["most_left_mm"] == pytest.approx(0.05)
+    assert small["out_of_reach_mm2"] >= corner.sum() * 0.16
+    large = left_in_reach(mesh, grid, design, deviation, "B6", Cutter.ball(6.0), 0.01)
+    assert large["out_of_reach_mm2"] > small["out_of_reach_mm2"]
+    assert large["reached_mm2"] + large["out_of_reach_mm2"] == pytest.approx(small["reached_mm2"] +
+                                                                              small["out_of_reach_mm2"])

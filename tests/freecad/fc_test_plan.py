@@ -1,16 +1,21 @@
 """The automatic planner's FreeCAD side (app/plan_run.py) on the plan core.plan makes for tests/data/plan_beet.yaml
 (beet_mm.stl, coarse values): one Job with the planned ops, their tool controllers and feeds, the whole Job posted
 (every tool's change in the G-code), simulated and verified (no gouge below the tolerance, no rapid through stock),
-the document saved and reopened with its ops recomputing after a changed value."""
+the document saved and reopened with its ops recomputing after a changed value. On a block raised from a plate
+(sharp concave corners at its foot): the rest and the pencil planned, run, and what they take off verified. A STEP
+model tessellated and planned."""
 from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import sys
 from pathlib import Path
+from typing import Any
 
 import FreeCAD
+import numpy as np
 
 from fc_helpers import OUT, FreeCADTestCase, close_all, parse_gcode
 from tmm_workbench.app import plan_run
@@ -54,6 +59,11 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual([o["label"] for o in verified["ops"]], [o.label for o in plan.ops])
         self.assertTrue(all(o["moves"] > 0 and o["cycle_seconds"] > 0 for o in verified["ops"]))
         self.assertAlmostEqual(verified["cycle_seconds"], sum(o["cycle_seconds"] for o in verified["ops"]), delta=0.2)
+        reach = verified["left_in_reach"]   # judged where the most reaching tool reaches; the rest reported
+        self.assertEqual(reach["tool"], plan.reach_tool)
+        self.assertGreater(reach["reached_mm2"], 0)
+        self.assertGreater(reach["out_of_reach_mm2"], 0)      # the beet's underside seen from above, its wrinkles
+        self.assertGreaterEqual(reach["most_left_mm"], reach["left_99_percentile_mm"])
         self.assertGreater(verified["removed_volume_mm3"], 0)
         # the whole Job in one G-code file: each planned tool's change and spindle speed, feeds from the table
         gcode = (folder / "beet_mm.ngc").read_text()
@@ -156,3 +166,98 @@ class PlanBeet(FreeCADTestCase):
             self.assertTrue(f"<td>{op['label']}</td>" in page, op["label"])
         self.assertEqual(page.count("data:image/png;base64,"), 2)
         self.assertGreater((out / "beet_mm_toolpath.png").stat().st_size, 10_000)
+
+
+def block_on_plate() -> Any:
+    """A 30 x 20 mm plate with a 12 x 6 mm block raised 2.5 mm in its middle, a height field on 0.4 mm (its walls
+    one cell wide, 81 deg): a ball leaves a fillet of its radius at the block's foot."""
+    from tmm_workbench.core.geometry.mesh import TriMesh
+
+    nx, ny = 76, 51
+    X, Y = np.meshgrid(np.linspace(0, 30, nx), np.linspace(0, 20, ny))
+    Z = np.where((np.abs(X - 15) <= 6) & (np.abs(Y - 10) <= 3), 2.5, 0.0)
+    idx = np.arange(nx * ny).reshape(ny, nx)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, 1:].ravel(), idx[1:, :-1].ravel()
+    faces = np.vstack([np.column_stack([a, b, c]), np.column_stack([a, c, d])])
+    return TriMesh(np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]), faces, "block")
+
+
+class PlanPencil(FreeCADTestCase):
+    def test_rest_and_pencil_take_the_corners(self) -> None:
+        """Ball D6 finishing, D3 rest, D1 pencil along the creases the D3 leaves: each rest op reports less
+        volume after than before, and the simulation of the Job without the pencil leaves more above the
+        tolerance where the D1 reaches (and more volume) than with it."""
+        import yaml
+
+        from tmm_workbench.core.geometry.mesh import save_stl
+        from tmm_workbench.core.plan.job_file import job_from_dict
+
+        folder = OUT / "plan_pencil"
+        folder.mkdir(parents=True, exist_ok=True)
+        data = yaml.safe_load(JOB.read_text())
+        data["model"]["file"] = str(save_stl(block_on_plate(), folder / "block.stl"))
+        data["outputs"]["dir"] = str(folder / "out")
+        data["planner"].update(compare_cutters=False, sim_cell=0.2)
+        data["finish"]["cusp"] = 0.01   # the finishing's cusps within the tolerance: what is left above it, corners
+        data["tools"] = [{"name": "F8", "type": "flat", "diameter": 8, "flute_length": 20}] + [
+            {"name": f"B{d}", "type": "ball", "diameter": d, "flute_length": 10} for d in (6, 3, 1)]
+        job = job_from_dict(data, folder / "job.yaml")
+        _, _, an, plan = launch.make_plan(job)
+        self.assertEqual([o.label for o in plan.ops][-2:], ["Rest B3", "Pencil B1"])
+        doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
+        results, verified = plan_run.run_plan(doc, folder)
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertEqual(verified["replanned"], [])
+        rows = {o["label"]: o for o in verified["ops"]}
+        for label in ("Rest B3", "Pencil B1"):
+            before, after = (float(v) for v in re.search(r"([\d.]+) mm3 above the design before, ([\d.]+) mm3 "
+                                                          r"after", rows[label]["rest"]).groups())
+            self.assertLess(after, 0.5 * before, rows[label]["rest"])
+        plan_run.drop_op(results[-1].op, results[:-1])
+        without = plan_run.verify(results[:-1], doc, folder)
+        with_it, left = verified["left_in_reach"], without["left_in_reach"]
+        self.assertEqual(with_it["tool"], "B1")
+        self.assertGreater(left["left_above_tolerance_mm2"], 1.5 * with_it["left_above_tolerance_mm2"] + 5.0)
+        self.assertGreater(without["remaining_volume_mm3"], verified["remaining_volume_mm3"])
+
+
+class PlanStep(FreeCADTestCase):
+    def test_step_model_planned(self) -> None:
+        """A STEP made here from a Part solid (a 30 x 20 x 4 mm plate with a boss r 6 h 3): app/step_mesh.py
+        tessellates it within half the tolerance (every triangle's centre that close to the solid's surface, the
+        boss's rim in facets as fine as that needs), a file that is no STEP is refused; `tmm plan` on it runs
+        verified and leaves the tessellation beside the G-code."""
+        import Part
+        import yaml
+
+        from tmm_workbench.app.step_mesh import step_mesh
+        from tmm_workbench.core.geometry.mesh import load_stl
+
+        folder = OUT / "plan_step"
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        solid = Part.makeBox(30, 20, 4).fuse(Part.makeCylinder(6, 3, FreeCAD.Vector(15, 10, 4)))
+        solid.exportStep(str(folder / "part.step"))
+        self.assertEqual(step_mesh(folder / "part.step", folder / "mesh.stl", 0.005), len(
+            load_stl(folder / "mesh.stl").triangles))
+        mesh = load_stl(folder / "mesh.stl")
+        centres = mesh.vertices[mesh.triangles].mean(axis=1)
+        far = max(solid.distToShape(Part.Vertex(FreeCAD.Vector(*map(float, c))))[0] for c in centres[::7])
+        self.assertLess(far, 0.005 + 1e-6)
+        rim = np.hypot(mesh.vertices[:, 0] - 15, mesh.vertices[:, 1] - 10)
+        on_rim = (np.abs(rim - 6) < 1e-3) & (np.abs(mesh.vertices[:, 2] - 7) < 1e-6)
+        self.assertGreater(on_rim.sum(), np.pi / np.arccos(1 - 0.005 / 6) * 0.9)   # facets for a 5 um chord
+        (folder / "not.step").write_text("solid not a step\n")
+        with self.assertRaises(ValueError):
+            step_mesh(folder / "not.step", folder / "not.stl", 0.005)
+        data = yaml.safe_load(JOB.read_text())
+        data["model"]["file"] = str(folder / "part.step")
+        data["outputs"]["dir"] = str(folder / "out")
+        data["planner"]["compare_cutters"] = False
+        (folder / "job.yaml").write_text(yaml.safe_dump(data))
+        self.assertEqual(launch.run(str(folder / "job.yaml"), freecadcmd(), quiet=True), launch.VERIFIED)
+        out = sorted(p.name for p in (folder / "out").iterdir())
+        self.assertEqual(out, ["part.FCStd", "part.ngc", "part_model.stl", "part_sim.png", "part_toolpath.png",
+                               "report.html", "report.json"])
+        report = json.loads((folder / "out" / "report.json").read_text())
+        self.assertEqual(report["analysis"]["size_mm"], [30.0, 20.0, 7.0])

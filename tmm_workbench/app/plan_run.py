@@ -14,7 +14,7 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
 TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
@@ -91,9 +91,11 @@ def drop_op(op: Any, kept: list) -> None:
 def op_rows(results: list, sim: Any) -> list:
     rows = []
     for r, s in zip(results, sim.ops):
-        rows.append({"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
-                     "rapids_through_stock": len(s.collisions),
-                     "holder": None if s.holder is None else s.holder.summary()})
+        row = {"label": r.op.Label, "moves": s.moves, "cycle_seconds": round(s.cycle_seconds, 1),
+               "rapids_through_stock": len(s.collisions), "holder": None if s.holder is None else s.holder.summary()}
+        if getattr(r.op, "RestReport", ""):   # a rest or pencil op: its rest area, the volume before and after
+            row["rest"] = r.op.RestReport
+        rows.append(row)
     return rows
 
 
@@ -127,7 +129,20 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
             "removed_volume_mm3": round(sim.removed_volume, 1), "remaining_volume_mm3": round(sim.remaining_volume, 1),
             "cycle_seconds": round(sim.cycle_seconds, 1), "ops": op_rows(results, sim.simulation),
             "sim_cell_mm": plan["sim_cell"], "tolerance_mm": plan["tolerance"],
-            "regions": rounded(dict(sorted(sim.regions.items())))}
+            "regions": rounded(dict(sorted(sim.regions.items()))), "left_in_reach": left_in_reach(sim, plan)}
+
+
+def left_in_reach(sim: Any, plan: dict) -> dict:
+    """The simulated Job's material left judged where the library's most reaching tool reaches
+    (core.plan.left_check)."""
+    from tmm_workbench.core.geometry.mesh import load_stl
+    from tmm_workbench.core.plan import left_check
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    js, tool = sim.simulation, plan["reach_tool"]
+    return left_check.left_in_reach(load_stl(plan["model_file"]), js.grid, js.design, js.comparison.deviation,
+                                    tool["name"], Cutter(tool["diameter"], tool["corner_radius"]),
+                                    plan["tolerance"])
 
 
 def rounded(value: Any) -> Any:
@@ -193,7 +208,9 @@ def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict
     tmp = launch.temporary_folder(out_dir, name)
     doc, before = model.Document, {o.Name for o in model.Document.Objects}
     try:
-        stl = save_stl(mesh_from_object(model), tmp / f"{name}_model.stl")
+        # a Part object tessellated as a STEP model is (core.plan.launch): within a share of the tolerance
+        deflection = launch.STEP_DEFLECTION_SHARE * float(data["finish"]["tolerance"])
+        stl = save_stl(mesh_from_object(model, deflection), tmp / f"{name}_model.stl")
         again = dict(data, model=dict(data["model"], file=stl.name), outputs=dict(data["outputs"], dir="."))
         (tmp / "job.json").write_text(json.dumps(again, indent=1, sort_keys=True) + "\n")
         job = job_from_dict(dict(data, model=dict(data["model"], file=str(stl))), tmp / "job.json")
@@ -232,10 +249,12 @@ def main() -> int:
     return 0
 
 
-def _entry() -> None:
+def exit_with(run: Callable[[], int]) -> None:
+    """A freecadcmd script's end: `run`'s exit code, FAILED with the traceback when it raises (freecadcmd would
+    swallow the exception and exit 0)."""
     try:
-        code = main()
-    except BaseException:  # noqa: BLE001 - freecadcmd would swallow it and exit 0
+        code = run()
+    except BaseException:  # noqa: BLE001
         traceback.print_exc()
         code = FAILED
     sys.stdout.flush()
@@ -244,4 +263,4 @@ def _entry() -> None:
 
 
 if __name__ in ("__main__", "plan_run"):
-    _entry()
+    exit_with(main)

@@ -14,7 +14,7 @@ import numpy as np
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.sim.compare import slope_deg
+from tmm_workbench.core.sim.compare import slope_cosine, slope_deg
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
 
@@ -23,6 +23,7 @@ FLAT_DEG = 1.0           # a face sloping less is a flat (a floor, a plateau)
 STEEP_DEG = 60.0         # a face sloping more is a wall for the report's count
 FAR_MM = 1.0             # a tool staying this far above the design leaves it to the next (a roughing tool's reach)
 SPECK_SHARE = 0.001      # unreached area below this share of the design's is the grid's noise
+STEEPEST_DEG = 80.0      # the grid's own cusp is judged at most at this slope (on a wall it grows without bound)
 
 
 @dataclass
@@ -31,7 +32,7 @@ class Reach:
     tool: str
     unreached_area: float    # mm^2 of design cells it stays above by more than the threshold
     deepest_left: float      # mm, the most it stays above the design
-    threshold: float         # mm: the tolerance + the grid's own cusp (cell^2 / 8 r)
+    threshold: float         # mm: the tolerance + the grid's own cusp on a flat (cell^2 / 8 r; more on slopes)
     far_area: float = 0.0    # mm^2 of design cells it stays above by more than FAR_MM (out of a roughing's reach)
 
     def as_dict(self) -> dict:
@@ -115,14 +116,25 @@ def analyse(mesh: TriMesh, cell: float, tools: Optional[list] = None, tolerance:
     for name, cutter in tools or []:
         env = tool_envelope(mesh, cutter, grid, surface)
         left = np.where(finite, env - design, 0.0)
-        threshold = tolerance + cell * cell / (8.0 * max(cutter.corner_radius, cutter.radius))
-        unreached = float(np.sum(left > threshold)) * grid.cell_area
+        radius = max(cutter.corner_radius, cutter.radius)
+        threshold = tolerance + cell * cell / (8.0 * radius)
+        unreached = float(np.sum(finite & (reach_excess(env, design, cell, radius) > tolerance))) * grid.cell_area
         if unreached < SPECK_SHARE * design_area:
             unreached = 0.0
         out.reach[name] = Reach(name, unreached, float(left.max()) if finite.any() else 0.0, threshold,
                                 float(np.sum(left > FAR_MM)) * grid.cell_area)
     out.concave_radius = concave_bracket(out.reach, dict(tools or []))
     return out
+
+
+def reach_excess(envelope: np.ndarray, design: np.ndarray, cell: float, radius: float) -> np.ndarray:
+    """How far a tool's envelope (core.footprint.rest.tool_envelope, its corner `radius`) stays above the design
+    beyond what the grid itself leaves, along the envelope's normal (the vertical gap times the cosine of the
+    envelope's slope: a wall's vertical gap is many times its depth): between the grid's positions the envelope
+    on a slope a keeps cusps of cell^2 / (8 r cos^2 a) along its normal. A cell is out of the tool's reach where
+    this exceeds the tolerance (NaN where there is no design)."""
+    cos = np.maximum(slope_cosine(envelope, cell), math.cos(math.radians(STEEPEST_DEG)))
+    return (envelope - design) * cos - cell * cell / (8.0 * radius * cos * cos)
 
 
 def concave_bracket(reach: dict, cutters: dict) -> tuple[float, float]:

@@ -16,6 +16,7 @@ from tmm_workbench.core.plan import materials
 
 FORMAT = "tmm-plan 1"
 UNITS = {"mm": 1.0, "inch": 25.4}
+MODEL_SUFFIXES = (".stl", ".step", ".stp")
 TOOL_TYPES = ("flat", "ball", "bull")
 MACHINE_TYPES = ("3-axis",)
 STOCK_TYPES = ("box",)
@@ -159,12 +160,19 @@ def _text(where: str, value: Any) -> str:
 def _model(d: Any, base: Path) -> ModelSpec:
     d = _mapping("model", d, ("file",), ("units", "translate"))
     path = _model_path(_text("model.file", d["file"]), base)
-    if path.suffix.lower() != ".stl":
-        raise _fail("model.file", d["file"], "an STL file (.stl); STEP and FreeCAD objects are not planned yet")
+    if path.suffix.lower() not in MODEL_SUFFIXES:
+        raise _fail("model.file", d["file"], "an STL (.stl) or STEP (.step, .stp) file; FreeCAD objects: TMM Auto")
     if not path.is_file():
-        raise _fail("model.file", d["file"], f"an existing STL file (looked for {path})")
+        raise _fail("model.file", d["file"], f"an existing model file (looked for {path})")
     units = _choice("model.units", d.get("units", "mm"), tuple(UNITS))
+    if is_step(path) and units != "mm":
+        raise _fail("model.units", units, "mm for a STEP file (it carries its own units: FreeCAD reads it in mm)")
     return ModelSpec(path, units, _vector("model.translate", d.get("translate", [0, 0, 0]), -1e4, 1e4))
+
+
+def is_step(path: Path) -> bool:
+    """A STEP model: FreeCAD tessellates it before the core sees it (core.plan.launch)."""
+    return path.suffix.lower() in (".step", ".stp")
 
 
 def _model_path(text: str, base: Path) -> Path:

@@ -27,10 +27,13 @@ import numpy as np
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
 from tmm_workbench.core.plan import analysis, decide, progress_note
-from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, ToolSpec, read_job
+from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, ToolSpec, is_step, read_job
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
 APP_SCRIPT = Path(__file__).resolve().parents[2] / "app" / "plan_run.py"
+STEP_SCRIPT = APP_SCRIPT.parent / "step_mesh.py"
+STEP_DEFLECTION_SHARE = 0.5   # of the tolerance: the STEP's tessellation's chordal error (the design the Job is
+#                               verified against lies within it of the solid; the rest of the tolerance is the Job's)
 REPORT_FORMAT = "tmm-plan-report 1"
 
 
@@ -74,11 +77,34 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
 def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     """What app/plan_run.py needs to run the plan."""
     o = job.outputs
+    reach = next(t for t in job.tools if t.name == plan.reach_tool)
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
             "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
-                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools}}
+                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools},
+            "reach_tool": {"name": plan.reach_tool, "diameter": reach.diameter, "corner_radius": reach.corner_radius}}
+
+
+def tessellate_step(job: JobSpec, folder: Path, freecad: str, quiet: bool) -> JobSpec:
+    """The job with its STEP model tessellated by FreeCAD (app/step_mesh.py) into `folder`/<name>_model.stl, the
+    chordal deflection STEP_DEFLECTION_SHARE of the tolerance. PlanInputError: FreeCAD cannot read it; TmmError:
+    FreeCAD could not be run or failed otherwise."""
+    stl = folder / f"{job.outputs.name}_model.stl"
+    deflection = round(STEP_DEFLECTION_SHARE * job.finish.tolerance, 6)
+    say(f"tessellating {job.model.file.name} within {deflection:g} mm (FreeCAD)", quiet)
+    env = dict(os.environ, TMM_STEP_FILE=str(job.model.file), TMM_STEP_STL=str(stl),
+               TMM_STEP_DEFLECTION=repr(deflection))
+    try:
+        proc = subprocess.run([freecad, str(STEP_SCRIPT)], env=env, cwd=str(folder), capture_output=True, text=True)
+    except OSError as exc:
+        raise TmmError(f"could not start {freecad}: {exc}") from None
+    tail = "\n".join((proc.stderr or proc.stdout or "").strip().splitlines()[-6:])
+    if proc.returncode == 2:
+        raise PlanInputError(f"model.file: {tail}")
+    if proc.returncode != 0 or not stl.is_file():
+        raise TmmError(f"the STEP tessellation failed (exit {proc.returncode}):\n{tail}")
+    return replace(job, model=replace(job.model, file=stl))
 
 
 def run_freecad(folder: Path, freecad: str, quiet: bool) -> Optional[str]:
@@ -167,19 +193,26 @@ def move_into_place(tmp: Path, target: Path) -> list:
 def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None) -> int:
     """Plans, runs and verifies the job; `out_dir` in place of the job file's outputs.dir (a batch's part folder)."""
     t0 = time.perf_counter()
+    tmp: Optional[Path] = None
     try:
         job = read_job(job_path)
         if out_dir is not None:
             job = replace(job, outputs=replace(job.outputs, dir=Path(out_dir).resolve()))
         progress_note.note(1, 0, "analysing the model and planning")
+        if is_step(job.model.file):
+            tmp = temporary_folder(job.outputs.dir, job.outputs.name)
+            job = tessellate_step(job, tmp, freecad, quiet)
         mesh, moved, an, plan = make_plan(job, quiet)
-    except PlanInputError as exc:
-        print(f"tmm plan: bad input: {exc}", file=sys.stderr)
-        return BAD_INPUT
+    except (PlanInputError, TmmError) as exc:
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
+        bad = isinstance(exc, PlanInputError)
+        print(f"tmm plan: {'bad input: ' if bad else ''}{exc}", file=sys.stderr)
+        return BAD_INPUT if bad else FAILED
     say(f"planned {len(plan.ops)} ops in {time.perf_counter() - t0:.1f} s: "
         + ", ".join(op.label for op in plan.ops), quiet)
     out = job.outputs
-    tmp = temporary_folder(out.dir, out.name)
+    tmp = tmp or temporary_folder(out.dir, out.name)
     try:
         model_file = job.model.file
         if moved:

@@ -65,6 +65,12 @@ def summary(report: Mapping) -> str:
             ("finish asked", f"cusp {mm(report['finish']['cusp_mm'])}"),
             ("verified on a grid of", mm(v.get("sim_cell_mm")))]
     rows += [("plan changed", change) for change in v.get("replanned", [])]
+    reach = v.get("left_in_reach")
+    if reach:
+        rows.append((f"left where {reach['tool']} reaches (along the normal)",
+                     f"{reach['left_above_tolerance_mm2']:g} mm2 above the tolerance, most {mm(reach['most_left_mm'])}"
+                     f", 99 %: {mm(reach['left_99_percentile_mm'])}; out of its reach from above: "
+                     f"{reach['out_of_reach_mm2']:g} mm2 of {reach['reached_mm2'] + reach['out_of_reach_mm2']:g}"))
     return "\n".join(parts) + pairs(rows)
 
 

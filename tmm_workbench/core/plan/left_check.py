@@ -1,0 +1,42 @@
+"""What a verified Job leaves where the library reaches (issue's target: the material left within the tolerance
+wherever the smallest library tool reaches, the rest reported): the simulated deviation on the cells the smallest
+radiused library tool reaches from above, against the tolerance.
+
+A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: dropped at every cell) comes within
+the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess).
+The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
+vertical measure of a wall's cusps is many times their depth. What no library tool reaches from above (sharp inner
+corners, undercuts) is reported as its area, not judged."""
+from __future__ import annotations
+
+import numpy as np
+
+from tmm_workbench.core.footprint.rest import tool_envelope
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.plan.analysis import reach_excess
+from tmm_workbench.core.sim.compare import slope_cosine
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.tools.cutter import Cutter
+
+
+def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.ndarray, tool: str,
+                  cutter: Cutter, tolerance: float) -> dict:
+    """`deviation` (ny, nx, vertical, + left; NaN without design) of the simulated Job against `design` on `grid`,
+    judged where `cutter` (the library's smallest radiused tool, named `tool`) reaches: areas in mm^2, depths in mm
+    along the normal."""
+    finite = np.isfinite(design) & np.isfinite(deviation)
+    envelope = tool_envelope(mesh, cutter, grid, DropSurface(mesh))
+    radius = max(cutter.corner_radius, cutter.radius)
+    with np.errstate(invalid="ignore"):
+        reached = finite & (reach_excess(envelope, design, grid.cell, radius) <= tolerance)
+    # along the normal of the stock left (its vertical deviation times the cosine of its slope)
+    stock = np.where(finite, design + np.where(finite, deviation, 0.0), np.nan)
+    left = np.where(reached, deviation, 0.0) * slope_cosine(stock, grid.cell)
+    above = reached & (left > tolerance)
+    inside = left[reached]
+    return {"tool": tool, "reached_mm2": round(float(reached.sum()) * grid.cell_area, 1),
+            "out_of_reach_mm2": round(float((finite & ~reached).sum()) * grid.cell_area, 1),
+            "left_above_tolerance_mm2": round(float(above.sum()) * grid.cell_area, 2),
+            "most_left_mm": round(float(inside.max()) if inside.size else 0.0, 4),
+            "left_99_percentile_mm": round(float(np.percentile(inside, 99)) if inside.size else 0.0, 4)}
