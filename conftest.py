@@ -2,9 +2,10 @@
 
 The longest tests start first, so that no worker is left with one of them at the end while the other idles: the
 GUI tests (tests/gui, each a FreeCAD under its own Xvfb, half a minute to a minute), then the FreeCAD modules
-(tests/freecad, one freecadcmd each), then the rest in their usual order. With `--dist loadgroup` the GUI tests
-form one group, run one after the other on one worker: two GUI FreeCADs at once would only compete for the same
-two cores (and `xvfb-run -a` picks its display without a lock). Without xdist the order changes nothing else.
+(tests/freecad, one freecadcmd each), then the rest in their usual order. The GUI tests run on every worker: a
+GUI FreeCAD waits on its event loop much of the time (one worker of GUI tests kept 1.5 of the 2 cores busy),
+and each worker's Xvfb displays start from a number of its own (tests/gui/launch.py: `xvfb-run -a` picks the
+first free one without a lock). Without xdist the order changes nothing else.
 """
 from __future__ import annotations
 
@@ -20,10 +21,6 @@ def _rank(nodeid: str) -> int:
     return len(_FIRST)
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the xdist_group marks
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the order
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     items.sort(key=lambda item: _rank(item.nodeid))  # stable: each part keeps its order
-    if config.pluginmanager.hasplugin("xdist"):
-        for item in items:
-            if item.nodeid.startswith("tests/gui/"):
-                item.add_marker(pytest.mark.xdist_group("gui"))

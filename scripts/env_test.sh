@@ -4,7 +4,7 @@
 # against it (native/wheel_test.sh), then puts that wheel's module into tmm_workbench/ (its own ABI tag, so it
 # sits beside the host's), so the kernel is compiled once per Python; links the add-on into this FreeCAD's user
 # Mod folder (versioned from 1.1: FreeCAD says where), and runs the FreeCAD tests and the GUI tests (two at a
-# time, pytest-xdist: the GUI tests one after the other on one worker, tests/conftest.py). The core tests that
+# time, pytest-xdist; each worker's Xvfb displays from a number of its own, tests/gui/launch.py). The core tests that
 # need only Python, numpy and the kernel ran on the host: here the interpreter is what is checked (the binding
 # tests, through the wheel) and FreeCAD's version (the FreeCAD and GUI tests, which run the core through the
 # ops). Extra arguments go to pytest.

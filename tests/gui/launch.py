@@ -25,13 +25,22 @@ def run_session(script: str, tmp_path: Path, timeout: float, **env: str) -> dict
     assert FREECAD is not None and XVFB_RUN is not None, "freecad and xvfb-run are needed (run scripts/setup.sh)"
     result = tmp_path / (Path(script).stem + ".json")
     code, out = fc_process.run(
-        [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", FREECAD, str(HERE / script)],
+        [XVFB_RUN, "-a", "-n", str(display_base()), "-s", "-screen 0 1280x1024x24", FREECAD, str(HERE / script)],
         cwd=tmp_path, timeout=timeout, TMM_GUI_RESULT=str(result),
         QTWEBENGINE_DISABLE_SANDBOX="1", **env)  # FreeCAD's start page uses QtWebEngine, which refuses root
     info = json.loads(result.read_text()) if result.is_file() else {}
     assert code == 0 and info.get("ok"), \
         f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     return info
+
+
+def display_base() -> int:
+    """The first X display number `xvfb-run -a` tries for this pytest-xdist worker (gw0: 100, gw1: 120, ...; 100
+    without xdist): it takes the first free one from there without a lock, so two workers starting a session at
+    the same moment must not start from the same number."""
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "gw0")
+    index = int(worker[2:]) if worker[2:].isdigit() else 0
+    return 100 + 20 * index
 
 
 def blank(png: Path) -> bool:
