@@ -36,6 +36,11 @@ trap cleanup EXIT
 mount_in() {  # mount_in SRC TARGET [options]: bind SRC at DIR/TARGET
   local target="$DIR$2"
   mkdir -p "$target"
+  # a run killed before its cleanup leaves its mounts: one still showing an older SRC (a checkout deleted and
+  # cloned again at the same path) is made again, or the chroot would see the deleted, empty folder
+  if mountpoint -q "$target" && [ "$(stat -c %d:%i "$1")" != "$(stat -c %d:%i "$target")" ]; then
+    $SUDO umount -l "$target"
+  fi
   mountpoint -q "$target" || $SUDO mount ${3:-} --bind "$1" "$target"
   MOUNTS+=("$target")
 }
