@@ -253,10 +253,7 @@ def five_axis(info: dict) -> None:
 def session(info: dict) -> None:
     timer = watch_message_boxes(info)
     TIMES.append(("start", time.monotonic()))
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.core.shared_data import benchmark_file
 
     try:

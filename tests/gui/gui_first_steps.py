@@ -43,10 +43,7 @@ def toolbar_texts(name: str) -> list:
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.app import model_proxy, registry, tools
     from tmm_workbench.core.shared_data import benchmark_file
 

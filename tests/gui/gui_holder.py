@@ -28,10 +28,7 @@ RESULT = Path(os.environ.get("TMM_GUI_RESULT") or ROOT / "out" / "gui_holder.jso
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from fc_test_holder import FAST, HOLDER, cavity_stl
     from tmm_workbench.app.api import run_surface
     from tmm_workbench.gui import region_marks_view, stick_out_cmd

@@ -40,10 +40,7 @@ def patch_stl(path: Path) -> str:
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.app.api import run_mesh5
 
     r = run_mesh5(patch_stl(Path.cwd() / "mesh5_patch.stl"), diameter=10.0, tolerance=0.05, tilt_limit_deg=24.0,

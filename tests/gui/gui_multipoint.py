@@ -49,10 +49,7 @@ def legend_lines(vp) -> list:
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.app.api import run_multipoint
     from tmm_workbench.core.geometry import bezier
     from tmm_workbench.core.preview.tool_axes import CONTACT_RGB

@@ -47,10 +47,7 @@ def widen_panel(page) -> None:
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     import Mesh
 
     from tmm_workbench.app.api import run_surface

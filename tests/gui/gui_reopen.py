@@ -61,10 +61,7 @@ def applied_undo_steps(op) -> list:
 
 def run(out: Path) -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.app import api
     from tmm_workbench.core.geometry import bezier
     from tmm_workbench.core.shared_data import benchmark_file

@@ -42,6 +42,16 @@ def pump(seconds: float) -> None:
         time.sleep(0.02)
 
 
+def start_tmm(root: Path) -> None:
+    """The checkout at `root` importable (the tests' helpers too) and the TMM workbench active, its toolbars up."""
+    if str(root) not in sys.path:
+        sys.path.insert(0, str(root))
+    import FreeCADGui
+
+    FreeCADGui.activateWorkbench("TMMWorkbench")
+    pump(0.5)
+
+
 def forget_found_widgets() -> None:
     """Call once a task panel (or a document) has closed. PySide's findChildren makes the parent's wrapper keep a
     wrapper of each child it found. When Qt deletes such a child, FreeCAD (Gui::WrapperManager, for wrappers it

@@ -65,10 +65,7 @@ def markers_in(scene) -> int:
 
 def run() -> dict:
     info: dict = {}
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.app.api import run_surface
     from tmm_workbench.gui import simulate_cmd, stock_view
 

@@ -394,10 +394,7 @@ def watch_message_boxes(info: dict) -> QtCore.QTimer:
 
 def session(info: dict) -> dict:
     info["_timer"] = watch_message_boxes(info)
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     from tmm_workbench.core.shared_data import benchmark_file
 
     stl = os.environ.get("TMM_GUI_STL") or str(benchmark_file("stl", "sphere_on_plate.stl"))

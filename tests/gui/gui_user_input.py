@@ -139,10 +139,7 @@ def open_panel(op) -> None:
 
 
 def session(info: dict) -> dict:
-    if str(ROOT) not in sys.path:
-        sys.path.insert(0, str(ROOT))
-    FreeCADGui.activateWorkbench("TMMWorkbench")
-    pump(0.5)
+    gui_runner.start_tmm(ROOT)
     mw = FreeCADGui.getMainWindow()
     report = mw.findChild(QtGui.QDockWidget, "Report view")
     if report is not None:
