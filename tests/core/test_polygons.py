@@ -64,6 +64,21 @@ def test_open_paths_clipped_and_swept():
     assert P.area(loop_band) == pytest.approx((12 ** 2 - 4 + math.pi) - 8 ** 2, abs=0.01)
 
 
+def test_many_open_paths_clipped_as_each_alone():
+    # more paths than one Clipper sweep takes: every path's pieces, none lost or doubled at a batch's end
+    ring = P.difference([square(0, 0, 10)], [square(3, 3, 4)])
+    rng = np.random.default_rng(7)
+    paths = [np.cumsum(rng.normal(size=(int(rng.integers(2, 6)), 2)) * 3, axis=0) + 5
+             for _ in range(2 * P._OPEN_BATCH + 7)]
+
+    def key(pieces):
+        return sorted(tuple(np.round(p if tuple(p[0]) <= tuple(p[-1]) else p[::-1], 6).ravel()) for p in pieces)
+
+    alone = [q for p in paths for q in P.clip_open([p], ring)]
+    assert len(alone) > 2 * P._OPEN_BATCH
+    assert key(P.clip_open(paths, ring)) == key(alone)
+
+
 def test_point_and_segment_containment():
     ring = P.difference([square(0, 0, 10)], [square(3, 3, 4)])
     assert P.contains_point(ring, (1, 1)) and not P.contains_point(ring, (5, 5))
