@@ -86,7 +86,8 @@ def main() -> None:
     rows.append(three_axis(mesh, tol, feed, safe, OFFSET3D, 0.0))
     best = min(rows, key=lambda r: r["seconds"])
     rows.append(five_axis(mesh, tol, feed, safe))
-    print("| strategy | passes | cutting mm | rapid mm | cycle s | compute wall s | CPU s |\n|---|---|---|---|---|---|---|")
+    print("| strategy | passes | cutting mm | rapid mm | cycle s | compute wall s | CPU s |")
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['name']} | {r['passes']} | {r['cut']:.0f} | {r['rapid']:.0f} | {r['seconds']:.0f} | "
               f"{r['compute'][0]:.1f} | {r['compute'][1]:.1f} |")
