@@ -294,22 +294,21 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
     from tmm_workbench.app import op_mesh5
     from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 
-    spec = lambda field: spec_of(Mesh5Params, field)  # noqa: E731
-    numbers(tolerance=(tolerance, spec("tolerance")), feed_angle_deg=(feed_angle_deg, spec("feed_angle_deg")),
-            forward_step=(forward_step, spec("forward_step")), chord_tolerance=(chord_tolerance, spec("chord_tol")),
-            least_tilt_deg=(least_tilt_deg, spec("tilt_min_deg")), tilt_limit_deg=(tilt_limit_deg, spec("tilt_max_deg")),
-            yaw_limit_deg=(yaw_limit_deg, spec("yaw_limit_deg")), grid_step_deg=(grid_step_deg, spec("grid_step_deg")),
+    # (argument, value, Mesh5Params field, op property); a None keeps the op's default
+    settings = (("tolerance", tolerance, "tolerance", "Tolerance"),
+                ("feed_angle_deg", feed_angle_deg, "feed_angle_deg", "FeedAngle"),
+                ("forward_step", forward_step, "forward_step", "ForwardStep"),
+                ("chord_tolerance", chord_tolerance, "chord_tol", "ChordTolerance"),
+                ("least_tilt_deg", least_tilt_deg, "tilt_min_deg", "LeastTilt"),
+                ("tilt_limit_deg", tilt_limit_deg, "tilt_max_deg", "TiltLimit"),
+                ("yaw_limit_deg", yaw_limit_deg, "yaw_limit_deg", "YawLimit"),
+                ("grid_step_deg", grid_step_deg, "grid_step_deg", "GridStep"))
+    numbers(**{arg: (value, spec_of(Mesh5Params, field)) for arg, value, field, _ in settings},
             axis_retract=(axis_retract, NON_NEGATIVE))  # the tool, stock, heights and feeds: run's
-    given = {"tolerance": tolerance, "forward_step": forward_step, "chord_tol": chord_tolerance,
-             "tilt_min_deg": least_tilt_deg, "tilt_max_deg": tilt_limit_deg, "yaw_limit_deg": yaw_limit_deg,
-             "grid_step_deg": grid_step_deg}
-    Mesh5Params(**{k: v for k, v in given.items() if v is not None}).grid()  # the tilts within the machine's range
+    given = [(field, prop, value) for _, value, field, prop in settings if value is not None]
+    Mesh5Params(**{field: value for field, _, value in given}).grid()  # the tilts within the machine's range
     values: dict[str, Any] = {"FeedAngle": feed_angle_deg, "ZigZag": bool(zigzag), "AxisRetract": axis_retract}
-    for prop, value in (("Tolerance", tolerance), ("ForwardStep", forward_step), ("ChordTolerance", chord_tolerance),
-                        ("LeastTilt", least_tilt_deg), ("TiltLimit", tilt_limit_deg), ("YawLimit", yaw_limit_deg),
-                        ("GridStep", grid_step_deg)):
-        if value is not None:
-            values[prop] = value
+    values.update({prop: value for _, prop, value in given})
     return run(op_mesh5.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
