@@ -80,7 +80,7 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     reach = next(t for t in job.tools if t.name == plan.reach_tool)
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
-            "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
+            "tolerance": job.finish.tolerance, "cusp": job.finish.cusp, "ops": [op.as_dict() for op in plan.ops],
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
                                "holder": t.holder, "stick_out": t.stick_out} for t in job.tools},
             "reach_tool": {"name": plan.reach_tool, "diameter": reach.diameter, "corner_radius": reach.corner_radius}}
