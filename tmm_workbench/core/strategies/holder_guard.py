@@ -185,18 +185,35 @@ def _low_between(drop: AssemblyDrop, sampled: list, allpts: np.ndarray) -> tuple
 
 
 def _refined(drop: AssemblyDrop, tips: np.ndarray) -> np.ndarray:
-    """Lifted tips with points inserted halfway wherever the straight move between two would pass more than
-    BETWEEN_MM under the bodies' height (a holder's rounded edge over a sharp rim), down to MIN_GAP_MM apart."""
+    """Lifted tips with points inserted wherever the straight move between two would pass more than BETWEEN_MM
+    under the bodies' height at a quarter, half or three quarters of it (a holder's rounded edge over a sharp rim,
+    a shank's edge crossing a wall's clearance: the bodies' height can jump there), down to MIN_GAP_MM apart: a
+    climbing or falling move becomes a staircase (up first, or down last: the tool higher, never lower), a level
+    one gets the lifted points where it passed under."""
     for _ in range(MAX_ROUNDS):
+        a, b = tips[:-1], tips[1:]
         gap = np.hypot(*np.diff(tips[:, :2], axis=0).T)
-        mid = 0.5 * (tips[1:] + tips[:-1])
-        zb, _ = drop.heights_of(BODIES, mid[:, :2])
-        low = (zb - mid[:, 2] > BETWEEN_MM) & (gap > MIN_GAP_MM)
+        low = np.zeros(len(a), dtype=bool)
+        lifted = []
+        for t in BETWEEN_FRACTIONS:
+            mid = a + t * (b - a)
+            zb, _ = drop.heights_of(BODIES, mid[:, :2])
+            under = (zb - mid[:, 2] > BETWEEN_MM) & (gap > MIN_GAP_MM)
+            mid[:, 2] = np.maximum(mid[:, 2], zb)
+            low |= under
+            lifted.append((under, mid, t))
         if not low.any():
             break
-        mid[:, 2] = np.maximum(mid[:, 2], zb)
-        at = np.flatnonzero(low) + 1
-        tips = np.insert(tips, at, mid[low], axis=0)
+        sloped = low & (np.abs(b[:, 2] - a[:, 2]) > BETWEEN_MM)
+        corner = np.where((b[:, 2] > a[:, 2])[:, None], np.column_stack([a[:, :2], b[:, 2]]),
+                          np.column_stack([b[:, :2], a[:, 2]]))
+        new, keys = [corner[sloped]], [np.flatnonzero(sloped) + 0.5]
+        for under, mid, t in lifted:
+            level = under & ~sloped
+            new.append(mid[level])
+            keys.append(np.flatnonzero(level) + t)   # between the move's start (its index) and end, in order
+        order = np.argsort(np.concatenate([np.arange(len(tips), dtype=float)] + keys), kind="stable")
+        tips = np.vstack([tips] + new)[order]
     return tips
 
 
