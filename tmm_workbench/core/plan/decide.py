@@ -362,8 +362,8 @@ def walls_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list) -> None:
     plan.decide("deep walls", f"{tool.describe()}: waterline Z{bottom:g}-{an.bounds[1][2]:g}, step-down "
                 f"{step_down:g} mm, nothing left, after the roughing",
                 f"{an.share_steeper(WALL_DEG) * 100:.0f} % of the model seen from above slopes more than "
-                f"{WALL_DEG:g} deg and the stock is {depth:.1f} mm deep; more than {short:g} mm below its top the finishing "
-                f"tools ({names}) hold their shanks, as wide as the cut, within their clearance of the "
+                f"{WALL_DEG:g} deg and the stock is {depth:.1f} mm deep; more than {short:g} mm below its top the "
+                f"finishing tools ({names}) hold their shanks, as wide as the cut, within their clearance of the "
                 f"{ROUGH_LEAVE:g} mm the roughing leaves on a wall; {tool.name}'s {tool.flute_length:g} mm flutes "
                 f"finish the walls first (its shank {ROUGH_SHANK_CLEAR:g} mm above the stock; a flat's side cuts a "
                 f"wall over its flutes' length: levels the roughing's step-down apart), so the later shanks pass the "

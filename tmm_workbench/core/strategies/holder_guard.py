@@ -7,7 +7,9 @@ left out: its own drop made the points); where one of them would come closer to 
 Raising a 3-axis tool never gouges (the cutter's drop is below), and the bodies' drop is monotone in height, so
 a vertical entry to a kept point is clear. Between two samples the bodies' height can rise steeply (a shank's
 edge rolling over a sharp rim: 0.19 mm under it halfway along a 0.5 mm step was measured): lifted moves get
-points inserted halfway until they pass at most BETWEEN_MM under it, inside the clearance. What it changed is reported with the shortest stick-out that cuts everything
+points inserted (a staircase where they climb or fall) until they pass at most BETWEEN_MM under it, inside the
+clearance; so do moves clear at both ends that pass under it in between (a raster's lean move climbing past a
+wall's top). What it changed is reported with the shortest stick-out that cuts everything
 (core.verify.holder_clearance.minimum_stick_out)."""
 from __future__ import annotations
 
