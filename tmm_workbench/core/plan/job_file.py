@@ -56,6 +56,7 @@ class MachineSpec:
     travels: tuple[float, float, float] = (300.0, 300.0, 100.0)
     spindle_max: float = 24000.0   # rpm
     feed_max: float = 5000.0       # mm/min
+    rapid: Optional[tuple[float, float]] = None   # mm/min in X and Y, in Z (None: the cycle estimate's default)
 
 
 @dataclass(frozen=True)
@@ -218,12 +219,17 @@ def _stock(d: Any, base: Path) -> StockSpec:
 
 
 def _machine(d: Any) -> MachineSpec:
-    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max"))
+    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max", "rapid"))
+    rapid = d.get("rapid")
+    if rapid is not None:
+        if not isinstance(rapid, (list, tuple)) or len(rapid) != 2:
+            raise _fail("machine.rapid", rapid, "a list of two rates [xy, z] in mm/min")
+        rapid = tuple(_number(f"machine.rapid[{i}]", v, 1.0, 1e6) for i, v in enumerate(rapid))
     return MachineSpec(_choice("machine.type", d.get("type", "3-axis"), MACHINE_TYPES),
                        _choice("machine.post", d["post"], POSTS),
                        _vector("machine.travels", d["travels"], 0.0, 1e4, low_open=True),
                        _number("machine.spindle_max", d.get("spindle_max", 24000.0), materials.MIN_RPM, 1e5),
-                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5))
+                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5), rapid)
 
 
 def _tool(i: int, d: Any) -> ToolSpec:

@@ -65,6 +65,21 @@ def planned_stock(job: JobSpec, mesh: TriMesh) -> PlannedStock:
     return stock
 
 
+def stock_of_plan(job: JobSpec, box: tuple) -> PlannedStock:
+    """The stock of `job` whose bounds `planned_stock` found as `box` (a plan's stock_box), without the model."""
+    kind = job.stock.type
+    if kind == "cylinder":
+        return PlannedStock(kind, box, ((box[0] + box[3]) / 2, (box[1] + box[4]) / 2), (box[3] - box[0]) / 2)
+    if kind == "solid":
+        return PlannedStock(kind, box, file=job.stock.file, scale=_scale(job), translate=tuple(job.model.translate))
+    return PlannedStock(kind, box)
+
+
+def _scale(job: JobSpec) -> float:
+    """A solid stock file's units to mm: a STEP is read in mm, an STL is in the model's units."""
+    return 1.0 if is_step(job.stock.file) else UNITS[job.model.units]
+
+
 def _outward(low: tuple, high: tuple) -> tuple:
     """Bounds rounded outward to 0.1 um: the stock holds the model (the roughing op refuses a model outside it)."""
     return tuple(math.floor(v * 1e4) / 1e4 for v in low) + tuple(math.ceil(v * 1e4) / 1e4 for v in high)
@@ -92,10 +107,10 @@ def _cylinder(job: JobSpec, mesh: TriMesh) -> PlannedStock:
     return PlannedStock("cylinder", box, centre, radius)
 
 
-def stock_mesh(job: JobSpec) -> tuple[TriMesh, float]:
-    """A solid stock's mesh as placed (the model's units for an STL, its translate) and the file's scale to mm."""
+def stock_mesh(job: JobSpec) -> TriMesh:
+    """A solid stock's mesh as placed (the model's units for an STL, its translate)."""
     s = job.stock
-    scale = 1.0 if is_step(s.file) else UNITS[job.model.units]
+    scale = _scale(job)
     try:
         mesh = load_stl(s.mesh_file or s.file)
     except TmmError as exc:
@@ -103,7 +118,7 @@ def stock_mesh(job: JobSpec) -> tuple[TriMesh, float]:
     if len(mesh.triangles) == 0:
         raise PlanInputError(f"stock.file: {s.file} has no triangles")
     vertices = mesh.vertices * scale + np.asarray(job.model.translate, dtype=float)
-    return TriMesh(vertices, mesh.triangles, name=mesh.name), scale
+    return TriMesh(vertices, mesh.triangles, name=mesh.name)
 
 
 def _solid(job: JobSpec, mesh: TriMesh) -> PlannedStock:
@@ -112,7 +127,7 @@ def _solid(job: JobSpec, mesh: TriMesh) -> PlannedStock:
     from tmm_workbench.core.query.drop import DropSurface
     from tmm_workbench.core.tools.cutter import Cutter
 
-    solid, scale = stock_mesh(job)
+    solid = stock_mesh(job)
     lo, hi = solid.bounds
     floor = float(lo[2]) - 1.0
     v = mesh.vertices
@@ -124,7 +139,7 @@ def _solid(job: JobSpec, mesh: TriMesh) -> PlannedStock:
                              f"{int(outside.sum())} of its {len(v)} points lie outside it (the first at "
                              f"X{p[0]:.4g} Y{p[1]:.4g} Z{p[2]:.4g}); a solid stock must hold the whole model")
     box = _outward(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
-    return PlannedStock("solid", box, file=job.stock.file, scale=scale, translate=tuple(job.model.translate))
+    return stock_of_plan(job, box)
 
 
 def _within_travels(job: JobSpec, mesh: TriMesh, stock: PlannedStock) -> None:
