@@ -380,7 +380,11 @@ def _library_file(p: Path) -> tuple[Any, tuple[str, ...]]:
                 "a mapping with one field, tools: the list of tools")
 
 
+def read_data(path: Union[str, Path]) -> Any:
+    """The data of the job file at `path` (.yaml / .yml / .json), not checked yet."""
+    return _parsed(Path(path), "job file")
+
+
 def read_job(path: Union[str, Path]) -> JobSpec:
     """The job file at `path` (.yaml / .yml / .json), checked."""
-    p = Path(path)
-    return job_from_dict(_parsed(p, "job file"), p)
+    return job_from_dict(read_data(path), Path(path))

@@ -20,14 +20,15 @@ import time
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
-from tmm_workbench.core.plan import analysis, decide, progress_note
-from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, ToolSpec, is_step, read_job
+from tmm_workbench.core.plan import analysis, decide, progress_note, recipes
+from tmm_workbench.core.plan.job_file import (MODEL_SUFFIXES, UNITS, JobSpec, PlanInputError, ToolSpec, is_step,
+                                              job_from_dict, read_data)
 from tmm_workbench.core.plan.stock import planned_stock, stock_of_plan
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
@@ -221,14 +222,37 @@ def move_into_place(tmp: Path, target: Path) -> list:
     return names
 
 
-def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None) -> int:
-    """Plans, runs and verifies the job; `out_dir` in place of the job file's outputs.dir (a batch's part folder)."""
+def job_of(job_path: str, overrides: Sequence[tuple[tuple[str, ...], Any]] = (), out_dir: Optional[str] = None
+           ) -> tuple[JobSpec, Optional[dict]]:
+    """The checked job of a job file, or of a model file (.stl, .step, .stp) planned with the default recipe
+    (core.plan.recipes.default_job, into <stem>_plan in the current folder); `overrides` (a field's path, its value)
+    set in its data, `out_dir` in place of outputs.dir. Returns the job and, for the default recipe, the data of
+    the job file that plans it again (written as job.json beside the outputs)."""
+    path = Path(job_path)
+    recipe = path.suffix.lower() in MODEL_SUFFIXES
+    if recipe:
+        data = recipes.default_job(str(path.resolve()), str(Path.cwd() / f"{path.stem}_plan"))
+    else:
+        data = read_data(path)
+    for keys, value in overrides:
+        if not isinstance(data, dict) or len(keys) > 1 and not isinstance(data.get(keys[0], {}), dict):
+            break   # job_from_dict names what is wrong with the file
+        section = data.setdefault(keys[0], {}) if len(keys) > 1 else data
+        section[keys[-1]] = value
+    if out_dir is not None and isinstance(data, dict) and isinstance(data.get("outputs"), dict):
+        data["outputs"]["dir"] = str(Path(out_dir).resolve())
+    job = job_from_dict(data, Path.cwd() / "job.json" if recipe else path)
+    return job, dict(data, outputs=dict(data["outputs"], dir=".")) if recipe else None
+
+
+def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None,
+        overrides: Sequence[tuple[tuple[str, ...], Any]] = ()) -> int:
+    """Plans, runs and verifies the job (a job file, or a model with the default recipe: job_of); `out_dir` in
+    place of the job file's outputs.dir (a batch's part folder)."""
     t0 = time.perf_counter()
     tmp: Optional[Path] = None
     try:
-        job = read_job(job_path)
-        if out_dir is not None:
-            job = replace(job, outputs=replace(job.outputs, dir=Path(out_dir).resolve()))
+        job, again = job_of(job_path, overrides, out_dir)
         progress_note.note(1, 0, "analysing the model and planning")
         if is_step(job.model.file) or job.stock.type == "solid" and is_step(job.stock.file):
             tmp = temporary_folder(job.outputs.dir, job.outputs.name)
@@ -254,6 +278,8 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         if moved:
             model_file = tmp / f"{out.name}_model.stl"
             save_stl(mesh, model_file)
+        if again is not None:
+            (tmp / "job.json").write_text(json.dumps(again, indent=1, sort_keys=True) + "\n")
         (tmp / "plan.json").write_text(json.dumps(plan_document(job, plan, model_file), indent=1, sort_keys=True))
         failure = run_freecad(tmp, freecad, quiet)
         if failure is not None:
@@ -277,10 +303,28 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m tmm_workbench.plan",
                                  description="Plans, runs and verifies a Job from a job file (docs/planner.md).")
-    ap.add_argument("job", help="the job file (.yaml, .yml or .json)")
+    ap.add_argument("job", help="the job file (.yaml, .yml or .json), or a model (.stl, .step, .stp) planned with "
+                    "the default recipe (docs/planner.md)")
     ap.add_argument("--freecad", default=os.environ.get("TMM_FREECADCMD", "freecadcmd"),
                     help="the freecadcmd to run (default: $TMM_FREECADCMD or freecadcmd)")
     ap.add_argument("--quiet", action="store_true", help="no progress lines (errors only)")
     ap.add_argument("--out", default=None, help="the folder for the outputs, in place of the job file's outputs.dir")
+    for flag, keys, kind, text in OVERRIDES:
+        ap.add_argument(flag, type=kind, default=None, help=f"{text}, in place of the job's {'.'.join(keys)}")
     args = ap.parse_args(argv)
-    return run(args.job, args.freecad, args.quiet, args.out)
+    overrides = [(keys, getattr(args, flag[2:])) for flag, keys, _, _ in OVERRIDES
+                 if getattr(args, flag[2:]) is not None]
+    return run(args.job, args.freecad, args.quiet, args.out, overrides)
+
+
+def _absolute(path: str) -> str:
+    return str(Path(path).resolve())
+
+
+# the command's options that change a job's field (a job file's or the default recipe's)
+OVERRIDES = (("--cusp", ("finish", "cusp"), float, "the scallop height, mm"),
+             ("--tolerance", ("finish", "tolerance"), float, "the verification's tolerance, mm"),
+             ("--material", ("material",), str, "the material of the speeds and feeds table"),
+             ("--tools", ("tools",), _absolute, "a tools file (YAML, JSON) or a FreeCAD tool library (.fctl)"),
+             ("--margin", ("stock", "margin"), float, "the stock beyond the model on each side, mm"),
+             ("--name", ("outputs", "name"), str, "the outputs' file name"))

@@ -88,7 +88,8 @@ def setup_sheet(report: Mapping) -> str:
     size = " x ".join(f"{b - a:.2f}" for a, b in zip(lo, hi))
     shape = report["stock"]["describe"] if "stock" in report else f"box {size} mm"
     rapid = report["machine"].get("rapid_mm_min")
-    stock = pairs([("stock", f"{shape} (X x Y x Z over all: {size} mm)"), ("material", report["material"].replace("_", " ")),
+    stock = pairs([("stock", f"{shape} (X x Y x Z over all: {size} mm)"),
+                   ("material", report["material"].replace("_", " ")),
                    ("stock corner (lowest X, Y, Z)", "X{:g} Y{:g} Z{:g}".format(*lo)),
                    ("stock top", f"Z{hi[2]:g}"),
                    ("zero point (G54)", "the model's origin: X0 Y0 Z0 of the model file as placed (the stock's "
