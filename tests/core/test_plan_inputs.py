@@ -330,3 +330,20 @@ def test_default_recipe_bad_input(tmp_path: Path, capsys, monkeypatch) -> None:
     assert launch.main([str(model), "--tools", "no_tools.fctl", "--quiet"]) == launch.BAD_INPUT
     assert "no_tools.fctl" in capsys.readouterr().err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["part.stl"]
+
+
+def test_library_notes_in_the_report(tmp_path: Path) -> None:
+    """The bits left out of a library are said in report.json's notes and on the page's setup sheet."""
+    data = good(tmp_path)
+    data["planner"]["compare_cutters"] = False
+    data["tools"] = str(FC_TOOLS / "v0_20" / "Library" / "Default.fctl")
+    data["machine"]["rapid"] = [6000, 2000]
+    assert run_job(tmp_path, data, stand_in(tmp_path, True)) == launch.VERIFIED
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert len(report["notes"]) == 6 and "T2 5mm_Drill.fctb" in report["notes"][0]
+    assert report["machine"]["rapid_mm_min"] == [6000, 2000]
+    assert [t["name"] for t in report["tools"]] == ["T1 5mm Endmill", "T3 6mm Ball End", "T4 6 mm Bull Nose"]
+    assert report["tools"][1]["shank_diameter"] == 3.0 and report["tools"][1]["length"] == 50.0
+    page = (tmp_path / "out" / "report.html").read_text()
+    assert "left out T2 5mm_Drill.fctb" in page and "rapids XY 6000 Z 2000 mm/min" in page
+    assert report["stock"]["describe"].startswith("box ") and report["stock"]["describe"] in page

@@ -254,12 +254,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
     try:
         job, again = job_of(job_path, overrides, out_dir)
         progress_note.note(1, 0, "analysing the model and planning")
-        if is_step(job.model.file) or job.stock.type == "solid" and is_step(job.stock.file):
-            tmp = temporary_folder(job.outputs.dir, job.outputs.name)
-        if is_step(job.model.file):
-            job = tessellate_step(job, tmp, freecad, quiet)
-        if job.stock.type == "solid" and is_step(job.stock.file):
-            job = tessellate_stock(job, tmp, freecad, quiet)
+        job, tmp = tessellated(job, freecad, quiet)
         mesh, moved, an, plan = make_plan(job, quiet)
         if job.stock.mesh_file is not None:
             job.stock.mesh_file.unlink()
@@ -291,13 +286,34 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         finish_outputs(tmp, job, mesh, an, plan, verified, quiet)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    say_outcome(verified, out.dir, time.perf_counter() - t0, quiet)
+    return VERIFIED if verified["passed"] else FAILED
+
+
+def say_outcome(verified: dict, out_dir: Path, seconds: float, quiet: bool) -> None:
     for change in verified.get("replanned", []):
         say(f"plan changed: {change}", quiet)
     state = "verified" if verified["passed"] else "verification FAILED: " + "; ".join(verified["problems"])
     say(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left {verified['most_material_left_mm']:g}"
-        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out.dir} "
-        f"({time.perf_counter() - t0:.0f} s)", quiet)
-    return VERIFIED if verified["passed"] else FAILED
+        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out_dir} ({seconds:.0f} s)", quiet)
+
+
+def tessellated(job: JobSpec, freecad: str, quiet: bool) -> tuple[JobSpec, Optional[Path]]:
+    """The job with its STEP model and its STEP stock tessellated by FreeCAD in a temporary folder beside the
+    outputs (the run's), and that folder; the job and None when neither is a STEP."""
+    model, stock = is_step(job.model.file), job.stock.type == "solid" and is_step(job.stock.file)
+    if not (model or stock):
+        return job, None
+    tmp = temporary_folder(job.outputs.dir, job.outputs.name)
+    try:
+        if model:
+            job = tessellate_step(job, tmp, freecad, quiet)
+        if stock:
+            job = tessellate_stock(job, tmp, freecad, quiet)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return job, tmp
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
