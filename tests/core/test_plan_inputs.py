@@ -222,14 +222,15 @@ def bit(shape: str, **parameter) -> dict:
 
 def test_library_quantities_and_order(tmp_path: Path) -> None:
     lib = library(tmp_path, {"ball": bit("ballend", Diameter="0.25 in", CuttingEdgeHeight=12.5, Flutes=3),
-                             "bull": bit("bullnose", Diameter="10 mm", FlatRadius="4 mm", CuttingEdgeHeight="25 mm",
-                                         Length="7.5 cm")})
+                             "bull": bit("bullnose", Diameter="10,00 mm", FlatRadius="4 mm", CuttingEdgeHeight="25 mm",
+                                         Length="7.5 cm", Flutes=0)})
     data = good(tmp_path)
     data["tools"] = str(lib.relative_to(tmp_path))
     job = job_of(tmp_path, data)
     assert [t.name for t in job.tools] == ["T9 my bullnose", "T10 my ballend"]   # by tool number
     bull, ball = job.tools
     assert bull.corner_radius == 1.0 and bull.length == 75.0 and bull.shank_diameter is None
+    assert bull.diameter == 10.0 and bull.flutes == 2   # a decimal comma; 1.1's unset Flutes 0: the default
     assert ball.diameter == pytest.approx(6.35) and ball.flute_length == 12.5 and ball.flutes == 3
     assert job.notes == ()
 

@@ -94,10 +94,9 @@ def read_bit(path: Path) -> dict | str:
     for key, name in (("shank_diameter", "ShankDiameter"), ("length", "Length")):
         if name in p:
             tool[key] = _mm(where, p, name)
-    if "Flutes" in p:
-        flutes = p["Flutes"]
-        tool["flutes"] = int(flutes) if isinstance(flutes, (int, float)) and not isinstance(flutes, bool) \
-            and flutes == int(flutes) else flutes   # anything else: the job file's check names it
+    flutes = p.get("Flutes")
+    if isinstance(flutes, (int, float)) and not isinstance(flutes, bool) and flutes != 0:   # 1.1's unset: 0
+        tool["flutes"] = int(flutes) if flutes == int(flutes) else flutes   # a fraction: the job's check names it
     return tool
 
 
@@ -109,7 +108,8 @@ def _mm(where: str, params: dict, name: str) -> float:
     value = params[name]
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value)
-    m = _QUANTITY.match(str(value))
+    text = str(value)
+    m = _QUANTITY.match(text if "." in text else text.replace(",", "."))   # 1.1 writes the user's UserString
     unit = m.group(2).lower() if m else ""
     if m is None or (unit and unit not in UNITS_MM):
         raise LibraryError(f"{where}: {name} is {value!r}; a length such as '6.0000 mm' (units "
