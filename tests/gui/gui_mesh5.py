@@ -1,9 +1,9 @@
 """GUI test of the 5-axis mesh op, run by FreeCAD itself under Xvfb: `xvfb-run -a freecad tests/gui/gui_mesh5.py`.
 
 The API makes a 'TMM 5-axis Mesh' op on a small patch (a convex cylinder, radius 60 mm, 24 x 24 mm, written as an
-STL here) with a flat D 10; its task panel opens with the op's values (the tool holder group too), the user types a coarser tolerance and a
-smaller tilt limit and presses OK: the op is kept, recomputed with them (a Path, fewer or as many passes, its
-summary rewritten). The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
+STL here) with a flat D 10; its task panel opens with the op's values (the tool holder group too), the user
+types a coarser tolerance and a smaller tilt limit and presses OK: the op is kept, recomputed with them (a Path,
+fewer or as many passes, its summary rewritten). The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
 """
 import math
 import os
