@@ -10,6 +10,7 @@ import FreeCAD
 import numpy as np
 
 from fc_helpers import OUT, FreeCADTestCase, write_ascii_stl
+from tmm_workbench.app import work_estimate
 from tmm_workbench.app.api import run_mesh5, simulate
 
 HOLDER, STICK_OUT, WALL_Y, WALL_TOP = "ER16 nut", 32.0, 12.0, 60.0
@@ -52,11 +53,16 @@ class HolderInTheMesh5Op(FreeCADTestCase):
         self.assertEqual(report.stock_collisions, [])    # and against the stock as the cut leaves it
         self.assertEqual(report.collisions, [])
         self.assertGreaterEqual(report.min_deviation, -0.01)
+        held = work_estimate.estimate(op)   # the estimate counts the holder's dearer C-spaces
+        self.assertIn("shank and holder", held.note)
         # the same op without the holder: the path brings the nut into the wall
         op.Holder = "None"
         r.doc.recompute()
         self.assertTrue(op.isValid(), op.getStatusString())
         self.assertEqual(op.HolderReport, "")
+        bare_estimate = work_estimate.estimate(op)
+        self.assertNotIn("shank and holder", bare_estimate.note)
+        self.assertLess(bare_estimate.compute_seconds, held.compute_seconds)
         self.assertLess(abs(min(a[1] for s in op.Proxy.segments for a in s.axes)), 1e-9)   # upright throughout
         bare = simulate(r.job, cell=0.25, tolerance=0.01, progress=False, holder=HOLDER, stick_out=STICK_OUT)
         self.assertTrue(bare.holder_collisions, "the bare path should drive the holder into the wall")
