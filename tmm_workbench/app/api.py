@@ -278,7 +278,9 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
               horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
               post: Optional[str] = "tarus", gcode_path: Optional[Union[str, os.PathLike]] = None,
               fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
-              progress: Union[bool, Callable[[float], bool]] = True) -> SurfaceResult:
+              progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
+              stick_out: Optional[float] = None, shank_clearance: Optional[float] = None,
+              holder_clearance: Optional[float] = None) -> SurfaceResult:
     """5-axis finishing of `model` (STL path, Mesh::Feature or Part::Feature) by seed 000's 3D C-space (a 'TMM
     5-axis Mesh' op in a new Job, or in `job`): adaptive passes within `tolerance` (the scallop, mm), the
     posture at every CC point chosen for the Tarus motion time (docs/mesh5.md).
@@ -289,9 +291,13 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
     grid_step_deg: the posture grid; None keeps the op's defaults (the seed's 0..45 deg, +-45 deg, 3 deg).
     post 'tarus' | 'apt_cl' | None (a 3-axis post would drop the tool axes: refused). The stock of a new Job
     as run_roughing's (the simulation cuts it). Heights, feeds (mm/min), files and progress as run_surface; the
-    result is a SurfaceResult (op: the 5-axis mesh op; what was left for clean-up: its Mesh5Summary).
+    result is a SurfaceResult (op: the 5-axis mesh op; what was left for clean-up: its Mesh5Summary and
+    CleanupRegions).
+    The whole tool (holder, stick_out, shank_clearance, holder_clearance) as run_surface: the shank and holder
+    bound every C-space, so the tool tilts away where they would come closer, or the place is left for
+    clean-up (the op's HolderReport says which).
     """
-    from tmm_workbench.app import op_mesh5
+    from tmm_workbench.app import op_mesh5, stages
     from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 
     # (argument, value, Mesh5Params field, op property); a None keeps the op's default
@@ -309,6 +315,8 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
     Mesh5Params(**{field: value for field, _, value in given}).grid()  # the tilts within the machine's range
     values: dict[str, Any] = {"FeedAngle": feed_angle_deg, "ZigZag": bool(zigzag), "AxisRetract": axis_retract}
     values.update({prop: value for _, prop, value in given})
+    values.update(stages.api_values(op_mesh5.TOOL_STAGES, Mesh5Params, dict(
+        holder=holder, stick_out=stick_out, shank_clearance=shank_clearance, holder_clearance=holder_clearance), model))
     return run(op_mesh5.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
