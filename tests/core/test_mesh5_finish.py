@@ -117,6 +117,14 @@ def test_work_is_estimated_from_the_box_alone():
     assert work.what == "CC points" and work.passes == 11 and work.count == pytest.approx(11 * (24 / 3 + 2))
     with pytest.raises(TmmError, match="CC points"):
         finish.estimate_work(Mesh5Params(forward_step=0.01), Cutter.flat(1.0), (0, 0, 0, 1e5, 1e5, 1))
+    # with the shank and holder every C-space costs more: the same CC points at a dearer pace
+    from tmm_workbench.core.tools.assembly import ToolAssembly
+
+    held = Mesh5Params(**PARAMS)
+    held.assembly = ToolAssembly(Cutter.flat(10.0), 10.0, 32.0, flute_length=30.0, holder="ER16 nut")
+    more = finish.estimate_work(held, Cutter.flat(10.0), (-12, -12, 0, 12, 12, 60))
+    assert more.count == work.count and dict(more.paces)["mesh5"] == finish.HOLDER_COST * dict(work.paces)["mesh5"]
+    assert "shank and holder" in more.note
 
 
 def test_progress_is_told_and_a_cancel_stops_the_passes():

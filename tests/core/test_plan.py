@@ -68,7 +68,7 @@ BAD = [  # (change, words the message must hold: the field, the value, what is a
     (lambda d: d["machine"].update(post="fanuc"), ["machine.post", "'fanuc'", "linuxcnc"]),
     (lambda d: d["machine"].update(type="5-axis"), ["machine.type", "'5-axis'", "3-axis"]),
     (lambda d: d["machine"].update(travels=[300, 200]), ["machine.travels", "[x, y, z]"]),
-    (lambda d: d["stock"].update(type="cylinder"), ["stock.type", "'cylinder'", "box"]),
+    (lambda d: d["stock"].update(type="sphere"), ["stock.type", "'sphere'", "box, cylinder, solid"]),
     (lambda d: d["stock"].update(margin=-1), ["stock.margin", "-1", "[0, 1000]"]),
     (lambda d: d.update(format="tmm-plan 2"), ["format", "tmm-plan 2", "tmm-plan 1"]),
     (lambda d: d.pop("finish"), ["job file", "missing", "finish"]),

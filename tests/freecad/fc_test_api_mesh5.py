@@ -1,6 +1,6 @@
 """The 'TMM 5-axis Mesh' op headless: `api.run_mesh5` and `api_run.run("TMM_Mesh5", ...)` on a gently curved patch
 (fc_test_mesh5's), computed and posted by the Tarus post (the default for a 5-axis op); the same G-code both ways;
-bad tools, values, tilts and posts refused by name before a document is made."""
+bad tools, values, tilts, holder settings and posts refused by name before a document is made."""
 from __future__ import annotations
 
 import FreeCAD
@@ -51,6 +51,8 @@ class RunMesh5(FreeCADTestCase):
             (lambda: run("TMM_Mesh5", stl, tool="endmill", post="grbl"), "post 'grbl' cannot write"),
             (lambda: run("TMM_Mesh5", stl, tool="endmill", TiltLimt=20.0), "did you mean TiltLimit?"),
             (lambda: run("TMM_Mesh5", stl, tool="endmill", GridStep=0.0), "posture grid step must be"),
+            (lambda: run_mesh5(stl, stick_out=30.0), "stick_out is used with a holder only"),
+            (lambda: run_mesh5(stl, holder="ER16 nut", stick_out=-1.0), "stick_out", "got -1"),
         ]
         for call, *said in cases:
             with self.subTest(said=said[0]), self.assertRaises(TmmError) as ctx:

@@ -261,3 +261,142 @@ class PlanStep(FreeCADTestCase):
                                "report.html", "report.json"])
         report = json.loads((folder / "out" / "report.json").read_text())
         self.assertEqual(report["analysis"]["size_mm"], [30.0, 20.0, 7.0])
+
+
+def stock_job(folder: Path, stock: dict, **machine) -> Any:
+    """tests/data/plan_beet.yaml with `stock`, no cutter comparison (a shorter run), the machine's extras."""
+    import yaml
+
+    from tmm_workbench.core.plan.job_file import job_from_dict
+
+    folder.mkdir(parents=True, exist_ok=True)
+    data = yaml.safe_load(JOB.read_text())
+    data["model"]["file"] = str(read_job(JOB).model.file)
+    data["outputs"]["dir"] = str(folder / "out")
+    data["planner"]["compare_cutters"] = False
+    data["stock"] = stock
+    data["machine"].update(machine)
+    return job_from_dict(data, folder / "job.yaml")
+
+
+def feed_moves(op: Any) -> np.ndarray:
+    """The op's cutting moves' end points (x, y, z)."""
+    return np.array([(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in op.Path.Commands
+                     if c.Name in ("G1", "G01") and {"X", "Y", "Z"} <= set(c.Parameters)])
+
+
+class PlanStocks(FreeCADTestCase):
+    def test_cylinder_stock_planned_and_verified(self) -> None:
+        """A cylinder stock: FreeCAD's CreateCylinder in the Job, the roughing cutting only within it (its feed
+        moves under the stock's top within the circle grown by the tool's radius but for its entries from the air
+        beside it), the simulation starting from
+        it (it removes less than the cylinder holds), verified; the machine's rapids on every tool controller."""
+        folder = OUT / "plan_cylinder"
+        job = stock_job(folder, {"type": "cylinder", "margin": 2, "above": 1}, rapid=[3000, 1500])
+        _, _, _, plan = launch.make_plan(job)
+        doc = dict(launch.plan_document(job, plan, job.model.file), fcstd=False, heat_map=False)
+        stock = doc["stock"]
+        results, verified = plan_run.run_plan(doc, folder)
+        self.assertTrue(verified["passed"], verified["problems"])
+        fc_stock = results[0].job.Stock
+        self.assertAlmostEqual(float(fc_stock.Radius), stock["radius_mm"], places=4)
+        self.assertAlmostEqual(float(fc_stock.Height), stock["box_mm"][5] - stock["box_mm"][2], places=4)
+        base = fc_stock.Placement.Base
+        self.assertAlmostEqual(base.x, stock["centre_mm"][0], places=4)
+        self.assertAlmostEqual(base.z, stock["box_mm"][2], places=4)
+        self.assertEqual([t.Label for t in results[0].job.Tools.Group],   # no default tool left in the Job
+                         list(dict.fromkeys(f"TC: {o.tool}" for o in plan.ops)))
+        rough = results[0].op
+        p = feed_moves(rough)
+        below = p[p[:, 2] < stock["box_mm"][5] - 0.01]
+        self.assertGreater(len(below), 100)
+        r_tool = rough.ToolController.Tool.Diameter.Value / 2
+        off_axis = np.hypot(below[:, 0] - stock["centre_mm"][0], below[:, 1] - stock["centre_mm"][1])
+        # the box's corners beyond the cylinder are 21 % of its area: a box stock's clearing would go there; the
+        # cylinder's takes only its entries from the air beside the stock (36 of 4,177 moves on 0.20)
+        self.assertLess(np.mean(off_axis > stock["radius_mm"] + r_tool + 0.01), 0.02)
+        volume = np.pi * stock["radius_mm"] ** 2 * (stock["box_mm"][5] - stock["box_mm"][2])
+        self.assertLess(verified["removed_volume_mm3"], volume)
+        box = stock["box_mm"]
+        self.assertGreater((box[3] - box[0]) * (box[4] - box[1]) * (box[5] - box[2]) - volume, 0.2 * volume)
+        for tc in results[0].job.Tools.Group:
+            self.assertEqual((tc.HorizRapid.Value, tc.VertRapid.Value), (50.0, 25.0))
+        gcode = (folder / "beet_mm.ngc").read_text()
+        self.assertTrue("M6 T1" in gcode)
+
+    def test_solid_stock_from_step_and_stl(self) -> None:
+        """A solid stock from a STEP (a block whose top slopes): its clone is the Job's stock, the plan verified, the
+        simulation removing less than the solid holds; an STL stock sewn into the same solid."""
+        import Part
+
+        from tmm_workbench.app.plan_stock import solid_shape
+        from tmm_workbench.app.step_mesh import step_mesh
+        from tmm_workbench.core.geometry.mesh import load_stl
+
+        folder = OUT / "plan_solid"
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        lo, hi = load_stl(read_job(JOB).model.file).bounds
+        x0, x1, z0 = lo[0] - 2, hi[0] + 2, lo[2]
+        top = lambda x: hi[2] + 0.5 + 0.3 * (x - x0)   # noqa: E731 - 0.5 mm over the model at its low side
+        side = Part.Face(Part.makePolygon([FreeCAD.Vector(x, lo[1] - 2, z) for x, z in
+                                           ((x0, z0), (x1, z0), (x1, top(x1)), (x0, top(x0)), (x0, z0))]))
+        solid = side.extrude(FreeCAD.Vector(0, hi[1] - lo[1] + 4, 0))
+        solid.exportStep(str(folder / "stock.step"))
+        job = stock_job(folder, {"type": "solid", "file": str(folder / "stock.step")})
+        step_mesh(folder / "stock.step", folder / "stock_mesh.stl", 0.005, solid=True)
+        from dataclasses import replace
+
+        job = replace(job, stock=replace(job.stock, mesh_file=folder / "stock_mesh.stl"))
+        _, _, _, plan = launch.make_plan(job)
+        doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
+        results, verified = plan_run.run_plan(doc, folder)
+        self.assertTrue(verified["passed"], verified["problems"])
+        fc_stock = results[0].job.Stock
+        self.assertEqual(fc_stock.PathResource, "Stock")
+        self.assertAlmostEqual(fc_stock.Shape.Volume, solid.Volume, delta=1e-6 * solid.Volume)
+        self.assertLess(verified["removed_volume_mm3"], solid.Volume)
+        self.assertAlmostEqual(plan.stock_box[5], solid.BoundBox.ZMax, places=3)
+        # an STL of the same solid: sewn into a solid of its volume
+        from tmm_workbench.app.geometry import mesh_from_shape
+        from tmm_workbench.core.geometry.mesh import save_stl
+
+        save_stl(mesh_from_shape(solid, 0.01, "stock"), folder / "stock.stl")
+        sewn = solid_shape(folder / "stock.stl", 1.0, [0, 0, 5])
+        self.assertAlmostEqual(sewn.Volume, solid.Volume, delta=1e-3 * solid.Volume)
+        self.assertAlmostEqual(sewn.BoundBox.ZMax, solid.BoundBox.ZMax + 5, places=3)
+
+
+class PlanLibrary(FreeCADTestCase):
+    def test_library_written_by_freecad(self) -> None:
+        """ToolBits made in FreeCAD and saved by FreeCAD's own ToolBit code (0.20 and 1.0: templateAttrs, what
+        saveToFile writes; 1.1: to_dict, what its .fctb serializer writes) in FreeCAD's folders, the library
+        naming them: read back into the planner's tools with their sizes."""
+        from tmm_workbench.app import tools
+        from tmm_workbench.core.plan.tool_library import read_library
+
+        doc = FreeCAD.newDocument("TmmPlanLibrary")
+        root = OUT / "plan_library" / "Tools"
+        shutil.rmtree(root, ignore_errors=True)
+        (root / "Bit").mkdir(parents=True)
+        (root / "Library").mkdir()
+        made = [tools.make_tool_bit(doc, "endmill", 8.0, label="flat8"),
+                tools.make_tool_bit(doc, "ballend", 6.0, label="ball6"),
+                tools.make_tool_bit(doc, "bullnose", 10.0, 1.0, label="bull10")]
+        doc.recompute()
+        entries = []
+        for nr, bit in enumerate(made, 1):
+            proxy = bit.Proxy
+            attrs = proxy.templateAttrs(bit) if hasattr(proxy, "templateAttrs") else proxy.to_dict()
+            (root / "Bit" / f"{bit.Label}.fctb").write_text(json.dumps(attrs, indent=2))
+            entries.append({"nr": nr, "path": f"{bit.Label}.fctb"})
+        (root / "Library" / "shop.fctl").write_text(json.dumps({"version": 1, "tools": entries}))
+        got, skipped = read_library(root / "Library" / "shop.fctl")
+        self.assertEqual(skipped, [])
+        self.assertEqual([(t["name"], t["type"], t["diameter"]) for t in got],
+                         [("T1 flat8", "flat", 8.0), ("T2 ball6", "ball", 6.0), ("T3 bull10", "bull", 10.0)])
+        self.assertAlmostEqual(got[2]["corner_radius"], 1.0, places=6)
+        for t, bit in zip(got, made):
+            self.assertAlmostEqual(t["flute_length"], float(bit.CuttingEdgeHeight), places=6)
+            self.assertAlmostEqual(t["length"], float(bit.Length), places=6)
+            self.assertAlmostEqual(t["shank_diameter"], float(bit.ShankDiameter), places=6)

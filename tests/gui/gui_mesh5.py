@@ -1,9 +1,9 @@
 """GUI test of the 5-axis mesh op, run by FreeCAD itself under Xvfb: `xvfb-run -a freecad tests/gui/gui_mesh5.py`.
 
 The API makes a 'TMM 5-axis Mesh' op on a small patch (a convex cylinder, radius 60 mm, 24 x 24 mm, written as an
-STL here) with a flat D 10; its task panel opens with the op's values, the user types a coarser tolerance and a
-smaller tilt limit and presses OK: the op is kept, recomputed with them (a Path, fewer or as many passes, its
-summary rewritten). The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
+STL here) with a flat D 10; its task panel opens with the op's values (the tool holder group too), the user
+types a coarser tolerance and a smaller tilt limit and presses OK: the op is kept, recomputed with them (a Path,
+fewer or as many passes, its summary rewritten). The outcome goes to env TMM_GUI_RESULT (JSON) and the exit code.
 """
 import math
 import os
@@ -54,6 +54,11 @@ def run() -> dict:
     tolerance, tilt = page.findChild(QtGui.QWidget, "tolerance"), page.findChild(QtGui.QWidget, "tiltLimit")
     info["fields"] = [tolerance.property("rawValue"), tilt.property("rawValue")]
     assert abs(info["fields"][0] - 0.05) < 1e-9 and abs(info["fields"][1] - 24.0) < 1e-9, info
+    # the tool holder group shows the op's whole-tool values (by default the tool controller's holder)
+    holder = page.findChild(QtGui.QComboBox, "holder")
+    info["holder"] = [holder.currentText(), op.Holder, [holder.itemText(i) for i in range(holder.count())]]
+    info["stick_out"] = [page.findChild(QtGui.QWidget, "stickOut").property("rawValue"), op.StickOut.Value]
+    info["cleanup_marks_view"] = hasattr(op.ViewObject, "ShowCleanupRegions")
     tolerance.setProperty("rawValue", 0.2)
     tilt.setProperty("rawValue", 18.0)
     pump(0.3)

@@ -23,6 +23,10 @@ def test_gui_mesh5_panel(tmp_path: Path) -> None:
     assert code == 0 and info.get("ok"), \
         f"FreeCAD exit code {code}\n{info.get('error', '')}\n{fc_process.failure_text(out)}"
     assert info["values_after"] == [0.2, 18.0], info
+    shown, held, offered = info["holder"]
+    assert shown == held == "FromToolController" and "ER16 nut" in offered and "None" in offered, info
+    assert info["stick_out"][0] == info["stick_out"][1] == 0.0, info
+    assert info["cleanup_marks_view"], info
     assert info["valid"] and info["commands"] > 10, info
     # a tolerance 4x coarser: wider passes; the tilt limit holds (the tilt from the vertical on this patch is the
     # tilt from the normal plus the normal's own, at most 11.5 deg)

@@ -12,16 +12,21 @@ one linker, core.strategies.multipoint.link_policy): each pass entered and left 
 axis, transits at the safe height for the tilted tool's lowest point, the op starting and ending upright at
 the clearance height. `Mesh5Summary` says passes, CC points and what was left for clean-up: strips no
 posture finishes within the tolerance and their CC points (a count and their extent), also printed as a
-warning. Errors never leave a partial path.
+warning; `CleanupRegions` holds points on the model covering those strips (the 3D view draws them). The
+whole tool (app.tool_assembly: Holder, StickOut, the clearances; by default the tool controller's holder):
+its shank and holder bound every C-space, so the tool tilts away where they would come closer, or the place
+is left for clean-up; the cut moves are checked against the model and one that would come closer is left out;
+`HolderReport` and `HolderRegions` say what they changed. Errors never leave a partial path.
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any, Optional
 
 import FreeCAD
 import Path
 
-from tmm_workbench.app import op_base, op_mesh, work_estimate
+from tmm_workbench.app import op_base, op_mesh, stages, tool_assembly, work_estimate
 from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import path5
@@ -55,9 +60,21 @@ PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
          "Entry and exit distance along the tool axis (then straight up/down to the safe height)"),
     Prop("App::PropertyString", "Mesh5Summary", "Mesh5",
          "Result of the last computation: passes, CC points, what is left for clean-up"),
+    Prop("App::PropertyVectorList", "CleanupRegions", "Mesh5",
+         "Points on the model no pass finishes within the tolerance (an empty C-space: the strips of "
+         "Mesh5Summary), marked for clean-up: drawn on the 3D view"),
 ]
 CHOICES: dict[str, dict[str, str]] = {}
 DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "AxisRetract": 5.0}
+
+# the whole tool (app.tool_assembly): its shank and holder bound every C-space, so the tool tilts away where they
+# would come closer, or the place is left for clean-up (no Lift / LeaveOut choice: the C-space decides)
+TOOL_STAGE = replace(tool_assembly.STAGE, fields=tuple(
+    f for f in tool_assembly.STAGE.fields if f.prop != "HolderCollision"))
+TOOL_STAGES = (TOOL_STAGE,)
+PROPERTIES += stages.properties(TOOL_STAGES)
+CHOICES.update(stages.choices(TOOL_STAGES))
+DEFAULTS.update(stages.defaults(TOOL_STAGES))
 
 
 class ObjectTmmMesh5(op_mesh.MeshOp):
@@ -72,7 +89,9 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
     PROPERTIES = PROPERTIES
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
-    READ_ONLY = ("Mesh5Summary",)
+    SPECS = stages.specs(TOOL_STAGES)
+    RESTORED_DEFAULTS = stages.restored(TOOL_STAGES)   # documents from before the holder: none
+    READ_ONLY = ("Mesh5Summary", "CleanupRegions")
     segments: Optional[list] = None
     diagnostics: Optional[dict] = None
 
@@ -91,6 +110,7 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
             raise TmmError(f"safe height {safe:g} mm must be above the model's top {top:g} mm")
         if clearance < safe:
             raise TmmError(f"clearance height {clearance:g} mm is below the safe height {safe:g} mm")
+        tool_assembly.prepare(obj, params)  # the shank and holder bound the C-space (no holder: the cutter alone)
         with self.reporting(obj) as cb:
             result = finish.compute(mesh, cutter, params, cb)
             toolpath = link(result.segments, link_policy(cutter, safe, clearance, obj.AxisRetract.Value))
@@ -99,6 +119,8 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
         text = finish.report(self.diagnostics)
         if obj.Mesh5Summary != text:
             obj.Mesh5Summary = text
+        obj.CleanupRegions = [FreeCAD.Vector(*map(float, p)) for p in self.diagnostics["cleanup_points"]]
+        tool_assembly.report(obj, params)
         if len(self.diagnostics["unfinished"]):
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {text}\n")
         else:
@@ -109,11 +131,13 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
     def on_fail(self, obj: Any) -> None:
         if obj.Mesh5Summary:
             obj.Mesh5Summary = ""
+        if obj.CleanupRegions:
+            obj.CleanupRegions = []
 
 
 def SetupProperties() -> list[str]:
     """Properties the Job's SetupSheet may hold defaults for."""
-    return op_base.setup_properties(ObjectTmmMesh5, exclude=("StlFile", "Model", "Mesh5Summary"))
+    return op_base.setup_properties(ObjectTmmMesh5, exclude=("StlFile", "Model", "Mesh5Summary", "CleanupRegions"))
 
 
 def Create(name: str = OP_NAME, obj: Any = None, parentJob: Any = None,

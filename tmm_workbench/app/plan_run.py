@@ -22,20 +22,24 @@ FAILED = 3
 
 
 def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
-    """The plan's ops in order, the first making the Job around the model and its stock (`model`, a Mesh or Part
-    object: its Job in the object's document; None: the plan's STL in a new document), the others added."""
+    """The plan's ops in order, the first making the Job around the model and its box stock (`model`, a Mesh or
+    Part object: its Job in the object's document; None: the plan's STL in a new document), the others added; a
+    cylinder or solid stock's Job made first (app.plan_stock), every op added to it."""
     from tmm_workbench.app import api
+    from tmm_workbench.app.plan_stock import new_job
     from tmm_workbench.core.plan import progress_note
 
     calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
     results: list = []
     controllers: dict = {}
+    job = None if plan.get("stock", {}).get("type", "box") == "box" else new_job(plan, model)
     for i, op in enumerate(plan["ops"]):
         progress_note.note(2 + i, steps(plan), f"computing {op['label']}")
         kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
         call = calls[op["api"]]
-        if results:
-            r = call(None, job=results[0], progress=progress, **kwargs)
+        if results or job is not None:
+            kwargs.pop("stock", None)   # the Job's stock (the roughing's box: only for a new Job)
+            r = call(None, job=results[0] if results else job, progress=progress, **kwargs)
         elif model is not None:
             r = call(model, progress=progress, **kwargs)
         else:
@@ -43,6 +47,9 @@ def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
         r.op.Label = op["label"]
         share_tool_controller(r.op, op["tool"], plan["tools"][op["tool"]], controllers)
         results.append(r)
+    if plan.get("rapid_mm_min") is not None:   # the machine's: every tool controller's by its expression
+        sheet = results[0].job.SetupSheet
+        sheet.HorizRapid, sheet.VertRapid = (v / 60.0 for v in plan["rapid_mm_min"])
     results[0].doc.recompute()   # the ops with the library's tools (lengths, holders) and shared controllers
     for r in results:
         if not r.op.isValid():
@@ -54,7 +61,7 @@ def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> 
     """One tool controller per library tool: an op of a tool already used takes that tool's controller (the same
     feeds: they are the tool's) and the one the API made for it is removed, so the G-code changes tools only
     when the tool changes. The kept controller and its ToolBit are named after the library's tool and given its
-    flute length, overall length and holder (the API makes a bit of standard proportions; the ops use the
+    flute length, overall length, shank and holder (the API makes a bit of standard proportions; the ops use the
     controller's holder: their Holder is FromToolController)."""
     from tmm_workbench.app import compat
     from tmm_workbench.app.api import set_holder
@@ -65,6 +72,8 @@ def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> 
         made.Tool.Label = tool
         made.Tool.CuttingEdgeHeight = float(spec["flute_length"])
         made.Tool.Length = float(spec["length"])
+        if spec.get("shank_diameter") is not None:
+            made.Tool.ShankDiameter = float(spec["shank_diameter"])
         if spec["holder"] is not None:
             set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
         controllers[tool] = made

@@ -18,9 +18,9 @@ REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
 UNREADABLE = 2   # app.plan_run.exit_with: 3 for any other failure
 
 
-def step_mesh(step: Path, stl: Path, deflection: float) -> int:
+def step_mesh(step: Path, stl: Path, deflection: float, solid: bool = False) -> int:
     """`step`'s shape tessellated within `deflection` mm (app.geometry.mesh_from_shape), written to `stl`; its
-    triangle count. ValueError: not readable as a STEP, or nothing to tessellate."""
+    triangle count. ValueError: not readable as a STEP, nothing to tessellate, or (`solid`: a stock) no solid."""
     import Part
 
     from tmm_workbench.app.geometry import mesh_from_shape
@@ -31,6 +31,8 @@ def step_mesh(step: Path, stl: Path, deflection: float) -> int:
         mesh = mesh_from_shape(shape, deflection, step.stem)
     except Exception as exc:  # noqa: BLE001 - OCC's reader raises its own kinds, TMM a TmmError without faces
         raise ValueError(f"FreeCAD could not read {step.name} as a STEP model: {exc}") from None
+    if solid and not shape.Solids:
+        raise ValueError(f"{step.name} holds no solid (a stock is a closed solid)")
     save_stl(mesh, stl)
     return len(mesh.triangles)
 
@@ -38,7 +40,7 @@ def step_mesh(step: Path, stl: Path, deflection: float) -> int:
 def main() -> int:
     try:
         step_mesh(Path(os.environ["TMM_STEP_FILE"]), Path(os.environ["TMM_STEP_STL"]),
-                  float(os.environ["TMM_STEP_DEFLECTION"]))
+                  float(os.environ["TMM_STEP_DEFLECTION"]), os.environ.get("TMM_STEP_SOLID") == "1")
     except ValueError as exc:
         print(exc, file=sys.stderr)
         return UNREADABLE

@@ -353,9 +353,12 @@ def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
 
 
 def mesh5(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
-    """5-axis mesh finishing's params over the model's box (its CC points: passes a quarter diameter apart)."""
+    """5-axis mesh finishing's params over the model's box (its CC points: passes a quarter diameter apart), with
+    the op's tool assembly (its holder makes every C-space dearer)."""
+    from tmm_workbench.app import tool_assembly
+
     b = model_bounds(proxy, obj, load_stl)
-    return None if b is None else (_params(proxy, obj, ov), _cutter(obj), b)
+    return None if b is None else (_params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b)
 
 
 def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> Estimate:

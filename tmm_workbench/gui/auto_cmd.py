@@ -111,8 +111,8 @@ class AutoPanel:
         self.machine.setToolTip("The machine: its post processor and travels")
         shop = ", ".join(t["name"] for t in recipes.TOOLS)
         library, self.library = _path_row("library", "", f"the shop library: {shop}", self._browse_library)
-        self.library.setToolTip("A tool library file (YAML or JSON, {tools: [...]}, docs/planner.md); empty: the "
-                                f"shop library ({shop})")
+        self.library.setToolTip("A tool library file (YAML or JSON, {tools: [...]}, or FreeCAD's .fctl; "
+                                f"docs/planner.md); empty: the shop library ({shop})")
         self.margin = _spin("stockMargin", recipes.STOCK["margin"], "Stock beyond the model on each side")
         self.above = _spin("stockAbove", recipes.STOCK["above"], "Stock above the model's top")
         out, self.out_dir = _path_row("outputDir", str(default_out_dir(self.model)), "", self._browse_folder)
@@ -130,7 +130,7 @@ class AutoPanel:
 
     def _browse_library(self, edit: QtGui.QLineEdit) -> None:
         name, _ = QtGui.QFileDialog.getOpenFileName(self.form, "Tool library", edit.text(),
-                                                    "Tool library (*.yaml *.yml *.json);;All files (*)")
+                                                    "Tool library (*.yaml *.yml *.json *.fctl);;All files (*)")
         if name:
             edit.setText(name)
 

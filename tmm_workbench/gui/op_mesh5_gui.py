@@ -1,9 +1,9 @@
 """GUI of the 'TMM 5-axis Mesh' operation: its task panel page (group boxes: tool, model, 5-axis finishing,
-posture; FreeCAD's Heights page beside it), view provider and command. The model widgets are the Surface
-op's (op_surface_gui)."""
+posture, tool holder; FreeCAD's Heights page beside it), view provider and command. The model widgets are the
+Surface op's (op_surface_gui)."""
 from __future__ import annotations
 
-from tmm_workbench.app import registry
+from tmm_workbench.app import op_mesh5, registry, stages
 from tmm_workbench.gui import op_page, op_surface_gui, resources
 
 ENTRY = registry.entry("TMM_Mesh5")
@@ -15,6 +15,9 @@ SPIN_BOXES = {"tolerance": "Tolerance", "forwardStep": "ForwardStep", "feedAngle
               "linearDeflection": "LinearDeflection"}
 COMBOS: dict[str, str] = {}
 CHECKS = {"zigZag": "ZigZag"}
+_HOLDER_SPINS, _HOLDER_COMBOS, _ = stages.widgets(op_mesh5.TOOL_STAGES)  # the "Tool holder" group
+SPIN_BOXES.update(_HOLDER_SPINS)
+COMBOS.update(_HOLDER_COMBOS)
 
 
 class TaskPanelOpPage(op_surface_gui.TaskPanelOpPage):

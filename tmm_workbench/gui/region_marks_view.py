@@ -1,7 +1,7 @@
 """Marks on an op's 3D view of where it left material on purpose or found it: the places its shank or holder kept
-the tool off the model (HolderRegions, app.tool_assembly: orange) and a rest op's rest cells (RestRegions,
-app.rest_source: magenta). Points under the op's node, each kind in a switch that follows its view property and
-hides with the op."""
+the tool off the model (HolderRegions, app.tool_assembly: orange), a rest op's rest cells (RestRegions,
+app.rest_source: magenta) and what the 5-axis mesh op left for clean-up (CleanupRegions, app.op_mesh5: red).
+Points under the op's node, each kind in a switch that follows its view property and hides with the op."""
 from __future__ import annotations
 
 from typing import Any, NamedTuple
@@ -19,6 +19,8 @@ MARKS = (
          "Draw where the shank or holder kept the tool off the model (material left there)"),
     Mark("RestRegions", "ShowRestRegions", (0.85, 0.0, 0.85),
          "Draw the rest cells this op machines (where earlier ops or a reference tool left material)"),
+    Mark("CleanupRegions", "ShowCleanupRegions", (0.9, 0.0, 0.0),
+         "Draw where no pass finishes within the tolerance (the 5-axis mesh op's empty C-space), left for clean-up"),
 )
 POINT_SIZE = 5.0
 

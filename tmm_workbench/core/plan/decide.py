@@ -98,27 +98,21 @@ LENGTH_PAST_FLUTES = 4.0     # a tool without a holder: its overall length past 
 
 
 def overall_length(tool: ToolSpec) -> float:
-    """The ToolBit's overall length: the stick-out plus the grip in the holder, or the flutes plus a shank."""
+    """The ToolBit's overall length: the library's, or the stick-out plus the grip in the holder, or the flutes plus
+    a shank."""
+    if tool.length is not None:
+        return tool.length
     if tool.stick_out is not None:
         return tool.stick_out + GRIP_DIAMETERS * tool.diameter
     return tool.flute_length + LENGTH_PAST_FLUTES * tool.diameter
 
 
 def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
-    """The stock around the placed model, checked against the machine's travels."""
-    lo, hi = mesh.bounds
-    s = job.stock
-    # rounded outward to 0.1 um: the box holds the model (the roughing op refuses a model outside its stock)
-    low = (float(lo[0]) - s.margin, float(lo[1]) - s.margin, float(lo[2]) - s.below)
-    high = (float(hi[0]) + s.margin, float(hi[1]) + s.margin, float(hi[2]) + s.above)
-    box = tuple(math.floor(v * 1e4) / 1e4 for v in low) + tuple(math.ceil(v * 1e4) / 1e4 for v in high)
-    size = [box[3] - box[0], box[4] - box[1], box[5] - box[2]]
-    for axis, got, travel in zip("xyz", size, job.machine.travels):
-        if got > travel:
-            raise PlanInputError(f"machine.travels: the stock is {got:.1f} mm in {axis} (model "
-                                 f"{got - (2 * s.margin if axis != 'z' else s.above + s.below):.1f} mm + stock "
-                                 f"margins), larger than the machine's {travel:g} mm travel")
-    return box
+    """The bounds of the stock around the placed model (core.plan.stock: checked against the machine's travels,
+    the model inside it)."""
+    from tmm_workbench.core.plan.stock import planned_stock
+
+    return planned_stock(job, mesh).box
 
 
 def api_tool(tool: ToolSpec) -> dict:

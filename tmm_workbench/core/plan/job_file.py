@@ -12,14 +12,16 @@ from typing import Any, Optional, Union
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.cusp import MIN_CUSP
-from tmm_workbench.core.plan import materials
+from tmm_workbench.core.plan import materials, tool_library
 
 FORMAT = "tmm-plan 1"
 UNITS = {"mm": 1.0, "inch": 25.4}
 MODEL_SUFFIXES = (".stl", ".step", ".stp")
 TOOL_TYPES = ("flat", "ball", "bull")
 MACHINE_TYPES = ("3-axis",)
-STOCK_TYPES = ("box",)
+STOCK_TYPES = ("box", "cylinder", "solid")
+STOCK_FIELDS = {"box": ("margin", "above", "below"), "cylinder": ("margin", "diameter", "above", "height", "below"),
+                "solid": ("file",)}
 SHARED = "shared:"   # model.file prefix: a file of the project's shared folder
 POSTS = ("linuxcnc", "grbl", "tmm_linuxcnc", "tmm_grbl")
 
@@ -37,10 +39,14 @@ class ModelSpec:
 
 @dataclass(frozen=True)
 class StockSpec:
-    type: str = "box"
-    margin: float = 2.0      # mm beyond the model on each side
+    type: str = "box"        # box | cylinder (axis Z) | solid (a STEP or STL file)
+    margin: float = 2.0      # mm beyond the model on each side (a cylinder: beyond its farthest point from the axis)
     above: float = 1.0       # mm above its top
     below: float = 0.0       # mm below its lowest point
+    diameter: Optional[float] = None   # cylinder: given in place of the margin
+    height: Optional[float] = None     # cylinder: given in place of `above` (from the model's lowest point - below)
+    file: Optional[Path] = None        # solid: the stock's shape, in the model file's frame (its units, translate)
+    mesh_file: Optional[Path] = None   # solid from a STEP: its tessellation (core.plan.launch), what the core reads
 
 
 @dataclass(frozen=True)
@@ -50,6 +56,7 @@ class MachineSpec:
     travels: tuple[float, float, float] = (300.0, 300.0, 100.0)
     spindle_max: float = 24000.0   # rpm
     feed_max: float = 5000.0       # mm/min
+    rapid: Optional[tuple[float, float]] = None   # mm/min in X and Y, in Z (None: the cycle estimate's default)
 
 
 @dataclass(frozen=True)
@@ -62,6 +69,8 @@ class ToolSpec:
     flute_length: float
     holder: Optional[str] = None
     stick_out: Optional[float] = None
+    shank_diameter: Optional[float] = None   # the ToolBit's (None: the cutting diameter)
+    length: Optional[float] = None           # the ToolBit's overall length (None: the planner's proportions)
 
     def describe(self) -> str:
         shape = {"flat": "flat", "ball": "ball", "bull": f"bull-nose r{self.corner_radius:g}"}[self.type]
@@ -102,6 +111,7 @@ class JobSpec:
     finish: FinishSpec
     outputs: OutputSpec
     planner: PlannerSpec = field(default_factory=PlannerSpec)
+    notes: tuple[str, ...] = ()   # what reading the job left out (a library's bits of shapes the planner cannot use)
 
 
 # --- field checks -------------------------------------------------------------------------------------------
@@ -175,7 +185,7 @@ def is_step(path: Path) -> bool:
     return path.suffix.lower() in (".step", ".stp")
 
 
-def _model_path(text: str, base: Path) -> Path:
+def _model_path(text: str, base: Path, where: str = "model.file") -> Path:
     """`shared:<path>`: under the project's shared folder (core.shared_data); otherwise relative to the job file."""
     if text.startswith(SHARED):
         from tmm_workbench.core.shared_data import shared_dir
@@ -183,30 +193,49 @@ def _model_path(text: str, base: Path) -> Path:
         try:
             return (shared_dir() / text[len(SHARED):]).resolve()
         except TmmError as exc:
-            raise _fail("model.file", text, str(exc)) from None
+            raise _fail(where, text, str(exc)) from None
     return (base / text).resolve()
 
 
-def _stock(d: Any) -> StockSpec:
-    d = _mapping("stock", d, (), ("type", "margin", "above", "below"))
+def _stock(d: Any, base: Path) -> StockSpec:
+    if not isinstance(d, dict):
+        raise _fail("stock", d, "a mapping: type (box, cylinder, solid) and its fields")
     kind = _choice("stock.type", d.get("type", "box"), STOCK_TYPES)
+    d = _mapping(f"stock (type {kind})", d, (), ("type",) + STOCK_FIELDS[kind])
+    if kind == "solid":
+        if "file" not in d:
+            raise PlanInputError("stock.file: missing; a solid stock is a STEP (.step, .stp) or STL (.stl) file")
+        path = _model_path(_text("stock.file", d["file"]), base, "stock.file")
+        if path.suffix.lower() not in MODEL_SUFFIXES or not path.is_file():
+            raise _fail("stock.file", d["file"], f"an existing STEP (.step, .stp) or STL (.stl) file (looked for "
+                        f"{path})")
+        return StockSpec(kind, file=path)
+    for given, instead in (("diameter", "margin"), ("height", "above")):
+        if given in d and instead in d:
+            raise _fail(f"stock.{given}", d[given], f"either stock.{given} or stock.{instead}, not both")
+    sizes = {k: _number(f"stock.{k}", d[k], 0.0, 1e4, low_open=True) for k in ("diameter", "height") if k in d}
     return StockSpec(kind, *(_number(f"stock.{k}", d.get(k, v), 0.0, 1000.0)
-                             for k, v in (("margin", 2.0), ("above", 1.0), ("below", 0.0))))
+                             for k, v in (("margin", 2.0), ("above", 1.0), ("below", 0.0))), **sizes)
 
 
 def _machine(d: Any) -> MachineSpec:
-    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max"))
+    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max", "rapid"))
+    rapid = d.get("rapid")
+    if rapid is not None:
+        if not isinstance(rapid, (list, tuple)) or len(rapid) != 2:
+            raise _fail("machine.rapid", rapid, "a list of two rates [xy, z] in mm/min")
+        rapid = tuple(_number(f"machine.rapid[{i}]", v, 1.0, 1e6) for i, v in enumerate(rapid))
     return MachineSpec(_choice("machine.type", d.get("type", "3-axis"), MACHINE_TYPES),
                        _choice("machine.post", d["post"], POSTS),
                        _vector("machine.travels", d["travels"], 0.0, 1e4, low_open=True),
                        _number("machine.spindle_max", d.get("spindle_max", 24000.0), materials.MIN_RPM, 1e5),
-                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5))
+                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5), rapid)
 
 
 def _tool(i: int, d: Any) -> ToolSpec:
     where = f"tools[{i}]"
     d = _mapping(where, d, ("type", "diameter", "flute_length"),
-                 ("name", "corner_radius", "flutes", "holder", "stick_out"))
+                 ("name", "corner_radius", "flutes", "holder", "stick_out", "shank_diameter", "length"))
     kind = _choice(f"{where}.type", d["type"], TOOL_TYPES)
     dia = _number(f"{where}.diameter", d["diameter"], 0.0, 100.0, low_open=True)
     if kind == "bull":
@@ -231,7 +260,21 @@ def _tool(i: int, d: Any) -> ToolSpec:
                         "holder's face)")
         stick_out = _number(f"{where}.stick_out", stick_out, length, 1000.0)
     name = _text(f"{where}.name", d.get("name", f"T{i + 1}"))
-    return ToolSpec(name, kind, dia, corner, flutes, length, holder, stick_out)
+    shank = None if d.get("shank_diameter") is None else \
+        _number(f"{where}.shank_diameter", d["shank_diameter"], 0.0, 100.0, low_open=True)
+    overall = None if d.get("length") is None else \
+        _number(f"{where}.length", d["length"], max(length, stick_out or 0.0), 1000.0, low_open=stick_out is not None)
+    return ToolSpec(name, kind, dia, corner, flutes, length, holder, stick_out, shank, overall)
+
+
+def _library_tool(i: int, d: Any, given: Any) -> ToolSpec:
+    """tools[i] of the job file, or of the library file `given` names (its bad values named with the file)."""
+    if not isinstance(given, str):
+        return _tool(i, d)
+    try:
+        return _tool(i, d)
+    except PlanInputError as exc:
+        raise PlanInputError(f"tools: {given}, {d.get('name', '')}: {exc}") from None
 
 
 def _holder(where: str, name: Any, shank: float) -> str:
@@ -280,22 +323,22 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
                     ("stock", "planner"))
     if data["format"] != FORMAT:
         raise _fail("format", data["format"], f"'{FORMAT}'")
-    tools = data["tools"]
-    if isinstance(tools, str):   # a library file shared by several jobs
-        tools = _library_file(base / tools)
+    tools, notes = data["tools"], ()
+    if isinstance(tools, str):   # a library file shared by several jobs: TMM's or FreeCAD's
+        tools, notes = _library_file(base / tools)
     if not isinstance(tools, list) or not tools:
         raise _fail("tools", tools, "a non-empty list of tools (type, diameter, flute_length, ...) or the name "
                     "of a YAML / JSON file holding one")
-    library = tuple(_tool(i, t) for i, t in enumerate(tools))
+    library = tuple(_library_tool(i, t, data["tools"]) for i, t in enumerate(tools))
     names = [t.name for t in library]
     for i, n in enumerate(names):
         if names.index(n) != i:
             raise _fail(f"tools[{i}].name", n, "a name no other tool has")
     material = _choice("material", data["material"], tuple(materials.names()))
     model = _model(data["model"], base)
-    return JobSpec(source, model, _stock(data.get("stock", {})), _machine(data["machine"]), library, material,
-                   _finish(data["finish"]), _outputs(data["outputs"], base, model.file.stem),
-                   _planner(data.get("planner", {})))
+    return JobSpec(source, model, _stock(data.get("stock", {}), base), _machine(data["machine"]), library,
+                   material, _finish(data["finish"]), _outputs(data["outputs"], base, model.file.stem),
+                   _planner(data.get("planner", {})), notes)
 
 
 def _parsed(p: Path, what: str) -> Any:
@@ -305,7 +348,8 @@ def _parsed(p: Path, what: str) -> Any:
     text = p.read_text(encoding="utf-8")
     suffix = p.suffix.lower()
     if suffix not in (".json", ".yaml", ".yml"):
-        raise PlanInputError(f"{what} {p.name}: the name must end in .yaml, .yml or .json")
+        raise PlanInputError(f"{what} {p.name}: the name must end in .yaml, .yml or .json" +
+                             (" (or .fctl: a FreeCAD tool library)" if what == "tools file" else ""))
     try:
         if suffix == ".json":
             return json.loads(text)
@@ -317,15 +361,30 @@ def _parsed(p: Path, what: str) -> Any:
                              f"{exc}") from None
 
 
-def _library_file(p: Path) -> Any:
+def _library_file(p: Path) -> tuple[Any, tuple[str, ...]]:
+    """The tools of a TMM tools file (YAML / JSON) or a FreeCAD tool library (.fctl: core.plan.tool_library), and
+    the notes on the library's bits left out."""
+    if tool_library.is_library(p.name):
+        try:
+            tools, skipped = tool_library.read_library(p)
+        except tool_library.LibraryError as exc:
+            raise PlanInputError(f"tools: {exc}") from None
+        if not tools:
+            raise _fail("tools", p.name, "a library holding an end mill, ball or bull-nose bit (the planner "
+                        "takes those): " + "; ".join(skipped))
+        return tools, tuple(f"tool library {p.name}: left out {s}" for s in skipped)
     data = _parsed(p, "tools file")
     if isinstance(data, dict) and set(data) == {"tools"}:
-        return data["tools"]
+        return data["tools"], ()
     raise _fail(f"tools file {p.name}", data if not isinstance(data, dict) else sorted(data),
                 "a mapping with one field, tools: the list of tools")
 
 
+def read_data(path: Union[str, Path]) -> Any:
+    """The data of the job file at `path` (.yaml / .yml / .json), not checked yet."""
+    return _parsed(Path(path), "job file")
+
+
 def read_job(path: Union[str, Path]) -> JobSpec:
     """The job file at `path` (.yaml / .yml / .json), checked."""
-    p = Path(path)
-    return job_from_dict(_parsed(p, "job file"), p)
+    return job_from_dict(read_data(path), Path(path))

@@ -20,14 +20,16 @@ import time
 from dataclasses import replace
 from functools import partial
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
-from tmm_workbench.core.plan import analysis, decide, progress_note
-from tmm_workbench.core.plan.job_file import UNITS, JobSpec, PlanInputError, ToolSpec, is_step, read_job
+from tmm_workbench.core.plan import analysis, decide, progress_note, recipes
+from tmm_workbench.core.plan.job_file import (MODEL_SUFFIXES, UNITS, JobSpec, PlanInputError, ToolSpec, is_step,
+                                              job_from_dict, read_data)
+from tmm_workbench.core.plan.stock import planned_stock, stock_of_plan
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
 APP_SCRIPT = Path(__file__).resolve().parents[2] / "app" / "plan_run.py"
@@ -61,6 +63,7 @@ def placed_mesh(job: JobSpec) -> tuple[TriMesh, bool]:
 def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis.Analysis, decide.Plan]:
     """The placed model, whether it was moved, its analysis and the plan (core only; PlanInputError on bad input)."""
     mesh, moved = placed_mesh(job)
+    planned_stock(job, mesh)   # a model outside its stock refused before the analysis
     say(f"model {job.model.file.name}: {len(mesh.triangles)} triangles; analysing", quiet)
     tools = [(t.name, decide.cutter_of(t)) for t in job.tools]
     an = analysis.analyse(mesh, job.planner.analysis_cell, tools, job.finish.tolerance)
@@ -78,11 +81,15 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     """What app/plan_run.py needs to run the plan."""
     o = job.outputs
     reach = next(t for t in job.tools if t.name == plan.reach_tool)
+    rapid = job.machine.rapid
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
             "tolerance": job.finish.tolerance, "cusp": job.finish.cusp, "ops": [op.as_dict() for op in plan.ops],
+            "stock": stock_of_plan(job, plan.stock_box).as_dict(),
+            "rapid_mm_min": None if rapid is None else list(rapid),
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
-                               "holder": t.holder, "stick_out": t.stick_out} for t in job.tools},
+                               "shank_diameter": t.shank_diameter, "holder": t.holder, "stick_out": t.stick_out}
+                      for t in job.tools},
             "reach_tool": {"name": plan.reach_tool, "diameter": reach.diameter, "corner_radius": reach.corner_radius}}
 
 
@@ -90,21 +97,41 @@ def tessellate_step(job: JobSpec, folder: Path, freecad: str, quiet: bool) -> Jo
     """The job with its STEP model tessellated by FreeCAD (app/step_mesh.py) into `folder`/<name>_model.stl, the
     chordal deflection STEP_DEFLECTION_SHARE of the tolerance. PlanInputError: FreeCAD cannot read it; TmmError:
     FreeCAD could not be run or failed otherwise."""
-    stl = folder / f"{job.outputs.name}_model.stl"
-    deflection = round(STEP_DEFLECTION_SHARE * job.finish.tolerance, 6)
-    say(f"tessellating {job.model.file.name} within {deflection:g} mm (FreeCAD)", quiet)
-    env = dict(os.environ, TMM_STEP_FILE=str(job.model.file), TMM_STEP_STL=str(stl),
-               TMM_STEP_DEFLECTION=repr(deflection))
+    stl = tessellate(job.model.file, folder / f"{job.outputs.name}_model.stl", job.finish.tolerance, freecad,
+                     quiet, "model.file")
+    return replace(job, model=replace(job.model, file=stl))
+
+
+def tessellate_stock(job: JobSpec, folder: Path, freecad: str, quiet: bool) -> JobSpec:
+    """The job with its STEP stock tessellated as a STEP model is (`stock.mesh_file`: what the core checks the
+    model against; the FreeCAD Job's stock is the STEP's exact solid)."""
+    stl = tessellate(job.stock.file, folder / STOCK_MESH, job.finish.tolerance, freecad, quiet, "stock.file",
+                     solid=True)
+    return replace(job, stock=replace(job.stock, mesh_file=stl))
+
+
+STOCK_MESH = "stock_mesh.stl"   # a STEP stock's tessellation in the run's folder (removed before the outputs)
+
+
+def tessellate(step: Path, stl: Path, tolerance: float, freecad: str, quiet: bool, where: str,
+               solid: bool = False) -> Path:
+    """`step` tessellated by FreeCAD (app/step_mesh.py) into `stl` within STEP_DEFLECTION_SHARE of `tolerance`.
+    PlanInputError naming `where`: FreeCAD cannot read it (or, `solid`, it holds no solid); TmmError: FreeCAD
+    could not be run or failed."""
+    deflection = round(STEP_DEFLECTION_SHARE * tolerance, 6)
+    say(f"tessellating {step.name} within {deflection:g} mm (FreeCAD)", quiet)
+    env = dict(os.environ, TMM_STEP_FILE=str(step), TMM_STEP_STL=str(stl), TMM_STEP_DEFLECTION=repr(deflection),
+               TMM_STEP_SOLID="1" if solid else "0")
     try:
-        proc = subprocess.run([freecad, str(STEP_SCRIPT)], env=env, cwd=str(folder), capture_output=True, text=True)
+        proc = subprocess.run([freecad, str(STEP_SCRIPT)], env=env, cwd=str(stl.parent), capture_output=True, text=True)
     except OSError as exc:
         raise TmmError(f"could not start {freecad}: {exc}") from None
     tail = "\n".join((proc.stderr or proc.stdout or "").strip().splitlines()[-6:])
     if proc.returncode == 2:
-        raise PlanInputError(f"model.file: {tail}")
+        raise PlanInputError(f"{where}: {tail}")
     if proc.returncode != 0 or not stl.is_file():
         raise TmmError(f"the STEP tessellation failed (exit {proc.returncode}):\n{tail}")
-    return replace(job, model=replace(job.model, file=stl))
+    return stl
 
 
 def run_freecad(folder: Path, freecad: str, quiet: bool) -> Optional[str]:
@@ -125,8 +152,12 @@ def report(job: JobSpec, an: analysis.Analysis, plan: decide.Plan, verified: dic
     return {"format": REPORT_FORMAT, "job_file": job.source.name, "passed": verified["passed"],
             "problems": verified["problems"], "verification": verified, "analysis": an.as_dict(),
             "plan": plan.as_dict(), "finish": {"cusp_mm": job.finish.cusp, "tolerance_mm": job.finish.tolerance},
-            "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels)},
-            "tools": [tool_row(t) for t in job.tools], "files": sorted(files)}
+            "stock": stock_of_plan(job, plan.stock_box).as_dict() | {"file": None if job.stock.file is None else
+                                                                      job.stock.file.name},
+            "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels),
+                                                  "rapid_mm_min": None if job.machine.rapid is None else
+                                                  list(job.machine.rapid)},
+            "tools": [tool_row(t) for t in job.tools], "notes": list(job.notes), "files": sorted(files)}
 
 
 def tool_row(tool: ToolSpec) -> dict:
@@ -135,7 +166,8 @@ def tool_row(tool: ToolSpec) -> dict:
     stick = tool.stick_out if tool.stick_out is not None else \
         decide.overall_length(tool) - decide.GRIP_DIAMETERS * tool.diameter
     return {"name": tool.name, "type": tool.type, "diameter": tool.diameter, "corner_radius": tool.corner_radius,
-            "flutes": tool.flutes, "flute_length": tool.flute_length, "holder": tool.holder,
+            "flutes": tool.flutes, "flute_length": tool.flute_length, "shank_diameter": tool.shank_diameter,
+            "length": decide.overall_length(tool), "holder": tool.holder,
             "stick_out_mm": round(stick, 4)}
 
 
@@ -190,19 +222,42 @@ def move_into_place(tmp: Path, target: Path) -> list:
     return names
 
 
-def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None) -> int:
-    """Plans, runs and verifies the job; `out_dir` in place of the job file's outputs.dir (a batch's part folder)."""
+def job_of(job_path: str, overrides: Sequence[tuple[tuple[str, ...], Any]] = (), out_dir: Optional[str] = None
+           ) -> tuple[JobSpec, Optional[dict]]:
+    """The checked job of a job file, or of a model file (.stl, .step, .stp) planned with the default recipe
+    (core.plan.recipes.default_job, into <stem>_plan in the current folder); `overrides` (a field's path, its value)
+    set in its data, `out_dir` in place of outputs.dir. Returns the job and, for the default recipe, the data of
+    the job file that plans it again (written as job.json beside the outputs)."""
+    path = Path(job_path)
+    recipe = path.suffix.lower() in MODEL_SUFFIXES
+    if recipe:
+        data = recipes.default_job(str(path.resolve()), str(Path.cwd() / f"{path.stem}_plan"))
+    else:
+        data = read_data(path)
+    for keys, value in overrides:
+        if not isinstance(data, dict) or len(keys) > 1 and not isinstance(data.get(keys[0], {}), dict):
+            break   # job_from_dict names what is wrong with the file
+        section = data.setdefault(keys[0], {}) if len(keys) > 1 else data
+        section[keys[-1]] = value
+    if out_dir is not None and isinstance(data, dict) and isinstance(data.get("outputs"), dict):
+        data["outputs"]["dir"] = str(Path(out_dir).resolve())
+    job = job_from_dict(data, Path.cwd() / "job.json" if recipe else path)
+    return job, dict(data, outputs=dict(data["outputs"], dir=".")) if recipe else None
+
+
+def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir: Optional[str] = None,
+        overrides: Sequence[tuple[tuple[str, ...], Any]] = ()) -> int:
+    """Plans, runs and verifies the job (a job file, or a model with the default recipe: job_of); `out_dir` in
+    place of the job file's outputs.dir (a batch's part folder)."""
     t0 = time.perf_counter()
     tmp: Optional[Path] = None
     try:
-        job = read_job(job_path)
-        if out_dir is not None:
-            job = replace(job, outputs=replace(job.outputs, dir=Path(out_dir).resolve()))
+        job, again = job_of(job_path, overrides, out_dir)
         progress_note.note(1, 0, "analysing the model and planning")
-        if is_step(job.model.file):
-            tmp = temporary_folder(job.outputs.dir, job.outputs.name)
-            job = tessellate_step(job, tmp, freecad, quiet)
+        job, tmp = tessellated(job, freecad, quiet)
         mesh, moved, an, plan = make_plan(job, quiet)
+        if job.stock.mesh_file is not None:
+            job.stock.mesh_file.unlink()
     except (PlanInputError, TmmError) as exc:
         if tmp is not None:
             shutil.rmtree(tmp, ignore_errors=True)
@@ -218,6 +273,8 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         if moved:
             model_file = tmp / f"{out.name}_model.stl"
             save_stl(mesh, model_file)
+        if again is not None:
+            (tmp / "job.json").write_text(json.dumps(again, indent=1, sort_keys=True) + "\n")
         (tmp / "plan.json").write_text(json.dumps(plan_document(job, plan, model_file), indent=1, sort_keys=True))
         failure = run_freecad(tmp, freecad, quiet)
         if failure is not None:
@@ -229,22 +286,61 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
         finish_outputs(tmp, job, mesh, an, plan, verified, quiet)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    say_outcome(verified, out.dir, time.perf_counter() - t0, quiet)
+    return VERIFIED if verified["passed"] else FAILED
+
+
+def say_outcome(verified: dict, out_dir: Path, seconds: float, quiet: bool) -> None:
     for change in verified.get("replanned", []):
         say(f"plan changed: {change}", quiet)
     state = "verified" if verified["passed"] else "verification FAILED: " + "; ".join(verified["problems"])
     say(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left {verified['most_material_left_mm']:g}"
-        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out.dir} "
-        f"({time.perf_counter() - t0:.0f} s)", quiet)
-    return VERIFIED if verified["passed"] else FAILED
+        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out_dir} ({seconds:.0f} s)", quiet)
+
+
+def tessellated(job: JobSpec, freecad: str, quiet: bool) -> tuple[JobSpec, Optional[Path]]:
+    """The job with its STEP model and its STEP stock tessellated by FreeCAD in a temporary folder beside the
+    outputs (the run's), and that folder; the job and None when neither is a STEP."""
+    model, stock = is_step(job.model.file), job.stock.type == "solid" and is_step(job.stock.file)
+    if not (model or stock):
+        return job, None
+    tmp = temporary_folder(job.outputs.dir, job.outputs.name)
+    try:
+        if model:
+            job = tessellate_step(job, tmp, freecad, quiet)
+        if stock:
+            job = tessellate_stock(job, tmp, freecad, quiet)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return job, tmp
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
     ap = argparse.ArgumentParser(prog="python3 -m tmm_workbench.plan",
                                  description="Plans, runs and verifies a Job from a job file (docs/planner.md).")
-    ap.add_argument("job", help="the job file (.yaml, .yml or .json)")
+    ap.add_argument("job", help="the job file (.yaml, .yml or .json), or a model (.stl, .step, .stp) planned with "
+                    "the default recipe (docs/planner.md)")
     ap.add_argument("--freecad", default=os.environ.get("TMM_FREECADCMD", "freecadcmd"),
                     help="the freecadcmd to run (default: $TMM_FREECADCMD or freecadcmd)")
     ap.add_argument("--quiet", action="store_true", help="no progress lines (errors only)")
     ap.add_argument("--out", default=None, help="the folder for the outputs, in place of the job file's outputs.dir")
+    for flag, keys, kind, text in OVERRIDES:
+        ap.add_argument(flag, type=kind, default=None, help=f"{text}, in place of the job's {'.'.join(keys)}")
     args = ap.parse_args(argv)
-    return run(args.job, args.freecad, args.quiet, args.out)
+    overrides = [(keys, getattr(args, flag[2:])) for flag, keys, _, _ in OVERRIDES
+                 if getattr(args, flag[2:]) is not None]
+    return run(args.job, args.freecad, args.quiet, args.out, overrides)
+
+
+def _absolute(path: str) -> str:
+    return str(Path(path).resolve())
+
+
+# the command's options that change a job's field (a job file's or the default recipe's)
+OVERRIDES = (("--cusp", ("finish", "cusp"), float, "the scallop height, mm"),
+             ("--tolerance", ("finish", "tolerance"), float, "the verification's tolerance, mm"),
+             ("--material", ("material",), str, "the material of the speeds and feeds table"),
+             ("--tools", ("tools",), _absolute, "a tools file (YAML, JSON) or a FreeCAD tool library (.fctl)"),
+             ("--margin", ("stock", "margin"), float, "the stock beyond the model on each side, mm"),
+             ("--name", ("outputs", "name"), str, "the outputs' file name"))

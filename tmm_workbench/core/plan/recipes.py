@@ -2,6 +2,7 @@
 front's form, the GUI's TMM Auto), turned into a job file's data (core.plan.job_file checks it)."""
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Optional, Union
 
 # the shop's machines: the planner's machine section
@@ -39,3 +40,18 @@ def job_data(material: str, finish: str, machine: str, model_file: str, out_dir:
             "tools": tools if isinstance(tools, str) else [dict(t) for t in (tools or TOOLS)],
             "material": material, "finish": dict(preset["finish"]), "outputs": {"dir": out_dir, "name": name},
             "planner": dict(preset["planner"])}
+
+
+# `tmm plan part.stl` without a job file (core.plan.launch): the benchmark jobs' recipe (benchmarks/jobs/*.yaml)
+SHOP_LIBRARY = Path(__file__).resolve().parents[3] / "benchmarks" / "jobs" / "shop_tools.yaml"
+DEFAULT_MACHINE = {"type": "3-axis", "post": "linuxcnc", "travels": [400, 300, 120], "spindle_max": 24000,
+                   "feed_max": 5000}
+DEFAULT_FINISH = {"cusp": 0.01, "tolerance": 0.01}
+DEFAULT_MATERIAL = "mdf"
+
+
+def default_job(model_file: str, out_dir: str) -> dict:
+    """The job file's data planning `model_file` (absolute; mm) with the default recipe into `out_dir`."""
+    return {"format": "tmm-plan 1", "model": {"file": model_file, "units": "mm"}, "stock": dict(STOCK),
+            "machine": dict(DEFAULT_MACHINE), "tools": str(SHOP_LIBRARY), "material": DEFAULT_MATERIAL,
+            "finish": dict(DEFAULT_FINISH), "outputs": {"dir": out_dir}}

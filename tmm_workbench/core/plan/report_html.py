@@ -90,13 +90,18 @@ def setup_sheet(report: Mapping) -> str:
     box = report["plan"]["stock_box_mm"]
     lo, hi = box[:3], box[3:]
     size = " x ".join(f"{b - a:.2f}" for a, b in zip(lo, hi))
-    stock = pairs([("stock", f"box {size} mm (X x Y x Z)"), ("material", report["material"].replace("_", " ")),
+    shape = report["stock"]["describe"] if "stock" in report else f"box {size} mm"
+    rapid = report["machine"].get("rapid_mm_min")
+    stock = pairs([("stock", f"{shape} (X x Y x Z over all: {size} mm)"),
+                   ("material", report["material"].replace("_", " ")),
                    ("stock corner (lowest X, Y, Z)", "X{:g} Y{:g} Z{:g}".format(*lo)),
                    ("stock top", f"Z{hi[2]:g}"),
                    ("zero point (G54)", "the model's origin: X0 Y0 Z0 of the model file as placed (the stock's "
                     f"top is Z{hi[2]:g}, its lowest corner X{lo[0]:g} Y{lo[1]:g})"),
                    ("machine", f"{report['machine']['post']} post, travels "
-                    + " x ".join(f"{t:g}" for t in report["machine"]["travels_mm"]) + " mm")])
+                    + " x ".join(f"{t:g}" for t in report["machine"]["travels_mm"]) + " mm"
+                    + (f", rapids XY {rapid[0]:g} Z {rapid[1]:g} mm/min" if rapid else ""))]
+                  + [("note", n) for n in report.get("notes", [])])
     numbers = tool_numbers(report)
     cutting = report["plan"]["tools"]
     tools = []

@@ -330,6 +330,6 @@ def _group_passes(mesh: TriMesh, cutter: Cutter, params: Any, group: RestStock,
                                    bottom_z=min(zs[-1], zs[0] - 1e-5), chord_tol=CHORD_TOL, z_levels=zs,
                                    stock_to_leave=max(params.stock_to_leave, 0.0), empty_ok=True,
                                    assembly=params.assembly, holder_collision=params.holder_collision,
-                                   holder_notes=params.holder_notes)
+                                   holder_notes=params.holder_notes, join_rest=False)   # finish joins them
     wp.rest, wp.rest_bridge = group, BRIDGE
     return waterline.compute(mesh, cutter, wp, cancel.asker(), surface).segments, zs

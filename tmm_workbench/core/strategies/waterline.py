@@ -33,7 +33,7 @@ from tmm_workbench.core.params import StrategyParams, check_finite, param
 from tmm_workbench.core.query import waterline as wl
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind, StrategyResult
-from tmm_workbench.core.strategies import holder_guard, rest_filter
+from tmm_workbench.core.strategies import holder_guard, rest_filter, rest_joins
 from tmm_workbench.core.strategies.holder_guard import WholeToolParams
 from tmm_workbench.core.strategies.rest_filter import RestParams
 from tmm_workbench.core.tools.cutter import Cutter
@@ -62,6 +62,7 @@ class WaterlineParams(StrategyParams, WholeToolParams, RestParams):  # + the who
     stock_z: Optional[tuple[float, float]] = None  # the stock's bottom and top, mm: the levels stay within it
     z_levels: Optional[list] = None   # the tip heights themselves, top-down (a rest's steep part); None: step-down
     empty_ok: bool = False            # no loop (or none cutting rest material): no segments rather than an error
+    join_rest: bool = True            # a rest's pieces joined by rest_joins (rest_steep joins its groups' together)
 
     def validate(self) -> None:
         super().validate()
@@ -183,6 +184,9 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
         return StrategyResult([], diagnostics)
     if not segments:
         raise TmmError("no waterline loop takes off rest material: nothing is left for this tool on the walls")
+    if getattr(params, "rest", None) is not None and params.join_rest:
+        # the rest leaves short pieces of loops: the next one reached with the tool down where a join is clear
+        segments, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments, surface)
     return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
 
 

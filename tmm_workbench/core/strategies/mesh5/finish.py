@@ -11,9 +11,12 @@ along the tool axis, transit above the tilted tool's lowest point), as the 5-axi
     path = link(result.segments, link_policy(cutter, safe, clearance, axis_retract))
 
 What no pass could finish (no posture of any gap finishes it: a groove narrower than the cutter) is never a
-silent hole: `diagnostics["unfinished"]` lists its strips (feed from, to, across from, to; mm) and
-`diagnostics["empty_points"]` the CC points of the strips' middle planes that lie in them (k, 3), for
-clean-up; `report(diagnostics)` says both.
+silent hole: `diagnostics["unfinished"]` lists its strips (feed from, to, across from, to; mm),
+`diagnostics["strip_corners"]` their XY corners, `diagnostics["empty_points"]` the CC points of the strips'
+middle planes that lie in them (k, 3) and `diagnostics["cleanup_points"]` points on the mesh covering them
+(planes 1 mm apart), marked for clean-up; `report(diagnostics)` says them. With a tool assembly (params.assembly)
+the shank and holder bound every C-space, and the cut moves are checked against the model (mesh5.holder):
+`diagnostics["holder"]` says what they changed.
 """
 from __future__ import annotations
 
@@ -29,6 +32,7 @@ from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.params import StrategyParams, param
 from tmm_workbench.core.segments import CutSegment, StrategyResult
+from tmm_workbench.core.strategies.mesh5 import holder
 from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths, plane_normal
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan, adaptive_passes
@@ -38,6 +42,10 @@ from tmm_workbench.core.work import Box, Work
 Progress = Callable[[float], bool]
 SUPPORTED_TOOLS = ("flat", "bull")  # Cutter.kind values: a tilted flat bottom cuts the wide strip
 _BYTES_PER_CC_POINT = 400_000       # the C-space of one CC point: its grid's lifts, tops and reach copies
+CLEANUP_SPACING = 1.0               # mm between the points marking an unfinished strip
+# a C-space with the shank and holder costs this many times the cutter's alone (their drop takes what lies
+# under the holder's radius: one pass of seed 000's convex surface, 4.6 s against 0.77 s of CPU)
+HOLDER_COST = 6.0
 
 
 @dataclass
@@ -52,6 +60,10 @@ class Mesh5Params(StrategyParams):
     grid_step_deg: float = param(3.0, "posture grid step", "deg", low=0.1, high=45.0)
     zigzag: bool = True
     machine: Any = None  # the TarusMachine whose limits bound the postures (None: the TPI-2000 defaults)
+    # the whole tool (core.tools.assembly): its shank and holder bound every C-space (None: the cutter alone);
+    # what they changed is appended to holder_notes (app.tool_assembly.report shows it)
+    assembly: Any = None
+    holder_notes: Optional[list] = None
 
     def validate(self) -> None:
         super().validate()
@@ -107,14 +119,18 @@ def _extents(lo: np.ndarray, hi: np.ndarray, params: Mesh5Params) -> tuple[float
 
 
 def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box) -> Work:
-    """The CC points over the model's box `bounds` (core.work); each costs a C-space and its rebuilds."""
+    """The CC points over the model's box `bounds` (core.work); each costs a C-space and its rebuilds (with
+    params.assembly, HOLDER_COST times as much)."""
     params.validate()
     check_tool(cutter)
     across, along = _extents(np.array(bounds[:3]), np.array(bounds[3:]), params)
     count, passes = count_points(across, along, params, cutter)
     cells = params.grid().shape
+    holder = params.assembly is not None
     return Work(count, "CC points", passes, passes * along,
-                note=f"a C-space of {cells[0] * cells[1]} postures at each", paces=(("mesh5", count),))
+                note=f"a C-space of {cells[0] * cells[1]} postures at each" + (
+                    f", the shank and holder in it (about {HOLDER_COST:g}x the compute)" if holder else ""),
+                paces=(("mesh5", count * (HOLDER_COST if holder else 1.0)),))
 
 
 def _segments(plan: AdaptivePlan, zigzag: bool) -> list[CutSegment]:
@@ -142,6 +158,32 @@ def empty_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params) -> np.n
     return np.vstack(found) if found else np.zeros((0, 3))
 
 
+def strip_corners(plan: AdaptivePlan, params: Mesh5Params) -> np.ndarray:
+    """(k, 4, 2) XY corners of the unfinished strips (feed from, to x across from, to)."""
+    d = np.array(params.direction())
+    m = plane_normal(d)[:2]
+    feed = np.array([m[1], -m[0]])
+    return np.array([[f * feed + a * m for f, a in ((f0, a0), (f1, a0), (f1, a1), (f0, a1))]
+                     for f0, f1, a0, a1 in plan.unfinished]).reshape(-1, 4, 2)
+
+
+def cleanup_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params, spacing: float = CLEANUP_SPACING
+                   ) -> np.ndarray:
+    """(k, 3) points on the mesh covering the unfinished strips, for clean-up and for the view: the CC points
+    of drive planes at most `spacing` mm apart across each strip, within its feed span (no pass finishes them)."""
+    d = np.array(params.direction())
+    m = plane_normal(d)
+    feed = np.array([m[1], -m[0], 0.0])
+    found = []
+    for f0, f1, a0, a1 in plan.unfinished:
+        n = max(1, math.ceil((a1 - a0) / spacing))
+        planes = a0 + (a1 - a0) * (np.arange(n) + 0.5) / n
+        for p in cc_paths(mesh, d, planes, min(params.forward_step, spacing), params.chord_tol):
+            f = p.points @ feed
+            found.append(p.points[(f >= f0 - 1e-9) & (f <= f1 + 1e-9)])
+    return np.vstack(found) if found else np.zeros((0, 3))
+
+
 def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
             progress: Optional[Progress] = None) -> StrategyResult:
     """The strategy (module doc): cut segments and diagnostics "plan" (the AdaptivePlan), "unfinished",
@@ -154,14 +196,20 @@ def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
     lo, hi = mesh.bounds
     count_points(*_extents(lo, hi, params), params, cutter)
     plan = adaptive_passes(mesh, cutter, params.tolerance, params.direction(), params.the_machine(), grid,
-                           params.forward_step, params.chord_tol, progress=progress)
-    segments = _segments(plan, params.zigzag)
+                           params.forward_step, params.chord_tol, progress=progress, assembly=params.assembly)
+    segments, note = holder.optional_guard(mesh, cutter, params.assembly, plan, _segments(plan, params.zigzag))
     if not segments:
-        raise TmmError(f"no pass could be placed on the mesh ({plan.report()})")
+        raise TmmError(f"no pass could be placed on the mesh ({plan.report()}" +
+                       (f"; {note.summary()})" if note is not None else ")"))
     empty = empty_points(mesh, plan, params)
     diagnostics = {"plan": plan, "unfinished": list(plan.unfinished), "empty_points": empty,
+                   "strip_corners": strip_corners(plan, params), "cleanup_points": cleanup_points(mesh, plan, params),
                    "passes": len(plan.passes), "cc_points": int(sum(len(q.tips) for p in plan.passes
                                                                     for q in p.postures))}
+    if note is not None:
+        diagnostics["holder"] = note
+        if params.holder_notes is not None:
+            params.holder_notes.append(note)
     return StrategyResult(segments, diagnostics)
 
 
@@ -171,9 +219,12 @@ def report(diagnostics: dict) -> str:
     text = f"{diagnostics['passes']} passes, {diagnostics['cc_points']} CC points cut ({plan.report()})"
     empty = diagnostics["empty_points"]
     if len(plan.unfinished):
-        x0, y0, z0 = empty.min(0) if len(empty) else (math.nan,) * 3
-        x1, y1, z1 = empty.max(0) if len(empty) else (math.nan,) * 3
+        marks = diagnostics["cleanup_points"]
+        xy = marks[:, :2] if len(marks) else diagnostics["strip_corners"].reshape(-1, 2)
+        (x0, y0), (x1, y1) = xy.min(0), xy.max(0)
         text += (f"; {len(empty)} CC points with an empty C-space (no posture finishes them within the tolerance) "
                  f"in {len(plan.unfinished)} strips, within x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: not "
-                 "finished, left for clean-up")
+                 f"finished, marked for clean-up ({len(marks)} points on the mesh)")
+    if "holder" in diagnostics:
+        text += f"; {diagnostics['holder'].summary()}"
     return text

@@ -43,6 +43,7 @@ from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_pos
 from tmm_workbench.core.strategies.mesh5.posture import (PostureGrid, require_plain, tool_rotation, touch_tip,
                                                         world_placement)
 from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile, surface_heights
+from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
@@ -138,7 +139,8 @@ class PlannedPass:
 
 
 def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: PassPostures, overrun: float,
-                      steps: int = OVERRUN_STEPS) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                      steps: int = OVERRUN_STEPS, assembly: Optional[ToolAssembly] = None
+                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(tips, axes, LCS frames) of the path's tool with its overruns: `overrun` mm beyond both end CC points along their
     feed LX at the end postures (at the ends the CC point lies on the mesh's boundary, and a tool stopping
     there would narrow its track within a radius of it), in `steps` positions each, every one lifted along
@@ -153,7 +155,7 @@ def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: 
         pts = path.points[k] + sgn * s[:, None] * frame[0]
         frm = np.repeat(frame[None], steps, 0)
         lam, omg = np.array([postures.lam[k]]), np.array([postures.omg[k]])
-        lift = lifts(reach, cutter, pts, frm, lam, omg, cutter.radius)[:, 0]
+        lift = lifts(reach, cutter, pts, frm, lam, omg, cutter.radius, assembly=assembly)[:, 0]
         blocked = np.flatnonzero(~np.isfinite(lift))
         keep = int(blocked[0]) if blocked.size else steps
         tips, axes = world_placement(cutter, pts[:keep], frm[:keep], np.repeat(lam, keep),
@@ -165,7 +167,7 @@ def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: 
 
 
 def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray,
-                frames: np.ndarray) -> np.ndarray:
+                frames: np.ndarray, assembly: Optional[ToolAssembly] = None) -> np.ndarray:
     """(n,) the least lift along its axis that clears the mesh for the tool at each (tip, axis) (0 where it is
     clear already; inf above a radius), by the C-space's S2 (lift.lifts): the posture read in the LCS
     `frames` (n, 3, 3) of a CC point nearby, the tip's touching point as the CC point."""
@@ -173,11 +175,13 @@ def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.nda
     lam, omg = np.arccos(np.clip(a[:, 2], -1.0, 1.0)), np.arctan2(a[:, 1], a[:, 0])
     pts = tips - np.einsum("nji,nj->ni", frames, touch_tip(cutter, tool_rotation(lam, omg)))
     n = len(tips)
-    return np.diagonal(lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, np.eye(n, dtype=bool))).copy()
+    return np.diagonal(lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, np.eye(n, dtype=bool),
+                             assembly=assembly)).copy()
 
 
 def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray, frames: np.ndarray,
-                      tol: float = BETWEEN_TOL, rounds: int = BETWEEN_ROUNDS) -> tuple[np.ndarray, np.ndarray]:
+                      tol: float = BETWEEN_TOL, rounds: int = BETWEEN_ROUNDS,
+                      assembly: Optional[ToolAssembly] = None) -> tuple[np.ndarray, np.ndarray]:
     """The run's positions (tips, axes, their LCS frames (n, 3, 3)) with a position inserted in the middle of
     each move whose midpoint (tip halfway, axis halfway) cuts into the mesh deeper than `tol`, lifted clear
     along its axis; `rounds` times. The C-space clears the tool at the CL points; between two, the move is a
@@ -189,7 +193,7 @@ def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: 
         mid_t = 0.5 * (tips[:-1] + tips[1:])
         mid_a = axes[:-1] + axes[1:]
         mid_a /= np.linalg.norm(mid_a, axis=1, keepdims=True)               # slerp at one half
-        lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1])
+        lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1], assembly)
         deep = np.flatnonzero(np.isfinite(lift) & (lift > tol))
         if deep.size == 0:
             break
@@ -321,19 +325,20 @@ class _Coverage:
 
 
 def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray, frm: np.ndarray,
-            side: np.ndarray, grid: PostureGrid) -> tuple[CSpace, np.ndarray]:
+            side: np.ndarray, grid: PostureGrid, assembly: Optional[ToolAssembly] = None) -> tuple[CSpace, np.ndarray]:
     """The C-space of the CC points for the side steps `side` (n, 2) (left, right), and the side steps used:
     where a CC point has no posture, its left step (the guess for the next pass) is halved, down to a
     quarter of what was asked, and only those CC points rebuilt."""
     side = np.minimum(side, 2 * cutter.radius)
-    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR)
+    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR, assembly=assembly)
     floor = 0.25 * side[:, 0]
     for _ in range(2):
         redo = np.flatnonzero(cs.empty & (side[:, 0] > floor + 1e-9))
         if redo.size == 0:
             break
         side[redo, 0] = np.maximum(0.5 * side[redo, 0], floor[redo])
-        sub = build_cspace(reach, cutter, pts[redo], frm[redo], grid, tolerance, side[redo], interior=INTERIOR)
+        sub = build_cspace(reach, cutter, pts[redo], frm[redo], grid, tolerance, side[redo], interior=INTERIOR,
+                           assembly=assembly)
         lift, top = cs.lift.copy(), cs.top.copy()
         lift[redo], top[redo] = sub.lift, sub.top
         cs = CSpace(cs.grid, lift, top)
@@ -341,12 +346,12 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
-               grid: PostureGrid, machine: TarusMachine, ideal_weight: float):
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
     ones relaxed where no posture meets them), or None where some CC point still has no posture."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid)
+    cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, assembly)
     if cs.empty.any():
         return None
     postures, start = [], 0
@@ -448,12 +453,14 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
                     machine: Optional[TarusMachine] = None, grid: Optional[PostureGrid] = None,
                     forward_step: float = 2.0, chord_tolerance: float = 0.01, ideal_weight: float = 0.1,
-                    progress: Optional[Progress] = None) -> AdaptivePlan:
+                    progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None) -> AdaptivePlan:
     """Passes across the mesh, each placed so that the scallop with the previous one stays within
     `tolerance` (module doc), their postures chosen for the Tarus motion time. Where no pass can advance the
     finished level (no posture for any gap), those places are listed in `AdaptivePlan.unfinished` for
     clean-up and the passes go on beside them. `progress(fraction done)` after each pass, False cancels
-    (Cancelled), as everywhere in the core. TmmError for a tolerance that is not a positive number."""
+    (Cancelled), as everywhere in the core. `assembly`: the cutter's ToolAssembly, whose shank and holder bound
+    every C-space and every lift (the tool tilts away, or the place is left unfinished). TmmError for a
+    tolerance that is not a positive number."""
     if not (isinstance(tolerance, (int, float)) and math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"tolerance must be a positive number of mm, got {tolerance!r}")
     require_plain(cutter)
@@ -475,7 +482,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
             side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
-            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight)
+            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, assembly)
             if got is not None:
                 level, short = cover.advanced(paths, got[2])
                 if (level > cover.level + 1e-9)[cover.open].any():
@@ -498,7 +505,8 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         postures, widths, ends, used = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
-        runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun))
+        runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun,
+                                                                    assembly=assembly), assembly=assembly)
                 for p, q in zip(paths, postures)]
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
                                        gap, runs))

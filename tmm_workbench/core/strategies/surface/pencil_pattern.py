@@ -15,6 +15,7 @@ from tmm_workbench.core.footprint import pencil
 from tmm_workbench.core.footprint.cusp import stepover_for_cusp
 from tmm_workbench.core.footprint.rest import LEAST_CUT
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.geometry.ordering import nearest_first
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.strategies.surface.params import (PENCIL_CLEANUP, PENCIL_CREASES, PENCIL_OUTLINE, STEPOVER,
                                                           SurfaceParams, crease_cell)
@@ -102,28 +103,7 @@ def chains(mesh: TriMesh, surface: DropSurface, cutter: Cutter, params: SurfaceP
     found = curves(mesh, surface, cutter, params, floor_z)
     area = params.region if params.region is not None else [polygons.rectangle(*params.boundary)]
     pieces = [p for p in polygons.clip_open(found, area) if len(p) >= 2] if found else []
-    ordered = _nearest_first(pieces)
+    ordered = nearest_first(pieces)
     diagnostics["pencil_curves"] = len(found)
     diagnostics["passes"] = len(ordered)
     return [[(False, c)] for c in pencil.sampled(ordered, params.sample_step)]
-
-
-def _nearest_first(pieces: list[np.ndarray]) -> list[np.ndarray]:
-    """Each next piece the one whose nearer end is nearest the last end (turned to start there)."""
-    if not pieces:
-        return []
-    heads = np.array([p[0] for p in pieces], dtype=float)
-    tails = np.array([p[-1] for p in pieces], dtype=float)
-    left = np.ones(len(pieces), dtype=bool)
-    out, k, at = [], 0, heads[0]             # the first piece as it comes
-    while True:
-        left[k] = False
-        p = pieces[k]
-        if out and np.hypot(*(p[-1] - at)) < np.hypot(*(p[0] - at)):
-            p = p[::-1]
-        out.append(p)
-        if not left.any():
-            return out
-        at = p[-1]
-        d = np.minimum(np.hypot(*(heads - at).T), np.hypot(*(tails - at).T))
-        k = int(np.argmin(np.where(left, d, np.inf)))

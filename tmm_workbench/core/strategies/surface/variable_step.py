@@ -29,6 +29,7 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.footprint.cusp import check_cusp
 from tmm_workbench.core.footprint.raster import Rect, clip_line_to_rect, sample_segment
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.geometry.ordering import nearest_first
 from tmm_workbench.core.linking import LinkPolicy, heights_top, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, SegmentKind
@@ -193,7 +194,7 @@ class _Levels:
     `run_on` beyond. Buckets: a gap's cells closer than `join` to each other. The cusp falls as the step squared,
     so a halving brings a cusp up to 4 x TARGET within; a higher one is halved again in the next round."""
 
-    serpentine = False  # the partial passes of a round in nearest-first order (_nearest_first)
+    serpentine = False  # the partial passes of a round in nearest-first order (nearest_first)
     join = 4.0          # tool diameters: partial passes closer than this are joined on the surface (the pieces
                         # are short and scattered: a lift costs more than a longer link)
 
@@ -285,23 +286,6 @@ def _extra_segments(xy: np.ndarray, drop: Drop, gouge_tol: float, chord_tol: flo
     return cut_segments(runs, z, air, ONEWAY, chord_tol)
 
 
-def _nearest_first(lines: list[np.ndarray], start: np.ndarray) -> list[np.ndarray]:
-    """`lines` in greedy nearest-neighbour order from `start`, each entered at its nearer end (so that more of
-    them are joined on the surface instead of a lift)."""
-    out: list[np.ndarray] = []
-    left = list(lines)
-    here = np.asarray(start, float)
-    while left:
-        ends = np.array([[ln[0], ln[-1]] for ln in left])                 # (n, 2 ends, 2)
-        d = np.hypot(*(ends - here).transpose(2, 0, 1))                    # (n, 2)
-        i, e = np.unravel_index(int(np.argmin(d)), d.shape)
-        line = left.pop(int(i))
-        line = line[::-1] if e == 1 else line
-        out.append(line)
-        here = line[-1]
-    return out
-
-
 def _surface_link(a: np.ndarray, b: np.ndarray, drop: Drop, sample_step: float,
                   gouge_tol: float) -> Optional[CutSegment]:
     """A LINK from tip a to tip b on the surface (dropped points, gouge-checked between them as raster_drop's
@@ -385,7 +369,7 @@ def verify_cusp(mesh: TriMesh, cutter: Cutter, segments: list[CutSegment], bound
         if passes.serpentine:  # the next partial pass starts near the last one's end
             todo = [xy[::-1] if i % 2 else xy for i, xy in enumerate(todo)]
         elif todo:  # from where the tool stands (the pass set is never empty here)
-            todo = _nearest_first(todo, (extra or segments)[-1].tips[-1, :2])
+            todo = nearest_first(todo, (extra or segments)[-1].tips[-1, :2])
         for xy in todo:
             new = _extra_segments(xy, drop, gouge_tol, chord_tol)
             if new and extra and extra[-1].kind is SegmentKind.PASS and \
