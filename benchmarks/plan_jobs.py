@@ -9,7 +9,8 @@ Columns: exit code (0 verified, 1 verification failed, 2 bad input), the deepest
 (mm, vertical, from the simulation), the 95th percentile of what is left, the simulated cycle time, the ops, the
 planning time (the decisions, core only) and the whole run's wall time (FreeCAD included). Then what is left
 where the library's most reaching tool reaches (core.plan.left_check, along the normal): the area above the
-tolerance, the most, and the area out of that tool's reach from above; each rest and pencil op's own report.
+tolerance (and above the finish's cusp when that is larger), the most, and the area out of that tool's reach from
+above; each rest and pencil op's own report.
 """
 from __future__ import annotations
 
@@ -80,8 +81,11 @@ def main() -> None:
               f"{wall:>7.0f}  {ops}", flush=True)
         reach = v.get("left_in_reach")
         if reach:
+            cusp = (f" ({reach['left_above_allowance_mm2']:g} mm2 above the cusp asked, {reach['allowance_mm']:g} mm)"
+                    if reach.get("allowance_mm", 0) > v["tolerance_mm"] else "")
             print(f"{'':<16} where {reach['tool']} reaches: {reach['left_above_tolerance_mm2']:g} mm2 left above the "
-                  f"tolerance, most {reach['most_left_mm']:g} mm (99 %: {reach['left_99_percentile_mm']:g} mm); out "
+                  f"tolerance{cusp}, most {reach['most_left_mm']:g} mm (99 %: {reach['left_99_percentile_mm']:g} mm); "
+                  "out "
                   f"of its reach {reach['out_of_reach_mm2']:g} of {reach['reached_mm2'] + reach['out_of_reach_mm2']:g}"
                   " mm2", flush=True)
         for op in v["ops"]:

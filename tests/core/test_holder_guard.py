@@ -109,3 +109,29 @@ def test_the_spots_are_the_lowest_point_of_each_cell_and_bounded() -> None:
         assert p[2] == expected[tuple(np.floor(p[:2]).astype(int))]
     assert len(holder_guard.spots(pts, cell=0.01, most=100)) <= 100
     assert holder_guard.spots(np.zeros((0, 3))).shape == (0, 3)
+
+
+def test_a_move_clear_at_both_ends_is_lifted_where_it_passes_under() -> None:
+    """A lean move climbing from the floor past a 50 mm wall's top (wheel_in_box's raster, 0.4 mm between its
+    samples): clear at both ends, the shank's edge within its clearance of the wall three quarters of the way;
+    the guard lifts it (points inserted) so no point of the move is under the bodies' height."""
+    from tests.conftest import grid_mesh
+    from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+    from tmm_workbench.core.segments import CutSegment
+    from tmm_workbench.core.strategies.segment_split import move_samples
+
+    wall = grid_mesh(lambda x, y: np.where(x >= 80.0, 50.0, 0.0), 80, 4, (60.0, -10.0, 100.0, 10.0), "wall")
+    ball8 = ToolAssembly(Cutter.ball(8), 8, 95, flute_length=30, holder="ER32 nut")
+    drop = AssemblyDrop(wall, ball8)
+    xy = np.array([[74.75, 0.0], [75.15, 0.0]])
+    need, _ = drop.heights_of(holder_guard.BODIES, xy)
+    tips = np.column_stack([xy, [max(need[0], 12.7), need[1] + 0.01]])
+    seg = CutSegment(tips)
+    fine = move_samples(seg, 0.01)[0]
+    under = drop.heights_of(holder_guard.BODIES, fine[:, :2])[0] - fine[:, 2]
+    assert under.max() > 1.0                                   # the straight move dips under the wall's clearance
+    (out,), report = holder_guard.guard(wall, ball8, [seg], holder_guard.LIFT, 0.4)
+    assert report.affected >= 2 and len(out) > 2                # points inserted
+    fine = move_samples(out, 0.01)[0]
+    under = drop.heights_of(holder_guard.BODIES, fine[:, :2])[0] - fine[:, 2]
+    assert under.max() <= 0.05

@@ -139,3 +139,18 @@ def test_low_links_hop_just_above_the_material_between_and_never_through_it():
     assert up.z == across.z == pytest.approx(8.0, abs=0.01) and (across.x, across.y) == (25.0, 22.0)
     high = link(segs, LinkPolicy(30.0, 35.0, material_top=StockHeights(grid, stock, tool)))
     assert max(m.z for m in high.moves[2:-1]) == 30.0
+
+
+def test_a_low_link_crosses_above_an_entry_lifted_over_the_material():
+    """A pass whose first tip stands above the material (the holder guard lifted it beside a wall): the low link
+    crosses at 1 mm over that tip, not over the material only and then up (that drove a rest's shank into
+    wheel_in_box's wall)."""
+    grid = Grid.covering(0, 0, 40, 40, 0.25)
+    stock = box_heights(grid, 4.0)
+    tool = Cutter.ball(4)
+    segs = [CutSegment(line(3.0, 5.0, 15.0, 18.0)), CutSegment(line(12.0, 25.0, 35.0, 22.0))]
+    tp = link(segs, LinkPolicy(30.0, 35.0, material_top=StockHeights(grid, stock, tool), low_links=True))
+    end = next(i for i, m in enumerate(tp.moves) if (m.x, m.y, m.z) == (15.0, 18.0, 3.0))
+    up, across = tp.moves[end + 1], tp.moves[end + 2]
+    assert (up.x, up.y) == (15.0, 18.0) and (across.x, across.y) == (25.0, 22.0)
+    assert up.z == across.z >= 12.0 + 1.0 - 1e-9

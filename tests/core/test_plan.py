@@ -200,12 +200,22 @@ def test_decisions_beet(tmp_path: Path) -> None:
     cutter = decide.cutter_of(next(t for t in library if t.name == shallow.tool))
     step = shallow.kwargs["stepover"]
     assert plane_cusp(cutter, step, transition) <= 0.1 + 1e-6 < plane_cusp(cutter, step + 0.01, transition)
+    # the shallow tool takes the largest step-over keeping the cusp (the comparison ranks by volume only)
+    from tmm_workbench.core.footprint.cusp import stepover_for_cusp
+
+    candidates = d_choice(plan, "finishing candidates").split(", ")
+    widest = max(stepover_for_cusp(decide.cutter_of(t), 0.1, 45.0) for t in library if t.name in candidates)
+    assert stepover_for_cusp(cutter, 0.1, 45.0) >= (1 - decide.STEP_TIE) * widest
     # every decision has its reason; the feeds are the material table's
     assert all(d.reason for d in plan.decisions)
     assert plan.cutting["T2 ball D6"]["rpm"] == round(materials.cutting("modelling_foam", 6, 2, 24000, 5000).rpm)
     # the same input gives the same plan
     again = plan_of(tmp_path, data)[3]
     assert json.dumps(again.as_dict(), sort_keys=True) == json.dumps(plan.as_dict(), sort_keys=True)
+
+
+def d_choice(plan: decide.Plan, topic: str) -> str:
+    return next(d.choice for d in plan.decisions if d.topic == topic)
 
 
 def test_no_comparison_and_placement(tmp_path: Path) -> None:
@@ -307,3 +317,37 @@ def test_roughing_stops_where_its_flutes_end(tmp_path: Path) -> None:
     assert "final_z" not in plan.ops[0].kwargs
     assert "roughing depth" not in [d.topic for d in plan.decisions]
 
+
+
+def test_deep_walls_finished_first(tmp_path: Path) -> None:
+    """A pocket deeper than the finishing ball's flutes: its shank would pass within its clearance of what the
+    roughing leaves on the walls, so the flat whose flutes reach finishes the walls by waterline first, nothing
+    left, as deep as its own shank stays clear. A ball without a holder (no shank checked) or with flutes
+    reaching the depth needs none."""
+    pocket = grid_mesh(lambda x, y: np.where((np.abs(x) < 10) & (np.abs(y) < 10), 0.0, 10.0), 80, 80,
+                       (-20, -20, 20, 20), "pocket")
+    stl = tmp_path / "pocket.stl"
+    from tmm_workbench.core.geometry.mesh import save_stl
+
+    save_stl(pocket, stl)
+    data = good(tmp_path)
+    data["model"]["file"] = str(stl)
+    data["planner"]["compare_cutters"] = False
+    data["tools"] = [{"name": "F8", "type": "flat", "diameter": 8, "flute_length": 10.5, "holder": "ER16 nut",
+                      "stick_out": 30},
+                     {"name": "B6", "type": "ball", "diameter": 6, "flute_length": 4, "holder": "ER16 nut",
+                      "stick_out": 30}]
+    plan = plan_of(tmp_path, data)[3]
+    face, walls = plan.ops[1:3]
+    assert (face.api, face.tool, face.label) == ("run_surface", "F8", "Face plateaus F8")
+    assert face.kwargs["final_depth"] == walls.kwargs["bottom_z"] and face.kwargs["off_model"] == "skip"
+    assert (walls.api, walls.tool, walls.label) == ("run_waterline", "F8", "Finish walls F8")
+    top = plan.stock_box[5]
+    assert walls.kwargs["stock_to_leave"] == 0.0 and walls.kwargs["top_z"] == pytest.approx(10.0)
+    assert walls.kwargs["bottom_z"] == pytest.approx(top - 10.5 + decide.ROUGH_SHANK_CLEAR)
+    assert "B6" in next(d.reason for d in plan.decisions if d.topic == "deep walls")
+    for change in ({"flute_length": 13}, {"holder": None, "stick_out": None, "flute_length": 13}):
+        data["tools"][1].update(change)
+        data["tools"][1] = {k: v for k, v in data["tools"][1].items() if v is not None}
+        plan = plan_of(tmp_path, data)[3]
+        assert not any(o.label.startswith("Finish walls") for o in plan.ops)

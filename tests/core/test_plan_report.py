@@ -37,7 +37,8 @@ def verification(plan, passed: bool = True) -> dict:
             "removed_volume_mm3": 5361.6, "remaining_volume_mm3": 113.2, "sim_cell_mm": 0.4,
             "cycle_seconds": sum(o["cycle_seconds"] for o in ops), "ops": ops, "replanned": [],
             "left_in_reach": {"tool": plan.reach_tool, "reached_mm2": 611.5, "out_of_reach_mm2": 21.3,
-                              "left_above_tolerance_mm2": 3.25, "most_left_mm": 0.0421,
+                              "left_above_tolerance_mm2": 3.25, "allowance_mm": 0.1,
+                              "left_above_allowance_mm2": 0.75, "most_left_mm": 0.0421,
                               "left_99_percentile_mm": 0.0097}}
 
 
@@ -49,8 +50,8 @@ def test_page_holds_the_report(planned) -> None:
     assert "VERIFIED" in page and "VERIFICATION FAILED" not in page
     text = re.sub(r"<[^>]+>", " ", page)   # the words as shown
     for words in ("0.0042 mm (tolerance 0.01 mm)", "2.39 mm", "5361.6 mm3", "113.2 mm3", "modelling foam",
-                  "ER16 nut", "linuxcnc", f"left where {plan.reach_tool} reaches", "3.25 mm2 above the tolerance, "
-                  "most 0.0421 mm", "21.3 mm2 of 632.8"):
+                  "ER16 nut", "linuxcnc", f"left where {plan.reach_tool} reaches", "3.25 mm2 above the tolerance "
+                  "(0.75 mm2 above the cusp asked, 0.1 mm), most 0.0421 mm", "21.3 mm2 of 632.8"):
         assert words in text, words
     # the stock's size from the plan's box, the zero point named
     box = plan.stock_box

@@ -108,6 +108,11 @@ def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():
     assert small["left_above_tolerance_mm2"] == pytest.approx(patch.sum() * 0.16)
     assert small["most_left_mm"] == pytest.approx(0.05)
     assert small["out_of_reach_mm2"] >= corner.sum() * 0.16
+    assert small["left_above_allowance_mm2"] == small["left_above_tolerance_mm2"]   # the cusp under the tolerance
+    # a finish whose cusp is above the 0.05 mm the patch keeps: its passes leave that by design
+    coarse = left_in_reach(mesh, grid, design, deviation, "B1", Cutter.ball(1.0), 0.01, cusp=0.06)
+    assert coarse["allowance_mm"] == 0.06 and coarse["left_above_allowance_mm2"] == 0.0
+    assert coarse["left_above_tolerance_mm2"] == small["left_above_tolerance_mm2"]
     large = left_in_reach(mesh, grid, design, deviation, "B6", Cutter.ball(6.0), 0.01)
     assert large["out_of_reach_mm2"] > small["out_of_reach_mm2"]
     assert large["reached_mm2"] + large["out_of_reach_mm2"] == pytest.approx(small["reached_mm2"] +

@@ -295,7 +295,8 @@ class SimulationReport:
 def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
              png_path: Optional[Union[str, os.PathLike]] = None, progress: Union[bool, Callable[[float], bool]] = True,
              fail_on_gouge: bool = False, holder: Optional[str] = None,
-             stick_out: Optional[float] = None, png_band: Optional[float] = None) -> SimulationReport:
+             stick_out: Optional[float] = None, png_band: Optional[float] = None,
+             body_tolerance: float = 1e-3) -> SimulationReport:
     """Cuts the stock of a Job with its active ops in order (or with one op), compares it with the Job's model
     and reports: the deviation (vertical, + material left, - gouge) extremes and percentiles, removed and
     remaining volume, rapids through stock, cycle time. `target`: a Job, an op, or a SurfaceResult /
@@ -305,7 +306,9 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     The shank and holder of each op (its Holder; or `holder`, a name of the holder library, with `stick_out` for
     every op: a job computed without one) are checked along its moves against the design: `holder_collisions`,
     and during the cut against the stock as each move finds it (uncut material too): `stock_collisions`, each
-    printed as an error (with fail_on_gouge: raised); png_path's heat map marks the stock collisions. png_band:
+    printed as an error (with fail_on_gouge: raised); png_path's heat map marks the stock collisions, stock within
+    `body_tolerance` mm of a body's clearance not counted (a finish leaves its cusps above the design the guards
+    keep the clearance from). png_band:
     the heat map's colours span +-png_band mm, the cells beyond in its darkest ends, counted in its title (TMM
     Simulate's colour band; None: the whole range)."""
     from tmm_workbench.app import simulation
@@ -318,7 +321,8 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     if stick_out is not None and holder is None:
         raise TmmError("stick_out is used with a holder only: give holder= (a name from the holder library) as well")
     numbers(stick_out=(stick_out, Spec(low=0.0, high=1000.0, unit="mm", label="stick_out", low_open=True)),
-            png_band=(png_band, Spec(low=0.0, high=1000.0, unit="mm", label="png_band", low_open=True, optional=True)))
+            png_band=(png_band, Spec(low=0.0, high=1000.0, unit="mm", label="png_band", low_open=True, optional=True)),
+            body_tolerance=(body_tolerance, Spec(low=0.0, high=10.0, unit="mm", label="body_tolerance")))
     if png_band is not None and not png_path:
         raise TmmError("png_band colours the heat map: give png_path as well")
     label = str(getattr(target, "Label", "simulation"))
@@ -326,7 +330,7 @@ def simulate(target: Any, *, cell: float = 0.1, tolerance: float = 0.01, max_ste
     with progress_mod.using(factory):
         with progress_mod.reporter(f"{label} simulation", bool(progress)) as cb:
             sim = simulation.simulate_job(target, cell, tolerance, max_step, cb,
-                                          None if holder is None else (holder, stick_out))
+                                          None if holder is None else (holder, stick_out), body_tolerance)
     o = sim.comparison.overall
     png = None
     if png_path:

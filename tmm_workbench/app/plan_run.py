@@ -121,8 +121,10 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
     progress_note.note(2 + len(plan["ops"]), steps(plan), "simulating the Job")
 
     png = folder / f"{plan['name']}_sim.png" if plan["heat_map"] else None
+    # the shanks keep their clearance from the design; the stock a finish leaves within the tolerance over it is
+    # not a collision
     sim = simulate(results[0].job, cell=plan["sim_cell"], tolerance=plan["tolerance"], png_path=png,
-                   progress=progress)
+                   progress=progress, body_tolerance=plan["tolerance"])
     problems = []
     if sim.gouged:
         problems.append(f"gouged {-sim.min_deviation:.4f} mm below the model (tolerance {plan['tolerance']:g} mm)")
@@ -151,7 +153,7 @@ def left_in_reach(sim: Any, plan: dict) -> dict:
     js, tool = sim.simulation, plan["reach_tool"]
     return left_check.left_in_reach(load_stl(plan["model_file"]), js.grid, js.design, js.comparison.deviation,
                                     tool["name"], Cutter(tool["diameter"], tool["corner_radius"]),
-                                    plan["tolerance"])
+                                    plan["tolerance"], plan.get("cusp", 0.0))
 
 
 def rounded(value: Any) -> Any:

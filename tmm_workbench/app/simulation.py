@@ -222,11 +222,13 @@ def simulation_grid(target: Any, cell: float) -> Grid:
 
 def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_step: Optional[float] = None,
                  progress: Optional[Callable[[float], bool]] = None,
-                 holder: Optional[tuple[str, Optional[float]]] = None) -> JobSimulation:
+                 holder: Optional[tuple[str, Optional[float]]] = None,
+                 body_tolerance: float = 1e-3) -> JobSimulation:
     """Cuts the stock of `target`'s Job with its active ops (or only `target` when it is an op) and
     compares the result with the Job's model; each op's shank and holder checked along its moves against the
     model and, during the cut, against the stock as the earlier moves left it (its own Holder, or `holder` =
-    (name, stick-out) for every op: a job computed without one)."""
+    (name, stick-out) for every op: a job computed without one), stock within `body_tolerance` mm of a body's
+    clearance not counted."""
     job = job_of(target)
     if job is None:
         raise TmmError(f"'{getattr(target, 'Label', target)}' is not in a Job")
@@ -252,7 +254,8 @@ def simulate_job(target: Any, cell: float = 0.1, tolerance: float = 0.01, max_st
         assembly = _assembly(op, holder)
         r = simulate(tp, cutter, grid, heights, shape=_five_axis_shape(op) if five else "bull_nose",
                      max_step=max_step, tolerance=tolerance,
-                     progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)), assembly=assembly)
+                     progress=share(0.2 + 0.8 * k / len(ops), 0.2 + 0.8 * (k + 1) / len(ops)), assembly=assembly,
+                     body_tolerance=body_tolerance)
         seconds = op_cycle_seconds(op, (tp, feeds))
         done.append(OpSimulation(str(op.Label), five, len(tp), seconds, r.collisions.tolist(), r.seconds,
                                  _holder_check(assembly, model, tp), r.stock_collisions))

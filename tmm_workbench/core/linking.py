@@ -226,11 +226,13 @@ def _approach(tp: Toolpath, seg: CutSegment, policy: LinkPolicy, descent: np.nda
     return z
 
 
-def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float) -> Optional[float]:
+def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float, start: float = -math.inf) -> Optional[float]:
     """The height of a low link from the tool's position to above (x, y): `entry_clearance` (at least 1 mm) over
     the highest material top along the straight line, sampled a tenth of the tool's reach apart (the top is the
-    tool dropped on the material, so the samples' footprints overlap); None when the policy keeps links at the
-    safe height, the top is not known, or the hop would not be lower."""
+    tool dropped on the material, so the samples' footprints overlap), and over the entry's `start` (a start the
+    holder guard lifted above the material: crossing lower and rising there drove the shank into a wall beside
+    it); None when the policy keeps links at the safe height, the top is not known, or the hop would not be
+    lower."""
     top = policy.material_top
     if not policy.low_links or top is None:
         return None
@@ -238,7 +240,7 @@ def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float) -> Optional[f
     step = min(0.5, max(0.05, 0.1 * reach))
     n = max(2, int(math.ceil(math.hypot(x - last.x, y - last.y) / step)) + 1)
     xy = np.column_stack([np.linspace(last.x, x, n), np.linspace(last.y, y, n)])
-    hop = max(float(np.max(top(xy))), last.z) + max(policy.entry_clearance, 1.0)
+    hop = max(float(np.max(top(xy))), last.z, start) + max(policy.entry_clearance, 1.0)
     return hop if math.isfinite(hop) and hop < policy.safe_height else None
 
 
@@ -352,7 +354,7 @@ def _link_vertical(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath:
                 raise TmmError(f"entry must be one of {', '.join(ENTRIES)}, got {name!r}")
             descent = _descent(seg, policy, name)
             x0, y0, top = descent[0]
-            hop = _hop_height(policy, tp.moves[-1], x0, y0) if tp.moves else None
+            hop = _hop_height(policy, tp.moves[-1], x0, y0, top) if tp.moves else None
             if hop is not None:  # up to just above the material between, across
                 last = tp.moves[-1]
                 tp.add(MoveKind.RAPID, last.x, last.y, hop, last.axis)

@@ -25,6 +25,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.plan import materials
 from tmm_workbench.core.plan.analysis import FAR_MM, Analysis
 from tmm_workbench.core.plan.job_file import JobSpec, PlanInputError, ToolSpec
+from tmm_workbench.core.strategies.zlevel_layers import PLATEAU_DEG
 from tmm_workbench.core.tools.cutter import Cutter
 
 ROUGH_LEAVE = 0.3          # mm left by roughing for the finishing tool (radial and axial)
@@ -34,10 +35,12 @@ TRANSITION_DEG = 45.0      # shallow / steep split without a comparison saying o
 TRANSITION_RANGE = (30.0, 60.0)
 MIN_SHARE = 0.005          # of the design cells: a slope class smaller than this gets no op of its own
 MIN_STEPOVER = 0.05        # mm: a finish needing a finer step-over than this is refused as too tight
+STEP_TIE = 0.05           # step-overs within this share of the largest are equal (the comparison's rank decides)
 MAX_COMPARED = 4           # radiused tools compared (the largest first)
 ROUGH_SHANK_CLEAR = 1.5    # mm: the roughing's flutes end this far above the stock (the API's shank clearance 1 mm)
 ROUGH_WIDTH_SHARE = 0.5    # a roughing tool wider than this share of the model's narrower side does not fit
 ROUGH_FAR_SHARE = 0.5      # nor one staying more than FAR_MM above over more than this share of the model's area
+WALL_DEG = 80.0            # a face steeper than this is a wall a flat end mill's side finishes
 PENCIL_GAIN = 0.8          # a pencil tool must leave at most this share of the rest tool's unreached area
 
 
@@ -190,6 +193,18 @@ def transition_from(comparison: Any, winner: str, ball: str) -> Optional[float]:
     return None
 
 
+def transition_of(cmp: Any, tool: ToolSpec, ball: ToolSpec) -> tuple[float, str]:
+    """The transition slope (deg) with `tool` as the shallow cutter and its reason: where the comparison finds
+    the ball leaving less, kept within TRANSITION_RANGE, else TRANSITION_DEG."""
+    edge = transition_from(cmp, tool.name, ball.name)
+    if edge is None:
+        return TRANSITION_DEG, (f"the ball {ball.name} never leaves less than {tool.name} in a slope band: the "
+                                "default split" if tool is not ball else "the ball everywhere: the default split")
+    return float(np.clip(edge, *TRANSITION_RANGE)), (
+        f"the ball {ball.name} leaves less than {tool.name} from {edge:g} deg up (mean left per slope band in the "
+        f"comparison), kept within {TRANSITION_RANGE[0]:g}-{TRANSITION_RANGE[1]:g} deg")
+
+
 def reaching(plan: Plan, an: Analysis, radiused: list) -> list:
     """The radiused tools that reach the model's lowest point from its top (the finishing and rest tools)."""
     height = an.size[2]
@@ -241,21 +256,30 @@ def choose_finishing(plan: Plan, job: JobSpec, an: Analysis, mesh: TriMesh, radi
         plan.decide("transition slope", f"{TRANSITION_DEG:g} deg", "the default split (no comparison)")
         return ball, ball, TRANSITION_DEG
     cmp = compare(mesh, [(t.name, cutter_of(t)) for t in candidates], stepover=round(step, 4))
-    best = next(t for t in candidates if t.name == cmp.scores[0].label)
+    by_volume = next(t for t in candidates if t.name == cmp.scores[0].label)
+    splits = {t.name: transition_of(cmp, t, ball) for t in candidates}
+    steps = {t.name: stepover_for_cusp(cutter_of(t), cusp, splits[t.name][0]) for t in candidates}
+    # the finish's cusp, not the volume at one step-over, sets each tool's raster: the raster's length goes with
+    # 1 / its step-over; the comparison's rank decides between step-overs within STEP_TIE of the largest
+    widest = max(steps.values())
+    best = next(t for t in (next(c for c in candidates if c.name == s.label) for s in cmp.scores)
+                if steps[t.name] >= (1 - STEP_TIE) * widest)
+    transition, why = splits[best.name]
     plan.decide("shallow finishing tool", best.describe(),
-                f"seed 003 section 4.2: the same raster (step-over {step:.3f} mm, the ball's for the cusp) with "
-                f"{len(candidates)} radiused tools simulated; ranked: " + " | ".join(cmp.reasons))
-    edge = transition_from(cmp, best.name, ball.name)
-    if edge is None:
-        transition = TRANSITION_DEG
-        why = (f"the ball {ball.name} never leaves less than {best.name} in a slope band: the default split"
-               if best is not ball else "the ball wins everywhere: the default split")
-    else:
-        transition = float(np.clip(edge, *TRANSITION_RANGE))
-        why = (f"the ball {ball.name} leaves less than {best.name} from {edge:g} deg up (mean left per slope band "
-               f"in the comparison), kept within {TRANSITION_RANGE[0]:g}-{TRANSITION_RANGE[1]:g} deg")
+                "the largest step-over keeping the finish's cusp up to each tool's transition slope ("
+                + ", ".join(f"{t.name} {steps[t.name]:.3f} mm at {splits[t.name][0]:g} deg" for t in candidates)
+                + f"; the raster's time goes with 1 / step-over); seed 003 section 4.2: the same raster (step-over "
+                f"{step:.3f} mm, the ball's for the cusp) with {len(candidates)} radiused tools simulated, ranked by "
+                f"the volume left" + (f" ({by_volume.name} first: at its own cusp step-over it would take "
+                                      f"{steps[best.name] / steps[by_volume.name]:.2f} x the passes)"
+                                      if by_volume is not best else "") + ": " + " | ".join(cmp.reasons))
     plan.decide("transition slope", f"{transition:g} deg", why)
     return best, ball, transition
+
+
+def sample_step(tool: ToolSpec) -> float:
+    """A raster's sampling along its passes: a twentieth of the diameter, within 0.1-0.5 mm."""
+    return round(min(0.5, max(0.1, tool.diameter / 20.0)), 3)
 
 
 def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, steep: ToolSpec,
@@ -264,18 +288,20 @@ def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, ste
     steep_share = an.share_steeper(transition)
     common = {"post": job.machine.post}
     if 1.0 - steep_share >= MIN_SHARE:
-        sample = round(min(0.5, max(0.1, shallow.diameter / 20.0)), 3)
+        sample = sample_step(shallow)
         # the steepest slope the raster cuts sets its step-over (the op's own cusp mode measures the crossings
         # of the whole surface: 40x slower on beet_mm, and its curvature term is not needed on a planned split)
         step = math.floor(stepover_for_cusp(cutter_of(shallow), cusp, transition) * 1000) / 1000
         kwargs = api_tool(shallow) | feeds(plan, job, shallow) | common | {
-            "stepover": step, "sample_step": sample, "slope_range": [0.0, transition],
+            "stepover": step, "sample_step": sample, "slope_range": [0.0, transition], "off_model": "skip",
             "chord_tolerance": round(min(0.01, tol / 2), 4)}
         plan.ops.append(OpPlan("run_surface", f"Finish shallow {shallow.name}", shallow.name, kwargs))
         plan.decide("shallow finishing", f"raster 0-{transition:g} deg, step-over {step:g} mm",
                     f"{(1 - steep_share) * 100:.0f} % of the model seen from above slopes less than "
                     f"{transition:g} deg; the step-over keeps the cusp {cusp:g} mm on a {transition:g} deg plane "
-                    f"across the passes, the steepest the raster cuts")
+                    f"across the passes, the steepest the raster cuts; it lifts where no part of the model lies under "
+                    "the tool (a through hole, beside the model: nothing to finish there; along the model's lowest "
+                    "point it drove the shank into the stock the roughing left in a hole's corners)")
     else:
         plan.decide("shallow finishing", "none", f"less than {MIN_SHARE * 100:g} % of the model is shallow")
     if steep_share >= MIN_SHARE:
@@ -291,6 +317,53 @@ def finishing_ops(plan: Plan, job: JobSpec, an: Analysis, shallow: ToolSpec, ste
     else:
         plan.decide("steep finishing", "none", f"less than {MIN_SHARE * 100:g} % of the model is steeper than "
                     f"{transition:g} deg")
+
+
+def walls_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list) -> None:
+    """Walls deeper than the finishing tools' flutes: their shanks would pass within their clearance of the stock
+    the roughing leaves on them (a guard keeps the clearance from the design, not from the stock). The flat or
+    bull-nose tool whose flutes reach deepest finishes them first by waterline, nothing left, as deep as its own
+    shank stays clear; the finishing tools' guards then keep them clear of the finished walls."""
+    top = plan.stock_box[5]
+    depth = top - an.bounds[0][2]
+    held = [t for t in finishing if t.holder is not None]   # a tool without a holder: no shank is checked
+    short = min((t.flute_length - ROUGH_SHANK_CLEAR for t in held), default=depth)
+    if short >= depth or an.share_steeper(WALL_DEG) < MIN_SHARE:
+        return
+    sides = [t for t in job.tools if t.type != "ball" and reach_length(t) >= depth
+             and t.flute_length - ROUGH_SHANK_CLEAR > short]
+    names = ", ".join(dict.fromkeys(t.name for t in held))
+    if not sides:
+        plan.decide("deep walls", "none", f"{names}: flutes shorter than the {depth:.1f} mm depth, and no flat or "
+                    "bull-nose library tool with longer flutes reaches it (their shanks may meet the walls' stock)")
+        return
+    tool = max(sides, key=lambda t: (t.flute_length, t.diameter, -job.tools.index(t)))
+    bottom = max(an.bounds[0][2], top - tool.flute_length + ROUGH_SHANK_CLEAR)
+    c = materials.cutting(job.material, tool.diameter, tool.flutes, job.machine.spindle_max, job.machine.feed_max)
+    step_down = round(min(c.step_down, tool.flute_length), 3)
+    kwargs = api_tool(tool) | feeds(plan, job, tool) | {
+        "step_down": step_down, "stock_to_leave": 0.0, "top_z": round(an.bounds[1][2], 4),
+        "bottom_z": round(bottom, 4), "chord_tolerance": round(min(0.01, job.finish.tolerance / 2), 4),
+        "post": job.machine.post}
+    plan.ops.insert(1, OpPlan("run_waterline", f"Finish walls {tool.name}", tool.name, kwargs))
+    # the plateaus first (the tops of the walls keep the stock over the model when it is within the roughing's
+    # stairs): faced flat, nothing left, so a later shank passing a wall's top at its clearance meets no stock
+    face = api_tool(tool) | feeds(plan, job, tool) | {
+        "stepover": round(c.stepover_percent / 100 * tool.diameter, 3), "sample_step": sample_step(tool),
+        "slope_range": [0.0, PLATEAU_DEG], "off_model": "skip", "final_depth": kwargs["bottom_z"],
+        "chord_tolerance": kwargs["chord_tolerance"], "post": job.machine.post}
+    plan.ops.insert(1, OpPlan("run_surface", f"Face plateaus {tool.name}", tool.name, face))
+    plan.decide("deep walls", f"{tool.describe()}: waterline Z{bottom:g}-{an.bounds[1][2]:g}, step-down "
+                f"{step_down:g} mm, nothing left, after the roughing",
+                f"{an.share_steeper(WALL_DEG) * 100:.0f} % of the model seen from above slopes more than "
+                f"{WALL_DEG:g} deg and the stock is {depth:.1f} mm deep; more than {short:g} mm below its top the "
+                f"finishing tools ({names}) hold their shanks, as wide as the cut, within their clearance of the "
+                f"{ROUGH_LEAVE:g} mm the roughing leaves on a wall; {tool.name}'s {tool.flute_length:g} mm flutes "
+                f"finish the walls first (its shank {ROUGH_SHANK_CLEAR:g} mm above the stock; a flat's side cuts a "
+                f"wall over its flutes' length: levels the roughing's step-down apart), so the later shanks pass the "
+                f"finished walls at their clearance; before it the plateaus (within {PLATEAU_DEG:g} deg) faced flat, "
+                f"step-over {face['stepover']:g} mm: the walls' tops keep the stock above the model where it is "
+                "within the roughing's stairs")
 
 
 def rest_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list, radiused: list) -> Optional[ToolSpec]:
@@ -320,7 +393,7 @@ def rest_op(plan: Plan, job: JobSpec, an: Analysis, finishing: list, radiused: l
 def rest_args(job: JobSpec, tool: ToolSpec) -> dict:
     """A rest op's region: where more than the tolerance is left by the earlier ops that `tool` reaches."""
     return {"region": "rest", "rest_from": "earlier_ops", "rest_tolerance": job.finish.tolerance,
-            "sample_step": round(min(0.5, max(0.1, tool.diameter / 20.0)), 3), "post": job.machine.post}
+            "sample_step": sample_step(tool), "post": job.machine.post}
 
 
 def pencil_op(plan: Plan, job: JobSpec, an: Analysis, rest: ToolSpec, radiused: list) -> None:
@@ -368,6 +441,7 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> 
     shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
                                                   compare)
     finishing_ops(plan, job, an, shallow, steep, transition)
+    walls_op(plan, job, an, [shallow, steep])
     rest = rest_op(plan, job, an, [shallow, steep], radiused)
     if rest is not None:
         pencil_op(plan, job, an, rest, radiused)

@@ -84,7 +84,7 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     rapid = job.machine.rapid
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
-            "tolerance": job.finish.tolerance, "ops": [op.as_dict() for op in plan.ops],
+            "tolerance": job.finish.tolerance, "cusp": job.finish.cusp, "ops": [op.as_dict() for op in plan.ops],
             "stock": stock_of_plan(job, plan.stock_box).as_dict(),
             "rapid_mm_min": None if rapid is None else list(rapid),
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),

@@ -6,7 +6,8 @@ A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: 
 the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess).
 The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
 vertical measure of a wall's cusps is many times their depth. What no library tool reaches from above (sharp inner
-corners, undercuts) is reported as its area, not judged."""
+corners, undercuts) is reported as its area, not judged. Where the finish asks a cusp larger than the tolerance,
+its passes leave cusps up to it by design: what is left is also counted against that allowance."""
 from __future__ import annotations
 
 import numpy as np
@@ -21,10 +22,10 @@ from tmm_workbench.core.tools.cutter import Cutter
 
 
 def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.ndarray, tool: str,
-                  cutter: Cutter, tolerance: float) -> dict:
+                  cutter: Cutter, tolerance: float, cusp: float = 0.0) -> dict:
     """`deviation` (ny, nx, vertical, + left; NaN without design) of the simulated Job against `design` on `grid`,
     judged where `cutter` (the library's smallest radiused tool, named `tool`) reaches: areas in mm^2, depths in mm
-    along the normal."""
+    along the normal; above the tolerance, and above the allowance: the larger of it and the finish's `cusp`."""
     finite = np.isfinite(design) & np.isfinite(deviation)
     envelope = tool_envelope(mesh, cutter, grid, DropSurface(mesh))
     radius = max(cutter.corner_radius, cutter.radius)
@@ -34,9 +35,12 @@ def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.n
     stock = np.where(finite, design + np.where(finite, deviation, 0.0), np.nan)
     left = np.where(reached, deviation, 0.0) * slope_cosine(stock, grid.cell)
     above = reached & (left > tolerance)
+    allowance = max(tolerance, cusp)
     inside = left[reached]
     return {"tool": tool, "reached_mm2": round(float(reached.sum()) * grid.cell_area, 1),
             "out_of_reach_mm2": round(float((finite & ~reached).sum()) * grid.cell_area, 1),
             "left_above_tolerance_mm2": round(float(above.sum()) * grid.cell_area, 2),
+            "allowance_mm": allowance,
+            "left_above_allowance_mm2": round(float((reached & (left > allowance)).sum()) * grid.cell_area, 2),
             "most_left_mm": round(float(inside.max()) if inside.size else 0.0, 4),
             "left_99_percentile_mm": round(float(np.percentile(inside, 99)) if inside.size else 0.0, 4)}

@@ -68,7 +68,11 @@ def summary(report: Mapping) -> str:
     reach = v.get("left_in_reach")
     if reach:
         rows.append((f"left where {reach['tool']} reaches (along the normal)",
-                     f"{reach['left_above_tolerance_mm2']:g} mm2 above the tolerance, most {mm(reach['most_left_mm'])}"
+                     f"{reach['left_above_tolerance_mm2']:g} mm2 above the tolerance"
+                     + (f" ({reach['left_above_allowance_mm2']:g} mm2 above the cusp asked, "
+                        f"{mm(reach['allowance_mm'])})"
+                        if reach.get("allowance_mm", 0) > report["finish"]["tolerance_mm"] else "")
+                     + f", most {mm(reach['most_left_mm'])}"
                      f", 99 %: {mm(reach['left_99_percentile_mm'])}; out of its reach from above: "
                      f"{reach['out_of_reach_mm2']:g} mm2 of {reach['reached_mm2'] + reach['out_of_reach_mm2']:g}"))
     return "\n".join(parts) + pairs(rows)

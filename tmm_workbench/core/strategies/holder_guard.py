@@ -7,7 +7,9 @@ left out: its own drop made the points); where one of them would come closer to 
 Raising a 3-axis tool never gouges (the cutter's drop is below), and the bodies' drop is monotone in height, so
 a vertical entry to a kept point is clear. Between two samples the bodies' height can rise steeply (a shank's
 edge rolling over a sharp rim: 0.19 mm under it halfway along a 0.5 mm step was measured): lifted moves get
-points inserted halfway until they pass at most BETWEEN_MM under it, inside the clearance. What it changed is reported with the shortest stick-out that cuts everything
+points inserted (a staircase where they climb or fall) until they pass at most BETWEEN_MM under it, inside the
+clearance; so do moves clear at both ends that pass under it in between (a raster's lean move climbing past a
+wall's top). What it changed is reported with the shortest stick-out that cuts everything
 (core.verify.holder_clearance.minimum_stick_out)."""
 from __future__ import annotations
 
@@ -31,6 +33,7 @@ BODIES = ("neck", "shank", "holder")
 TOLERANCE_MM = 1e-4    # a body this little above a point is not a collision (the drops' own accuracy is ~1e-9)
 BETWEEN_MM = 0.005     # a lifted move may pass this far under the bodies' height between its points (of ~1 mm)
 MIN_GAP_MM = 0.005     # and points are not inserted closer than this
+BETWEEN_FRACTIONS = (0.25, 0.5, 0.75)   # where a move clear at both ends is checked in between
 MAX_ROUNDS = 12        # halvings: a 0.5 mm sample step down to about 0.1 um
 MARK_CELL_MM = 0.5     # the report's spots: one affected point per cell this wide (the view draws them)
 MAX_SPOTS = 20000      # and at most this many (a larger region keeps every k-th)
@@ -104,11 +107,14 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     zb, owner = drop.heights_of(BODIES, allpts[:, :2], progress=progress)
     over = zb - allpts[:, 2]
     hit = (over > TOLERANCE_MM) & (owner >= 0)   # where the needle standing in for the cutter set it, no body did
+    between, between_owner = _low_between(drop, sampled, allpts)
+    owner = np.where(between & ~hit, between_owner, owner)   # the piece that set the height between
+    hit |= between
     report = HolderReport(mode, len(allpts))
     if not hit.any():
         return segments, report
     report.affected = int(hit.sum())
-    report.max_lift = float(over[hit].max())
+    report.max_lift = max(0.0, float(over[hit].max()))
     p = allpts[hit]
     report.region = (float(p[:, 0].min()), float(p[:, 1].min()), float(p[:, 0].max()), float(p[:, 1].max()))
     report.spots = spots(p)
@@ -151,19 +157,65 @@ def spots(points: np.ndarray, cell: float = MARK_CELL_MM, most: int = MAX_SPOTS)
     return kept[:: max(1, -(-len(kept) // most))]
 
 
+def _low_between(drop: AssemblyDrop, sampled: list, allpts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per sample: whether the straight move from it to the segment's next sample passes more than BETWEEN_MM
+    under the bodies' height at a quarter, half or three quarters of the way, both ends clear (a raster's lean
+    move climbing past a wall's top: the shank's edge crosses the wall's clearance between two samples 0.4 mm
+    apart). Both ends of such a move count as hit: the segment is lifted and refined (lift), the move left out
+    (leave_out). With the piece that set the height there (-1 elsewhere)."""
+    ends = np.cumsum([len(p) for p, _ in sampled])
+    inner = np.ones(len(allpts), dtype=bool)
+    inner[ends - 1] = False                        # a segment's last sample has no next one in it
+    first = np.flatnonzero(inner)
+    out = np.zeros(len(allpts), dtype=bool)
+    owners = np.full(len(allpts), -1, dtype=np.int64)
+    if not len(first):
+        return out, owners
+    a, b = allpts[first], allpts[first + 1]
+    low = np.zeros(len(first), dtype=bool)
+    by = np.full(len(first), -1, dtype=np.int64)
+    for t in BETWEEN_FRACTIONS:
+        at = a + t * (b - a)
+        zb, owner = drop.heights_of(BODIES, at[:, :2])
+        now = (zb - at[:, 2] > BETWEEN_MM) & (owner >= 0) & ~low
+        by[now] = owner[now]
+        low |= now
+    for k in (first[low], first[low] + 1):
+        out[k] = True
+        owners[k] = by[low]
+    return out, owners
+
+
 def _refined(drop: AssemblyDrop, tips: np.ndarray) -> np.ndarray:
-    """Lifted tips with points inserted halfway wherever the straight move between two would pass more than
-    BETWEEN_MM under the bodies' height (a holder's rounded edge over a sharp rim), down to MIN_GAP_MM apart."""
+    """Lifted tips with points inserted wherever the straight move between two would pass more than BETWEEN_MM
+    under the bodies' height at a quarter, half or three quarters of it (a holder's rounded edge over a sharp rim,
+    a shank's edge crossing a wall's clearance: the bodies' height can jump there), down to MIN_GAP_MM apart: a
+    climbing or falling move becomes a staircase (up first, or down last: the tool higher, never lower), a level
+    one gets the lifted points where it passed under."""
     for _ in range(MAX_ROUNDS):
+        a, b = tips[:-1], tips[1:]
         gap = np.hypot(*np.diff(tips[:, :2], axis=0).T)
-        mid = 0.5 * (tips[1:] + tips[:-1])
-        zb, _ = drop.heights_of(BODIES, mid[:, :2])
-        low = (zb - mid[:, 2] > BETWEEN_MM) & (gap > MIN_GAP_MM)
+        low = np.zeros(len(a), dtype=bool)
+        lifted = []
+        for t in BETWEEN_FRACTIONS:
+            mid = a + t * (b - a)
+            zb, _ = drop.heights_of(BODIES, mid[:, :2])
+            under = (zb - mid[:, 2] > BETWEEN_MM) & (gap > MIN_GAP_MM)
+            mid[:, 2] = np.maximum(mid[:, 2], zb)
+            low |= under
+            lifted.append((under, mid, t))
         if not low.any():
             break
-        mid[:, 2] = np.maximum(mid[:, 2], zb)
-        at = np.flatnonzero(low) + 1
-        tips = np.insert(tips, at, mid[low], axis=0)
+        sloped = low & (np.abs(b[:, 2] - a[:, 2]) > BETWEEN_MM)
+        corner = np.where((b[:, 2] > a[:, 2])[:, None], np.column_stack([a[:, :2], b[:, 2]]),
+                          np.column_stack([b[:, :2], a[:, 2]]))
+        new, keys = [corner[sloped]], [np.flatnonzero(sloped) + 0.5]
+        for under, mid, t in lifted:
+            level = under & ~sloped
+            new.append(mid[level])
+            keys.append(np.flatnonzero(level) + t)   # between the move's start (its index) and end, in order
+        order = np.argsort(np.concatenate([np.arange(len(tips), dtype=float)] + keys), kind="stable")
+        tips = np.vstack([tips] + new)[order]
     return tips
 
 
