@@ -4,7 +4,9 @@
 // rotated frame.
 #include "tmm/query/drop_assembly_direction.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -18,6 +20,8 @@ using direction_detail::kParallelAxisTol;
 using direction_detail::require_unit;
 
 namespace {
+
+constexpr double kTileFactor = 2.0;  // a tile's side in cutter radii
 
 // A frustum grown by c from its narrow end (radius rn, `narrow` along the tool axis from the tip) to its wide
 // end (radius rw, `length` further towards dir: +1 up the axis, -1 down it). `wide_covered`: another grown
@@ -93,10 +97,11 @@ std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std:
 // capped at max_travel. `lead` (or null): the solid dropped first, then set to the one that set the travel. The
 // next start is likely stopped by the same solid: its travel, found first, caps the others' searches (a holder
 // that holds the tool well above the part leaves the cutter little to test). A solid earlier in the list than
-// the one that stopped the tool so far wins a tie, as in the list's order.
+// the one that stopped the tool so far wins a tie, as in the list's order. `from`: the solids before it are left
+// out.
 double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
                     const Vector3d& start, const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats,
-                    int32_t* hints, std::size_t* lead) {
+                    int32_t* hints, std::size_t* lead, std::size_t from = 0) {
   constexpr std::size_t kNone = ~std::size_t{0};
   double best = max_travel;
   std::size_t winner = kNone;
@@ -108,14 +113,144 @@ double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<
       winner = k;
     }
   };
-  const std::size_t first = lead && *lead < solids.size() ? *lead : 0;
+  const std::size_t first = lead && *lead >= from && *lead < solids.size() ? *lead : from;
   drop(first);
-  for (std::size_t k = 0; k < solids.size(); ++k)
+  for (std::size_t k = from; k < solids.size(); ++k)
     if (k != first) drop(k);
-  if (lead) *lead = winner == kNone ? 0 : winner;
+  if (lead) *lead = winner == kNone ? from : winner;
   if (set_by) *set_by = winner == kNone ? kSetByFloor : solids[winner].owner;
   return best;
 }
+
+// A batch's starts in tiles `side` wide on the index's XY' plane: the starts by tile (in their order within
+// one) and where each tile's run begins (the last entry: n).
+void tile_runs(const DirectionalIndex& index, const double* starts, std::size_t n, double side,
+               std::vector<std::size_t>& order, std::vector<std::size_t>& runs) {
+  std::vector<std::uint64_t> key(n);
+  double x0 = INFINITY, y0 = INFINITY;
+  std::vector<Eigen::Vector2d> xy(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+    xy[i] = s.head<2>();
+    x0 = std::min(x0, s.x()), y0 = std::min(y0, s.y());
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    key[i] = (static_cast<std::uint64_t>((xy[i].y() - y0) / side) << 32) |
+             static_cast<std::uint64_t>((xy[i].x() - x0) / side);
+  order.resize(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  runs.clear();
+  for (std::size_t k = 0; k < n; ++k)
+    if (k == 0 || key[order[k]] != key[order[k - 1]]) runs.push_back(k);
+  runs.push_back(n);
+}
+
+// One axis for the batch: per tile of nearby starts, the first solid (the cutter's) dropped from each start by
+// its walk, then each further solid from the tile's candidates, gathered once with those travels as the caps
+// (the tool stops no later than its cutter: a holder high above the part gathers nothing). A solid's candidates
+// are the triangles within its reach of a start, above its lowest point at that start's cap and not below one
+// of its planes at every start: the same travels as a walk per start and solid. Starts with no finite cap
+// yet, and tiles of too few starts, walk. Ties go to the solid earlier in the list, as in along_solids.
+class TiledSolids {
+ public:
+  TiledSolids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters, const Vector3d& axis,
+              double max_travel)
+      : solids_(solids), cutters_(cutters), axis_(axis), max_travel_(max_travel), wins_(solids.size(), 0) {}
+
+  // The tile's starts starts[run[j]]: travels and owners into travel_out and set_by (may be null).
+  void solve(const double* starts, const std::size_t* run, std::size_t m, double* travel_out, int32_t* set_by,
+             int32_t* hints, DropStats* stats) {
+    constexpr int32_t kNone = -1;
+    best_.assign(m, max_travel_);
+    winner_.assign(m, kNone);
+    tips_.resize(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      const double* p = starts + 3 * run[j];
+      tips_[j] = Vector3d(p[0], p[1], p[2]);
+    }
+    led_.assign(m, 0);
+    for (std::size_t j = 0; j < m; ++j) {
+      // The solid that stopped the last start first (a holder over a deep pocket caps the cutter's walk),
+      // then the cutter capped by it.
+      led_[j] = lead_;
+      update(j, lead_, drop(lead_, j, stats, hints));
+      if (lead_ != 0) update(j, 0, drop(0, j, stats, hints));
+      if (!std::isfinite(best_[j])) {
+        // Nothing caps the bodies: each one's walk (the lead again), the one that stops the tool first.
+        std::size_t first = lead_;
+        const double t = along_solids(solids_, cutters_, tips_[j], axis_, best_[j], nullptr, stats, hints, &first, 1);
+        update(j, first, t);
+      }
+      if (winner_[j] != kNone) lead_ = static_cast<std::size_t>(winner_[j]);
+    }
+    // The bodies that stopped most of the last tile's starts first: their travels lower the others' caps.
+    order_.resize(solids_.size() - 1);
+    for (std::size_t k = 1; k < solids_.size(); ++k) order_[k - 1] = k;
+    std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return wins_[a] > wins_[b]; });
+    std::fill(wins_.begin(), wins_.end(), 0);
+    for (const std::size_t k : order_) {
+      const Vector3d lift = solids_[k].lift * axis_;
+      lifted_.clear();
+      caps_.clear();
+      listed_.clear();
+      for (std::size_t j = 0; j < m; ++j) {
+        if (!std::isfinite(best_[j]) || led_[j] == k) continue;  // done above
+        if (m >= kMinTileStarts) {
+          lifted_.push_back(tips_[j] + lift);
+          caps_.push_back(cap(j, k));
+          listed_.push_back(j);
+        } else {
+          update(j, k, cutters_[k].drop(tips_[j] + lift, cap(j, k), stats, &hints[k]));
+        }
+      }
+      if (listed_.empty()) continue;
+      // A list longer than this many triangles a start (a holder over a dense plate): each start's walk,
+      // which prunes it by its own contacts, costs less.
+      const bool listed = cutters_[k].gather(lifted_.data(), caps_.data(), lifted_.size(), cands_,
+                                             kMaxListPerStart * lifted_.size());
+      for (std::size_t q = 0; q < listed_.size(); ++q)
+        update(listed_[q], k, listed ? cutters_[k].drop_listed(lifted_[q], caps_[q], cands_, stats, &hints[k])
+                                     : cutters_[k].drop(lifted_[q], caps_[q], stats, &hints[k]));
+    }
+    for (std::size_t j = 0; j < m; ++j) {
+      if (winner_[j] != kNone) ++wins_[winner_[j]];
+      travel_out[run[j]] = best_[j];
+      if (set_by) set_by[run[j]] = winner_[j] == kNone ? kSetByFloor : solids_[winner_[j]].owner;
+    }
+  }
+
+ private:
+  static constexpr std::size_t kMinTileStarts = 4;  // fewer: each start's walk costs less than a gather
+  static constexpr std::size_t kMaxListPerStart = 40;
+
+  double drop(std::size_t k, std::size_t j, DropStats* stats, int32_t* hints) const {
+    return cutters_[k].drop(tips_[j] + solids_[k].lift * axis_, cap(j, k), stats, &hints[k]);
+  }
+
+  // A solid earlier in the list than the one that stopped start j so far wins a tie (as in along_solids).
+  bool before(std::size_t j, std::size_t k) const { return winner_[j] >= 0 && k < static_cast<std::size_t>(winner_[j]); }
+  double cap(std::size_t j, std::size_t k) const { return before(j, k) ? std::nextafter(best_[j], INFINITY) : best_[j]; }
+  void update(std::size_t j, std::size_t k, double t) {
+    if (t < best_[j] || (t == best_[j] && before(j, k))) {
+      best_[j] = t;
+      winner_[j] = static_cast<int32_t>(k);
+    }
+  }
+
+  const std::vector<AssemblySolid>& solids_;
+  const std::vector<AlongCutter>& cutters_;
+  Vector3d axis_;
+  double max_travel_;
+  std::size_t lead_ = 0;  // the solid that stopped the last start
+  std::vector<std::size_t> led_;  // per start: the solid dropped first
+  std::vector<double> best_, caps_;
+  std::vector<int32_t> winner_;
+  std::vector<std::size_t> order_, wins_;  // the bodies' order in a tile; each solid's wins in the last tile
+  std::vector<std::size_t> listed_;
+  std::vector<Vector3d> tips_, lifted_;
+  AlongCutter::Candidates cands_;
+};
 
 }  // namespace
 
@@ -175,9 +310,25 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
-  std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
-  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized(), true);
   std::atomic<std::size_t> tested{0};
+  if (any_tilted && !axes_per_point) {
+    // One tilted axis for all: the solids set up once, the starts in tiles.
+    const Vector3d a = Vector3d(axes[0], axes[1], axes[2]).normalized();
+    const std::vector<AlongCutter> shared = along_cutters(index, solids, a, true);
+    std::vector<std::size_t> order, runs;
+    tile_runs(index, starts, n, kTileFactor * tool.cutter().max_radius(), order, runs);
+    // Hints start afresh with each chunk of tiles, so results do not depend on the thread count.
+    parallel_chunks(runs.size() - 1, 8, options, [&](std::size_t begin, std::size_t end) {
+      DropStats local;
+      std::vector<int32_t> hints(solids.size(), -1);
+      TiledSolids tiles(solids, shared, a, max_travel);
+      for (std::size_t r = begin; r < end; ++r)
+        tiles.solve(starts, order.data() + runs[r], runs[r + 1] - runs[r], travel_out, set_by, hints.data(), &local);
+      tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+    });
+    if (stats) stats->triangles_tested += tested.load();
+    return;
+  }
   // Hints and the solid dropped first start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
@@ -191,8 +342,8 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
         travel_out[i] = axial_drop(index, tool, start, max_travel, by, &local);
       } else {
         const Vector3d a = axis.normalized();
-        travel_out[i] = along_solids(solids, axes_per_point ? along_cutters(index, solids, a) : shared, start, a,
-                                     max_travel, by, &local, hints.data(), &lead);
+        travel_out[i] = along_solids(solids, along_cutters(index, solids, a), start, a, max_travel, by, &local,
+                                     hints.data(), &lead);
       }
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
