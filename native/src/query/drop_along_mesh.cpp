@@ -245,9 +245,13 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, const 
     const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
     const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
     if (dx * dx + dy * dy > r2 || c.tri == skip) continue;
-    // Below the gather's plane at this start's tip (as below_everywhere, one start): missed before the best.
-    const double lim = q.s.z() - q.best + c.gx * q.s.x() + c.gy * q.s.y();
-    if (lim - c.h > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(c.h))) continue;
+    // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before
+    // the best.
+    auto under = [&](int w) {
+      const double lim = q.s.z() - q.best + c.gx[w] * q.s.x() + c.gy[w] * q.s.y();
+      return lim - c.h[w] > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(c.h[w]));
+    };
+    if (under(0) || under(1)) continue;
     consider(q, tris[c.tri], c.tri);
   }
   if (stats) stats->triangles_tested += q.tested;
@@ -261,17 +265,21 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, const 
 bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth,
                                    Candidate& best) const {
   const double* offsets = g.offsets.data();
-  double slack = -kInfinity;
+  double slack[2] = {-kInfinity, -kInfinity};  // at the worst start, at the centre
+  best.h[0] = best.h[1] = kInfinity;  // no plane: never below
+  best.gx[0] = best.gx[1] = best.gy[0] = best.gy[1] = 0.0;
   auto try_plane = [&](const Plane& p, double offset) {
     if (!(p.c > -kInfinity)) return false;
     double h = -kInfinity;
     for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + p.gx * t.p[k][0] + p.gy * t.p[k][1]);
     const double lim = p.c + offset, s = lim - h;
     if (s > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(h))) return true;  // margin against rounding
-    if (s > slack) {
-      slack = s;
-      best.h = h - p.c, best.gx = p.gx, best.gy = p.gy;
-    }
+    const double sc = p.c + g.centre.z() + p.gx * g.centre.x() + p.gy * g.centre.y() - h;
+    for (int w = 0; w < 2; ++w)
+      if ((w == 0 ? s : sc) > slack[w]) {
+        slack[w] = w == 0 ? s : sc;
+        best.h[w] = h - p.c, best.gx[w] = p.gx, best.gy[w] = p.gy;
+      }
     return false;
   };
   std::size_t k = 0;
@@ -291,7 +299,6 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int 
     const std::size_t f = static_cast<std::size_t>(fine_azimuth * kFineTilts + j);
     if (try_plane(fine_[f], offsets[k + f])) return true;
   }
-  if (slack == -kInfinity) best.h = kInfinity, best.gx = 0.0, best.gy = 0.0;  // no plane: never below
   return false;
 }
 
@@ -311,7 +318,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
     x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()), y1 = std::max(y1, s.y());
     out.tips.emplace_back(s.x(), s.y(), top);
-    centre += out.tips.back() / static_cast<double>(m);
+    out.centre = centre += out.tips.back() / static_cast<double>(m);
     std::size_t k = 0;
     for (const auto* set : {&planes_, &axial_})
       for (const Plane& p : *set) {
@@ -352,7 +359,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
       const int az = fine_.empty() ? 0 : azimuth(centre - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0);
-      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, 0.0, 0.0, 0.0};
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}};
       if (below_everywhere(t, out, az, c)) continue;
       if (out.list.size() == limit) return false;
       out.list.push_back(c);

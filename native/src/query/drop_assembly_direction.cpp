@@ -146,110 +146,118 @@ void tile_runs(const DirectionalIndex& index, const double* starts, std::size_t 
   runs.push_back(n);
 }
 
-// One axis for the batch: per tile of nearby starts, the first solid (the cutter's) dropped from each start by
-// its walk, then each further solid from the tile's candidates, gathered once with those travels as the caps
-// (the tool stops no later than its cutter: a holder high above the part gathers nothing). A solid's candidates
-// are the triangles within its reach of a start, above its lowest point at that start's cap and not below one
-// of its planes at every start: the same travels as a walk per start and solid. Starts with no finite cap
-// yet, and tiles of too few starts, walk. Ties go to the solid earlier in the list, as in along_solids.
+// One tilted axis for a batch, in two passes. In the starts' order, each start's lead solid (the one that
+// stopped the last start: a holder over a deep pocket caps the cutter's walk) by its walk, then the cutter's
+// walk capped by it; a start still uncapped (its cutter misses) gets every body's walk. Then per tile of nearby
+// starts, each other body from one gather of candidates with the travels so far as the caps (the tool stops no
+// later than that: a holder high above the part gathers nothing): the triangles within its reach of a start,
+// above its lowest point at that start's cap and not below one of its planes at every start, the same travels
+// as a walk per start and body. Ties go to the solid earlier in the list, as in along_solids.
 class TiledSolids {
  public:
   TiledSolids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters, const Vector3d& axis,
-              double max_travel)
-      : solids_(solids), cutters_(cutters), axis_(axis), max_travel_(max_travel), wins_(solids.size(), 0) {}
+              const double* starts, std::size_t n, double max_travel)
+      : solids_(solids), cutters_(cutters), axis_(axis), starts_(starts), best_(n, max_travel), winner_(n, kNone),
+        led_(n, kDone) {}
 
-  // The tile's starts starts[run[j]]: travels and owners into travel_out and set_by (may be null).
-  void solve(const double* starts, const std::size_t* run, std::size_t m, double* travel_out, int32_t* set_by,
-             int32_t* hints, DropStats* stats) {
-    constexpr int32_t kNone = -1;
-    best_.assign(m, max_travel_);
-    winner_.assign(m, kNone);
-    tips_.resize(m);
-    for (std::size_t j = 0; j < m; ++j) {
-      const double* p = starts + 3 * run[j];
-      tips_[j] = Vector3d(p[0], p[1], p[2]);
-    }
-    led_.assign(m, 0);
-    for (std::size_t j = 0; j < m; ++j) {
-      // The solid that stopped the last start first (a holder over a deep pocket caps the cutter's walk),
-      // then the cutter capped by it.
-      led_[j] = lead_;
-      update(j, lead_, drop(lead_, j, stats, hints));
-      if (lead_ != 0) update(j, 0, drop(0, j, stats, hints));
-      if (!std::isfinite(best_[j])) {
-        // Nothing caps the bodies: each one's walk (the lead again), the one that stops the tool first.
-        std::size_t first = lead_;
-        const double t = along_solids(solids_, cutters_, tips_[j], axis_, best_[j], nullptr, stats, hints, &first, 1);
-        update(j, first, t);
+  // A worker's lists, kept from tile to tile.
+  struct TileScratch {
+    explicit TileScratch(std::size_t solids) : wins(solids, 0), skip(solids, 0) {}
+    std::vector<std::size_t> order, wins, listed;  // the bodies' order; each solid's wins in the last tile
+    std::vector<int> skip;  // per solid: tiles left that walk (its last list was too long)
+    std::vector<Vector3d> lifted;
+    std::vector<double> caps;
+    AlongCutter::Candidates cands;
+  };
+
+  // The first pass over starts [begin, end), in their order.
+  void lead(std::size_t begin, std::size_t end, DropStats* stats) {
+    std::vector<int32_t> hints(solids_.size(), -1);
+    std::size_t lead = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      update(i, lead, drop(lead, i, stats, hints.data()));
+      if (lead != 0) update(i, 0, drop(0, i, stats, hints.data()));
+      if (std::isfinite(best_[i])) {
+        led_[i] = static_cast<int32_t>(lead);
+      } else {  // nothing caps the bodies: the one that stops the tool first (the lead again)
+        std::size_t first = lead;
+        update(i, first, along_solids(solids_, cutters_, tip(i), axis_, best_[i], nullptr, stats, hints.data(),
+                                      &first, 1));
       }
-      if (winner_[j] != kNone) lead_ = static_cast<std::size_t>(winner_[j]);
+      if (winner_[i] != kNone) lead = static_cast<std::size_t>(winner_[i]);
     }
+  }
+
+  // The second pass over the tile of starts run[0, m) (their order within the tile kept): the other bodies.
+  void bodies(const std::size_t* run, std::size_t m, std::vector<int32_t>& hints, TileScratch& t,
+              DropStats* stats) {
     // The bodies that stopped most of the last tile's starts first: their travels lower the others' caps.
-    order_.resize(solids_.size() - 1);
-    for (std::size_t k = 1; k < solids_.size(); ++k) order_[k - 1] = k;
-    std::stable_sort(order_.begin(), order_.end(), [&](std::size_t a, std::size_t b) { return wins_[a] > wins_[b]; });
-    std::fill(wins_.begin(), wins_.end(), 0);
-    for (const std::size_t k : order_) {
-      const Vector3d lift = solids_[k].lift * axis_;
-      lifted_.clear();
-      caps_.clear();
-      listed_.clear();
+    t.order.resize(solids_.size() - 1);
+    for (std::size_t k = 1; k < solids_.size(); ++k) t.order[k - 1] = k;
+    std::stable_sort(t.order.begin(), t.order.end(), [&](std::size_t a, std::size_t b) { return t.wins[a] > t.wins[b]; });
+    for (const std::size_t k : t.order) {
+      t.lifted.clear(), t.caps.clear(), t.listed.clear();
       for (std::size_t j = 0; j < m; ++j) {
-        if (!std::isfinite(best_[j]) || led_[j] == k) continue;  // done above
-        if (m >= kMinTileStarts) {
-          lifted_.push_back(tips_[j] + lift);
-          caps_.push_back(cap(j, k));
-          listed_.push_back(j);
-        } else {
-          update(j, k, cutters_[k].drop(tips_[j] + lift, cap(j, k), stats, &hints[k]));
+        const std::size_t i = run[j];
+        if (led_[i] == kDone || led_[i] == static_cast<int32_t>(k)) continue;  // done in the first pass
+        if (m < kMinTileStarts || t.skip[k] > 0) {
+          update(i, k, drop(k, i, stats, hints.data()));
+          continue;
         }
+        t.lifted.push_back(tip(i) + solids_[k].lift * axis_);
+        t.caps.push_back(cap(i, k));
+        t.listed.push_back(i);
       }
-      if (listed_.empty()) continue;
+      if (t.skip[k] > 0) --t.skip[k];
+      if (t.listed.empty()) continue;
       // A list longer than this many triangles a start (a holder over a dense plate): each start's walk,
       // which prunes it by its own contacts, costs less.
-      const bool listed = cutters_[k].gather(lifted_.data(), caps_.data(), lifted_.size(), cands_,
-                                             kMaxListPerStart * lifted_.size());
-      for (std::size_t q = 0; q < listed_.size(); ++q)
-        update(listed_[q], k, listed ? cutters_[k].drop_listed(lifted_[q], caps_[q], cands_, stats, &hints[k])
-                                     : cutters_[k].drop(lifted_[q], caps_[q], stats, &hints[k]));
+      const bool listed = cutters_[k].gather(t.lifted.data(), t.caps.data(), t.lifted.size(), t.cands,
+                                             kMaxListPerStart * t.lifted.size());
+      if (!listed) t.skip[k] = kWalkAfterLong;  // the next tiles are likely alike: no gather for a few
+      for (std::size_t q = 0; q < t.listed.size(); ++q)
+        update(t.listed[q], k,
+               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &hints[k])
+                      : cutters_[k].drop(t.lifted[q], t.caps[q], stats, &hints[k]));
     }
-    for (std::size_t j = 0; j < m; ++j) {
-      if (winner_[j] != kNone) ++wins_[winner_[j]];
-      travel_out[run[j]] = best_[j];
-      if (set_by) set_by[run[j]] = winner_[j] == kNone ? kSetByFloor : solids_[winner_[j]].owner;
+    std::fill(t.wins.begin(), t.wins.end(), 0);
+    for (std::size_t j = 0; j < m; ++j)
+      if (winner_[run[j]] != kNone) ++t.wins[winner_[run[j]]];
+  }
+
+  void write(double* travel_out, int32_t* set_by) const {
+    for (std::size_t i = 0; i < best_.size(); ++i) {
+      travel_out[i] = best_[i];
+      if (set_by) set_by[i] = winner_[i] == kNone ? kSetByFloor : solids_[winner_[i]].owner;
     }
   }
 
  private:
-  static constexpr std::size_t kMinTileStarts = 4;  // fewer: each start's walk costs less than a gather
+  static constexpr int32_t kNone = -1, kDone = -2;  // kDone: every solid dropped in the first pass
+  static constexpr std::size_t kMinTileStarts = 4;   // fewer: each start's walk costs less than a gather
   static constexpr std::size_t kMaxListPerStart = 40;
+  static constexpr int kWalkAfterLong = 4;
 
-  double drop(std::size_t k, std::size_t j, DropStats* stats, int32_t* hints) const {
-    return cutters_[k].drop(tips_[j] + solids_[k].lift * axis_, cap(j, k), stats, &hints[k]);
+  Vector3d tip(std::size_t i) const { return {starts_[3 * i], starts_[3 * i + 1], starts_[3 * i + 2]}; }
+  double drop(std::size_t k, std::size_t i, DropStats* stats, int32_t* hints) const {
+    return cutters_[k].drop(tip(i) + solids_[k].lift * axis_, cap(i, k), stats, &hints[k]);
   }
-
-  // A solid earlier in the list than the one that stopped start j so far wins a tie (as in along_solids).
-  bool before(std::size_t j, std::size_t k) const { return winner_[j] >= 0 && k < static_cast<std::size_t>(winner_[j]); }
-  double cap(std::size_t j, std::size_t k) const { return before(j, k) ? std::nextafter(best_[j], INFINITY) : best_[j]; }
-  void update(std::size_t j, std::size_t k, double t) {
-    if (t < best_[j] || (t == best_[j] && before(j, k))) {
-      best_[j] = t;
-      winner_[j] = static_cast<int32_t>(k);
+  // A solid earlier in the list than the one that stopped start i so far wins a tie (as in along_solids).
+  bool before(std::size_t i, std::size_t k) const { return winner_[i] >= 0 && k < static_cast<std::size_t>(winner_[i]); }
+  double cap(std::size_t i, std::size_t k) const { return before(i, k) ? std::nextafter(best_[i], INFINITY) : best_[i]; }
+  void update(std::size_t i, std::size_t k, double t) {
+    if (t < best_[i] || (t == best_[i] && before(i, k))) {
+      best_[i] = t;
+      winner_[i] = static_cast<int32_t>(k);
     }
   }
 
   const std::vector<AssemblySolid>& solids_;
   const std::vector<AlongCutter>& cutters_;
   Vector3d axis_;
-  double max_travel_;
-  std::size_t lead_ = 0;  // the solid that stopped the last start
-  std::vector<std::size_t> led_;  // per start: the solid dropped first
-  std::vector<double> best_, caps_;
-  std::vector<int32_t> winner_;
-  std::vector<std::size_t> order_, wins_;  // the bodies' order in a tile; each solid's wins in the last tile
-  std::vector<std::size_t> listed_;
-  std::vector<Vector3d> tips_, lifted_;
-  AlongCutter::Candidates cands_;
+  const double* starts_;
+  std::vector<double> best_;
+  std::vector<int32_t> winner_, led_;  // led_: per start the solid dropped first, or kDone
 };
 
 }  // namespace
@@ -315,17 +323,24 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
     // One tilted axis for all: the solids set up once, the starts in tiles.
     const Vector3d a = Vector3d(axes[0], axes[1], axes[2]).normalized();
     const std::vector<AlongCutter> shared = along_cutters(index, solids, a, true);
+    TiledSolids tiled(solids, shared, a, starts, n, max_travel);
+    // Hints and leads start afresh with each chunk, so results do not depend on the thread count.
+    parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
+      DropStats local;
+      tiled.lead(begin, end, &local);
+      tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+    });
     std::vector<std::size_t> order, runs;
     tile_runs(index, starts, n, kTileFactor * tool.cutter().max_radius(), order, runs);
-    // Hints start afresh with each chunk of tiles, so results do not depend on the thread count.
     parallel_chunks(runs.size() - 1, 8, options, [&](std::size_t begin, std::size_t end) {
       DropStats local;
       std::vector<int32_t> hints(solids.size(), -1);
-      TiledSolids tiles(solids, shared, a, max_travel);
+      TiledSolids::TileScratch scratch(solids.size());
       for (std::size_t r = begin; r < end; ++r)
-        tiles.solve(starts, order.data() + runs[r], runs[r + 1] - runs[r], travel_out, set_by, hints.data(), &local);
+        tiled.bodies(order.data() + runs[r], runs[r + 1] - runs[r], hints, scratch, &local);
       tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
     });
+    tiled.write(travel_out, set_by);
     if (stats) stats->triangles_tested += tested.load();
     return;
   }

@@ -133,17 +133,18 @@ class AlongCutter {
               int32_t* hint = nullptr) const;
 
   // The candidate triangles of a group of nearby starts (a tile), kept from tile to tile: each with its
-  // bounds and the plane under K it is most nearly below over the group, by which most of them are proven
-  // missed from one start in three products.
+  // bounds and two planes under K it is most nearly below (at the group's worst start, at its centre), by
+  // which most of them are proven missed from one start in a few products.
   struct Candidate {
     int32_t tri;
     double zmax, xmin, xmax, ymin, ymax;
-    double h, gx, gy;  // a plane under K, c - g . p: max over the corners of z + g . xy, less c
+    double h[2], gx[2], gy[2];  // planes under K, c - g . p: max over the corners of z + g . xy, less c
   };
   struct Candidates {
     std::vector<Candidate> list;  // by decreasing highest point
     std::vector<double> offsets;  // per plane under K: the lowest over the starts of top + g . tip
     std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
+    Eigen::Vector3d centre;             // their mean
     std::vector<char> fine_done;        // per azimuth: its fine planes' offsets are in
   };
   // One walk of the index for m starts (model frame) with their caps (finite): into `out` every triangle
