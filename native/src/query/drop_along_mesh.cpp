@@ -358,7 +358,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
-      const int az = fine_.empty() ? 0 : azimuth(centre - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0);
+      const Vector3d mid = (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
+      const int az = fine_.empty() ? 0 : azimuth(centre - mid);
       Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}};
       if (below_everywhere(t, out, az, c)) continue;
       if (out.list.size() == limit) return false;

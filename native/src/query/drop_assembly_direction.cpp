@@ -194,7 +194,8 @@ class TiledSolids {
     // The bodies that stopped most of the last tile's starts first: their travels lower the others' caps.
     t.order.resize(solids_.size() - 1);
     for (std::size_t k = 1; k < solids_.size(); ++k) t.order[k - 1] = k;
-    std::stable_sort(t.order.begin(), t.order.end(), [&](std::size_t a, std::size_t b) { return t.wins[a] > t.wins[b]; });
+    std::stable_sort(t.order.begin(), t.order.end(),
+                     [&](std::size_t a, std::size_t b) { return t.wins[a] > t.wins[b]; });
     for (const std::size_t k : t.order) {
       t.lifted.clear(), t.caps.clear(), t.listed.clear();
       for (std::size_t j = 0; j < m; ++j) {
@@ -243,8 +244,12 @@ class TiledSolids {
     return cutters_[k].drop(tip(i) + solids_[k].lift * axis_, cap(i, k), stats, &hints[k]);
   }
   // A solid earlier in the list than the one that stopped start i so far wins a tie (as in along_solids).
-  bool before(std::size_t i, std::size_t k) const { return winner_[i] >= 0 && k < static_cast<std::size_t>(winner_[i]); }
-  double cap(std::size_t i, std::size_t k) const { return before(i, k) ? std::nextafter(best_[i], INFINITY) : best_[i]; }
+  bool before(std::size_t i, std::size_t k) const {
+    return winner_[i] >= 0 && k < static_cast<std::size_t>(winner_[i]);
+  }
+  double cap(std::size_t i, std::size_t k) const {
+    return before(i, k) ? std::nextafter(best_[i], INFINITY) : best_[i];
+  }
   void update(std::size_t i, std::size_t k, double t) {
     if (t < best_[i] || (t == best_[i] && before(i, k))) {
       best_[i] = t;

@@ -168,9 +168,9 @@ class AlongCutter {
   };
   Search search(const Eigen::Vector3d& start, double max_travel) const;
   void consider(Search& q, const IndexedTriangle& t, int32_t i) const;
-  // Over a gather's starts (`offsets` as in Candidates): true when t lies below one of K's planes at every
-  // start; else `best` gets the plane nearest to that.
-    bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
+  // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
+  // planes at every start; else `best` gets the two planes nearest to that.
+  bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
   // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
   struct Plane {
     double c, gx, gy;
