@@ -97,11 +97,10 @@ std::vector<AlongCutter> along_cutters(const DirectionalIndex& index, const std:
 // capped at max_travel. `lead` (or null): the solid dropped first, then set to the one that set the travel. The
 // next start is likely stopped by the same solid: its travel, found first, caps the others' searches (a holder
 // that holds the tool well above the part leaves the cutter little to test). A solid earlier in the list than
-// the one that stopped the tool so far wins a tie, as in the list's order. `from`: the solids before it are left
-// out.
+// the one that stopped the tool so far wins a tie, as in the list's order.
 double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters,
                     const Vector3d& start, const Vector3d& axis, double max_travel, int32_t* set_by, DropStats* stats,
-                    int32_t* hints, std::size_t* lead, std::size_t from = 0) {
+                    int32_t* hints, std::size_t* lead) {
   constexpr std::size_t kNone = ~std::size_t{0};
   double best = max_travel;
   std::size_t winner = kNone;
@@ -113,11 +112,11 @@ double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<
       winner = k;
     }
   };
-  const std::size_t first = lead && *lead >= from && *lead < solids.size() ? *lead : from;
+  const std::size_t first = lead && *lead < solids.size() ? *lead : 0;
   drop(first);
-  for (std::size_t k = from; k < solids.size(); ++k)
+  for (std::size_t k = 0; k < solids.size(); ++k)
     if (k != first) drop(k);
-  if (lead) *lead = winner == kNone ? from : winner;
+  if (lead) *lead = winner == kNone ? 0 : winner;
   if (set_by) *set_by = winner == kNone ? kSetByFloor : solids[winner].owner;
   return best;
 }
@@ -126,6 +125,7 @@ double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<
 // one) and where each tile's run begins (the last entry: n).
 void tile_runs(const DirectionalIndex& index, const double* starts, std::size_t n, double side,
                std::vector<std::size_t>& order, std::vector<std::size_t>& runs) {
+  if (!(side > 0.0)) side = 1.0;  // a point cutter: any tile will do
   std::vector<std::uint64_t> key(n);
   double x0 = INFINITY, y0 = INFINITY;
   std::vector<Eigen::Vector2d> xy(n);
@@ -179,12 +179,11 @@ class TiledSolids {
       if (lead != 0) update(i, 0, drop(0, i, stats, hints.data()));
       if (std::isfinite(best_[i])) {
         led_[i] = static_cast<int32_t>(lead);
-      } else {  // nothing caps the bodies: the one that stops the tool first (the lead again)
-        std::size_t first = lead;
-        update(i, first, along_solids(solids_, cutters_, tip(i), axis_, best_[i], nullptr, stats, hints.data(),
-                                      &first, 1));
+      } else {  // nothing caps the bodies: each one's walk (the lead's found nothing), capped by those before
+        for (std::size_t k = 1; k < solids_.size(); ++k)
+          if (k != lead) update(i, k, drop(k, i, stats, hints.data()));
       }
-      if (winner_[i] != kNone) lead = static_cast<std::size_t>(winner_[i]);
+      lead = winner_[i] == kNone ? 0 : static_cast<std::size_t>(winner_[i]);
     }
   }
 
