@@ -166,6 +166,11 @@ bool AlongCutter::below(const Plane& p, const IndexedTriangle& t, double x, doub
   return true;
 }
 
+inline int AlongCutter::azimuth(const Vector3d& c) const {
+  const double ph = std::atan2(frame_.e2.dot(c), frame_.e1.dot(c));
+  return static_cast<int>(std::lround(ph * (kFineAzimuths / (2.0 * M_PI)))) & (kFineAzimuths - 1);
+}
+
 bool AlongCutter::below_a_plane(const IndexedTriangle& t, double x, double y, double top) const {
   if (fine_.empty()) {
     for (const Plane& p : planes_)
@@ -175,56 +180,196 @@ bool AlongCutter::below_a_plane(const IndexedTriangle& t, double x, double y, do
   for (const Plane& p : axial_)
     if (below(p, t, x, y, top)) return true;
   // The planes leaning away from the triangle's centre, seen from the axis (K lies beyond each plane).
-  const Vector3d c = Vector3d(x, y, top) - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
-  const double ph = std::atan2(frame_.e2.dot(c), frame_.e1.dot(c));
-  const int k = static_cast<int>(std::lround(ph * (kFineAzimuths / (2.0 * M_PI)))) & (kFineAzimuths - 1);
+  const int k = azimuth(Vector3d(x, y, top) - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0);
   for (int j = 0; j < kFineTilts; ++j)
     if (below(fine_[k * kFineTilts + j], t, x, y, top)) return true;
   return false;
 }
 
+AlongCutter::Search AlongCutter::search(const Vector3d& start, double max_travel) const {
+  Search q;
+  q.s = index_->rotation() * start;
+  q.best = max_travel;
+  q.floor = q.s.z() - max_travel + lowest_ - 1e-9;  // margin against rounding
+  return q;
+}
+
+inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i) const {
+  // Most candidates are not touched before the best contact so far: a plane under K that has the whole
+  // triangle below it proves it in a few products; else a separating plane found by the clearance
+  // certificate, at a fraction of the cost of the triangle's pieces.
+  if (q.best < kNoTravel && below_a_plane(t, q.s.x(), q.s.y(), q.s.z() - q.best)) return;
+  ++q.tested;
+  const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - q.s), q1 = frame_.to_tool(Vector3d(t.p[1]) - q.s),
+                 q2 = frame_.to_tool(Vector3d(t.p[2]) - q.s);
+  if (q.best < kNoTravel) {
+    const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
+    if (t0 >= q.best) return;
+    if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), q.best)) return;
+  }
+  const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges);
+  if (tr < q.best) {
+    q.best = tr;
+    q.winner = i;
+    q.floor = q.s.z() - tr + lowest_ - 1e-9;
+  }
+}
+
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
-  const Vector3d s = index_->rotation() * start;
-  const MeshIndex& mi = index_->index();
-  double best = max_travel;
-  int32_t winner = -1;
-  std::size_t tested = 0;
-  auto floor_of = [&](double t) { return s.z() - t + lowest_ - 1e-9; };  // margin against rounding
-  double floor_ref = floor_of(best);
-  auto test = [&](const IndexedTriangle& t, int32_t i) {
-    // Most candidates are not touched before the best contact so far: a plane under K that has the whole
-    // triangle below it proves it in a few products; else a separating plane found by the clearance
-    // certificate, at a fraction of the cost of the triangle's pieces.
-    if (best < kNoTravel && below_a_plane(t, s.x(), s.y(), s.z() - best)) return;
-    ++tested;
-    const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - s), q1 = frame_.to_tool(Vector3d(t.p[1]) - s),
-                   q2 = frame_.to_tool(Vector3d(t.p[2]) - s);
-    if (best < kNoTravel) {
-      const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
-      if (t0 >= best) return;
-      if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), best)) return;
-    }
-    const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, best, t.owned_edges);
-    if (tr < best) {
-      best = tr;
-      winner = i;
-      floor_ref = floor_of(best);
-    }
-  };
-  const auto& tris = mi.triangles();
-  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) test(tris[*hint], *hint);
+  Search q = search(start, max_travel);
+  const auto& tris = index_->index().triangles();
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
   walk_lowest(
-      mi, s.x(), s.y(), reach_, floor_ref,
+      index_->index(), q.s.x(), q.s.y(), reach_, q.floor,
       [&](double d, double x0, double x1, double y0, double y1, double enough) {
         return rise(d, x0, x1, y0, y1, enough);
       },
       [&](const IndexedTriangle& t, int32_t i) {
-        if (i != skip) test(t, i);
+        if (i != skip) consider(q, t, i);
       });
-  if (stats) stats->triangles_tested += tested;
-  if (hint) *hint = winner;
-  return best;
+  if (stats) stats->triangles_tested += q.tested;
+  if (hint) *hint = q.winner;
+  return q.best;
+}
+
+double AlongCutter::drop_listed(const Vector3d& start, double max_travel, const Candidates& cands, DropStats* stats,
+                                int32_t* hint) const {
+  Search q = search(start, max_travel);
+  const auto& tris = index_->index().triangles();
+  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) consider(q, tris[*hint], *hint);
+  const int32_t skip = hint ? *hint : -1;
+  const double r2 = reach_ * reach_;
+  for (const Candidate& c : cands.list) {
+    if (c.zmax <= q.floor) break;  // by decreasing height: the rest are no higher
+    const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
+    const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
+    if (dx * dx + dy * dy > r2 || c.tri == skip) continue;
+    // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before
+    // the best.
+    auto under = [&](int w) {
+      const double lim = q.s.z() - q.best + c.gx[w] * q.s.x() + c.gy[w] * q.s.y();
+      return lim - c.h[w] > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(c.h[w]));
+    };
+    if (under(0) || under(1)) continue;
+    consider(q, tris[c.tri], c.tri);
+  }
+  if (stats) stats->triangles_tested += q.tested;
+  if (hint) *hint = q.winner;
+  return q.best;
+}
+
+// Over a group of starts, a plane under K sits at each start's tip at its cap; `offsets` holds per plane the
+// lowest of top + g . tip over the starts, so that a point X lies below the plane at every start when
+// X.z + g . X.xy < c + offset (the per-start test of below(), the tip's terms gathered).
+bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth,
+                                   Candidate& best) const {
+  const double* offsets = g.offsets.data();
+  double slack[2] = {-kInfinity, -kInfinity};  // at the worst start, at the centre
+  best.h[0] = best.h[1] = kInfinity;  // no plane: never below
+  best.gx[0] = best.gx[1] = best.gy[0] = best.gy[1] = 0.0;
+  auto try_plane = [&](const Plane& p, double offset) {
+    if (!(p.c > -kInfinity)) return false;
+    double h = -kInfinity;
+    for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + p.gx * t.p[k][0] + p.gy * t.p[k][1]);
+    const double lim = p.c + offset, s = lim - h;
+    if (s > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(h))) return true;  // margin against rounding
+    const double sc = p.c + g.centre.z() + p.gx * g.centre.x() + p.gy * g.centre.y() - h;
+    for (int w = 0; w < 2; ++w)
+      if ((w == 0 ? s : sc) > slack[w]) {
+        slack[w] = w == 0 ? s : sc;
+        best.h[w] = h - p.c, best.gx[w] = p.gx, best.gy[w] = p.gy;
+      }
+    return false;
+  };
+  std::size_t k = 0;
+  for (const Plane& p : planes_)
+    if (try_plane(p, offsets[k++])) return true;
+  for (const Plane& p : axial_)
+    if (try_plane(p, offsets[k++])) return true;
+  if (!fine_.empty() && !g.fine_done[fine_azimuth]) {  // the azimuth's offsets, once a gather needs them
+    g.fine_done[fine_azimuth] = 1;
+    for (int j = 0; j < kFineTilts; ++j) {
+      const Plane& p = fine_[fine_azimuth * kFineTilts + j];
+      double& o = g.offsets[k + fine_azimuth * kFineTilts + j];
+      for (const Vector3d& tip : g.tips) o = std::min(o, tip.z() + p.gx * tip.x() + p.gy * tip.y());
+    }
+  }
+  for (int j = 0; j < (fine_.empty() ? 0 : kFineTilts); ++j) {
+    const std::size_t f = static_cast<std::size_t>(fine_azimuth * kFineTilts + j);
+    if (try_plane(fine_[f], offsets[k + f])) return true;
+  }
+  return false;
+}
+
+bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t m, Candidates& out,
+                         std::size_t limit) const {
+  out.list.clear();
+  if (m == 0) return true;
+  const std::size_t coarse = planes_.size() + axial_.size();
+  out.offsets.assign(coarse + fine_.size(), kInfinity);
+  double x0 = kInfinity, x1 = -kInfinity, y0 = kInfinity, y1 = -kInfinity, floor = kInfinity;
+  out.fine_done.assign(kFineAzimuths, 0);
+  out.tips.clear();
+  Vector3d centre = Vector3d::Zero();
+  for (std::size_t j = 0; j < m; ++j) {
+    const Vector3d s = index_->rotation() * starts[j];
+    const double top = s.z() - caps[j];
+    floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
+    x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()), y1 = std::max(y1, s.y());
+    out.tips.emplace_back(s.x(), s.y(), top);
+    out.centre = centre += out.tips.back() / static_cast<double>(m);
+    std::size_t k = 0;
+    for (const auto* set : {&planes_, &axial_})
+      for (const Plane& p : *set) {
+        out.offsets[k] = std::min(out.offsets[k], top + p.gx * s.x() + p.gy * s.y());
+        ++k;
+      }
+  }
+  const double r2 = reach_ * reach_;
+  auto far = [&](double xmin, double ymin, double xmax, double ymax) {
+    const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
+    return dx * dx + dy * dy > r2;
+  };
+  // A box whose highest corner under a plane's slope is below that plane at every start.
+  auto box_below = [&](const BvhNode& b) {
+    std::size_t k = 0;
+    for (const auto* set : {&planes_, &axial_})
+      for (const Plane& p : *set) {
+        const double hi = b.zmax + std::max(p.gx * b.xmin, p.gx * b.xmax) + std::max(p.gy * b.ymin, p.gy * b.ymax);
+        const double lim = p.c + out.offsets[k++];
+        if (hi < lim - 1e-9 * (1.0 + std::fabs(lim))) return true;
+      }
+    return false;
+  };
+  const MeshIndex& mi = index_->index();
+  const auto& nodes = mi.nodes();
+  const auto& tris = mi.triangles();
+  std::vector<int32_t> stack{0};
+  while (!stack.empty()) {
+    const BvhNode& node = nodes[stack.back()];
+    stack.pop_back();
+    if (node.zmax <= floor || far(node.xmin, node.ymin, node.xmax, node.ymax) || box_below(node)) continue;
+    if (node.count == 0) {
+      stack.push_back(node.first);
+      stack.push_back(node.first + 1);
+      continue;
+    }
+    for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
+      const IndexedTriangle& t = tris[i];
+      if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
+      const Vector3d mid = (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
+      const int az = fine_.empty() ? 0 : azimuth(centre - mid);
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}};
+      if (below_everywhere(t, out, az, c)) continue;
+      if (out.list.size() == limit) return false;
+      out.list.push_back(c);
+    }
+  }
+  std::sort(out.list.begin(), out.list.end(), [](const Candidate& a, const Candidate& b) {
+    return a.zmax != b.zmax ? a.zmax > b.zmax : a.tri < b.tri;
+  });
+  return true;
 }
 
 double drop_along_point(const DirectionalIndex& index, const Cutter& cutter, const Vector3d& start,

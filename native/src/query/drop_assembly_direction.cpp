@@ -4,7 +4,9 @@
 // rotated frame.
 #include "tmm/query/drop_assembly_direction.hpp"
 
+#include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -18,6 +20,8 @@ using direction_detail::kParallelAxisTol;
 using direction_detail::require_unit;
 
 namespace {
+
+constexpr double kTileFactor = 2.0;  // a tile's side in cutter radii
 
 // A frustum grown by c from its narrow end (radius rn, `narrow` along the tool axis from the tip) to its wide
 // end (radius rw, `length` further towards dir: +1 up the axis, -1 down it). `wide_covered`: another grown
@@ -117,6 +121,149 @@ double along_solids(const std::vector<AssemblySolid>& solids, const std::vector<
   return best;
 }
 
+// A batch's starts in tiles `side` wide on the index's XY' plane: the starts by tile (in their order within
+// one) and where each tile's run begins (the last entry: n).
+void tile_runs(const DirectionalIndex& index, const double* starts, std::size_t n, double side,
+               std::vector<std::size_t>& order, std::vector<std::size_t>& runs) {
+  if (!(side > 0.0)) side = 1.0;  // a point cutter: any tile will do
+  std::vector<std::uint64_t> key(n);
+  double x0 = INFINITY, y0 = INFINITY;
+  std::vector<Eigen::Vector2d> xy(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vector3d s = index.rotation() * Vector3d(starts[3 * i], starts[3 * i + 1], starts[3 * i + 2]);
+    xy[i] = s.head<2>();
+    x0 = std::min(x0, s.x()), y0 = std::min(y0, s.y());
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    key[i] = (static_cast<std::uint64_t>((xy[i].y() - y0) / side) << 32) |
+             static_cast<std::uint64_t>((xy[i].x() - x0) / side);
+  order.resize(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return key[a] < key[b]; });
+  runs.clear();
+  for (std::size_t k = 0; k < n; ++k)
+    if (k == 0 || key[order[k]] != key[order[k - 1]]) runs.push_back(k);
+  runs.push_back(n);
+}
+
+// One tilted axis for a batch, in two passes. In the starts' order, each start's lead solid (the one that
+// stopped the last start: a holder over a deep pocket caps the cutter's walk) by its walk, then the cutter's
+// walk capped by it; a start still uncapped (its cutter misses) gets every body's walk. Then per tile of nearby
+// starts, each other body from one gather of candidates with the travels so far as the caps (the tool stops no
+// later than that: a holder high above the part gathers nothing): the triangles within its reach of a start,
+// above its lowest point at that start's cap and not below one of its planes at every start, the same travels
+// as a walk per start and body. Ties go to the solid earlier in the list, as in along_solids.
+class TiledSolids {
+ public:
+  TiledSolids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters, const Vector3d& axis,
+              const double* starts, std::size_t n, double max_travel)
+      : solids_(solids), cutters_(cutters), axis_(axis), starts_(starts), best_(n, max_travel), winner_(n, kNone),
+        led_(n, kDone) {}
+
+  // A worker's lists, kept from tile to tile.
+  struct TileScratch {
+    explicit TileScratch(std::size_t solids) : wins(solids, 0), skip(solids, 0) {}
+    std::vector<std::size_t> order, wins, listed;  // the bodies' order; each solid's wins in the last tile
+    std::vector<int> skip;  // per solid: tiles left that walk (its last list was too long)
+    std::vector<Vector3d> lifted;
+    std::vector<double> caps;
+    AlongCutter::Candidates cands;
+  };
+
+  // The first pass over starts [begin, end), in their order.
+  void lead(std::size_t begin, std::size_t end, DropStats* stats) {
+    std::vector<int32_t> hints(solids_.size(), -1);
+    std::size_t lead = 0;
+    for (std::size_t i = begin; i < end; ++i) {
+      update(i, lead, drop(lead, i, stats, hints.data()));
+      if (lead != 0) update(i, 0, drop(0, i, stats, hints.data()));
+      if (std::isfinite(best_[i])) {
+        led_[i] = static_cast<int32_t>(lead);
+      } else {  // nothing caps the bodies: each one's walk (the lead's found nothing), capped by those before
+        for (std::size_t k = 1; k < solids_.size(); ++k)
+          if (k != lead) update(i, k, drop(k, i, stats, hints.data()));
+      }
+      lead = winner_[i] == kNone ? 0 : static_cast<std::size_t>(winner_[i]);
+    }
+  }
+
+  // The second pass over the tile of starts run[0, m) (their order within the tile kept): the other bodies.
+  void bodies(const std::size_t* run, std::size_t m, std::vector<int32_t>& hints, TileScratch& t,
+              DropStats* stats) {
+    // The bodies that stopped most of the last tile's starts first: their travels lower the others' caps.
+    t.order.resize(solids_.size() - 1);
+    for (std::size_t k = 1; k < solids_.size(); ++k) t.order[k - 1] = k;
+    std::stable_sort(t.order.begin(), t.order.end(),
+                     [&](std::size_t a, std::size_t b) { return t.wins[a] > t.wins[b]; });
+    for (const std::size_t k : t.order) {
+      t.lifted.clear(), t.caps.clear(), t.listed.clear();
+      for (std::size_t j = 0; j < m; ++j) {
+        const std::size_t i = run[j];
+        if (led_[i] == kDone || led_[i] == static_cast<int32_t>(k)) continue;  // done in the first pass
+        if (m < kMinTileStarts || t.skip[k] > 0) {
+          update(i, k, drop(k, i, stats, hints.data()));
+          continue;
+        }
+        t.lifted.push_back(tip(i) + solids_[k].lift * axis_);
+        t.caps.push_back(cap(i, k));
+        t.listed.push_back(i);
+      }
+      if (t.skip[k] > 0) --t.skip[k];
+      if (t.listed.empty()) continue;
+      // A list longer than this many triangles a start (a holder over a dense plate): each start's walk,
+      // which prunes it by its own contacts, costs less.
+      const bool listed = cutters_[k].gather(t.lifted.data(), t.caps.data(), t.lifted.size(), t.cands,
+                                             kMaxListPerStart * t.lifted.size());
+      if (!listed) t.skip[k] = kWalkAfterLong;  // the next tiles are likely alike: no gather for a few
+      for (std::size_t q = 0; q < t.listed.size(); ++q)
+        update(t.listed[q], k,
+               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &hints[k])
+                      : cutters_[k].drop(t.lifted[q], t.caps[q], stats, &hints[k]));
+    }
+    std::fill(t.wins.begin(), t.wins.end(), 0);
+    for (std::size_t j = 0; j < m; ++j)
+      if (winner_[run[j]] != kNone) ++t.wins[winner_[run[j]]];
+  }
+
+  void write(double* travel_out, int32_t* set_by) const {
+    for (std::size_t i = 0; i < best_.size(); ++i) {
+      travel_out[i] = best_[i];
+      if (set_by) set_by[i] = winner_[i] == kNone ? kSetByFloor : solids_[winner_[i]].owner;
+    }
+  }
+
+ private:
+  static constexpr int32_t kNone = -1, kDone = -2;  // kDone: every solid dropped in the first pass
+  static constexpr std::size_t kMinTileStarts = 4;   // fewer: each start's walk costs less than a gather
+  static constexpr std::size_t kMaxListPerStart = 40;
+  static constexpr int kWalkAfterLong = 4;
+
+  Vector3d tip(std::size_t i) const { return {starts_[3 * i], starts_[3 * i + 1], starts_[3 * i + 2]}; }
+  double drop(std::size_t k, std::size_t i, DropStats* stats, int32_t* hints) const {
+    return cutters_[k].drop(tip(i) + solids_[k].lift * axis_, cap(i, k), stats, &hints[k]);
+  }
+  // A solid earlier in the list than the one that stopped start i so far wins a tie (as in along_solids).
+  bool before(std::size_t i, std::size_t k) const {
+    return winner_[i] >= 0 && k < static_cast<std::size_t>(winner_[i]);
+  }
+  double cap(std::size_t i, std::size_t k) const {
+    return before(i, k) ? std::nextafter(best_[i], INFINITY) : best_[i];
+  }
+  void update(std::size_t i, std::size_t k, double t) {
+    if (t < best_[i] || (t == best_[i] && before(i, k))) {
+      best_[i] = t;
+      winner_[i] = static_cast<int32_t>(k);
+    }
+  }
+
+  const std::vector<AssemblySolid>& solids_;
+  const std::vector<AlongCutter>& cutters_;
+  Vector3d axis_;
+  const double* starts_;
+  std::vector<double> best_;
+  std::vector<int32_t> winner_, led_;  // led_: per start the solid dropped first, or kDone
+};
+
 }  // namespace
 
 std::vector<AssemblySolid> assembly_solids(const ToolAssembly& tool) {
@@ -175,9 +322,32 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
   for (std::size_t i = 0; i < (axes_per_point ? n : std::size_t{1}) && !any_tilted; ++i)
     any_tilted = !along_axis(index, Vector3d(axes[3 * i], axes[3 * i + 1], axes[3 * i + 2]));
   if (any_tilted) solids = assembly_solids(tool);  // throws here, not in a worker
-  std::vector<AlongCutter> shared;  // one tilted axis for all: the solids set up once
-  if (any_tilted && !axes_per_point) shared = along_cutters(index, solids, Vector3d(axes[0], axes[1], axes[2]).normalized(), true);
   std::atomic<std::size_t> tested{0};
+  if (any_tilted && !axes_per_point) {
+    // One tilted axis for all: the solids set up once, the starts in tiles.
+    const Vector3d a = Vector3d(axes[0], axes[1], axes[2]).normalized();
+    const std::vector<AlongCutter> shared = along_cutters(index, solids, a, true);
+    TiledSolids tiled(solids, shared, a, starts, n, max_travel);
+    // Hints and leads start afresh with each chunk, so results do not depend on the thread count.
+    parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
+      DropStats local;
+      tiled.lead(begin, end, &local);
+      tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+    });
+    std::vector<std::size_t> order, runs;
+    tile_runs(index, starts, n, kTileFactor * tool.cutter().max_radius(), order, runs);
+    parallel_chunks(runs.size() - 1, 8, options, [&](std::size_t begin, std::size_t end) {
+      DropStats local;
+      std::vector<int32_t> hints(solids.size(), -1);
+      TiledSolids::TileScratch scratch(solids.size());
+      for (std::size_t r = begin; r < end; ++r)
+        tiled.bodies(order.data() + runs[r], runs[r + 1] - runs[r], hints, scratch, &local);
+      tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
+    });
+    tiled.write(travel_out, set_by);
+    if (stats) stats->triangles_tested += tested.load();
+    return;
+  }
   // Hints and the solid dropped first start afresh with each chunk, so results do not depend on the thread count.
   parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
     DropStats local;
@@ -191,8 +361,8 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
         travel_out[i] = axial_drop(index, tool, start, max_travel, by, &local);
       } else {
         const Vector3d a = axis.normalized();
-        travel_out[i] = along_solids(solids, axes_per_point ? along_cutters(index, solids, a) : shared, start, a,
-                                     max_travel, by, &local, hints.data(), &lead);
+        travel_out[i] = along_solids(solids, along_cutters(index, solids, a), start, a, max_travel, by, &local,
+                                     hints.data(), &lead);
       }
     }
     tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);

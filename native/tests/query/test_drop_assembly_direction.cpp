@@ -356,6 +356,60 @@ TEST(DropAssemblyDirection, SharedTiltedAxisBatchIsPointByPoint) {
   }
 }
 
+// One tilted axis over thin posts standing on a low plate, a dense raster: the batch takes the bodies from one
+// candidate list per tile of starts, gathered once for all of them. Within a tile the cutter reaches the plate
+// at most starts and a post at a few (the caps far apart), and the holder meets a post from some starts only,
+// a post out of reach of the others: every travel and piece must be the point query's, which walks per start
+// (a list cut to one start's reach or cap, or a plane proof taken at the best start rather than the worst,
+// loses these contacts).
+TEST(DropAssemblyDirection, TiledBatchKeepsNeighboursCandidates) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> pos(-14, 14), tall(-12, 6);
+  const int posts = 40;
+  tmm::Vertices V(4 + 3 * posts, 3);
+  tmm::Triangles F(2 + posts, 3);
+  V.row(0) << -60, -60, -30;
+  V.row(1) << 60, -60, -30;
+  V.row(2) << 60, 60, -30;
+  V.row(3) << -60, 60, -30;
+  F.row(0) << 0, 1, 2;
+  F.row(1) << 0, 2, 3;
+  for (int k = 0; k < posts; ++k) {  // a fin 0.4 wide from the plate up to its top
+    const double x = pos(rng), y = pos(rng), a = pos(rng);
+    const int v = 4 + 3 * k;
+    V.row(v) << x, y, -30;
+    V.row(v + 1) << x + 0.4 * std::cos(a), y + 0.4 * std::sin(a), -30;
+    V.row(v + 2) << x + 0.2 * std::cos(a), y + 0.2 * std::sin(a), tall(rng);
+    F.row(2 + k) << v, v + 1, v + 2;
+  }
+  const Vector3d dir = Vector3d(0.15, -0.1, -1).normalized();
+  const tmm::DirectionalIndex index(V, F, dir);
+  const Vector3d axis = Vector3d(-0.3, 0.2, 1).normalized();
+  std::vector<double> starts;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) starts.insert(starts.end(), {-10 + 0.5 * (i % 2 ? 39 - j : j), -10 + 0.5 * i, 20.0});
+  const std::size_t n = starts.size() / 3;
+  for (const Tool& t : tools()) {
+    const ToolAssembly tool(t.cutter, t.bodies, t.clearance);
+    std::vector<double> travel(n);
+    std::vector<int32_t> by(n);
+    tmm::drop_assembly_along_batch(index, tool, starts.data(), axis.data(), false, n, kInf, travel.data(), by.data(),
+                                   tmm::BatchOptions());
+    int cutter_on_post = 0, body = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      int32_t b = 0;
+      const double tp = tmm::drop_assembly_along_point(index, tool, Vector3d(&starts[3 * i]), axis, kInf, &b);
+      ASSERT_NEAR(travel[i], tp, 1e-12) << i;
+      ASSERT_EQ(by[i], b) << i;
+      body += b >= 0;
+      cutter_on_post += b == tmm::kSetByCutter && tp < 49.0;  // the plate is about 50 below the starts
+    }
+    EXPECT_GT(body, 100);  // the bodies stop the tool at many starts, not all
+    EXPECT_LT(body, static_cast<int>(n) * 9 / 10);
+    EXPECT_GT(cutter_on_post, 10);
+  }
+}
+
 TEST(DropAssemblyDirection, Refusals) {
   const auto [V, F] = big_plane({0, 0, 0}, Vector3d::UnitX(), Vector3d::UnitY());
   const tmm::DirectionalIndex index(V, F, -Vector3d::UnitZ());

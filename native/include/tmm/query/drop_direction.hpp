@@ -132,7 +132,45 @@ class AlongCutter {
   double drop(const Eigen::Vector3d& start, double max_travel = kNoTravel, DropStats* stats = nullptr,
               int32_t* hint = nullptr) const;
 
+  // The candidate triangles of a group of nearby starts (a tile), kept from tile to tile: each with its
+  // bounds and two planes under K it is most nearly below (at the group's worst start, at its centre), by
+  // which most of them are proven missed from one start in a few products.
+  struct Candidate {
+    int32_t tri;
+    double zmax, xmin, xmax, ymin, ymax;
+    double h[2], gx[2], gy[2];  // planes under K, c - g . p: max over the corners of z + g . xy, less c
+  };
+  struct Candidates {
+    std::vector<Candidate> list;  // by decreasing highest point
+    std::vector<double> offsets;  // per plane under K: the lowest over the starts of top + g . tip
+    std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
+    Eigen::Vector3d centre;             // their mean
+    std::vector<char> fine_done;        // per azimuth: its fine planes' offsets are in
+  };
+  // One walk of the index for m starts (model frame) with their caps (finite): into `out` every triangle
+  // that may stop K before its cap from one of them, less those below one of K's planes at every start.
+  // False, the list unfinished, when it would hold more than `limit` triangles.
+  bool gather(const Eigen::Vector3d* starts, const double* caps, std::size_t m, Candidates& out,
+              std::size_t limit) const;
+  // drop() over a list gathered for this start with a cap of at least max_travel, in place of the walk: the
+  // same travel.
+  double drop_listed(const Eigen::Vector3d& start, double max_travel, const Candidates& cands,
+                     DropStats* stats = nullptr, int32_t* hint = nullptr) const;
+
  private:
+  // A drop's state: the start (index frame), the best travel so far, its triangle, the lowest height a
+  // triangle must reach to matter (K's lowest point at that travel).
+  struct Search {
+    Eigen::Vector3d s;
+    double best, floor;
+    int32_t winner = -1;
+    std::size_t tested = 0;
+  };
+  Search search(const Eigen::Vector3d& start, double max_travel) const;
+  void consider(Search& q, const IndexedTriangle& t, int32_t i) const;
+  // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
+  // planes at every start; else `best` gets the two planes nearest to that.
+  bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
   // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
   struct Plane {
     double c, gx, gy;
