@@ -319,7 +319,7 @@ class _Coverage:
         return np.where(touched & ~failed, np.maximum(self.level, cand), self.level), int(short.sum())
 
 
-def _tilt_reached(machine: TarusMachine, frm: np.ndarray, grid: PostureGrid) -> np.ndarray:
+def tilt_reached(machine: TarusMachine, frm: np.ndarray, grid: PostureGrid) -> np.ndarray:
     """(n, nl, no): the postures whose axis the machine's tilt C reaches at each CC point (the others are
     never taken: their lift S2, the costly half of the C-space, is not asked)."""
     axes = np.einsum("nji,pj->npi", frm, tool_rotation(*(g.ravel() for g in grid.mesh()))[:, 2, :])
@@ -332,7 +332,7 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
     where a CC point has no posture (within the machine's tilt), its left step (the guess for the next pass)
     is halved, down to a quarter of what was asked, and only those CC points rebuilt."""
     side = np.minimum(side, 2 * cutter.radius)
-    ask = _tilt_reached(machine, frm, grid)
+    ask = tilt_reached(machine, frm, grid)
     cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR, ask=ask)
     floor = 0.25 * side[:, 0]
     for _ in range(2):
@@ -389,7 +389,7 @@ class _Planes:
         out = []
         for p in cc_paths(self.mesh, self.direction, np.array([offset]), self.forward_step,
                           self.chord_tolerance):
-            ok = _tilt_reached(self.machine, p.frames, self.grid).any(axis=(1, 2)) if trim else True
+            ok = tilt_reached(self.machine, p.frames, self.grid).any(axis=(1, 2)) if trim else True
             if np.all(ok):
                 out.append(p)
                 continue
