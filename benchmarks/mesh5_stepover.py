@@ -97,6 +97,16 @@ def _largest(ok, b: float, rounds: int = 10) -> float:
     return a
 
 
+def _in_strips(q: np.ndarray, strips, grow: float) -> np.ndarray:
+    """(n,) whether each point (feed X, across Y) lies in one of the plan's unfinished strips (feed from, to,
+    across from, to), each grown by `grow` mm."""
+    inside = np.zeros(len(q), dtype=bool)
+    for f0, f1, c0, c1 in strips:
+        inside |= (q[:, 0] >= f0 - grow) & (q[:, 0] <= f1 + grow) & (q[:, 1] >= min(c0, c1) - grow) & \
+            (q[:, 1] <= max(c0, c1) + grow)
+    return inside
+
+
 def slow_check(mesh, plan, cutter, x_lines: int, step: float, sub: int = 16) -> tuple[np.ndarray, np.ndarray, float]:
     """The material left (mm, along the facet normals) at surface samples on `x_lines` lines across the whole
     feed width, every `step` mm across, under all passes' tools with their overruns, `sub` - 1 positions
@@ -162,6 +172,11 @@ def main() -> None:
         on = q[:, 0] == x
         print(f"  x = {x:6.1f} mm: {on.sum()} points, max {h[on].max():.4f} mm, above tau + 0.002 mm: "
               f"{(h[on] > tol + 0.002).sum()}, uncut {(~np.isfinite(h[on])).sum()}, least {h[on].min():.4f} mm")
+    if plan.unfinished:
+        inside = _in_strips(q, plan.unfinished, cutter.radius)
+        print(f"  outside the {len(plan.unfinished)} strips left for clean-up (grown by a radius): "
+              f"{int((~inside).sum())} points, max {h[~inside & np.isfinite(h)].max():.4f} mm, above tau + 0.002 mm: "
+              f"{int((h[~inside] > tol + 0.002).sum())}, uncut {int((~np.isfinite(h[~inside])).sum())}")
     for i in over[:: max(1, len(over) // 20)]:
         print(f"  ({q[i, 0]:.2f}, {q[i, 1]:.2f}) left {h[i]:.4f} mm")
     print()

@@ -262,10 +262,12 @@ class _Coverage:
 
     def _segments(self, path: CCPath) -> tuple[np.ndarray, np.ndarray]:
         """Per segment of the path, its CC points' two indices and the bins it spans (lo, hi); the overrun
-        adds a segment at each end from the end point to overrun mm beyond it."""
+        adds a segment at each end from the end point to overrun mm beyond it, except where the path was cut
+        short inside the mesh (beyond the machine's tilt: the overrun, lifted clear of the slope, cuts
+        little there)."""
         b = self.bin(path.points @ self.feed)
-        ext = self.bin(np.array([path.points[0] @ self.feed - self.overrun,
-                                 path.points[-1] @ self.feed + self.overrun]))
+        run = np.where(path.cut_short, 0.0, self.overrun)
+        ext = self.bin(np.array([path.points[0] @ self.feed - run[0], path.points[-1] @ self.feed + run[1]]))
         n = len(b)
         ij = np.array([[0, 0]] + [[i, i + 1] for i in range(n - 1)] + [[n - 1, n - 1]])
         bins = np.column_stack([np.r_[ext[0], b[:-1], b[-1]], np.r_[b[0], b[1:], ext[1]]])
@@ -394,7 +396,8 @@ class _Planes:
                 out.append(p)
                 continue
             edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
-            out += [replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b])
+            out += [replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b],
+                            cut_short=(bool(a > 0), bool(b < len(ok))))
                     for a, b in zip(edges[::2], edges[1::2]) if b - a >= 2]
         return out
 
@@ -474,7 +477,8 @@ def _beyond_tilt(plan: AdaptivePlan, cover: _Coverage, level: np.ndarray, whole:
     """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
     the machine's tilt do not (_Planes._reachable) are left for clean-up up to the plane (added to
     plan.unfinished), so that the next passes go on beside them instead of coming back for them."""
-    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & (level <= cover.level + 1e-9)
+    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & (level <= cover.level + 1e-9) & \
+        (cover.level < offset)
     if hole.any():
         for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
             f0 = cover.f0 + cover.width * a
