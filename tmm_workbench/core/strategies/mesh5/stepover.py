@@ -475,16 +475,18 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
 def _beyond_tilt(plan: AdaptivePlan, cover: _Coverage, level: np.ndarray, whole: List[CCPath],
                  paths: List[CCPath], offset: float) -> None:
     """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
-    the machine's tilt do not (_Planes._reachable) are left for clean-up up to the plane (added to
-    plan.unfinished), so that the next passes go on beside them instead of coming back for them."""
-    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & (level <= cover.level + 1e-9) & \
-        (cover.level < offset)
+    the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
+    reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of
+    coming back for them (or being held back by them)."""
+    gained = level > cover.level + 1e-9
+    reached = float(level[gained].min()) if gained.any() else offset
+    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & ~gained & (cover.level < reached)
     if hole.any():
         for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
             f0 = cover.f0 + cover.width * a
             plan.unfinished.append((float(f0), float(cover.f0 + cover.width * b), float(cover.level[a:b].min()),
-                                    float(offset)))
-        level = np.where(hole, np.maximum(level, offset), level)
+                                    reached))
+        level = np.where(hole, np.maximum(level, reached), level)
     cover.level = level
 
 
