@@ -353,12 +353,18 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
                grid: PostureGrid, machine: TarusMachine, ideal_weight: float):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
-    ones relaxed where no posture meets them), or None where some CC point still has no posture."""
+    ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
+    some CC point still has no posture. Where a path was cut short (beyond the machine's tilt), the CC points
+    with no posture next to that end are left out too (the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine)
     if cs.empty.any():
-        return None
+        paths, keep = _peel(paths, cs.empty)
+        if not paths or cs.empty[keep].any():
+            return None
+        pts, frm, side = pts[keep], frm[keep], side[keep]
+        cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
@@ -370,7 +376,26 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
         start += len(p)
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance)
-    return postures, widths, ends, side
+    return postures, widths, ends, side, paths
+
+
+def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
+    """The paths without the CC points with an empty C-space next to an end cut short, and the kept CC
+    points' indices (all paths in order); a path left with fewer than 2 CC points is dropped."""
+    out, keep, start = [], [], 0
+    for p in paths:
+        e = empty[start:start + len(p)]
+        a, b = 0, len(p)
+        while p.cut_short[0] and a < b and e[a]:
+            a += 1
+        while p.cut_short[1] and b > a and e[b - 1]:
+            b -= 1
+        if b - a >= 2:
+            out.append(p if (a, b) == (0, len(p)) else
+                       replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b]))
+            keep.append(np.arange(start + a, start + b))
+        start += len(p)
+    return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
 
 
 class _Planes:
@@ -522,6 +547,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
             got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight)
             if got is not None:
+                paths = got[4]
                 level, short = cover.advanced(paths, got[2])
                 if (level > cover.level + 1e-9)[cover.open].any():
                     break
@@ -540,7 +566,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             gap = skip
             guess = base + 2 * skip
             continue
-        postures, widths, ends, used = got
+        postures, widths, ends, used, paths = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
         runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun))
