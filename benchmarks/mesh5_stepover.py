@@ -3,11 +3,12 @@ D 0.5 in, tolerance 0.004 in, postures chosen for the Tarus motion time; the sca
 reference on the real tool positions; and one pass's motion time against the seed's nearest-to-ideal choice.
 
     .venv/bin/python benchmarks/mesh5_stepover.py [--surface convex|concave|complex] [--tolerance-in 0.004]
-        [--x-lines 11] [--step 0.25] [--no-pass-times]
+        [--x-lines 11] [--step 0.25] [--no-pass-times] [--constant [--every 5]]
 
 Prints the passes (seed: 49 adaptive, 84 at constant step-over), the compute time (wall and CPU: the machine is
 shared), the C-spaces built, the step between planes, and the slow check: the material left at surface samples
 on lines across the whole surface (every 0.25 mm) under all passes' tools with their overruns; then a table.
+--constant: instead, the largest constant step-over (constant_step) and its pass count.
 """
 from __future__ import annotations
 
@@ -23,11 +24,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 from benchmarks.seed000_surfaces import INCH, seed000_mesh  # noqa: E402
 from tests.core.scallop5_reference import remaining, surface_samples, swept_positions  # noqa: E402
 from tmm_workbench.core.machine.tarus import TarusMachine  # noqa: E402
-from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths, plane_normal  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.optimal import nearest_ideal, pass_motion_time, smooth_postures  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid  # noqa: E402
-from tmm_workbench.core.strategies.mesh5.stepover import OVERRUN_STEPS, adaptive_passes  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.lift import MeshReach  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.stepover import (INTERIOR, MARGIN, OVERRUN_STEPS, tilt_reached,  # noqa: E402
+                                                         adaptive_passes)
+from tmm_workbench.core.strategies.mesh5.top_bound import top_bounds  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 
@@ -42,6 +46,65 @@ def one_pass_times(mesh, cutter, tol: float, machine: TarusMachine) -> None:
     a, b = pass_motion_time(machine, seed), pass_motion_time(machine, dp)
     print(f"pass y = 0 ({len(path)} CC points, half step 2.5 mm): Tarus motion time nearest-to-ideal {a:.2f} s "
           f"({t1 - t0:.2f} s to choose), shortest path {b:.2f} s ({t2 - t1:.2f} s to choose), ratio {a / b:.2f}")
+
+
+def constant_step(mesh, cutter, tol: float, machine: TarusMachine, every: float = 5.0) -> tuple[float, int, float]:
+    """Seed 000's constant step-over by the same machinery: the largest step s between drive planes with which
+    every CC point of planes `every` mm apart (across the whole mesh) has a posture in its C-space (S2 <= S1
+    at MARGIN x tau, within the machine's tilt) leaving the tolerance at s / 2 on both sides (along LY: s / 2
+    over LY's share of the plane normal), so that any two neighbouring passes s apart meet. Bisection on S1
+    (S1 >= 0 is necessary), then on the whole C-space. (s, passes over the mesh, seconds)."""
+    t0 = time.perf_counter()
+    reach, grid = MeshReach(mesh), PostureGrid.degrees()
+    lo, hi = mesh.bounds[0][1], mesh.bounds[1][1]
+    lam, omg = (g.ravel() for g in grid.mesh())
+    best = np.inf
+    for offset in np.arange(lo + 0.125 * cutter.diameter, hi - 0.125 * cutter.diameter + 1e-9, every):
+        paths = cc_paths(mesh, (1, 0), np.array([offset]), 2.0, 0.01)
+        pts, frm = np.concatenate([p.points for p in paths]), np.concatenate([p.frames for p in paths])
+        ask = tilt_reached(machine, frm, grid)
+        keep = ask.any(axis=(1, 2))                                       # as the plan: beyond the tilt, left
+        pts, frm, ask = pts[keep], frm[keep], ask[keep]
+        across = np.maximum(frm[:, 1] @ plane_normal((1, 0)), 0.2)         # LY's share of the plane normal
+
+        def side(s: float) -> np.ndarray:
+            return np.minimum(0.5 * s / across, 2 * cutter.radius)
+
+        def s1_ok(s: float) -> bool:
+            top = top_bounds(reach, cutter, pts, frm, lam, omg, MARGIN * tol, side(s), interior=INTERIOR)
+            return bool(((top.reshape(ask.shape) >= 0) & ask).any(axis=(1, 2)).all())
+
+        def full_ok(s: float) -> bool:
+            return not build_cspace(reach, cutter, pts, frm, grid, MARGIN * tol, side(s), interior=INTERIOR,
+                                    ask=ask).empty.any()
+
+        b = min(best, 4 * cutter.radius)                                  # only a smaller step matters
+        if s1_ok(b) and full_ok(b):
+            continue
+        s = _largest(s1_ok, b)                                            # S1 >= 0 is necessary
+        best = s if full_ok(s) else _largest(full_ok, s)
+        print(f"  plane y = {offset:7.2f} mm: constant step <= {best:.3f} mm", flush=True)
+    count = 1 + int(np.ceil((hi - lo - 0.25 * cutter.diameter) / best - 1e-9))
+    return best, count, time.perf_counter() - t0
+
+
+def _largest(ok, b: float, rounds: int = 10) -> float:
+    """The largest s in (0, b) found ok by bisection (ok(0) taken as true)."""
+    a = 0.0
+    for _ in range(rounds):
+        mid = 0.5 * (a + b)
+        a, b = (mid, b) if ok(mid) else (a, mid)
+    return a
+
+
+def _in_strips(q: np.ndarray, strips, grow: float) -> np.ndarray:
+    """(n,) whether each point (feed X, across Y) lies in one of the plan's unfinished strips (feed from, to,
+    across from, to), each grown by `grow` mm."""
+    inside = np.zeros(len(q), dtype=bool)
+    for f0, f1, c0, c1 in strips:
+        inside |= (q[:, 0] >= f0 - grow) & (q[:, 0] <= f1 + grow) & (q[:, 1] >= min(c0, c1) - grow) & \
+            (q[:, 1] <= max(c0, c1) + grow)
+    return inside
 
 
 def slow_check(mesh, plan, cutter, x_lines: int, step: float, sub: int = 16) -> tuple[np.ndarray, np.ndarray, float]:
@@ -73,11 +136,21 @@ def main() -> None:
     ap.add_argument("--x-lines", type=int, default=11, help="lines across the feed for the slow check")
     ap.add_argument("--step", type=float, default=0.25, help="mm between the slow check's samples across")
     ap.add_argument("--no-pass-times", action="store_true")
+    ap.add_argument("--constant", action="store_true", help="only the constant step-over (seed: 84 passes on "
+                    "the convex surface at 0.004 in), planes every --every mm")
+    ap.add_argument("--every", type=float, default=5.0)
     a = ap.parse_args()
     mesh, _ = seed000_mesh(a.surface)
     cutter = Cutter.flat(0.5 * INCH)
     tol = a.tolerance_in * INCH
     machine = TarusMachine()
+    if a.constant:
+        cpu = time.process_time()
+        step, count, secs = constant_step(mesh, cutter, tol, machine, a.every)
+        print(f"seed 000 {a.surface}, tau {tol:.4f} mm: largest constant step {step:.3f} mm -> {count} passes over "
+              f"{mesh.bounds[1][1] - mesh.bounds[0][1]:.1f} mm (planes checked every {a.every:g} mm; "
+              f"{secs:.1f} s wall / {time.process_time() - cpu:.1f} s CPU)")
+        return
     if not a.no_pass_times:
         one_pass_times(mesh, cutter, tol, machine)
     cpu = time.process_time()
@@ -99,6 +172,11 @@ def main() -> None:
         on = q[:, 0] == x
         print(f"  x = {x:6.1f} mm: {on.sum()} points, max {h[on].max():.4f} mm, above tau + 0.002 mm: "
               f"{(h[on] > tol + 0.002).sum()}, uncut {(~np.isfinite(h[on])).sum()}, least {h[on].min():.4f} mm")
+    if plan.unfinished:
+        inside = _in_strips(q, plan.unfinished, cutter.radius)
+        print(f"  outside the {len(plan.unfinished)} strips left for clean-up (grown by a radius): "
+              f"{int((~inside).sum())} points, max {h[~inside & np.isfinite(h)].max():.4f} mm, above tau + 0.002 mm: "
+              f"{int((h[~inside] > tol + 0.002).sum())}, uncut {int((~np.isfinite(h[~inside])).sum())}")
     for i in over[:: max(1, len(over) // 20)]:
         print(f"  ({q[i, 0]:.2f}, {q[i, 1]:.2f}) left {h[i]:.4f} mm")
     print()

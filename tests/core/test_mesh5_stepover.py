@@ -14,13 +14,14 @@ from tests.core.scallop5_reference import remaining, surface_samples, swept_posi
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
-from tmm_workbench.core.strategies.mesh5.lift import MeshReach
+from tmm_workbench.core.machine.tarus import TarusMachine
+from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
 from tmm_workbench.core.strategies.mesh5.stepover import (BETWEEN_TOL, OVERRUN_STEPS, _Coverage, adaptive_passes,
                                                          between_positions, clear_lifts, half_widths,
-                                                         overrun_positions)
+                                                         overrun_positions, tilt_reached)
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -219,3 +220,36 @@ def test_the_finished_level_moves_only_in_the_bins_a_pass_runs_through():
     level, short = cover.advanced([path], ends)
     assert short == 3 and np.allclose(level[cover.bin(np.array([6.0, 10.0]))], 0.0)
     assert np.allclose(level[cover.bin(np.array([2.0, 14.0]))], 9.0)
+
+
+def test_cc_points_beyond_the_machine_tilt_are_left_out_and_their_bins_reported():
+    # flat for x < 4, then falling along the feed at 30 deg: with the tool leaning along the feed, every
+    # posture there tilts the axis 30 deg or more from vertical, beyond a machine tilt of 20 deg
+    mesh = grid_mesh(lambda x, y: -np.clip(x - 4.0, 0, None) * math.tan(math.radians(30)), 24, 40,
+                     (-12, -10, 12, 10), "drop")
+    machine = TarusMachine(c_limits=(0.0, math.radians(20.0)))
+    grid = PostureGrid.degrees((0, 12), (-12, 12))
+    assert not tilt_reached(machine, cc_paths(mesh, (1, 0), np.array([0.0]), 3.0, 0.01)[0].frames[-1:],
+                            grid).any()
+    plan = adaptive_passes(mesh, Cutter.flat(10.0), TOL, (1, 0), machine, grid, forward_step=3.0)
+    pts = np.concatenate([p.points for q in plan.passes for p in q.paths])
+    assert pts[:, 0].max() < 6.0                                            # none on the slope
+    assert all(p.cut_short == (False, True) for q in plan.passes for p in q.paths)
+    strips = np.array(plan.unfinished)
+    assert len(strips) and (strips[:, 1] > 6.0).all() and (strips[:, 0] >= 2.0).all()    # on the slope
+    assert strips[:, 2].min() <= -9.0 and strips[:, 3].max() >= 9.0        # all across
+    assert plan.passes[-1].band[1] == pytest.approx(10.0)                  # the flat part finished
+
+
+def test_paired_lifts_are_the_diagonal_of_the_masked_call():
+    mesh = grid_mesh(lambda x, y: 0.02 * x * x - 0.01 * y * y, 10, 10, (-10, -10, 10, 10), "saddle")
+    path = cc_paths(mesh, (1, 0), np.array([0.0]), 3.0, 0.01)[0]
+    n = len(path)
+    lam, omg = np.radians(np.linspace(0, 30, n)), np.radians(np.linspace(-20, 20, n))
+    cutter = Cutter.flat(8.0)
+    reach = MeshReach(mesh)
+    both = lifts(reach, cutter, path.points, path.frames, lam, omg, 4.0, np.eye(n, dtype=bool))
+    one = lifts(reach, cutter, path.points, path.frames, lam, omg, 4.0, paired=True)
+    assert one.shape == (n,) and np.array_equal(one, np.diagonal(both)) and (one > 0).any()
+    with pytest.raises(TmmError, match="paired lifts take one posture per CC point"):
+        lifts(reach, cutter, path.points, path.frames, lam[:2], omg[:2], 4.0, paired=True)

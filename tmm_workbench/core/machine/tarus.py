@@ -148,6 +148,15 @@ class TarusMachine:
         return {"X": self.x_limits, "Y": self.y_limits, "Z": self.z_limits, "A": self.a_limits,
                 "C": self.c_limits}
 
+    def tilt_within(self, axes: np.ndarray, slack: float = 1e-9) -> np.ndarray:
+        """(...,) for unit axes (..., 3): whether the tilt C of one of the two joint solutions (C or -C, as
+        `candidates` gives them) lies within the C limits, `slack` rad wider: a necessary condition of
+        `inverse` (the other joints' limits are not checked)."""
+        u = np.asarray(axes, dtype=float)
+        c = np.arctan2(np.hypot(u[..., 0], u[..., 1]), u[..., 2])
+        lo, hi = self.c_limits[0] - slack, self.c_limits[1] + slack
+        return ((lo <= c) & (c <= hi)) | ((lo <= -c) & (-c <= hi))
+
     # --- kinematics --------------------------------------------------------------------------
     def forward(self, joints: Joints | Sequence[float]) -> tuple[np.ndarray, np.ndarray]:
         """(tip, axis) in the work frame for machine joints (Joints or x, y, z, a, c)."""

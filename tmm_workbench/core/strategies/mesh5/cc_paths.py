@@ -30,6 +30,9 @@ class CCPath:
     points: np.ndarray      # (n, 3) CC points on the mesh, in feed order
     normals: np.ndarray     # (n, 3) unit normals interpolated from the vertex normals
     frames: np.ndarray      # (n, 3, 3) rows LX (feed), LY, LZ (normal) of each CC point's LCS
+    # the path stops inside the mesh at its start / end (the planner left out CC points beyond the machine's
+    # tilt there), not where the plane leaves the mesh
+    cut_short: tuple[bool, bool] = (False, False)
 
     def __len__(self) -> int:
         return len(self.points)

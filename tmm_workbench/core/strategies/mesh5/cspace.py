@@ -60,13 +60,14 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
                  grid: PostureGrid, tolerance: float, side_step, lift_limit: Optional[float] = None,
                  tool_length: Optional[float] = None, all_lifts: bool = False,
                  progress: Optional[Progress] = None, assembly: Optional[ToolAssembly] = None,
-                 interior: int = 0) -> CSpace:
+                 interior: int = 0, ask: Optional[np.ndarray] = None) -> CSpace:
     """The C-spaces at the n CC points (points (n, 3), frames (n, 3, 3) rows LX, LY, LZ, as cc_paths gives
     them). `side_step`: the half step-over on each side (number, (n,) or (n, 2): left +LY, right -LY).
     `lift_limit`: lifts above it count as unavailable (default: the largest finite top bound, at least the
     tolerance; with `all_lifts` the cutter radius). `assembly`: the cutter's ToolAssembly, whose shank and
     holder (with their clearances) then bound S2 too. `interior`: points checked inside each side step too
-    (top_bounds)."""
+    (top_bounds). `ask` (n, nl, no) bool: the postures that may be taken at all (e.g. those whose axis the
+    machine reaches); S2 is not asked elsewhere (NaN: unavailable)."""
     require_plain(cutter)
     reach = mesh if isinstance(mesh, MeshReach) else MeshReach(mesh)
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
@@ -85,5 +86,11 @@ def build_cspace(mesh: TriMesh | MeshReach, cutter: Cutter, points: np.ndarray, 
     elif not (isinstance(lift_limit, (int, float)) and math.isfinite(lift_limit) and lift_limit >= 0):
         raise TmmError(f"lift limit must be a finite number of mm >= 0, got {lift_limit!r}")
     mask = None if all_lifts else top >= 0
+    if ask is not None:
+        ask = np.asarray(ask, dtype=bool)
+        if ask.shape != shape:
+            raise TmmError(f"ask must be a {shape} array of postures, got shape {ask.shape}")
+        ask = ask.reshape(len(pts), -1)
+        mask = ask if mask is None else mask & ask
     lf = lifts(reach, cutter, pts, frm, lam, omg, float(lift_limit), mask, tool_length, progress, assembly)
     return CSpace(grid, lf.reshape(shape), top.reshape(shape))

@@ -91,15 +91,29 @@ def _pair_copies(reach: MeshReach, cutter: Cutter, point: np.ndarray, frame: np.
     cone = R + rmax + tan_max * (np.maximum(cen[:, 2] + rad, 0.0) + rmax) + rad
     near = np.hypot(cen[:, 0], cen[:, 1]) <= cone
     idx, cen, rad = idx[near], cen[near], rad[near]
-    # centroids in every posture's tool frame, one matrix product per component: (k, P) each
-    qx, qy, qz = (cen @ rp[:, c, :].T - tip_t[postures][:, c] for c in range(3))
+    # the centroid test, a necessary condition of the exact one below: the centroids in every posture's tool
+    # frame, (k, P) per component, in float32 (memory-bound; its rounding, < 1e-5 mm here, is covered by
+    # `slack`, so the candidates are a superset and the exact test's result is the same)
+    tp = tip_t[postures].astype(np.float32)
+    rq = np.ascontiguousarray(rp.transpose(1, 2, 0), dtype=np.float32)    # (component, LCS axis, P)
+    c32 = cen.astype(np.float32)
+    slack = 1e-6 * (float(np.abs(cen).max(initial=0.0)) + R + top) + 1e-9 * R
+    qx = c32 @ rq[0]
+    qx -= tp[:, 0]
+    qy = c32 @ rq[1]
+    qy -= tp[:, 1]
     qx *= qx
     qy *= qy
     qx += qy
-    reach_r = rmax * (1 + 1e-9) + rad[:, None]
-    eps = 1e-9 * R
-    keep = (qx <= reach_r * reach_r) & (qz + rad[:, None] >= zlow - eps) & (qz - rad[:, None] <= top)
+    reach_r = (rmax + slack + rad.astype(np.float32))[:, None]
+    keep = qx <= reach_r * reach_r
+    del qx, qy
+    qz = c32 @ rq[2]
+    qz -= tp[:, 2]
+    r32 = (rad + slack).astype(np.float32)[:, None]
+    keep &= (qz + r32 >= zlow) & (qz - r32 <= top)
     k_of, p_of = np.nonzero(keep)
+    eps = 1e-9 * R
     loc = (reach.corners[idx] - point) @ frame.T
     tri = np.matmul(loc[k_of], rp[p_of].transpose(0, 2, 1)) - tip_t[postures][p_of][:, None, :]
     # the exact test on the candidates: the triangle's shadow within a column's radius, its z range reaching it
@@ -131,11 +145,12 @@ def _axis_distance(xy: np.ndarray) -> np.ndarray:
 def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
           omg: np.ndarray, lift_limit: float, mask: Optional[np.ndarray] = None,
           tool_length: Optional[float] = None, progress: Optional[Progress] = None,
-          assembly: Optional[ToolAssembly] = None) -> np.ndarray:
+          assembly: Optional[ToolAssembly] = None, paired: bool = False) -> np.ndarray:
     """Lifts (n, P) of the P postures (lam, omg: (P,) radians) at the n CC points (points (n, 3), frames
     (n, 3, 3) rows LX, LY, LZ). NaN where `mask` (n, P) is False (not asked), inf above `lift_limit`. With an
     `assembly` (of this cutter) the flutes, neck, shank and holder keep their clearances too (the kernel's
-    assembly drop), and tool_length is the assembly's top."""
+    assembly drop), and tool_length is the assembly's top. `paired`: the k-th posture is the k-th CC
+    point's only one (P = n, no mask), and the lifts come back (n,)."""
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     frm = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
     lam = np.asarray(lam, dtype=float).reshape(-1)
@@ -150,11 +165,13 @@ def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarr
     if not (math.isfinite(tool_length) and tool_length > 0):
         raise TmmError(f"tool length must be a positive number of mm, got {tool_length!r}")
     n, P = len(pts), len(lam)
-    ask = np.ones((n, P), dtype=bool) if mask is None else np.asarray(mask, dtype=bool).reshape(n, P)
+    if paired and (P != n or mask is not None):
+        raise TmmError(f"paired lifts take one posture per CC point and no mask: {n} CC points, {P} postures")
+    ask = None if mask is None or paired else np.asarray(mask, dtype=bool).reshape(n, P)
     columns = tool_columns(cutter, tool_length, assembly)
     rot = tool_rotation(lam, omg)                                        # (P, 3, 3)
     tip_t = np.einsum("pij,pj->pi", rot, touch_tip(cutter, rot))         # tip in each tool frame
-    out = np.full((n, P), np.nan)
+    out = np.full((n, 1 if paired else P), np.nan)
     ask_progress = cancel.asker() if progress is None else progress
     pairs, tris = [], []
     budget = 0
@@ -166,11 +183,11 @@ def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarr
         pairs, tris, budget = [], [], 0
 
     for i in range(n):
-        postures = np.flatnonzero(ask[i])
+        postures = np.array([i]) if paired else np.arange(P) if ask is None else np.flatnonzero(ask[i])
         if postures.size == 0:
             continue
         p_of, tri = _pair_copies(reach, cutter, pts[i], frm[i], rot, tip_t, postures, columns, lift_limit)
-        pairs.append((i, postures, p_of))
+        pairs.append((i, np.zeros(1, dtype=np.int64) if paired else postures, p_of))
         tris.append(tri)
         budget += len(tri)
         if budget >= CHUNK_TRIANGLES:
@@ -178,7 +195,7 @@ def lifts(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarr
         if ask_progress is not None and not ask_progress((i + 1) / n):
             raise Cancelled("tool path computation cancelled")
     flush()
-    return out
+    return out[:, 0] if paired else out
 
 
 def _drop_atlas(cutter: Cutter, assembly: Optional[ToolAssembly], reach_radius: float, pairs, tris,

@@ -174,9 +174,7 @@ def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.nda
     a = np.einsum("nij,nj->ni", frames, axes)                              # the axis in each LCS
     lam, omg = np.arccos(np.clip(a[:, 2], -1.0, 1.0)), np.arctan2(a[:, 1], a[:, 0])
     pts = tips - np.einsum("nji,nj->ni", frames, touch_tip(cutter, tool_rotation(lam, omg)))
-    n = len(tips)
-    return np.diagonal(lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, np.eye(n, dtype=bool),
-                             assembly=assembly)).copy()
+    return lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, paired=True, assembly=assembly)
 
 
 def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray, frames: np.ndarray,
@@ -267,10 +265,12 @@ class _Coverage:
 
     def _segments(self, path: CCPath) -> tuple[np.ndarray, np.ndarray]:
         """Per segment of the path, its CC points' two indices and the bins it spans (lo, hi); the overrun
-        adds a segment at each end from the end point to overrun mm beyond it."""
+        adds a segment at each end from the end point to overrun mm beyond it, except where the path was cut
+        short inside the mesh (beyond the machine's tilt: the overrun, lifted clear of the slope, cuts
+        little there)."""
         b = self.bin(path.points @ self.feed)
-        ext = self.bin(np.array([path.points[0] @ self.feed - self.overrun,
-                                 path.points[-1] @ self.feed + self.overrun]))
+        run = np.where(path.cut_short, 0.0, self.overrun)
+        ext = self.bin(np.array([path.points[0] @ self.feed - run[0], path.points[-1] @ self.feed + run[1]]))
         n = len(b)
         ij = np.array([[0, 0]] + [[i, i + 1] for i in range(n - 1)] + [[n - 1, n - 1]])
         bins = np.column_stack([np.r_[ext[0], b[:-1], b[-1]], np.r_[b[0], b[1:], ext[1]]])
@@ -324,13 +324,22 @@ class _Coverage:
         return np.where(touched & ~failed, np.maximum(self.level, cand), self.level), int(short.sum())
 
 
+def tilt_reached(machine: TarusMachine, frm: np.ndarray, grid: PostureGrid) -> np.ndarray:
+    """(n, nl, no): the postures whose axis the machine's tilt C reaches at each CC point (the others are
+    never taken: their lift S2, the costly half of the C-space, is not asked)."""
+    axes = np.einsum("nji,pj->npi", frm, tool_rotation(*(g.ravel() for g in grid.mesh()))[:, 2, :])
+    return machine.tilt_within(axes).reshape((len(frm),) + grid.shape)
+
+
 def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray, frm: np.ndarray,
-            side: np.ndarray, grid: PostureGrid, assembly: Optional[ToolAssembly] = None) -> tuple[CSpace, np.ndarray]:
+            side: np.ndarray, grid: PostureGrid, machine: TarusMachine,
+            assembly: Optional[ToolAssembly] = None) -> tuple[CSpace, np.ndarray]:
     """The C-space of the CC points for the side steps `side` (n, 2) (left, right), and the side steps used:
-    where a CC point has no posture, its left step (the guess for the next pass) is halved, down to a
-    quarter of what was asked, and only those CC points rebuilt."""
+    where a CC point has no posture (within the machine's tilt), its left step (the guess for the next pass)
+    is halved, down to a quarter of what was asked, and only those CC points rebuilt."""
     side = np.minimum(side, 2 * cutter.radius)
-    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR, assembly=assembly)
+    ask = tilt_reached(machine, frm, grid)
+    cs = build_cspace(reach, cutter, pts, frm, grid, tolerance, side, interior=INTERIOR, ask=ask, assembly=assembly)
     floor = 0.25 * side[:, 0]
     for _ in range(2):
         redo = np.flatnonzero(cs.empty & (side[:, 0] > floor + 1e-9))
@@ -338,7 +347,7 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
             break
         side[redo, 0] = np.maximum(0.5 * side[redo, 0], floor[redo])
         sub = build_cspace(reach, cutter, pts[redo], frm[redo], grid, tolerance, side[redo], interior=INTERIOR,
-                           assembly=assembly)
+                           ask=ask[redo], assembly=assembly)
         lift, top = cs.lift.copy(), cs.top.copy()
         lift[redo], top[redo] = sub.lift, sub.top
         cs = CSpace(cs.grid, lift, top)
@@ -348,12 +357,18 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
                grid: PostureGrid, machine: TarusMachine, ideal_weight: float, assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
-    ones relaxed where no posture meets them), or None where some CC point still has no posture."""
+    ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
+    some CC point still has no posture. Where a path was cut short (beyond the machine's tilt), the CC points
+    with no posture next to that end are left out too (the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, assembly)
+    cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
     if cs.empty.any():
-        return None
+        paths, keep = _peel(paths, cs.empty)
+        if not paths or cs.empty[keep].any():
+            return None
+        pts, frm, side = pts[keep], frm[keep], side[keep]
+        cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
@@ -365,7 +380,26 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
         start += len(p)
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance)
-    return postures, widths, ends, side
+    return postures, widths, ends, side, paths
+
+
+def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
+    """The paths without the CC points with an empty C-space next to an end cut short, and the kept CC
+    points' indices (all paths in order); a path left with fewer than 2 CC points is dropped."""
+    out, keep, start = [], [], 0
+    for p in paths:
+        e = empty[start:start + len(p)]
+        a, b = 0, len(p)
+        while p.cut_short[0] and a < b and e[a]:
+            a += 1
+        while p.cut_short[1] and b > a and e[b - 1]:
+            b -= 1
+        if b - a >= 2:
+            out.append(p if (a, b) == (0, len(p)) else
+                       replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b]))
+            keep.append(np.arange(start + a, start + b))
+        start += len(p)
+    return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
 
 
 class _Planes:
@@ -374,19 +408,36 @@ class _Planes:
     the top of any open bin (a plane beyond it never comes back to finish that bin)."""
 
     def __init__(self, mesh: TriMesh, direction, cover: _Coverage, forward_step: float, chord_tolerance: float,
-                 radius: float):
+                 radius: float, machine: TarusMachine, grid: PostureGrid):
         self.mesh, self.direction, self.cover, self.radius = mesh, direction, cover, radius
         self.forward_step, self.chord_tolerance = forward_step, chord_tolerance
+        self.machine, self.grid = machine, grid
 
-    def paths(self, offset: float) -> List[CCPath]:
-        """The plane's CC paths, their end points moved inside along the feed: on the mesh's boundary the
-        sections' rays graze it, and a side that reads "off the mesh" is neither bounded by the C-space nor
-        measured by the half-widths. The section (LX = 0) drifts along the feed by LY's and LZ's share of it
-        as it goes out to the side, so the end points go in by that drift over a diameter across (at most a
-        radius; the overrun covers it)."""
+    def _reachable(self, offset: float, trim: bool = True) -> List[CCPath]:
+        """The plane's CC paths split where no posture of the grid has an axis within the machine's tilt
+        (a slope steeper than the tilt limit, falling along the feed: no gap helps there; those CC points are
+        left out, their bins reported for clean-up by the plan), runs of fewer than 2 CC points dropped."""
         out = []
         for p in cc_paths(self.mesh, self.direction, np.array([offset]), self.forward_step,
                           self.chord_tolerance):
+            ok = tilt_reached(self.machine, p.frames, self.grid).any(axis=(1, 2)) if trim else True
+            if np.all(ok):
+                out.append(p)
+                continue
+            edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
+            out += [replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b],
+                            cut_short=(bool(a > 0), bool(b < len(ok))))
+                    for a, b in zip(edges[::2], edges[1::2]) if b - a >= 2]
+        return out
+
+    def paths(self, offset: float, trim: bool = True) -> List[CCPath]:
+        """The plane's CC paths (within the machine's tilt: _reachable), their end points moved inside along
+        the feed: on the mesh's boundary the sections' rays graze it, and a side that reads "off the mesh" is
+        neither bounded by the C-space nor measured by the half-widths. The section (LX = 0) drifts along the
+        feed by LY's and LZ's share of it as it goes out to the side, so the end points go in by that drift
+        over a diameter across (at most a radius; the overrun covers it). `trim` False: not split."""
+        out = []
+        for p in self._reachable(offset, trim):
             pts = p.points.copy()
             if len(pts) > 1:
                 most = min(self.radius, float(np.linalg.norm(pts[-1] - pts[0])) / 3)
@@ -450,6 +501,24 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
     return lo
 
 
+def _beyond_tilt(plan: AdaptivePlan, cover: _Coverage, level: np.ndarray, whole: List[CCPath],
+                 paths: List[CCPath], offset: float) -> None:
+    """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
+    the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
+    reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of
+    coming back for them (or being held back by them)."""
+    gained = level > cover.level + 1e-9
+    reached = float(level[gained].min()) if gained.any() else offset
+    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & ~gained & (cover.level < reached)
+    if hole.any():
+        for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
+            f0 = cover.f0 + cover.width * a
+            plan.unfinished.append((float(f0), float(cover.f0 + cover.width * b), float(cover.level[a:b].min()),
+                                    reached))
+        level = np.where(hole, np.maximum(level, reached), level)
+    cover.level = level
+
+
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
                     machine: Optional[TarusMachine] = None, grid: Optional[PostureGrid] = None,
                     forward_step: float = 2.0, chord_tolerance: float = 0.01, ideal_weight: float = 0.1,
@@ -473,7 +542,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
     cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
-    planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius)
+    planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius, machine, grid)
     gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
     ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
     guess = lo + gap
@@ -484,6 +553,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
             got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, assembly)
             if got is not None:
+                paths = got[4]
                 level, short = cover.advanced(paths, got[2])
                 if (level > cover.level + 1e-9)[cover.open].any():
                     break
@@ -502,7 +572,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             gap = skip
             guess = base + 2 * skip
             continue
-        postures, widths, ends, used = got
+        postures, widths, ends, used, paths = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
         runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun,
@@ -511,7 +581,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
                                        gap, runs))
         plan.partial += short > 0
-        cover.level = level
+        _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset)
         # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
         # asked a little more while every CC point meets them
         relaxed = bool((used[:, 0] < ahead - 1e-9).any())

@@ -108,6 +108,10 @@ def surface_heights(reach: MeshReach, points: np.ndarray, frames: np.ndarray, la
     for i, (p, f) in enumerate(zip(points, frames)):
         idx = reach.near(p, radius)
         t = (reach.corners[idx] - p) @ f.T                                 # (k, 3, 3) in LCS
+        # only the triangles that cross LX = 0 (the rays' plane) can be hit; the margin is far above the
+        # barycentric test's own 1e-12
+        x = t[:, :, 0]
+        t = t[(x.min(axis=1) <= 1e-9) & (x.max(axis=1) >= -1e-9)]
         a, b, c = t[:, 0], t[:, 1], t[:, 2]
         det = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (c[:, 0] - a[:, 0]) * (b[:, 1] - a[:, 1])
         ok = np.abs(det) > 1e-300
