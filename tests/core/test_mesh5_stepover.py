@@ -253,3 +253,26 @@ def test_paired_lifts_are_the_diagonal_of_the_masked_call():
     assert one.shape == (n,) and np.array_equal(one, np.diagonal(both)) and (one > 0).any()
     with pytest.raises(TmmError, match="paired lifts take one posture per CC point"):
         lifts(reach, cutter, path.points, path.frames, lam[:2], omg[:2], 4.0, paired=True)
+
+
+def test_a_move_over_a_ridge_higher_than_a_radius_is_lifted_over_it_or_refused():
+    # two clear positions either side of a narrow ridge: the straight move between them would cut through it;
+    # its middle needs a lift above the tool's radius (clear_lifts' first limit), never a silent gouge
+    cutter = Cutter.flat(10.0)
+    tips = np.array([[-8.0, 0.0, 0.0], [8.0, 0.0, 0.0]])
+    axes = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    frames = np.repeat(np.eye(3)[None], 2, axis=0)
+    for height in (8.0, 30.0):
+        ridge = grid_mesh(lambda x, y, h=height: np.clip(h - 20.0 * np.abs(x), 0.0, None), 400, 20,
+                          (-10, -5, 10, 5), "ridge")
+        reach = MeshReach(ridge)
+        assert np.allclose(clear_lifts(reach, cutter, tips, axes, frames), 0.0)     # the ends are clear
+        if height < 4 * cutter.radius:
+            got, _ = between_positions(reach, cutter, tips, axes, frames)
+            mid = got[np.argmin(np.abs(got[:, 0]))]
+            assert len(got) >= 3 and mid[0] == 0.0 and mid[2] == pytest.approx(height, abs=0.05)   # over the top
+            ident = np.repeat(np.eye(3)[None], len(got), axis=0)
+            assert np.allclose(clear_lifts(reach, cutter, got, np.repeat(axes[:1], len(got), 0), ident), 0.0)
+        else:
+            with pytest.raises(TmmError, match="no lift of 4 tool radii clears its middle"):
+                between_positions(reach, cutter, tips, axes, frames)

@@ -59,10 +59,9 @@ MARGIN = 0.85
 INTERIOR = 3
 # positions along each overrun, each lifted clear of the mesh (a radius in 4: about the CC points' spacing)
 OVERRUN_STEPS = 4
-# the deepest a straight move between two tool positions may cut into the mesh (mm), and how many times a move
-# is halved to keep it there (between_positions)
-BETWEEN_TOL = 0.002
-BETWEEN_ROUNDS = 2
+# between_positions: the deepest a straight move between two tool positions may cut into the mesh (mm), how many
+# times a move is halved to keep it there, and the most (tool radii) a middle is lifted before the move is refused
+BETWEEN_TOL, BETWEEN_ROUNDS, FAR_RADII = 0.002, 2, 4.0
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -167,14 +166,14 @@ def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: 
 
 
 def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray,
-                frames: np.ndarray, assembly: Optional[ToolAssembly] = None) -> np.ndarray:
+                frames: np.ndarray, assembly: Optional[ToolAssembly] = None, radii: float = 1.0) -> np.ndarray:
     """(n,) the least lift along its axis that clears the mesh for the tool at each (tip, axis) (0 where it is
-    clear already; inf above a radius), by the C-space's S2 (lift.lifts): the posture read in the LCS
+    clear already; inf above `radii` tool radii), by the C-space's S2 (lift.lifts): the posture read in the LCS
     `frames` (n, 3, 3) of a CC point nearby, the tip's touching point as the CC point."""
     a = np.einsum("nij,nj->ni", frames, axes)                              # the axis in each LCS
     lam, omg = np.arccos(np.clip(a[:, 2], -1.0, 1.0)), np.arctan2(a[:, 1], a[:, 0])
     pts = tips - np.einsum("nji,nj->ni", frames, touch_tip(cutter, tool_rotation(lam, omg)))
-    return lifts(reach, cutter, pts, frames, lam, omg, cutter.radius, paired=True, assembly=assembly)
+    return lifts(reach, cutter, pts, frames, lam, omg, radii * cutter.radius, paired=True, assembly=assembly)
 
 
 def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray, frames: np.ndarray,
@@ -192,7 +191,13 @@ def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: 
         mid_a = axes[:-1] + axes[1:]
         mid_a /= np.linalg.norm(mid_a, axis=1, keepdims=True)               # slerp at one half
         lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1], assembly)
-        deep = np.flatnonzero(np.isfinite(lift) & (lift > tol))
+        for k in np.flatnonzero(~np.isfinite(lift)):   # deeper than a radius: asked again, never left to gouge
+            one = slice(k, k + 1)
+            lift[k] = clear_lifts(reach, cutter, mid_t[one], mid_a[one], frames[one], assembly, FAR_RADII)[0]
+            if not np.isfinite(lift[k]):
+                raise TmmError(f"the move from {np.round(tips[k], 3).tolist()} to {np.round(tips[k + 1], 3).tolist()}"
+                               f" would cut the model: no lift of {FAR_RADII:g} tool radii clears its middle")
+        deep = np.flatnonzero(lift > tol)
         if deep.size == 0:
             break
         at = deep + 1
