@@ -26,11 +26,15 @@ from tmm_workbench.app import model_proxy, tools
 from tmm_workbench.app import progress as progress_mod
 from tmm_workbench.app.api_args import (FEED, LENGTH, CallbackProgress, by_core_name, numbers, option,
                                         plain_numbers)
-from tmm_workbench.app.api_five import MultipointResult, run_mesh5, run_multipoint  # noqa: F401 - the API's names
-from tmm_workbench.app.api_run import StockBox, SurfaceResult, run  # noqa: F401 - the API's names
+from tmm_workbench.app.api_five import MultipointResult, run_mesh5, run_multipoint
+from tmm_workbench.app.api_run import StockBox, SurfaceResult, run
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import Spec, spec_of
 from tmm_workbench.core.tools.cutter import Cutter
+
+__all__ = ["run_surface", "run_roughing", "run_waterline", "run_mesh5", "run_multipoint", "run", "simulate",
+           "minimum_stick_out", "set_holder", "compare_cutters", "SurfaceResult", "MultipointResult",
+           "SimulationReport", "StockBox", "TmmError"]
 
 TOOL_ALIASES = tools.SHAPE_ALIASES
 DEFAULT_STEPOVER = 1.0  # mm, stepover_mode 'stepover' without a step-over given
