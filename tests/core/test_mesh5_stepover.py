@@ -4,7 +4,6 @@ slow reference (the solid cylinder swept between the CL points, material measure
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -117,7 +116,7 @@ def test_the_overrun_clears_a_surface_that_rises_beyond_the_end_of_the_path():
     cutter = Cutter.flat(10.0)
     full = cc_paths(mesh, (1, 0), np.array([0.0]), 2.0, 0.01)[0]
     keep = (full.points[:, 0] >= -10.0) & (full.points[:, 0] <= 1e-9)
-    path = replace(full, points=full.points[keep], normals=full.normals[keep], frames=full.frames[keep])
+    path = full.take(keep)
     cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 24), (-30, 30)), TOL, 1.0)
     q = smooth_postures(cs, cutter, path.points, path.frames)
     tips, axes, _ = overrun_positions(MeshReach(mesh), cutter, path, q, 5.0)
@@ -144,7 +143,7 @@ def test_a_move_that_would_cut_in_between_two_cl_points_gets_a_position_lifted_c
     cutter = Cutter.flat(10.0)
     path = cc_paths(mesh, (1, 0), np.array([-4.0]), 3.0, 0.01)[0]
     keep = np.abs(path.points[:, 0]) <= 9.0
-    path = replace(path, points=path.points[keep], normals=path.normals[keep], frames=path.frames[keep])
+    path = path.take(keep)
     cs = build_cspace(mesh, cutter, path.points, path.frames, PostureGrid.degrees((0, 6), (-30, 30)), TOL, 1.0)
     q = smooth_postures(cs, cutter, path.points, path.frames)
     reach = MeshReach(mesh)

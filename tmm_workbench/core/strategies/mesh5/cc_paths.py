@@ -13,7 +13,7 @@ LX the feed direction = the drive plane's line in the tangent plane (oriented al
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import List, Optional, Sequence
 
 import numpy as np
@@ -36,6 +36,11 @@ class CCPath:
 
     def __len__(self) -> int:
         return len(self.points)
+
+    def take(self, index, cut_short: Optional[tuple[bool, bool]] = None) -> "CCPath":
+        """The path's CC points at `index` (a slice or a mask, in order), cut short as given (else as it is)."""
+        return replace(self, points=self.points[index], normals=self.normals[index], frames=self.frames[index],
+                       cut_short=self.cut_short if cut_short is None else cut_short)
 
 
 def _unit_xy(direction: Sequence[float]) -> np.ndarray:

@@ -191,12 +191,13 @@ def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: 
         mid_a = axes[:-1] + axes[1:]
         mid_a /= np.linalg.norm(mid_a, axis=1, keepdims=True)               # slerp at one half
         lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1], assembly)
-        for k in np.flatnonzero(~np.isfinite(lift)):   # deeper than a radius: asked again, never left to gouge
-            one = slice(k, k + 1)
-            lift[k] = clear_lifts(reach, cutter, mid_t[one], mid_a[one], frames[one], assembly, FAR_RADII)[0]
-            if not np.isfinite(lift[k]):
-                raise TmmError(f"the move from {np.round(tips[k], 3).tolist()} to {np.round(tips[k + 1], 3).tolist()}"
-                               f" would cut the model: no lift of {FAR_RADII:g} tool radii clears its middle")
+        far = np.flatnonzero(~np.isfinite(lift))   # deeper than a radius: asked again, never left to gouge
+        if far.size:
+            lift[far] = clear_lifts(reach, cutter, mid_t[far], mid_a[far], frames[far], assembly, FAR_RADII)
+        if not np.isfinite(lift).all():
+            k = int(np.argmin(np.isfinite(lift)))
+            raise TmmError(f"the move from {np.round(tips[k], 3).tolist()} to {np.round(tips[k + 1], 3).tolist()}"
+                           f" would cut the model: no lift of {FAR_RADII:g} tool radii clears its middle")
         deep = np.flatnonzero(lift > tol)
         if deep.size == 0:
             break
@@ -400,8 +401,7 @@ def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndar
         while p.cut_short[1] and b > a and e[b - 1]:
             b -= 1
         if b - a >= 2:
-            out.append(p if (a, b) == (0, len(p)) else
-                       replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b]))
+            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b)))
             keep.append(np.arange(start + a, start + b))
         start += len(p)
     return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
@@ -430,8 +430,7 @@ class _Planes:
                 out.append(p)
                 continue
             edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
-            out += [replace(p, points=p.points[a:b], normals=p.normals[a:b], frames=p.frames[a:b],
-                            cut_short=(bool(a > 0), bool(b < len(ok))))
+            out += [p.take(slice(a, b), cut_short=(bool(a > 0), bool(b < len(ok))))
                     for a, b in zip(edges[::2], edges[1::2]) if b - a >= 2]
         return out
 
