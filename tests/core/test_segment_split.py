@@ -30,6 +30,18 @@ def test_runs_of_kept_tips_and_moves() -> None:
     assert not keep_runs(seg, ok_tip, ok_move, joined=False)[0].joined
 
 
+def test_a_five_axis_segments_runs_keep_their_own_tool_axes() -> None:
+    n = 6
+    tilt = np.radians(np.arange(n) * 5.0)
+    axes = np.column_stack([np.sin(tilt), np.zeros(n), np.cos(tilt)])
+    seg = CutSegment(line(n).tips, axes=axes, pass_index=3)
+    ok_move = np.ones(n, dtype=bool)
+    ok_move[3] = False                      # the move into tip 3 left out
+    pieces = keep_runs(seg, np.ones(n, dtype=bool), ok_move)
+    assert [p.tips[:, 0].tolist() for p in pieces] == [[0, 1, 2], [3, 4, 5]]
+    assert np.array_equal(pieces[1].axes, axes[3:]) and all(p.pass_index == 3 for p in pieces)
+
+
 def test_move_samples_cover_every_move_at_the_step() -> None:
     seg = line(3)
     pts, move = move_samples(seg, 0.3)

@@ -1,6 +1,6 @@
 """A cut segment split where some of its tips or moves are not to be cut (the holder guard's leave-out, the rest
-filter): the runs of kept tips joined by kept moves, each run of two tips or more a segment entered anew by the
-linker."""
+filter, the 5-axis mesh finish's holder check): the runs of kept tips joined by kept moves, each run of two tips
+or more a segment entered anew by the linker (its tool axes with it)."""
 from __future__ import annotations
 
 from dataclasses import replace
@@ -30,9 +30,10 @@ def keep_runs(seg: CutSegment, ok_tip: np.ndarray, ok_move: np.ndarray, joined: 
             arcs = None if seg.arcs is None else (None,) + tuple(seg.arcs[i + 1:j])
             first = i == 0
             entry = seg.entry if first or (seg.entry is None and seg.helix_centre is None) else RAMP
-            pieces.append(replace(seg, tips=seg.tips[i:j], arcs=arcs, joined=seg.joined and joined and first, closed=False,
-                                  entry_z=seg.entry_z if first else None, entry=entry,
-                                  helix_centre=seg.helix_centre if first else None))
+            axes = None if seg.axes is None else seg.axes[i:j]
+            pieces.append(replace(seg, tips=seg.tips[i:j], axes=axes, arcs=arcs, closed=False,
+                                  joined=seg.joined and joined and first, entry_z=seg.entry_z if first else None,
+                                  entry=entry, helix_centre=seg.helix_centre if first else None))
         i = j
     return pieces
 

@@ -24,6 +24,7 @@ import numpy as np
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan
+from tmm_workbench.core.strategies.segment_split import keep_runs
 from tmm_workbench.core.toolpath import Move, MoveKind, Toolpath
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
@@ -109,11 +110,7 @@ def guard(mesh, reach: MeshReach, cutter: Cutter, assembly: ToolAssembly, plan: 
     out, start = [], 0
     for s in segments:
         n = len(s.tips)
-        breaks = [i for i in range(1, n) if cut[start + i]]
-        for a, b in zip([0] + breaks, breaks + [n]):
-            if b - a >= 2:
-                out.append(CutSegment(s.tips[a:b], axes=None if s.axes is None else s.axes[a:b],
-                                      pass_index=s.pass_index))
+        out += keep_runs(s, np.ones(n, dtype=bool), ~cut[start:start + n])
         start += n
     tips = path.points()
     keep = np.isin(check.move, bad)
