@@ -145,25 +145,39 @@ def _segments(plan: AdaptivePlan, zigzag: bool) -> list[CutSegment]:
     return out
 
 
-def empty_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params) -> np.ndarray:
-    """(k, 3) CC points no pass finishes: those of each unfinished strip's middle plane within its feed span."""
+def _strip_frame(params: Mesh5Params) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(feed direction as given, the drive planes' normal m, the feed along the planes): the strips' axes."""
     d = np.array(params.direction())
     m = plane_normal(d)
-    feed = np.array([m[1], -m[0], 0.0])
+    return d, m, np.array([m[1], -m[0], 0.0])
+
+
+def _strip_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params, spacing: Optional[float]) -> np.ndarray:
+    """(k, 3) CC points within the unfinished strips' feed spans, on each strip's middle drive plane (`spacing`
+    None, at the forward step) or on planes at most `spacing` mm apart across it (and along)."""
+    d, _, feed = _strip_frame(params)
     found = []
     for f0, f1, a0, a1 in plan.unfinished:
-        for p in cc_paths(mesh, d, np.array([0.5 * (a0 + a1)]), params.forward_step, params.chord_tol):
+        if spacing is None:
+            planes, step = np.array([0.5 * (a0 + a1)]), params.forward_step
+        else:
+            n = max(1, math.ceil((a1 - a0) / spacing))
+            planes, step = a0 + (a1 - a0) * (np.arange(n) + 0.5) / n, min(params.forward_step, spacing)
+        for p in cc_paths(mesh, d, planes, step, params.chord_tol):
             f = p.points @ feed
             found.append(p.points[(f >= f0 - 1e-9) & (f <= f1 + 1e-9)])
     return np.vstack(found) if found else np.zeros((0, 3))
 
 
+def empty_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params) -> np.ndarray:
+    """(k, 3) CC points no pass finishes: those of each unfinished strip's middle plane within its feed span."""
+    return _strip_points(mesh, plan, params, None)
+
+
 def strip_corners(plan: AdaptivePlan, params: Mesh5Params) -> np.ndarray:
     """(k, 4, 2) XY corners of the unfinished strips (feed from, to x across from, to)."""
-    d = np.array(params.direction())
-    m = plane_normal(d)[:2]
-    feed = np.array([m[1], -m[0]])
-    return np.array([[f * feed + a * m for f, a in ((f0, a0), (f1, a0), (f1, a1), (f0, a1))]
+    _, m, feed = _strip_frame(params)
+    return np.array([[f * feed[:2] + a * m[:2] for f, a in ((f0, a0), (f1, a0), (f1, a1), (f0, a1))]
                      for f0, f1, a0, a1 in plan.unfinished]).reshape(-1, 4, 2)
 
 
@@ -171,17 +185,7 @@ def cleanup_points(mesh: TriMesh, plan: AdaptivePlan, params: Mesh5Params, spaci
                    ) -> np.ndarray:
     """(k, 3) points on the mesh covering the unfinished strips, for clean-up and for the view: the CC points
     of drive planes at most `spacing` mm apart across each strip, within its feed span (no pass finishes them)."""
-    d = np.array(params.direction())
-    m = plane_normal(d)
-    feed = np.array([m[1], -m[0], 0.0])
-    found = []
-    for f0, f1, a0, a1 in plan.unfinished:
-        n = max(1, math.ceil((a1 - a0) / spacing))
-        planes = a0 + (a1 - a0) * (np.arange(n) + 0.5) / n
-        for p in cc_paths(mesh, d, planes, min(params.forward_step, spacing), params.chord_tol):
-            f = p.points @ feed
-            found.append(p.points[(f >= f0 - 1e-9) & (f <= f1 + 1e-9)])
-    return np.vstack(found) if found else np.zeros((0, 3))
+    return _strip_points(mesh, plan, params, spacing)
 
 
 def compute(mesh: TriMesh, cutter: Cutter, params: Mesh5Params,
