@@ -25,6 +25,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.plan import materials
 from tmm_workbench.core.plan.analysis import FAR_MM, Analysis
 from tmm_workbench.core.plan.job_file import JobSpec, PlanInputError, ToolSpec
+from tmm_workbench.core.plan.stock import PlannedStock, planned_stock
 from tmm_workbench.core.strategies.zlevel_layers import PLATEAU_DEG
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -69,11 +70,16 @@ class OpPlan:
 
 @dataclass
 class Plan:
-    stock_box: tuple          # (xmin, ymin, zmin, xmax, ymax, zmax) mm
+    stock: PlannedStock       # the stock around the placed model (core.plan.stock)
     ops: list = field(default_factory=list)
     decisions: list = field(default_factory=list)
     cutting: dict = field(default_factory=dict)   # tool name -> materials.Cutting.as_dict()
     reach_tool: str = ""      # the library tool reaching the most: what is left is judged where it reaches
+
+    @property
+    def stock_box(self) -> tuple:
+        """(xmin, ymin, zmin, xmax, ymax, zmax) mm of the stock."""
+        return self.stock.box
 
     def decide(self, topic: str, choice: str, reason: str) -> None:
         self.decisions.append(Decision(topic, choice, reason))
@@ -105,14 +111,6 @@ def overall_length(tool: ToolSpec) -> float:
     if tool.stick_out is not None:
         return tool.stick_out + GRIP_DIAMETERS * tool.diameter
     return tool.flute_length + LENGTH_PAST_FLUTES * tool.diameter
-
-
-def stock_box(job: JobSpec, mesh: TriMesh) -> tuple:
-    """The bounds of the stock around the placed model (core.plan.stock: checked against the machine's travels,
-    the model inside it)."""
-    from tmm_workbench.core.plan.stock import planned_stock
-
-    return planned_stock(job, mesh).box
 
 
 def api_tool(tool: ToolSpec) -> dict:
@@ -423,10 +421,12 @@ def pencil_op(plan: Plan, job: JobSpec, an: Analysis, rest: ToolSpec, radiused: 
                 f"more than {job.finish.tolerance:g} mm is left")
 
 
-def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None) -> Plan:
+def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None,
+             stock: Optional[PlannedStock] = None) -> Plan:
     """The ops and decisions for `job` on its placed `mesh` with its analysis `an` (reach-tested with every
-    library tool); `compare`: core.plan.optimal_cutter.compare_cutters bound to its cell (None: not compared)."""
-    plan = Plan(stock_box(job, mesh))
+    library tool); `compare`: core.plan.optimal_cutter.compare_cutters bound to its cell (None: not compared);
+    `stock`: the job's planned_stock when the caller has it (else found here)."""
+    plan = Plan(stock if stock is not None else planned_stock(job, mesh))
     radiused = [t for t in job.tools if t.corner_radius > 0]
     if not radiused:
         raise PlanInputError("tools: no ball or bull-nose tool in the library; a sculptured surface is finished "

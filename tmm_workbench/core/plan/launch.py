@@ -29,7 +29,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
 from tmm_workbench.core.plan import analysis, decide, progress_note, recipes
 from tmm_workbench.core.plan.job_file import (MODEL_SUFFIXES, UNITS, JobSpec, PlanInputError, ToolSpec, is_step,
                                               job_from_dict, read_data)
-from tmm_workbench.core.plan.stock import planned_stock, stock_of_plan
+from tmm_workbench.core.plan.stock import planned_stock
 
 VERIFIED, FAILED, BAD_INPUT = 0, 1, 2
 APP_SCRIPT = Path(__file__).resolve().parents[2] / "app" / "plan_run.py"
@@ -63,7 +63,7 @@ def placed_mesh(job: JobSpec) -> tuple[TriMesh, bool]:
 def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis.Analysis, decide.Plan]:
     """The placed model, whether it was moved, its analysis and the plan (core only; PlanInputError on bad input)."""
     mesh, moved = placed_mesh(job)
-    planned_stock(job, mesh)   # a model outside its stock refused before the analysis
+    stock = planned_stock(job, mesh)   # a model outside its stock refused before the analysis
     say(f"model {job.model.file.name}: {len(mesh.triangles)} triangles; analysing", quiet)
     tools = [(t.name, decide.cutter_of(t)) for t in job.tools]
     an = analysis.analyse(mesh, job.planner.analysis_cell, tools, job.finish.tolerance)
@@ -74,7 +74,7 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
         compare = partial(compare_cutters, sample_step=0.5, cell=job.planner.sim_cell,
                           tolerance=job.finish.tolerance)
         say("comparing the finishing cutters (seed 003)", quiet)
-    return mesh, moved, an, decide.plan_job(job, mesh, an, compare)
+    return mesh, moved, an, decide.plan_job(job, mesh, an, compare, stock)
 
 
 def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
@@ -85,7 +85,7 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     return {"model_file": str(model_file), "name": o.name, "post": job.machine.post, "gcode": o.gcode,
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
             "tolerance": job.finish.tolerance, "cusp": job.finish.cusp, "ops": [op.as_dict() for op in plan.ops],
-            "stock": stock_of_plan(job, plan.stock_box).as_dict(),
+            "stock": plan.stock.as_dict(),
             "rapid_mm_min": None if rapid is None else list(rapid),
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
                                "shank_diameter": t.shank_diameter, "holder": t.holder, "stick_out": t.stick_out}
@@ -152,8 +152,7 @@ def report(job: JobSpec, an: analysis.Analysis, plan: decide.Plan, verified: dic
     return {"format": REPORT_FORMAT, "job_file": job.source.name, "passed": verified["passed"],
             "problems": verified["problems"], "verification": verified, "analysis": an.as_dict(),
             "plan": plan.as_dict(), "finish": {"cusp_mm": job.finish.cusp, "tolerance_mm": job.finish.tolerance},
-            "stock": stock_of_plan(job, plan.stock_box).as_dict() | {"file": None if job.stock.file is None else
-                                                                      job.stock.file.name},
+            "stock": plan.stock.as_dict() | {"file": None if job.stock.file is None else job.stock.file.name},
             "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels),
                                                   "rapid_mm_min": None if job.machine.rapid is None else
                                                   list(job.machine.rapid)},
