@@ -226,9 +226,13 @@ def new_op(info: dict, doc, job):
     return op
 
 
-def edit(op) -> None:
+def edit(op, seconds: float = 10.0) -> None:
+    """The op's panel opened as a double click opens it; waits until it is up (not a fixed pause)."""
     op.ViewObject.Document.setEdit(op.ViewObject, 0)
-    pump(1.0)
+    end = time.monotonic() + seconds
+    while not FreeCADGui.Control.activeDialog() and time.monotonic() < end:
+        pump(0.1)
+    pump(0.3)
 
 
 def tx(doc) -> dict:
@@ -329,7 +333,7 @@ def cancel_in_creation_session(info: dict, doc, job) -> None:
     info["creation_step_over"] = kept.StepOver.Value if kept is not None else None
 
 
-def focus_rounds(info: dict, doc, op, rounds: int = 6) -> None:
+def focus_rounds(info: dict, doc, op, rounds: int = 3) -> None:
     """Step 4d: the panel opened, the focus moved through quantity fields (each bound by FreeCAD's field
     controller), Cancel; several times. FreeCAD 1.0 crashed in the controllers' event filter on the first round of
     such a loop before panel_state.release_field_filters (SIGSEGV in PySide's getMetaDataFromQObject); the op must
