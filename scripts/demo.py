@@ -1,7 +1,8 @@
 """TMM's main job, headless: three models finished with a 3-axis surface raster, a block roughed down to
 sphere_on_plate and its walls finished by waterline (one Job), sphere_on_plate finished with a ball D10 and its
-rest taken by a ball D3 (one Job), then seed 001's convex Bézier patch finished 5-axis by multipoint positioning
-(tarus G-code, APT CL, document, pictures).
+rest taken by a ball D3 (one Job), seed 003's sign planned with no operator (tmm plan), seed 001's convex Bézier
+patch finished 5-axis by multipoint positioning (tarus G-code, APT CL, document, pictures), and seed 000's convex
+surface as a mesh finished 5-axis by the 3D C-space method (scripts/demo_mesh5.py).
 
     freecadcmd scripts/demo.py            # G-code (.ngc), FreeCAD document (.FCStd) and picture (.png)
     /usr/bin/python3 scripts/demo.py      # without FreeCAD: the core alone, pictures only
@@ -157,6 +158,7 @@ def describe_tool(p: dict[str, Any]) -> str:
 
 def main() -> None:
     sys.path.insert(0, str(REPO))
+    sys.path.insert(0, str(REPO / "scripts"))
     from tmm_workbench.core.preview.toolpath_png import path_statistics, render_toolpath_png
 
     out = Path(os.environ.get("TMM_OUT") or REPO / "out").resolve()
@@ -212,6 +214,12 @@ def main() -> None:
     t5 = time.perf_counter()
     row5 = run_multipoint_case(out, with_freecad)
     print_table5(row5, time.perf_counter() - t5)
+
+    # 5-axis on a mesh: seed 000's convex surface, the 3D C-space method, Tarus G-code
+    from demo_mesh5 import print_mesh5, run_mesh5_case
+
+    t_m5 = time.perf_counter()
+    print_mesh5(run_mesh5_case(out, with_freecad, simulate_case), time.perf_counter() - t_m5, sim_line, print_files)
 
 
 # --- stock to part ----------------------------------------------------------------------------------
