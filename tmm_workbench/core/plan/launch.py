@@ -71,8 +71,9 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
     if job.planner.compare_cutters:
         from tmm_workbench.core.plan.optimal_cutter import compare_cutters
 
+        rapid = None if job.machine.rapid is None else tuple(r / 60.0 for r in job.machine.rapid)
         compare = partial(compare_cutters, sample_step=0.5, cell=job.planner.sim_cell,
-                          tolerance=job.finish.tolerance)
+                          tolerance=job.finish.tolerance, rapid=rapid)   # the machine's rapids: its cycle times
         say("comparing the finishing cutters (seed 003)", quiet)
     plan = decide.plan_job(job, mesh, an, compare, stock)
     if job.machine.five_axis:
