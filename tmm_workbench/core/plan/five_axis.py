@@ -190,7 +190,9 @@ def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Op
     seconds, passes, tool = min(timed, key=lambda s: (s[0], tools.index(s[2])))
     total = sum(three.values())
     compared = (f"estimated cycle times at the cusp {job.finish.cusp:g} mm: 5-axis {tool.name} {seconds / 60:.2f} min "
-                f"({passes} passes, the Tarus post's estimate) against the 3-axis "
+                f"({passes} passes, the Tarus post's estimate"
+                + "".join(f"; {t.name} {sec / 60:.2f} min" for sec, _, t in timed if t is not tool)
+                + ") against the 3-axis "
                 + " + ".join(f"{label} {t / 60:.2f}" for label, t in three.items())
                 + (f" = {total / 60:.2f}" if len(three) > 1 else "") + " min (the core's paths, the machine's rapids)"
                 + "".join(f"; {n}" for n in notes))

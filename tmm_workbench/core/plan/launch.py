@@ -184,12 +184,13 @@ def tool_row(tool: ToolSpec) -> dict:
             "stick_out_mm": round(stick, 4)}
 
 
-def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path) -> None:
-    """The whole Job's G-code read back and drawn over the model (core.preview.toolpath_png)."""
+def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path, name: Optional[str] = None) -> None:
+    """The whole Job's G-code read back and drawn over the model (core.preview.toolpath_png); `name` the title's
+    file name (the G-code's own by default)."""
     from tmm_workbench.core.preview.toolpath_png import render_toolpath_png, toolpath_of_gcode
 
     toolpath = toolpath_of_gcode(gcode.read_text(errors="replace"))
-    render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {gcode.name}", size_px=(1400, 650))
+    render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {name or gcode.name}", size_px=(1400, 650))
 
 
 def write_pages(tmp: Path, job: JobSpec, doc: dict) -> None:
@@ -211,7 +212,8 @@ def finish_outputs(tmp: Path, job: JobSpec, mesh: TriMesh, an: analysis.Analysis
     gcode, tip = tmp / f"{out.name}.ngc", tmp / TIP_GCODE   # the Tarus's joints drawn at the tool tip
     if gcode.is_file():
         say("drawing the tool path", quiet)
-        draw_toolpath(mesh, tip if tip.is_file() else gcode, tmp / f"{out.name}_toolpath.png")
+        draw_toolpath(mesh, tip if tip.is_file() else gcode, tmp / f"{out.name}_toolpath.png",
+                      f"{gcode.name}" + (" (the tool tip: the same program in TCP mode)" if tip.is_file() else ""))
     if tip.is_file():
         tip.unlink()
     files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
