@@ -127,7 +127,8 @@ def seed000_mesh(name: str, nt: int = 401, ns: int | None = None, window: tuple 
     return TriMesh(pts, tri, f"seed000_{name}"), deviation
 
 
-TARUS_WINDOW = (0.4, 0.6, 0.4, 0.6)   # the convex surface's middle, 51 x 53 x 5.5 mm: tests/data/seed000_convex_window.stl
+# the convex surface's middle, 51 x 53 x 5.5 mm: tests/data/seed000_convex_window.stl
+TARUS_WINDOW = (0.4, 0.6, 0.4, 0.6)
 
 
 def write_window(path: Path) -> Path:
