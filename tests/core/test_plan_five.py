@@ -5,6 +5,7 @@ tilted flat end replaces the 3-axis finishing with both estimated times in its r
 fallback; never, a solid model and a 3-axis machine keep the 3-axis plan with the reason."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -143,3 +144,16 @@ def test_never_and_solid_keep_the_3_axis_plan(tmp_path: Path) -> None:
     _, _, _, plan = launch.make_plan(job_of(tmp_path, data))
     (reason,) = [d.reason for d in plan.decisions if d.topic == five_axis.TOPIC]
     assert plan.five_axis is None and "faces down" in reason
+
+
+def test_a_small_flat_end_does_not_pay(tmp_path: Path) -> None:
+    """A flat D2 against the ball D10's raster: the 5-axis finish is slower, the plan stays 3-axis, both times in
+    the reason."""
+    data = tarus(tmp_path)
+    data["tools"][0].update(name="T1 flat D2", diameter=2)
+    _, _, _, plan = launch.make_plan(job_of(tmp_path, data))
+    assert plan.five_axis is None and not any(op.api == "run_mesh5" for op in plan.ops)
+    (d,) = [d for d in plan.decisions if d.topic == five_axis.TOPIC]
+    minutes = [float(m) for m in re.findall(r"(\d+\.\d\d) min", d.reason)]
+    assert d.choice == "none" and d.reason.startswith("it does not pay") and "T1 flat D2" in d.reason
+    assert minutes[0] > minutes[-1]   # the 5-axis time first, the 3-axis finishing's sum last
