@@ -2,7 +2,7 @@
 (core.plan.decide), on a `tarus5` machine, seed 000's tilted flat end (core.strategies.mesh5, the TMM 5-axis Mesh
 op's strategy) is planned over the model with the library's flat-end tools and timed by the Tarus post's estimate
 (joint speeds, A and C planned); the 3-axis finishing raster it would replace is computed and timed as the Job's
-simulation times it (core.sim.cycle_time, the machine's rapids). Both keep the finish's cusp: the raster by its
+simulation times it (core.sim.cycle_time, at machine.rapid). Both keep the finish's cusp: the raster by its
 step-over for the cusp up to the transition slope, the 5-axis passes with the cusp as their scallop tolerance. The
 faster wins (planner.five_axis: always takes the 5-axis op when it can be made); the decision and both times go
 into the report. The 3-axis ops it replaces are kept as the fallback: the FreeCAD side (app.plan_five) runs them
@@ -26,6 +26,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.plan import decide, materials
 from tmm_workbench.core.plan.analysis import Analysis
 from tmm_workbench.core.plan.job_file import JobSpec, ToolSpec
+from tmm_workbench.core.sim.cycle_time import DEFAULT_RAPID_MM_S
 
 TOPIC = "5-axis finishing"
 REPLACED = ("Finish shallow", "Finish steep")   # the 3-axis finishing ops the 5-axis op replaces (decide's labels)
@@ -86,7 +87,7 @@ def why_not(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Opt
 def finishing_seconds(job: JobSpec, mesh: TriMesh, op: decide.OpPlan) -> float:
     """A planned 3-axis finishing op's cycle time, s: its path made by the core (the API's strategy with the op's
     step-over or step-down, sampling, slope range, lift off the model) and timed as the Job's simulation times it
-    (core.sim.cycle_time, the machine's rapids)."""
+    (core.sim.cycle_time, at machine.rapid)."""
     from tmm_workbench.core.linking import LinkPolicy, link
     from tmm_workbench.core.sim.cycle_time import three_axis_time, toolpath_feeds
     from tmm_workbench.core.strategies import waterline
@@ -194,7 +195,9 @@ def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Op
                 + "".join(f"; {t.name} {sec / 60:.2f} min" for sec, _, t in timed if t is not tool)
                 + ") against the 3-axis "
                 + " + ".join(f"{label} {t / 60:.2f}" for label, t in three.items())
-                + (f" = {total / 60:.2f}" if len(three) > 1 else "") + " min (the core's paths, the machine's rapids)"
+                + (f" = {total / 60:.2f}" if len(three) > 1 else "") + " min (the core's paths, rapids "
+                + ("at machine.rapid" if job.machine.rapid else f"at the estimate's {DEFAULT_RAPID_MM_S * 60:g} mm/min")
+                + ")"
                 + "".join(f"; {n}" for n in notes))
     if seconds >= total and job.planner.five_axis != "always":
         plan.decide(TOPIC, "none", f"it does not pay: {compared}")
