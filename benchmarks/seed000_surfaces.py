@@ -100,8 +100,10 @@ def _grid_triangles(nt: int, ns: int) -> np.ndarray:
     return np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
 
 
-def seed000_mesh(name: str, nt: int = 401, ns: int | None = None) -> tuple[TriMesh, float]:
-    """The surface `name` ("convex", "concave" or "complex") in mm and the mesh's largest deviation from it (mm)."""
+def seed000_mesh(name: str, nt: int = 401, ns: int | None = None, window: tuple | None = None
+                 ) -> tuple[TriMesh, float]:
+    """The surface `name` ("convex", "concave" or "complex") in mm and the mesh's largest deviation from it (mm);
+    `window` (t0, t1, s0, s1): only that part of its parameters (the planner's Tarus test: a 51 x 53 mm piece)."""
     if name == "complex":
         sections = [p * INCH for p in complex_sections()]
         ns = 81 if ns is None else ns                   # it bends along X too: 41 columns left 0.106 mm
@@ -109,7 +111,8 @@ def seed000_mesh(name: str, nt: int = 401, ns: int | None = None) -> tuple[TriMe
         data = json.loads((shared_dir() / "benchmarks" / "seed_surfaces.json").read_text())
         sections = [np.asarray(p) * INCH for p in data["lu2007_bspline_sections"]["surfaces"][name]]
         ns = 41 if ns is None else ns
-    tt, ss = (g.ravel() for g in np.meshgrid(np.linspace(0, 1, nt), np.linspace(0, 1, ns), indexing="ij"))
+    t0, t1, s0, s1 = window or (0.0, 1.0, 0.0, 1.0)
+    tt, ss = (g.ravel() for g in np.meshgrid(np.linspace(t0, t1, nt), np.linspace(s0, s1, ns), indexing="ij"))
     pts = through_points(sections, tt, ss)
     tri = _grid_triangles(nt, ns)
     # a height field faces up: wind every triangle so (its normal).z >= 0 (the grid's (t, s) may map onto (x, y)
@@ -124,7 +127,21 @@ def seed000_mesh(name: str, nt: int = 401, ns: int | None = None) -> tuple[TriMe
     return TriMesh(pts, tri, f"seed000_{name}"), deviation
 
 
+# the convex surface's middle, 51 x 53 x 5.5 mm: tests/data/seed000_convex_window.stl
+TARUS_WINDOW = (0.4, 0.6, 0.4, 0.6)
+
+
+def write_window(path: Path) -> Path:
+    """The planner's Tarus test model: the convex surface's TARUS_WINDOW, 41 x 21 points (1,600 triangles)."""
+    from tmm_workbench.core.geometry.mesh import save_stl
+
+    mesh, _ = seed000_mesh("convex", nt=41, ns=21, window=TARUS_WINDOW)
+    return save_stl(mesh, path)
+
+
 if __name__ == "__main__":
+    if sys.argv[1:2] == ["--window"]:
+        raise SystemExit(print(write_window(Path(sys.argv[2]))))
     for n in ("convex", "concave", "complex"):
         mesh, dev = seed000_mesh(n)
         lo, hi = mesh.bounds

@@ -39,3 +39,16 @@ def test_on_a_45_degree_ramp_the_ball_leaves_less():
 def test_no_candidates():
     with pytest.raises(TmmError, match="no candidate cutters"):
         compare_cutters(grid_mesh(lambda x, y: 0 * x, 2, 2, (0, 0, 10, 10)), [], stepover=1.0, sample_step=0.5)
+
+
+def test_cycle_times_at_the_machines_rapids():
+    """The machine's rapid rates (the job's machine.rapid) time the rasters' retracts and hops; the ranking by the
+    volume left is the same."""
+    bump = grid_mesh(lambda x, y: 3.0 * np.exp(-((x - 20) ** 2 + (y - 20) ** 2) / 60.0), 24, 24, (0, 0, 40, 40))
+    args = dict(stepover=2.0, sample_step=0.5, cell=0.2, margin=4.0)
+    default = compare_cutters(bump, CANDIDATES, **args)
+    slow = compare_cutters(bump, CANDIDATES, rapid=(500 / 60, 200 / 60), **args)
+    fast = compare_cutters(bump, CANDIDATES, rapid=(20000 / 60, 20000 / 60), **args)
+    for a, b, c in zip(slow.scores, default.scores, fast.scores):
+        assert a.label == b.label == c.label and a.remaining_volume == b.remaining_volume
+        assert a.cycle_seconds > b.cycle_seconds > c.cycle_seconds

@@ -14,7 +14,7 @@ import pytest
 from tests.core.test_plan import BEET_JOB, good, refused, run_job, stand_in
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
 from tmm_workbench.core.plan import launch, recipes
-from tmm_workbench.core.plan.job_file import job_from_dict, read_job
+from tmm_workbench.core.plan.job_file import PlanInputError, job_from_dict, read_job
 from tmm_workbench.core.plan.stock import INSIDE_MM, planned_stock, stock_of_plan
 
 FC_TOOLS = Path(__file__).resolve().parents[1] / "data" / "freecad_tools"
@@ -175,6 +175,54 @@ def test_model_touching_the_solid_is_inside(tmp_path: Path) -> None:
     lo, hi = beet().bounds
     data = solid_job(tmp_path, box_mesh(lo - [0, 0, 1], hi + [0, 0, INSIDE_MM / 2]))   # the model's sides on its
     assert planned_stock(job_of(tmp_path, data), beet()).type == "solid"               # walls, its top under its top
+
+
+def field_block(top, n: int, size: float, z0: float) -> TriMesh:
+    """A closed block over [0, size]^2 from z0 up to the heights top(x, y) at n x n grid points."""
+    g = np.linspace(0.0, size, n)
+    x, y = (a.ravel() for a in np.meshgrid(g, g, indexing="ij"))
+    v = np.concatenate([np.stack([x, y, top(x, y)], 1), np.stack([x, y, np.full_like(x, z0)], 1)])
+    i, j = (a.ravel() for a in np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="ij"))
+    q = i * n + j
+    faces = [np.stack([q, q + n, q + n + 1], 1), np.stack([q, q + n + 1, q + 1], 1)]   # the top, facing up
+    faces += [f[:, ::-1] + n * n for f in faces]                                          # the bottom, down
+    ring = [k * n for k in range(n)] + [(n - 1) * n + k for k in range(1, n)] + \
+        [(n - 1) * n + n - 1 - k for k in range(1, n)] + [(n - 1 - k) * n for k in range(1, n - 1)]
+    for a, b in zip(ring, ring[1:] + ring[:1]):                                           # the walls
+        faces.append(np.array([[a, a + n * n, b], [b, a + n * n, b + n * n]]))
+    mesh = TriMesh(v, np.concatenate(faces), "block")
+    outward = mesh.face_normals()[:, 2]
+    assert (outward[: 2 * (n - 1) ** 2] > 0).all() and (outward[2 * (n - 1) ** 2: 4 * (n - 1) ** 2] < 0).all()
+    return mesh
+
+
+def plate(z: float, corners) -> TriMesh:
+    """A flat model of triangles at height z (the corners in XY, a fan from the first)."""
+    v = np.array([(x, y, z) for x, y in corners], float)
+    return TriMesh(v, np.array([[0, k, k + 1] for k in range(1, len(v) - 1)]), "plate")
+
+
+@pytest.mark.parametrize("dip, model, words", [
+    # a valley across the stock's top, deeper than the model between its points: the model's edges cross it
+    (lambda x, y: np.where(np.isclose(x, 5.0), 3.0, 10.0), [(1, 1), (9, 1), (9, 9), (1, 9)],
+     ["edges pass through the stock's surface", "X1 Y1 Z6"]),
+    # a pit inside one of the model's faces: no model edge crosses, the pit's edges cross the face
+    (lambda x, y: np.where(np.isclose(x, 5.0) & np.isclose(y, 5.0), 3.0, 10.0), [(0.5, 0.5), (9.5, 0.5), (5, 9.5)],
+     ["the stock's edge from", "X5 Y5 Z3", "passes through its faces"]),
+])
+def test_model_crossing_the_solid_refused(tmp_path: Path, dip, model, words: list) -> None:
+    """Every model point lies under the stock's top, but its surface crosses the stock's: refused (the points'
+    check alone passed it)."""
+    data = solid_job(tmp_path, field_block(dip, 5, 10.0, 0.0))
+    with pytest.raises(PlanInputError) as ctx:
+        planned_stock(job_of(tmp_path, data), plate(6.0, model))
+    text = str(ctx.value)
+    assert all(w in text for w in ["stock.file", "not inside the stock stock.stl", "(its points lie inside it)"]
+               + words), text
+    flat = solid_job(tmp_path, field_block(lambda x, y: np.full_like(x, 10.0), 5, 10.0, 0.0))
+    assert planned_stock(job_of(tmp_path, flat), plate(6.0, model)).type == "solid"   # the same model held
+    on_top = plate(10.0, model)   # the model's face on the stock's top (and its underside on the stock's bottom)
+    assert planned_stock(job_of(tmp_path, flat), on_top).type == "solid"
 
 
 def test_empty_solid_stock_exit_2(tmp_path: Path, capsys) -> None:

@@ -91,3 +91,17 @@ def test_failed_page_escaped_and_without_pictures(planned) -> None:
     assert "gouged 0.0500 mm below the model &lt;&amp; &quot;here&quot;&gt;" in page
     assert "<mm>" not in page and "beet &lt;mm&gt;" in page
     assert "data:image" not in page and "not drawn" in page
+
+
+def test_tarus_on_the_setup_sheet(planned) -> None:
+    """The machine's row names the Tarus and its tilt limit, and travels it does not check."""
+    from dataclasses import replace
+
+    job, an, plan = planned
+    tarus = replace(job, machine=replace(job.machine, type="tarus5", post="tarus", travels=(1e4, 1e4, 1e4),
+                                         tilt_limit=30.0))
+    page = report_html(launch.report(tarus, an, plan, verification(plan), ["beet_mm.ngc"]), "beet_mm")
+    assert "Tarus 5-axis (tarus5), the tool at most 30 deg from the surface normal, tarus post, travels not checked" \
+        in page
+    page = report_html(launch.report(job, an, plan, verification(plan), ["beet_mm.ngc"]), "beet_mm")
+    assert "linuxcnc post, travels 300 x 200 x 100 mm" in page and "Tarus" not in page

@@ -279,6 +279,18 @@ def stock_job(folder: Path, stock: dict, **machine) -> Any:
     return job_from_dict(data, folder / "job.yaml")
 
 
+def feed_moves_from(op: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The op's cutting moves' start and end points (x, y, z): the position before each G1 (modal) and after."""
+    pos, start, end = {}, [], []
+    for c in op.Path.Commands:
+        before = dict(pos)
+        pos.update({k: c.Parameters[k] for k in "XYZ" if k in c.Parameters})
+        if c.Name in ("G1", "G01") and len(before) == 3:
+            start.append([before[k] for k in "XYZ"])
+            end.append([pos[k] for k in "XYZ"])
+    return np.array(start), np.array(end)
+
+
 def feed_moves(op: Any) -> np.ndarray:
     """The op's cutting moves' end points (x, y, z)."""
     return np.array([(c.Parameters["X"], c.Parameters["Y"], c.Parameters["Z"]) for c in op.Path.Commands
@@ -307,14 +319,21 @@ class PlanStocks(FreeCADTestCase):
         self.assertEqual([t.Label for t in results[0].job.Tools.Group],   # no default tool left in the Job
                          list(dict.fromkeys(f"TC: {o.tool}" for o in plan.ops)))
         rough = results[0].op
-        p = feed_moves(rough)
-        below = p[p[:, 2] < stock["box_mm"][5] - 0.01]
-        self.assertGreater(len(below), 100)
+        start, end = feed_moves_from(rough)
+        deep = end[:, 2] < stock["box_mm"][5] - 0.01
+        self.assertGreater(deep.sum(), 100)
         r_tool = rough.ToolController.Tool.Diameter.Value / 2
-        off_axis = np.hypot(below[:, 0] - stock["centre_mm"][0], below[:, 1] - stock["centre_mm"][1])
+        off_axis = np.hypot(end[:, 0] - stock["centre_mm"][0], end[:, 1] - stock["centre_mm"][1])
+        outside = deep & (off_axis > stock["radius_mm"] + r_tool + 0.01)
         # the box's corners beyond the cylinder are 21 % of its area: a box stock's clearing would go there; the
-        # cylinder's takes only its entries from the air beside the stock (36 of 4,177 moves on 0.20)
-        self.assertLess(np.mean(off_axis > stock["radius_mm"] + r_tool + 0.01), 0.02)
+        # cylinder's feed moves end within the circle grown by the tool's radius, but for each layer's entry: a
+        # plunge in the air beside the stock (straight down: a step-over and the roughing's 1 mm air margin
+        # beyond the first loop, whose tool touches the stock), then fed in at depth
+        self.assertGreater(outside.sum(), 0)
+        plunge = np.all(np.isclose(start[:, :2], end[:, :2], atol=1e-6), axis=1) & (start[:, 2] > end[:, 2])
+        self.assertTrue(plunge[outside].all(), end[outside & ~plunge][:5])
+        step = float(plan.ops[0].kwargs["stepover_percent"]) / 100 * 2 * r_tool
+        self.assertLess(off_axis[outside].max(), stock["radius_mm"] + r_tool + step + 1.0 + 0.05)
         volume = np.pi * stock["radius_mm"] ** 2 * (stock["box_mm"][5] - stock["box_mm"][2])
         self.assertLess(verified["removed_volume_mm3"], volume)
         box = stock["box_mm"]

@@ -29,7 +29,8 @@ def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
     from tmm_workbench.app.plan_stock import new_job
     from tmm_workbench.core.plan import progress_note
 
-    calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline}
+    calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline,
+             "run_mesh5": api.run_mesh5}
     results: list = []
     controllers: dict = {}
     job = None if plan.get("stock", {}).get("type", "box") == "box" else new_job(plan, model)
@@ -196,7 +197,7 @@ def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False)
         for r in results:   # a tool controller where its tool comes in (once per tool)
             objects += [r.op] if r.op.ToolController in objects else [r.op.ToolController, r.op]
         # without the header's export time: the same plan gives the same G-code, byte for byte
-        args = posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
+        args = plan.get("post_args") or posts.DEFAULT_ARGS.get(plan["post"], "--no-show-editor") + " --no-header"
         posts.export(plan["post"], objects, folder / f"{plan['name']}.ngc", args)
     return results, report
 
@@ -252,7 +253,9 @@ def main() -> int:
     plan = json.loads(plan_file.read_text())
     from tmm_workbench.core.plan import progress_note
 
-    results, report = run_plan(plan, folder)
+    from tmm_workbench.app import plan_five
+
+    results, report = plan_five.run(plan, folder, run_plan)   # a 5-axis op's fallback; the tarus extras
     if plan["fcstd"]:
         progress_note.note(steps(plan), steps(plan), "saving the document")
         results[0].job.Document.saveAs(str(folder / f"{plan['name']}.FCStd"))

@@ -75,6 +75,7 @@ class Plan:
     decisions: list = field(default_factory=list)
     cutting: dict = field(default_factory=dict)   # tool name -> materials.Cutting.as_dict()
     reach_tool: str = ""      # the library tool reaching the most: what is left is judged where it reaches
+    five_axis: Any = None     # core.plan.five_axis.FiveAxisChoice: the 5-axis op put in, the 3-axis fallback
 
     @property
     def stock_box(self) -> tuple:

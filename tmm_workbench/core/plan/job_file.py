@@ -18,7 +18,12 @@ FORMAT = "tmm-plan 1"
 UNITS = {"mm": 1.0, "inch": 25.4}
 MODEL_SUFFIXES = (".stl", ".step", ".stp")
 TOOL_TYPES = ("flat", "ball", "bull")
-MACHINE_TYPES = ("3-axis",)
+MACHINE_TYPES = ("3-axis", "tarus5")
+TARUS = "tarus5"               # the Tarus head-head 5-axis mill (core.machine.tarus): its post, its C range
+TARUS_POSTS = ("tarus",)
+TARUS_TILT_MAX = 45.0          # deg: the Tarus's C range (0..45), the 5-axis op's largest tilt from the normal
+NO_TRAVELS = (1e4, 1e4, 1e4)   # a tarus5 machine without travels: the post checks its joints
+FIVE_AXIS = ("auto", "always", "never")   # planner.five_axis: 5-axis finishing where it pays, always, never
 STOCK_TYPES = ("box", "cylinder", "solid")
 STOCK_FIELDS = {"box": ("margin", "above", "below"), "cylinder": ("margin", "diameter", "above", "height", "below"),
                 "solid": ("file",)}
@@ -57,6 +62,11 @@ class MachineSpec:
     spindle_max: float = 24000.0   # rpm
     feed_max: float = 5000.0       # mm/min
     rapid: Optional[tuple[float, float]] = None   # mm/min in X and Y, in Z (None: the cycle estimate's default)
+    tilt_limit: float = TARUS_TILT_MAX   # tarus5: the 5-axis op's largest tool tilt from the surface normal, deg
+
+    @property
+    def five_axis(self) -> bool:
+        return self.type == TARUS
 
 
 @dataclass(frozen=True)
@@ -90,6 +100,7 @@ class OutputSpec:
     gcode: bool = True
     fcstd: bool = True
     heat_map: bool = True
+    apt_cl: bool = False     # the whole Job through the APT CL post too (<name>.apt)
 
 
 @dataclass(frozen=True)
@@ -98,6 +109,7 @@ class PlannerSpec:
     analysis_cell: float = 0.5     # mm, the reach tests' and slope map's grid
     sim_cell: float = 0.2          # mm, the verification's simulation grid
     compare_cutters: bool = True   # seed 003's cutter comparison for the finishing tool
+    five_axis: str = "auto"        # tarus5: 5-axis finishing where it pays (core.plan.five_axis), always, never
 
 
 @dataclass(frozen=True)
@@ -219,17 +231,32 @@ def _stock(d: Any, base: Path) -> StockSpec:
 
 
 def _machine(d: Any) -> MachineSpec:
-    d = _mapping("machine", d, ("post", "travels"), ("type", "spindle_max", "feed_max", "rapid"))
+    if d == "tarus":   # the shorthand: the Tarus with its post, C range and no travels given
+        d = {"type": TARUS}
+    if not isinstance(d, dict):
+        raise _fail("machine", d, "a mapping (type, post, travels, ...) or 'tarus' (the Tarus 5-axis mill)")
+    kind = _choice("machine.type", d.get("type", "3-axis"), MACHINE_TYPES)
+    five = kind == TARUS
+    d = _mapping(f"machine (type {kind})", d, () if five else ("post", "travels"),
+                 ("type", "post", "travels", "spindle_max", "feed_max", "rapid") + (("tilt_limit",) if five else ()))
     rapid = d.get("rapid")
     if rapid is not None:
         if not isinstance(rapid, (list, tuple)) or len(rapid) != 2:
             raise _fail("machine.rapid", rapid, "a list of two rates [xy, z] in mm/min")
         rapid = tuple(_number(f"machine.rapid[{i}]", v, 1.0, 1e6) for i, v in enumerate(rapid))
-    return MachineSpec(_choice("machine.type", d.get("type", "3-axis"), MACHINE_TYPES),
-                       _choice("machine.post", d["post"], POSTS),
-                       _vector("machine.travels", d["travels"], 0.0, 1e4, low_open=True),
+    if five:
+        post = _choice("machine.post", d.get("post", TARUS_POSTS[0]), TARUS_POSTS)
+    elif d["post"] in TARUS_POSTS:
+        raise _fail("machine.post", d["post"], f"one of {', '.join(POSTS)} for a 3-axis machine (the tarus post "
+                    f"is the Tarus's: machine.type {TARUS})")
+    else:
+        post = _choice("machine.post", d["post"], POSTS)
+    travels = _vector("machine.travels", d["travels"], 0.0, 1e4, low_open=True) if "travels" in d else NO_TRAVELS
+    return MachineSpec(kind, post, travels,
                        _number("machine.spindle_max", d.get("spindle_max", 24000.0), materials.MIN_RPM, 1e5),
-                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5), rapid)
+                       _number("machine.feed_max", d.get("feed_max", 5000.0), 1.0, 1e5), rapid,
+                       _number("machine.tilt_limit", d.get("tilt_limit", TARUS_TILT_MAX), 0.0, TARUS_TILT_MAX,
+                               low_open=True))
 
 
 def _tool(i: int, d: Any) -> ToolSpec:
@@ -297,22 +324,27 @@ def _finish(d: Any) -> FinishSpec:
 
 
 def _outputs(d: Any, base: Path, default_name: str) -> OutputSpec:
-    d = _mapping("outputs", d, ("dir",), ("name", "gcode", "fcstd", "heat_map"))
+    d = _mapping("outputs", d, ("dir",), ("name", "gcode", "fcstd", "heat_map", "apt_cl"))
     name = _text("outputs.name", d.get("name", default_name))
     if any(c in name for c in "/\\") or name.startswith("."):
         raise _fail("outputs.name", name, "a file name without folders (the files are <dir>/<name>.*)")
     return OutputSpec((base / _text("outputs.dir", d["dir"])).resolve(), name,
-                      *(_flag(f"outputs.{k}", d.get(k, True)) for k in ("gcode", "fcstd", "heat_map")))
+                      *(_flag(f"outputs.{k}", d.get(k, True)) for k in ("gcode", "fcstd", "heat_map")),
+                      _flag("outputs.apt_cl", d.get("apt_cl", False)))
 
 
-def _planner(d: Any) -> PlannerSpec:
-    d = _mapping("planner", d, (), ("analysis_cell", "sim_cell", "compare_cutters"))
+def _planner(d: Any, machine: MachineSpec) -> PlannerSpec:
+    d = _mapping("planner", d, (), ("analysis_cell", "sim_cell", "compare_cutters", "five_axis"))
+    five = _choice("planner.five_axis", d.get("five_axis", "auto"), FIVE_AXIS)
+    if five == "always" and not machine.five_axis:
+        raise _fail("planner.five_axis", five, f"auto or never on a 3-axis machine (5-axis finishing needs "
+                    f"machine.type {TARUS})")
     return PlannerSpec(_number("planner.analysis_cell", d.get("analysis_cell", 0.5), 0.05, 5.0),
                        _number("planner.sim_cell", d.get("sim_cell", 0.2), 0.02, 5.0),
-                       _flag("planner.compare_cutters", d.get("compare_cutters", True)))
+                       _flag("planner.compare_cutters", d.get("compare_cutters", True)), five)
 
 
-TOP_FIELDS = ("format", "model", "stock", "machine", "tools", "material", "finish", "outputs", "planner")
+TOP_FIELDS = ("format", "model", "stock", "machine", "tools", "holders", "material", "finish", "outputs", "planner")
 
 
 def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
@@ -320,7 +352,7 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
     source = Path(source).resolve()
     base = source.parent
     data = _mapping("job file", data, ("format", "model", "machine", "tools", "material", "finish", "outputs"),
-                    ("stock", "planner"))
+                    ("stock", "holders", "planner"))
     if data["format"] != FORMAT:
         raise _fail("format", data["format"], f"'{FORMAT}'")
     tools, notes = data["tools"], ()
@@ -329,6 +361,7 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
     if not isinstance(tools, list) or not tools:
         raise _fail("tools", tools, "a non-empty list of tools (type, diameter, flute_length, ...) or the name "
                     "of a YAML / JSON file holding one")
+    tools = _held(tools, data.get("holders", {}))
     library = tuple(_library_tool(i, t, data["tools"]) for i, t in enumerate(tools))
     names = [t.name for t in library]
     for i, n in enumerate(names):
@@ -336,9 +369,31 @@ def job_from_dict(data: Any, source: Union[str, Path]) -> JobSpec:
             raise _fail(f"tools[{i}].name", n, "a name no other tool has")
     material = _choice("material", data["material"], tuple(materials.names()))
     model = _model(data["model"], base)
-    return JobSpec(source, model, _stock(data.get("stock", {}), base), _machine(data["machine"]), library,
+    machine = _machine(data["machine"])
+    return JobSpec(source, model, _stock(data.get("stock", {}), base), machine, library,
                    material, _finish(data["finish"]), _outputs(data["outputs"], base, model.file.stem),
-                   _planner(data.get("planner", {})), notes)
+                   _planner(data.get("planner", {}), machine), notes)
+
+
+def _held(tools: list, holders: Any) -> list:
+    """The tools with the job's `holders` (tool name, or its number T<nr>, -> {holder, stick_out}) given to them:
+    a FreeCAD library's bits have no holder (a .fctb holds none); checked with the tool as its own fields."""
+    if not isinstance(holders, dict):
+        raise _fail("holders", holders, "a mapping of tool names (or numbers, T3) to {holder, stick_out}")
+    out = [dict(t) if isinstance(t, dict) else t for t in tools]
+    for key, given in holders.items():
+        where = f"holders[{key!r}]"
+        given = _mapping(where, given, ("holder",), ("stick_out",))
+        names = [str(t.get("name", f"T{i + 1}")) if isinstance(t, dict) else "" for i, t in enumerate(out)]
+        hits = [i for i, n in enumerate(names) if n == key] or \
+            [i for i, n in enumerate(names) if isinstance(key, str) and n.split(" ")[0] == key]
+        if len(hits) != 1:
+            raise _fail("holders", key, f"the name (or number) of one library tool: {', '.join(names)}")
+        tool = out[hits[0]]
+        if "holder" in tool:
+            raise _fail(where, given, f"no second holder: the tool {names[hits[0]]} has its own ({tool['holder']})")
+        tool.update(given)
+    return out
 
 
 def _parsed(p: Path, what: str) -> Any:

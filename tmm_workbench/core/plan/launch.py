@@ -26,7 +26,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
-from tmm_workbench.core.plan import analysis, decide, progress_note, recipes
+from tmm_workbench.core.plan import analysis, decide, five_axis, progress_note, recipes
 from tmm_workbench.core.plan.job_file import (MODEL_SUFFIXES, UNITS, JobSpec, PlanInputError, ToolSpec, is_step,
                                               job_from_dict, read_data)
 from tmm_workbench.core.plan.stock import planned_stock
@@ -71,10 +71,15 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
     if job.planner.compare_cutters:
         from tmm_workbench.core.plan.optimal_cutter import compare_cutters
 
+        rapid = None if job.machine.rapid is None else tuple(r / 60.0 for r in job.machine.rapid)
         compare = partial(compare_cutters, sample_step=0.5, cell=job.planner.sim_cell,
-                          tolerance=job.finish.tolerance)
+                          tolerance=job.finish.tolerance, rapid=rapid)   # the machine's rapids: its cycle times
         say("comparing the finishing cutters (seed 003)", quiet)
-    return mesh, moved, an, decide.plan_job(job, mesh, an, compare, stock)
+    plan = decide.plan_job(job, mesh, an, compare, stock)
+    if job.machine.five_axis:
+        say("timing 5-axis finishing against the 3-axis raster (Tarus)", quiet)
+        plan.five_axis = five_axis.consider(job, mesh, an, plan)
+    return mesh, moved, an, plan
 
 
 def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
@@ -86,7 +91,9 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
             "fcstd": o.fcstd, "heat_map": o.heat_map, "sim_cell": job.planner.sim_cell,
             "tolerance": job.finish.tolerance, "cusp": job.finish.cusp, "ops": [op.as_dict() for op in plan.ops],
             "stock": plan.stock.as_dict(),
-            "rapid_mm_min": None if rapid is None else list(rapid),
+            "rapid_mm_min": None if rapid is None else list(rapid), "apt_cl": o.apt_cl,
+            "post_args": TARUS_POST_ARGS if job.machine.five_axis else None,
+            "five_axis": None if plan.five_axis is None else plan.five_axis.as_dict(),
             "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
                                "shank_diameter": t.shank_diameter, "holder": t.holder, "stick_out": t.stick_out}
                       for t in job.tools},
@@ -110,6 +117,8 @@ def tessellate_stock(job: JobSpec, folder: Path, freecad: str, quiet: bool) -> J
     return replace(job, stock=replace(job.stock, mesh_file=stl))
 
 
+TARUS_POST_ARGS = "--no-show-editor"   # the tarus post writes no date (it has no --no-header)
+TIP_GCODE = "tip.ngc"   # a tarus Job's G-code in tool-tip coordinates (--tcp), for the picture (removed after)
 STOCK_MESH = "stock_mesh.stl"   # a STEP stock's tessellation in the run's folder (removed before the outputs)
 
 
@@ -153,10 +162,15 @@ def report(job: JobSpec, an: analysis.Analysis, plan: decide.Plan, verified: dic
             "problems": verified["problems"], "verification": verified, "analysis": an.as_dict(),
             "plan": plan.as_dict(), "finish": {"cusp_mm": job.finish.cusp, "tolerance_mm": job.finish.tolerance},
             "stock": plan.stock.as_dict() | {"file": None if job.stock.file is None else job.stock.file.name},
-            "material": job.material, "machine": {"post": job.machine.post, "travels_mm": list(job.machine.travels),
-                                                  "rapid_mm_min": None if job.machine.rapid is None else
-                                                  list(job.machine.rapid)},
+            "material": job.material, "machine": machine_row(job),
             "tools": [tool_row(t) for t in job.tools], "notes": list(job.notes), "files": sorted(files)}
+
+
+def machine_row(job: JobSpec) -> dict:
+    m = job.machine
+    row = {"type": m.type, "post": m.post, "travels_mm": list(m.travels),
+           "rapid_mm_min": None if m.rapid is None else list(m.rapid)}
+    return row | ({"tilt_limit_deg": m.tilt_limit} if m.five_axis else {})
 
 
 def tool_row(tool: ToolSpec) -> dict:
@@ -170,12 +184,13 @@ def tool_row(tool: ToolSpec) -> dict:
             "stick_out_mm": round(stick, 4)}
 
 
-def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path) -> None:
-    """The whole Job's G-code read back and drawn over the model (core.preview.toolpath_png)."""
+def draw_toolpath(mesh: TriMesh, gcode: Path, png: Path, name: Optional[str] = None) -> None:
+    """The whole Job's G-code read back and drawn over the model (core.preview.toolpath_png); `name` the title's
+    file name (the G-code's own by default)."""
     from tmm_workbench.core.preview.toolpath_png import render_toolpath_png, toolpath_of_gcode
 
     toolpath = toolpath_of_gcode(gcode.read_text(errors="replace"))
-    render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {gcode.name}", size_px=(1400, 650))
+    render_toolpath_png(mesh, toolpath, str(png), title=f"the tool path: {name or gcode.name}", size_px=(1400, 650))
 
 
 def write_pages(tmp: Path, job: JobSpec, doc: dict) -> None:
@@ -194,10 +209,13 @@ def finish_outputs(tmp: Path, job: JobSpec, mesh: TriMesh, an: analysis.Analysis
     """After the FreeCAD side wrote its files into `tmp`: the tool path picture, report.json and report.html, all
     moved into the job's outputs.dir. Returns the report."""
     out = job.outputs
-    gcode = tmp / f"{out.name}.ngc"
+    gcode, tip = tmp / f"{out.name}.ngc", tmp / TIP_GCODE   # the Tarus's joints drawn at the tool tip
     if gcode.is_file():
         say("drawing the tool path", quiet)
-        draw_toolpath(mesh, gcode, tmp / f"{out.name}_toolpath.png")
+        draw_toolpath(mesh, tip if tip.is_file() else gcode, tmp / f"{out.name}_toolpath.png",
+                      f"{gcode.name}" + (" (the tool tip: the same program in TCP mode)" if tip.is_file() else ""))
+    if tip.is_file():
+        tip.unlink()
     files = sorted(f.name for f in tmp.iterdir()) + ["report.html", "report.json"]
     doc = report(job, an, plan, verified, files)
     write_pages(tmp, job, doc)
@@ -280,6 +298,8 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
             print(f"tmm plan: {failure}", file=sys.stderr)
             return FAILED
         verified = json.loads((tmp / "verify.json").read_text())
+        if verified.get("five_axis_fallback"):
+            five_axis.fallen_back(plan, plan.five_axis, verified["five_axis_fallback"])
         for name in ("plan.json", "verify.json"):
             (tmp / name).unlink()
         finish_outputs(tmp, job, mesh, an, plan, verified, quiet)

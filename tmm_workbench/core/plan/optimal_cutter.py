@@ -59,10 +59,12 @@ class CutterComparison:
 def compare_cutters(mesh: TriMesh, candidates: Sequence[tuple[str, Cutter]], *, stepover: float,
                     sample_step: float, cell: float = 0.1, tolerance: float = 0.01, angle_deg: float = 0.0,
                     boundary: Optional[tuple[float, float, float, float]] = None, horiz_feed: float = 1000 / 60,
-                    vert_feed: float = 300 / 60, margin: float = 0.0) -> CutterComparison:
+                    vert_feed: float = 300 / 60, margin: float = 0.0,
+                    rapid: Optional[tuple[float, float]] = None) -> CutterComparison:
     """Each candidate finishes `mesh` with the same raster (core.strategies.raster_drop) and is simulated in a
     box stock 1 mm above the model over `boundary` (default: the model's XY box shrunk by `margin`).
-    Ranked by: no gouge first, then the volume left above the design, then the cycle time."""
+    Ranked by: no gouge first, then the volume left above the design, then the cycle time (feeds and `rapid`,
+    the machine's rapid rates in XY and Z, in mm/s; None: the cycle estimate's default)."""
     if not candidates:
         raise TmmError("no candidate cutters to compare")
     lo, hi = mesh.bounds
@@ -86,7 +88,7 @@ def compare_cutters(mesh: TriMesh, candidates: Sequence[tuple[str, Cutter]], *, 
         for band in SLOPE_BANDS:
             sel = np.isfinite(d) & (slope >= band[0]) & (slope < band[1])
             by_slope[band] = float(np.mean(np.clip(d[sel], 0, None))) if sel.any() else math.nan
-        seconds = three_axis_time(tp.points(), toolpath_feeds(tp, horiz_feed, vert_feed)).seconds
+        seconds = three_axis_time(tp.points(), toolpath_feeds(tp, horiz_feed, vert_feed), *(rapid or ())).seconds
         scores.append(CutterScore(label, cutter, seconds, cmp.overall.max_left, float(np.mean(np.clip(left, 0, None))),
                                   float(np.std(left)), cmp.overall.percentiles[95], cmp.overall.remaining_volume,
                                   cmp.removed_volume, max(0.0, -cmp.overall.min_deviation), by_slope))

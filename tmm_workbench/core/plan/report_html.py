@@ -78,6 +78,17 @@ def summary(report: Mapping) -> str:
     return "\n".join(parts) + pairs(rows)
 
 
+def machine(m: Mapping) -> str:
+    """The setup sheet's machine: its type (the Tarus with its tilt limit), post, travels and rapids."""
+    rapid = m.get("rapid_mm_min")
+    kind = (f"Tarus 5-axis (tarus5), the tool at most {m['tilt_limit_deg']:g} deg from the surface normal, "
+            if m.get("type") == "tarus5" else "")
+    travels = "not checked (the post checks the joints)" if m.get("type") == "tarus5" and \
+        min(m["travels_mm"]) >= 1e4 else " x ".join(f"{t:g}" for t in m["travels_mm"]) + " mm"
+    return (f"{kind}{m['post']} post, travels {travels}"
+            + (f", rapids XY {rapid[0]:g} Z {rapid[1]:g} mm/min" if rapid else ""))
+
+
 def tool_numbers(report: Mapping) -> dict[str, int]:
     """The library tools' numbers in the G-code: T1, T2, ... in the order the ops first use them."""
     numbers: dict[str, int] = {}
@@ -91,16 +102,13 @@ def setup_sheet(report: Mapping) -> str:
     lo, hi = box[:3], box[3:]
     size = " x ".join(f"{b - a:.2f}" for a, b in zip(lo, hi))
     shape = report["stock"]["describe"] if "stock" in report else f"box {size} mm"
-    rapid = report["machine"].get("rapid_mm_min")
     stock = pairs([("stock", f"{shape} (X x Y x Z over all: {size} mm)"),
                    ("material", report["material"].replace("_", " ")),
                    ("stock corner (lowest X, Y, Z)", "X{:g} Y{:g} Z{:g}".format(*lo)),
                    ("stock top", f"Z{hi[2]:g}"),
                    ("zero point (G54)", "the model's origin: X0 Y0 Z0 of the model file as placed (the stock's "
                     f"top is Z{hi[2]:g}, its lowest corner X{lo[0]:g} Y{lo[1]:g})"),
-                   ("machine", f"{report['machine']['post']} post, travels "
-                    + " x ".join(f"{t:g}" for t in report["machine"]["travels_mm"]) + " mm"
-                    + (f", rapids XY {rapid[0]:g} Z {rapid[1]:g} mm/min" if rapid else ""))]
+                   ("machine", machine(report["machine"]))]
                   + [("note", n) for n in report.get("notes", [])])
     numbers = tool_numbers(report)
     cutting = report["plan"]["tools"]

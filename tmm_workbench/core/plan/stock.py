@@ -123,7 +123,8 @@ def stock_mesh(job: JobSpec) -> TriMesh:
 
 def _solid(job: JobSpec, mesh: TriMesh) -> PlannedStock:
     """A solid stock: the model's points must lie under its top and over its lowest point (the planner cuts from
-    above: the stock is what its top surface covers)."""
+    above: the stock is what its top surface covers), and its surface must not cross the stock's but for the
+    underside (boundary_crossings)."""
     from tmm_workbench.core.query.drop import DropSurface
     from tmm_workbench.core.tools.cutter import Cutter
 
@@ -138,8 +139,66 @@ def _solid(job: JobSpec, mesh: TriMesh) -> PlannedStock:
         raise PlanInputError(f"stock.file: the model is not inside the stock {job.stock.file.name}: "
                              f"{int(outside.sum())} of its {len(v)} points lie outside it (the first at "
                              f"X{p[0]:.4g} Y{p[1]:.4g} Z{p[2]:.4g}); a solid stock must hold the whole model")
+    crossing = boundary_crossings(mesh, solid)
+    if crossing is not None:
+        raise PlanInputError(f"stock.file: the model is not inside the stock {job.stock.file.name}: {crossing} (its "
+                             "points lie inside it); a solid stock must hold the whole model")
     box = _outward(tuple(float(x) for x in lo), tuple(float(x) for x in hi))
     return stock_of_plan(job, box)
+
+
+def _edges(mesh: TriMesh, keep: np.ndarray) -> np.ndarray:
+    """(m, 2) vertex indices of the edges of the triangles in `keep` (each once)."""
+    t = mesh.triangles[keep]
+    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
+    return np.unique(e, axis=0)
+
+
+def _crossing(p0: np.ndarray, p1: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """Which segments p0-p1 pass through which triangles abc (arrays broadcast, (m, 3)): from more than INSIDE_MM
+    on one side of its plane to more than INSIDE_MM on the other, through its inside (a segment touching a face,
+    lying in it or ending on it does not cross)."""
+    n = np.cross(b - a, c - a)
+    size = np.linalg.norm(n, axis=-1, keepdims=True)
+    n = n / np.where(size > 1e-12, size, np.inf)
+    d0, d1 = np.sum((p0 - a) * n, axis=-1), np.sum((p1 - a) * n, axis=-1)
+    through = ((d0 < -INSIDE_MM) & (d1 > INSIDE_MM)) | ((d0 > INSIDE_MM) & (d1 < -INSIDE_MM))
+    x = p0 + (d0 / np.where(through, d0 - d1, 1.0))[..., None] * (p1 - p0)
+    inside = np.ones(through.shape, bool)
+    for u, v in ((a, b), (b, c), (c, a)):
+        inside &= np.sum(np.cross(v - u, x - u) * n, axis=-1) >= -1e-9
+    return through & inside
+
+
+def boundary_crossings(model: TriMesh, solid: TriMesh) -> Optional[str]:
+    """Where the model's surface crosses the solid stock's (a model edge through a stock face, or a stock edge
+    through a model face: a groove or pit in the stock's top between the model's points), None when nowhere. The
+    stock's underside (faces facing down) is not checked: the planner cuts from above. Loops over the stock's
+    faces and edges (a stock has few), each against all of the model's (culled by their boxes)."""
+    up = solid.face_normals()[:, 2] > -1e-9
+    mv, sv = model.vertices, solid.vertices
+    me = _edges(model, np.ones(len(model.triangles), bool))
+    e0, e1 = mv[me[:, 0]], mv[me[:, 1]]
+    elo, ehi = np.minimum(e0, e1), np.maximum(e0, e1)
+    for tri in solid.triangles[up]:
+        a, b, c = sv[tri]
+        near = np.all((elo <= np.maximum(np.maximum(a, b), c) + INSIDE_MM) &
+                      (ehi >= np.minimum(np.minimum(a, b), c) - INSIDE_MM), axis=1)
+        hit = np.flatnonzero(near)[_crossing(e0[near], e1[near], a, b, c)]
+        if len(hit):
+            p, q = e0[hit[0]], e1[hit[0]]
+            return (f"{len(hit)} of its edges pass through the stock's surface (the first from X{p[0]:.4g} "
+                    f"Y{p[1]:.4g} Z{p[2]:.4g} to X{q[0]:.4g} Y{q[1]:.4g} Z{q[2]:.4g})")
+    corners = mv[model.triangles]
+    tlo, thi = corners.min(axis=1), corners.max(axis=1)
+    for i, j in _edges(solid, up):
+        p, q = sv[i], sv[j]
+        near = np.all((tlo <= np.maximum(p, q) + INSIDE_MM) & (thi >= np.minimum(p, q) - INSIDE_MM), axis=1)
+        c = corners[near]
+        if _crossing(p, q, c[:, 0], c[:, 1], c[:, 2]).any():
+            return (f"the stock's edge from X{p[0]:.4g} Y{p[1]:.4g} Z{p[2]:.4g} to X{q[0]:.4g} Y{q[1]:.4g} "
+                    f"Z{q[2]:.4g} passes through its faces")
+    return None
 
 
 def _within_travels(job: JobSpec, mesh: TriMesh, stock: PlannedStock) -> None:
