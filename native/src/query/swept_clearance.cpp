@@ -122,14 +122,11 @@ bool closest_on_tetrahedron(Simplex& s, Vector3d& v) {
   return true;
 }
 
-}  // namespace
-
-namespace {
-
 // The point of D lowest along d: the triangle's corner lowest along d minus S's point highest along it
 // (inlined: GJK's inner step).
-[[gnu::always_inline]] inline Vector3d lowest_along(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                      const Vector3d& W, double t0, double cap, const Vector3d& d) {
+[[gnu::always_inline]] inline Vector3d lowest_along(const Cutter& c, const Vector3d& q0, const Vector3d& q1,
+                                                    const Vector3d& q2, const Vector3d& W, double t0, double cap,
+                                                    const Vector3d& d) {
   const double a0 = d.dot(q0), a1 = d.dot(q1), a2 = d.dot(q2);
   const Vector3d& q = a0 <= a1 ? (a0 <= a2 ? q0 : q2) : (a1 <= a2 ? q1 : q2);
   return q - support(c, d).point - (d.dot(W) >= 0 ? cap : t0) * W;
