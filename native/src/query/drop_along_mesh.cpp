@@ -194,10 +194,11 @@ AlongCutter::Search AlongCutter::search(const Vector3d& start, double max_travel
   return q;
 }
 
-inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i) const {
+inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i, Vector3d* plane) const {
   // Most candidates are not touched before the best contact so far: a plane under K that has the whole
-  // triangle below it proves it in a few products; else a separating plane found by the clearance
-  // certificate, at a fraction of the cost of the triangle's pieces.
+  // triangle below it proves it in a few products; else the plane that cleared the triangle from a nearby
+  // start (one support point), else a separating plane found by the clearance certificate, at a fraction of
+  // the cost of the triangle's pieces.
   if (q.best < kNoTravel && below_a_plane(t, q.s.x(), q.s.y(), q.s.z() - q.best)) return;
   ++q.tested;
   const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - q.s), q1 = frame_.to_tool(Vector3d(t.p[1]) - q.s),
@@ -205,7 +206,9 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
   if (q.best < kNoTravel) {
     const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
     if (t0 >= q.best) return;
-    if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, t0 - 1e-9 * (1 + std::fabs(t0)), q.best)) return;
+    const double low = t0 - 1e-9 * (1 + std::fabs(t0));
+    if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
+    if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
   const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges);
   if (tr < q.best) {
@@ -233,27 +236,42 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   return q.best;
 }
 
-double AlongCutter::drop_listed(const Vector3d& start, double max_travel, const Candidates& cands, DropStats* stats,
+double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candidates& cands, DropStats* stats,
                                 int32_t* hint) const {
   Search q = search(start, max_travel);
   const auto& tris = index_->index().triangles();
   if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = reach_ * reach_;
-  for (const Candidate& c : cands.list) {
-    if (c.zmax <= q.floor) break;  // by decreasing height: the rest are no higher
+  const Plane& kp = cands.key_plane;
+  // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
+  // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
+  auto under = [&](double h, double gx, double gy) {
+    const double lim = q.s.z() - q.best + gx * q.s.x() + gy * q.s.y();
+    return lim - h > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(h));
+  };
+  auto cleared = [&](const Candidate& c) {
+    return under(c.h[0], c.gx[0], c.gy[0]) || under(c.h[1], c.gx[1], c.gy[1]);
+  };
+  std::vector<std::pair<double, Candidate*>> open;  // the candidates left, by their bound
+  for (Candidate& c : cands.list) {
+    // By decreasing key: once one lies below the key plane at this start, so do the rest (the margin grows
+    // slower than the gap).
+    if (under(c.key, kp.gx, kp.gy)) break;
+    if (c.zmax <= q.floor) continue;
     const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
     const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
-    if (dx * dx + dy * dy > r2 || c.tri == skip) continue;
-    // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before
-    // the best.
-    auto under = [&](int w) {
-      const double lim = q.s.z() - q.best + c.gx[w] * q.s.x() + c.gy[w] * q.s.y();
-      return lim - c.h[w] > 1e-9 * (1.0 + std::fabs(lim) + std::fabs(c.h[w]));
-    };
-    if (under(0) || under(1)) continue;
-    consider(q, tris[c.tri], c.tri);
+    if (dx * dx + dy * dy > r2 || c.tri == skip || cleared(c)) continue;
+    double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
+    for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
+    open.emplace_back(bound, &c);
   }
+  // The likely first contacts first: each lowers the best, which clears more of the rest on their planes.
+  std::sort(open.begin(), open.end(), [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first < b.first : a.second->tri < b.second->tri;
+  });
+  for (const auto& [bound, c] : open)
+    if (!under(c->key, kp.gx, kp.gy) && !cleared(*c)) consider(q, tris[c->tri], c->tri, &c->plane);
   if (stats) stats->triangles_tested += q.tested;
   if (hint) *hint = q.winner;
   return q.best;
@@ -342,6 +360,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       }
     return false;
   };
+  // The key plane: K's flat end along the axis where it faces down, else its lowest point.
+  const Plane kp = out.key_plane = axial_.empty() ? Plane{lowest_, 0.0, 0.0} : axial_.front();
   const MeshIndex& mi = index_->index();
   const auto& nodes = mi.nodes();
   const auto& tris = mi.triangles();
@@ -360,14 +380,17 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
       const Vector3d mid = (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
       const int az = fine_.empty() ? 0 : azimuth(centre - mid);
-      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}};
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, Vector3d::Zero()};
       if (below_everywhere(t, out, az, c)) continue;
       if (out.list.size() == limit) return false;
+      double h = -kInfinity;
+      for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + kp.gx * t.p[k][0] + kp.gy * t.p[k][1]);
+      c.key = h - kp.c;
       out.list.push_back(c);
     }
   }
   std::sort(out.list.begin(), out.list.end(), [](const Candidate& a, const Candidate& b) {
-    return a.zmax != b.zmax ? a.zmax > b.zmax : a.tri < b.tri;
+    return a.key != b.key ? a.key > b.key : a.tri < b.tri;
   });
   return true;
 }

@@ -274,12 +274,15 @@ std::vector<AssemblySolid> assembly_solids(const ToolAssembly& tool) {
     const ToolBody& b = bodies[i];
     const auto owner = static_cast<int32_t>(i);
     try {
-      if (b.r1 > b.r0)
-        add_grown_frustum(out, b.z0, 1.0, b.r0, b.r1, b.z1 - b.z0, b.clearance,
-                          tool.disc_covered(i, b.z1, b.r1, b.clearance), owner);
-      else  // narrowing upwards, or a cylinder: from the top down
-        add_grown_frustum(out, b.z1, -1.0, b.r1, b.r0, b.z1 - b.z0, b.clearance,
-                          tool.disc_covered(i, b.z0, b.r0, b.clearance), owner);
+      const bool top_covered = tool.disc_covered(i, b.z1, b.r1, b.clearance);
+      const bool bottom_covered = tool.disc_covered(i, b.z0, b.r0, b.clearance);
+      // A cylinder either way: from the bottom up (its rounded rim at the bottom, where the part is met, and
+      // the seam to the top disc's piece far from it, or none under a body sitting on it), unless only the
+      // bottom disc is covered.
+      if (b.r1 > b.r0 || (b.r1 == b.r0 && (top_covered || !bottom_covered)))
+        add_grown_frustum(out, b.z0, 1.0, b.r0, b.r1, b.z1 - b.z0, b.clearance, top_covered, owner);
+      else  // narrowing upwards: from the top down
+        add_grown_frustum(out, b.z1, -1.0, b.r1, b.r0, b.z1 - b.z0, b.clearance, bottom_covered, owner);
     } catch (const std::invalid_argument& e) {  // a cone too flat for an APT profile
       throw std::invalid_argument("tool body " + std::to_string(i) + " along a direction: " + e.what());
     }

@@ -122,17 +122,32 @@ bool closest_on_tetrahedron(Simplex& s, Vector3d& v) {
   return true;
 }
 
+// The point of D lowest along d: the triangle's corner lowest along d minus S's point highest along it
+// (inlined: GJK's inner step).
+[[gnu::always_inline]] inline Vector3d lowest_along(const Cutter& c, const Vector3d& q0, const Vector3d& q1,
+                                                    const Vector3d& q2, const Vector3d& W, double t0, double cap,
+                                                    const Vector3d& d) {
+  const double a0 = d.dot(q0), a1 = d.dot(q1), a2 = d.dot(q2);
+  const Vector3d& q = a0 <= a1 ? (a0 <= a2 ? q0 : q2) : (a1 <= a2 ? q1 : q2);
+  return q - support(c, d).point - (d.dot(W) >= 0 ? cap : t0) * W;
+}
+
+bool sweep_valid(const Cutter& c, double t0, double cap) {
+  return std::isfinite(t0) && std::isfinite(cap) && t0 <= cap && std::isfinite(c.cutting_length());
+}
+
 }  // namespace
 
+bool plane_clears(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2, const Vector3d& W,
+                  double t0, double cap, const Vector3d& v) {
+  if (!sweep_valid(c, t0, cap) || !(v.squaredNorm() > 0)) return false;
+  return v.dot(lowest_along(c, q0, q1, q2, W, t0, cap, v)) > kSeparation * v.norm();
+}
+
 bool triangle_clear(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                    const Vector3d& W, double t0, double cap) {
-  if (!(std::isfinite(t0) && std::isfinite(cap) && t0 <= cap && std::isfinite(c.cutting_length()))) return false;
-  // The point of D lowest along d: the triangle's corner lowest along d minus S's point highest along it.
-  auto lowest = [&](const Vector3d& d) {
-    const double a0 = d.dot(q0), a1 = d.dot(q1), a2 = d.dot(q2);
-    const Vector3d& q = a0 <= a1 ? (a0 <= a2 ? q0 : q2) : (a1 <= a2 ? q1 : q2);
-    return Vector3d(q - support(c, d).point - (d.dot(W) >= 0 ? cap : t0) * W);
-  };
+                    const Vector3d& W, double t0, double cap, Vector3d* plane) {
+  if (!sweep_valid(c, t0, cap)) return false;
+  auto lowest = [&](const Vector3d& d) { return lowest_along(c, q0, q1, q2, W, t0, cap, d); };
   Simplex s;
   Vector3d v = lowest(W);
   s.y[0] = v;
@@ -142,7 +157,10 @@ bool triangle_clear(const Cutter& c, const Vector3d& q0, const Vector3d& q1, con
     if (!(vv > kSeparation * kSeparation)) return false;  // touching, or nearly
     const Vector3d w = lowest(v);
     const double vw = v.dot(w);
-    if (vw > kSeparation * std::sqrt(vv)) return true;  // D lies beyond the plane v . x = v . w > 0
+    if (vw > kSeparation * std::sqrt(vv)) {  // D lies beyond the plane v . x = v . w > 0
+      if (plane) *plane = v;
+      return true;
+    }
     if (vv - vw <= 1e-12 * vv) return false;             // no progress: as close as it gets, not separated
     s.y[s.n++] = w;
     bool ok = true;

@@ -5,7 +5,9 @@
 //    past it), for every cutter shape and random axes, motions and triangles;
 //  - it is not vacuous: with the cap well before the contact (or a triangle never touched) it clears nearly all;
 //  - a triangle touched exactly at the cap is not cleared (the plane must clear it by 1e-9 mm);
-//  - an endless cutter or an unbounded sweep is never cleared.
+//  - an endless cutter or an unbounded sweep is never cleared;
+//  - the plane a clear answer gives proves the same case again on its own (plane_clears), and proves nothing
+//    once the triangle is touched before the cap.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -21,6 +23,7 @@ namespace {
 
 using Eigen::Vector3d;
 using tmm::Cutter;
+using tmm::direction_detail::plane_clears;
 using tmm::direction_detail::support;
 using tmm::direction_detail::triangle_clear;
 using tmm::direction_detail::triangle_travel;
@@ -112,6 +115,25 @@ TEST(SweptClearance, AMissedTriangleIsClearedAndATouchedOneIsNot) {
   EXPECT_FALSE(triangle_clear(Cutter(3, 0), q0, q1, q2, W, t0, 6.0));
   EXPECT_FALSE(triangle_clear(flat, q0, q1, q2, W, t0, kInf));
   EXPECT_FALSE(triangle_clear(flat, q0, q1, q2, W, -kInf, 6.0));
+}
+
+TEST(SweptClearance, TheSeparatingPlaneProvesTheCaseAgain) {
+  const Cutter flat = Cutter::apt(3, 0, 7, 0, 0);
+  const Vector3d W = Vector3d::UnitX();
+  const Vector3d q0(10, -5, 1), q1(10, 5, 1), q2(10, 0, 6);  // touched at travel 7 (as above)
+  const double t0 = 5.0;
+  Vector3d v = Vector3d::Zero();
+  ASSERT_TRUE(triangle_clear(flat, q0, q1, q2, W, t0, 6.5, &v));
+  ASSERT_GT(v.norm(), 0.0);
+  EXPECT_TRUE(plane_clears(flat, q0, q1, q2, W, t0, 6.5, v));
+  // A nearby start (the triangle 0.2 mm further, 0.1 mm aside) with the same plane.
+  const Vector3d d(0.2, 0.1, 0.0);
+  EXPECT_TRUE(plane_clears(flat, q0 + d, q1 + d, q2 + d, W, t0, 6.5, v));
+  // Touched before the cap, or no plane: nothing is proven.
+  EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 7.01, v));
+  EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 7.0, v));
+  EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 6.5, Vector3d::Zero()));
+  EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, kInf, v));
 }
 
 }  // namespace

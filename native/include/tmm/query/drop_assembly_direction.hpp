@@ -11,6 +11,9 @@
 //     the side offset by c (the pieces of the vertical drop), then the wide rim's ball up to the wide end's
 //     plane (a bull-nose of radius r + c, corner c, height c);
 //   beyond the wide end: the wide disc grown by c, the same bull-nose upside down.
+// A cylinder's narrow end is its bottom (the rounded rim low, where the part is met, and the seam to the top
+// disc far from it; the top disc is often covered by the body sitting on it), unless only its bottom disc is
+// covered.
 // The cutter is the cutter solid of drop_direction (with a clearance: grown alike); an endless cutter is cut
 // at the first body's z0 (the bodies sit on it). Above the last body nothing is modelled. The union of the
 // solids is the grown assembly exactly; the first contact of a union is the earliest of its solids'.

@@ -132,6 +132,10 @@ class AlongCutter {
   double drop(const Eigen::Vector3d& start, double max_travel = kNoTravel, DropStats* stats = nullptr,
               int32_t* hint = nullptr) const;
 
+  // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
+  struct Plane {
+    double c, gx, gy;
+  };
   // The candidate triangles of a group of nearby starts (a tile), kept from tile to tile: each with its
   // bounds and two planes under K it is most nearly below (at the group's worst start, at its centre), by
   // which most of them are proven missed from one start in a few products.
@@ -139,9 +143,15 @@ class AlongCutter {
     int32_t tri;
     double zmax, xmin, xmax, ymin, ymax;
     double h[2], gx[2], gy[2];  // planes under K, c - g . p: max over the corners of z + g . xy, less c
+    double key;                 // h of the key plane
+    Eigen::Vector3d plane;      // the normal (tool frame) that last proved it clear of a start, or zero
   };
   struct Candidates {
-    std::vector<Candidate> list;  // by decreasing highest point
+    // By decreasing key: the height over the plane under K along its axis (a flat end, which a tilted holder
+    // meets first), so that a start stops where the rest lie below that plane and meets the likely contacts
+    // first. Without that plane (axis level): by decreasing highest point.
+    std::vector<Candidate> list;
+    Plane key_plane{0.0, 0.0, 0.0};
     std::vector<double> offsets;  // per plane under K: the lowest over the starts of top + g . tip
     std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
     Eigen::Vector3d centre;             // their mean
@@ -153,8 +163,8 @@ class AlongCutter {
   bool gather(const Eigen::Vector3d* starts, const double* caps, std::size_t m, Candidates& out,
               std::size_t limit) const;
   // drop() over a list gathered for this start with a cap of at least max_travel, in place of the walk: the
-  // same travel.
-  double drop_listed(const Eigen::Vector3d& start, double max_travel, const Candidates& cands,
+  // same travel. Each candidate keeps the plane that proved it clear, which the next start tries first.
+  double drop_listed(const Eigen::Vector3d& start, double max_travel, Candidates& cands,
                      DropStats* stats = nullptr, int32_t* hint = nullptr) const;
 
  private:
@@ -167,14 +177,11 @@ class AlongCutter {
     std::size_t tested = 0;
   };
   Search search(const Eigen::Vector3d& start, double max_travel) const;
-  void consider(Search& q, const IndexedTriangle& t, int32_t i) const;
+  // plane (or null): a candidate's last separating normal, tried first and updated.
+  void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr) const;
   // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
   // planes at every start; else `best` gets the two planes nearest to that.
   bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
-  // Below the XY' offset p from the tip, K is no lower than c - g . p (a plane under K).
-  struct Plane {
-    double c, gx, gy;
-  };
   double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
   Plane plane_under(const Eigen::Vector3d& n) const;  // n: unit, index frame, n.z > 0
   // True when one of the planes, with the tip `top` high over the XY' point (x, y), has all of t's corners

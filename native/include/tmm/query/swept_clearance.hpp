@@ -16,8 +16,15 @@ namespace tmm::direction_detail {
 // that contact (e.g. min q . W - max_K X . W). Searched by GJK on the Minkowski difference (a few support
 // points of K); false when it is not found in a few dozen steps (touching, too close or degenerate), and
 // always for an unbounded K or sweep: the caller then solves the contact. Every true answer is checked on
-// the separating plane itself, so it never depends on the search converging.
+// the separating plane itself, so it never depends on the search converging. `plane` (or null): set to that
+// plane's normal when the answer is true.
 bool triangle_clear(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
-                    const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double t0, double cap);
+                    const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double t0, double cap,
+                    Eigen::Vector3d* plane = nullptr);
+// The same proof on one given plane normal v (e.g. the one that cleared the same triangle from a nearby
+// start): one support point of K; false when v is zero or does not separate by more than 1e-9 mm.
+bool plane_clears(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
+                  const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double t0, double cap,
+                  const Eigen::Vector3d& v);
 
 }  // namespace tmm::direction_detail
