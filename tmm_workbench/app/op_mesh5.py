@@ -15,8 +15,10 @@ posture finishes within the tolerance and their CC points (a count and their ext
 warning; `CleanupRegions` holds points on the model covering those strips (the 3D view draws them). The
 whole tool (app.tool_assembly: Holder, StickOut, the clearances; by default the tool controller's holder):
 its shank and holder bound every C-space, so the tool tilts away where they would come closer, or the place
-is left for clean-up; the cut moves are checked against the model and one that would come closer is left out;
-`HolderReport` and `HolderRegions` say what they changed. Errors never leave a partial path.
+is left for clean-up; the cut moves are checked against the model and one that would come closer is left out,
+and so are the links (a pass whose exit straight up would bring the holder into an overhang leaves along its
+axis to the transit height: mesh5.holder.link_clear); `HolderReport` and `HolderRegions` say what they
+changed. Errors never leave a partial path.
 """
 from __future__ import annotations
 
@@ -31,8 +33,7 @@ from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.linking import link
-from tmm_workbench.core.strategies.mesh5 import finish
+from tmm_workbench.core.strategies.mesh5 import finish, holder
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 from tmm_workbench.core.strategies.multipoint import link_policy
 
@@ -113,9 +114,12 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
         tool_assembly.prepare(obj, params)  # the shank and holder bound the C-space (no holder: the cutter alone)
         with self.reporting(obj) as cb:
             result = finish.compute(mesh, cutter, params, cb)
-            toolpath = link(result.segments, link_policy(cutter, safe, clearance, obj.AxisRetract.Value))
+            policy = link_policy(cutter, safe, clearance, obj.AxisRetract.Value)
+            toolpath, links = holder.link_clear(mesh, result.segments, policy, params.assembly)
         self.mesh, self.toolpath, self.segments = mesh, toolpath, result.segments
         self.diagnostics = dict(result.diagnostics)
+        if links is not None:
+            self.diagnostics["links"] = links
         text = finish.report(self.diagnostics)
         if obj.Mesh5Summary != text:
             obj.Mesh5Summary = text
