@@ -26,6 +26,7 @@ from tmm_workbench.core.footprint.rest import rest_area, tool_envelope, without_
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core import polygons
+from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
@@ -39,6 +40,40 @@ MAX_CELL = 0.25          # mm: the simulation's cells, at most (a ball radius / 
 STOCK_ABOVE = 0.5        # mm of stock over the design the finish starts from (as after a roughing)
 CUSP_SHARE = 0.5         # of the tolerance: the ball's cusp on a flat between its passes
 _BYTES_PER_CELL = 64     # design, stock, left, envelope and the masks
+
+
+@dataclass
+class Left:
+    """What a 5-axis path leaves more than the tolerance above the design (the simulation's cells)."""
+    grid: Grid
+    design: np.ndarray             # (ny, nx) the design's heights (NaN off the model)
+    heights: np.ndarray            # (ny, nx) the stock after the path
+    above: np.ndarray              # (ny, nx) cells above the tolerance (patches of fewer than 3 dropped)
+    outside: np.ndarray            # (ny, nx) of them outside the listed strips (grown by the finish tool's radius)
+    tolerance: float
+
+    @property
+    def area(self) -> float:
+        return float(self.above.sum() * self.grid.cell_area)
+
+    @property
+    def outside_area(self) -> float:
+        return float(self.outside.sum() * self.grid.cell_area)
+
+    def points(self, mask: np.ndarray) -> np.ndarray:
+        """(k, 3) the centres of the mask's cells on the design."""
+        return np.column_stack([self.grid.centres()[mask.ravel()], self.design[mask]])
+
+    def summary(self) -> str:
+        if not self.above.any():
+            return f"the simulated finish leaves nothing above {self.tolerance:g} mm ({self.grid.cell:g} mm cells)"
+        text = (f"the simulated finish leaves {self.area:.1f} mm2 above {self.tolerance:g} mm "
+                f"({self.grid.cell:g} mm cells)")
+        if self.outside.any():
+            (x0, y0, _), (x1, y1, _) = self.points(self.outside).min(0), self.points(self.outside).max(0)
+            text += (f", {self.outside_area:.1f} mm2 of it outside the strips, within x {x0:.4g}..{x1:.4g}, y "
+                     f"{y0:.4g}..{y1:.4g} mm: marked for clean-up")
+        return text
 
 
 @dataclass
@@ -73,10 +108,15 @@ def check_tool(tool: Cutter) -> None:
         raise TmmError(f"clean-up tool must be a ball end mill, got {what}")
 
 
-def cleanup_grid(mesh: TriMesh, tool: Cutter, cell: Optional[float] = None) -> Grid:
-    """The simulation's grid over the mesh's box: cells of a ball radius / 8, at most MAX_CELL (refused above the
-    limits)."""
-    c = min(MAX_CELL, tool.radius / 8.0) if cell is None else float(cell)
+def ball_stepover(radius: float, tolerance: float) -> float:
+    """The ball's passes apart for a cusp of CUSP_SHARE of the tolerance on a flat (mm)."""
+    cusp = min(CUSP_SHARE * tolerance, radius)
+    return 2.0 * math.sqrt(2.0 * radius * cusp - cusp * cusp)
+
+
+def cleanup_grid(mesh: TriMesh, cell: float = MAX_CELL) -> Grid:
+    """The simulation's grid over the mesh's box (refused above the limits)."""
+    c = float(cell)
     if not (math.isfinite(c) and c > 0):
         raise TmmError(f"clean-up cell must be a length > 0 mm, got {cell!r}")
     lo, hi = mesh.bounds
@@ -103,6 +143,19 @@ def in_strips(grid: Grid, strips: Sequence[np.ndarray], grow: float) -> np.ndarr
     return polygons.grid_inside(shape, grid.xs(), grid.ys()) if shape else np.zeros((grid.ny, grid.nx), dtype=bool)
 
 
+def left_above(mesh: TriMesh, cutter: Cutter, path: Toolpath, tolerance: float, *, strips: Sequence[np.ndarray] = (),
+               stock_above: float = STOCK_ABOVE, cell: float = MAX_CELL) -> Left:
+    """What the 5-axis `path` of `cutter` leaves more than `tolerance` above the mesh, from `stock_above` over it
+    (the simulation on cells of `cell` mm), and which of it lies outside the plan's `strips` (finish.strip_corners)
+    grown by the cutter's radius."""
+    if not (math.isfinite(tolerance) and tolerance > 0):
+        raise TmmError(f"clean-up tolerance must be a length > 0 mm, got {tolerance!r}")
+    grid = cleanup_grid(mesh, cell)
+    design, left = material_left(mesh, cutter, path, grid, stock_above)
+    above = without_specks(np.isfinite(design) & (left - design > tolerance))
+    return Left(grid, design, left, above, above & ~in_strips(grid, strips, cutter.radius), tolerance)
+
+
 def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, tolerance: float, *,
             feed_angle_deg: float = 0.0, strips: Sequence[np.ndarray] = (), stock_above: float = STOCK_ABOVE,
             cell: Optional[float] = None, assembly: Any = None, holder_notes: Optional[list] = None
@@ -110,40 +163,45 @@ def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, toleran
     """The ball `tool`'s 3-axis clean-up of what the 5-axis `path` of `cutter` leaves more than `tolerance` above
     the mesh (module doc): its cut segments (tips, vertical axis; passes along the feed angle) and the note.
     `strips`: the plan's strip corners (finish.strip_corners), to say how much was left outside them.
-    `assembly`: the ball's whole tool (the holder guard keeps its shank and holder clear)."""
+    `assembly`: the ball's whole tool (the holder guard keeps its shank and holder clear). Cells of a ball radius
+    / 8, at most MAX_CELL."""
     check_tool(tool)
-    if not (math.isfinite(tolerance) and tolerance > 0):
-        raise TmmError(f"clean-up tolerance must be a length > 0 mm, got {tolerance!r}")
-    grid = cleanup_grid(mesh, tool, cell)
-    design, left = material_left(mesh, cutter, path, grid, stock_above)
-    above = without_specks(np.isfinite(design) & (left - design > tolerance))
-    a = grid.cell_area
-    outside = float(np.sum(above & ~in_strips(grid, strips, cutter.radius)) * a)
-    if not above.any():
-        return [], CleanupNote(tool.describe(), tolerance, grid.cell, 0.0, 0.0, 0.0, np.zeros((0, 3)), 0)
+    c = min(MAX_CELL, tool.radius / 8.0) if cell is None else cell
+    found = left_above(mesh, cutter, path, tolerance, strips=strips, stock_above=stock_above, cell=c)
+    if not found.above.any():
+        return [], CleanupNote(tool.describe(), tolerance, c, 0.0, 0.0, 0.0, np.zeros((0, 3)), 0)
+    grid, rows, cols = _around(found.grid, found.above, tool.radius)
+    design, left, above = found.design[rows, cols], found.heights[rows, cols], found.above[rows, cols]
     area = rest_area(np.where(above | ~np.isfinite(design), left, design), design,
                      tool_envelope(mesh, tool, grid), grid, tolerance, tool.radius)
     segments: list[CutSegment] = []
     if not area.empty:
-        cusp = CUSP_SHARE * tolerance
         params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, angle_deg=feed_angle_deg,
-                               stepover=2.0 * math.sqrt(max(2.0 * tool.radius * cusp - cusp * cusp, 1e-12)),
-                               sample_step=min(0.5, tool.radius / 4.0), cusp_check="off")
+                               stepover=ball_stepover(tool.radius, tolerance), sample_step=min(0.5, tool.radius / 4.0),
+                               cusp_check="off")
         params.rest, params.assembly, params.holder_notes = area.stock(left), assembly, holder_notes
         segments = raster_drop.compute(mesh, tool, params).segments
-    after = _after(grid, design, left, tool, segments)
+    after = _after(grid, left, tool, segments)
     still = np.isfinite(design) & (after - design > tolerance) & above
     pts = np.column_stack([grid.centres()[still.ravel()], design[still]]) if still.any() else np.zeros((0, 3))
-    return segments, CleanupNote(tool.describe(), tolerance, grid.cell, float(above.sum() * a), outside,
-                                 float(still.sum() * a), pts, int(sum(len(s) for s in segments)))
+    return segments, CleanupNote(tool.describe(), tolerance, c, found.area, found.outside_area,
+                                 float(still.sum() * grid.cell_area), pts, int(sum(len(s) for s in segments)))
 
 
-def _after(grid: Grid, design: np.ndarray, left: np.ndarray, tool: Cutter, segments: list[CutSegment]
-           ) -> np.ndarray:
+def _around(grid: Grid, mask: np.ndarray, reach: float) -> tuple[Grid, slice, slice]:
+    """The part of `grid` around the mask's cells (their box grown by `reach` and two cells), and its rows and
+    columns: the ball's envelope and passes are worked out there only."""
+    j, i = np.nonzero(mask)
+    n = int(math.ceil(reach / grid.cell)) + 2
+    j0, j1 = max(0, j.min() - n), min(grid.ny, j.max() + n + 1)
+    i0, i1 = max(0, i.min() - n), min(grid.nx, i.max() + n + 1)
+    sub = Grid(grid.x0 + i0 * grid.cell, grid.y0 + j0 * grid.cell, grid.cell, int(i1 - i0), int(j1 - j0))
+    return sub, slice(j0, j1), slice(i0, i1)
+
+
+def _after(grid: Grid, left: np.ndarray, tool: Cutter, segments: list[CutSegment]) -> np.ndarray:
     """What is left after the clean-up's segments (linked straight up and down, simulated on `left`)."""
     if not segments:
         return left
-    from tmm_workbench.core.linking import LinkPolicy, link
-
     top = float(np.nanmax(left)) + tool.diameter + 1.0
     return simulate(link(segments, LinkPolicy(top, top)), tool, grid, left.copy()).heights
