@@ -170,10 +170,9 @@ def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, toleran
     found = left_above(mesh, cutter, path, tolerance, strips=strips, stock_above=stock_above, cell=c)
     if not found.above.any():
         return [], CleanupNote(tool.describe(), tolerance, c, 0.0, 0.0, 0.0, np.zeros((0, 3)), 0)
-    grid, rows, cols = _around(found.grid, found.above, tool.radius)
-    design, left, above = found.design[rows, cols], found.heights[rows, cols], found.above[rows, cols]
+    grid, design, left, above = found.grid, found.design, found.heights, found.above
     area = rest_area(np.where(above | ~np.isfinite(design), left, design), design,
-                     tool_envelope(mesh, tool, grid), grid, tolerance, tool.radius)
+                     _envelope(mesh, tool, grid, above, left), grid, tolerance, tool.radius)
     segments: list[CutSegment] = []
     if not area.empty:
         params = SurfaceParams(boundary=polygons.bounds(area.region), region=area.region, angle_deg=feed_angle_deg,
@@ -188,15 +187,21 @@ def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, toleran
                                  float(still.sum() * grid.cell_area), pts, int(sum(len(s) for s in segments)))
 
 
-def _around(grid: Grid, mask: np.ndarray, reach: float) -> tuple[Grid, slice, slice]:
-    """The part of `grid` around the mask's cells (their box grown by `reach` and two cells), and its rows and
-    columns: the ball's envelope and passes are worked out there only."""
-    j, i = np.nonzero(mask)
-    n = int(math.ceil(reach / grid.cell)) + 2
-    j0, j1 = max(0, j.min() - n), min(grid.ny, j.max() + n + 1)
-    i0, i1 = max(0, i.min() - n), min(grid.nx, i.max() + n + 1)
-    sub = Grid(grid.x0 + i0 * grid.cell, grid.y0 + j0 * grid.cell, grid.cell, int(i1 - i0), int(j1 - j0))
-    return sub, slice(j0, j1), slice(i0, i1)
+def _envelope(mesh: TriMesh, tool: Cutter, grid: Grid, mask: np.ndarray, left: np.ndarray) -> np.ndarray:
+    """The ball's envelope (core.footprint.rest.tool_envelope) on the boxes around the mask's patches (grown by
+    its radius and two cells), `left` elsewhere (nothing reached): the finish's leftovers lie scattered along the
+    boundaries, and the envelope over the whole model costs a drop per cell."""
+    from scipy import ndimage
+
+    out = left.copy()
+    n = int(math.ceil(tool.radius / grid.cell)) + 2
+    near = ndimage.binary_dilation(mask, structure=np.ones((3, 3), dtype=bool), iterations=n)
+    labels, _ = ndimage.label(near)
+    for rows, cols in ndimage.find_objects(labels):
+        sub = Grid(grid.x0 + cols.start * grid.cell, grid.y0 + rows.start * grid.cell, grid.cell,
+                   cols.stop - cols.start, rows.stop - rows.start)
+        out[rows, cols] = tool_envelope(mesh, tool, sub)
+    return out
 
 
 def _after(grid: Grid, left: np.ndarray, tool: Cutter, segments: list[CutSegment]) -> np.ndarray:
