@@ -96,11 +96,11 @@ def main() -> None:
         after = simulate(link(segs, LinkPolicy(top + 5.0, top + 10.0)), ball, grid, sim.heights.copy()).heights
         print(f"after the clean-up ({time.perf_counter() - t1:.1f} s):")
         png = a.png.with_name(a.png.stem + "_cleanup.png") if a.png else None
-        compare(a, grid, design, after, info, cutter, tol, png)
+        compare(a, grid, design, after, info, cutter, tol, png, f" + ball D{a.cleanup_diameter:g} clean-up")
 
 
 def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, cutter: Cutter, tol: float,
-            png: Path | None) -> None:
+            png: Path | None, what: str = "") -> None:
     """The table of the simulated heights against the design (module doc), and the heat map to `png`."""
     dev = heights - design                                               # vertical, NaN off the surface
     gy, gx = np.gradient(design, grid.cell)
@@ -140,7 +140,7 @@ def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, 
     for q in (50, 90, 99, 99.9):
         print(f"  scallop percentile {q}: {np.percentile(n, q):.4f} mm")
     if png:
-        heat_map(png, grid, np.where(inside, normal, np.nan), tol, a.surface)
+        heat_map(png, grid, np.where(inside, normal, np.nan), tol, a.surface + what)
         print(f"wrote {png}")
 
 

@@ -42,6 +42,7 @@ from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 from tmm_workbench.core.strategies.multipoint import link_policy
 
 OP_NAME = "TMM_Mesh5"
+MAX_MARKS = 20_000   # cells the simulated finish leaves marked on the view (every k-th of more)
 
 PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyDistance", "Tolerance", "Mesh5",
@@ -134,7 +135,8 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
             left = cleanup.left_above(mesh, cutter, toolpath, params.tolerance,
                                       strips=self.diagnostics["strip_corners"])
             self.diagnostics["left"] = left
-            marks = np.vstack([marks, left.points(left.outside)])
+            extra = left.points(left.outside)
+            marks = np.vstack([marks, extra[::max(1, len(extra) // MAX_MARKS)]])
         text = finish.report(self.diagnostics)
         if obj.Mesh5Summary != text:
             obj.Mesh5Summary = text
