@@ -32,6 +32,7 @@ from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import max_tilt, simulate, sub_step
 from tmm_workbench.core.sim.stock import mesh_heights
 from tmm_workbench.core.strategies import raster_drop
+from tmm_workbench.core.strategies.rest_steep import gradient
 from tmm_workbench.core.strategies.surface.params import SurfaceParams
 from tmm_workbench.core.toolpath import Toolpath
 from tmm_workbench.core.tools.cutter import Cutter
@@ -44,13 +45,15 @@ _BYTES_PER_CELL = 64     # design, stock, left, envelope and the masks
 
 @dataclass
 class Left:
-    """What a 5-axis path leaves more than the tolerance above the design (the simulation's cells)."""
+    """What a 5-axis path leaves more than the tolerance above the design, along its normal (the simulation's
+    cells)."""
     grid: Grid
     design: np.ndarray             # (ny, nx) the design's heights (NaN off the model)
     heights: np.ndarray            # (ny, nx) the stock after the path
     above: np.ndarray              # (ny, nx) cells above the tolerance (patches of fewer than 3 dropped)
     outside: np.ndarray            # (ny, nx) of them outside the listed strips (grown by the finish tool's radius)
     tolerance: float
+    cos: np.ndarray                # (ny, nx) cos(the design's slope): a height above it x cos is along the normal
 
     @property
     def area(self) -> float:
@@ -148,15 +151,19 @@ def in_strips(grid: Grid, strips: Sequence[np.ndarray], grow: float) -> np.ndarr
 
 def left_above(mesh: TriMesh, cutter: Cutter, path: Toolpath, tolerance: float, *, strips: Sequence[np.ndarray] = (),
                stock_above: float = STOCK_ABOVE, cell: float = MAX_CELL) -> Left:
-    """What the 5-axis `path` of `cutter` leaves more than `tolerance` above the mesh, from `stock_above` over it
-    (the simulation on cells of `cell` mm), and which of it lies outside the plan's `strips` (finish.strip_corners)
-    grown by the cutter's radius."""
+    """What the 5-axis `path` of `cutter` leaves more than `tolerance` above the mesh (along its normal: the
+    vertical height x cos(slope)), from `stock_above` over it (at least 3 times the tolerance, so that an uncut
+    cell counts; the simulation on cells of `cell` mm), and which of it lies outside the plan's `strips`
+    (finish.strip_corners) grown by the cutter's radius."""
     if not (math.isfinite(tolerance) and tolerance > 0):
         raise TmmError(f"clean-up tolerance must be a length > 0 mm, got {tolerance!r}")
     grid = cleanup_grid(mesh, cell)
-    design, left = material_left(mesh, cutter, path, grid, tolerance, stock_above)
-    above = without_specks(np.isfinite(design) & (left - design > tolerance))
-    return Left(grid, design, left, above, above & ~in_strips(grid, strips, cutter.radius), tolerance)
+    stock = max(stock_above, 3.0 * tolerance)        # an uncut cell stands above the tolerance (up to 70 deg)
+    design, left = material_left(mesh, cutter, path, grid, tolerance, stock)
+    gy, gx = gradient(design, grid.cell)             # the tolerance is along the normal, as the plan's
+    cos = 1.0 / np.sqrt(1.0 + gx * gx + gy * gy)
+    above = without_specks(np.isfinite(design) & ((left - design) * cos > tolerance))
+    return Left(grid, design, left, above, above & ~in_strips(grid, strips, cutter.radius), tolerance, cos)
 
 
 def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, tolerance: float, *,
@@ -184,7 +191,7 @@ def cleanup(mesh: TriMesh, cutter: Cutter, path: Toolpath, tool: Cutter, toleran
         params.rest, params.assembly, params.holder_notes = area.stock(left), assembly, holder_notes
         segments = raster_drop.compute(mesh, tool, params).segments
     after = _after(grid, left, tool, segments)
-    still = np.isfinite(design) & (after - design > tolerance) & above
+    still = np.isfinite(design) & ((after - design) * found.cos > tolerance) & above
     pts = np.column_stack([grid.centres()[still.ravel()], design[still]]) if still.any() else np.zeros((0, 3))
     return segments, CleanupNote(tool.describe(), tolerance, c, found.area, found.outside_area,
                                  float(still.sum() * grid.cell_area), pts, int(sum(len(s) for s in segments)))
