@@ -6,8 +6,10 @@ gouge below 0) and the largest remaining height along the normal (vertical devia
 CC paths' area (cells within half the widest gap between planes of a CC point) and over the whole surface.
 
     .venv/bin/python benchmarks/mesh5_verify.py [--surface convex] [--cell 0.2] [--png docs/mesh5_verify.png]
-        [--max-step 0.05] [--plan /tmp/plan.pkl]
-    (--plan: the cut segments saved there and read back, so the simulation can be rerun without the plan)
+        [--max-step 0.05] [--plan /tmp/plan.pkl] [--cleanup-diameter 6.35]
+    (--plan: the cut segments saved there and read back, so the simulation can be rerun without the plan;
+    --cleanup-diameter: the ball clean-up (mesh5.cleanup) after the 5-axis path, its note, and the same table
+    after both)
 """
 from __future__ import annotations
 
@@ -24,11 +26,11 @@ from scipy.spatial import cKDTree
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from benchmarks.seed000_surfaces import INCH, seed000_mesh  # noqa: E402
-from tmm_workbench.core.linking import link  # noqa: E402
+from tmm_workbench.core.linking import LinkPolicy, link  # noqa: E402
 from tmm_workbench.core.sim.grid import Grid  # noqa: E402
 from tmm_workbench.core.sim.simulate import simulate  # noqa: E402
 from tmm_workbench.core.sim.stock import mesh_heights  # noqa: E402
-from tmm_workbench.core.strategies.mesh5 import finish  # noqa: E402
+from tmm_workbench.core.strategies.mesh5 import cleanup, finish  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params  # noqa: E402
 from tmm_workbench.core.strategies.multipoint import link_policy  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
@@ -47,7 +49,8 @@ def planned(mesh, cutter, tol: float, store: Path | None):
     cc = np.vstack([q.tips for p in plan.passes for q in p.postures])
     pts = np.vstack([path.points for p in plan.passes for path in p.paths])
     out = (result.segments, {"report": finish.report(result.diagnostics), "offsets": offsets, "cc": pts,
-                             "cl": cc, "unfinished": list(plan.unfinished)}, time.perf_counter() - t0)
+                             "cl": cc, "unfinished": list(plan.unfinished),
+                             "strip_corners": result.diagnostics["strip_corners"]}, time.perf_counter() - t0)
     if store is not None:
         store.write_bytes(pickle.dumps(out))
     return out
@@ -62,6 +65,7 @@ def main() -> None:
                     "bottom tilted lambda to the surface along the travel leaves a sawtooth step x tan(lambda))")
     ap.add_argument("--plan", type=Path, default=None)
     ap.add_argument("--png", type=Path, default=None)
+    ap.add_argument("--cleanup-diameter", type=float, default=None, help="ball clean-up after the 5-axis path (mm)")
     a = ap.parse_args()
     mesh, _ = seed000_mesh(a.surface)
     cutter = Cutter.flat(0.5 * INCH)
@@ -81,7 +85,24 @@ def main() -> None:
     print(f"grid {grid.nx} x {grid.ny} cells of {a.cell:g} mm; design heights {t1 - t0:.1f} s, simulation "
           f"{t2 - t1:.1f} s (instances {a.max_step:g} mm apart, {sim.moves_cut} moves, rapids through stock "
           f"{len(sim.collisions)})")
-    dev = sim.heights - design                                           # vertical, NaN off the surface
+    compare(a, grid, design, sim.heights, info, cutter, tol, a.png)
+    if a.cleanup_diameter:
+        ball = Cutter.ball(a.cleanup_diameter)
+        t0 = time.perf_counter()
+        segs, note = cleanup.cleanup(mesh, cutter, path, ball, tol, strips=info.get("strip_corners", ()),
+                                     stock_above=STOCK_ABOVE)
+        t1 = time.perf_counter()
+        print(f"{note.summary()} ({t1 - t0:.1f} s)")
+        after = simulate(link(segs, LinkPolicy(top + 5.0, top + 10.0)), ball, grid, sim.heights.copy()).heights
+        print(f"after the clean-up ({time.perf_counter() - t1:.1f} s):")
+        png = a.png.with_name(a.png.stem + "_cleanup.png") if a.png else None
+        compare(a, grid, design, after, info, cutter, tol, png, f" + ball D{a.cleanup_diameter:g} clean-up")
+
+
+def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, cutter: Cutter, tol: float,
+            png: Path | None, what: str = "") -> None:
+    """The table of the simulated heights against the design (module doc), and the heat map to `png`."""
+    dev = heights - design                                               # vertical, NaN off the surface
     gy, gx = np.gradient(design, grid.cell)
     cos = 1.0 / np.sqrt(1.0 + gx ** 2 + gy ** 2)
     # along the normal (locally planar); at the rim, where the slope is unknown, vertical
@@ -118,9 +139,9 @@ def main() -> None:
     n = normal[inside]
     for q in (50, 90, 99, 99.9):
         print(f"  scallop percentile {q}: {np.percentile(n, q):.4f} mm")
-    if a.png:
-        heat_map(a.png, grid, np.where(inside, normal, np.nan), tol, a.surface)
-        print(f"wrote {a.png}")
+    if png:
+        heat_map(png, grid, np.where(inside, normal, np.nan), tol, a.surface + what)
+        print(f"wrote {png}")
 
 
 def heat_map(png: Path, grid: Grid, normal: np.ndarray, tol: float, surface: str) -> None:

@@ -11,9 +11,12 @@ import pytest
 
 from tests.conftest import grid_mesh
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import link
+from tmm_workbench.core.errors import TmmError
+from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import CutSegment
-from tmm_workbench.core.strategies.mesh5 import finish, holder
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.strategies.mesh5 import cleanup, finish, holder
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan
 from tmm_workbench.core.strategies.multipoint import link_policy
@@ -95,3 +98,46 @@ def test_a_move_sweeping_the_holder_past_a_corner_is_left_out_and_reported():
     assert note.affected == 1 and np.allclose(note.left_out, [[20.0, 0, 0]])
     assert "1 moves left out" in note.summary() and "holder" in note.summary()
     assert holder.optional_guard(mesh, cutter, None, AdaptivePlan(), [seg]) == ([seg], None)
+
+
+def _above_tau_in_strips(mesh, paths, corners, tol: float, cell: float = 0.2) -> np.ndarray:
+    """The simulation's cells (0.2 mm, another grid than the clean-up's) inside the strips that stay more than
+    `tol` above the floor after `paths` ((toolpath, cutter) each, from 0.5 mm of stock)."""
+    grid = Grid.covering(-5.0, -6.0, 5.0, WALL_Y, cell)
+    heights = np.full((grid.ny, grid.nx), 0.5)
+    for path, cutter in paths:
+        heights = simulate(path, cutter, grid, heights).heights
+    xy = grid.centres()
+    inside = np.zeros(len(xy), dtype=bool)
+    for c in corners:
+        (x0, y0), (x1, y1) = c.min(0), c.max(0)
+        inside |= (xy[:, 0] > x0) & (xy[:, 0] < x1) & (xy[:, 1] > y0) & (xy[:, 1] < y1)
+    return xy[inside & (heights.ravel() > tol)]
+
+
+def test_the_ball_clean_up_finishes_the_strips_but_the_corner_it_cannot_reach(planned):
+    mesh, _, whole, path, _, _ = planned
+    cutter, ball, tol = Cutter.flat(10.0), Cutter.ball(4.0), PARAMS["tolerance"]
+    corners = whole.diagnostics["strip_corners"]
+    segments, note = cleanup.cleanup(mesh, cutter, path, ball, tol, feed_angle_deg=0.0, strips=corners)
+    before = _above_tau_in_strips(mesh, [(path, cutter)], corners, tol)
+    after = _above_tau_in_strips(mesh, [(path, cutter), (link(segments, LinkPolicy(80.0, 90.0)), ball)], corners, tol)
+    # the 5-axis passes leave the strips beside the wall (7 mm wide) above the tolerance
+    assert len(before) * 0.04 > 50.0 and before[:, 1].min() < WALL_Y - 5.0
+    # the ball D4 takes them down to the tolerance but where it cannot reach: the fillet its radius leaves in the
+    # corner, above 0.3 mm within 2 - sqrt(4 - 1.7^2) = 0.946 mm of the wall
+    assert len(after) and after[:, 1].min() > WALL_Y - 0.946 - 0.2
+    assert note.left * 0.9 < len(before) * 0.04 < note.left * 1.1 and note.outside_strips == 0.0
+    assert abs(note.after - 10.0 * 0.946) < 10.0 * 0.3
+    assert note.after_points[:, 1].min() > WALL_Y - 0.946 - 0.25
+    assert "stay above it (out of the ball's reach too)" in note.summary()
+    # a 3-axis ball dropped on the mesh: on the floor where its tip is over it (beside its x = +-5 edges it drops
+    # over the edge), never nearer the wall than its radius
+    tips = np.vstack([s.tips for s in segments])
+    over = np.abs(tips[:, 0]) < 5.0 - 1e-6
+    assert over.any() and tips[over, 2].min() > -1e-6 and tips[over, 1].max() <= WALL_Y - ball.radius + 1e-6
+
+
+def test_a_clean_up_tool_must_be_a_ball():
+    with pytest.raises(TmmError, match="clean-up tool must be a ball end mill, got flat D4"):
+        cleanup.check_tool(Cutter.flat(4.0))

@@ -53,6 +53,7 @@ class RunMesh5(FreeCADTestCase):
             (lambda: run("TMM_Mesh5", stl, tool="endmill", GridStep=0.0), "posture grid step must be"),
             (lambda: run_mesh5(stl, stick_out=30.0), "stick_out is used with a holder only"),
             (lambda: run_mesh5(stl, holder="ER16 nut", stick_out=-1.0), "stick_out", "got -1"),
+            (lambda: run_mesh5(stl, cleanup_diameter=0.0), "cleanup_diameter", "got 0"),
         ]
         for call, *said in cases:
             with self.subTest(said=said[0]), self.assertRaises(TmmError) as ctx:

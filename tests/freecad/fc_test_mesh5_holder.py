@@ -67,3 +67,26 @@ class HolderInTheMesh5Op(FreeCADTestCase):
         bare = simulate(r.job, cell=0.25, tolerance=0.01, progress=False, holder=HOLDER, stick_out=STICK_OUT)
         self.assertTrue(bare.holder_collisions, "the bare path should drive the holder into the wall")
         FreeCAD.closeDocument(r.doc.Name)
+
+    def test_the_ball_clean_up_op_finishes_what_the_5_axis_op_left_beside_the_wall(self) -> None:
+        gcode = OUT / "mesh5_cleanup.tarus.ngc"
+        r = run_mesh5(floor_and_wall_stl(), holder=HOLDER, stick_out=STICK_OUT, doc_name="TmmMesh5Cleanup",
+                      cleanup_diameter=4.0, gcode_path=gcode, **ARGS)
+        c = r.cleanup
+        self.assertTrue(c.isValid(), c.getStatusString())
+        self.assertEqual((c.Region, c.RestFrom), ("Rest", "EarlierOps"))
+        self.assertAlmostEqual(c.RestTolerance.Value, ARGS["tolerance"])
+        self.assertIn("rest", c.RestReport)
+        ops = r.job.Operations.Group
+        self.assertLess(ops.index(r.op), ops.index(c))               # after the 5-axis op, which it reads
+        self.assertEqual(c.ToolController.Tool.Diameter.Value, 4.0)
+        self.assertTrue(gcode.is_file())
+        self.assertEqual(r.gcode.count("M6"), 2)                      # both ops, a tool change before each
+        # the material the 5-axis op left beside the wall (simulated on the Job's stock) is taken by the ball
+        alone = simulate(r.op, cell=0.25, tolerance=0.01, progress=False)
+        both = simulate(r.job, cell=0.25, tolerance=0.01, progress=False)
+        self.assertGreater(alone.remaining_volume, 30.0)
+        self.assertLess(both.remaining_volume, 0.3 * alone.remaining_volume)
+        self.assertGreaterEqual(both.min_deviation, -0.01)
+        self.assertEqual(both.collisions, [])
+        FreeCAD.closeDocument(r.doc.Name)

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable, Optional, Sequence, Union
 
+import FreeCAD
 
-from tmm_workbench.app.api_args import LENGTH, NON_NEGATIVE, by_core_name, numbers, option, plain_numbers
+from tmm_workbench.app.api_args import LENGTH, NON_NEGATIVE, POSITIVE, by_core_name, numbers, option, plain_numbers
 from tmm_workbench.app.api_run import StockBox, SurfaceResult, run
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.params import spec_of
@@ -30,7 +31,8 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
               fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
               progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
               stick_out: Optional[float] = None, shank_clearance: Optional[float] = None,
-              holder_clearance: Optional[float] = None) -> SurfaceResult:
+              holder_clearance: Optional[float] = None, simulate_left: bool = True,
+              cleanup_diameter: Optional[float] = None) -> SurfaceResult:
     """5-axis finishing of `model` (STL path, Mesh::Feature or Part::Feature) by seed 000's 3D C-space (a 'TMM
     5-axis Mesh' op in a new Job, or in `job`): adaptive passes within `tolerance` (the scallop, mm), the
     posture at every CC point chosen for the Tarus motion time (docs/mesh5.md).
@@ -46,6 +48,12 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
     The whole tool (holder, stick_out, shank_clearance, holder_clearance) as run_surface: the shank and holder
     bound every C-space, so the tool tilts away where they would come closer, or the place is left for
     clean-up (the op's HolderReport says which).
+    simulate_left: the op's SimulateLeft (what the simulated finish leaves above the tolerance outside the strips
+    is marked for clean-up too). cleanup_diameter (mm, None: no clean-up): a companion 3-axis ball end mill op of
+    that diameter after the 5-axis one in the Job (a TMM Surface, Region 'Rest' from the Job's earlier ops, rest
+    tolerance the 5-axis tolerance, passes along the feed angle for a cusp of half of it: it finishes what the
+    5-axis op left where the ball reaches, and its RestReport says what stays); it is `result.cleanup`, and the
+    G-code holds both ops (a tool change between).
     """
     from tmm_workbench.app import op_mesh5, stages
     from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
@@ -60,18 +68,50 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
                 ("yaw_limit_deg", yaw_limit_deg, "yaw_limit_deg", "YawLimit"),
                 ("grid_step_deg", grid_step_deg, "grid_step_deg", "GridStep"))
     numbers(**{arg: (value, spec_of(Mesh5Params, field)) for arg, value, field, _ in settings},
-            axis_retract=(axis_retract, NON_NEGATIVE))  # the tool, stock, heights and feeds: run's
+            axis_retract=(axis_retract, NON_NEGATIVE),
+            cleanup_diameter=(cleanup_diameter, POSITIVE))  # the tool, stock, heights and feeds: run's
     given = [(field, prop, value) for _, value, field, prop in settings if value is not None]
     Mesh5Params(**{field: value for field, _, value in given}).grid()  # the tilts within the machine's range
-    values: dict[str, Any] = {"FeedAngle": feed_angle_deg, "ZigZag": bool(zigzag), "AxisRetract": axis_retract}
+    values: dict[str, Any] = {"FeedAngle": feed_angle_deg, "ZigZag": bool(zigzag), "AxisRetract": axis_retract,
+                              "SimulateLeft": bool(simulate_left)}
     values.update({prop: value for _, prop, value in given})
     values.update(stages.api_values(op_mesh5.TOOL_STAGES, Mesh5Params, dict(
         holder=holder, stick_out=stick_out, shank_clearance=shank_clearance, holder_clearance=holder_clearance), model))
-    return run(op_mesh5.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
-               stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
-               clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
-               spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
-               doc_name=doc_name, progress=progress, **values)
+    later = cleanup_diameter is not None   # the posting and saving wait for the clean-up op
+    r = run(op_mesh5.OP_NAME, model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius, stock=stock,
+            stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
+            clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
+            spindle_speed=spindle_speed, post=None if later else post, gcode_path=None if later else gcode_path,
+            fcstd_path=None if later else fcstd_path, doc_name=doc_name, progress=progress, **values)
+    if not later:
+        return r
+    try:
+        return _with_cleanup(r, float(cleanup_diameter), feed_angle_deg, horiz_feed, vert_feed, spindle_speed, post,
+                             gcode_path, fcstd_path, progress)
+    except BaseException:
+        if job is None and isinstance(model, (str, os.PathLike)):   # the document run_mesh5 opened
+            FreeCAD.closeDocument(r.doc.Name)
+        raise
+
+
+def _with_cleanup(r: SurfaceResult, diameter: float, angle: float, horiz_feed: float, vert_feed: float,
+                  spindle_speed: float, post: Optional[str], gcode_path: Any, fcstd_path: Any,
+                  progress: Any) -> SurfaceResult:
+    """The 5-axis result `r` with its companion ball clean-up op (run_mesh5's cleanup_diameter) after it in the
+    Job, both posted together and the document saved."""
+    from tmm_workbench.app import posts
+    from tmm_workbench.app.api import run_surface
+    from tmm_workbench.core.strategies.mesh5.cleanup import ball_stepover
+
+    tol = float(r.op.Tolerance.Value)
+    c = run_surface(None, job=r.job, tool="ballend", diameter=diameter, stepover=ball_stepover(0.5 * diameter, tol),
+                    angle_deg=angle, region="rest", rest_tolerance=tol, horiz_feed=horiz_feed, vert_feed=vert_feed,
+                    spindle_speed=spindle_speed, post=None, progress=progress)
+    gcode = posts.export(post, [r.op.ToolController, r.op, c.op.ToolController, c.op], gcode_path) if post else ""
+    if fcstd_path:
+        Path(fcstd_path).parent.mkdir(parents=True, exist_ok=True)
+        r.doc.saveAs(str(fcstd_path))
+    return replace(r, gcode=gcode, cleanup=c.op)
 
 
 

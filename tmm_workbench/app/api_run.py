@@ -46,6 +46,7 @@ class SurfaceResult:
     gcode: str           # post-processed G-code
     toolpath: Toolpath   # the core tool path the op's Path was made from
     mesh: TriMesh        # the core mesh that was machined
+    cleanup: Any = None  # run_mesh5's companion clean-up op (a TMM Surface, Region 'Rest'), when asked for
 
 
 @contextmanager

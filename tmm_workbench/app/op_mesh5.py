@@ -12,11 +12,16 @@ one linker, core.strategies.multipoint.link_policy): each pass entered and left 
 axis, transits at the safe height for the tilted tool's lowest point, the op starting and ending upright at
 the clearance height. `Mesh5Summary` says passes, CC points and what was left for clean-up: strips no
 posture finishes within the tolerance and their CC points (a count and their extent), also printed as a
-warning; `CleanupRegions` holds points on the model covering those strips (the 3D view draws them). The
+warning; `CleanupRegions` holds points on the model covering those strips (the 3D view draws them), and with
+`SimulateLeft` (the default) the cells the simulated finish leaves above the tolerance outside them
+(core.strategies.mesh5.cleanup.left_above; a companion 3-axis ball op machines both: app.api.run_mesh5's
+cleanup_diameter, a TMM Surface op with Region 'Rest' after this one). The
 whole tool (app.tool_assembly: Holder, StickOut, the clearances; by default the tool controller's holder):
 its shank and holder bound every C-space, so the tool tilts away where they would come closer, or the place
-is left for clean-up; the cut moves are checked against the model and one that would come closer is left out;
-`HolderReport` and `HolderRegions` say what they changed. Errors never leave a partial path.
+is left for clean-up; the cut moves are checked against the model and one that would come closer is left out,
+and so are the links (a pass whose exit straight up would bring the holder into an overhang leaves along its
+axis to the transit height: mesh5.holder.link_clear); `HolderReport` and `HolderRegions` say what they
+changed. Errors never leave a partial path.
 """
 from __future__ import annotations
 
@@ -24,6 +29,7 @@ from dataclasses import replace
 from typing import Any, Optional
 
 import FreeCAD
+import numpy as np
 import Path
 
 from tmm_workbench.app import op_base, op_mesh, stages, tool_assembly, work_estimate
@@ -31,12 +37,12 @@ from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import path5
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.linking import link
-from tmm_workbench.core.strategies.mesh5 import finish
+from tmm_workbench.core.strategies.mesh5 import cleanup, finish, holder
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 from tmm_workbench.core.strategies.multipoint import link_policy
 
 OP_NAME = "TMM_Mesh5"
+MAX_MARKS = 20_000   # cells the simulated finish leaves marked on the view (every k-th of more)
 
 PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyDistance", "Tolerance", "Mesh5",
@@ -58,6 +64,10 @@ PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
     Prop("App::PropertyBool", "ZigZag", "Mesh5", "Alternate the direction of the passes", "zigzag"),
     Prop("App::PropertyDistance", "AxisRetract", "Linking",
          "Entry and exit distance along the tool axis (then straight up/down to the safe height)"),
+    Prop("App::PropertyBool", "SimulateLeft", "Mesh5",
+         "Simulate the finish (the 5-axis stock simulation, 0.25 mm cells, from 0.5 mm over the model) and mark "
+         "what it leaves above the tolerance outside the strips too (the passes' ends along a slanted boundary) "
+         "in CleanupRegions"),
     Prop("App::PropertyString", "Mesh5Summary", "Mesh5",
          "Result of the last computation: passes, CC points, what is left for clean-up"),
     Prop("App::PropertyVectorList", "CleanupRegions", "Mesh5",
@@ -65,7 +75,7 @@ PROPERTIES: list[Prop] = op_mesh.MODEL_PROPERTIES + [
          "Mesh5Summary), marked for clean-up: drawn on the 3D view"),
 ]
 CHOICES: dict[str, dict[str, str]] = {}
-DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "AxisRetract": 5.0}
+DEFAULTS: dict[str, Any] = {**op_mesh.MODEL_DEFAULTS, "AxisRetract": 5.0, "SimulateLeft": True}
 
 # the whole tool (app.tool_assembly): its shank and holder bound every C-space, so the tool tilts away where they
 # would come closer, or the place is left for clean-up (no Lift / LeaveOut choice: the C-space decides)
@@ -90,7 +100,8 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
     CHOICES = CHOICES
     DEFAULTS = DEFAULTS
     SPECS = stages.specs(TOOL_STAGES)
-    RESTORED_DEFAULTS = stages.restored(TOOL_STAGES)   # documents from before the holder: none
+    RESTORED_DEFAULTS = {**stages.restored(TOOL_STAGES),   # documents from before the holder: none
+                         "SimulateLeft": False}             # from before the simulation: the plan's strips only
     READ_ONLY = ("Mesh5Summary", "CleanupRegions")
     segments: Optional[list] = None
     diagnostics: Optional[dict] = None
@@ -113,15 +124,25 @@ class ObjectTmmMesh5(op_mesh.MeshOp):
         tool_assembly.prepare(obj, params)  # the shank and holder bound the C-space (no holder: the cutter alone)
         with self.reporting(obj) as cb:
             result = finish.compute(mesh, cutter, params, cb)
-            toolpath = link(result.segments, link_policy(cutter, safe, clearance, obj.AxisRetract.Value))
+            policy = link_policy(cutter, safe, clearance, obj.AxisRetract.Value)
+            toolpath, links = holder.link_clear(mesh, result.segments, policy, params.assembly)
         self.mesh, self.toolpath, self.segments = mesh, toolpath, result.segments
         self.diagnostics = dict(result.diagnostics)
+        if links is not None:
+            self.diagnostics["links"] = links
+        marks = self.diagnostics["cleanup_points"]
+        if obj.SimulateLeft:   # what the plan does not list: the simulation of the linked path finds it
+            left = cleanup.left_above(mesh, cutter, toolpath, params.tolerance,
+                                      strips=self.diagnostics["strip_corners"])
+            self.diagnostics["left"] = left
+            extra = left.points(left.outside)
+            marks = np.vstack([marks, extra[::max(1, len(extra) // MAX_MARKS)]])
         text = finish.report(self.diagnostics)
         if obj.Mesh5Summary != text:
             obj.Mesh5Summary = text
-        obj.CleanupRegions = [FreeCAD.Vector(*map(float, p)) for p in self.diagnostics["cleanup_points"]]
+        obj.CleanupRegions = [FreeCAD.Vector(*map(float, p)) for p in marks]
         tool_assembly.report(obj, params)
-        if len(self.diagnostics["unfinished"]):
+        if len(marks):
             FreeCAD.Console.PrintWarning(f"{obj.Label}: {text}\n")
         else:
             FreeCAD.Console.PrintMessage(f"{obj.Label}: {text}\n")

@@ -3,11 +3,11 @@
 Between segments the tool either stays down (a segment `joined` to the previous one: a zig-zag link the
 strategy made of dropped, gouge-free points, then the next pass) or leaves and re-enters:
   retract VERTICAL (3-axis): straight up to the safe height, a rapid across, the entry down;
-  retract ALONG_AXIS (5-axis): back along the tool axis by `axis_retract` (fed: the tilted tool moves
-      sideways too, through what may still be stock), straight up to the transit height (the lowest point
-      of the tilted tool at the safe height), a rapid across with the tool already turned, down (fed, as
-      everything below the safe height) to `axis_retract` above the next first point on its axis, the
-      entry along it.
+  retract ALONG_AXIS (5-axis): back along the tool axis by `axis_retract` (the segment's own, else the
+      policy's; fed: the tilted tool moves sideways too, through what may still be stock), straight up to
+      the transit height (the lowest point of the tilted tool at the safe height), a rapid across with the
+      tool already turned, down (fed, as everything below the safe height) to `axis_retract` above the next
+      first point on its axis, the entry along it.
 Entries (3-axis), rows of ENTRIES; a segment may name its own (CutSegment.entry), else the policy's:
   PLUNGE  straight down at the vertical feed onto the first tip;
   HELIX   down a helix at `ramp_angle_deg` on the circle about `helix_centre` through the first tip, from where
@@ -393,14 +393,17 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
     if any(seg.entry not in (None, PLUNGE) for seg in segments):
         raise TmmError(f"helix and ramp entries are 3-axis only; linking along the tool axis enters by '{PLUNGE}'")
 
-    def above(tip: np.ndarray, a: Axis) -> tuple[float, float, float]:
-        """On the axis `r` above the tip, raised to the transit height if lower."""
-        p = tip + r * np.asarray(a)
+    def along(seg: CutSegment) -> float:
+        return r if seg.axis_retract is None else seg.axis_retract
+
+    def above(tip: np.ndarray, a: Axis, d: float) -> tuple[float, float, float]:
+        """On the axis `d` above the tip, raised to the transit height if lower."""
+        p = tip + d * np.asarray(a)
         return float(p[0]), float(p[1]), max(float(p[2]), policy.safe_height + below(a))
 
     tp = Toolpath()
     a0 = segments[0].axis(0)
-    x, y, z = above(segments[0].tips[0], a0)
+    x, y, z = above(segments[0].tips[0], a0, along(segments[0]))
     tp.add(MoveKind.RAPID, x, y, max(policy.clearance_height, z), Z_AXIS)
     tp.add(MoveKind.RAPID, x, y, max(policy.clearance_height, z), a0)
     for k, seg in enumerate(segments):
@@ -408,18 +411,19 @@ def _link_along_axis(segments: list[CutSegment], policy: LinkPolicy) -> Toolpath
         start = 0
         if k == 0 or not seg.joined:
             a = seg.axis(0)
-            tp.add(MoveKind.RAPID, *above(seg.tips[0], a), a)              # transit, the tool turned above the entry
+            d = along(seg)
+            tp.add(MoveKind.RAPID, *above(seg.tips[0], a, d), a)           # transit, the tool turned above the entry
             # below the safe height at the vertical feed, as the 3-axis entry: rapids stay above the stock
-            tp.add(MoveKind.PLUNGE, *(seg.tips[0] + r * np.asarray(a)), a)  # down to the entry point on the axis
+            tp.add(MoveKind.PLUNGE, *(seg.tips[0] + d * np.asarray(a)), a)  # down to the entry point on the axis
             tp.add(MoveKind.PLUNGE, *seg.tips[0], a)                         # along the axis onto the face
             start = 1
         for i in range(start, len(seg)):
             tp.add(MoveKind.FEED, *seg.tips[i], seg.axis(i), seg.arc(i))
         if k + 1 < len(segments) and segments[k + 1].joined:
             continue
-        a1 = seg.axis(len(seg) - 1)
-        tp.add(MoveKind.PLUNGE, *(seg.tips[-1] + r * np.asarray(a1)), a1)   # back along the axis, fed: the
-        tp.add(MoveKind.RAPID, *above(seg.tips[-1], a1), a1)                # tilted tool moves sideways; up
+        a1, d = seg.axis(len(seg) - 1), along(seg)
+        tp.add(MoveKind.PLUNGE, *(seg.tips[-1] + d * np.asarray(a1)), a1)   # back along the axis, fed: the
+        tp.add(MoveKind.RAPID, *above(seg.tips[-1], a1, d), a1)             # tilted tool moves sideways; up
     last = tp.moves[-1]
     top = max(policy.clearance_height, last.z)
     tp.add(MoveKind.RAPID, last.x, last.y, top, last.axis)

@@ -45,6 +45,7 @@ class CutSegment:
     helix_ccw: bool = True
     closed: bool = False                  # the tips are a closed loop
     arcs: Optional[ArcsAt] = None         # per tip, the arc ending there; None: lines only
+    axis_retract: Optional[float] = None  # linking along the axis: this segment's entry and exit (None: the policy's)
 
     def __post_init__(self) -> None:
         self.tips = np.asarray(self.tips, dtype=float).reshape(-1, 3)

@@ -14,7 +14,7 @@ SPIN_BOXES = {"tolerance": "Tolerance", "forwardStep": "ForwardStep", "feedAngle
               "tiltLimit": "TiltLimit", "yawLimit": "YawLimit", "gridStep": "GridStep",
               "linearDeflection": "LinearDeflection"}
 COMBOS: dict[str, str] = {}
-CHECKS = {"zigZag": "ZigZag"}
+CHECKS = {"zigZag": "ZigZag", "simulateLeft": "SimulateLeft"}
 _HOLDER_SPINS, _HOLDER_COMBOS, _ = stages.widgets(op_mesh5.TOOL_STAGES)  # the "Tool holder" group
 SPIN_BOXES.update(_HOLDER_SPINS)
 COMBOS.update(_HOLDER_COMBOS)

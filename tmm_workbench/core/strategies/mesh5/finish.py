@@ -229,6 +229,7 @@ def report(diagnostics: dict) -> str:
         text += (f"; {len(empty)} CC points with an empty C-space (no posture finishes them within the tolerance) "
                  f"in {len(plan.unfinished)} strips, within x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: not "
                  f"finished, marked for clean-up ({len(marks)} points on the mesh)")
-    if "holder" in diagnostics:
-        text += f"; {diagnostics['holder'].summary()}"
+    for key in ("left", "holder", "links"):
+        if key in diagnostics:
+            text += f"; {diagnostics[key].summary()}"
     return text

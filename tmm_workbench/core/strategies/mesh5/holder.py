@@ -12,15 +12,19 @@ the place is left unfinished (the plan's strips). Two things are added here:
   sweeping the holder past a wall's corner). Every cut move is checked by core.verify.holder_clearance (its
   shank and holder against the model's surface points along the move, axis by slerp); a move that comes closer
   than the clearance is left out (the segment split there, the linker leaves and enters along the axis), and
-  counted in the report, never cut silently.
+  counted in the report, never cut silently;
+* the links (link_clear): each pass's entry and exit, the linker's axis retract then straight up to the transit
+  height, checked the same way; where straight up brings the shank or holder into the model (under an
+  overhang) the pass is left and entered along its axis all the way to the transit height, checked again.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import List, Optional
 
 import numpy as np
 
+from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan
@@ -125,3 +129,82 @@ def optional_guard(mesh, cutter: Cutter, assembly: Optional[ToolAssembly], plan:
     if assembly is None:
         return segments, None
     return guard(mesh, MeshReach(mesh), cutter, assembly, plan, segments)
+
+
+# --- the links: leaving and entering a pass with the whole tool clear -------------------------------------------
+
+@dataclass
+class LinkNote:
+    """What the whole tool did to the links between passes (module doc of link_clear)."""
+    checked: int                       # entries and exits checked
+    raised: np.ndarray                 # (k, 3) tips whose entry or exit now goes along the axis to the transit height
+    blocked: np.ndarray                # (m, 3) tips whose entry or exit stays closer than the clearance
+    samples: int
+
+    def summary(self) -> str:
+        text = f"links: {self.checked} entries and exits checked ({self.samples} positions)"
+        if len(self.raised):
+            text += (f", {len(self.raised)} passes left and entered along the tool axis up to the transit height "
+                     f"(straight up the shank or holder came closer than the clearance)")
+        if len(self.blocked):
+            (x0, y0, _), (x1, y1, _) = self.blocked.min(0), self.blocked.max(0)
+            text += (f"; {len(self.blocked)} still closer than the clearance along the axis too, within x "
+                     f"{x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: check them")
+        return text
+
+
+def _trips(segments: List[CutSegment], policy: LinkPolicy) -> tuple[Toolpath, np.ndarray, np.ndarray]:
+    """Every segment's entry and exit as the linker makes them (each linked alone), as trips down from the
+    clearance height and back, in one path; the segment owning each move (-1: between trips) and each trip's
+    tip (the segment's first or last)."""
+    moves, owner, tips = [], [], []
+    for k, seg in enumerate(segments):
+        m = link([seg], policy).moves
+        entry, exit_ = m[:5], m[-5:][::-1]          # (clearance ... tip), each as the linker moves
+        for part, ends in ((entry, not seg.joined), (exit_, k + 1 == len(segments) or not segments[k + 1].joined)):
+            if ends:
+                trip = part + part[::-1][1:]
+                moves += trip
+                owner += [-1] + [k] * (len(trip) - 1)
+                tips.append((part[-1].x, part[-1].y, part[-1].z))
+    return Toolpath(moves), np.asarray(owner, dtype=np.int64), np.asarray(tips, dtype=float).reshape(-1, 3)
+
+
+def _to_transit(seg: CutSegment, policy: LinkPolicy) -> float:
+    """The axis retract that takes the segment's first and last tips along their axes to the transit height
+    (the tilted tool's lowest point at the safe height): no vertical move is left below it."""
+    out = policy.axis_retract
+    for i in (0, len(seg) - 1):
+        a = np.asarray(seg.axis(i))
+        out = max(out, (policy.safe_height + policy.lowest_below_tip(tuple(a)) - seg.tips[i, 2]) / max(a[2], 1e-3))
+    return float(out) + 1e-6
+
+
+def link_clear(mesh, segments: List[CutSegment], policy: LinkPolicy, assembly: Optional[ToolAssembly]
+               ) -> tuple[Toolpath, Optional[LinkNote]]:
+    """The segments linked (core.linking, along the axis) with every entry and exit checked for the shank and
+    holder (core.verify.holder_clearance): the straight rise to the transit height after the axis retract
+    ignores the holder, which under an overhang can come up into it. A segment whose entry or exit comes closer
+    than the clearance leaves and enters along its tool axis all the way to the transit height, and that is
+    checked again; what still comes closer is reported in the note, never linked silently. No assembly: the
+    linker's path and no note."""
+    if assembly is None or not segments:
+        return link(segments, policy), None
+    segs = list(segments)
+    path, owner, tips = _trips(segs, policy)
+    check = check_holder_clearance(mesh, assembly, path, sample_step=SAMPLE_STEP, surface_step=SURFACE_STEP,
+                                   tolerance=CHECK_TOL)
+    bad = sorted({int(k) for k in owner[check.move] if k >= 0})
+    samples, checked = check.samples, len(tips)
+    for k in bad:
+        segs[k] = replace(segs[k], axis_retract=_to_transit(segs[k], policy))
+    blocked = np.zeros((0, 3))
+    if bad:
+        again, owner2, tips2 = _trips([segs[k] for k in bad], policy)
+        check2 = check_holder_clearance(mesh, assembly, again, sample_step=SAMPLE_STEP, surface_step=SURFACE_STEP,
+                                        tolerance=CHECK_TOL)
+        samples += check2.samples
+        still = sorted({int(k) for k in owner2[check2.move] if k >= 0})
+        blocked = np.array([segs[bad[k]].tips[0] for k in still]).reshape(-1, 3)
+    raised = np.array([segs[k].tips[0] for k in bad]).reshape(-1, 3)
+    return link(segs, policy), LinkNote(checked, raised, blocked, samples)
