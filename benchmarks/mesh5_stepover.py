@@ -29,8 +29,8 @@ from tmm_workbench.core.strategies.mesh5.cspace import build_cspace  # noqa: E40
 from tmm_workbench.core.strategies.mesh5.optimal import nearest_ideal, pass_motion_time, smooth_postures  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach  # noqa: E402
-from tmm_workbench.core.strategies.mesh5.stepover import (INTERIOR, MARGIN, OVERRUN_STEPS, tilt_reached,  # noqa: E402
-                                                         adaptive_passes)
+from tmm_workbench.core.strategies.mesh5.stepover import INTERIOR, MARGIN, tilt_reached, adaptive_passes  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.tool_moves import OVERRUN_STEPS  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.top_bound import top_bounds  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 

@@ -18,9 +18,10 @@ from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
-from tmm_workbench.core.strategies.mesh5.stepover import (BETWEEN_TOL, OVERRUN_STEPS, _Coverage, adaptive_passes,
-                                                         between_positions, clear_lifts, half_widths,
-                                                         overrun_positions, tilt_reached)
+from tmm_workbench.core.strategies.mesh5.coverage import Coverage
+from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths, tilt_reached
+from tmm_workbench.core.strategies.mesh5.tool_moves import (BETWEEN_TOL, OVERRUN_STEPS, between_positions,
+                                                           clear_lifts, overrun_positions)
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -203,7 +204,7 @@ def test_the_finished_level_moves_only_in_the_bins_a_pass_runs_through():
     # across, and a pass along part of the feed leaves the other bins as they were
     plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 40, 20), "plane")
     m, feed = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
-    cover = _Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
+    cover = Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
     assert np.allclose(cover.lo, 0.0) and np.allclose(cover.hi, 20.0) and cover.open.all()
     xs = np.arange(0.0, 16.1, 2.0)
     frames = np.tile(np.eye(3), (len(xs), 1, 1))
