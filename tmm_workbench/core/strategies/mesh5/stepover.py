@@ -16,7 +16,7 @@ boundary runs slanted across the planes). The first plane lies 0.125 D inside th
 plane goes a gap beyond the least finished level of the open bins its own path runs through, and no higher
 than the top of any open bin. Its C-space is built with, per CC point, the right side step reaching back to
 the level of its bins and the left one the gap asked of the next pass (eq. 3.21's d_step_{i+1,R} =
-d_step_{i,L}: measured_gap, from the last pass's measured half-widths); a CC point with no posture for its left
+d_step_{i,L}, asked 10 % more after a pass that met it everywhere); a CC point with no posture for its left
 step gets a smaller one, a CC point with none for its right step moves the plane nearer. The postures are
 chosen for the motion time (optimal.smooth_postures) and the real half-widths measured; a bin advances to the
 least left boundary of its CC points where their right boundaries reach its level, and keeps its level
@@ -58,10 +58,6 @@ MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
-# the next gap is this quantile of the half-widths the last pass measured (measured_gap)
-GAP_QUANTILE = 0.1
-STALLS = 2              # passes in a row that leave a bin they run through where it was: it is left (_leave_behind)
-GROW = 1.2              # the least growth of the ask after a pass that met it everywhere (measured_gap)
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -338,46 +334,22 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
     return lo
 
 
-def _leave_behind(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: List[CCPath],
-                  paths: List[CCPath], offset: float, stalls: np.ndarray) -> None:
-    """Takes the pass's new `level`; these open bins are left for clean-up up to the least level the pass
-    reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of coming
-    back for them (or being held back by them): those the plane's whole paths run through but its paths within
-    the machine's tilt do not (_Planes._reachable), and those its paths ran through that STALLS passes in a
-    row left where they were (`stalls` counts them per bin: their CC points' right sides fall short of the
-    level, on seed 000's complex surface where it falls along the feed near the tilt limit, and the next
-    plane, placed from the least level, came back to the same offset up to 3 times)."""
+def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: List[CCPath],
+                 paths: List[CCPath], offset: float) -> None:
+    """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
+    the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
+    reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of
+    coming back for them (or being held back by them)."""
     gained = level > cover.level + 1e-9
     reached = float(level[gained].min()) if gained.any() else offset
-    stalls[:] = np.where(gained, 0, stalls + (cover.spanned(paths) & cover.open))
-    hole = ((cover.spanned(whole) & ~cover.spanned(paths)) | (stalls >= STALLS)) & cover.open & ~gained & \
-        (cover.level < reached)
+    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & ~gained & (cover.level < reached)
     if hole.any():
         for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
             f0 = cover.f0 + cover.width * a
             plan.unfinished.append((float(f0), float(cover.f0 + cover.width * b), float(cover.level[a:b].min()),
                                     reached))
         level = np.where(hole, np.maximum(level, reached), level)
-        stalls[hole] = 0
     cover.level = level
-
-
-def measured_gap(widths: np.ndarray, frames: np.ndarray, m: np.ndarray, radius: float, asked: float,
-                 met: bool) -> float:
-    """The gap (mm along the plane normal m) to ask of the next pass, from the left half-widths a pass measured
-    at its CC points (widths (n, 2), LCS `frames`): the next pass's right side reaches back as far as this
-    one's left side reached (eq. 3.21's d_step_{i+1,R}* = d_step_{i,L}), on the lower tail of the CC points
-    (GAP_QUANTILE: the least finished level per bin sets the next plane). The postures are chosen for the
-    motion time and meet what is asked rather than the widest they could, so the ask also grows by itself:
-    GROW times the `asked` left step where the CC points met it (`met`: all but the lower tail), 0.95 times it
-    where they did not. Asked less than the posture gave, the next posture meets the ask just so, where the
-    sweep along a curving pass leaves more than the section shows (a cylinder patch: 1.24 tau)."""
-    w = widths[:, 0] * np.maximum(frames[:, 1] @ m, 0.2)
-    w = w[np.isfinite(w)]
-    gap = asked * (GROW if met else 0.95)
-    if w.size:
-        gap = max(gap, float(np.quantile(w, GAP_QUANTILE)))
-    return float(np.clip(gap, 0.05 * radius, 2 * radius))
 
 
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
@@ -403,7 +375,6 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
     cover = Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
-    stalls = np.zeros(len(cover.level), dtype=np.int64)                     # passes in a row a bin stayed
     planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius, machine, grid)
     gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
     ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
@@ -443,11 +414,12 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
                                        gap, runs))
         plan.partial += short > 0
-        _leave_behind(plan, cover, level, planes.paths(offset, trim=False), paths, offset, stalls)
-        # the next pass's side steps from the half-widths this one measured (eq. 3.21's d_step_{i+1,R} =
-        # d_step_{i,L}), not a fixed share of the diameter
-        met = bool(np.mean(used[:, 0] >= ahead - 1e-9) >= 1.0 - GAP_QUANTILE)
-        gap = ahead = measured_gap(widths, np.concatenate([p.frames for p in paths]), m, cutter.radius, ahead, met)
+        _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset)
+        # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
+        # asked a little more while every CC point meets them
+        relaxed = bool((used[:, 0] < ahead - 1e-9).any())
+        ahead = float(np.clip(ahead * (0.95 if relaxed else 1.1), 0.05 * cutter.radius, 2 * cutter.radius))
+        gap = ahead
         guess = offset + 2 * gap
         if progress is not None and progress(1.0 - float(np.mean(cover.open))) is False:
             raise Cancelled("5-axis mesh step-over cancelled")   # never a partial plan passed on as whole
