@@ -3,12 +3,13 @@ D 0.5 in, tolerance 0.004 in, postures chosen for the Tarus motion time; the sca
 reference on the real tool positions; and one pass's motion time against the seed's nearest-to-ideal choice.
 
     .venv/bin/python benchmarks/mesh5_stepover.py [--surface convex|concave|complex] [--tolerance-in 0.004]
-        [--x-lines 11] [--step 0.25] [--no-pass-times] [--constant [--every 5]]
+        [--x-lines 11] [--step 0.25] [--no-pass-times] [--constant [--every 5]] [--widest [--every 5]]
 
 Prints the passes (seed: 49 adaptive, 84 at constant step-over), the compute time (wall and CPU: the machine is
 shared), the C-spaces built, the step between planes, and the slow check: the material left at surface samples
 on lines across the whole surface (every 0.25 mm) under all passes' tools with their overruns; then a table.
---constant: instead, the largest constant step-over (constant_step) and its pass count.
+--constant: instead, the largest constant step-over (constant_step) and its pass count. --widest: instead, an upper
+bound on each pass's width (widest_steps) and the least pass count it allows.
 """
 from __future__ import annotations
 
@@ -29,8 +30,8 @@ from tmm_workbench.core.strategies.mesh5.cspace import build_cspace  # noqa: E40
 from tmm_workbench.core.strategies.mesh5.optimal import nearest_ideal, pass_motion_time, smooth_postures  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach  # noqa: E402
-from tmm_workbench.core.strategies.mesh5.stepover import (INTERIOR, MARGIN, OVERRUN_STEPS, tilt_reached,  # noqa: E402
-                                                         adaptive_passes)
+from tmm_workbench.core.strategies.mesh5.stepover import INTERIOR, MARGIN, tilt_reached, adaptive_passes  # noqa: E402
+from tmm_workbench.core.strategies.mesh5.tool_moves import OVERRUN_STEPS  # noqa: E402
 from tmm_workbench.core.strategies.mesh5.top_bound import top_bounds  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
@@ -88,6 +89,43 @@ def constant_step(mesh, cutter, tol: float, machine: TarusMachine, every: float 
     return best, count, time.perf_counter() - t0
 
 
+def widest_steps(mesh, cutter, tol: float, machine: TarusMachine, every: float = 10.0
+                 ) -> tuple[np.ndarray, np.ndarray, float]:
+    """An upper bound on the width one pass can finish, per drive plane `every` mm across: the largest w such
+    that every CC point of the plane (within the machine's tilt, as the plan) has a posture whose top bound S1
+    at the full tolerance is >= 0 (necessary: S2 >= 0) with its side steps a and w - a along the plane normal
+    (a = w / 3, w / 2 or 2 w / 3), by bisection. A pass covers at most its plane's w, so the passes number at
+    least the integral of dy / w(y) across the mesh. (planes' y, w, seconds)."""
+    t0 = time.perf_counter()
+    reach, grid = MeshReach(mesh), PostureGrid.degrees()
+    lo, hi = mesh.bounds[0][1], mesh.bounds[1][1]
+    lam, omg = (g.ravel() for g in grid.mesh())
+    ys, ws = [], []
+    for offset in np.arange(lo + 0.5 * every, hi, every):
+        paths = cc_paths(mesh, (1, 0), np.array([offset]), 2.0, 0.01)
+        pts, frm = np.concatenate([p.points for p in paths]), np.concatenate([p.frames for p in paths])
+        ask = tilt_reached(machine, frm, grid)
+        keep = ask.any(axis=(1, 2))
+        pts, frm, ask = pts[keep], frm[keep], ask[keep].reshape(int(keep.sum()), -1)
+        across = np.maximum(frm[:, 1] @ plane_normal((1, 0)), 0.2)
+
+        def ok(w: float) -> bool:
+            met = np.zeros(len(pts), dtype=bool)
+            for share in (0.5, 1 / 3, 2 / 3):
+                side = np.minimum(np.column_stack([share * w / across, (1 - share) * w / across]), 2 * cutter.radius)
+                top = top_bounds(reach, cutter, pts, frm, lam, omg, tol, side, interior=INTERIOR)
+                met |= ((top >= 0) & ask).any(axis=1)
+                if met.all():
+                    return True
+            return False
+
+        w = _largest(ok, 4 * cutter.radius, 8)
+        ys.append(offset)
+        ws.append(w)
+        print(f"  plane y = {offset:7.2f} mm ({len(pts)} CC points): widest pass <= {w:.2f} mm", flush=True)
+    return np.array(ys), np.array(ws), time.perf_counter() - t0
+
+
 def _largest(ok, b: float, rounds: int = 10) -> float:
     """The largest s in (0, b) found ok by bisection (ok(0) taken as true)."""
     a = 0.0
@@ -139,6 +177,8 @@ def main() -> None:
     ap.add_argument("--constant", action="store_true", help="only the constant step-over (seed: 84 passes on "
                     "the convex surface at 0.004 in), planes every --every mm")
     ap.add_argument("--every", type=float, default=5.0)
+    ap.add_argument("--widest", action="store_true", help="only an upper bound on each pass's width (planes "
+                    "every 2 x --every mm) and the least pass count it allows")
     a = ap.parse_args()
     mesh, _ = seed000_mesh(a.surface)
     cutter = Cutter.flat(0.5 * INCH)
@@ -150,6 +190,14 @@ def main() -> None:
         print(f"seed 000 {a.surface}, tau {tol:.4f} mm: largest constant step {step:.3f} mm -> {count} passes over "
               f"{mesh.bounds[1][1] - mesh.bounds[0][1]:.1f} mm (planes checked every {a.every:g} mm; "
               f"{secs:.1f} s wall / {time.process_time() - cpu:.1f} s CPU)")
+        return
+    if a.widest:
+        ys, ws, secs = widest_steps(mesh, cutter, tol, machine, 2 * a.every)
+        span = mesh.bounds[1][1] - mesh.bounds[0][1]
+        least = float(np.sum(2 * a.every / ws))
+        print(f"seed 000 {a.surface}, tau {tol:.4f} mm: widest pass per plane (mm) min {ws.min():.2f}, median "
+              f"{np.median(ws):.2f}, max {ws.max():.2f}; passes >= sum(dy / w) = {least:.1f} over {span:.1f} mm "
+              f"({secs:.1f} s)")
         return
     if not a.no_pass_times:
         one_pass_times(mesh, cutter, tol, machine)

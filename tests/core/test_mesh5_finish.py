@@ -10,7 +10,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import link
 from tmm_workbench.core.strategies.mesh5 import finish
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
-from tmm_workbench.core.strategies.mesh5.stepover import OVERRUN_STEPS
+from tmm_workbench.core.strategies.mesh5.tool_moves import OVERRUN_STEPS
 from tmm_workbench.core.strategies.multipoint import link_policy
 from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.core.tools.cutter import Cutter

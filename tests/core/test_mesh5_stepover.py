@@ -18,9 +18,10 @@ from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
-from tmm_workbench.core.strategies.mesh5.stepover import (BETWEEN_TOL, OVERRUN_STEPS, _Coverage, adaptive_passes,
-                                                         between_positions, clear_lifts, half_widths,
-                                                         overrun_positions, tilt_reached)
+from tmm_workbench.core.strategies.mesh5.coverage import Coverage
+from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths, tilt_reached
+from tmm_workbench.core.strategies.mesh5.tool_moves import (BETWEEN_TOL, OVERRUN_STEPS, between_positions,
+                                                           clear_lifts, overrun_positions)
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -166,6 +167,29 @@ def test_a_move_that_would_cut_in_between_two_cl_points_gets_a_position_lifted_c
     assert least(tips, axes) >= -BETWEEN_TOL
 
 
+def test_a_move_whose_middle_is_clear_but_not_its_last_quarter_gets_a_position_there():
+    # a long move (6 radii) over a plane with a bump near its end: both ends and the middle stand clear of the
+    # bump, the tool at three quarters stands on it (seed 000's complex surface: an overrun off a steep edge,
+    # the tool's side over the mesh's edge at 3/4 of a move, -0.0137 mm in the slow check, the middle clear)
+    cutter = Cutter.flat(10.0)
+    bump = grid_mesh(lambda x, y: np.clip(1.0 - np.abs(x - 22.0) / 1.5, 0.0, None), 400, 10, (-10, -5, 40, 5),
+                     "bump")
+    reach = MeshReach(bump)
+    tips = np.array([[0.0, 0.0, 0.0], [30.0, 0.0, 0.0]])
+    axes = np.array([[0.0, 0.0, 1.0], [0.0, 0.0, 1.0]])
+    ident = np.repeat(np.eye(3)[None], 3, axis=0)
+    ends_mid = np.array([tips[0], [15.0, 0.0, 0.0], tips[1]])
+    assert np.allclose(clear_lifts(reach, cutter, ends_mid, np.repeat(axes[:1], 3, 0), ident), 0.0)
+    got, got_a = between_positions(reach, cutter, tips, axes, ident[:2])
+    assert len(got) > 2 and np.allclose(got_a, axes[0])
+    # along the moves now (tip linear), the tool stands at most BETWEEN_TOL into the bump
+    s = np.linspace(0.0, 1.0, 33)[:-1]
+    along = np.concatenate([a + s[:, None] * (b - a) for a, b in zip(got[:-1], got[1:])])
+    lift = clear_lifts(reach, cutter, along, np.repeat(axes[:1], len(along), 0),
+                       np.repeat(np.eye(3)[None], len(along), axis=0))
+    assert lift.max() <= BETWEEN_TOL + 1e-6
+
+
 def test_bad_tolerance_and_tool_are_refused_by_name():
     plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 10, 10), "plane")
     with pytest.raises(TmmError, match="tolerance must be a positive number of mm, got 0"):
@@ -203,7 +227,7 @@ def test_the_finished_level_moves_only_in_the_bins_a_pass_runs_through():
     # across, and a pass along part of the feed leaves the other bins as they were
     plane = grid_mesh(lambda x, y: 0.0 * x, 4, 4, (0, 0, 40, 20), "plane")
     m, feed = np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0])
-    cover = _Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
+    cover = Coverage(plane, m, feed, 2.0, 1e-3, 3.0)
     assert np.allclose(cover.lo, 0.0) and np.allclose(cover.hi, 20.0) and cover.open.all()
     xs = np.arange(0.0, 16.1, 2.0)
     frames = np.tile(np.eye(3), (len(xs), 1, 1))
@@ -273,5 +297,5 @@ def test_a_move_over_a_ridge_higher_than_a_radius_is_lifted_over_it_or_refused()
             ident = np.repeat(np.eye(3)[None], len(got), axis=0)
             assert np.allclose(clear_lifts(reach, cutter, got, np.repeat(axes[:1], len(got), 0), ident), 0.0)
         else:
-            with pytest.raises(TmmError, match="no lift of 4 tool radii clears its middle"):
+            with pytest.raises(TmmError, match="no lift of 4 tool radii clears it"):
                 between_positions(reach, cutter, tips, axes, frames)

@@ -22,7 +22,7 @@ chosen for the motion time (optimal.smooth_postures) and the real half-widths me
 least left boundary of its CC points where their right boundaries reach its level, and keeps its level
 (for the next pass) where they do not. The passes are planned at MARGIN of the tolerance. The tools go on an
 overrun of a radius beyond the ends of each path, each position lifted clear of the mesh
-(overrun_positions), which the bins count.
+(tool_moves.overrun_positions), which the bins count (coverage.Coverage).
 """
 from __future__ import annotations
 
@@ -37,11 +37,12 @@ from tmm_workbench.core.errors import Cancelled, TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths, plane_normal
+from tmm_workbench.core.strategies.mesh5.coverage import Coverage
 from tmm_workbench.core.strategies.mesh5.cspace import CSpace, build_cspace
-from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
+from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_postures
-from tmm_workbench.core.strategies.mesh5.posture import (PostureGrid, require_plain, tool_rotation, touch_tip,
-                                                        world_placement)
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
+from tmm_workbench.core.strategies.mesh5.tool_moves import between_positions, overrun_positions
 from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile, surface_heights
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
@@ -57,11 +58,6 @@ MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
-# positions along each overrun, each lifted clear of the mesh (a radius in 4: about the CC points' spacing)
-OVERRUN_STEPS = 4
-# between_positions: the deepest a straight move between two tool positions may cut into the mesh (mm), how many
-# times a move is halved to keep it there, and the most (tool radii) a middle is lifted before the move is refused
-BETWEEN_TOL, BETWEEN_ROUNDS, FAR_RADII = 0.002, 2, 4.0
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -137,77 +133,6 @@ class PlannedPass:
         return self.runs
 
 
-def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: PassPostures, overrun: float,
-                      steps: int = OVERRUN_STEPS, assembly: Optional[ToolAssembly] = None
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(tips, axes, LCS frames) of the path's tool with its overruns: `overrun` mm beyond both end CC points along their
-    feed LX at the end postures (at the ends the CC point lies on the mesh's boundary, and a tool stopping
-    there would narrow its track within a radius of it), in `steps` positions each, every one lifted along
-    the axis by the least lift that clears the mesh there (the C-space's S2 at that place). Straight along
-    LX at the end's own lift, the tool ran into the mesh where it goes on beyond the path's end (a boundary
-    slanted across the planes, the tool's body yawed over the surface beside the path: 0.07 mm deep on seed
-    000's concave surface). An overrun stops before a position no lift within the tool's radius clears."""
-    s = overrun * np.arange(1, steps + 1) / steps
-    ends = []
-    for k, sgn in ((0, -1.0), (-1, 1.0)):
-        frame = path.frames[k]
-        pts = path.points[k] + sgn * s[:, None] * frame[0]
-        frm = np.repeat(frame[None], steps, 0)
-        lam, omg = np.array([postures.lam[k]]), np.array([postures.omg[k]])
-        lift = lifts(reach, cutter, pts, frm, lam, omg, cutter.radius, assembly=assembly)[:, 0]
-        blocked = np.flatnonzero(~np.isfinite(lift))
-        keep = int(blocked[0]) if blocked.size else steps
-        tips, axes = world_placement(cutter, pts[:keep], frm[:keep], np.repeat(lam, keep),
-                                     np.repeat(omg, keep), lift[:keep])
-        ends.append((tips, axes, frm[:keep]))
-    (t0, a0, f0), (t1, a1, f1) = ends
-    return (np.concatenate([t0[::-1], postures.tips, t1]), np.concatenate([a0[::-1], postures.axes, a1]),
-            np.concatenate([f0, path.frames, f1]))
-
-
-def clear_lifts(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray,
-                frames: np.ndarray, assembly: Optional[ToolAssembly] = None, radii: float = 1.0) -> np.ndarray:
-    """(n,) the least lift along its axis that clears the mesh for the tool at each (tip, axis) (0 where it is
-    clear already; inf above `radii` tool radii), by the C-space's S2 (lift.lifts): the posture read in the LCS
-    `frames` (n, 3, 3) of a CC point nearby, the tip's touching point as the CC point."""
-    a = np.einsum("nij,nj->ni", frames, axes)                              # the axis in each LCS
-    lam, omg = np.arccos(np.clip(a[:, 2], -1.0, 1.0)), np.arctan2(a[:, 1], a[:, 0])
-    pts = tips - np.einsum("nji,nj->ni", frames, touch_tip(cutter, tool_rotation(lam, omg)))
-    return lifts(reach, cutter, pts, frames, lam, omg, radii * cutter.radius, paired=True, assembly=assembly)
-
-
-def between_positions(reach: MeshReach, cutter: Cutter, tips: np.ndarray, axes: np.ndarray, frames: np.ndarray,
-                      tol: float = BETWEEN_TOL, rounds: int = BETWEEN_ROUNDS,
-                      assembly: Optional[ToolAssembly] = None) -> tuple[np.ndarray, np.ndarray]:
-    """The run's positions (tips, axes, their LCS frames (n, 3, 3)) with a position inserted in the middle of
-    each move whose midpoint (tip halfway, axis halfway) cuts into the mesh deeper than `tol`, lifted clear
-    along its axis; `rounds` times. The C-space clears the tool at the CL points; between two, the move is a
-    straight line, and where the least lift curves along the pass (a surface concave along the feed, a saddle)
-    the line sags into the surface by about step^2 / (8 radius)."""
-    for _ in range(rounds):
-        if len(tips) < 2:
-            break
-        mid_t = 0.5 * (tips[:-1] + tips[1:])
-        mid_a = axes[:-1] + axes[1:]
-        mid_a /= np.linalg.norm(mid_a, axis=1, keepdims=True)               # slerp at one half
-        lift = clear_lifts(reach, cutter, mid_t, mid_a, frames[:-1], assembly)
-        far = np.flatnonzero(~np.isfinite(lift))   # deeper than a radius: asked again, never left to gouge
-        if far.size:
-            lift[far] = clear_lifts(reach, cutter, mid_t[far], mid_a[far], frames[far], assembly, FAR_RADII)
-        if not np.isfinite(lift).all():
-            k = int(np.argmin(np.isfinite(lift)))
-            raise TmmError(f"the move from {np.round(tips[k], 3).tolist()} to {np.round(tips[k + 1], 3).tolist()}"
-                           f" would cut the model: no lift of {FAR_RADII:g} tool radii clears its middle")
-        deep = np.flatnonzero(lift > tol)
-        if deep.size == 0:
-            break
-        at = deep + 1
-        tips = np.insert(tips, at, mid_t[deep] + lift[deep, None] * mid_a[deep], axis=0)
-        axes = np.insert(axes, at, mid_a[deep], axis=0)
-        frames = np.insert(frames, at, frames[deep], axis=0)
-    return tips, axes
-
-
 @dataclass
 class AdaptivePlan:
     passes: List[PlannedPass] = field(default_factory=list)
@@ -232,102 +157,6 @@ class AdaptivePlan:
                         f"({a:.1f}, {b:.1f}, {c:.2f}, {d:.2f})" for a, b, c, d in self.unfinished)
                     if self.unfinished else ""))
 
-
-def _edge_samples(mesh: TriMesh, feed: np.ndarray, spacing: float) -> np.ndarray:
-    """Points along every edge of the mesh, at most `spacing` apart along the feed, so that every feed bin
-    sees the mesh's extent across (its vertices alone may lie several bins apart)."""
-    e = np.unique(np.sort(mesh.triangles[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
-    a, b = mesh.vertices[e[:, 0]], mesh.vertices[e[:, 1]]
-    k = np.minimum(np.ceil(np.abs((b - a) @ feed) / spacing).astype(np.int64), 1000) + 2
-    idx = np.repeat(np.arange(len(e)), k)
-    frac = (np.arange(len(idx)) - np.repeat(np.cumsum(k) - k, k)) / np.repeat(k - 1, k)
-    return a[idx] + frac[:, None] * (b[idx] - a[idx])
-
-
-class _Coverage:
-    """How far across (along the plane normal m) the surface is finished, per bin of the feed coordinate:
-    passes end where the mesh's boundary runs slanted across the planes, so one level for the whole width
-    would take a pass's band for places its path never reaches."""
-
-    def __init__(self, mesh: TriMesh, m: np.ndarray, feed: np.ndarray, width: float, edge: float,
-                 overrun: float) -> None:
-        self.m, self.feed, self.width, self.edge, self.overrun = m, feed, width, edge, overrun
-        pts = _edge_samples(mesh, feed, 0.5 * width)
-        f, s = pts @ feed, pts @ m
-        self.f0 = float(f.min())
-        nb = int((float(f.max()) - self.f0) // width) + 1
-        self.lo, self.hi = np.full(nb, np.inf), np.full(nb, -np.inf)
-        b = self.bin(f)
-        np.minimum.at(self.lo, b, s)
-        np.maximum.at(self.hi, b, s)
-        self.level = self.lo.copy()                                         # finished up to here
-
-    def bin(self, f: np.ndarray) -> np.ndarray:
-        return np.clip(((f - self.f0) // self.width).astype(np.int64), 0, len(self.lo) - 1)
-
-    @property
-    def open(self) -> np.ndarray:
-        return self.level < self.hi - self.edge
-
-    def _segments(self, path: CCPath) -> tuple[np.ndarray, np.ndarray]:
-        """Per segment of the path, its CC points' two indices and the bins it spans (lo, hi); the overrun
-        adds a segment at each end from the end point to overrun mm beyond it, except where the path was cut
-        short inside the mesh (beyond the machine's tilt: the overrun, lifted clear of the slope, cuts
-        little there)."""
-        b = self.bin(path.points @ self.feed)
-        run = np.where(path.cut_short, 0.0, self.overrun)
-        ext = self.bin(np.array([path.points[0] @ self.feed - run[0], path.points[-1] @ self.feed + run[1]]))
-        n = len(b)
-        ij = np.array([[0, 0]] + [[i, i + 1] for i in range(n - 1)] + [[n - 1, n - 1]])
-        bins = np.column_stack([np.r_[ext[0], b[:-1], b[-1]], np.r_[b[0], b[1:], ext[1]]])
-        return ij, np.sort(bins, axis=1)
-
-    def spanned(self, paths: List[CCPath]) -> np.ndarray:
-        """The bins the paths (with their overruns) run through."""
-        span = np.zeros(len(self.lo), dtype=bool)
-        for p in paths:
-            _, bins = self._segments(p)
-            span[int(bins.min()):int(bins.max()) + 1] = True
-        return span
-
-    def needed(self, paths: List[CCPath]) -> tuple[np.ndarray, np.ndarray]:
-        """Per CC point, the least level of the bins of its two segments (how far back its right side must
-        reach), and whether one of them is still at the mesh's own edge (no pass finished it yet)."""
-        need, edge = [], []
-        for p in paths:
-            ij, bins = self._segments(p)
-            low = np.array([self.level[a:b + 1].min() for a, b in bins])
-            fresh = np.array([(self.level[a:b + 1] <= self.lo[a:b + 1]).any() for a, b in bins])
-            n, e = np.full(len(p), np.inf), np.zeros(len(p), dtype=bool)
-            for k in (0, 1):
-                np.minimum.at(n, ij[:, k], low)
-                np.logical_or.at(e, ij[:, k], fresh)
-            need.append(n)
-            edge.append(e)
-        return np.concatenate(need), np.concatenate(edge)
-
-    def advanced(self, paths: List[CCPath], ends: np.ndarray) -> tuple[np.ndarray, int]:
-        """The level after a pass and how many of its CC points fall short of the level: a segment whose
-        right boundaries reach the level of every bin it spans raises them to the lesser of its left
-        boundaries (inf where the left side ran off the mesh); a bin that any short segment spans keeps its
-        level, for the next pass."""
-        left = np.where(np.isnan(ends[:, 0, 0]), np.inf, ends[:, 0] @ self.m)
-        right = np.where(np.isnan(ends[:, 1, 0]), -np.inf, ends[:, 1] @ self.m)
-        cand = np.full(len(self.level), np.inf)
-        touched, failed = np.zeros(len(cand), dtype=bool), np.zeros(len(cand), dtype=bool)
-        short, start = np.zeros(len(left), dtype=bool), 0
-        for p in paths:
-            ij, bins = self._segments(p)
-            lp, rp = left[start:start + len(p)], right[start:start + len(p)]
-            for (i, j), (a, b) in zip(ij, bins):
-                touched[a:b + 1] = True
-                if max(rp[i], rp[j]) <= self.level[a:b + 1].min() + 1e-9:
-                    cand[a:b + 1] = np.minimum(cand[a:b + 1], min(lp[i], lp[j]))
-                else:
-                    failed[a:b + 1] = True
-                    short[start + i] = short[start + j] = True
-            start += len(p)
-        return np.where(touched & ~failed, np.maximum(self.level, cand), self.level), int(short.sum())
 
 
 def tilt_reached(machine: TarusMachine, frm: np.ndarray, grid: PostureGrid) -> np.ndarray:
@@ -412,7 +241,7 @@ class _Planes:
     runs through (not of all bins: the passes end where the mesh's boundary runs slanted), and no higher than
     the top of any open bin (a plane beyond it never comes back to finish that bin)."""
 
-    def __init__(self, mesh: TriMesh, direction, cover: _Coverage, forward_step: float, chord_tolerance: float,
+    def __init__(self, mesh: TriMesh, direction, cover: Coverage, forward_step: float, chord_tolerance: float,
                  radius: float, machine: TarusMachine, grid: PostureGrid):
         self.mesh, self.direction, self.cover, self.radius = mesh, direction, cover, radius
         self.forward_step, self.chord_tolerance = forward_step, chord_tolerance
@@ -505,7 +334,7 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
     return lo
 
 
-def _beyond_tilt(plan: AdaptivePlan, cover: _Coverage, level: np.ndarray, whole: List[CCPath],
+def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: List[CCPath],
                  paths: List[CCPath], offset: float) -> None:
     """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
     the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
@@ -545,7 +374,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     s = mesh.vertices @ m
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
-    cover = _Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
+    cover = Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
     planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius, machine, grid)
     gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
     ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
