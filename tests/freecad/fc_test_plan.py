@@ -247,7 +247,7 @@ class PlanPencil(FreeCADTestCase):
             before, after = (float(v) for v in re.search(r"([\d.]+) mm3 above the design before, ([\d.]+) mm3 "
                                                           r"after", rows[label]["rest"]).groups())
             self.assertLess(after, 0.5 * before, rows[label]["rest"])
-        plan_run.drop_op(results[-1].op, results[:-2])   # the clean-up and the pencil
+        plan_run.drop_op(results[-1].op, results[:-1])   # the clean-up, then the pencil (its tool controller)
         plan_run.drop_op(results[-2].op, results[:-2])
         without = plan_run.verify(results[:-2], doc, folder)
         with_it, left = verified["left_in_reach"], without["left_in_reach"]
