@@ -120,3 +120,32 @@ def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():
     assert large["out_of_reach_mm2"] > small["out_of_reach_mm2"]
     assert large["reached_mm2"] + large["out_of_reach_mm2"] == pytest.approx(small["reached_mm2"] +
                                                                               small["out_of_reach_mm2"])
+
+
+def test_left_in_reach_with_the_whole_tool():
+    """A D1 whose flutes are 1 mm long does not reach the background within its shank's radius and clearance of
+    the border's 2.5 mm wall (its shank would meet the wall's top): what is left there counts with the cutter
+    alone, not with the whole tool; with 10 mm flutes the shank passes above the wall and it counts again."""
+    from tests.core.sign import BORDER, sign_mesh
+    from tmm_workbench.core.plan.left_check import left_in_reach, whole_tool
+    from tmm_workbench.core.sim.grid import Grid
+    from tmm_workbench.core.sim.stock import mesh_heights
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    mesh = sign_mesh(0.4)
+    grid = Grid.covering(0, 0, 84, 44, 0.4)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    deviation = np.zeros_like(design)
+    band = (x > BORDER + 0.8) & (x < BORDER + 1.2) & (y > 10) & (y < 30)   # one column, 0.8-1.2 mm out
+    deviation[band] = 0.05
+    cutter = Cutter.ball(1.0)
+    spec = {"holder": "ER11 nut", "stick_out": 20.0, "flute_length": 1.0, "length": 30.0, "shank_diameter": None}
+    alone = left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01)
+    short = left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01, assembly=whole_tool(cutter, spec))
+    assert alone["left_above_tolerance_mm2"] == pytest.approx(band.sum() * 0.16)
+    assert short["left_above_tolerance_mm2"] < 0.5 * alone["left_above_tolerance_mm2"]
+    assert short["out_of_reach_mm2"] > alone["out_of_reach_mm2"] + 0.5 * band.sum() * 0.16
+    long = whole_tool(cutter, dict(spec, flute_length=10.0))
+    assert left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01, assembly=long) == alone
+    assert whole_tool(cutter, dict(spec, holder=None)) is None   # no holder: no shank checked

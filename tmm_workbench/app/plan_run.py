@@ -193,16 +193,18 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
 
 
 def left_in_reach(sim: Any, plan: dict) -> dict:
-    """The simulated Job's material left judged where the library's most reaching tool reaches
-    (core.plan.left_check)."""
+    """The simulated Job's material left judged where the library's most reaching tool reaches with its shank and
+    holder (core.plan.left_check)."""
     from tmm_workbench.core.geometry.mesh import load_stl
     from tmm_workbench.core.plan import left_check
     from tmm_workbench.core.tools.cutter import Cutter
 
     js, tool = sim.simulation, plan["reach_tool"]
+    cutter = Cutter(tool["diameter"], tool["corner_radius"])
+    # where the whole tool reaches: its shank and holder as the simulation checks them
     return left_check.left_in_reach(load_stl(plan["model_file"]), js.grid, js.design, js.comparison.deviation,
-                                    tool["name"], Cutter(tool["diameter"], tool["corner_radius"]),
-                                    plan["tolerance"], plan.get("cusp", 0.0))
+                                    tool["name"], cutter, plan["tolerance"], plan.get("cusp", 0.0),
+                                    left_check.whole_tool(cutter, plan["tools"][tool["name"]]))
 
 
 def rounded(value: Any) -> Any:
