@@ -59,14 +59,17 @@ def test_pencil_after_the_rest_in_the_corners(tmp_path):
     (only where material is left; optional: left out if it alone fails the verification)."""
     _, _, an, plan = launch.make_plan(sign_job(tmp_path, BALLS))
     labels = [o.label for o in plan.ops]
-    assert labels[-2:] == ["Rest B3", "Pencil B1"], labels
-    rest, pencil = plan.ops[-2:]
+    assert labels[-3:] == ["Rest B3", "Pencil B1", "Clean-up B1"], labels
+    rest, pencil, cleanup = plan.ops[-3:]
     assert rest.kwargs["region"] == "rest" and "pattern" not in rest.kwargs
     step = pencil.kwargs["stepover"]   # the cusp's step-over of the D1: (1.5 - 0.5) mm covered outward
     wanted = {"region": "rest", "rest_from": "earlier_ops", "pattern": "pencil", "pencil_source": "creases",
               "pencil_passes": 1 + math.ceil(1.0 / step), "rest_tolerance": 0.01}
     assert {k: pencil.kwargs.get(k) for k in wanted} == wanted
-    assert pencil.optional and rest.optional
+    assert pencil.optional and rest.optional and cleanup.optional
+    # then the D1 as a raster over what is still left that it reaches (the floors between the creases' passes)
+    assert {k: cleanup.kwargs.get(k) for k in ("region", "rest_from", "pattern", "stepover")} == {
+        "region": "rest", "rest_from": "earlier_ops", "pattern": None, "stepover": step}
     left = {t: an.reach[t].unreached_area for t in ("B6", "B3", "B1")}
     assert left["B6"] > left["B3"] > left["B1"] / decide.PENCIL_GAIN > 0, left
     why = next(d for d in plan.decisions if d.topic == "pencil")
@@ -77,7 +80,7 @@ def test_no_pencil_without_a_smaller_tool_that_reaches_more(tmp_path):
     """Without the D1 the rest is the last op and the pencil decision says why there is none; a D2.8 that the
     reach tests find hardly better than the D3 is not worth its op either."""
     _, _, _, plan = launch.make_plan(sign_job(tmp_path, BALLS[:2]))
-    assert [o.label for o in plan.ops][-1] == "Rest B3"
+    assert [o.label for o in plan.ops][-1] == "Rest B3"   # nor a clean-up
     why = next(d for d in plan.decisions if d.topic == "pencil")
     assert why.choice == "none" and "no smaller library tool" in why.reason
     near = BALLS[:2] + [{"name": "B2.8", "type": "ball", "diameter": 2.8, "flutes": 2, "flute_length": 10}]
@@ -117,3 +120,32 @@ def test_left_in_reach_judges_only_what_the_smallest_tool_reaches():
     assert large["out_of_reach_mm2"] > small["out_of_reach_mm2"]
     assert large["reached_mm2"] + large["out_of_reach_mm2"] == pytest.approx(small["reached_mm2"] +
                                                                               small["out_of_reach_mm2"])
+
+
+def test_left_in_reach_with_the_whole_tool():
+    """A D1 whose flutes are 1 mm long does not reach the background within its shank's radius and clearance of
+    the border's 2.5 mm wall (its shank would meet the wall's top): what is left there counts with the cutter
+    alone, not with the whole tool; with 10 mm flutes the shank passes above the wall and it counts again."""
+    from tests.core.sign import BORDER, sign_mesh
+    from tmm_workbench.core.plan.left_check import left_in_reach, whole_tool
+    from tmm_workbench.core.sim.grid import Grid
+    from tmm_workbench.core.sim.stock import mesh_heights
+    from tmm_workbench.core.tools.cutter import Cutter
+
+    mesh = sign_mesh(0.4)
+    grid = Grid.covering(0, 0, 84, 44, 0.4)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    deviation = np.zeros_like(design)
+    band = (x > BORDER + 0.8) & (x < BORDER + 1.2) & (y > 10) & (y < 30)   # one column, 0.8-1.2 mm out
+    deviation[band] = 0.05
+    cutter = Cutter.ball(1.0)
+    spec = {"holder": "ER11 nut", "stick_out": 20.0, "flute_length": 1.0, "length": 30.0, "shank_diameter": None}
+    alone = left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01)
+    short = left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01, assembly=whole_tool(cutter, spec))
+    assert alone["left_above_tolerance_mm2"] == pytest.approx(band.sum() * 0.16)
+    assert short["left_above_tolerance_mm2"] < 0.5 * alone["left_above_tolerance_mm2"]
+    assert short["out_of_reach_mm2"] > alone["out_of_reach_mm2"] + 0.5 * band.sum() * 0.16
+    long = whole_tool(cutter, dict(spec, flute_length=10.0))
+    assert left_in_reach(mesh, grid, design, deviation, "B1", cutter, 0.01, assembly=long) == alone
+    assert whole_tool(cutter, dict(spec, holder=None)) is None   # no holder: no shank checked

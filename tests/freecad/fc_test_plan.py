@@ -36,6 +36,28 @@ def freecadcmd() -> str:
     raise AssertionError(f"no freecadcmd found (sys.executable {sys.executable}, {home}); set TMM_FREECADCMD")
 
 
+class failing:
+    """plan_run.verify made to name `label` failing (shank too close) on the calls `when(n, labels)` says (n from
+    1, the labels of the ops verified), the labels of each call appended to `calls`."""
+
+    def __init__(self, label: str, calls: list, when: Any) -> None:
+        self.label, self.calls, self.when, self.real = label, calls, when, plan_run.verify
+
+    def __enter__(self) -> "failing":
+        def verify(results: list, plan_doc: dict, out: Path, progress: Any = False) -> dict:
+            report = self.real(results, plan_doc, out, progress)
+            self.calls.append([r.op.Label for r in results])
+            if self.when(len(self.calls), self.calls[-1]):
+                report.update(passed=False, problems=[f"{self.label}: shank too close"], failing_ops=[self.label])
+            return report
+
+        plan_run.verify = verify
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        plan_run.verify = self.real
+
+
 class PlanBeet(FreeCADTestCase):
     def test_plan_runs_verified(self) -> None:
         job = read_job(JOB)
@@ -99,8 +121,9 @@ class PlanBeet(FreeCADTestCase):
         self.assertLess(len(steep.Path.Commands), before)
 
     def test_optional_op_left_out(self) -> None:
-        """An optional op (the rest) failing the verification alone is left out and the Job verified again: the
-        first verification is made to name the last op (a real one needs a long run); the second is the real."""
+        """An optional op (the rest) failing the verification alone is changed (its moves left out where the shank
+        would come too close, core.plan.replan), and when that fails too, left out and the Job verified again: the
+        verifications with it are made to name the last op (a real one needs a long run); the last is the real."""
         job = read_job(JOB)
         _, _, _, plan = launch.make_plan(job)
         folder = OUT / "plan_beet_drop"
@@ -110,31 +133,42 @@ class PlanBeet(FreeCADTestCase):
         last["optional"] = True
         (folder / "plan.json").write_text(json.dumps(doc))
         os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
-        real, calls = plan_run.verify, []
-
-        def first_fails(results, plan_doc, out, progress=False):
-            report = real(results, plan_doc, out, progress)
-            calls.append([r.op.Label for r in results])
-            if len(calls) == 1:
-                report.update(passed=False, problems=[f"{last['label']}: shank too close"],
-                              failing_ops=[last["label"]])
-            return report
-
-        plan_run.verify = first_fails
-        try:
+        calls: list = []
+        with failing(last["label"], calls, lambda n, labels: last["label"] in labels):
             self.assertEqual(plan_run.main(), 0)
-        finally:
-            plan_run.verify = real
         verified = json.loads((folder / "verify.json").read_text())
-        self.assertEqual(calls[1], calls[0][:-1])
+        # with it, with it changed, with it as planned again (failing), without it
+        self.assertEqual(calls[1:3], [calls[0], calls[0]])
+        self.assertEqual(calls[3], calls[0][:-1])
         self.assertTrue(verified["passed"], verified["problems"])
         self.assertEqual(verified["replanned"], [f"left out {last['label']}: {last['label']}: shank too close"])
-        self.assertEqual([o["label"] for o in verified["ops"]], calls[1])
+        self.assertEqual([o["label"] for o in verified["ops"]], calls[3])
         gcode = (folder / "beet_mm.ngc").read_text()
         self.assertFalse(f"(begin operation: {last['label']})" in gcode)
         self.assertTrue(f"(begin operation: {doc['ops'][0]['label']})" in gcode)
         saved = FreeCAD.openDocument(str(folder / "beet_mm.FCStd"))
         self.assertFalse([o for o in saved.Objects if o.Label == last["label"]])
+
+    def test_optional_op_changed(self) -> None:
+        """An optional op failing the verification alone, verified once its moves where the shank would come too
+        close are left out in place of lifted (the second verification is the real one), is kept so changed."""
+        job = read_job(JOB)
+        _, _, _, plan = launch.make_plan(job)
+        folder = OUT / "plan_beet_change"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
+        last = doc["ops"][-1]
+        last["optional"] = True
+        calls: list = []
+        with failing(last["label"], calls, lambda n, labels: n == 1):
+            results, verified = plan_run.run_plan(doc, folder)
+        self.assertEqual(len(calls), 2)
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertEqual(len(verified["replanned"]), 1)
+        self.assertTrue(verified["replanned"][0].startswith(f"changed {last['label']}: its moves where the shank"))
+        self.assertEqual([r.op.Label for r in results], [o["label"] for o in doc["ops"]])
+        self.assertEqual(results[-1].op.HolderCollision, "LeaveOut")
+        self.assertEqual(results[0].op.getPropertyByName("HolderCollision"), "Lift")   # the others as planned
 
     def test_command_end_to_end(self) -> None:
         """`python -m tmm_workbench.plan`'s run(): the core plans, a freecadcmd of its own runs the plan, the files
@@ -184,9 +218,9 @@ def block_on_plate() -> Any:
 
 class PlanPencil(FreeCADTestCase):
     def test_rest_and_pencil_take_the_corners(self) -> None:
-        """Ball D6 finishing, D3 rest, D1 pencil along the creases the D3 leaves: each rest op reports less
-        volume after than before, and the simulation of the Job without the pencil leaves more above the
-        tolerance where the D1 reaches (and more volume) than with it."""
+        """Ball D6 finishing, D3 rest, D1 pencil along the creases the D3 leaves, D1 clean-up raster: the rest and
+        the pencil report less volume after than before, and the simulation of the Job without the pencil and the
+        clean-up leaves more above the tolerance where the D1 reaches (and more volume) than with them."""
         import yaml
 
         from tmm_workbench.core.geometry.mesh import save_stl
@@ -203,7 +237,7 @@ class PlanPencil(FreeCADTestCase):
             {"name": f"B{d}", "type": "ball", "diameter": d, "flute_length": 10} for d in (6, 3, 1)]
         job = job_from_dict(data, folder / "job.yaml")
         _, _, an, plan = launch.make_plan(job)
-        self.assertEqual([o.label for o in plan.ops][-2:], ["Rest B3", "Pencil B1"])
+        self.assertEqual([o.label for o in plan.ops][-3:], ["Rest B3", "Pencil B1", "Clean-up B1"])
         doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
         results, verified = plan_run.run_plan(doc, folder)
         self.assertTrue(verified["passed"], verified["problems"])
@@ -213,8 +247,9 @@ class PlanPencil(FreeCADTestCase):
             before, after = (float(v) for v in re.search(r"([\d.]+) mm3 above the design before, ([\d.]+) mm3 "
                                                           r"after", rows[label]["rest"]).groups())
             self.assertLess(after, 0.5 * before, rows[label]["rest"])
-        plan_run.drop_op(results[-1].op, results[:-1])
-        without = plan_run.verify(results[:-1], doc, folder)
+        plan_run.drop_op(results[-1].op, results[:-1])   # the clean-up, then the pencil (its tool controller)
+        plan_run.drop_op(results[-2].op, results[:-2])
+        without = plan_run.verify(results[:-2], doc, folder)
         with_it, left = verified["left_in_reach"], without["left_in_reach"]
         self.assertEqual(with_it["tool"], "B1")
         self.assertGreater(left["left_above_tolerance_mm2"], 1.5 * with_it["left_above_tolerance_mm2"] + 5.0)

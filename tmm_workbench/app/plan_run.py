@@ -98,6 +98,55 @@ def drop_op(op: Any, kept: list) -> None:
     doc.recompute()
 
 
+def change_failing(results: list, plan: dict, folder: Path, report: dict, replanned: list,
+                   progress: Any = False) -> dict:
+    """Each failing optional op changed by core.plan.replan's changes in turn, the Job verified after each, until
+    it no longer fails (the change kept, said in `replanned`) or none is left (the op as planned again, for the
+    caller to leave out). The ops after a changed one are recomputed: a rest reads the stock its earlier ops
+    leave. Returns the last verification."""
+    from tmm_workbench.core.plan import replan
+
+    ops = {op["label"]: op for op in plan["ops"]}
+    for label in list(report["failing_ops"]):
+        changes = replan.retries(ops[label])
+        if not changes:
+            continue
+        index = next(i for i, r in enumerate(results) if r.op.Label == label)
+        planned = op_properties(results[index].op, {})
+        for change, why in changes:
+            set_properties(results[index:], op_properties(results[index].op, change))
+            report = verify(results, plan, folder, progress)
+            if label not in report["failing_ops"] and not report["gouged"]:
+                replanned.append(f"changed {label}: {why}")
+                break
+        else:
+            set_properties(results[index:], planned)
+            report = verify(results, plan, folder, progress)
+    return report
+
+
+def op_properties(op: Any, change: dict) -> dict:
+    """The op's tool-assembly properties for `change` (API keyword arguments; empty: their values now)."""
+    from tmm_workbench.app import stages, tool_assembly
+
+    if not change:
+        return {f.prop: getattr(op, f.prop) for f in tool_assembly.STAGE.fields if f.api}
+    return stages.api_values((tool_assembly.STAGE,), None, dict(change, holder="tool_controller"), None)
+
+
+def set_properties(results: list, values: dict) -> None:
+    """`values` set on the first result's op, it and the ops after it recomputed."""
+    op = results[0].op
+    for prop, value in values.items():
+        setattr(op, prop, value)
+    for r in results:
+        r.op.touch()
+    op.Document.recompute()
+    for r in results:
+        if not r.op.isValid():
+            raise RuntimeError(f"{r.op.Label}: {r.op.getStatusString()}")
+
+
 def op_rows(results: list, sim: Any) -> list:
     rows = []
     for r, s in zip(results, sim.ops):
@@ -145,16 +194,18 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
 
 
 def left_in_reach(sim: Any, plan: dict) -> dict:
-    """The simulated Job's material left judged where the library's most reaching tool reaches
-    (core.plan.left_check)."""
+    """The simulated Job's material left judged where the library's most reaching tool reaches with its shank and
+    holder (core.plan.left_check)."""
     from tmm_workbench.core.geometry.mesh import load_stl
     from tmm_workbench.core.plan import left_check
     from tmm_workbench.core.tools.cutter import Cutter
 
     js, tool = sim.simulation, plan["reach_tool"]
+    cutter = Cutter(tool["diameter"], tool["corner_radius"])
+    # where the whole tool reaches: its shank and holder as the simulation checks them
     return left_check.left_in_reach(load_stl(plan["model_file"]), js.grid, js.design, js.comparison.deviation,
-                                    tool["name"], Cutter(tool["diameter"], tool["corner_radius"]),
-                                    plan["tolerance"], plan.get("cusp", 0.0))
+                                    tool["name"], cutter, plan["tolerance"], plan.get("cusp", 0.0),
+                                    left_check.whole_tool(cutter, plan["tools"][tool["name"]]))
 
 
 def rounded(value: Any) -> Any:
@@ -177,13 +228,16 @@ def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False)
     results = run_ops(plan, model, progress)
     report = verify(results, plan, folder, progress)
     optional = {op["label"] for op in plan["ops"] if op.get("optional")}
+    replanned: list = []
+    if not report["passed"] and not report["gouged"] and set(report["failing_ops"]) <= optional:
+        # an optional op (a rest, a pencil) failing the verification alone is changed (core.plan.replan) and
+        # verified again; one no change clears is left out, its material reported as left; a failing roughing or
+        # finishing op stops the plan with the reason (exit 1)
+        report = change_failing(results, plan, folder, report, replanned, progress)
     dropping = set(report["failing_ops"])
-    replanned = []
     if not report["passed"] and not report["gouged"] and dropping and dropping <= optional:
-        # the plan changed once: an optional op (the rest) that fails the verification is left out, its material
-        # reported as left; a failing roughing or finishing op stops the plan with the reason (exit 1)
-        replanned = [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))
-                     for label in sorted(dropping)]
+        replanned += [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))
+                      for label in sorted(dropping)]
         kept = [r for r in results if r.op.Label not in dropping]
         for r in results:
             if r.op.Label in dropping:

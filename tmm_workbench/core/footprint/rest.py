@@ -96,17 +96,21 @@ class RestArea:
 
 
 def tool_envelope(mesh: TriMesh, cutter: Cutter, grid: Grid, surface: Optional[DropSurface] = None,
-                  progress: Optional[Progress] = None) -> np.ndarray:
+                  progress: Optional[Progress] = None, tips: Optional[np.ndarray] = None) -> np.ndarray:
     """(ny, nx) the lowest the tool's surface comes over each cell centre when it is dropped onto the mesh at
     every cell centre (each CL point plunged into by the z-map cut); the mesh's floor where it touches nothing.
     Between the grid's positions a tool could go a cusp lower (cell^2 / 8 r for a ball of radius r): the
-    envelope errs on the side of material left."""
+    envelope errs on the side of material left. `tips`: (ny, nx) tip heights to plunge to in place of the
+    cutter's drop (the whole tool's: its shank or holder may hold it up)."""
     surface = surface or DropSurface(mesh)
     floor = float(mesh.vertices[:, 2].min())
     xs, ys = grid.xs(), grid.ys()
     X, Y = np.meshgrid(xs, ys)
     part = None if progress is None else (lambda f: progress(0.5 * f))
-    z = surface.drop(cutter, np.column_stack([X.ravel(), Y.ravel()]), floor, part).reshape(grid.ny, grid.nx)
+    if tips is None:
+        z = surface.drop(cutter, np.column_stack([X.ravel(), Y.ravel()]), floor, part).reshape(grid.ny, grid.nx)
+    else:
+        z = np.asarray(tips, dtype=float).reshape(grid.ny, grid.nx)
     reach = float(cutter.native.height(np.array([cutter.native.max_radius]))[0])
     top = float(z.max()) + reach + 1.0   # above the tool everywhere
     # each CL point plunged into on its own, straight down from `top` and back up: a straight move between two

@@ -10,24 +10,36 @@ corners, undercuts) is reported as its area, not judged. Where the finish asks a
 its passes leave cusps up to it by design: what is left is also counted against that allowance."""
 from __future__ import annotations
 
+from typing import Optional
+
 import numpy as np
 
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.plan.analysis import reach_excess
 from tmm_workbench.core.sim.compare import slope_cosine
 from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 
 def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.ndarray, tool: str,
-                  cutter: Cutter, tolerance: float, cusp: float = 0.0) -> dict:
+                  cutter: Cutter, tolerance: float, cusp: float = 0.0, assembly: Optional[ToolAssembly] = None
+                  ) -> dict:
     """`deviation` (ny, nx, vertical, + left; NaN without design) of the simulated Job against `design` on `grid`,
     judged where `cutter` (the library's smallest radiused tool, named `tool`) reaches: areas in mm^2, depths in mm
-    along the normal; above the tolerance, and above the allowance: the larger of it and the finish's `cusp`."""
+    along the normal; above the tolerance, and above the allowance: the larger of it and the finish's `cusp`.
+    `assembly`: the tool with its shank and holder (core.tools.assembly), which reaches only where they keep their
+    clearance (a 4 mm flute does not reach a floor 5 mm down beside a wall); None: the cutter alone."""
     finite = np.isfinite(design) & np.isfinite(deviation)
-    envelope = tool_envelope(mesh, cutter, grid, DropSurface(mesh))
+    surface = DropSurface(mesh)
+    tips = None
+    if assembly is not None:   # the lowest tip heights at which neither its shank nor its holder comes too close
+        X, Y = np.meshgrid(grid.xs(), grid.ys())
+        tips = AssemblyDrop(mesh, assembly, surface).heights(np.column_stack([X.ravel(), Y.ravel()]))[0]
+    envelope = tool_envelope(mesh, cutter, grid, surface, tips=tips)
     radius = max(cutter.corner_radius, cutter.radius)
     with np.errstate(invalid="ignore"):
         reached = finite & (reach_excess(envelope, design, grid.cell, radius) <= tolerance)
@@ -44,3 +56,18 @@ def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.n
             "left_above_allowance_mm2": round(float((reached & (left > allowance)).sum()) * grid.cell_area, 2),
             "most_left_mm": round(float(inside.max()) if inside.size else 0.0, 4),
             "left_99_percentile_mm": round(float(np.percentile(inside, 99)) if inside.size else 0.0, 4)}
+
+
+GRIP_DIAMETERS = 3.0   # shank diameters in the holder when the library gives no stick-out (app.tools' default)
+
+
+def whole_tool(cutter: Cutter, spec: dict) -> Optional[ToolAssembly]:
+    """The library tool `spec` (the plan document's tools entry: flute_length, length, shank_diameter, holder,
+    stick_out) as the assembly the simulation checks; None without a holder (no shank is checked then either)."""
+    if spec.get("holder") is None:
+        return None
+    shank = float(spec.get("shank_diameter") or cutter.diameter)
+    stick_out = spec.get("stick_out") or float(spec["length"]) - GRIP_DIAMETERS * shank
+    return ToolAssembly(cutter, shank_diameter=shank, stick_out=float(stick_out),
+                        flute_length=float(spec["flute_length"]), holder=spec["holder"],
+                        overall_length=float(spec["length"]))
