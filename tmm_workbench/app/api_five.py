@@ -100,7 +100,7 @@ def _with_cleanup(r: SurfaceResult, diameter: float, angle: float, horiz_feed: f
     """The 5-axis result `r` with its companion ball clean-up op (run_mesh5's cleanup_diameter) after it in the
     Job, both posted together and the document saved."""
     from tmm_workbench.app import posts
-    from tmm_workbench.app.api import run_surface
+    from tmm_workbench.app.api_surface import run_surface
     from tmm_workbench.core.strategies.mesh5.cleanup import ball_stepover
 
     tol = float(r.op.Tolerance.Value)
