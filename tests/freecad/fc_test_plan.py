@@ -170,6 +170,32 @@ class PlanBeet(FreeCADTestCase):
         self.assertEqual(results[-1].op.HolderCollision, "LeaveOut")
         self.assertEqual(results[0].op.getPropertyByName("HolderCollision"), "Lift")   # the others as planned
 
+    def test_optional_op_with_nothing_to_cut_left_out(self) -> None:
+        """An optional rest op whose Region 'Rest' is empty (the ops before it left nothing above its rest tolerance)
+        fails to compute: it is removed with its tool controller and named with the reason, the run goes on and
+        verifies (it stopped the whole run before, 3-axis and 5-axis alike); a required op's failure still stops it."""
+        job = read_job(JOB)
+        _, _, _, plan = launch.make_plan(job)
+        folder = OUT / "plan_beet_nothing"
+        folder.mkdir(parents=True, exist_ok=True)
+        doc = dict(launch.plan_document(job, plan, job.model.file), gcode=False, fcstd=False, heat_map=False)
+        shallow = next(o for o in doc["ops"] if o["api"] == "run_surface")
+        rest = dict(shallow, label="Rest T3 bull D6 r1", tool="T3 bull D6 r1", optional=True,
+                    kwargs=dict(shallow["kwargs"], tool="bullnose", corner_radius=1.0, region="rest",
+                                rest_tolerance=10.0))   # the beet is 7 mm tall: nothing is left 10 mm above it
+        doc["ops"].append(rest)
+        results, verified = plan_run.run_plan(doc, folder)
+        self.assertTrue(verified["passed"], verified["problems"])
+        self.assertEqual(len(verified["replanned"]), 1)
+        self.assertTrue(verified["replanned"][0].startswith(f"left out {rest['label']}: Region 'Rest'"),
+                        verified["replanned"])
+        self.assertEqual([r.op.Label for r in results], [o["label"] for o in doc["ops"][:-1]])
+        self.assertEqual(sorted(o.Name for o in results[0].job.Operations.Group), sorted(r.op.Name for r in results))
+        self.assertEqual(len(results[0].job.Tools.Group), len({r.op.ToolController.Name for r in results}))
+        rest["optional"] = False
+        with self.assertRaises(Exception):
+            plan_run.run_plan(doc, OUT / "plan_beet_nothing_required")
+
     def test_command_end_to_end(self) -> None:
         """`python -m tmm_workbench.plan`'s run(): the core plans, a freecadcmd of its own runs the plan, the files
         appear in the output folder (and nothing else beside it), exit code 0."""

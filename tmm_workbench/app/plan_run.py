@@ -14,19 +14,22 @@ import os
 import sys
 import traceback
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Optional
 
 REPO = Path(globals().get("__file__") or sys.argv[0]).resolve().parents[2]
 TUPLES = ("stock", "slope_range")   # JSON lists the API takes as tuples
 FAILED = 3
 
 
-def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
+def run_ops(plan: dict, model: Any = None, progress: Any = False, left_out: Optional[list] = None) -> list:
     """The plan's ops in order, the first making the Job around the model and its box stock (`model`, a Mesh or
     Part object: its Job in the object's document; None: the plan's STL in a new document), the others added; a
-    cylinder or solid stock's Job made first (app.plan_stock), every op added to it."""
+    cylinder or solid stock's Job made first (app.plan_stock), every op added to it. An optional op (a rest, a
+    pencil, a clean-up) that fails to compute (e.g. its Region 'Rest' is empty: the ops before it left nothing it
+    reaches) is removed again and named with its reason in `left_out`; any other op's failure stops the run."""
     from tmm_workbench.app import api
     from tmm_workbench.app.plan_stock import new_job
+    from tmm_workbench.core.errors import TmmError
     from tmm_workbench.core.plan import progress_note
 
     calls = {"run_roughing": api.run_roughing, "run_surface": api.run_surface, "run_waterline": api.run_waterline,
@@ -40,7 +43,15 @@ def run_ops(plan: dict, model: Any = None, progress: Any = False) -> list:
         call = calls[op["api"]]
         if results or job is not None:
             kwargs.pop("stock", None)   # the Job's stock (the roughing's box: only for a new Job)
-            r = call(None, job=results[0] if results else job, progress=progress, **kwargs)
+            into = results[0].job if results else job
+            try:
+                r = call(None, job=into, progress=progress, **kwargs)
+            except TmmError as exc:
+                if not op.get("optional") or left_out is None:
+                    raise
+                left_out.append(f"left out {op['label']}: {exc}")
+                remove_unused(into, results, controllers)
+                continue
         elif model is not None:
             r = call(model, progress=progress, **kwargs)
         else:
@@ -83,6 +94,23 @@ def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> 
     bit = made.Tool
     op.Document.removeObject(made.Name)
     compat.remove_toolbit(bit)
+
+
+def remove_unused(job: Any, results: list, controllers: dict) -> None:
+    """Removes from `job` the ops none of `results` is (what a failed API call added) and the tool controllers
+    neither their ops nor `controllers` (the library tools' shared ones) hold."""
+    from tmm_workbench.app import compat
+
+    kept = [r.op for r in results]
+    doc = job.Document
+    for op in [o for o in job.Operations.Group if o not in kept]:
+        doc.removeObject(op.Name)
+    used = [o.ToolController for o in kept] + list(controllers.values())
+    for tc in [t for t in job.Tools.Group if t not in used]:
+        bit = tc.Tool
+        doc.removeObject(tc.Name)
+        compat.remove_toolbit(bit)
+    doc.recompute()
 
 
 def drop_op(op: Any, kept: list) -> None:
@@ -225,10 +253,10 @@ def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False)
     from tmm_workbench.app import posts
     from tmm_workbench.core.plan import progress_note
 
-    results = run_ops(plan, model, progress)
+    replanned: list = []
+    results = run_ops(plan, model, progress, replanned)
     report = verify(results, plan, folder, progress)
     optional = {op["label"] for op in plan["ops"] if op.get("optional")}
-    replanned: list = []
     if not report["passed"] and not report["gouged"] and set(report["failing_ops"]) <= optional:
         # an optional op (a rest, a pencil) failing the verification alone is changed (core.plan.replan) and
         # verified again; one no change clears is left out, its material reported as left; a failing roughing or
