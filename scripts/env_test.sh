@@ -3,8 +3,8 @@
 # scripts/env_test.sh`): builds the kernel's wheel for this environment's python3 and runs the binding tests
 # against it (native/wheel_test.sh), then puts that wheel's module into tmm_workbench/ (its own ABI tag, so it
 # sits beside the host's), so the kernel is compiled once per Python; links the add-on into this FreeCAD's user
-# Mod folder (versioned from 1.1: FreeCAD says where), and runs the FreeCAD tests and the GUI tests (two at a
-# time, pytest-xdist; each worker's Xvfb displays from a number of its own, tests/gui/launch.py). The core tests that
+# Mod folder (versioned from 1.1: FreeCAD says where), and runs the FreeCAD tests and the GUI tests (one more at a
+# time than the cores, pytest-xdist; each worker's Xvfb displays from a number of its own, tests/gui/launch.py). The core tests that
 # need only Python, numpy and the kernel ran on the host: here the interpreter is what is checked (the binding
 # tests, through the wheel) and FreeCAD's version (the FreeCAD and GUI tests, which run the core through the
 # ops). Extra arguments go to pytest.
@@ -24,5 +24,5 @@ USER_DIR="$(freecadcmd -c 'import FreeCAD; print("TMM_USER_DIR=" + FreeCAD.getUs
 [ -n "$USER_DIR" ] || { echo "[env_test] FreeCAD did not give its user folder" >&2; exit 1; }
 mkdir -p "$USER_DIR/Mod"
 ln -sfn "$PWD" "$USER_DIR/Mod/TMM"
-xvfb-run -a python3 -m pytest -p no:cacheprovider -n "${TMM_TEST_WORKERS:-2}" --dist loadgroup --durations=10 \
+xvfb-run -a python3 -m pytest -p no:cacheprovider -n "${TMM_TEST_WORKERS:-$(($(nproc) + 1))}" --dist loadgroup --durations=10 \
   tests/freecad tests/gui "$@"

@@ -3,7 +3,8 @@
 # over tests/ (core and binding, the OpenCAMLib cross-check, FreeCAD 0.20 under freecadcmd, the GUI under Xvfb),
 # then the binding (the kernel's wheel), FreeCAD and GUI tests again under FreeCAD 1.0 (Debian 13) and 1.1
 # (Debian testing), each in a Debian chroot made once and reused (scripts/fc_env.sh; TMM_ENVS names them, default both).
-# pytest runs TMM_TEST_WORKERS tests at a time (pytest-xdist; default 2, 0 for one process); each step prints
+# pytest runs TMM_TEST_WORKERS tests at a time (pytest-xdist; default one more than the cores: the FreeCAD and GUI
+# tests wait on FreeCAD's start and event loop a quarter of their time; 0 for one process); each step prints
 # its time. The compilers run through ccache, its cache beside the chroots ($TMM_ENV_CACHE/ccache; each chroot
 # keeps its own inside), so a run recompiles only what changed; an empty or missing cache only costs time.
 set -euo pipefail
@@ -30,7 +31,7 @@ fi
 step setup bash scripts/setup.sh
 # the side builds below (UBSan, fuzz, the wheel) through ccache too, when there is a cache (setup installed it)
 [ -n "${CCACHE_DIR:-}" ] && command -v ccache >/dev/null && export CMAKE_CXX_COMPILER_LAUNCHER=ccache
-WORKERS="${TMM_TEST_WORKERS:-2}"
+WORKERS="${TMM_TEST_WORKERS:-$(($(nproc) + 1))}"
 JOBS="$(nproc)"
 step ctest ctest --test-dir build -j"$JOBS" --output-on-failure
 # The kernel, its tests and the binding tests again under UBSan (build-ubsan; see TMM_SANITIZE in native/CMakeLists.txt):
