@@ -273,8 +273,7 @@ class PlanPencil(FreeCADTestCase):
             before, after = (float(v) for v in re.search(r"([\d.]+) mm3 above the design before, ([\d.]+) mm3 "
                                                           r"after", rows[label]["rest"]).groups())
             self.assertLess(after, 0.5 * before, rows[label]["rest"])
-        plan_run.drop_op(results[-1].op, results[:-1])   # the clean-up, then the pencil (its tool controller)
-        plan_run.drop_op(results[-2].op, results[:-2])
+        plan_run.remove_unused(results[0].job, results[:-2])   # the clean-up and the pencil (their tool controller)
         without = plan_run.verify(results[:-2], doc, folder)
         with_it, left = verified["left_in_reach"], without["left_in_reach"]
         self.assertEqual(with_it["tool"], "B1")

@@ -96,30 +96,17 @@ def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> 
     compat.remove_toolbit(bit)
 
 
-def remove_unused(job: Any, results: list, controllers: dict) -> None:
-    """Removes from `job` the ops none of `results` is (what a failed API call added) and the tool controllers
-    neither their ops nor `controllers` (the library tools' shared ones) hold."""
+def remove_unused(job: Any, results: list, controllers: Optional[dict] = None) -> None:
+    """Removes from `job` the ops none of `results` is (ops left out, or what a failed API call added) and the
+    tool controllers neither their ops nor `controllers` (the library tools' shared ones) hold."""
     from tmm_workbench.app import compat
 
     kept = [r.op for r in results]
     doc = job.Document
     for op in [o for o in job.Operations.Group if o not in kept]:
         doc.removeObject(op.Name)
-    used = [o.ToolController for o in kept] + list(controllers.values())
+    used = [o.ToolController for o in kept] + list((controllers or {}).values())
     for tc in [t for t in job.Tools.Group if t not in used]:
-        bit = tc.Tool
-        doc.removeObject(tc.Name)
-        compat.remove_toolbit(bit)
-    doc.recompute()
-
-
-def drop_op(op: Any, kept: list) -> None:
-    """Removes `op` from its Job, and its tool controller when none of the `kept` results' ops uses it."""
-    from tmm_workbench.app import compat
-
-    doc, tc = op.Document, op.ToolController
-    doc.removeObject(op.Name)
-    if all(r.op.ToolController is not tc for r in kept):
         bit = tc.Tool
         doc.removeObject(tc.Name)
         compat.remove_toolbit(bit)
@@ -267,9 +254,7 @@ def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False)
         replanned += [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))
                       for label in sorted(dropping)]
         kept = [r for r in results if r.op.Label not in dropping]
-        for r in results:
-            if r.op.Label in dropping:
-                drop_op(r.op, kept)
+        remove_unused(results[0].job, kept)
         results = kept
         report = verify(results, plan, folder, progress)
     report["replanned"] = replanned
