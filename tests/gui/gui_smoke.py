@@ -245,7 +245,7 @@ def zlevel_panels(info: dict) -> None:
 
 def stale_form_attribute(info: dict) -> None:
     """gui/form_wrappers.rewrapped: a panel's check box handed out as a plain QWidget wrapper (what a stale wrapper
-    at a reused address gives: FreeCAD 1.0 in CI) comes back as a QCheckBox; a right one stays as it is."""
+    at a reused address gives: FreeCAD 1.0 in CI) comes back as a QCheckBox; a right one comes back as its class."""
     from tmm_workbench.gui import form_wrappers, resources
 
     form = FreeCADGui.PySideUic.loadUi(resources.panel("surface_op"))
@@ -258,7 +258,8 @@ def stale_form_attribute(info: dict) -> None:
     form_wrappers.rewrapped(form)
     info["rewrapped_type"] = type(getattr(form, name)).__name__
     info["rewrapped_same_object"] = getattr(form, name).objectName() == name
-    info["right_kept"] = form.verifyCusp is right
+    info["right_kept"] = type(form.verifyCusp).__name__ == type(right).__name__ == "QCheckBox" \
+        and form.verifyCusp.objectName() == "verifyCusp"
     form.deleteLater()
 
 

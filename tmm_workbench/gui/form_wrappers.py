@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from PySide import QtCore, QtGui
+from PySide import QtCore
 
 try:
     import shiboken6 as shiboken
@@ -19,21 +19,15 @@ except ImportError:  # FreeCAD 0.20 and 1.0: PySide2
     import shiboken2 as shiboken
 
 
-def _stale(widget: Any) -> bool:
-    """Dead, or typed as a class other than the Qt object's own where PySide has that class."""
-    if not shiboken.isValid(widget):
-        return True
-    real = widget.metaObject().className()
-    return real != type(widget).__name__ and isinstance(getattr(QtGui, real, None), type)
-
-
 def rewrapped(form: Any) -> Any:
-    """`form` with every named-widget attribute that is a stale wrapper replaced by a new one of the widget there
-    (found by its name); returns `form`."""
+    """`form` with every named-widget attribute wrapped anew from the widget found under that name. No method is
+    called on the loaded wrappers first: a stale one can look valid to shiboken and still crash on its first call
+    (FreeCAD 1.1 in CI: SIGSEGV in `metaObject()` on such a wrapper), so each is taken out of the map unseen and the
+    search wraps what is at that address now, typed by Qt's own meta object. Returns `form`."""
     for name, widget in list(vars(form).items()):
-        if not isinstance(widget, QtCore.QObject) or not _stale(widget):
+        if not isinstance(widget, QtCore.QObject):
             continue
-        shiboken.invalidate(widget)  # out of the map: the search below wraps what is at that address now
+        shiboken.invalidate(widget)  # out of the map: the search below wraps the live widget
         found = form.findChild(QtCore.QObject, name)
         if found is not None:
             setattr(form, name, found)
