@@ -334,6 +334,17 @@ def test_apt_arguments_and_errors():
         write_apt([Operation("Op", [("G1", {"X": 0.0, "Y": 0.0, "Z": 0.0})])])
 
 
+def test_apt_without_header_is_the_same_file_whatever_the_date():
+    tp = Toolpath()
+    tp.add(MoveKind.RAPID, 0, 0, 10)
+    tp.add(MoveKind.PLUNGE, 0, 0, 0)
+    tp.add(MoveKind.FEED, 5, 0, 0)
+    plain = apt_writer.parse_args("--no-header")
+    texts = [write_apt(program(tp), AptOptions(date=d, header=plain.header)) for d in ("Monday", "Tuesday")]
+    assert texts[0] == texts[1] and "$$" not in texts[0].split("PARTNO")[0]
+    assert "Monday" in write_apt(program(tp), AptOptions(date="Monday"))
+
+
 # --- FreeCAD-like objects -> program ------------------------------------------------------------
 class Cmd:
     def __init__(self, name, params):

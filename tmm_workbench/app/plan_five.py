@@ -62,4 +62,4 @@ def post_extras(results: list, plan: dict, folder: Path) -> None:
     if plan["post"] == "tarus":
         posts.export("tarus", objects, folder / TIP_GCODE, "--no-show-editor --tcp")
     if plan.get("apt_cl"):
-        posts.export("apt_cl", objects, folder / f"{plan['name']}.apt", "--no-show-editor")
+        posts.export("apt_cl", objects, folder / f"{plan['name']}.apt", "--no-show-editor --no-header")

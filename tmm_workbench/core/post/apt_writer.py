@@ -22,7 +22,7 @@ _CANONICAL = {"G00": "G0", "G01": "G1", "G02": "G2", "G03": "G3"}
 class AptOptions:
     """inches: UNITS/INCHES, lengths in inches, FEDRAT in IPM. precision: decimals of coordinates;
     axis_precision: decimals of i, j, k. partno: the PARTNO text. arc_tolerance: mm. date: header date text
-    (None: now)."""
+    (None: now). header: the $$ block with the date (off: the same path gives the same file)."""
     inches: bool = False
     precision: int = 6
     axis_precision: int = 6
@@ -30,6 +30,7 @@ class AptOptions:
     comments: bool = True
     arc_tolerance: float = 0.001
     date: Optional[str] = None
+    header: bool = True
 
 
 class _AptWriter:
@@ -49,9 +50,10 @@ class _AptWriter:
             self.lines.append(f"$$ {text}")
 
     def header(self) -> None:
-        date = self.o.date or datetime.datetime.now().strftime("%A, %B %d, %Y %I:%M:%S %p")
-        self.lines += ["$$ -----", f"$$      Generated on {date}", "$$      TMM APT CL post (FreeCAD)",
-                       "$$      GOTO/x,y,z,i,j,k: tool tip and unit tool axis (tip -> spindle)", "$$ -----"]
+        if self.o.header:
+            date = self.o.date or datetime.datetime.now().strftime("%A, %B %d, %Y %I:%M:%S %p")
+            self.lines += ["$$ -----", f"$$      Generated on {date}", "$$      TMM APT CL post (FreeCAD)",
+                           "$$      GOTO/x,y,z,i,j,k: tool tip and unit tool axis (tip -> spindle)", "$$ -----"]
         self.lines.append(f"PARTNO {self.o.partno}")
         self.lines.append("UNITS/INCHES" if self.o.inches else "UNITS/MM")
         self.lines.append("MULTAX/ON")
@@ -149,6 +151,8 @@ def argument_parser() -> ArgumentParser:
     p.add_argument("--axis-precision", type=int, default=6, help="decimals of i, j, k (default 6)")
     p.add_argument("--partno", default="PART TO BE MACHINED", help="PARTNO text")
     p.add_argument("--arc-tolerance", type=float, default=0.001, help="chord tolerance of arcs, mm")
+    p.add_argument("--no-header", action="store_true", help="no $$ header (its export date): the same path gives "
+                   "the same file")
     return p
 
 
@@ -157,7 +161,7 @@ def parse_args(argstring: Optional[str]) -> AptOptions:
     if not (0 <= a.precision <= 12 and 0 <= a.axis_precision <= 15) or not a.arc_tolerance > 0:
         raise TmmError("apt_cl post arguments: precisions 0..12 (axis 0..15), arc tolerance > 0")
     return AptOptions(inches=a.inches, precision=a.precision, axis_precision=a.axis_precision, partno=a.partno,
-                      comments=not a.no_comments, arc_tolerance=a.arc_tolerance)
+                      comments=not a.no_comments, arc_tolerance=a.arc_tolerance, header=not a.no_header)
 
 
 TOOLTIP_ARGS = argument_parser().format_help()
