@@ -84,15 +84,17 @@ def least_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_an
 def predict_passes(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
                    tilt_deg: tuple[float, float]) -> Optional[int]:
     """The passes across the sampled model, None when the sample holds no width (a model smaller than its
-    nodes): planes from 0.125 D inside its edge, each a step beyond the last, the step the least width there
-    and at most what the step-over asks (0.25 D first, eq. 3.22-3.23, then 1.1 times the last, up to D)."""
+    nodes), placed as the step-over places them: the first plane 0.125 D inside its edge, each next one the
+    last one's left half-width beyond it and a gap more, the gap what its right half-width reaches back and at
+    most what the step-over asks (0.25 D first, eq. 3.22-3.23, then GROWTH times the last, up to D)."""
     m, w = least_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
     if not len(m):
         return None
-    half = 0.5 * max(sample.step, 1e-9)
-    at, end, ask, passes = m[0] - half + 0.125 * cutter.diameter, m[-1] + half, 0.25 * cutter.diameter, 1
+    edge = 0.5 * max(sample.step, 1e-9)
+    at, end, ask, passes = m[0] - edge + 0.125 * cutter.diameter, m[-1] + edge, 0.25 * cutter.diameter, 1
     while at + 0.5 * float(np.interp(at, m, w)) < end:
-        at += min(ask, float(np.interp(at, m, w)))
+        half = 0.5 * float(np.interp(at, m, w))
+        at += half + min(ask, half)
         ask = min(GROWTH * ask, cutter.diameter)
         passes += 1
     return passes
