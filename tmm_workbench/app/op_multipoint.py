@@ -183,8 +183,8 @@ def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> l
         areas = placement.unreached
         if areas:
             out.append(f"the scallop {params.scallop:g} mm is not held on {len(areas)} areas "
-                       f"({within(np.vstack([a.outline for a in areas]))}), up to {max(a.height for a in areas):.4g} mm above the "
-                       "face: machined as reached (the report view lists them)")
+                       f"({within(np.vstack([a.outline for a in areas]))}), up to {max(a.height for a in areas):.4g} "
+                       "mm above the face: machined as reached (the report view lists them)")
     return out
 
 

@@ -369,8 +369,9 @@ def mesh5(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inpu
     mesh = _mesh_at_hand(proxy, obj, load_stl)
     if mesh is not None and (not _needles or _needles[0] is not mesh):
         _needles[:] = [mesh, estimate.surface_sample(mesh)]
+    left = cleanup.MAX_CELL if getattr(obj, "SimulateLeft", False) else None
     return (_params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b,
-            _needles[1] if mesh is not None else None, cleanup.MAX_CELL if getattr(obj, "SimulateLeft", False) else None)
+            _needles[1] if mesh is not None else None, left)
 
 
 _needles: list[Any] = []   # [mesh, its needle sample]: the last model's (the panel asks on every value entered)

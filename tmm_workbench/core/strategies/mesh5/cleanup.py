@@ -103,7 +103,8 @@ class CleanupNote:
                 f"passes (simulated, {self.cell:g} mm cells; {self.outside_strips:.1f} mm2 of it outside the listed "
                 f"strips), {self.moves} positions")
         if self.after > 0:
-            return text + f"; {self.after:.1f} mm2 stay above it (out of the ball's reach too), {within(self.after_points)}"
+            return text + (f"; {self.after:.1f} mm2 stay above it (out of the ball's reach too), "
+                           f"{within(self.after_points)}")
         return text + "; nothing stays above it"
 
 
@@ -186,7 +187,8 @@ def material_left(mesh: TriMesh, cutter: Cutter, path: Toolpath, grid: Grid, tol
     if not path.is_five_axis():
         return design, simulate(path, cutter, grid, stock).heights
     if cutter.kind == "flat":
-        return design, simulate(sim_path(path, cutter.radius, tolerance), cutter, grid, stock, max_step=MAX_STEP).heights
+        dense = sim_path(path, cutter.radius, tolerance)
+        return design, simulate(dense, cutter, grid, stock, max_step=MAX_STEP).heights
     return design, simulate(path, cutter, grid, stock, max_step=sub_step(cutter, tolerance, max_tilt(path))).heights
 
 
