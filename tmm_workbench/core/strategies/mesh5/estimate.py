@@ -7,13 +7,13 @@ effective cutting profile across the feed is the bottom's ellipse, curving up as
 section across curves up (concave) or down (convex) as kappa. The remaining height at y across is about
 (sin(lambda) / R - kappa) y^2 / 2 (seed 000 eq. 3.22-3.33 for the flat end mill, to second order), so the half
 width within the tolerance is sqrt(2 tau / (sin(lambda) / R - kappa)), at most R (the profile's end). The lead
-tilt is the least one that keeps the bottom's heel off a surface curving up along the feed (sin(lambda) >= R
-kappa_f / 2) and its sides off one curving up across (sin(lambda) >= R kappa), within the tilt limits. The width
-across, seen from above, is the width on the surface x cos(slope across).
+tilt is the least one that keeps the bottom's heel (2 R behind its lowest point) off a surface curving up along
+the feed (sin(lambda) >= R kappa_f) and its sides off one curving up across (sin(lambda) >= R kappa), within the
+tilt limits. The width across, seen from above, is the width on the surface x cos(slope across).
 
 Passes. A pass is as wide as its narrowest place along the feed (the plan advances each pass by the least level
-it finishes along it), so the passes are the sum over the surface's extent across of (step / least width), from
-a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model).
+it finishes along it); the planes are placed across the model as the step-over places them (predict_passes),
+from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model).
 """
 from __future__ import annotations
 
@@ -26,9 +26,9 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.height_sample import CELLS, HeightSample
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies.mesh5.stepover import MARGIN
 from tmm_workbench.core.tools.cutter import Cutter
 
-MARGIN = 0.85   # of the tolerance: the passes are planned at this share (mesh5.stepover.MARGIN)
 GROWTH = 1.1    # the step-over asks this much more of each next pass while they meet it
 
 
@@ -58,7 +58,8 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
     sin_lead = lead_tilt(cutter, along, across, tilt_deg)
     bend = sin_lead / cutter.radius - across             # the profile over the section, per y^2 / 2
     with np.errstate(divide="ignore", invalid="ignore"):
-        half = np.where(bend > 0, np.sqrt(2.0 * MARGIN * tolerance / bend), np.inf)
+        wide = np.where(np.isnan(bend), np.nan, np.inf)       # off the model / no curvature left to bound it
+        half = np.where(bend > 0, np.sqrt(2.0 * MARGIN * tolerance / bend), wide)
     return 2.0 * np.minimum(half, cutter.radius) / np.sqrt(1.0 + slope * slope)
 
 
