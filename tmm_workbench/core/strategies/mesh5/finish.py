@@ -21,7 +21,7 @@ the shank and holder bound every C-space, and the cut moves are checked against 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 import numpy as np
@@ -140,16 +140,15 @@ def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box, sample: Opti
     cells = params.grid().shape
     holder = params.assembly is not None
     cut = passes * along * climb
-    work = Work(count, "CC points", passes, cut,
-                note=("passes from the tilted cutter's width over the model's slopes" if told is not None else
-                      "at most: passes a quarter diameter apart") +
-                f"; a C-space of {cells[0] * cells[1]} postures at each" + (
-                    f", the shank and holder in it (about {HOLDER_COST:g}x the compute)" if holder else ""),
-                paces=(("mesh5", count * (HOLDER_COST if holder else 1.0)),))
-    if left_cell is None:
-        return work
-    return replace(work, note=work.note + f"; the finish simulated on {left_cell:g} mm cells",
-                   paces=work.paces + estimate.left_paces(bounds, left_cell, cut, cutter))
+    said = ["passes told from the tilted cutter's width over the model's curvature" if told is not None else
+            "at most: passes a quarter diameter apart (the model not at hand)",
+            f"a C-space of {cells[0] * cells[1]} postures at each" + (
+                f", the shank and holder in it (about {HOLDER_COST:g}x the compute)" if holder else "")]
+    paces = (("mesh5", count * (HOLDER_COST if holder else 1.0)),)
+    if left_cell is not None:
+        said.append(f"the finish simulated on {left_cell:g} mm cells")
+        paces += estimate.left_paces(bounds, left_cell, cut, cutter)
+    return Work(count, "CC points", passes, cut, note=f"({'; '.join(said)})", paces=paces)
 
 
 def _segments(plan: AdaptivePlan, zigzag: bool) -> list[CutSegment]:
