@@ -9,6 +9,7 @@ from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import link
 from tmm_workbench.core.strategies.mesh5 import finish
+from tmm_workbench.core.strategies.mesh5.estimate import surface_sample
 from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
 from tmm_workbench.core.strategies.mesh5.tool_moves import OVERRUN_STEPS
 from tmm_workbench.core.strategies.multipoint import link_policy
@@ -19,10 +20,15 @@ TOL, SAFE, CLEAR, RETRACT = 0.05, 70.0, 80.0, 5.0
 PARAMS = dict(tolerance=TOL, tilt_max_deg=24.0, yaw_limit_deg=30.0, forward_step=3.0)
 
 
+def _cylinder():
+    """A convex cylinder patch (radius 60 mm, axis along the feed +X)."""
+    return grid_mesh(lambda x, y: np.sqrt(60.0 ** 2 - y * y), 8, 48, (-12, -12, 12, 12), "cylinder")
+
+
 @pytest.fixture(scope="module")
 def linked():
-    """A convex cylinder patch (radius 60 mm, axis along the feed +X) finished with a flat D 10."""
-    mesh = grid_mesh(lambda x, y: np.sqrt(60.0 ** 2 - y * y), 8, 48, (-12, -12, 12, 12), "cylinder")
+    """The convex cylinder patch finished with a flat D 10."""
+    mesh = _cylinder()
     cutter = Cutter.flat(10.0)
     result = finish.compute(mesh, cutter, Mesh5Params(**PARAMS))
     return result, link(result.segments, link_policy(cutter, SAFE, CLEAR, RETRACT)), cutter
@@ -125,6 +131,37 @@ def test_work_is_estimated_from_the_box_alone():
     more = finish.estimate_work(held, Cutter.flat(10.0), (-12, -12, 0, 12, 12, 60))
     assert more.count == work.count and dict(more.paces)["mesh5"] == finish.HOLDER_COST * dict(work.paces)["mesh5"]
     assert "shank and holder" in more.note
+
+
+def _told(mesh, cutter, **values):
+    """The estimate's passes from the model's needle sample (mesh5.estimate.surface_sample)."""
+    lo, hi = mesh.bounds
+    return finish.estimate_work(Mesh5Params(**PARAMS), cutter, (*lo, *hi), surface_sample(mesh), **values)
+
+
+def test_the_passes_are_told_from_the_tilted_cutters_width_over_the_models_curvature(linked):
+    # the convex cylinder (the module's) and one concave across the feed: within 1.5x of the plan's passes,
+    # where the box alone tells passes a quarter diameter apart (the upper bound the limits refuse on)
+    result, _, cutter = linked
+    planned = result.diagnostics["passes"]
+    assert planned / 1.5 <= _told(_cylinder(), cutter).passes <= planned * 1.5
+    valley = grid_mesh(lambda x, y: 80.0 - np.sqrt(80.0 ** 2 - y * y), 8, 48, (-12, -20, 12, 20), "valley")
+    told = _told(valley, cutter).passes
+    planned = finish.compute(valley, cutter, Mesh5Params(**PARAMS)).diagnostics["passes"]
+    assert planned / 1.5 <= told <= planned * 1.5
+    box = finish.estimate_work(Mesh5Params(**PARAMS), cutter, (*valley.bounds[0], *valley.bounds[1]))
+    assert box.passes > told and "at most" in box.note
+
+
+def test_the_estimate_counts_the_simulation_of_what_is_left_and_still_refuses_before_allocating():
+    mesh = grid_mesh(lambda x, y: 0.01 * x * x, 6, 6, (0, 0, 50, 50), "bowl")
+    plain, checked = _told(mesh, Cutter.flat(10.0)), _told(mesh, Cutter.flat(10.0), left_cell=0.25)
+    assert checked.count == plain.count and dict(checked.paces)["mesh5_left_cells"] == pytest.approx(52 * 52 / 0.0625)
+    assert dict(checked.paces)["mesh5_left_cut"] > 0 and "simulated on 0.25 mm cells" in checked.note
+    # the limits refuse on the box's upper bound, before any sample or C-space counts
+    with pytest.raises(TmmError, match="CC points"):
+        finish.estimate_work(Mesh5Params(forward_step=0.01), Cutter.flat(1.0), (0, 0, 0, 1e5, 1e5, 1),
+                             surface_sample(mesh), left_cell=0.25)
 
 
 def test_progress_is_told_and_a_cancel_stops_the_passes():

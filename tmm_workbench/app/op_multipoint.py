@@ -43,6 +43,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.linking import link
 from tmm_workbench.core.machine import TarusMachine
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.strategies import multipoint
 from tmm_workbench.core.strategies.multipoint import (STATUS_FAILED, MultipointParams, MultipointResults,
                                                       face_top)
@@ -181,11 +182,9 @@ def spacing_warnings(params: MultipointParams, cutter: Any, placement: Any) -> l
                    f"(tolerance {params.scallop:g} mm)")
         areas = placement.unreached
         if areas:
-            xy = np.vstack([a.outline for a in areas])
-            (x0, y0), (x1, y1) = xy.min(0), xy.max(0)
-            out.append(f"the scallop {params.scallop:g} mm is not held on {len(areas)} areas (within x {x0:.4g}.."
-                       f"{x1:.4g}, y {y0:.4g}..{y1:.4g} mm), up to {max(a.height for a in areas):.4g} mm above the "
-                       "face: machined as reached (the report view lists them)")
+            out.append(f"the scallop {params.scallop:g} mm is not held on {len(areas)} areas "
+                       f"({within(np.vstack([a.outline for a in areas]))}), up to {max(a.height for a in areas):.4g} "
+                       "mm above the face: machined as reached (the report view lists them)")
     return out
 
 
@@ -203,9 +202,7 @@ def unreached_warning(res: MultipointResults) -> str:
     failed = res.xy[res.status == STATUS_FAILED]
     if not len(failed):
         return ""
-    (x0, y0), (x1, y1) = failed.min(0), failed.max(0)
-    return (f"{len(failed)} footprint points have no tool position and are not machined (within x {x0:.4g}.."
-            f"{x1:.4g}, y {y0:.4g}..{y1:.4g} mm)")
+    return f"{len(failed)} footprint points have no tool position and are not machined ({within(failed)})"
 
 
 def summary(res: MultipointResults) -> str:

@@ -34,7 +34,10 @@ EXTRA_SPECS: dict[str, Spec] = {
 # of the runs that benchmarks/compute_estimate.py measured; a machine to itself computes up to ~2x faster)
 PACE = {"surface": 2e-5, "adaptive": 7e-5, "surface_flat_cusp": 4e-5, "offset3d": 5e-4, "verify": 4e-6,
         "waterline": 2e-5, "roughing": 1.5e-5, "multipoint": 2.4e-3, "multipoint_scallop": 0.025,
-        "mesh5": 0.1}   # a CC point's C-space and its rebuilds (docs/mesh5.md, the cylinder of its tests)
+        # a CC point's C-space and its rebuilds (seed 000's convex and concave finishes at 0.004 in: 0.022 and
+        # 0.029 s per CC point cut, load 9), and the simulation of what the finish leaves (SimulateLeft: per cell
+        # of its grid, and per mm cut over the cells under the tool; docs/mesh5.md "The op's estimate")
+        "mesh5": 0.025, "mesh5_left_cells": 2e-6, "mesh5_left_cut": 8e-7}
 TELL_COMPUTE_S = 5.0    # the panel's estimate names the compute time from here
 LONG_COMPUTE_S = 30.0   # the op says so before it starts (console), with how to cancel
 # a side of a range the params leave open, for the panel's minimum / maximum
@@ -353,12 +356,25 @@ def multipoint(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) ->
 
 
 def mesh5(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inputs:
-    """5-axis mesh finishing's params over the model's box (its CC points: passes a quarter diameter apart), with
-    the op's tool assembly (its holder makes every C-space dearer)."""
+    """5-axis mesh finishing's params over the model's box, with the op's tool assembly (its holder makes every
+    C-space dearer), the model's needle sample when the model is at hand (its passes told from the tilted
+    cutter's width over its slopes; else at most a quarter diameter apart), and the cells of the simulation of
+    what the finish leaves (SimulateLeft)."""
     from tmm_workbench.app import tool_assembly
+    from tmm_workbench.core.strategies.mesh5 import cleanup, estimate
 
     b = model_bounds(proxy, obj, load_stl)
-    return None if b is None else (_params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b)
+    if b is None:
+        return None
+    mesh = _mesh_at_hand(proxy, obj, load_stl)
+    if mesh is not None and (not _needles or _needles[0] is not mesh):
+        _needles[:] = [mesh, estimate.surface_sample(mesh)]
+    left = cleanup.MAX_CELL if getattr(obj, "SimulateLeft", False) else None
+    return (_params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b,
+            _needles[1] if mesh is not None else None, left)
+
+
+_needles: list[Any] = []   # [mesh, its needle sample]: the last model's (the panel asks on every value entered)
 
 
 def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> Estimate:

@@ -23,6 +23,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.assembly import ToolAssembly
@@ -81,10 +82,9 @@ class HolderReport:
             return f"the shank and holder keep their clearance everywhere ({self.points} points checked)"
         what = "raised" if self.mode == LIFT else "left out"
         by = ", ".join(f"{p} {n}" for p, n in sorted(self.pieces.items()))
-        x0, y0, x1, y1 = self.region
         text = (f"{self.affected} of {self.points} points {what} where the shank or holder would come closer than "
-                f"its clearance ({by}; up to {self.max_lift:.3f} mm), within x {x0:.1f}..{x1:.1f}, "
-                f"y {y0:.1f}..{y1:.1f} mm: material is left there")
+                f"its clearance ({by}; up to {self.max_lift:.3f} mm), "
+                f"{within(np.reshape(self.region, (2, 2)))}: material is left there")
         if self.stick_out is not None:
             text += f"; {self.stick_out.summary()}"
         return text + (f" ({self.note})" if self.note else "")

@@ -34,6 +34,7 @@ from tmm_workbench.core.geometry.bezier import grid_triangles
 from tmm_workbench.core.geometry.face import BezierFace
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop_assembly import body_pieces
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.strategies.multipoint_status import STATUS_FAILED, STATUS_ONE
 from tmm_workbench.core.toolpath import MoveKind, Toolpath
 from tmm_workbench.core.verify.body_distance import SurfacePoints
@@ -136,9 +137,8 @@ class MultipointHolderReport:
         if self.inserted:
             parts.append(f"{self.inserted} positions inserted on moves")
         if len(self.unreachable):
-            x0, y0, x1, y1 = self.region
             parts.append(f"{len(self.unreachable)} positions unreachable ({'no tilt within the limits clears them' if self.mode == TILT else 'left out'}), "
-                         f"within x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} mm: not cut, the pass split there")
+                         f"{within(np.reshape(self.region, (2, 2)))}: not cut, the pass split there")
         if self.split_moves:
             parts.append(f"{self.split_moves} moves between positions left out (the pass split there)")
         if not self.pieces and not self.split_moves:

@@ -31,8 +31,10 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.params import StrategyParams, param
+from tmm_workbench.core.query.height_sample import HeightSample
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment, StrategyResult
-from tmm_workbench.core.strategies.mesh5 import holder
+from tmm_workbench.core.strategies.mesh5 import estimate, holder
 from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths, plane_normal
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan, adaptive_passes
@@ -118,19 +120,35 @@ def _extents(lo: np.ndarray, hi: np.ndarray, params: Mesh5Params) -> tuple[float
     return float(np.ptp(corners @ m)), float(np.ptp(corners @ d))
 
 
-def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box) -> Work:
-    """The CC points over the model's box `bounds` (core.work); each costs a C-space and its rebuilds (with
-    params.assembly, HOLDER_COST times as much)."""
+def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box, sample: Optional[HeightSample] = None,
+                  left_cell: Optional[float] = None) -> Work:
+    """The CC points over the model's box `bounds` (core.work), refused above the limits on the upper bound
+    (count_points); each costs a C-space and its rebuilds (with params.assembly, HOLDER_COST times as much).
+    `sample`: the model's needle heights (estimate.surface_sample): the passes from the tilted cutter's width
+    over its slopes (mesh5.estimate), else the upper bound's. `left_cell`: the op simulates what the finish leaves
+    on cells of this size (SimulateLeft; mesh5.cleanup.left_above), its compute counted too."""
     params.validate()
     check_tool(cutter)
     across, along = _extents(np.array(bounds[:3]), np.array(bounds[3:]), params)
     count, passes = count_points(across, along, params, cutter)
+    told = None if sample is None else estimate.predict_passes(
+        sample, cutter, params.tolerance, params.feed_angle_deg, (params.tilt_min_deg, params.tilt_max_deg))
+    climb = 1.0
+    if told is not None:
+        climb = estimate.climb(sample, params.feed_angle_deg)
+        passes, count = told, told * (climb * along / params.forward_step + 2)
     cells = params.grid().shape
     holder = params.assembly is not None
-    return Work(count, "CC points", passes, passes * along,
-                note=f"a C-space of {cells[0] * cells[1]} postures at each" + (
-                    f", the shank and holder in it (about {HOLDER_COST:g}x the compute)" if holder else ""),
-                paces=(("mesh5", count * (HOLDER_COST if holder else 1.0)),))
+    cut = passes * along * climb
+    said = ["passes told from the tilted cutter's width over the model's curvature" if told is not None else
+            "at most: passes a quarter diameter apart (the model not at hand)",
+            f"a C-space of {cells[0] * cells[1]} postures at each" + (
+                f", the shank and holder in it (about {HOLDER_COST:g}x the compute)" if holder else "")]
+    paces = (("mesh5", count * (HOLDER_COST if holder else 1.0)),)
+    if left_cell is not None:
+        said.append(f"the finish simulated on {left_cell:g} mm cells")
+        paces += estimate.left_paces(bounds, left_cell, cut, cutter)
+    return Work(count, "CC points", passes, cut, note=f"({'; '.join(said)})", paces=paces)
 
 
 def _segments(plan: AdaptivePlan, zigzag: bool) -> list[CutSegment]:
@@ -225,9 +243,8 @@ def report(diagnostics: dict) -> str:
     if len(plan.unfinished):
         marks = diagnostics["cleanup_points"]
         xy = marks[:, :2] if len(marks) else diagnostics["strip_corners"].reshape(-1, 2)
-        (x0, y0), (x1, y1) = xy.min(0), xy.max(0)
         text += (f"; {len(empty)} CC points with an empty C-space (no posture finishes them within the tolerance) "
-                 f"in {len(plan.unfinished)} strips, within x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: not "
+                 f"in {len(plan.unfinished)} strips, {within(xy)}: not "
                  f"finished, marked for clean-up ({len(marks)} points on the mesh)")
     for key in ("left", "holder", "links"):
         if key in diagnostics:

@@ -25,6 +25,7 @@ from typing import List, Optional
 import numpy as np
 
 from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.stepover import AdaptivePlan
@@ -66,10 +67,9 @@ class HolderNote:
             text += (f"; at {len(self.tilted)} of {self.cc_points} CC points they block the upright posture and the "
                      f"tool tilts away (up to {self.most_tilt_deg:.0f} deg from the normal)")
         if len(self.left_out):
-            (x0, y0, _), (x1, y1, _) = self.left_out.min(0), self.left_out.max(0)
             pieces = ", ".join(f"{p} {n}" for p, n in self.pieces.items())
             text += (f"; {len(self.left_out)} moves left out where they would come closer than the clearance "
-                     f"({pieces} samples), within x {x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: not cut there")
+                     f"({pieces} samples), {within(self.left_out)}: not cut there")
         return text + f"; checked along the cut moves: {self.samples} positions"
 
 
@@ -147,9 +147,8 @@ class LinkNote:
             text += (f", {len(self.raised)} passes left and entered along the tool axis up to the transit height "
                      f"(straight up the shank or holder came closer than the clearance)")
         if len(self.blocked):
-            (x0, y0, _), (x1, y1, _) = self.blocked.min(0), self.blocked.max(0)
-            text += (f"; {len(self.blocked)} still closer than the clearance along the axis too, within x "
-                     f"{x0:.4g}..{x1:.4g}, y {y0:.4g}..{y1:.4g} mm: check them")
+            text += (f"; {len(self.blocked)} still closer than the clearance along the axis too, "
+                     f"{within(self.blocked)}: check them")
         return text
 
 

@@ -24,6 +24,7 @@ from tmm_workbench.core import cancel, polygons
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
+from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.sim.cusp_field import (STOCK_ABOVE_MM, CuspField, field_of, grid_envelope, measure_grid,
@@ -70,9 +71,8 @@ class CuspCheck:
             return (f"cusp check {self.tolerance:g} mm: held on all {self.measured} measured cells "
                     f"(largest {self.max_cusp:.4f} mm, {self.cell:.3g} mm cells{coarse})")
         where = "; ".join(f"({x:.1f}, {y:.1f}) {c:.4f} mm" for x, y, c, _ in self.places)
-        x0, y0, x1, y1 = self.box
         return (f"cusp check {self.tolerance:g} mm: {self.exceeding} of {self.measured} measured {self.cell:.3g} mm "
-                f"cells above it, up to {self.max_cusp:.4f} mm, within x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} mm; "
+                f"cells above it, up to {self.max_cusp:.4f} mm, {within(np.reshape(self.box, (2, 2)))}; "
                 f"worst at {where}" + (" (after VerifyCusp's rounds)" if self.verified else
                                        f". VerifyCusp adds partial passes there{coarse}"))
 

@@ -1,0 +1,120 @@
+"""The work of a 5-axis mesh finish told before it runs (core.work): the passes from the tilted cutter's effective
+width at the tolerance over the surface's slopes and curvatures, the CC points they hold, and the simulation of
+what the finish leaves (the op's SimulateLeft).
+
+Width. Where the tool's bottom stands on the surface at a lead tilt lambda (from the normal, along the feed), its
+effective cutting profile across the feed is the bottom's ellipse, curving up as sin(lambda) / R; the surface's
+section across curves up (concave) or down (convex) as kappa. The remaining height at y across is about
+(sin(lambda) / R - kappa) y^2 / 2 (seed 000 eq. 3.22-3.33 for the flat end mill, to second order), so the half
+width within the tolerance is sqrt(2 tau / (sin(lambda) / R - kappa)), at most R (the profile's end). The lead
+tilt is the least one that keeps the bottom's heel (2 R behind its lowest point) off a surface curving up along
+the feed (sin(lambda) >= R kappa_f) and its sides off one curving up across (sin(lambda) >= R kappa), within the
+tilt limits. The width across, seen from above, is the width on the surface x cos(slope across).
+
+Passes. A pass is as wide as its narrowest place along the feed (the plan advances each pass by the least level
+it finishes along it); the planes are placed across the model as the step-over places them (predict_passes),
+from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model).
+"""
+from __future__ import annotations
+
+import math
+from typing import Any, Optional
+
+import numpy as np
+
+from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.query.height_sample import CELLS, HeightSample
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies.mesh5.stepover import MARGIN
+from tmm_workbench.core.tools.cutter import Cutter
+
+GROWTH = 1.1    # the step-over asks this much more of each next pass while they meet it
+
+
+def surface_sample(mesh: TriMesh, cells: int = CELLS) -> HeightSample:
+    """The model's heights on a grid of `cells` nodes along its box's longer side (a needle drop: NaN off it)."""
+    lo, hi = mesh.bounds
+    step = max(float(hi[0] - lo[0]), float(hi[1] - lo[1]), 1e-6) / max(cells - 1, 1)
+    grid = Grid.covering(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), step)
+    return HeightSample(grid.xs(), grid.ys(), mesh_heights(mesh, grid))
+
+
+def lead_tilt(cutter: Cutter, along: np.ndarray, across: np.ndarray, tilt_deg: tuple[float, float]) -> np.ndarray:
+    """sin of the least lead tilt at each node: the bottom's heel clear of the section along the feed curving up
+    (curvature `along`, 1/mm, > 0 concave) and its sides of the one across (`across`), within `tilt_deg`."""
+    lo, hi = (math.sin(math.radians(t)) for t in tilt_deg)
+    need = cutter.radius * np.maximum(along, across)
+    return np.clip(need, lo, hi)
+
+
+def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
+                tilt_deg: tuple[float, float]) -> np.ndarray:
+    """(ny, nx) the width across the feed, seen from above, that one pass finishes within `tolerance` at each
+    node (module doc; NaN off the model and at its rim)."""
+    _, slope = sample.slopes(feed_angle_deg)
+    across = sample.curvature(feed_angle_deg)            # the section across the passes
+    along = sample.curvature(feed_angle_deg - 90.0)      # the section along the feed
+    sin_lead = lead_tilt(cutter, along, across, tilt_deg)
+    bend = sin_lead / cutter.radius - across             # the profile over the section, per y^2 / 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        wide = np.where(np.isnan(bend), np.nan, np.inf)       # off the model / no curvature left to bound it
+        half = np.where(bend > 0, np.sqrt(2.0 * MARGIN * tolerance / bend), wide)
+    return 2.0 * np.minimum(half, cutter.radius) / np.sqrt(1.0 + slope * slope)
+
+
+def least_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
+                 tilt_deg: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """(m, w): the sample's nodes binned across the feed (m, mm along the drive planes' normal, a node step
+    apart) and the least width one pass finishes in each bin (module doc); empty where none is known."""
+    w = pass_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
+    ok = np.isfinite(w)
+    if not ok.any():
+        return np.zeros(0), np.zeros(0)
+    a = math.radians(feed_angle_deg)
+    X, Y = np.meshgrid(sample.xs, sample.ys)
+    m = (-X * math.sin(a) + Y * math.cos(a))[ok]
+    step = max(sample.step, 1e-9)
+    bins = np.floor((m - m.min()) / step).astype(np.int64)
+    least = np.full(int(bins.max()) + 1, np.inf)
+    np.minimum.at(least, bins, w[ok])
+    keep = np.isfinite(least)
+    return (m.min() + step * (np.arange(len(least)) + 0.5))[keep], least[keep]
+
+
+def predict_passes(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
+                   tilt_deg: tuple[float, float]) -> Optional[int]:
+    """The passes across the sampled model, None when the sample holds no width (a model smaller than its
+    nodes), placed as the step-over places them: the first plane 0.125 D inside its edge, each next one the
+    last one's left half-width beyond it and a gap more, the gap what its right half-width reaches back and at
+    most what the step-over asks (0.25 D first, eq. 3.22-3.23, then GROWTH times the last, up to D)."""
+    m, w = least_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
+    if not len(m):
+        return None
+    edge = 0.5 * max(sample.step, 1e-9)
+    at, end, ask, passes = m[0] - edge + 0.125 * cutter.diameter, m[-1] + edge, 0.25 * cutter.diameter, 1
+    while at + 0.5 * float(np.interp(at, m, w)) < end:
+        half = 0.5 * float(np.interp(at, m, w))
+        at += half + min(ask, half)
+        ask = min(GROWTH * ask, cutter.diameter)
+        passes += 1
+    return passes
+
+
+def climb(sample: HeightSample, feed_angle_deg: float) -> float:
+    """How much longer the passes are on the model than seen from above (the mean of 1 / cos(slope along))."""
+    along, _ = sample.slopes(feed_angle_deg)
+    ok = np.isfinite(along)
+    return float(np.mean(np.sqrt(1.0 + along[ok] ** 2))) if ok.any() else 1.0
+
+
+def left_cells(bounds: Any, cell: float) -> float:
+    """The cells of the simulation of what the finish leaves (mesh5.cleanup.cleanup_grid: the box and 1 mm)."""
+    return (float(bounds[3] - bounds[0]) + 2.0) * (float(bounds[4] - bounds[1]) + 2.0) / (cell * cell)
+
+
+def left_paces(bounds: Any, cell: float, cut_length: float, cutter: Cutter) -> tuple[tuple[str, float], ...]:
+    """The compute of the simulation of what the finish leaves (mesh5.cleanup.left_above) as pace rows
+    (core.work): the design's heights per cell, and the cut per mm travelled over the cells under the tool."""
+    return (("mesh5_left_cells", left_cells(bounds, cell)),
+            ("mesh5_left_cut", cut_length * (cutter.diameter / cell) ** 2))
