@@ -175,8 +175,8 @@ def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Op
             notes.append(f"{tool.name}: {exc}")
             continue
         if est.blocked:
-            notes.append(f"{tool.name}: at {est.blocked} of {est.probed} probed CC points no tilt clears the mesh "
-                         "(the op may leave them for clean-up: not the same finish)")
+            notes.append(f"{tool.name}: at {est.blocked} of {est.probed} probed CC points no tilt clears the mesh and "
+                         "finishes it within the cusp (the op may leave them for clean-up: not the same finish)")
             continue
         timed.append((est.seconds, est.passes, tool))
     if not timed:

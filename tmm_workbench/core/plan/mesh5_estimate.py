@@ -15,8 +15,8 @@ beyond the last (read from the nearest probe plane) until a half step reaches th
 Time. Those planes are cut into CC paths, the tool placed at the probes' most common tilt (lift 0), each path
 with a radius of overrun at both ends, zig-zag, linked as the op links (multipoint.link_policy), and the result
 timed by the Tarus post (core.post.tarus_writer: the joint speeds, A and C planned, the feeds of the materials
-table), as the real op is. A probe CC point where no probed tilt clears the mesh is counted (`blocked`): the op may
-find a yawed posture there, or leave it for clean-up.
+table), as the real op is. A probe CC point where no probed tilt clears the mesh and finishes it within the tolerance
+is counted (`blocked`): the op may find a yawed posture there, or leave it for clean-up.
 """
 from __future__ import annotations
 
@@ -43,7 +43,7 @@ OVERRUN_STEPS = 3
 @dataclass(frozen=True)
 class Mesh5Estimate:
     """The estimate: cycle time s (the Tarus post's), passes, cut length mm, the tilt placed (deg), the probe
-    CC points and those no probed tilt clears."""
+    CC points and those no probed tilt finishes (blocked)."""
     seconds: float
     passes: int
     length: float
@@ -54,23 +54,26 @@ class Mesh5Estimate:
 
 def half_steps(reach: MeshReach, cutter: Cutter, params: finish.Mesh5Params, points: np.ndarray,
                frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(half step along the plane normal mm (n,), best tilt rad (n,)) of n CC points: the best of the grid's
-    TILTS least tilts (module doc); 0 and NaN where none clears the mesh within a radius."""
+    """(half step mm (n,), best tilt rad (n,)) of n CC points: the best of the grid's TILTS least tilts (module
+    doc), each next tilt measured only where the last one widened the step or had none (the step grows with the
+    tilt where a flatter tool gouges and must be lifted, then narrows: the profile curves more); 0 and NaN where
+    none clears the mesh within a radius or finishes within the tolerance."""
     lam = params.grid().lambdas[:TILTS]
-    omg = np.zeros_like(lam)
-    lift = lifts(reach, cutter, points, frames, lam, omg, cutter.radius)          # (n, TILTS), inf: blocked
+    lift = lifts(reach, cutter, points, frames, lam, np.zeros_like(lam), cutter.radius)   # (n, TILTS), inf: blocked
     best, tilt = np.zeros(len(points)), np.full(len(points), np.nan)
+    growing = np.ones(len(points), dtype=bool)
     for k, lam_k in enumerate(lam):
-        ok = np.isfinite(lift[:, k])
-        if not ok.any():
+        ask = np.flatnonzero(growing & np.isfinite(lift[:, k]))
+        growing[:] = ~np.isfinite(lift[:, k]) & growing    # a blocked tilt: the next may clear
+        if ask.size == 0:
             continue
-        n = int(ok.sum())
-        w, _ = half_widths(reach, cutter, points[ok], frames[ok], np.full(n, lam_k), np.zeros(n), lift[ok, k],
+        n = len(ask)
+        w, _ = half_widths(reach, cutter, points[ask], frames[ask], np.full(n, lam_k), np.zeros(n), lift[ask, k],
                            MARGIN * params.tolerance)
         w = np.where(np.isinf(w), 2.0 * cutter.radius, w).min(axis=1)      # inf: the mesh ends first
-        better = w > best[ok]
-        idx = np.flatnonzero(ok)[better]
-        best[idx], tilt[idx] = w[better], lam_k
+        wider = w > best[ask]
+        best[ask[wider]], tilt[ask[wider]] = w[wider], lam_k
+        growing[ask[wider | (w <= 0.0)]] = True            # none yet at this tilt: the next may have one
     return best, tilt
 
 
