@@ -105,9 +105,9 @@ class PlanTarus(FreeCADTestCase):
 
     def test_tmm_auto_falls_back_when_not_verified(self) -> None:
         """TMM Auto (plan_object) with the Tarus recipe and planner.five_axis: always on a 25 x 27 mm piece of the
-        window, its 5-axis op planned with a 0.5 mm scallop (mesh5_args patched): the Job does not verify, the
-        3-axis plan is made instead in the model's document with nothing of the 5-axis Job left, the reason in
-        the report."""
+        window, the first verification (the 5-axis Job's) made to fail with a gouge (injected: the op itself
+        verifies): the 3-axis plan is made instead in the model's document with nothing of the 5-axis Job left,
+        verified, the reason in the report."""
         import FreeCAD
         import Mesh
 
@@ -128,15 +128,24 @@ class PlanTarus(FreeCADTestCase):
         doc.recompute()
         data = recipes.job_data("modelling_foam", "draft", "Tarus 5-axis", "", str(folder / "out"), "piece")
         data["planner"]["five_axis"] = "always"
-        args = five_axis.mesh5_args
-        five_axis.mesh5_args = lambda job, tool: args(job, tool) | {"tolerance": 0.5}
+        verify, seen = plan_run.verify, []
+
+        def first_gouges(results, plan, where, progress=False):
+            report = verify(results, plan, where, progress)
+            seen.append([r.op.Label for r in results])
+            if len(seen) == 1:
+                report.update(passed=False, gouged=True, problems=["gouged 0.5000 mm below the model (injected)"])
+            return report
+
+        plan_run.verify = first_gouges
         try:
             job, report = plan_run.plan_object(model, data, progress=False)
         finally:
-            five_axis.mesh5_args = args
+            plan_run.verify = verify
+        self.assertTrue(any(label.startswith(five_axis.LABEL) for label in seen[0]), seen)
         verified = report["verification"]
         self.assertTrue(report["passed"], report["problems"])
-        self.assertIn("did not verify", verified["five_axis_fallback"])
+        self.assertIn("did not verify: gouged 0.5000 mm", verified["five_axis_fallback"])
         labels = [op.Label for op in job.Operations.Group]
         self.assertFalse(any(label.startswith(five_axis.LABEL) for label in labels), labels)
         self.assertTrue(any(label.startswith("Finish") for label in labels), labels)
