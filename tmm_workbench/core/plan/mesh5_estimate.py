@@ -22,10 +22,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.machine.tarus import TarusMachine
+from tmm_workbench.core.post import ToolInfo
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.mesh5 import finish
 from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths, plane_normal
@@ -96,8 +99,7 @@ def plane_offsets(probes: np.ndarray, steps: np.ndarray, lo: float, hi: float, r
     return np.array(out)
 
 
-def segments(reach: MeshReach, mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, offsets: np.ndarray,
-             tilt: float) -> list:
+def segments(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, offsets: np.ndarray, tilt: float) -> list:
     """The estimated passes as cut segments (tips and axes at `tilt` rad along the feed, a radius of overrun at
     both ends, every other pass reversed)."""
     out = []
@@ -119,13 +121,12 @@ def segments(reach: MeshReach, mesh: TriMesh, cutter: Cutter, params: finish.Mes
     return out
 
 
-def estimate(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, tool_info, feed: float, plunge: float,
-             machine=None) -> Mesh5Estimate:
+def estimate(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, tool_info: ToolInfo, feed: float,
+             plunge: float, machine: Optional[TarusMachine] = None) -> Mesh5Estimate:
     """The op's cycle time and passes, estimated (module doc); `tool_info` (core.post.ToolInfo) and the feeds
     (mm/s) as the post gets them. TmmError where the op refuses the tool, the tilts or the work."""
     from tmm_workbench.core import path5
     from tmm_workbench.core.linking import link
-    from tmm_workbench.core.machine.tarus import TarusMachine
     from tmm_workbench.core.post import Operation
     from tmm_workbench.core.post.tarus_writer import write_tarus
     from tmm_workbench.core.strategies.multipoint import link_policy
@@ -158,7 +159,7 @@ def estimate(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, tool_inf
     offsets = plane_offsets(probes, steps, lo, hi, cutter.radius)
     values, counts = np.unique(np.round(tilts, 9), return_counts=True)
     tilt = float(values[np.argmax(counts)]) if len(values) else 0.0
-    segs = segments(reach, mesh, cutter, params, offsets, tilt)
+    segs = segments(mesh, cutter, params, offsets, tilt)
     top = float(hi_box[2])
     tp = link(segs, link_policy(cutter, top + 5.0, top + 10.0, 5.0))
     program = [tool_info, Operation("estimate", path5.encode_toolpath(tp, feed, plunge), "Flood")]
