@@ -126,8 +126,18 @@ def test_five_axis_pays_on_the_convex_window(tmp_path: Path) -> None:
         assert f"{minutes:.2f}" in decision.reason
     doc = launch.plan_document(job, plan, job.model.file)
     assert doc["five_axis"]["fallback_ops"][1]["label"] == fallback[1] and doc["apt_cl"] is True
+    # after the Job's run: the built op's simulated time beside the estimate, said when it is slower than the
+    # 3-axis estimate
+    for built, slower in ((choice.seconds_5axis * 1.1, False), (choice.seconds_3axis + 1.0, True)):
+        verified = {"ops": [{"label": labels[0], "cycle_seconds": 60.0}, {"label": op.label, "cycle_seconds": built}]}
+        five_axis.after_run(plan, verified)
+        row = verified["five_axis"]
+        assert (row["built_seconds"], row["slower_than_three_axis"]) == (round(built, 1), slower)
+        assert plan.decisions[-1].choice == ("built: slower than the 3-axis estimate" if slower else "built")
+        assert f"{built / 60:.2f} min as built" in plan.decisions[-1].reason
+    assert choice.as_dict()["built_seconds"] == round(built, 1)
     # the FreeCAD side's fallback: the 3-axis ops back, the reason written
-    five_axis.fallen_back(plan, choice, "did not verify: gouged")
+    five_axis.after_run(plan, {"five_axis_fallback": "did not verify: gouged", "ops": []})
     assert [o.label for o in plan.ops] == fallback
     assert plan.decisions[-1].choice == "fell back to the 3-axis plan" and "gouged" in plan.decisions[-1].reason
 
@@ -157,3 +167,17 @@ def test_a_small_flat_end_does_not_pay(tmp_path: Path) -> None:
     minutes = [float(m) for m in re.findall(r"(\d+\.\d\d) min", d.reason)]
     assert d.choice == "none" and d.reason.startswith("it does not pay") and "T1 flat D2" in d.reason
     assert minutes[0] > minutes[-1]   # the 5-axis time first, the 3-axis finishing's sum last
+
+
+def test_always_takes_the_slower_five_axis_finish(tmp_path: Path) -> None:
+    """planner.five_axis: always with the flat D2 that does not pay: the 5-axis op goes in all the same, slower
+    than the 3-axis estimate, the reason says why."""
+    data = tarus(tmp_path)
+    data["tools"][0].update(name="T1 flat D2", diameter=2)
+    data["planner"]["five_axis"] = "always"
+    _, _, _, plan = launch.make_plan(job_of(tmp_path, data))
+    choice = plan.five_axis
+    assert choice is not None and choice.seconds_5axis > choice.seconds_3axis
+    assert [op.label for op in plan.ops][-1] == "Finish 5-axis T1 flat D2"
+    (d,) = [d for d in plan.decisions if d.topic == five_axis.TOPIC]
+    assert d.reason.startswith("planner.five_axis: always") and f"{choice.seconds_5axis / 60:.2f}" in d.reason

@@ -2,7 +2,8 @@
 plan's 5-axis mesh op run in the Job after the roughing, the whole Job posted by the Tarus post (and the APT CL
 post), simulated (the 5-axis stock simulation) and verified; its simulated cycle time near the planner's estimate;
 the report and page with the decision. Then the 5-axis op made to fail (a tilt beyond the machine's C range): the
-3-axis plan it replaced is run instead, verified, and the reason reported. About 40 s on FreeCAD 0.20."""
+3-axis plan it replaced is run instead, verified, and the reason reported; and TMM Auto (plan_object) on a piece
+of the window whose 5-axis op does not verify falls back the same way in the model's document."""
 from __future__ import annotations
 
 import json
@@ -11,6 +12,8 @@ import re
 import shutil
 from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from fc_helpers import OUT, FreeCADTestCase, close_all
 from tmm_workbench.app import plan_five, plan_run
@@ -45,10 +48,14 @@ class PlanTarus(FreeCADTestCase):
         self.assertLess(verified["deepest_gouge_mm"], job.finish.tolerance)
         five = verified["ops"][1]
         self.assertTrue(five["label"].startswith(five_axis.LABEL))
-        # the simulation times the op by the Tarus post, as the planner's estimate did (its own path, the same
-        # strategy and settings)
-        self.assertLess(abs(five["cycle_seconds"] - choice.seconds_5axis), 0.2 * choice.seconds_5axis)
-        self.assertLess(five["cycle_seconds"], choice.seconds_3axis)
+        # the simulation times the op by the Tarus post, as the planner's estimate does with the estimated passes
+        # (it runs low: the op's postures turn A more at the links; core.plan.mesh5_estimate)
+        sim = five["cycle_seconds"]
+        self.assertTrue(-0.35 * sim < choice.seconds_5axis - sim < 0.1 * sim, (choice.seconds_5axis, sim))
+        self.assertLess(sim, choice.seconds_3axis)
+        five_axis.after_run(plan, verified)   # the built op's time beside the estimate
+        self.assertEqual(verified["five_axis"]["built_seconds"], sim)
+        self.assertFalse(verified["five_axis"]["slower_than_three_axis"])
         # the whole Job through the Tarus post: joints, the head tilted in the 5-axis op, upright in the roughing
         gcode = (folder / "seed000_convex_window.ngc").read_text()
         self.assertIn("(TMM Tarus post", gcode)
@@ -72,6 +79,7 @@ class PlanTarus(FreeCADTestCase):
         page = (out / "report.html").read_text()
         self.assertIn("5-axis finishing", page)
         self.assertIn(f"{choice.seconds_5axis / 60:.2f} min", page)
+        self.assertIn(f"{sim / 60:.2f} min as built", page)
         close_all()
 
     def test_failing_five_axis_op_falls_back(self) -> None:
@@ -93,4 +101,58 @@ class PlanTarus(FreeCADTestCase):
         five_axis.fallen_back(plan, plan.five_axis, verified["five_axis_fallback"])
         self.assertEqual([op.label for op in plan.ops], fallback)
         self.assertIn("(TMM Tarus post", (folder / "seed000_convex_window.ngc").read_text())
+        close_all()
+
+    def test_tmm_auto_falls_back_when_not_verified(self) -> None:
+        """TMM Auto (plan_object) with the Tarus recipe and planner.five_axis: always on a 25 x 27 mm piece of the
+        window, the first verification (the 5-axis Job's) made to fail with a gouge (injected: the op itself
+        verifies): the 3-axis plan is made instead in the model's document with nothing of the 5-axis Job left,
+        verified, the reason in the report."""
+        import FreeCAD
+        import Mesh
+
+        from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
+        from tmm_workbench.core.plan import recipes
+
+        folder = OUT / "plan_tarus_auto"
+        shutil.rmtree(folder, ignore_errors=True)
+        folder.mkdir(parents=True)
+        mesh = load_stl(JOB.parent / "seed000_convex_window.stl")
+        c = mesh.vertices[mesh.triangles].mean(axis=1)
+        keep = mesh.triangles[(c[:, 0] < 127.0) & (c[:, 1] < -6.0)]
+        used, index = np.unique(keep, return_inverse=True)
+        stl = save_stl(TriMesh(mesh.vertices[used], index.reshape(-1, 3), "piece"), folder / "piece.stl")
+        doc = FreeCAD.newDocument("TarusAuto")
+        model = doc.addObject("Mesh::Feature", "Piece")
+        model.Mesh = Mesh.Mesh(str(stl))
+        doc.recompute()
+        data = recipes.job_data("modelling_foam", "draft", "Tarus 5-axis", "", str(folder / "out"), "piece")
+        data["planner"]["five_axis"] = "always"
+        verify, seen = plan_run.verify, []
+
+        def first_gouges(results, plan, where, progress=False):
+            report = verify(results, plan, where, progress)
+            seen.append([r.op.Label for r in results])
+            if len(seen) == 1:
+                report.update(passed=False, gouged=True, problems=["gouged 0.5000 mm below the model (injected)"])
+            return report
+
+        plan_run.verify = first_gouges
+        try:
+            job, report = plan_run.plan_object(model, data, progress=False)
+        finally:
+            plan_run.verify = verify
+        self.assertTrue(any(label.startswith(five_axis.LABEL) for label in seen[0]), seen)
+        verified = report["verification"]
+        self.assertTrue(report["passed"], report["problems"])
+        self.assertIn("did not verify: gouged 0.5000 mm", verified["five_axis_fallback"])
+        labels = [op.Label for op in job.Operations.Group]
+        self.assertFalse(any(label.startswith(five_axis.LABEL) for label in labels), labels)
+        self.assertTrue(any(label.startswith("Finish") for label in labels), labels)
+        jobs = [o for o in doc.Objects if o.TypeId == "Path::FeaturePython" and hasattr(o, "Operations")]
+        self.assertEqual(len(jobs), 1)   # the 5-axis Job removed
+        self.assertFalse(any(o.Label.startswith(five_axis.LABEL) for o in doc.Objects))
+        decisions = [d for d in report["plan"]["decisions"] if d["topic"] == five_axis.TOPIC]
+        self.assertEqual(decisions[-1]["choice"], "fell back to the 3-axis plan")
+        self.assertTrue((folder / "out" / "piece.ngc").is_file())
         close_all()

@@ -7,16 +7,21 @@ post's (3-axis paths post too, the axis vertical); beside it, for the picture, t
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Optional
 
 import FreeCAD
+
+from tmm_workbench.core.errors import Cancelled
 
 PROBLEMS_SHOWN = 3   # of a failed verification, in the fallback's reason
 
 
-def run(plan: dict, folder: Path, run_plan: Callable, model: Any = None, progress: Any = False) -> tuple[list, dict]:
+def run(plan: dict, folder: Path, run_plan: Callable, model: Any = None, progress: Any = False,
+        discard: Optional[Callable[[], None]] = None) -> tuple[list, dict]:
     """`run_plan(plan, folder, model, progress)`, and for a plan with a 5-axis op its 3-axis fallback when the op
-    fails or does not verify; then the tarus extras (post_extras)."""
+    fails or does not verify; then the tarus extras (post_extras). `discard()` removes what the failed 5-axis run
+    added (the GUI's TMM Auto: its objects in the model's document); by default the documents it opened are closed
+    (`tmm plan`: the Job's own document)."""
     choice = plan.get("five_axis")
     if not choice:
         results, report = run_plan(plan, folder, model, progress)
@@ -25,6 +30,8 @@ def run(plan: dict, folder: Path, run_plan: Callable, model: Any = None, progres
     before = set(FreeCAD.listDocuments())
     try:
         results, report = run_plan(plan, folder, model, progress)
+    except Cancelled:
+        raise
     except Exception as exc:  # noqa: BLE001 - any failure of the 5-axis run: the 3-axis plan is the answer
         reason = f"failed: {exc}"
     else:
@@ -32,6 +39,8 @@ def run(plan: dict, folder: Path, run_plan: Callable, model: Any = None, progres
             post_extras(results, plan, folder)
             return results, report
         reason = "did not verify: " + "; ".join(report["problems"][:PROBLEMS_SHOWN])
+    if discard is not None:
+        discard()
     for name in set(FreeCAD.listDocuments()) - before:   # the 5-axis Job's document, made by this run
         FreeCAD.closeDocument(name)
     FreeCAD.Console.PrintWarning(f"{choice['op']} {reason}: the 3-axis plan instead\n")

@@ -278,9 +278,10 @@ def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict
     Returns (the Job, the report). PlanInputError: the recipe refused (its message names the field)."""
     import shutil
 
+    from tmm_workbench.app import plan_five
     from tmm_workbench.app.geometry import mesh_from_object
     from tmm_workbench.core.geometry.mesh import save_stl
-    from tmm_workbench.core.plan import launch
+    from tmm_workbench.core.plan import five_axis, launch
     from tmm_workbench.core.plan.job_file import job_from_dict
 
     name, out_dir = data["outputs"]["name"], Path(data["outputs"]["dir"])
@@ -295,11 +296,13 @@ def plan_object(model: Any, data: dict, progress: Any = True) -> tuple[Any, dict
         job = job_from_dict(dict(data, model=dict(data["model"], file=str(stl))), tmp / "job.json")
         mesh, _, an, plan = launch.make_plan(job)
         plan_doc = dict(launch.plan_document(job, plan, stl), fcstd=False)
-        try:
-            results, verified = run_plan(plan_doc, tmp, model, progress)
+        try:   # a 5-axis op that fails or does not verify: the 3-axis plan instead, as `tmm plan` does
+            results, verified = plan_five.run(plan_doc, tmp, run_plan, model, progress,
+                                              discard=lambda: remove_added(doc, before))
         except BaseException:
             remove_added(doc, before)
             raise
+        five_axis.after_run(plan, verified)
         return results[0].job, launch.finish_outputs(tmp, job, mesh, an, plan, verified)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)

@@ -1,17 +1,19 @@
 """5-axis finishing on the Tarus where it pays (docs/planner.md, "The Tarus 5-axis machine"): after the 3-axis plan
 (core.plan.decide), on a `tarus5` machine, seed 000's tilted flat end (core.strategies.mesh5, the TMM 5-axis Mesh
-op's strategy) is planned over the model with the library's flat-end tools and timed by the Tarus post's estimate
-(joint speeds, A and C planned); the 3-axis finishing raster it would replace is computed and timed as the Job's
-simulation times it (core.sim.cycle_time, at machine.rapid). Both keep the finish's cusp: the raster by its
-step-over for the cusp up to the transition slope, the 5-axis passes with the cusp as their scallop tolerance. The
-faster wins (planner.five_axis: always takes the 5-axis op when it can be made); the decision and both times go
-into the report. The 3-axis ops it replaces are kept as the fallback: the FreeCAD side (app.plan_five) runs them
-when the 5-axis op fails or does not verify.
+op's strategy) is estimated over the model with the library's flat-end tools without planning the op
+(core.plan.mesh5_estimate: passes from the tilted tool's strip width at the cusp, their path timed by the Tarus
+post); the 3-axis finishing raster it would replace is computed and timed as the Job's simulation times it
+(core.sim.cycle_time, at machine.rapid). Both keep the finish's cusp: the raster by its step-over for the cusp up
+to the transition slope, the 5-axis passes with the cusp as their scallop tolerance. The faster wins
+(planner.five_axis: always takes the 5-axis op when it can be made); the decision and both times go into the
+report, and after the Job's run the op's own simulated time beside the estimate (after_run). The 3-axis ops it
+replaces are kept as the fallback: the FreeCAD side (app.plan_five) runs them when the 5-axis op fails or does not
+verify.
 
 Where it applies: a model the mesh op can finish whole (it has no region yet): an open surface facing up (nothing
 facing down), at most MIN_SHARE of its area steeper than the job's tilt limit (45 deg, the Tarus's C range:
-steeper, the flat bottom cannot lie on the face), and a C-space that is nowhere empty (no strip left for clean-up:
-the same finish everywhere). It replaces the 3-axis finishing ops (the shallow raster and the steep waterline, both
+steeper, the flat bottom cannot lie on the face), and a tool with a tilt clearing the mesh at every probed CC
+point (no strip left for clean-up: the same finish everywhere). It replaces the 3-axis finishing ops (the shallow raster and the steep waterline, both
 timed)."""
 from __future__ import annotations
 
@@ -26,27 +28,33 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.plan import decide, materials
 from tmm_workbench.core.plan.analysis import Analysis
 from tmm_workbench.core.plan.job_file import JobSpec, ToolSpec
+from tmm_workbench.core.plan.mesh5_estimate import Mesh5Estimate, estimate
 from tmm_workbench.core.sim.cycle_time import DEFAULT_RAPID_MM_S
 
 TOPIC = "5-axis finishing"
 REPLACED = ("Finish shallow", "Finish steep")   # the 3-axis finishing ops the 5-axis op replaces (decide's labels)
-MAX_CANDIDATES = 2                # flat-end tools planned (the largest first): each plan takes seconds
+MAX_CANDIDATES = 3                # flat-end tools estimated (the largest first): about 1.5 s each
 FORWARD_STEP = 2.0                # mm between CC points along a pass (the op's default)
 LABEL = "Finish 5-axis"
 
 
 @dataclass
 class FiveAxisChoice:
-    """What the 5-axis decision changed: the op put in and the 3-axis ops it replaced (the fallback plan)."""
+    """What the 5-axis decision changed: the op put in and the 3-axis ops it replaced (the fallback plan), the
+    estimated times (s) and, once the Job is simulated, the op's own (seconds_built, after_run)."""
     op: decide.OpPlan
     fallback_ops: list
     seconds_5axis: float
     seconds_3axis: float
     notes: list = field(default_factory=list)
+    passes: int = 0
+    seconds_built: Optional[float] = None
 
     def as_dict(self) -> dict:
         return {"op": self.op.label, "fallback_ops": [o.as_dict() for o in self.fallback_ops],
-                "estimated_seconds": {"5-axis": round(self.seconds_5axis, 1), "3-axis": round(self.seconds_3axis, 1)}}
+                "estimated_seconds": {"5-axis": round(self.seconds_5axis, 1), "3-axis": round(self.seconds_3axis, 1)},
+                "estimated_passes": self.passes,
+                "built_seconds": None if self.seconds_built is None else round(self.seconds_built, 1)}
 
 
 def flat_tools(job: JobSpec, an: Analysis) -> list:
@@ -124,35 +132,21 @@ def mesh5_args(job: JobSpec, tool: ToolSpec) -> dict:
                                     "post": job.machine.post}
 
 
-def mesh5_seconds(job: JobSpec, mesh: TriMesh, tool: ToolSpec) -> tuple[float, int, int]:
-    """The 5-axis finish with `tool`: (its Tarus cycle time s, passes, CC points left for clean-up). TmmError: the
-    op cannot be made (work limits, a CC point no posture reaches)."""
-    from tmm_workbench.core import path5
-    from tmm_workbench.core.linking import link
-    from tmm_workbench.core.machine.tarus import TarusMachine
-    from tmm_workbench.core.post import Operation, ToolInfo
-    from tmm_workbench.core.post.tarus_writer import write_tarus
-    from tmm_workbench.core.strategies.mesh5 import finish
+def mesh5_estimate(job: JobSpec, mesh: TriMesh, tool: ToolSpec) -> Mesh5Estimate:
+    """The 5-axis finish with `tool` estimated without planning it (core.plan.mesh5_estimate: the strip width
+    at the cusp from the tilted tool's profile over the surface's sections, the passes, their path timed by the
+    Tarus post at the materials table's feeds). TmmError: the op would refuse it (the tool, the work limits)."""
+    from tmm_workbench.core.post import ToolInfo
     from tmm_workbench.core.strategies.mesh5.finish import Mesh5Params
-    from tmm_workbench.core.strategies.multipoint import link_policy
 
     args = mesh5_args(job, tool)
-    cutter = decide.cutter_of(tool)
     params = Mesh5Params(tolerance=args["tolerance"], tilt_max_deg=args["tilt_limit_deg"],
                          forward_step=args["forward_step"], chord_tol=args["chord_tolerance"])
-    finish.check_tool(cutter)
-    lo, hi = mesh.bounds
-    finish.estimate_work(params, cutter, tuple(map(float, lo)) + tuple(map(float, hi)))   # the work limits first
-    result = finish.compute(mesh, cutter, params)
-    top = float(mesh.bounds[1][2])
-    tp = link(result.segments, link_policy(cutter, top + 5.0, top + 10.0, 5.0))
     c = materials.cutting(job.material, tool.diameter, tool.flutes, job.machine.spindle_max, job.machine.feed_max)
     info = ToolInfo(number=1, label=tool.name, shape="endmill" if tool.type == "flat" else "bullnose",
                     diameter=tool.diameter, corner_radius=tool.corner_radius, cutting_height=tool.flute_length,
                     spindle_rpm=c.rpm)
-    program = [info, Operation(LABEL, path5.encode_toolpath(tp, c.feed / 60.0, c.plunge / 60.0), "Flood")]
-    return (float(write_tarus(program, TarusMachine()).cycle_time), int(result.diagnostics["passes"]),
-            len(result.diagnostics["unfinished"]))
+    return estimate(mesh, decide.cutter_of(tool), params, info, c.feed / 60.0, c.plunge / 60.0)
 
 
 def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Optional[FiveAxisChoice]:
@@ -176,22 +170,22 @@ def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Op
     timed, notes = [], []
     for tool in tools:
         try:
-            seconds, passes, left = mesh5_seconds(job, mesh, tool)
+            est = mesh5_estimate(job, mesh, tool)
         except TmmError as exc:
             notes.append(f"{tool.name}: {exc}")
             continue
-        if left:
-            notes.append(f"{tool.name}: {left} CC points with an empty C-space (left for clean-up: not the same "
-                         "finish)")
+        if est.blocked:
+            notes.append(f"{tool.name}: at {est.blocked} of {est.probed} probed CC points no tilt clears the mesh and "
+                         "finishes it within the cusp (the op may leave them for clean-up: not the same finish)")
             continue
-        timed.append((seconds, passes, tool))
+        timed.append((est.seconds, est.passes, tool))
     if not timed:
         plan.decide(TOPIC, "none", "the 5-axis mesh op cannot finish the model: " + "; ".join(notes))
         return None
     seconds, passes, tool = min(timed, key=lambda s: (s[0], tools.index(s[2])))
     total = sum(three.values())
     compared = (f"estimated cycle times at the cusp {job.finish.cusp:g} mm: 5-axis {tool.name} {seconds / 60:.2f} min "
-                f"({passes} passes, the Tarus post's estimate"
+                f"(about {passes} passes: the strip width at the cusp, timed by the Tarus post"
                 + "".join(f"; {t.name} {sec / 60:.2f} min" for sec, _, t in timed if t is not tool)
                 + ") against the 3-axis "
                 + " + ".join(f"{label} {t / 60:.2f}" for label, t in three.items())
@@ -213,7 +207,7 @@ def consider(job: JobSpec, mesh: TriMesh, an: Analysis, plan: decide.Plan) -> Op
                 f"{', '.join(three)}",
                 f"{why}: {compared}; the tilt at most {job.machine.tilt_limit:g} deg from the normal; verified by "
                 "the 5-axis stock simulation, the 3-axis plan run instead when it does not verify")
-    return FiveAxisChoice(op, fallback, seconds, total, notes)
+    return FiveAxisChoice(op, fallback, seconds, total, notes, passes)
 
 
 def fallen_back(plan: decide.Plan, choice: FiveAxisChoice, reason: str) -> None:
@@ -222,3 +216,27 @@ def fallen_back(plan: decide.Plan, choice: FiveAxisChoice, reason: str) -> None:
     plan.decide(TOPIC, "fell back to the 3-axis plan", f"{choice.op.label} {reason}")
 
 
+def after_run(plan: decide.Plan, verified: dict) -> None:
+    """The Job's outcome (app.plan_five's verify.json) into the 5-axis decision: the fallback's reason, or the
+    built op's simulated cycle time beside the estimate, and whether it came out slower than the 3-axis estimate."""
+    choice = plan.five_axis
+    if choice is None:
+        return
+    if verified.get("five_axis_fallback"):
+        fallen_back(plan, choice, verified["five_axis_fallback"])
+        return
+    built = next((o["cycle_seconds"] for o in verified.get("ops", []) if o["label"] == choice.op.label), None)
+    if built is None:
+        return
+    choice.seconds_built = float(built)
+    slower = built > choice.seconds_3axis
+    verified["five_axis"] = {"op": choice.op.label, "estimated_seconds": round(choice.seconds_5axis, 1),
+                             "estimated_passes": choice.passes, "built_seconds": round(built, 1),
+                             "three_axis_estimated_seconds": round(choice.seconds_3axis, 1),
+                             "slower_than_three_axis": slower}
+    plan.decide(TOPIC, "built: slower than the 3-axis estimate" if slower else "built",
+                f"{choice.op.label} {built / 60:.2f} min as built and simulated against the estimated "
+                f"{choice.seconds_5axis / 60:.2f} min ({(built / max(choice.seconds_5axis, 1e-9) - 1) * 100:+.0f} %)"
+                + (f"; the 3-axis finishing was estimated at {choice.seconds_3axis / 60:.2f} min: it would have been "
+                   "faster (the op verified, so it is kept)" if slower else
+                   f"; still faster than the 3-axis estimate {choice.seconds_3axis / 60:.2f} min"))

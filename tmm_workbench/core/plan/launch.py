@@ -298,8 +298,7 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
             print(f"tmm plan: {failure}", file=sys.stderr)
             return FAILED
         verified = json.loads((tmp / "verify.json").read_text())
-        if verified.get("five_axis_fallback"):
-            five_axis.fallen_back(plan, plan.five_axis, verified["five_axis_fallback"])
+        five_axis.after_run(plan, verified)   # the fallback, or the built op's time beside the estimate
         for name in ("plan.json", "verify.json"):
             (tmp / name).unlink()
         finish_outputs(tmp, job, mesh, an, plan, verified, quiet)

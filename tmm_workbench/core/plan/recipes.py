@@ -9,6 +9,7 @@ from typing import Optional, Union
 MACHINES: dict[str, dict] = {
     "3-axis linuxcnc": {"type": "3-axis", "post": "linuxcnc", "travels": [300, 200, 100]},
     "3-axis grbl": {"type": "3-axis", "post": "grbl", "travels": [300, 300, 80]},
+    "Tarus 5-axis": {"type": "tarus5"},   # 5-axis finishing where it pays (core.plan.five_axis), the tarus post
 }
 # finish presets: the cusp kept, the verification's tolerance and the planner's grids (coarser: faster);
 # `draft` is tests/data/plan_beet.yaml's coarse values
