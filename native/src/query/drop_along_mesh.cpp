@@ -236,11 +236,19 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   return q.best;
 }
 
+double AlongCutter::drop_on(const Vector3d& start, double max_travel, int32_t tri, DropStats* stats) const {
+  Search q = search(start, max_travel);
+  consider(q, index_->index().triangles()[static_cast<std::size_t>(tri)], tri);
+  if (stats) stats->triangles_tested += q.tested;
+  return q.best;
+}
+
 double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candidates& cands, DropStats* stats,
-                                int32_t* hint) const {
+                                int32_t* hint, int32_t known) const {
   Search q = search(start, max_travel);
   const auto& tris = index_->index().triangles();
-  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) consider(q, tris[*hint], *hint);
+  if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
+    consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = reach_ * reach_;
   const Plane& kp = cands.key_plane;
@@ -261,7 +269,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     if (c.zmax <= q.floor) continue;
     const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
     const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
-    if (dx * dx + dy * dy > r2 || c.tri == skip || cleared(c)) continue;
+    if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || cleared(c)) continue;
     double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
     for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
     open.emplace_back(bound, &c);

@@ -164,8 +164,12 @@ class AlongCutter {
               std::size_t limit) const;
   // drop() over a list gathered for this start with a cap of at least max_travel, in place of the walk: the
   // same travel. Each candidate keeps the plane that proved it clear, which the next start tries first.
+  // `known` (or -1): a triangle already solved from this start (drop_on) with a cap of at least max_travel.
   double drop_listed(const Eigen::Vector3d& start, double max_travel, Candidates& cands,
-                     DropStats* stats = nullptr, int32_t* hint = nullptr) const;
+                     DropStats* stats = nullptr, int32_t* hint = nullptr, int32_t known = -1) const;
+  // The first contact with the index's triangle `tri` alone, below max_travel (else max_travel): the travel a
+  // walk finds for it, so an upper bound of drop() that is a contact of this solid.
+  double drop_on(const Eigen::Vector3d& start, double max_travel, int32_t tri, DropStats* stats = nullptr) const;
 
  private:
   // A drop's state: the start (index frame), the best travel so far, its triangle, the lowest height a
