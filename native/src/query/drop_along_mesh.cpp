@@ -199,6 +199,9 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
   // triangle below it proves it in a few products; else the plane that cleared the triangle from a nearby
   // start (one support point), else a separating plane found by the clearance certificate, at a fraction of
   // the cost of the triangle's pieces.
+  if (q.tangent.dot(Vector3d(t.p[0])) >= q.level && q.tangent.dot(Vector3d(t.p[1])) >= q.level &&
+      q.tangent.dot(Vector3d(t.p[2])) >= q.level)
+    return;
   if (q.best < kNoTravel && below_a_plane(t, q.s.x(), q.s.y(), q.s.z() - q.best)) return;
   ++q.tested;
   const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - q.s), q1 = frame_.to_tool(Vector3d(t.p[1]) - q.s),
@@ -210,12 +213,26 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
     if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
-  const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges);
+  Vector3d n;
+  const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges, &n);
   if (tr < q.best) {
     q.best = tr;
     q.winner = i;
     q.floor = q.s.z() - tr + lowest_ - 1e-9;
+    set_tangent(q, n);
   }
+}
+
+void AlongCutter::set_tangent(Search& q, const Vector3d& n) const {
+  // K at travel t lies within n . X <= h_K(n) + t n . W (tool frame, the start at the origin): below the level
+  // at the best for every earlier travel when n . W > 0. A plane nearly along the motion proves little and
+  // would turn rounding into travel: none then.
+  const double len = n.norm();
+  q.level = kInfinity;
+  if (!(len > 0) || !(n.dot(W_) > 0.05 * len)) return;
+  const Vector3d u = n / len;
+  q.tangent = frame_.to_world(u);
+  q.level = direction_detail::support(cutter_, u).value + q.best * u.dot(W_) + q.tangent.dot(q.s);
 }
 
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
