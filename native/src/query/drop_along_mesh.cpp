@@ -253,16 +253,19 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   return q.best;
 }
 
-double AlongCutter::drop_on(const Vector3d& start, double max_travel, int32_t tri, DropStats* stats) const {
+double AlongCutter::drop_on(const Vector3d& start, double max_travel, int32_t tri, DropStats* stats,
+                            Eigen::Vector4d* tangent) const {
   Search q = search(start, max_travel);
   consider(q, index_->index().triangles()[static_cast<std::size_t>(tri)], tri);
   if (stats) stats->triangles_tested += q.tested;
+  if (tangent) *tangent << q.tangent, q.level;
   return q.best;
 }
 
 double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candidates& cands, DropStats* stats,
-                                int32_t* hint, int32_t known) const {
+                                int32_t* hint, int32_t known, const Eigen::Vector4d* tangent) const {
   Search q = search(start, max_travel);
+  if (tangent) q.tangent = tangent->head<3>(), q.level = (*tangent)[3];  // proves no contact before a later travel
   const auto& tris = index_->index().triangles();
   if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
     consider(q, tris[*hint], *hint);

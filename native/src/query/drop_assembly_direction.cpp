@@ -168,6 +168,7 @@ class TiledSolids {
     std::vector<int32_t> hints;  // per solid: its walk's or list's last winner (tried first), or -1
     std::vector<int32_t> probe;  // per solid: the last triangle that stopped it, or -1
     std::vector<int32_t> known;  // per start of the tile and solid: the triangle its probe solved, or -1
+    std::vector<Eigen::Vector4d> tangents;  // the same: the plane of support of its contact (level +inf: none)
     std::size_t last = ~std::size_t{0};  // the start the first step did last
     std::vector<std::size_t> order, wins, listed;  // the bodies' order; each solid's wins in the last tile
     std::vector<int> skip;  // per solid: tiles left that walk (its last list was too long)
@@ -180,6 +181,7 @@ class TiledSolids {
   void cutter(const std::size_t* run, std::size_t m, TileScratch& t, DropStats* stats) {
     const std::size_t S = solids_.size();
     t.known.assign(m * S, -1);
+    t.tangents.assign(m * S, Eigen::Vector4d(0.0, 0.0, 0.0, INFINITY));
     for (std::size_t j = 0; j < m; ++j) {
       const std::size_t i = run[j];
       // The tool stops near where it stopped at the last start: a probe solved beyond that is not worth it.
@@ -188,7 +190,7 @@ class TiledSolids {
       for (std::size_t k = 1; k < S; ++k)
         if (t.probe[k] >= 0) {
           const double c = std::min(cap(i, k), near);
-          const double u = cutters_[k].drop_on(lifted(i, k), c, t.probe[k], stats);
+          const double u = cutters_[k].drop_on(lifted(i, k), c, t.probe[k], stats, &t.tangents[j * S + k]);
           if (u < c) update(i, k, u);
           if (u < c || !(near < cap(i, k))) t.known[j * S + k] = t.probe[k];
         }
@@ -232,7 +234,8 @@ class TiledSolids {
       for (std::size_t q = 0; q < t.listed.size(); ++q) {
         const std::size_t j = t.listed[q];
         update(run[j], k,
-               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &t.hints[k], t.known[j * S + k])
+               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &t.hints[k], t.known[j * S + k],
+                                                 &t.tangents[j * S + k])
                       : cutters_[k].drop(t.lifted[q], t.caps[q], stats, &t.hints[k]));
         if (t.hints[k] >= 0) t.probe[k] = t.hints[k];
       }

@@ -166,12 +166,17 @@ class AlongCutter {
               std::size_t limit) const;
   // drop() over a list gathered for this start with a cap of at least max_travel, in place of the walk: the
   // same travel. Each candidate keeps the plane that proved it clear, which the next start tries first.
-  // `known` (or -1): a triangle already solved from this start (drop_on) with a cap of at least max_travel.
+  // `known` (or -1): a triangle already solved from this start (drop_on) with a cap of at least max_travel;
+  // `tangent` (or null): the plane of support drop_on found with it.
   double drop_listed(const Eigen::Vector3d& start, double max_travel, Candidates& cands,
-                     DropStats* stats = nullptr, int32_t* hint = nullptr, int32_t known = -1) const;
+                     DropStats* stats = nullptr, int32_t* hint = nullptr, int32_t known = -1,
+                     const Eigen::Vector4d* tangent = nullptr) const;
   // The first contact with the index's triangle `tri` alone, below max_travel (else max_travel): the travel a
-  // walk finds for it, so an upper bound of drop() that is a contact of this solid.
-  double drop_on(const Eigen::Vector3d& start, double max_travel, int32_t tri, DropStats* stats = nullptr) const;
+  // walk finds for it, so an upper bound of drop() that is a contact of this solid. tangent (or null): set to
+  // K's plane of support there (index frame: normal, level; level +inf for none), which proves every triangle
+  // beyond it missed before that travel.
+  double drop_on(const Eigen::Vector3d& start, double max_travel, int32_t tri, DropStats* stats = nullptr,
+                 Eigen::Vector4d* tangent = nullptr) const;
 
  private:
   // A drop's state: the start (index frame), the best travel so far, its triangle, the lowest height a
