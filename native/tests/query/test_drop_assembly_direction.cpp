@@ -19,6 +19,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "support/test_meshes.hpp"
@@ -123,6 +124,26 @@ TEST(DropAssemblyDirection, SolidsAreTheGrownAssembly) {
     EXPECT_GT(in, 1000);
     EXPECT_GT(out, 1000);
   }
+}
+
+// A height field z(x, y) over a plate 40 wide about the origin, 1 mm cells of two triangles.
+template <class Height>
+std::pair<tmm::Vertices, tmm::Triangles> height_grid(Height&& z) {
+  const int cells = 40;
+  tmm::Vertices V((cells + 1) * (cells + 1), 3);
+  tmm::Triangles F(2 * cells * cells, 3);
+  for (int i = 0; i <= cells; ++i)
+    for (int j = 0; j <= cells; ++j) {
+      const double x = i - 20.0, y = j - 20.0;
+      V.row(i * (cells + 1) + j) << x, y, z(x, y);
+    }
+  for (int i = 0, f = 0; i < cells; ++i)
+    for (int j = 0; j < cells; ++j) {
+      const int a = i * (cells + 1) + j;
+      F.row(f++) << a, a + cells + 1, a + 1;
+      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
+    }
+  return {V, F};
 }
 
 // Every solid against every triangle by drop_along: the earliest travel and its piece.
@@ -303,21 +324,10 @@ TEST(DropAssemblyDirection, BatchIsPointByPointAndThreadsAgree) {
 // batch; every travel and piece is the point's own, and the exact per-triangle reference's on a sample.
 TEST(DropAssemblyDirection, SharedTiltedAxisBatchIsPointByPoint) {
   // A plate 40 wide with a pocket 16 wide and 18 deep (its floor a dome): the bodies meet the walls and the rim.
-  const int cells = 40;
-  tmm::Vertices V((cells + 1) * (cells + 1), 3);
-  tmm::Triangles F(2 * cells * cells, 3);
-  for (int i = 0; i <= cells; ++i)
-    for (int j = 0; j <= cells; ++j) {
-      const double x = i - 20.0, y = j - 20.0;
-      const bool inside = std::fabs(x) < 8 && std::fabs(y) < 8;
-      V.row(i * (cells + 1) + j) << x, y, inside ? -18 + 2 * std::cos(x / 4) * std::cos(y / 4) : 0.0;
-    }
-  for (int i = 0, f = 0; i < cells; ++i)
-    for (int j = 0; j < cells; ++j) {
-      const int a = i * (cells + 1) + j;
-      F.row(f++) << a, a + cells + 1, a + 1;
-      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
-    }
+  const auto [V, F] = height_grid([](double x, double y) {
+    const bool inside = std::fabs(x) < 8 && std::fabs(y) < 8;
+    return inside ? -18 + 2 * std::cos(x / 4) * std::cos(y / 4) : 0.0;
+  });
   const Vector3d dir = Vector3d(0.2, 0.1, -1).normalized();
   const tmm::DirectionalIndex index(V, F, dir);
   const Vector3d axis = Vector3d(0.45, -0.2, 1).normalized();  // about 26 deg off -dir
@@ -418,21 +428,10 @@ TEST(DropAssemblyDirection, TiledBatchKeepsNeighboursCandidates) {
 // support; the dome's triangles meet the tool at shared vertices (ties no clearance proof separates). Every
 // travel and piece is the point query's, and the exact per-triangle reference's on a sample.
 TEST(DropAssemblyDirection, HolderStopsTheToolFirstBesideADome) {
-  const int cells = 40;
-  const double R = 12.0;
-  tmm::Vertices V((cells + 1) * (cells + 1), 3);
-  tmm::Triangles F(2 * cells * cells, 3);
-  for (int i = 0; i <= cells; ++i)
-    for (int j = 0; j <= cells; ++j) {
-      const double x = i - 20.0, y = j - 20.0, r2 = x * x + y * y;
-      V.row(i * (cells + 1) + j) << x, y, r2 < R * R ? std::sqrt(R * R - r2) : 0.0;
-    }
-  for (int i = 0, f = 0; i < cells; ++i)
-    for (int j = 0; j < cells; ++j) {
-      const int a = i * (cells + 1) + j;
-      F.row(f++) << a, a + cells + 1, a + 1;
-      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
-    }
+  const auto [V, F] = height_grid([](double x, double y) {  // a dome of radius 12
+    const double r2 = x * x + y * y;
+    return r2 < 144 ? std::sqrt(144 - r2) : 0.0;
+  });
   const Vector3d dir = Vector3d(0.2, 0.1, -1).normalized();
   const tmm::DirectionalIndex index(V, F, dir);
   const Vector3d axis = Vector3d(0.45, 0.1, 1).normalized();  // about 15 deg off -dir
