@@ -194,14 +194,18 @@ AlongCutter::Search AlongCutter::search(const Vector3d& start, double max_travel
   return q;
 }
 
+// Every corner of t beyond the plane of support at q's best contact: t is missed before it.
+inline bool AlongCutter::beyond(const Search& q, const IndexedTriangle& t) {
+  return q.tangent.dot(Vector3d(t.p[0])) >= q.level && q.tangent.dot(Vector3d(t.p[1])) >= q.level &&
+         q.tangent.dot(Vector3d(t.p[2])) >= q.level;
+}
+
 inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i, Vector3d* plane) const {
   // Most candidates are not touched before the best contact so far: a plane under K that has the whole
   // triangle below it proves it in a few products; else the plane that cleared the triangle from a nearby
   // start (one support point), else a separating plane found by the clearance certificate, at a fraction of
   // the cost of the triangle's pieces.
-  if (q.tangent.dot(Vector3d(t.p[0])) >= q.level && q.tangent.dot(Vector3d(t.p[1])) >= q.level &&
-      q.tangent.dot(Vector3d(t.p[2])) >= q.level)
-    return;
+  if (beyond(q, t)) return;
   if (q.best < kNoTravel && below_a_plane(t, q.s.x(), q.s.y(), q.s.z() - q.best)) return;
   ++q.tested;
   const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - q.s), q1 = frame_.to_tool(Vector3d(t.p[1]) - q.s),
@@ -290,6 +294,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
     const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
     if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || cleared(c)) continue;
+    if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
     double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
     for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
     open.emplace_back(bound, &c);

@@ -193,6 +193,7 @@ class AlongCutter {
     double level = std::numeric_limits<double>::infinity();
   };
   Search search(const Eigen::Vector3d& start, double max_travel) const;
+  static bool beyond(const Search& q, const IndexedTriangle& t);
   // q's tangent plane from K's outward normal n (tool frame) at its best contact.
   void set_tangent(Search& q, const Eigen::Vector3d& n) const;
   // plane (or null): a candidate's last separating normal, tried first and updated.
