@@ -2,6 +2,7 @@
 // hierarchy bounded by the cutter solid's lowest point and its supporting planes from below; each candidate
 // triangle first given the clearance certificate (swept_clearance.hpp), then, unless it is proven clear, solved
 // by the general method, both with the best travel so far as the cap (docs/drop_direction.md, "Mesh query").
+// A triangle beyond the solid's plane of support at the best contact so far is missed before it (set_tangent).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
