@@ -2,6 +2,7 @@
 // hierarchy bounded by the cutter solid's lowest point and its supporting planes from below; each candidate
 // triangle first given the clearance certificate (swept_clearance.hpp), then, unless it is proven clear, solved
 // by the general method, both with the best travel so far as the cap (docs/drop_direction.md, "Mesh query").
+// A triangle beyond the solid's plane of support at the best contact so far is missed before it (set_tangent).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -194,11 +195,18 @@ AlongCutter::Search AlongCutter::search(const Vector3d& start, double max_travel
   return q;
 }
 
+// Every corner of t beyond the plane of support at q's best contact: t is missed before it.
+inline bool AlongCutter::beyond(const Search& q, const IndexedTriangle& t) {
+  return q.tangent.dot(Vector3d(t.p[0])) >= q.level && q.tangent.dot(Vector3d(t.p[1])) >= q.level &&
+         q.tangent.dot(Vector3d(t.p[2])) >= q.level;
+}
+
 inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i, Vector3d* plane) const {
   // Most candidates are not touched before the best contact so far: a plane under K that has the whole
   // triangle below it proves it in a few products; else the plane that cleared the triangle from a nearby
   // start (one support point), else a separating plane found by the clearance certificate, at a fraction of
   // the cost of the triangle's pieces.
+  if (beyond(q, t)) return;
   if (q.best < kNoTravel && below_a_plane(t, q.s.x(), q.s.y(), q.s.z() - q.best)) return;
   ++q.tested;
   const Vector3d q0 = frame_.to_tool(Vector3d(t.p[0]) - q.s), q1 = frame_.to_tool(Vector3d(t.p[1]) - q.s),
@@ -210,12 +218,26 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
     if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
-  const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges);
+  Vector3d n;
+  const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges, &n);
   if (tr < q.best) {
     q.best = tr;
     q.winner = i;
     q.floor = q.s.z() - tr + lowest_ - 1e-9;
+    set_tangent(q, n);
   }
+}
+
+void AlongCutter::set_tangent(Search& q, const Vector3d& n) const {
+  // K at travel t lies within n . X <= h_K(n) + t n . W (tool frame, the start at the origin): below the level
+  // at the best for every earlier travel when n . W > 0. A plane nearly along the motion proves little and
+  // would turn rounding into travel: none then.
+  const double len = n.norm();
+  q.level = kInfinity;
+  if (!(len > 0) || !(n.dot(W_) > 0.05 * len)) return;
+  const Vector3d u = n / len;
+  q.tangent = frame_.to_world(u);
+  q.level = direction_detail::support(cutter_, u).value + q.best * u.dot(W_) + q.tangent.dot(q.s);
 }
 
 double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* stats, int32_t* hint) const {
@@ -236,11 +258,22 @@ double AlongCutter::drop(const Vector3d& start, double max_travel, DropStats* st
   return q.best;
 }
 
-double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candidates& cands, DropStats* stats,
-                                int32_t* hint) const {
+double AlongCutter::drop_on(const Vector3d& start, double max_travel, int32_t tri, DropStats* stats,
+                            Eigen::Vector4d* tangent) const {
   Search q = search(start, max_travel);
+  consider(q, index_->index().triangles()[static_cast<std::size_t>(tri)], tri);
+  if (stats) stats->triangles_tested += q.tested;
+  if (tangent) *tangent << q.tangent, q.level;
+  return q.best;
+}
+
+double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candidates& cands, DropStats* stats,
+                                int32_t* hint, int32_t known, const Eigen::Vector4d* tangent) const {
+  Search q = search(start, max_travel);
+  if (tangent) q.tangent = tangent->head<3>(), q.level = (*tangent)[3];  // proves no contact before a later travel
   const auto& tris = index_->index().triangles();
-  if (hint && *hint >= 0 && static_cast<std::size_t>(*hint) < tris.size()) consider(q, tris[*hint], *hint);
+  if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
+    consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = reach_ * reach_;
   const Plane& kp = cands.key_plane;
@@ -261,7 +294,8 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     if (c.zmax <= q.floor) continue;
     const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
     const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
-    if (dx * dx + dy * dy > r2 || c.tri == skip || cleared(c)) continue;
+    if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || cleared(c)) continue;
+    if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
     double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
     for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
     open.emplace_back(bound, &c);

@@ -146,23 +146,30 @@ void tile_runs(const DirectionalIndex& index, const double* starts, std::size_t 
   runs.push_back(n);
 }
 
-// One tilted axis for a batch, in two passes. In the starts' order, each start's lead solid (the one that
-// stopped the last start: a holder over a deep pocket caps the cutter's walk) by its walk, then the cutter's
-// walk capped by it; a start still uncapped (its cutter misses) gets every body's walk. Then per tile of nearby
-// starts, each other body from one gather of candidates with the travels so far as the caps (the tool stops no
-// later than that: a holder high above the part gathers nothing): the triangles within its reach of a start,
-// above its lowest point at that start's cap and not below one of its planes at every start, the same travels
-// as a walk per start and body. Ties go to the solid earlier in the list, as in along_solids.
+// One tilted axis for a batch, per tile of nearby starts (their order within the tile kept), in two steps.
+// First, at each start, each body against the triangle that last stopped it nearby (a contact of the body, so
+// an upper bound of its travel that costs one triangle: beside a tall part or over a deep pocket the holder's
+// caps the cutter's walk, which then meets little), then the cutter's walk capped by them; a start still
+// uncapped (its cutter misses) gets every body's walk. Then each body from one gather of candidates with the
+// travels so far as the caps (the tool stops no later than that: a holder high above the part gathers
+// nothing): the triangles within its reach of a start, above its lowest point at that start's cap and not
+// below one of its planes at every start, the same travels as a walk per start and body. Ties go to the solid
+// earlier in the list, as in along_solids.
 class TiledSolids {
  public:
   TiledSolids(const std::vector<AssemblySolid>& solids, const std::vector<AlongCutter>& cutters, const Vector3d& axis,
               const double* starts, std::size_t n, double max_travel)
       : solids_(solids), cutters_(cutters), axis_(axis), starts_(starts), best_(n, max_travel), winner_(n, kNone),
-        led_(n, kDone) {}
+        walked_(n, 0) {}
 
   // A worker's lists, kept from tile to tile.
   struct TileScratch {
-    explicit TileScratch(std::size_t solids) : wins(solids, 0), skip(solids, 0) {}
+    explicit TileScratch(std::size_t solids) : hints(solids, -1), probe(solids, -1), wins(solids, 0), skip(solids, 0) {}
+    std::vector<int32_t> hints;  // per solid: its walk's or list's last winner (tried first), or -1
+    std::vector<int32_t> probe;  // per solid: the last triangle that stopped it, or -1
+    std::vector<int32_t> known;  // per start of the tile and solid: the triangle its probe solved, or -1
+    std::vector<Eigen::Vector4d> tangents;  // the same: the plane of support of its contact (level +inf: none)
+    std::size_t last = ~std::size_t{0};  // the start the first step did last
     std::vector<std::size_t> order, wins, listed;  // the bodies' order; each solid's wins in the last tile
     std::vector<int> skip;  // per solid: tiles left that walk (its last list was too long)
     std::vector<Vector3d> lifted;
@@ -170,43 +177,52 @@ class TiledSolids {
     AlongCutter::Candidates cands;
   };
 
-  // The first pass over starts [begin, end), in their order.
-  void lead(std::size_t begin, std::size_t end, DropStats* stats) {
-    std::vector<int32_t> hints(solids_.size(), -1);
-    std::size_t lead = 0;
-    for (std::size_t i = begin; i < end; ++i) {
-      update(i, lead, drop(lead, i, stats, hints.data()));
-      if (lead != 0) update(i, 0, drop(0, i, stats, hints.data()));
-      if (std::isfinite(best_[i])) {
-        led_[i] = static_cast<int32_t>(lead);
-      } else {  // nothing caps the bodies: each one's walk (the lead's found nothing), capped by those before
-        for (std::size_t k = 1; k < solids_.size(); ++k)
-          if (k != lead) update(i, k, drop(k, i, stats, hints.data()));
+  // The first step over the tile of starts run[0, m): the bodies' probes, the cutter's walk.
+  void cutter(const std::size_t* run, std::size_t m, TileScratch& t, DropStats* stats) {
+    const std::size_t S = solids_.size();
+    t.known.assign(m * S, -1);
+    t.tangents.assign(m * S, Eigen::Vector4d(0.0, 0.0, 0.0, INFINITY));
+    for (std::size_t j = 0; j < m; ++j) {
+      const std::size_t i = run[j];
+      // The tool stops near where it stopped at the last start: a probe solved beyond that is not worth it.
+      const double near = t.last < best_.size()
+                              ? best_[t.last] + kProbeSlope * (lifted(i, 0) - lifted(t.last, 0)).norm() : INFINITY;
+      for (std::size_t k = 1; k < S; ++k)
+        if (t.probe[k] >= 0) {
+          const double c = std::min(cap(i, k), near);
+          const double u = cutters_[k].drop_on(lifted(i, k), c, t.probe[k], stats, &t.tangents[j * S + k]);
+          if (u < c) update(i, k, u);
+          if (u < c || !(near < cap(i, k))) t.known[j * S + k] = t.probe[k];
+        }
+      update(i, 0, drop(0, i, stats, t));
+      t.last = i;
+      if (!std::isfinite(best_[i])) {  // nothing caps the bodies: each one's walk, capped by those before
+        for (std::size_t k = 1; k < S; ++k) update(i, k, drop(k, i, stats, t));
+        walked_[i] = 1;
       }
-      lead = winner_[i] == kNone ? 0 : static_cast<std::size_t>(winner_[i]);
     }
   }
 
-  // The second pass over the tile of starts run[0, m) (their order within the tile kept): the other bodies.
-  void bodies(const std::size_t* run, std::size_t m, std::vector<int32_t>& hints, TileScratch& t,
-              DropStats* stats) {
+  // The second step over the same tile: the bodies.
+  void bodies(const std::size_t* run, std::size_t m, TileScratch& t, DropStats* stats) {
+    const std::size_t S = solids_.size();
     // The bodies that stopped most of the last tile's starts first: their travels lower the others' caps.
-    t.order.resize(solids_.size() - 1);
-    for (std::size_t k = 1; k < solids_.size(); ++k) t.order[k - 1] = k;
+    t.order.resize(S - 1);
+    for (std::size_t k = 1; k < S; ++k) t.order[k - 1] = k;
     std::stable_sort(t.order.begin(), t.order.end(),
                      [&](std::size_t a, std::size_t b) { return t.wins[a] > t.wins[b]; });
     for (const std::size_t k : t.order) {
       t.lifted.clear(), t.caps.clear(), t.listed.clear();
       for (std::size_t j = 0; j < m; ++j) {
         const std::size_t i = run[j];
-        if (led_[i] == kDone || led_[i] == static_cast<int32_t>(k)) continue;  // done in the first pass
+        if (walked_[i]) continue;  // done in the first step
         if (m < kMinTileStarts || t.skip[k] > 0) {
-          update(i, k, drop(k, i, stats, hints.data()));
+          update(i, k, drop(k, i, stats, t));
           continue;
         }
-        t.lifted.push_back(tip(i) + solids_[k].lift * axis_);
+        t.lifted.push_back(lifted(i, k));
         t.caps.push_back(cap(i, k));
-        t.listed.push_back(i);
+        t.listed.push_back(j);
       }
       if (t.skip[k] > 0) --t.skip[k];
       if (t.listed.empty()) continue;
@@ -215,10 +231,14 @@ class TiledSolids {
       const bool listed = cutters_[k].gather(t.lifted.data(), t.caps.data(), t.lifted.size(), t.cands,
                                              kMaxListPerStart * t.lifted.size());
       if (!listed) t.skip[k] = kWalkAfterLong;  // the next tiles are likely alike: no gather for a few
-      for (std::size_t q = 0; q < t.listed.size(); ++q)
-        update(t.listed[q], k,
-               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &hints[k])
-                      : cutters_[k].drop(t.lifted[q], t.caps[q], stats, &hints[k]));
+      for (std::size_t q = 0; q < t.listed.size(); ++q) {
+        const std::size_t j = t.listed[q];
+        update(run[j], k,
+               listed ? cutters_[k].drop_listed(t.lifted[q], t.caps[q], t.cands, stats, &t.hints[k], t.known[j * S + k],
+                                                 &t.tangents[j * S + k])
+                      : cutters_[k].drop(t.lifted[q], t.caps[q], stats, &t.hints[k]));
+        if (t.hints[k] >= 0) t.probe[k] = t.hints[k];
+      }
     }
     std::fill(t.wins.begin(), t.wins.end(), 0);
     for (std::size_t j = 0; j < m; ++j)
@@ -233,14 +253,20 @@ class TiledSolids {
   }
 
  private:
-  static constexpr int32_t kNone = -1, kDone = -2;  // kDone: every solid dropped in the first pass
+  static constexpr int32_t kNone = -1;
   static constexpr std::size_t kMinTileStarts = 4;   // fewer: each start's walk costs less than a gather
   static constexpr std::size_t kMaxListPerStart = 40;
   static constexpr int kWalkAfterLong = 4;
+  static constexpr double kProbeSlope = 2.0;  // a probe counts up to this much travel per mm from the last start
 
-  Vector3d tip(std::size_t i) const { return {starts_[3 * i], starts_[3 * i + 1], starts_[3 * i + 2]}; }
-  double drop(std::size_t k, std::size_t i, DropStats* stats, int32_t* hints) const {
-    return cutters_[k].drop(tip(i) + solids_[k].lift * axis_, cap(i, k), stats, &hints[k]);
+  Vector3d lifted(std::size_t i, std::size_t k) const {
+    return Vector3d(starts_[3 * i], starts_[3 * i + 1], starts_[3 * i + 2]) + solids_[k].lift * axis_;
+  }
+  // Solid k's walk from start i; the triangle that stopped it is tried first at the next start.
+  double drop(std::size_t k, std::size_t i, DropStats* stats, TileScratch& t) const {
+    const double travel = cutters_[k].drop(lifted(i, k), cap(i, k), stats, &t.hints[k]);
+    if (t.hints[k] >= 0) t.probe[k] = t.hints[k];
+    return travel;
   }
   // A solid earlier in the list than the one that stopped start i so far wins a tie (as in along_solids).
   bool before(std::size_t i, std::size_t k) const {
@@ -261,7 +287,8 @@ class TiledSolids {
   Vector3d axis_;
   const double* starts_;
   std::vector<double> best_;
-  std::vector<int32_t> winner_, led_;  // led_: per start the solid dropped first, or kDone
+  std::vector<int32_t> winner_;
+  std::vector<char> walked_;  // per start: every solid walked in the first step
 };
 
 }  // namespace
@@ -331,20 +358,16 @@ void drop_assembly_along_batch(const DirectionalIndex& index, const ToolAssembly
     const Vector3d a = Vector3d(axes[0], axes[1], axes[2]).normalized();
     const std::vector<AlongCutter> shared = along_cutters(index, solids, a, true);
     TiledSolids tiled(solids, shared, a, starts, n, max_travel);
-    // Hints and leads start afresh with each chunk, so results do not depend on the thread count.
-    parallel_chunks(n, 64, options, [&](std::size_t begin, std::size_t end) {
-      DropStats local;
-      tiled.lead(begin, end, &local);
-      tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
-    });
     std::vector<std::size_t> order, runs;
     tile_runs(index, starts, n, kTileFactor * tool.cutter().max_radius(), order, runs);
+    // Hints and probes start afresh with each chunk of tiles, so results do not depend on the thread count.
     parallel_chunks(runs.size() - 1, 8, options, [&](std::size_t begin, std::size_t end) {
       DropStats local;
-      std::vector<int32_t> hints(solids.size(), -1);
       TiledSolids::TileScratch scratch(solids.size());
-      for (std::size_t r = begin; r < end; ++r)
-        tiled.bodies(order.data() + runs[r], runs[r + 1] - runs[r], hints, scratch, &local);
+      for (std::size_t r = begin; r < end; ++r) {
+        tiled.cutter(order.data() + runs[r], runs[r + 1] - runs[r], scratch, &local);
+        tiled.bodies(order.data() + runs[r], runs[r + 1] - runs[r], scratch, &local);
+      }
       tested.fetch_add(local.triangles_tested, std::memory_order_relaxed);
     });
     tiled.write(travel_out, set_by);

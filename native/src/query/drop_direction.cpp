@@ -189,7 +189,8 @@ double vertex_travel(const Cutter& c, const Vector3d& q, const Vector3d& W, doub
   return a;
 }
 
-double edge_travel(const Cutter& c, const Vector3d& q1, const Vector3d& q2, const Vector3d& W, double cap) {
+double edge_travel(const Cutter& c, const Vector3d& q1, const Vector3d& q2, const Vector3d& W, double cap,
+                   Vector3d* contact_normal) {
   // Cheap bound first: q(s) - t W = X in K gives t = (q(s) - X) . W >= min q . W - max_K X . W.
   if (std::min(q1.dot(W), q2.dot(W)) - support(c, W).value >= cap) return kNoTravel;
   const Vector3d E = q2 - q1;
@@ -248,7 +249,9 @@ double edge_travel(const Cutter& c, const Vector3d& q1, const Vector3d& q2, cons
   // Guard against a lost contact (a line nearly parallel to the motion's plane): the contact must be in K's
   // bounding ball about the tip (loosely: only garbage is to be caught).
   const double reach = std::hypot(c.max_radius(), c.cutting_length());
-  return (origin + u * E).norm() <= 1.01 * reach ? t : kNoTravel;
+  if (!((origin + u * E).norm() <= 1.01 * reach)) return kNoTravel;
+  if (contact_normal) *contact_normal = N;  // the supporting plane of K that the line meets
+  return t;
 }
 
 double facet_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
@@ -277,16 +280,48 @@ double facet_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, con
   return t;
 }
 
+namespace {
+
+// K's outward normal at the point x of its surface (not unit): the top cap, the side, or the profile below.
+Vector3d surface_normal(const Cutter& c, const Vector3d& x) {
+  const double rho = std::sqrt(x.x() * x.x() + x.y() * x.y()), rmax = c.max_radius();
+  const double rr = std::min(rho, rmax);
+  if (x.z() - c.cutting_length() > c.height(rr) - x.z()) return Vector3d::UnitZ();
+  if (!(rho > 0)) return -Vector3d::UnitZ();
+  if (rho >= rmax) return Vector3d(x.x() / rho, x.y() / rho, 0.0);
+  const double k = c.slope(rr) / rho;
+  return Vector3d(k * x.x(), k * x.y(), -1.0);
+}
+
+}  // namespace
+
 double triangle_travel(const Cutter& c, const Vector3d& q0, const Vector3d& q1, const Vector3d& q2,
-                       const Vector3d& W, double cap, unsigned edges) {
-  double t = std::min(cap, facet_travel(c, q0, q1, q2, W, cap));
-  t = std::min(t, vertex_travel(c, q0, W, t));
-  t = std::min(t, vertex_travel(c, q1, W, t));
-  t = std::min(t, vertex_travel(c, q2, W, t));
-  if (edges & 1u) t = std::min(t, edge_travel(c, q0, q1, W, t));
-  if (edges & 2u) t = std::min(t, edge_travel(c, q1, q2, W, t));
-  if (edges & 4u) t = std::min(t, edge_travel(c, q2, q0, W, t));
-  return t < cap ? t : kNoTravel;
+                       const Vector3d& W, double cap, unsigned edges, Vector3d* normal) {
+  const double facet = facet_travel(c, q0, q1, q2, W, cap);
+  double t = std::min(cap, facet);
+  const Vector3d* q[3] = {&q0, &q1, &q2};
+  int vertex = -1, edge = -1;
+  for (int k = 0; k < 3; ++k) {
+    const double v = vertex_travel(c, *q[k], W, t);
+    if (v < t) t = v, vertex = k;
+  }
+  Vector3d n;
+  for (int k = 0; k < 3; ++k)
+    if (edges & (1u << k)) {
+      const double e = edge_travel(c, *q[k], *q[(k + 1) % 3], W, t, normal ? &n : nullptr);
+      if (e < t) t = e, edge = k;
+    }
+  if (!(t < cap)) return kNoTravel;
+  if (normal && edge < 0) {
+    if (vertex >= 0) {
+      n = surface_normal(c, *q[vertex] - t * W);
+    } else {  // the facet: its normal facing away from the incoming K
+      n = (q1 - q0).cross(q2 - q0);
+      if (n.dot(W) < 0) n = -n;
+    }
+  }
+  if (normal) *normal = n;
+  return t;
 }
 
 void require_finite_length(const Cutter& c) {

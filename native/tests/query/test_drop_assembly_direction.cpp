@@ -8,7 +8,9 @@
 //    lowest grown rim;
 //  - along the tool's axis the vertical assembly drop, bit for bit; a hair off the axis (the solids' path) the
 //    same within the hair's effect;
-//  - the batch equals the points, threads agree; an endless cutter with nothing above it is refused.
+//  - the batch equals the points, threads agree, also where the holder stops the tool beside a dome (the
+//    bodies dropped first on the triangle that last stopped them); an endless cutter with nothing above it is
+//    refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Core>
@@ -17,6 +19,7 @@
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "support/test_meshes.hpp"
@@ -121,6 +124,26 @@ TEST(DropAssemblyDirection, SolidsAreTheGrownAssembly) {
     EXPECT_GT(in, 1000);
     EXPECT_GT(out, 1000);
   }
+}
+
+// A height field z(x, y) over a plate 40 wide about the origin, 1 mm cells of two triangles.
+template <class Height>
+std::pair<tmm::Vertices, tmm::Triangles> height_grid(Height&& z) {
+  const int cells = 40;
+  tmm::Vertices V((cells + 1) * (cells + 1), 3);
+  tmm::Triangles F(2 * cells * cells, 3);
+  for (int i = 0; i <= cells; ++i)
+    for (int j = 0; j <= cells; ++j) {
+      const double x = i - 20.0, y = j - 20.0;
+      V.row(i * (cells + 1) + j) << x, y, z(x, y);
+    }
+  for (int i = 0, f = 0; i < cells; ++i)
+    for (int j = 0; j < cells; ++j) {
+      const int a = i * (cells + 1) + j;
+      F.row(f++) << a, a + cells + 1, a + 1;
+      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
+    }
+  return {V, F};
 }
 
 // Every solid against every triangle by drop_along: the earliest travel and its piece.
@@ -301,21 +324,10 @@ TEST(DropAssemblyDirection, BatchIsPointByPointAndThreadsAgree) {
 // batch; every travel and piece is the point's own, and the exact per-triangle reference's on a sample.
 TEST(DropAssemblyDirection, SharedTiltedAxisBatchIsPointByPoint) {
   // A plate 40 wide with a pocket 16 wide and 18 deep (its floor a dome): the bodies meet the walls and the rim.
-  const int cells = 40;
-  tmm::Vertices V((cells + 1) * (cells + 1), 3);
-  tmm::Triangles F(2 * cells * cells, 3);
-  for (int i = 0; i <= cells; ++i)
-    for (int j = 0; j <= cells; ++j) {
-      const double x = i - 20.0, y = j - 20.0;
-      const bool inside = std::fabs(x) < 8 && std::fabs(y) < 8;
-      V.row(i * (cells + 1) + j) << x, y, inside ? -18 + 2 * std::cos(x / 4) * std::cos(y / 4) : 0.0;
-    }
-  for (int i = 0, f = 0; i < cells; ++i)
-    for (int j = 0; j < cells; ++j) {
-      const int a = i * (cells + 1) + j;
-      F.row(f++) << a, a + cells + 1, a + 1;
-      F.row(f++) << a + 1, a + cells + 1, a + cells + 2;
-    }
+  const auto [V, F] = height_grid([](double x, double y) {
+    const bool inside = std::fabs(x) < 8 && std::fabs(y) < 8;
+    return inside ? -18 + 2 * std::cos(x / 4) * std::cos(y / 4) : 0.0;
+  });
   const Vector3d dir = Vector3d(0.2, 0.1, -1).normalized();
   const tmm::DirectionalIndex index(V, F, dir);
   const Vector3d axis = Vector3d(0.45, -0.2, 1).normalized();  // about 26 deg off -dir
@@ -408,6 +420,48 @@ TEST(DropAssemblyDirection, TiledBatchKeepsNeighboursCandidates) {
     EXPECT_LT(body, static_cast<int>(n) * 9 / 10);
     EXPECT_GT(cutter_on_post, 10);
   }
+}
+
+// One tilted axis over a dome on a plate (as sphere_on_plate): beside the dome the holder stops the tool while
+// the cutter hangs over the plate, and the batch drops each body first against the triangle that last stopped it
+// nearby (its travel caps the cutter's walk), then solves the rest of its list past that contact's plane of
+// support; the dome's triangles meet the tool at shared vertices (ties no clearance proof separates). Every
+// travel and piece is the point query's, and the exact per-triangle reference's on a sample.
+TEST(DropAssemblyDirection, HolderStopsTheToolFirstBesideADome) {
+  const auto [V, F] = height_grid([](double x, double y) {  // a dome of radius 12
+    const double r2 = x * x + y * y;
+    return r2 < 144 ? std::sqrt(144 - r2) : 0.0;
+  });
+  const Vector3d dir = Vector3d(0.2, 0.1, -1).normalized();
+  const tmm::DirectionalIndex index(V, F, dir);
+  const Vector3d axis = Vector3d(0.45, 0.1, 1).normalized();  // about 15 deg off -dir
+  const ToolAssembly tool(Cutter::apt(3, 1, 8, 0, 0), {{8, 16, 3, 3, 0.5}, {16, 60, 14, 14, 1.5}}, 0.0);
+  const auto solids = tmm::assembly_solids(tool);
+  std::vector<double> starts;
+  for (int i = 0; i < 26; ++i)  // a zig-zag raster, as a path visits it
+    for (int j = 0; j < 26; ++j) starts.insert(starts.end(), {-26 + 1.5 * (i % 2 ? 25 - j : j), -22 + 1.5 * i, 40.0});
+  const std::size_t n = starts.size() / 3;
+  std::vector<double> travel(n);
+  std::vector<int32_t> by(n);
+  tmm::drop_assembly_along_batch(index, tool, starts.data(), axis.data(), false, n, 80.0, travel.data(), by.data(),
+                                 tmm::BatchOptions());
+  int holder = 0, cutter = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    int32_t b = 0;
+    const double tp = tmm::drop_assembly_along_point(index, tool, Vector3d(&starts[3 * i]), axis, 80.0, &b);
+    ASSERT_NEAR(travel[i], tp, 1e-12) << i;
+    ASSERT_EQ(by[i], b) << i;
+    holder += b == 1;
+    cutter += b == tmm::kSetByCutter;
+    if (i % 23 == 0) {
+      int32_t brute_by = 0;
+      const double brute = brute_travel(solids, V, F, Vector3d(&starts[3 * i]), axis, dir, brute_by);
+      ASSERT_NEAR(travel[i], std::min(brute, 80.0), 1e-9) << i;
+      ASSERT_EQ(by[i], brute < 80.0 ? brute_by : tmm::kSetByFloor) << i;
+    }
+  }
+  EXPECT_GT(holder, static_cast<int>(n) / 10) << cutter;
+  EXPECT_GT(cutter, static_cast<int>(n) / 5) << holder;
 }
 
 TEST(DropAssemblyDirection, Refusals) {

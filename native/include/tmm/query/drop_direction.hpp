@@ -65,15 +65,17 @@ Support support(const Cutter& c, const Eigen::Vector3d& d);
 // Each returns the first-contact travel if it is below `cap`, else kNoTravel (only earlier contacts matter
 // in a mesh query, which lets most candidates stop early).
 double vertex_travel(const Cutter& c, const Eigen::Vector3d& q, const Eigen::Vector3d& W, double cap = kNoTravel);
+// normal (or null): set to K's outward normal at the contact when one is returned.
 double edge_travel(const Cutter& c, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2, const Eigen::Vector3d& W,
-                   double cap = kNoTravel);
+                   double cap = kNoTravel, Eigen::Vector3d* normal = nullptr);
 double facet_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1, const Eigen::Vector3d& q2,
                     const Eigen::Vector3d& W, double cap = kNoTravel);
 // The triangle's first contact before cap (kNoTravel if none): facet, vertices and the edges selected by bit k
-// of `edges` (corner k to k + 1; see IndexedTriangle::owned_edges).
+// of `edges` (corner k to k + 1; see IndexedTriangle::owned_edges). normal (or null): K's outward normal at
+// that contact (a normal of its plane of support there; not unit), when one is returned.
 double triangle_travel(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
                        const Eigen::Vector3d& q2, const Eigen::Vector3d& W, double cap = kNoTravel,
-                       unsigned edges = 7u);
+                       unsigned edges = 7u, Eigen::Vector3d* normal = nullptr);
 // std::invalid_argument for an endless cutter (L_C = inf): the general method needs a bounded solid.
 void require_finite_length(const Cutter& c);
 }  // namespace direction_detail
@@ -164,8 +166,17 @@ class AlongCutter {
               std::size_t limit) const;
   // drop() over a list gathered for this start with a cap of at least max_travel, in place of the walk: the
   // same travel. Each candidate keeps the plane that proved it clear, which the next start tries first.
+  // `known` (or -1): a triangle already solved from this start (drop_on) with a cap of at least max_travel;
+  // `tangent` (or null): the plane of support drop_on found with it.
   double drop_listed(const Eigen::Vector3d& start, double max_travel, Candidates& cands,
-                     DropStats* stats = nullptr, int32_t* hint = nullptr) const;
+                     DropStats* stats = nullptr, int32_t* hint = nullptr, int32_t known = -1,
+                     const Eigen::Vector4d* tangent = nullptr) const;
+  // The first contact with the index's triangle `tri` alone, below max_travel (else max_travel): the travel a
+  // walk finds for it, so an upper bound of drop() that is a contact of this solid. tangent (or null): set to
+  // K's plane of support there (index frame: normal, level; level +inf for none), which proves every triangle
+  // beyond it missed before that travel.
+  double drop_on(const Eigen::Vector3d& start, double max_travel, int32_t tri, DropStats* stats = nullptr,
+                 Eigen::Vector4d* tangent = nullptr) const;
 
  private:
   // A drop's state: the start (index frame), the best travel so far, its triangle, the lowest height a
@@ -175,8 +186,16 @@ class AlongCutter {
     double best, floor;
     int32_t winner = -1;
     std::size_t tested = 0;
+    // K's plane of support at the best contact (index frame): n . X <= level holds on K at every earlier travel,
+    // so a triangle with its corners on the far side (n . p >= level) is missed before the best. Unset: level
+    // +inf.
+    Eigen::Vector3d tangent = Eigen::Vector3d::Zero();
+    double level = std::numeric_limits<double>::infinity();
   };
   Search search(const Eigen::Vector3d& start, double max_travel) const;
+  static bool beyond(const Search& q, const IndexedTriangle& t);
+  // q's tangent plane from K's outward normal n (tool frame) at its best contact.
+  void set_tangent(Search& q, const Eigen::Vector3d& n) const;
   // plane (or null): a candidate's last separating normal, tried first and updated.
   void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr) const;
   // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
