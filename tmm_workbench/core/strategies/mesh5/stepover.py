@@ -58,6 +58,12 @@ MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
+# the postures kept at each CC point: those reaching at least this share of the left reach the pass can make
+# at the WIDE_QUANTILE of its CC points (or of the point's own widest, where less)
+WIDE_SHARE = 0.97
+WIDE_QUANTILE = 0.05
+GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
+AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -112,6 +118,74 @@ def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn:
         else:
             b = mid
     return 0.5 * (a + b)
+
+
+def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, cs: CSpace,
+                 tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """(n, P) left and right half-widths (as half_widths, inf where the mesh ends first, NaN where the
+    posture is not available) of every available posture of the C-space at its lift S2, to the section's
+    samples (the crossing linear between two): what each posture would finish, to choose from."""
+    n = len(points)
+    lam, omg = (g.ravel() for g in cs.grid.mesh())
+    ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
+    lateral = np.concatenate([ys, -ys[1:]])
+    S = surface_heights(reach, points, frames, np.tile(lateral, (n, 1)), 3.0 * cutter.radius)
+    py, pz = lower_profile(cutter, lam, omg, 2001)
+    h = 0.01 * cutter.radius
+    g = np.arange(-3.0 * cutter.radius, 3.0 * cutter.radius + h, h)
+    # the profile on a uniform grid (far above beyond its ends: the side wall is no cutting edge)
+    Z = np.array([np.interp(g, py[p], pz[p], left=1e9, right=1e9) for p in range(len(lam))])
+    a = tool_rotation(lam, omg)[:, 2, 1:]
+    avail = cs.available.reshape(n, -1)
+    lift = cs.lift.reshape(n, -1)
+    out = np.full((2, n, len(lam)), np.nan)
+    sides = (np.arange(len(ys)), np.r_[0, len(ys):len(lateral)])
+    for i in range(n):
+        ps = np.flatnonzero(avail[i])
+        if ps.size == 0:
+            continue
+        d = lift[i, ps][:, None]
+        u = np.clip((lateral[None, :] - d * a[ps, :1] - g[0]) / h, 0.0, len(g) - 1.001)
+        k = u.astype(np.int64)
+        t = u - k
+        z = Z[ps[:, None], k] * (1 - t) + Z[ps[:, None], k + 1] * t + d * a[ps, 1:]
+        rem = z - S[i][None, :]
+        for side, sl in enumerate(sides):
+            r = rem[:, sl]
+            over = ~(r <= tolerance)
+            first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
+            rows = np.arange(len(ps))
+            k1 = np.minimum(first, len(ys) - 1)
+            k0 = np.maximum(first - 1, 0)
+            r0, r1 = r[rows, k0], r[rows, k1]
+            frac = np.clip((tolerance - r0) / np.where(r1 > r0, r1 - r0, np.inf), 0.0, 1.0)
+            w = np.where(first == 0, 0.0, ys[k0] + frac * (ys[k1] - ys[k0]))
+            w = np.where(first >= len(ys), ys[-1], w)
+            w = np.where((first < len(ys)) & np.isnan(r1), np.inf, w)       # the mesh ended first
+            out[side, i, ps] = w
+    return out[0], out[1]
+
+
+def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
+                  cs: CSpace, right: np.ndarray, across: np.ndarray) -> CSpace:
+    """The C-space kept to the postures that finish the widest strip: at each CC point those whose right
+    half-width reaches its right side step `right` (n,) (all that reach furthest where none does) and whose
+    left one reaches, along the plane normal (LY's share `across` (n,)), as far as the pass can uniformly
+    (WIDE_QUANTILE of the CC points' widest) or its own widest where less. The seed measures the half-widths
+    at the ideal posture; chosen for the motion time alone, the postures only just meet the side steps asked,
+    and the passes are no wider than the guess."""
+    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance)
+    ok = rgt >= right[:, None] - 1e-6
+    none = ~ok.any(axis=1)
+    best_r = np.nanmax(np.where(np.isnan(rgt), -np.inf, rgt), axis=1)
+    ok[none] = rgt[none] >= best_r[none, None] - 0.05 * cutter.radius
+    reach_l = np.where(ok, left * across[:, None], -np.inf)
+    best = reach_l.max(axis=1)
+    fin = best[np.isfinite(best)]
+    target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
+    keep = ok & (reach_l >= WIDE_SHARE * np.minimum(best, target)[:, None])
+    lift = np.where(keep.reshape(cs.lift.shape), cs.lift, np.nan)
+    return CSpace(cs.grid, lift, cs.top)
 
 
 @dataclass(frozen=True)
@@ -190,7 +264,8 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
-               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, assembly: Optional[ToolAssembly] = None):
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray,
+               assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
     ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
     some CC point still has no posture. Where a path was cut short (beyond the machine's tilt), the CC points
@@ -204,6 +279,7 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
             return None
         pts, frm, side = pts[keep], frm[keep], side[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
+    cs = widest_cspace(reach, cutter, tolerance, pts, frm, cs, side[:, 1], np.maximum(frm[:, 1] @ m, 0.2))
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
@@ -384,7 +460,8 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
             side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
-            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, assembly)
+            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, m,
+                             assembly)
             if got is not None:
                 paths = got[4]
                 level, short = cover.advanced(paths, got[2])
@@ -415,11 +492,12 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
                                        gap, runs))
         plan.partial += short > 0
         _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset)
-        # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
-        # asked a little more while every CC point meets them
-        relaxed = bool((used[:, 0] < ahead - 1e-9).any())
-        ahead = float(np.clip(ahead * (0.95 if relaxed else 1.1), 0.05 * cutter.radius, 2 * cutter.radius))
-        gap = ahead
+        # the next pass's right side step as this one's left one (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
+        # the postures being the widest: half the width this pass finished (left + right along m) at most CC
+        # points, so that the next one splits it evenly
+        total = (left - offset) + (offset - right)
+        gap = float(np.clip(0.5 * np.quantile(total, GAP_QUANTILE), 0.05 * cutter.radius, 2 * cutter.radius))
+        ahead = AHEAD_SHARE * gap
         guess = offset + 2 * gap
         if progress is not None and progress(1.0 - float(np.mean(cover.open))) is False:
             raise Cancelled("5-axis mesh step-over cancelled")   # never a partial plan passed on as whole
