@@ -62,6 +62,11 @@ INTERIOR = 3
 # at the WIDE_QUANTILE of its CC points (or of the point's own widest, where less)
 WIDE_SHARE = 0.97
 WIDE_QUANTILE = 0.05
+# a CC point at a path's end whose widest left reach is below this share of the pass's median (the end runs
+# down a slope near the machine's tilt, or across a curve the flat bottom cannot follow) is left out, its bins
+# for clean-up, up to END_PEEL of them at each end: kept, it held every next plane back to its bins
+NARROW = 0.5
+END_PEEL = 3
 GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
 AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
@@ -161,19 +166,27 @@ def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: n
             frac = np.clip((tolerance - r0) / np.where(r1 > r0, r1 - r0, np.inf), 0.0, 1.0)
             w = np.where(first == 0, 0.0, ys[k0] + frac * (ys[k1] - ys[k0]))
             w = np.where(first >= len(ys), ys[-1], w)
-            w = np.where((first < len(ys)) & np.isnan(r1), np.inf, w)       # the mesh ended first
+            # the mesh ended first: the whole side when the tool is there beyond the last sample on the mesh
+            # too (the section there extrapolated), else only up to that sample (the edge left a sliver)
+            k2 = np.maximum(first - 2, 0)
+            s_sl = S[i][sl]
+            ext = 2 * s_sl[k0] - s_sl[k2]
+            zk = z[rows, sl[k1]]
+            covered = (zk < 1e8) & (zk - ext <= tolerance)
+            w = np.where((first < len(ys)) & np.isnan(r1), np.where(covered, np.inf, ys[k0]), w)
             out[side, i, ps] = w
     return out[0], out[1]
 
 
 def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
-                  cs: CSpace, right: np.ndarray, across: np.ndarray) -> CSpace:
+                  cs: CSpace, right: np.ndarray, across: np.ndarray) -> tuple[CSpace, np.ndarray]:
     """The C-space kept to the postures that finish the widest strip: at each CC point those whose right
     half-width reaches its right side step `right` (n,) (all that reach furthest where none does) and whose
     left one reaches, along the plane normal (LY's share `across` (n,)), as far as the pass can uniformly
     (WIDE_QUANTILE of the CC points' widest) or its own widest where less. The seed measures the half-widths
     at the ideal posture; chosen for the motion time alone, the postures only just meet the side steps asked,
-    and the passes are no wider than the guess."""
+    and the passes are no wider than the guess. Also (n,): the CC points that fall short, their right side
+    short of its step or their left reach below NARROW of the pass's."""
     left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance)
     ok = rgt >= right[:, None] - 1e-6
     none = ~ok.any(axis=1)
@@ -185,7 +198,27 @@ def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np
     target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
     keep = ok & (reach_l >= WIDE_SHARE * np.minimum(best, target)[:, None])
     lift = np.where(keep.reshape(cs.lift.shape), cs.lift, np.nan)
-    return CSpace(cs.grid, lift, cs.top)
+    narrow = none | (best < NARROW * float(np.median(fin)) if fin.size else none)
+    return CSpace(cs.grid, lift, cs.top), narrow
+
+
+def _peel_ends(paths: List[CCPath], short: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
+    """The paths without the runs of up to END_PEEL CC points at either end that fall `short` (n,) (those
+    ends then cut short: their bins are left for clean-up, _beyond_tilt), and the kept indices."""
+    out, keep, start = [], [], 0
+    for p in paths:
+        e = short[start:start + len(p)]
+        a, b = 0, len(p)
+        while a < min(END_PEEL, b) and e[a]:
+            a += 1
+        while b > max(len(p) - END_PEEL, a) and e[b - 1]:
+            b -= 1
+        if b - a >= 2:
+            cut = (p.cut_short[0] or a > 0, p.cut_short[1] or b < len(p))
+            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b), cut_short=cut))
+            keep.append(np.arange(start + a, start + b))
+        start += len(p)
+    return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
 
 
 @dataclass(frozen=True)
@@ -264,7 +297,7 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
-               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray,
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, edge: np.ndarray,
                assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
     ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
@@ -272,14 +305,22 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     with no posture next to that end are left out too (the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
+    need = np.where(edge, np.inf, side[:, 1])             # at the mesh's own edge: the right side all the way
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
     if cs.empty.any():
         paths, keep = _peel(paths, cs.empty)
         if not paths or cs.empty[keep].any():
             return None
+        pts, frm, side, need = pts[keep], frm[keep], side[keep], need[keep]
+        cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
+    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, need, np.maximum(frm[:, 1] @ m, 0.2))
+    narrow &= np.isfinite(need)                            # not for the mesh's own edge alone
+    if narrow.any():
+        paths, keep = _peel_ends(paths, narrow)
+        if not paths:
+            return None
         pts, frm, side = pts[keep], frm[keep], side[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
-    cs = widest_cspace(reach, cutter, tolerance, pts, frm, cs, side[:, 1], np.maximum(frm[:, 1] @ m, 0.2))
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
@@ -459,9 +500,10 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         for _ in range(MAX_TRIES):
             offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
-            side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
+            need = cover.needed(paths)
+            side = _side_steps(reach, paths, need, offset, m, ahead, 2 * cutter.radius)
             got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, m,
-                             assembly)
+                             need[1], assembly)
             if got is not None:
                 paths = got[4]
                 level, short = cover.advanced(paths, got[2])
