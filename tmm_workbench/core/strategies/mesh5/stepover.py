@@ -67,6 +67,10 @@ WIDE_QUANTILE = 0.05
 # for clean-up, up to END_PEEL of them at each end: kept, it held every next plane back to its bins
 NARROW = 0.5
 END_PEEL = 3
+# a plane that would come back to less than REPEAT x the gap beyond the last one, pulled back by at most LAGGING
+# bins, leaves those for clean-up instead (each such plane cut a sliver: 8 passes for 5 mm)
+REPEAT = 0.3
+LAGGING = 4
 GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
 AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
@@ -336,18 +340,20 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
 
 
 def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
-    """The paths without the CC points with an empty C-space next to an end cut short, and the kept CC
-    points' indices (all paths in order); a path left with fewer than 2 CC points is dropped."""
+    """The paths without the CC points with an empty C-space next to an end cut short (or up to END_PEEL at
+    any end: that end then cut short, its bins left for clean-up), and the kept CC points' indices (all paths
+    in order); a path left with fewer than 2 CC points is dropped."""
     out, keep, start = [], [], 0
     for p in paths:
         e = empty[start:start + len(p)]
         a, b = 0, len(p)
-        while p.cut_short[0] and a < b and e[a]:
+        while (p.cut_short[0] or a < END_PEEL) and a < b and e[a]:
             a += 1
-        while p.cut_short[1] and b > a and e[b - 1]:
+        while (p.cut_short[1] or b > len(p) - END_PEEL) and b > a and e[b - 1]:
             b -= 1
         if b - a >= 2:
-            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b)))
+            cut = (p.cut_short[0] or a > 0, p.cut_short[1] or b < len(p))
+            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b), cut_short=cut))
             keep.append(np.arange(start + a, start + b))
         start += len(p)
     return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
@@ -469,6 +475,24 @@ def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: 
     cover.level = level
 
 
+def _give_up_lagging(plan: AdaptivePlan, cover: Coverage, paths: List[CCPath], base: float, gap: float) -> bool:
+    """A plane about to come back to the last one's offset, pulled back by a few bins that passes left short
+    (a path's end held by the slope or the mesh's edge): those bins (within half a gap of the least level,
+    at most LAGGING of them) are listed for clean-up up to the least level of the plane's other bins, and the
+    plane is placed again from there. True where some were."""
+    span = cover.spanned(paths) & cover.open
+    lag = span & (cover.level < base + 0.5 * gap)
+    rest = span & ~lag
+    if not lag.any() or lag.sum() > LAGGING or not rest.any():
+        return False
+    reached = float(cover.level[rest].min())
+    for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, lag.astype(np.int8), 0]))[k::2] for k in (0, 1))):
+        plan.unfinished.append((float(cover.f0 + cover.width * a), float(cover.f0 + cover.width * b),
+                                float(cover.level[a:b].min()), reached))
+    cover.level = np.where(lag, np.maximum(cover.level, reached), cover.level)
+    return True
+
+
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
                     machine: Optional[TarusMachine] = None, grid: Optional[PostureGrid] = None,
                     forward_step: float = 2.0, chord_tolerance: float = 0.01, ideal_weight: float = 0.1,
@@ -499,6 +523,9 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     while cover.open.any():
         for _ in range(MAX_TRIES):
             offset, paths, base = planes.place(guess, gap)
+            if plan.passes and offset < plan.passes[-1].offset + REPEAT * gap and \
+                    _give_up_lagging(plan, cover, paths, base, gap):
+                offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
             need = cover.needed(paths)
             side = _side_steps(reach, paths, need, offset, m, ahead, 2 * cutter.radius)
