@@ -70,7 +70,7 @@ END_PEEL = 3
 # a plane that would come back to less than REPEAT x the gap beyond the last one, pulled back by at most LAGGING
 # bins, leaves those for clean-up instead (each such plane cut a sliver: 8 passes for 5 mm)
 REPEAT = 0.3
-LAGGING = 4
+LAGGING = 6
 GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
 AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
@@ -130,10 +130,11 @@ def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn:
 
 
 def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, cs: CSpace,
-                 tolerance: float) -> tuple[np.ndarray, np.ndarray]:
-    """(n, P) left and right half-widths (as half_widths, inf where the mesh ends first, NaN where the
-    posture is not available) of every available posture of the C-space at its lift S2, to the section's
-    samples (the crossing linear between two): what each posture would finish, to choose from."""
+                 tolerance: float, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, P) how far along the plane normal m each available posture of the C-space at its lift S2
+    finishes on the left (+m) and back on the right (-m) (the half-widths as half_widths, to the section's
+    samples, the crossing linear between two, and their section points' share of m; inf where the mesh ends
+    first, NaN where the posture is not available): what each posture would finish, to choose from."""
     n = len(points)
     lam, omg = (g.ravel() for g in cs.grid.mesh())
     ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
@@ -149,6 +150,7 @@ def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: n
     lift = cs.lift.reshape(n, -1)
     out = np.full((2, n, len(lam)), np.nan)
     sides = (np.arange(len(ys)), np.r_[0, len(ys):len(lateral)])
+    ly, lz = frames[:, 1] @ m, frames[:, 2] @ m
     for i in range(n):
         ps = np.flatnonzero(avail[i])
         if ps.size == 0:
@@ -178,25 +180,28 @@ def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: n
             zk = z[rows, sl[k1]]
             covered = (zk < 1e8) & (zk - ext <= tolerance)
             w = np.where((first < len(ys)) & np.isnan(r1), np.where(covered, np.inf, ys[k0]), w)
-            out[side, i, ps] = w
+            s0, s1 = s_sl[k0], s_sl[k1]
+            s_w = np.where(first >= len(ys), s_sl[-1], np.where(np.isnan(s1), s0, s0 + frac * (s1 - s0)))
+            sgn = 1.0 if side == 0 else -1.0
+            out[side, i, ps] = np.where(np.isinf(w), w, w * ly[i] + sgn * s_w * lz[i])
     return out[0], out[1]
 
 
 def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
-                  cs: CSpace, right: np.ndarray, across: np.ndarray) -> tuple[CSpace, np.ndarray]:
+                  cs: CSpace, back: np.ndarray, m: np.ndarray) -> tuple[CSpace, np.ndarray]:
     """The C-space kept to the postures that finish the widest strip: at each CC point those whose right
-    half-width reaches its right side step `right` (n,) (all that reach furthest where none does) and whose
-    left one reaches, along the plane normal (LY's share `across` (n,)), as far as the pass can uniformly
+    half-width reaches `back` (n,) along -m (the level of its bins; all that reach furthest where none does)
+    and whose left one reaches, along the plane normal m, as far as the pass can uniformly
     (WIDE_QUANTILE of the CC points' widest) or its own widest where less. The seed measures the half-widths
     at the ideal posture; chosen for the motion time alone, the postures only just meet the side steps asked,
     and the passes are no wider than the guess. Also (n,): the CC points that fall short, their right side
     short of its step or their left reach below NARROW of the pass's."""
-    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance)
-    ok = rgt >= right[:, None] - 1e-6
+    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance, m)
+    ok = rgt >= back[:, None] - 1e-6
     none = ~ok.any(axis=1)
     best_r = np.nanmax(np.where(np.isnan(rgt), -np.inf, rgt), axis=1)
     ok[none] = rgt[none] >= best_r[none, None] - 0.05 * cutter.radius
-    reach_l = np.where(ok, left * across[:, None], -np.inf)
+    reach_l = np.where(ok, left, -np.inf)
     best = reach_l.max(axis=1)
     fin = best[np.isfinite(best)]
     target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
@@ -301,7 +306,7 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
-               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, edge: np.ndarray,
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, back: np.ndarray,
                assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
     ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
@@ -309,16 +314,15 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     with no posture next to that end are left out too (the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
-    need = np.where(edge, np.inf, side[:, 1])             # at the mesh's own edge: the right side all the way
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
     if cs.empty.any():
         paths, keep = _peel(paths, cs.empty)
         if not paths or cs.empty[keep].any():
             return None
-        pts, frm, side, need = pts[keep], frm[keep], side[keep], need[keep]
+        pts, frm, side, back = pts[keep], frm[keep], side[keep], back[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
-    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, need, np.maximum(frm[:, 1] @ m, 0.2))
-    narrow &= np.isfinite(need)                            # not for the mesh's own edge alone
+    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, back, m)
+    narrow &= np.isfinite(back)                            # not for the mesh's own edge alone
     if narrow.any():
         paths, keep = _peel_ends(paths, narrow)
         if not paths:
@@ -530,7 +534,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             need = cover.needed(paths)
             side = _side_steps(reach, paths, need, offset, m, ahead, 2 * cutter.radius)
             got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, m,
-                             need[1], assembly)
+                             np.where(need[1], np.inf, offset - need[0]), assembly)
             if got is not None:
                 paths = got[4]
                 level, short = cover.advanced(paths, got[2])
