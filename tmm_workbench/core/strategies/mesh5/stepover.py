@@ -15,14 +15,18 @@ across the surface is finished is kept per 2 mm bin of the feed coordinate (pass
 boundary runs slanted across the planes). The first plane lies 0.125 D inside the mesh (eq. 3.22). Each next
 plane goes a gap beyond the least finished level of the open bins its own path runs through, and no higher
 than the top of any open bin. Its C-space is built with, per CC point, the right side step reaching back to
-the level of its bins and the left one the gap asked of the next pass (eq. 3.21's d_step_{i+1,R} =
-d_step_{i,L}, asked 10 % more after a pass that met it everywhere); a CC point with no posture for its left
-step gets a smaller one, a CC point with none for its right step moves the plane nearer. The postures are
-chosen for the motion time (optimal.smooth_postures) and the real half-widths measured; a bin advances to the
-least left boundary of its CC points where their right boundaries reach its level, and keeps its level
-(for the next pass) where they do not. The passes are planned at MARGIN of the tolerance. The tools go on an
-overrun of a radius beyond the ends of each path, each position lifted clear of the mesh
-(tool_moves.overrun_positions), which the bins count (coverage.Coverage).
+the level of its bins and the left one a share of the gap; a CC point with no posture for its left step gets a
+smaller one, a CC point with none for its right step moves the plane nearer (next to a path's end it is left
+out instead, its bins for clean-up). In the C-space each CC point keeps the postures that finish the widest
+strip (widest_cspace: the right side back to its bins' level, the left as far along the plane normal as the
+pass can reach at nearly all its CC points; the seed measures the half-widths at its ideal posture), and among
+them the postures are chosen for the motion time (optimal.smooth_postures); the next gap is half the width the
+pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured; a
+bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
+keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
+pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
+tolerance. The tools go on an overrun of a radius beyond the ends of each path, each position lifted clear of
+the mesh (tool_moves.overrun_positions), which the bins count (coverage.Coverage).
 """
 from __future__ import annotations
 
