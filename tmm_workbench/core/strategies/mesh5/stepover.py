@@ -8,7 +8,8 @@ difference. The left (+LY) half-width is the largest d with the remaining height
 [0, d], the right one the same on [-d, 0]: the seed's eq. 3.29-3.32 solve the same for one rim point of the
 flat end mill (alpha); here it is the whole profile, for any posture and the bull-nose too, at the posture
 that will be cut (the seed estimates it by CM2 first, and takes 0.9 of the result, eq. 3.33). Where the mesh
-ends first, that side is covered to the edge (inf).
+ends first, that side is covered to the edge (inf) when the tool is there beyond the last section sample on
+the mesh too; else it ends at that sample (the bin stays open: no sliver left along the edge silently).
 
 Passes. The drive planes are placed one after another across the mesh (along their normal m); how far
 across the surface is finished is kept per 2 mm bin of the feed coordinate (passes end where the mesh's
@@ -108,15 +109,26 @@ def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np
                 widths[i, side] = np.inf if np.isnan(hs).any() else y[-1]
                 continue
             k = int(over[0])
-            if np.isnan(hs[k]):
+            sgn = 1.0 if side == 0 else -1.0
+            if np.isnan(hs[k]) and _past_edge(py[i], pz[i], y, S[i][sl], sgn, k, tolerance):
                 widths[i, side] = np.inf
                 continue
-            sgn = 1.0 if side == 0 else -1.0
-            d = 0.0 if k == 0 else _crossing(py[i], pz[i], y, S[i][sl], sgn, y[k - 1], y[k], tolerance)
+            d = 0.0 if k == 0 else y[k - 1] if np.isnan(hs[k]) else _crossing(py[i], pz[i], y, S[i][sl], sgn, y[k - 1], y[k], tolerance)
             widths[i, side] = d
-            s_d = np.interp(d, y, S[i][sl])
+            s_d = S[i][sl][k - 1] if np.isnan(hs[k]) else np.interp(d, y, S[i][sl])
             ends[i, side] = pts[i] + sgn * d * frm[i, 1] + s_d * frm[i, 2]
     return widths, ends
+
+
+def _past_edge(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, k: int,
+               tolerance: float) -> bool:
+    """Whether the profile covers the section beyond its last sample on the mesh (k - 1): at sample k (off
+    the mesh, the section extrapolated from the two before) the tool is there within the tolerance. Else the
+    side ends at that sample, short of the mesh's edge (a sliver the next pass or the clean-up takes)."""
+    if k == 0:
+        return True                                                         # the CC point itself: as before
+    z = np.interp(sgn * y[k], py, pz, left=np.inf, right=np.inf)
+    return bool(z - (s[0] if k == 1 else 2 * s[k - 1] - s[k - 2]) <= tolerance)
 
 
 def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, a: float, b: float,
@@ -209,7 +221,8 @@ def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np
     best = reach_l.max(axis=1)
     fin = best[np.isfinite(best)]
     target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
-    keep = ok & (reach_l >= WIDE_SHARE * np.minimum(best, target)[:, None])
+    # where some posture covers the section to the mesh's edge, only those (the pass finishes the side)
+    keep = ok & (reach_l >= WIDE_SHARE * np.where(np.isinf(best), np.inf, np.minimum(best, target))[:, None])
     lift = np.where(keep.reshape(cs.lift.shape), cs.lift, np.nan)
     narrow = none | (best < NARROW * float(np.median(fin)) if fin.size else none)
     return CSpace(cs.grid, lift, cs.top), narrow
