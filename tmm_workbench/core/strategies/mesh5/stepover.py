@@ -228,25 +228,6 @@ def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np
     return CSpace(cs.grid, lift, cs.top), narrow
 
 
-def _peel_ends(paths: List[CCPath], short: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
-    """The paths without the runs of up to END_PEEL CC points at either end that fall `short` (n,) (those
-    ends then cut short: their bins are left for clean-up, _beyond_tilt), and the kept indices."""
-    out, keep, start = [], [], 0
-    for p in paths:
-        e = short[start:start + len(p)]
-        a, b = 0, len(p)
-        while a < min(END_PEEL, b) and e[a]:
-            a += 1
-        while b > max(len(p) - END_PEEL, a) and e[b - 1]:
-            b -= 1
-        if b - a >= 2:
-            cut = (p.cut_short[0] or a > 0, p.cut_short[1] or b < len(p))
-            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b), cut_short=cut))
-            keep.append(np.arange(start + a, start + b))
-        start += len(p)
-    return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
-
-
 @dataclass(frozen=True)
 class PlannedPass:
     """One drive plane's pass: its CC paths with their chosen postures, the half-widths (n, 2) of its CC
@@ -326,9 +307,11 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
                grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, back: np.ndarray,
                assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
-    ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
-    some CC point still has no posture. Where a path was cut short (beyond the machine's tilt), the CC points
-    with no posture next to that end are left out too (the tool there reaches the slope)."""
+    ones relaxed where no posture meets them), each CC point's postures kept to the widest (widest_cspace:
+    `back` (n,) the reach along -m to its bins' level, inf at the mesh's own edge): (postures, widths, ends,
+    side steps, paths), or None where some CC point still has no posture. CC points with no posture, or
+    narrow, at a path's end are left out (_peel; next to an end cut short by the machine's tilt, all with no
+    posture: the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
@@ -341,7 +324,7 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, back, m)
     narrow &= np.isfinite(back)                            # not for the mesh's own edge alone
     if narrow.any():
-        paths, keep = _peel_ends(paths, narrow)
+        paths, keep = _peel(paths, narrow, through_cut=False)
         if not paths:
             return None
         pts, frm, side = pts[keep], frm[keep], side[keep]
@@ -360,17 +343,18 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     return postures, widths, ends, side, paths
 
 
-def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
-    """The paths without the CC points with an empty C-space next to an end cut short (or up to END_PEEL at
-    any end: that end then cut short, its bins left for clean-up), and the kept CC points' indices (all paths
-    in order); a path left with fewer than 2 CC points is dropped."""
+def _peel(paths: List[CCPath], drop: np.ndarray, through_cut: bool = True) -> tuple[List[CCPath], np.ndarray]:
+    """The paths without the runs of CC points in `drop` (n,) at their ends: up to END_PEEL at any end (that
+    end then cut short, its bins left for clean-up: _beyond_tilt), and with `through_cut` all of a run next
+    to an end already cut short (beyond the machine's tilt: the tool there reaches the slope); and the kept CC
+    points' indices (all paths in order). A path left with fewer than 2 CC points is dropped."""
     out, keep, start = [], [], 0
     for p in paths:
-        e = empty[start:start + len(p)]
+        e = drop[start:start + len(p)]
         a, b = 0, len(p)
-        while (p.cut_short[0] or a < END_PEEL) and a < b and e[a]:
+        while ((through_cut and p.cut_short[0]) or a < END_PEEL) and a < b and e[a]:
             a += 1
-        while (p.cut_short[1] or b > len(p) - END_PEEL) and b > a and e[b - 1]:
+        while ((through_cut and p.cut_short[1]) or b > len(p) - END_PEEL) and b > a and e[b - 1]:
             b -= 1
         if b - a >= 2:
             cut = (p.cut_short[0] or a > 0, p.cut_short[1] or b < len(p))
