@@ -19,7 +19,8 @@ from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
 from tmm_workbench.core.strategies.mesh5.coverage import Coverage
-from tmm_workbench.core.strategies.mesh5.stepover import adaptive_passes, half_widths, tilt_reached
+from tmm_workbench.core.strategies.mesh5.stepover import (adaptive_passes, half_widths, reach_widths, tilt_reached,
+                                                        widest_cspace)
 from tmm_workbench.core.strategies.mesh5.tool_moves import (BETWEEN_TOL, OVERRUN_STEPS, between_positions,
                                                            clear_lifts, overrun_positions)
 from tmm_workbench.core.tools.cutter import Cutter
@@ -299,3 +300,32 @@ def test_a_move_over_a_ridge_higher_than_a_radius_is_lifted_over_it_or_refused()
         else:
             with pytest.raises(TmmError, match="no lift of 4 tool radii clears it"):
                 between_positions(reach, cutter, tips, axes, frames)
+
+
+def test_every_postures_reach_is_its_half_widths_and_the_widest_are_kept():
+    # a plane sloping across the feed: the reach along m of each available posture is where half_widths
+    # ends its side at the same posture and lift (the section point's share of m); widest_cspace keeps the
+    # widest
+    mesh = grid_mesh(lambda x, y: 0.2 * y, 20, 20, (-20, -20, 20, 20), "slope")
+    path = cc_paths(mesh, (1, 0), np.array([0.0]), 4.0, 0.01)[0]
+    pts, frm = path.points[2:4], path.frames[2:4]
+    cutter, grid, reach = Cutter.flat(10.0), PostureGrid.degrees((0, 18), (-9, 9)), MeshReach(mesh)
+    cs = build_cspace(reach, cutter, pts, frm, grid, TOL, 1.0)
+    m = np.array([0.0, 1.0, 0.0])
+    left, right = reach_widths(reach, cutter, pts, frm, cs, TOL, m)
+    lam, omg = (g.ravel() for g in grid.mesh())
+    for i in range(len(pts)):
+        ps = np.flatnonzero(cs.available[i].ravel())
+        assert ps.size > 10
+        w, ends = half_widths(reach, cutter, np.repeat(pts[i:i + 1], ps.size, 0), np.repeat(frm[i:i + 1], ps.size, 0),
+                              lam[ps], omg[ps], cs.lift[i].ravel()[ps], TOL)
+        # to the section's samples (2 R / 96 apart), never beyond the exact crossing
+        for got, exact in ((left[i, ps], (ends[:, 0] - pts[i]) @ m), (right[i, ps], (pts[i] - ends[:, 1]) @ m)):
+            assert (got <= exact + 5e-3).all() and (got >= exact - 10.0 / 96 - 5e-3).all()
+    kept, short = widest_cspace(reach, cutter, TOL, pts, frm, cs, np.full(len(pts), 0.5), m)
+    assert not short.any()
+    for i in range(len(pts)):
+        k = kept.available[i].ravel()
+        assert k.any() and (k <= cs.available[i].ravel()).all()
+        assert left[i, k].min() >= 0.97 * np.nanmax(left[i]) - 1e-9 or left[i, k].min() >= 0.97 * np.nanmin(
+            np.nanmax(left, axis=1)) - 1e-9

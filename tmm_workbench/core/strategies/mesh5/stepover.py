@@ -8,21 +8,26 @@ difference. The left (+LY) half-width is the largest d with the remaining height
 [0, d], the right one the same on [-d, 0]: the seed's eq. 3.29-3.32 solve the same for one rim point of the
 flat end mill (alpha); here it is the whole profile, for any posture and the bull-nose too, at the posture
 that will be cut (the seed estimates it by CM2 first, and takes 0.9 of the result, eq. 3.33). Where the mesh
-ends first, that side is covered to the edge (inf).
+ends first, that side is covered to the edge (inf) when the tool is there beyond the last section sample on
+the mesh too; else it ends at that sample (the bin stays open: no sliver left along the edge silently).
 
 Passes. The drive planes are placed one after another across the mesh (along their normal m); how far
 across the surface is finished is kept per 2 mm bin of the feed coordinate (passes end where the mesh's
 boundary runs slanted across the planes). The first plane lies 0.125 D inside the mesh (eq. 3.22). Each next
 plane goes a gap beyond the least finished level of the open bins its own path runs through, and no higher
 than the top of any open bin. Its C-space is built with, per CC point, the right side step reaching back to
-the level of its bins and the left one the gap asked of the next pass (eq. 3.21's d_step_{i+1,R} =
-d_step_{i,L}, asked 10 % more after a pass that met it everywhere); a CC point with no posture for its left
-step gets a smaller one, a CC point with none for its right step moves the plane nearer. The postures are
-chosen for the motion time (optimal.smooth_postures) and the real half-widths measured; a bin advances to the
-least left boundary of its CC points where their right boundaries reach its level, and keeps its level
-(for the next pass) where they do not. The passes are planned at MARGIN of the tolerance. The tools go on an
-overrun of a radius beyond the ends of each path, each position lifted clear of the mesh
-(tool_moves.overrun_positions), which the bins count (coverage.Coverage).
+the level of its bins and the left one a share of the gap; a CC point with no posture for its left step gets a
+smaller one, a CC point with none for its right step moves the plane nearer (next to a path's end it is left
+out instead, its bins for clean-up). In the C-space each CC point keeps the postures that finish the widest
+strip (widest_cspace: the right side back to its bins' level, the left as far along the plane normal as the
+pass can reach at nearly all its CC points; the seed measures the half-widths at its ideal posture), and among
+them the postures are chosen for the motion time (optimal.smooth_postures); the next gap is half the width the
+pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured; a
+bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
+keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
+pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
+tolerance. The tools go on an overrun of a radius beyond the ends of each path, each position lifted clear of
+the mesh (tool_moves.overrun_positions), which the bins count (coverage.Coverage).
 """
 from __future__ import annotations
 
@@ -58,6 +63,21 @@ MARGIN = 0.85
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
+# the postures kept at each CC point: those reaching at least this share of the left reach the pass can make
+# at the WIDE_QUANTILE of its CC points (or of the point's own widest, where less)
+WIDE_SHARE = 0.97
+WIDE_QUANTILE = 0.05
+# a CC point at a path's end whose widest left reach is below this share of the pass's median (the end runs
+# down a slope near the machine's tilt, or across a curve the flat bottom cannot follow) is left out, its bins
+# for clean-up, up to END_PEEL of them at each end: kept, it held every next plane back to its bins
+NARROW = 0.5
+END_PEEL = 3
+# a plane that would come back to less than REPEAT x the gap beyond the last one, pulled back by at most LAGGING
+# bins, leaves those for clean-up instead (each such plane cut a sliver: 8 passes for 5 mm)
+REPEAT = 0.3
+LAGGING = 6
+GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
+AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
@@ -89,15 +109,26 @@ def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np
                 widths[i, side] = np.inf if np.isnan(hs).any() else y[-1]
                 continue
             k = int(over[0])
-            if np.isnan(hs[k]):
+            sgn = 1.0 if side == 0 else -1.0
+            if np.isnan(hs[k]) and _past_edge(py[i], pz[i], y, S[i][sl], sgn, k, tolerance):
                 widths[i, side] = np.inf
                 continue
-            sgn = 1.0 if side == 0 else -1.0
-            d = 0.0 if k == 0 else _crossing(py[i], pz[i], y, S[i][sl], sgn, y[k - 1], y[k], tolerance)
+            d = 0.0 if k == 0 else y[k - 1] if np.isnan(hs[k]) else _crossing(py[i], pz[i], y, S[i][sl], sgn, y[k - 1], y[k], tolerance)
             widths[i, side] = d
-            s_d = np.interp(d, y, S[i][sl])
+            s_d = S[i][sl][k - 1] if np.isnan(hs[k]) else np.interp(d, y, S[i][sl])
             ends[i, side] = pts[i] + sgn * d * frm[i, 1] + s_d * frm[i, 2]
     return widths, ends
+
+
+def _past_edge(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, k: int,
+               tolerance: float) -> bool:
+    """Whether the profile covers the section beyond its last sample on the mesh (k - 1): at sample k (off
+    the mesh, the section extrapolated from the two before) the tool is there within the tolerance. Else the
+    side ends at that sample, short of the mesh's edge (a sliver the next pass or the clean-up takes)."""
+    if k == 0:
+        return True                                                         # the CC point itself: as before
+    z = np.interp(sgn * y[k], py, pz, left=np.inf, right=np.inf)
+    return bool(z - (s[0] if k == 1 else 2 * s[k - 1] - s[k - 2]) <= tolerance)
 
 
 def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, a: float, b: float,
@@ -112,6 +143,89 @@ def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn:
         else:
             b = mid
     return 0.5 * (a + b)
+
+
+def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, cs: CSpace,
+                 tolerance: float, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, P) how far along the plane normal m each available posture of the C-space at its lift S2
+    finishes on the left (+m) and back on the right (-m) (the half-widths as half_widths, to the section's
+    samples, the crossing linear between two, and their section points' share of m; inf where the mesh ends
+    first, NaN where the posture is not available): what each posture would finish, to choose from."""
+    n = len(points)
+    lam, omg = (g.ravel() for g in cs.grid.mesh())
+    ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
+    lateral = np.concatenate([ys, -ys[1:]])
+    S = surface_heights(reach, points, frames, np.tile(lateral, (n, 1)), 3.0 * cutter.radius)
+    py, pz = lower_profile(cutter, lam, omg, 2001)
+    h = 0.01 * cutter.radius
+    g = np.arange(-3.0 * cutter.radius, 3.0 * cutter.radius + h, h)
+    # the profile on a uniform grid (far above beyond its ends: the side wall is no cutting edge)
+    Z = np.array([np.interp(g, py[p], pz[p], left=1e9, right=1e9) for p in range(len(lam))])
+    a = tool_rotation(lam, omg)[:, 2, 1:]
+    avail = cs.available.reshape(n, -1)
+    lift = cs.lift.reshape(n, -1)
+    out = np.full((2, n, len(lam)), np.nan)
+    sides = (np.arange(len(ys)), np.r_[0, len(ys):len(lateral)])
+    ly, lz = frames[:, 1] @ m, frames[:, 2] @ m
+    for i in range(n):
+        ps = np.flatnonzero(avail[i])
+        if ps.size == 0:
+            continue
+        d = lift[i, ps][:, None]
+        u = np.clip((lateral[None, :] - d * a[ps, :1] - g[0]) / h, 0.0, len(g) - 1.001)
+        k = u.astype(np.int64)
+        t = u - k
+        z = Z[ps[:, None], k] * (1 - t) + Z[ps[:, None], k + 1] * t + d * a[ps, 1:]
+        rem = z - S[i][None, :]
+        for side, sl in enumerate(sides):
+            r = rem[:, sl]
+            over = ~(r <= tolerance)
+            first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
+            rows = np.arange(len(ps))
+            k1 = np.minimum(first, len(ys) - 1)
+            k0 = np.maximum(first - 1, 0)
+            r0, r1 = r[rows, k0], r[rows, k1]
+            frac = np.clip((tolerance - r0) / np.where(r1 > r0, r1 - r0, np.inf), 0.0, 1.0)
+            w = np.where(first == 0, 0.0, ys[k0] + frac * (ys[k1] - ys[k0]))
+            w = np.where(first >= len(ys), ys[-1], w)
+            # the mesh ended first: the whole side when the tool is there beyond the last sample on the mesh
+            # too (the section there extrapolated), else only up to that sample (the edge left a sliver)
+            k2 = np.maximum(first - 2, 0)
+            s_sl = S[i][sl]
+            ext = 2 * s_sl[k0] - s_sl[k2]
+            zk = z[rows, sl[k1]]
+            covered = (zk < 1e8) & (zk - ext <= tolerance)
+            w = np.where((first < len(ys)) & np.isnan(r1), np.where(covered, np.inf, ys[k0]), w)
+            s0, s1 = s_sl[k0], s_sl[k1]
+            s_w = np.where(first >= len(ys), s_sl[-1], np.where(np.isnan(s1), s0, s0 + frac * (s1 - s0)))
+            sgn = 1.0 if side == 0 else -1.0
+            out[side, i, ps] = np.where(np.isinf(w), w, w * ly[i] + sgn * s_w * lz[i])
+    return out[0], out[1]
+
+
+def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
+                  cs: CSpace, back: np.ndarray, m: np.ndarray) -> tuple[CSpace, np.ndarray]:
+    """The C-space kept to the postures that finish the widest strip: at each CC point those whose right
+    half-width reaches `back` (n,) along -m (the level of its bins; all that reach furthest where none does)
+    and whose left one reaches, along the plane normal m, as far as the pass can uniformly
+    (WIDE_QUANTILE of the CC points' widest) or its own widest where less. The seed measures the half-widths
+    at the ideal posture; chosen for the motion time alone, the postures only just meet the side steps asked,
+    and the passes are no wider than the guess. Also (n,): the CC points that fall short, their right side
+    short of its step or their left reach below NARROW of the pass's."""
+    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance, m)
+    ok = rgt >= back[:, None] - 1e-6
+    none = ~ok.any(axis=1)
+    best_r = np.nanmax(np.where(np.isnan(rgt), -np.inf, rgt), axis=1)
+    ok[none] = rgt[none] >= best_r[none, None] - 0.05 * cutter.radius
+    reach_l = np.where(ok, left, -np.inf)
+    best = reach_l.max(axis=1)
+    fin = best[np.isfinite(best)]
+    target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
+    # where some posture covers the section to the mesh's edge, only those (the pass finishes the side)
+    keep = ok & (reach_l >= WIDE_SHARE * np.where(np.isinf(best), np.inf, np.minimum(best, target))[:, None])
+    lift = np.where(keep.reshape(cs.lift.shape), cs.lift, np.nan)
+    narrow = none | (best < NARROW * float(np.median(fin)) if fin.size else none)
+    return CSpace(cs.grid, lift, cs.top), narrow
 
 
 @dataclass(frozen=True)
@@ -190,17 +304,28 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
-               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, assembly: Optional[ToolAssembly] = None):
+               grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, back: np.ndarray,
+               assembly: Optional[ToolAssembly] = None):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
-    ones relaxed where no posture meets them): (postures, widths, ends, side steps, paths), or None where
-    some CC point still has no posture. Where a path was cut short (beyond the machine's tilt), the CC points
-    with no posture next to that end are left out too (the tool there reaches the slope)."""
+    ones relaxed where no posture meets them), each CC point's postures kept to the widest (widest_cspace:
+    `back` (n,) the reach along -m to its bins' level, inf at the mesh's own edge): (postures, widths, ends,
+    side steps, paths), or None where some CC point still has no posture. CC points with no posture, or
+    narrow, at a path's end are left out (_peel; next to an end cut short by the machine's tilt, all with no
+    posture: the tool there reaches the slope)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
     if cs.empty.any():
         paths, keep = _peel(paths, cs.empty)
         if not paths or cs.empty[keep].any():
+            return None
+        pts, frm, side, back = pts[keep], frm[keep], side[keep], back[keep]
+        cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
+    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, back, m)
+    narrow &= np.isfinite(back)                            # not for the mesh's own edge alone
+    if narrow.any():
+        paths, keep = _peel(paths, narrow, through_cut=False)
+        if not paths:
             return None
         pts, frm, side = pts[keep], frm[keep], side[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
@@ -218,19 +343,22 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     return postures, widths, ends, side, paths
 
 
-def _peel(paths: List[CCPath], empty: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
-    """The paths without the CC points with an empty C-space next to an end cut short, and the kept CC
-    points' indices (all paths in order); a path left with fewer than 2 CC points is dropped."""
+def _peel(paths: List[CCPath], drop: np.ndarray, through_cut: bool = True) -> tuple[List[CCPath], np.ndarray]:
+    """The paths without the runs of CC points in `drop` (n,) at their ends: up to END_PEEL at any end (that
+    end then cut short, its bins left for clean-up: _beyond_tilt), and with `through_cut` all of a run next
+    to an end already cut short (beyond the machine's tilt: the tool there reaches the slope); and the kept CC
+    points' indices (all paths in order). A path left with fewer than 2 CC points is dropped."""
     out, keep, start = [], [], 0
     for p in paths:
-        e = empty[start:start + len(p)]
+        e = drop[start:start + len(p)]
         a, b = 0, len(p)
-        while p.cut_short[0] and a < b and e[a]:
+        while ((through_cut and p.cut_short[0]) or a < END_PEEL) and a < b and e[a]:
             a += 1
-        while p.cut_short[1] and b > a and e[b - 1]:
+        while ((through_cut and p.cut_short[1]) or b > len(p) - END_PEEL) and b > a and e[b - 1]:
             b -= 1
         if b - a >= 2:
-            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b)))
+            cut = (p.cut_short[0] or a > 0, p.cut_short[1] or b < len(p))
+            out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b), cut_short=cut))
             keep.append(np.arange(start + a, start + b))
         start += len(p)
     return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
@@ -352,6 +480,24 @@ def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: 
     cover.level = level
 
 
+def _give_up_lagging(plan: AdaptivePlan, cover: Coverage, paths: List[CCPath], base: float, gap: float) -> bool:
+    """A plane about to come back to the last one's offset, pulled back by a few bins that passes left short
+    (a path's end held by the slope or the mesh's edge): those bins (within half a gap of the least level,
+    at most LAGGING of them) are listed for clean-up up to the least level of the plane's other bins, and the
+    plane is placed again from there. True where some were."""
+    span = cover.spanned(paths) & cover.open
+    lag = span & (cover.level < base + 0.5 * gap)
+    rest = span & ~lag
+    if not lag.any() or lag.sum() > LAGGING or not rest.any():
+        return False
+    reached = float(cover.level[rest].min())
+    for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, lag.astype(np.int8), 0]))[k::2] for k in (0, 1))):
+        plan.unfinished.append((float(cover.f0 + cover.width * a), float(cover.f0 + cover.width * b),
+                                float(cover.level[a:b].min()), reached))
+    cover.level = np.where(lag, np.maximum(cover.level, reached), cover.level)
+    return True
+
+
 def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: Sequence[float] = (1.0, 0.0),
                     machine: Optional[TarusMachine] = None, grid: Optional[PostureGrid] = None,
                     forward_step: float = 2.0, chord_tolerance: float = 0.01, ideal_weight: float = 0.1,
@@ -382,9 +528,14 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     while cover.open.any():
         for _ in range(MAX_TRIES):
             offset, paths, base = planes.place(guess, gap)
+            if plan.passes and offset < plan.passes[-1].offset + REPEAT * gap and \
+                    _give_up_lagging(plan, cover, paths, base, gap):
+                offset, paths, base = planes.place(guess, gap)
             plan.builds += 1
-            side = _side_steps(reach, paths, cover.needed(paths), offset, m, ahead, 2 * cutter.radius)
-            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, assembly)
+            need = cover.needed(paths)
+            side = _side_steps(reach, paths, need, offset, m, ahead, 2 * cutter.radius)
+            got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, m,
+                             np.where(need[1], np.inf, offset - need[0]), assembly)
             if got is not None:
                 paths = got[4]
                 level, short = cover.advanced(paths, got[2])
@@ -415,11 +566,12 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
                                        gap, runs))
         plan.partial += short > 0
         _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset)
-        # the next pass's right side steps as this one's left ones (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
-        # asked a little more while every CC point meets them
-        relaxed = bool((used[:, 0] < ahead - 1e-9).any())
-        ahead = float(np.clip(ahead * (0.95 if relaxed else 1.1), 0.05 * cutter.radius, 2 * cutter.radius))
-        gap = ahead
+        # the next pass's right side step as this one's left one (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
+        # the postures being the widest: half the width this pass finished (left + right along m) at most CC
+        # points, so that the next one splits it evenly
+        total = (left - offset) + (offset - right)
+        gap = float(np.clip(0.5 * np.quantile(total, GAP_QUANTILE), 0.05 * cutter.radius, 2 * cutter.radius))
+        ahead = AHEAD_SHARE * gap
         guess = offset + 2 * gap
         if progress is not None and progress(1.0 - float(np.mean(cover.open))) is False:
             raise Cancelled("5-axis mesh step-over cancelled")   # never a partial plan passed on as whole
