@@ -138,3 +138,20 @@ def test_a_cell_the_tool_brings_within_the_tolerance_is_rest_however_little_it_t
     # out of reach and lowered that little: no rest
     assert not rest.rest_area(left, design, envelope + 0.0025, grid, TOL, D3.radius).mask.any()
     assert rest.rest_area(left + 0.01, design, envelope + 0.0025, grid, TOL, D3.radius).mask.all()
+
+
+def test_a_rest_of_two_pieces_is_cut_piece_by_piece() -> None:
+    # two patches left 0.05 mm on a wavy floor, 18 mm apart along the raster's passes, in one region: nearest first,
+    # the tool finishes one before it goes to the other (in the raster's own order it crossed over on every pass)
+    mesh = grid_mesh(lambda x, y: 0.3 * np.sin(x) + 0.02 * y, 240, 40, (0.0, 0.0, 30.0, 10.0), "waves")
+    grid = Grid.covering(0.0, 0.0, 30.0, 10.0, 0.25)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    patches = ((y > 2) & (y < 8)) & (((x > 2) & (x < 6)) | ((x > 24) & (x < 28)))
+    left = RestStock(grid, np.where(patches, design + 0.05, -np.inf), 0.002, design, TOL, envelope=design.copy())
+    params = SurfaceParams(boundary=(0.0, 0.0, 30.0, 10.0), region=[polygons.rectangle(1.0, 1.0, 29.0, 9.0)],
+                           sample_step=0.25, rest=left, stepover=0.3)
+    segments = raster_drop.compute(mesh, D3, params).segments
+    side = np.array([seg.tips[0, 0] > 15.0 for seg in segments])
+    assert side.any() and not side.all()
+    assert int(np.sum(side[1:] != side[:-1])) == 1
