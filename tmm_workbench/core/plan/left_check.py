@@ -4,8 +4,8 @@ radiused library tool reaches from above, against the tolerance.
 
 A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: dropped at every cell) comes within
 the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess).
-The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope, the
-gentler one-sided slope: analysis.gentle_cosine): the vertical measure of a wall's cusps is many times their depth.
+The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
+vertical measure of a wall's cusps is many times their depth.
 What no library tool reaches from above (sharp inner corners, undercuts) is reported as its area, not judged. Where
 the finish asks a cusp larger than the tolerance, its passes leave cusps up to it by design: what is left is also
 counted against that allowance."""
@@ -18,7 +18,8 @@ import numpy as np
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.plan.analysis import gentle_cosine, reach_excess, whole_tool_tips
+from tmm_workbench.core.plan.analysis import reach_excess, whole_tool_tips
+from tmm_workbench.core.sim.compare import slope_cosine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
@@ -39,10 +40,9 @@ def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.n
     radius = max(cutter.corner_radius, cutter.radius)
     with np.errstate(invalid="ignore"):
         reached = finite & (reach_excess(envelope, design, grid.cell, radius) <= tolerance)
-    # along the normal of the stock left (its vertical deviation times the cosine of its slope; beside a wall the
-    # floor's, not the step's)
+    # along the normal of the stock left (its vertical deviation times the cosine of its slope)
     stock = np.where(finite, design + np.where(finite, deviation, 0.0), np.nan)
-    left = np.where(reached, deviation, 0.0) * gentle_cosine(stock, grid.cell)
+    left = np.where(reached, deviation, 0.0) * slope_cosine(stock, grid.cell)
     above = reached & (left > tolerance)
     allowance = max(tolerance, cusp)
     inside = left[reached]
