@@ -161,6 +161,42 @@ def test_analysis_slopes_and_reach() -> None:
     assert an.concave_radius == (0.0, 2.0)
 
 
+def test_analysis_reach_test_with_the_whole_tool() -> None:
+    # a floor beside a wall 10 mm high: a ball D2 with 2 mm flutes reaches the floor at the wall's foot alone, but
+    # its shank (1 mm clearance) holds it up within its radius and clearance of the wall; a 15 mm flute does not
+    from tmm_workbench.core.tools.assembly import ToolAssembly
+
+    mesh = grid_mesh(lambda x, y: np.clip((x - 15.0) * 10.0, 0.0, 10.0), 80, 20, (0, 0, 40, 10), "wall")
+    ball = Cutter.ball(2.0)
+    short = ToolAssembly(ball, 2.0, 20.0, flute_length=2.0, holder="ER11 nut")
+    long = ToolAssembly(ball, 2.0, 20.0, flute_length=15.0, holder="ER11 nut")
+    an = analysis.analyse(mesh, 0.25, [("alone", ball), ("short", ball, short), ("long", ball, long),
+                                       ("none", ball, None)], 0.01)
+    alone = an.reach["alone"].unreached_area
+    assert an.reach["short"].unreached_area > alone + 10 * 1.5   # a 1.5 mm band more along the 10 mm wall at least
+    assert an.reach["long"].unreached_area == an.reach["none"].unreached_area == alone
+
+
+def test_reach_excess_reads_a_step_beside_a_cell_as_the_flat_side() -> None:
+    # a floor; the envelope of a ball r0.5 held up by its shank beside a wall: 0.2 mm above the floor one cell off
+    # the step (its nearest plunge 0.4 mm away: at least 0.14 mm off along the normal), 5 mm above beyond it
+    cell = 0.2
+    design = np.zeros((5, 12))
+    envelope = np.zeros_like(design)
+    envelope[:, 6] = 0.042
+    envelope[:, 7] = 0.2
+    envelope[:, 8:] = 5.0
+    excess = analysis.reach_excess(envelope, design, cell, 0.5)
+    assert excess[2, 7] > 0.1               # out of reach (the central difference read the step's slope: reached)
+    assert excess[2, 3] <= 0.0              # on the floor it plunges to
+    # a smooth 75 deg flank the envelope stands 0.03 mm above vertically: 0.03 cos 75 along the normal, as before
+    ramp = np.tile(np.arange(12) * cell * math.tan(math.radians(75.0)), (5, 1))
+    flank = analysis.reach_excess(ramp + 0.03, ramp, cell, 0.5)
+    assert flank[2, 5] == pytest.approx(0.03 * math.cos(math.radians(75.0)) -
+                                        cell ** 2 / (8 * 0.5 * math.cos(math.radians(75.0)) ** 2), rel=1e-6)
+    assert np.allclose(analysis.gentle_cosine(ramp, cell)[:, 1:-1], math.cos(math.radians(75.0)))
+
+
 def plan_of(tmp_path: Path, data: dict):
     job = job_from_dict(data, tmp_path / "job.yaml")
     return launch.make_plan(job)
@@ -285,7 +321,9 @@ def test_launcher_failed_run_writes_nothing(tmp_path: Path, capsys) -> None:
 def test_tools_file_and_candidates(tmp_path: Path) -> None:
     data = good(tmp_path)
     library = data["tools"] + [{"name": "T4 ball D2", "type": "ball", "diameter": 2, "flute_length": 10},
-                               {"name": "T5 ball D4 short", "type": "ball", "diameter": 4, "flute_length": 5}]
+                               {"name": "T5 ball D4 short", "type": "ball", "diameter": 4, "flute_length": 5},
+                               {"name": "T6 ball D1 held", "type": "ball", "diameter": 1, "flute_length": 3,
+                                "holder": "ER11 nut", "stick_out": 6}]
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump({"tools": library}))
     data["tools"] = "shop.yaml"
     _, _, an, plan = plan_of(tmp_path, data)
@@ -295,6 +333,10 @@ def test_tools_file_and_candidates(tmp_path: Path) -> None:
     assert d["finishing candidates"].reason.endswith("left for the rest: T4 ball D2")
     assert d["tools left out"].choice == "T5 ball D4 short (5 mm)"
     assert "T5 ball D4 short" not in {o.tool for o in plan.ops}
+    # a short tool in a holder: no finishing, its whole-tool reach test judges where it reaches for the rest
+    assert d["tools for the rest only"].choice == "T6 ball D1 held (6 mm)"
+    assert "T6 ball D1 held" not in d["finishing candidates"].reason
+    assert an.reach["T6 ball D1 held"].unreached_area > 0
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump(library))
     with pytest.raises(PlanInputError, match="tools file shop.yaml: got .*one field, tools"):
         job_from_dict(data, tmp_path / "job.yaml")

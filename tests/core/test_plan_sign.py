@@ -71,7 +71,7 @@ def test_pencil_after_the_rest_in_the_corners(tmp_path):
     assert {k: cleanup.kwargs.get(k) for k in ("region", "rest_from", "pattern", "stepover")} == {
         "region": "rest", "rest_from": "earlier_ops", "pattern": None, "stepover": step}
     left = {t: an.reach[t].unreached_area for t in ("B6", "B3", "B1")}
-    assert left["B6"] > left["B3"] > left["B1"] / decide.PENCIL_GAIN > 0, left
+    assert left["B6"] > left["B3"] > left["B1"] + decide.PENCIL_GAIN * an.seen_area > 0, left
     why = next(d for d in plan.decisions if d.topic == "pencil")
     assert why.choice.startswith("B1 (ball D1") and f"{left['B3']:.0f} mm2" in why.reason, why
 
@@ -85,7 +85,7 @@ def test_no_pencil_without_a_smaller_tool_that_reaches_more(tmp_path):
     assert why.choice == "none" and "no smaller library tool" in why.reason
     near = BALLS[:2] + [{"name": "B2.8", "type": "ball", "diameter": 2.8, "flutes": 2, "flute_length": 10}]
     _, an, plan = launch.make_plan(sign_job(tmp_path, near))[1:]
-    assert an.reach["B2.8"].unreached_area > decide.PENCIL_GAIN * an.reach["B3"].unreached_area
+    assert an.reach["B2.8"].unreached_area > an.reach["B3"].unreached_area - decide.PENCIL_GAIN * an.seen_area
     assert not any(o.label.startswith("Pencil") for o in plan.ops)
 
 

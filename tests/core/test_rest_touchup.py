@@ -97,7 +97,35 @@ def test_touch_ups_keep_the_holder_clear_of_a_wall() -> None:
     holder = ToolAssembly(ball, 4, 20.0, flute_length=12, holder="SK40 ER32x70")
     params = SurfaceParams(boundary=PARAMS.boundary, stepover=0.3, assembly=holder, holder_collision="leave_out",
                            holder_notes=[])
-    assert rest_touchup.pieces(mesh, ball, params, left, surface) == [] and params.holder_notes[-1].affected > 0
+    # every position that reaches the cell puts the holder on the wall: none is put there
+    assert rest_touchup.pieces(mesh, ball, params, left, surface) == []
+
+
+def test_a_touch_up_takes_the_position_where_the_shank_keeps_its_clearance() -> None:
+    # a floor beside a wall 8 mm high (x < 10), taller than the flutes; a bull D4 r0.5 reaches a floor cell at
+    # x 12.5 from positions up to 1.5 mm off it, but its shank (D4, 1 mm clearance) is clear of the wall above the
+    # flutes (x < 9.7) only from x 12.7
+    mesh = grid_mesh(lambda x, y: np.clip((10.0 - x) * 10.0, 0.0, 8.0), 120, 40, (0.0, 0.0, 30.0, 10.0), "wall")
+    surface = DropSurface(mesh)
+    bull = Cutter(4, 0.5)
+    grid = Grid.covering(0.0, 0.0, 30.0, 10.0, 0.25)
+    design = mesh_heights(mesh, grid)
+    heights = np.full_like(design, -np.inf)
+    iy, ix = 20, int(np.argmin(np.abs(grid.xs() - 12.5)))
+    heights[iy, ix] = 0.05
+    left = RestStock(grid, heights, 0.002, design, TOL)
+    shank = ToolAssembly(bull, 4, 20.0, flute_length=3, holder="SK40 ER32x70")
+    params = SurfaceParams(boundary=PARAMS.boundary, stepover=0.3, assembly=shank, holder_collision="leave_out",
+                           holder_notes=[])
+    pieces = rest_touchup.pieces(mesh, bull, params, left, surface)
+    assert len(pieces) == 1 and params.holder_notes[-1].affected == 0
+    tip = pieces[0].tips[0]
+    assert tip[0] >= 9.7 + 2.0 + 1.0 - 1e-6 and abs(tip[2]) < 1e-6          # the shank clear, on the floor
+    assert np.hypot(tip[0] - grid.xs()[ix], tip[1] - grid.ys()[iy]) <= 1.5    # the flat bottom over the cell
+    # the cutter alone would stand where its shank meets the wall: the guard leaves that touch-up out
+    alone = SurfaceParams(boundary=PARAMS.boundary, stepover=0.3)
+    spot = rest_touchup.pieces(mesh, bull, alone, left, surface)[0].tips[0]
+    assert spot[0] < 12.7
 
 
 def test_a_cell_the_tool_brings_within_the_tolerance_is_rest_however_little_it_takes_off() -> None:
@@ -110,3 +138,20 @@ def test_a_cell_the_tool_brings_within_the_tolerance_is_rest_however_little_it_t
     # out of reach and lowered that little: no rest
     assert not rest.rest_area(left, design, envelope + 0.0025, grid, TOL, D3.radius).mask.any()
     assert rest.rest_area(left + 0.01, design, envelope + 0.0025, grid, TOL, D3.radius).mask.all()
+
+
+def test_a_rest_of_two_pieces_is_cut_piece_by_piece() -> None:
+    # two patches left 0.05 mm on a wavy floor, 18 mm apart along the raster's passes, in one region: nearest first,
+    # the tool finishes one before it goes to the other (in the raster's own order it crossed over on every pass)
+    mesh = grid_mesh(lambda x, y: 0.3 * np.sin(x) + 0.02 * y, 240, 40, (0.0, 0.0, 30.0, 10.0), "waves")
+    grid = Grid.covering(0.0, 0.0, 30.0, 10.0, 0.25)
+    design = mesh_heights(mesh, grid)
+    x, y = np.meshgrid(grid.xs(), grid.ys())
+    patches = ((y > 2) & (y < 8)) & (((x > 2) & (x < 6)) | ((x > 24) & (x < 28)))
+    left = RestStock(grid, np.where(patches, design + 0.05, -np.inf), 0.002, design, TOL, envelope=design.copy())
+    params = SurfaceParams(boundary=(0.0, 0.0, 30.0, 10.0), region=[polygons.rectangle(1.0, 1.0, 29.0, 9.0)],
+                           sample_step=0.25, rest=left, stepover=0.3)
+    segments = raster_drop.compute(mesh, D3, params).segments
+    side = np.array([seg.tips[0, 0] > 15.0 for seg in segments])
+    assert side.any() and not side.all()
+    assert int(np.sum(side[1:] != side[:-1])) == 1

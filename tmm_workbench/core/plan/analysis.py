@@ -1,7 +1,9 @@
 """What the planner knows of a model before it chooses: its size, how its surface slopes (area per slope band,
 from the triangles), its flat areas and steep walls, what faces down (no tool reaches it from above), and per
 library tool what that tool cannot reach from above (the reach test of core.footprint.rest: the tool's envelope
-dropped at every cell against the design's heights). The smallest concave radius is bracketed by the reach tests
+dropped at every cell against the design's heights; a tool with a holder dropped whole, its shank and holder keeping
+their clearance, as the simulation checks it: a D1 with 4 mm flutes does not reach a floor 5 mm down beside a
+wall). The smallest concave radius is bracketed by the reach tests
 of the library's radiused tools: a ball that leaves nothing has a radius at most the smallest concave one."""
 from __future__ import annotations
 
@@ -14,9 +16,11 @@ import numpy as np
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.sim.compare import slope_cosine, slope_deg
+from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+from tmm_workbench.core.sim.compare import slope_deg
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.tools.assembly import ToolAssembly
 
 SLOPE_EDGES = (0.0, 1.0, 15.0, 30.0, 45.0, 60.0, 75.0, 90.0)   # degrees from the horizontal
 FLAT_DEG = 1.0           # a face sloping less is a flat (a floor, a plateau)
@@ -61,6 +65,11 @@ class Analysis:
         lo, hi = self.bounds
         return tuple(h - l for l, h in zip(lo, hi))  # type: ignore[return-value]
 
+    @property
+    def seen_area(self) -> float:
+        """mm^2 of the model seen from above (the design cells)."""
+        return float(np.isfinite(self.design).sum()) * self.grid.cell_area
+
     def share_steeper(self, deg: float) -> float:
         """Share of the design cells (seen from above) sloping more than `deg`."""
         finite = np.isfinite(self.design)
@@ -102,7 +111,8 @@ def slope_shares(mesh: TriMesh) -> tuple[float, dict, float, float, float]:
 
 
 def analyse(mesh: TriMesh, cell: float, tools: Optional[list] = None, tolerance: float = 0.01) -> Analysis:
-    """The model's analysis on a grid of `cell` mm over its XY box; `tools`: (name, Cutter) pairs to reach-test."""
+    """The model's analysis on a grid of `cell` mm over its XY box; `tools`: (name, Cutter) pairs to reach-test,
+    or (name, Cutter, ToolAssembly or None) to reach-test a tool with its shank and holder."""
     lo, hi = mesh.bounds
     grid = Grid.covering(float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]), cell)
     surface = DropSurface(mesh)
@@ -113,8 +123,9 @@ def analyse(mesh: TriMesh, cell: float, tools: Optional[list] = None, tolerance:
                    down, slope, design, grid)
     finite = np.isfinite(design)
     design_area = float(finite.sum()) * grid.cell_area
-    for name, cutter in tools or []:
-        env = tool_envelope(mesh, cutter, grid, surface)
+    for name, cutter, *whole in tools or []:
+        tips = whole_tool_tips(mesh, whole[0], grid, surface) if whole and whole[0] is not None else None
+        env = tool_envelope(mesh, cutter, grid, surface, tips=tips)
         left = np.where(finite, env - design, 0.0)
         radius = max(cutter.corner_radius, cutter.radius)
         threshold = tolerance + cell * cell / (8.0 * radius)
@@ -123,8 +134,16 @@ def analyse(mesh: TriMesh, cell: float, tools: Optional[list] = None, tolerance:
             unreached = 0.0
         out.reach[name] = Reach(name, unreached, float(left.max()) if finite.any() else 0.0, threshold,
                                 float(np.sum(left > FAR_MM)) * grid.cell_area)
-    out.concave_radius = concave_bracket(out.reach, dict(tools or []))
+    out.concave_radius = concave_bracket(out.reach, {t[0]: t[1] for t in tools or []})
     return out
+
+
+def whole_tool_tips(mesh: TriMesh, assembly: ToolAssembly, grid: Grid, surface: DropSurface) -> np.ndarray:
+    """(ny, nx) the lowest tip heights on `grid`'s cell centres at which neither the cutter nor the shank or
+    holder of `assembly` comes closer to the mesh than its clearance (core.query.drop_assembly)."""
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    z = AssemblyDrop(mesh, assembly, surface).heights(np.column_stack([X.ravel(), Y.ravel()]))[0]
+    return z.reshape(grid.ny, grid.nx)
 
 
 def reach_excess(envelope: np.ndarray, design: np.ndarray, cell: float, radius: float) -> np.ndarray:
@@ -133,8 +152,33 @@ def reach_excess(envelope: np.ndarray, design: np.ndarray, cell: float, radius: 
     envelope's slope: a wall's vertical gap is many times its depth): between the grid's positions the envelope
     on a slope a keeps cusps of cell^2 / (8 r cos^2 a) along its normal. A cell is out of the tool's reach where
     this exceeds the tolerance (NaN where there is no design)."""
-    cos = np.maximum(slope_cosine(envelope, cell), math.cos(math.radians(STEEPEST_DEG)))
+    cos = np.maximum(gentle_cosine(envelope, cell), math.cos(math.radians(STEEPEST_DEG)))
     return (envelope - design) * cos - cell * cell / (8.0 * radius * cos * cos)
+
+
+def gentle_cosine(z: np.ndarray, cell: float) -> np.ndarray:
+    """(ny, nx) cos of the slope of heights `z`, each axis' slope the gentler of its two one-sided differences (a
+    smooth slope reads as with central ones; a step beside a cell, as the side without it). A central difference
+    across a step reads the step's slope: the envelope of a D1 held up by its shank beside a letter rises 5 mm
+    one cell off a floor cell it stands 0.2 mm above (at least 0.14 mm along the normal), and that cell was
+    counted reached (pycam_textbox: 153 of the 154 mm2 left "in reach"); so was a ball's fillet at a wall's foot.
+    1 where no slope is known (no neighbour with a height)."""
+    z = np.asarray(z, dtype=float)
+    out = []
+    for axis in (0, 1):
+        if z.shape[axis] < 2:
+            out.append(np.zeros_like(z))
+            continue
+        step = np.diff(z, axis=axis) / cell
+        pad = [(0, 0), (0, 0)]
+        pad[axis] = (1, 0)
+        back = np.abs(np.pad(step, pad, constant_values=np.nan))
+        pad[axis] = (0, 1)
+        ahead = np.abs(np.pad(step, pad, constant_values=np.nan))
+        with np.errstate(invalid="ignore"):
+            out.append(np.fmin(back, ahead))
+    cos = 1.0 / np.sqrt(1.0 + out[0] ** 2 + out[1] ** 2)
+    return np.where(np.isfinite(cos), cos, 1.0)
 
 
 def concave_bracket(reach: dict, cutters: dict) -> tuple[float, float]:

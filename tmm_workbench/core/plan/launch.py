@@ -26,7 +26,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.geometry.mesh import TriMesh, load_stl, save_stl
-from tmm_workbench.core.plan import analysis, decide, five_axis, progress_note, recipes
+from tmm_workbench.core.plan import analysis, decide, five_axis, left_check, progress_note, recipes
 from tmm_workbench.core.plan.job_file import (MODEL_SUFFIXES, UNITS, JobSpec, PlanInputError, ToolSpec, is_step,
                                               job_from_dict, read_data)
 from tmm_workbench.core.plan.stock import planned_stock
@@ -65,7 +65,9 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
     mesh, moved = placed_mesh(job)
     stock = planned_stock(job, mesh)   # a model outside its stock refused before the analysis
     say(f"model {job.model.file.name}: {len(mesh.triangles)} triangles; analysing", quiet)
-    tools = [(t.name, decide.cutter_of(t)) for t in job.tools]
+    # each tool reach-tested whole: its shank and holder as the simulation checks them
+    tools = [(t.name, decide.cutter_of(t), left_check.whole_tool(decide.cutter_of(t), tool_entry(t)))
+             for t in job.tools]
     an = analysis.analyse(mesh, job.planner.analysis_cell, tools, job.finish.tolerance)
     compare = None
     if job.planner.compare_cutters:
@@ -82,6 +84,12 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
     return mesh, moved, an, plan
 
 
+def tool_entry(tool: ToolSpec) -> dict:
+    """A library tool's lengths, shank and holder (core.plan.left_check.whole_tool's spec)."""
+    return {"flute_length": tool.flute_length, "length": decide.overall_length(tool),
+            "shank_diameter": tool.shank_diameter, "holder": tool.holder, "stick_out": tool.stick_out}
+
+
 def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
     """What app/plan_run.py needs to run the plan."""
     o = job.outputs
@@ -94,9 +102,7 @@ def plan_document(job: JobSpec, plan: decide.Plan, model_file: Path) -> dict:
             "rapid_mm_min": None if rapid is None else list(rapid), "apt_cl": o.apt_cl,
             "post_args": TARUS_POST_ARGS if job.machine.five_axis else None,
             "five_axis": None if plan.five_axis is None else plan.five_axis.as_dict(),
-            "tools": {t.name: {"flute_length": t.flute_length, "length": decide.overall_length(t),
-                               "shank_diameter": t.shank_diameter, "holder": t.holder, "stick_out": t.stick_out}
-                      for t in job.tools},
+            "tools": {t.name: tool_entry(t) for t in job.tools},
             "reach_tool": {"name": plan.reach_tool, "diameter": reach.diameter, "corner_radius": reach.corner_radius}}
 
 

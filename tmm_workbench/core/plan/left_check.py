@@ -5,9 +5,10 @@ radiused library tool reaches from above, against the tolerance.
 A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: dropped at every cell) comes within
 the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess).
 The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
-vertical measure of a wall's cusps is many times their depth. What no library tool reaches from above (sharp inner
-corners, undercuts) is reported as its area, not judged. Where the finish asks a cusp larger than the tolerance,
-its passes leave cusps up to it by design: what is left is also counted against that allowance."""
+vertical measure of a wall's cusps is many times their depth.
+What no library tool reaches from above (sharp inner corners, undercuts) is reported as its area, not judged. Where
+the finish asks a cusp larger than the tolerance, its passes leave cusps up to it by design: what is left is also
+counted against that allowance."""
 from __future__ import annotations
 
 from typing import Optional
@@ -17,8 +18,7 @@ import numpy as np
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.query.drop_assembly import AssemblyDrop
-from tmm_workbench.core.plan.analysis import reach_excess
+from tmm_workbench.core.plan.analysis import reach_excess, whole_tool_tips
 from tmm_workbench.core.sim.compare import slope_cosine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.tools.assembly import ToolAssembly
@@ -35,10 +35,7 @@ def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.n
     clearance (a 4 mm flute does not reach a floor 5 mm down beside a wall); None: the cutter alone."""
     finite = np.isfinite(design) & np.isfinite(deviation)
     surface = DropSurface(mesh)
-    tips = None
-    if assembly is not None:   # the lowest tip heights at which neither its shank nor its holder comes too close
-        X, Y = np.meshgrid(grid.xs(), grid.ys())
-        tips = AssemblyDrop(mesh, assembly, surface).heights(np.column_stack([X.ravel(), Y.ravel()]))[0]
+    tips = None if assembly is None else whole_tool_tips(mesh, assembly, grid, surface)
     envelope = tool_envelope(mesh, cutter, grid, surface, tips=tips)
     radius = max(cutter.corner_radius, cutter.radius)
     with np.errstate(invalid="ignore"):

@@ -169,10 +169,11 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     surface = surface or DropSurface(mesh)
     touch = rest_touchup.pieces(mesh, cutter, params, _reached(residue(rest, segments + loops, cutter)), surface)
     diagnostics["touch_ups"] = len(touch)
-    if touch:
-        loops = ordered(loops + touch)
-    # the pieces of passes and loops reached with the tool down where a join from the one before passes its checks
-    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments + loops, surface)
+    # passes, loops and touch-ups in one nearest-first order: in the raster's own order a rest of many pieces was
+    # crossed line by line (a link over the gaps between the pieces on every pass: the sign's clean-up, 12 pieces)
+    pieces = ordered(segments + loops + touch)
+    # the pieces reached with the tool down where a join from the one before passes its checks
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, pieces, surface)
     if cut:   # a join lifted over a ridge between two pieces may stand above both
         diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     if params.verify_notes is not None:

@@ -9,7 +9,11 @@ over it (among the cell centres within the tool's radius, as the envelope found 
 brings the cell within the tolerance; the points are chained where they are grid neighbours, each chain a piece
 (consecutive points joined by the straight move lifted onto the surface, as rest_joins does), the others single
 points (a piece of two equal tips: the tool goes down there and up); the shank and holder kept clear of the model
-as the passes' are (core.strategies.holder_guard).
+as the passes' are (core.strategies.holder_guard). With the whole tool (the params' assembly) a position's height
+is the lowest at which neither its cutter nor its shank or holder comes too close: beside a wall taller than the
+flutes the cutter's own lowest position over a floor cell often puts the shank in the wall (pycam_textbox's floor
+between the letters: the guard then lifted or left out the touch-up), while another position within the radius
+cuts the cell with the shank clear.
 """
 from __future__ import annotations
 
@@ -21,6 +25,7 @@ import numpy as np
 from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
+from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies import holder_guard, rest_joins
 from tmm_workbench.core.tools.cutter import Cutter
@@ -37,7 +42,8 @@ def pieces(mesh: TriMesh, cutter: Cutter, params: Any, left: Optional[RestStock]
     if left is None:
         return []
     s = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0)
-    points = _best_positions(left, cutter, surface, s)
+    bodies = None if getattr(params, "assembly", None) is None else AssemblyDrop(mesh, params.assembly, surface)
+    points = _best_positions(left, cutter, surface, s, bodies)
     if not len(points):
         return []
     grown = cutter.offset(s)
@@ -53,9 +59,11 @@ def pieces(mesh: TriMesh, cutter: Cutter, params: Any, left: Optional[RestStock]
     return holder_guard.apply(mesh, params, out, params.sample_step, surface, {})
 
 
-def _best_positions(left: RestStock, cutter: Cutter, surface: DropSurface, s: float) -> np.ndarray:
+def _best_positions(left: RestStock, cutter: Cutter, surface: DropSurface, s: float,
+                    bodies: Optional[AssemblyDrop] = None) -> np.ndarray:
     """(k, 3) distinct tips: for each cell of `left`, the cell centre within the tool's radius whose drop comes
-    lowest over it, where that is within the tolerance of the design (plus the stock to leave)."""
+    lowest over it, where that is within the tolerance of the design (plus the stock to leave); with `bodies`
+    (the whole tool) no lower than its shank and holder keep their clearance there."""
     g = left.grid
     iy, ix = np.nonzero(np.isfinite(left.heights))
     rmax = float(cutter.native.max_radius)
@@ -74,6 +82,8 @@ def _best_positions(left: RestStock, cutter: Cutter, surface: DropSurface, s: fl
         unique, inverse = np.unique((cy * g.nx + cx).ravel(), return_inverse=True)
         xy = np.column_stack([g.xs()[unique % g.nx], g.ys()[unique // g.nx]])
         z = surface.drop(grown, xy, floor) + s
+        if bodies is not None:
+            z = np.maximum(z, bodies.heights_of(holder_guard.BODIES, xy, floor)[0])
         d = np.hypot(g.xs()[cx] - g.xs()[bx][:, None], g.ys()[cy] - g.ys()[by][:, None])
         profile = np.asarray(grown.native.height(np.ascontiguousarray(d.ravel())), dtype=float).reshape(d.shape)
         over = z[inverse].reshape(d.shape) + profile
