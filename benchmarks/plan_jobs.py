@@ -2,6 +2,7 @@
 `python3 -m tmm_workbench.plan <job> --quiet` for each and prints a table from its report.json.
 
     /usr/bin/python3 benchmarks/plan_jobs.py [job.yaml ...]     # default: every job of benchmarks/jobs
+    /usr/bin/python3 benchmarks/plan_jobs.py --decisions [job.yaml ...]   # the decisions alone, wall and CPU s
 
 benchmarks/jobs/sign.yaml plans seed 003's wooden sign: its model is made here first (core.geometry.sign, SIGN).
 
@@ -53,10 +54,28 @@ def planning_seconds(job: Path) -> float:
     return time.perf_counter() - t0
 
 
+def decisions(paths: list[Path]) -> None:
+    """The decisions alone (core only, no FreeCAD), each job planned twice: the better wall and CPU seconds."""
+    from tmm_workbench.core.plan.job_file import read_job
+    from tmm_workbench.core.plan.launch import make_plan
+
+    print(f"{'job':<24} {'wall s':>7} {'CPU s':>7}")
+    for job in paths:
+        runs = []
+        for _ in range(2):
+            w, c = time.perf_counter(), time.process_time()
+            make_plan(read_job(job))
+            runs.append((time.perf_counter() - w, time.process_time() - c))
+        print(f"{job.stem:<24} {min(r[0] for r in runs):>7.1f} {min(r[1] for r in runs):>7.1f}", flush=True)
+
+
 def main() -> None:
     from tmm_workbench.core.plan.job_file import read_job
 
     make_sign_model()
+    if sys.argv[1:2] == ["--decisions"]:
+        decisions(jobs(sys.argv[2:]))
+        return
     head = (f"{'job':<16} {'exit':>4} {'gouge mm':>9} {'left mm':>8} {'p95 mm':>7} {'cycle min':>9} "
             f"{'plan s':>6} {'wall s':>7}  ops")
     print(head)
