@@ -265,8 +265,8 @@ class AdaptivePlan:
 
     def report(self) -> str:
         return (f"{len(self.passes)} passes over {self.extent[1] - self.extent[0]:.1f} mm, "
-                f"{self.builds} C-spaces built ({self.shrunk} with a smaller gap, {self.partial} passes left "
-                f"some bins to the next), {self.seconds:.1f} s" + (
+                f"{self.builds} C-spaces built ({self.shrunk} with a smaller gap, {self.partial} "
+                f"{'pass' if self.partial == 1 else 'passes'} left some bins to the next), {self.seconds:.1f} s" + (
                     "; left unfinished (feed from, to, across from, to; mm): " + ", ".join(
                         f"({a:.1f}, {b:.1f}, {c:.2f}, {d:.2f})" for a, b, c, d in self.unfinished)
                     if self.unfinished else ""))
