@@ -23,6 +23,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.footprint.rest import rest_area, tool_envelope, without_specks
+from tmm_workbench.core.geometry.axes import slerp
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
 from tmm_workbench.core import polygons
@@ -169,11 +170,7 @@ def _pieces(pts: np.ndarray, axes: np.ndarray, n: np.ndarray) -> tuple[np.ndarra
     slerp): the move of each piece's end, its tip and its axis."""
     k = np.repeat(np.arange(len(n)), n)
     f = ((np.arange(len(k)) - np.repeat(np.cumsum(n) - n, n) + 1) / np.repeat(n, n))[:, None]
-    a0, a1 = axes[k], axes[k + 1]
-    th = np.arccos(np.clip(np.einsum("ij,ij->i", a0, a1), -1.0, 1.0))[:, None]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        turned = np.where(th > 1e-9, (np.sin((1.0 - f) * th) * a0 + np.sin(f * th) * a1) / np.sin(th), a1)
-    return k, pts[k] + f * (pts[k + 1] - pts[k]), turned / np.linalg.norm(turned, axis=1, keepdims=True)
+    return k, pts[k] + f * (pts[k + 1] - pts[k]), slerp(axes[k], axes[k + 1], f)
 
 
 def material_left(mesh: TriMesh, cutter: Cutter, path: Toolpath, grid: Grid, tolerance: float,
