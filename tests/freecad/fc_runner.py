@@ -9,11 +9,24 @@ with the add-on linked into its Mod folder: freecadcmd -t fc_test_op -M <repo>/t
 """
 import os
 import sys
+import time
 import traceback
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
+
+
+class TimedResult(unittest.TextTestResult):
+    """Each test's wall time (the suite's time budget: which FreeCAD test costs what, on every version)."""
+
+    def startTest(self, test: unittest.TestCase) -> None:
+        self._started = time.monotonic()
+        super().startTest(test)
+
+    def stopTest(self, test: unittest.TestCase) -> None:
+        super().stopTest(test)
+        self.times = getattr(self, "times", []) + [(time.monotonic() - self._started, test.id())]
 
 
 def main() -> int:
@@ -36,7 +49,9 @@ def main() -> int:
     if not names:
         names = sorted(f[:-3] for f in os.listdir(HERE) if f.startswith("fc_test_") and f.endswith(".py"))
     suite = unittest.defaultTestLoader.loadTestsFromNames(names)
-    result = unittest.TextTestRunner(stream=sys.stderr, verbosity=2).run(suite)
+    result = unittest.TextTestRunner(stream=sys.stderr, verbosity=2, resultclass=TimedResult).run(suite)
+    for seconds, name in sorted(getattr(result, "times", []), reverse=True):
+        sys.stderr.write(f"TMM-FC-TIME {seconds:7.1f} s {name}\n")
     sys.stderr.write(f"TMM-FC-RESULT {'PASS' if result.wasSuccessful() else 'FAIL'} "
                      f"run={result.testsRun} failures={len(result.failures)} errors={len(result.errors)}\n")
     return 0 if result.wasSuccessful() and result.testsRun > 0 else 1

@@ -60,6 +60,31 @@ class RunByName(FreeCADTestCase):
         self.assertEqual(set(FreeCAD.listDocuments()), before)
 
 
+class SharedToolController(FreeCADTestCase):
+    def test_ops_of_one_tool_share_its_controller_and_the_call_is_checked_against_it(self) -> None:
+        """tool_controller: a second op cuts with the first one's controller (one tool in the Job, no tool change
+        in its G-code); a call naming another tool, other feeds, no job or another Job's controller is refused by
+        name, and nothing is added to the Job."""
+        first = run_roughing(str(SPHERE_ON_PLATE), diameter=10.0, step_down=6.0, horiz_feed=1200.0, progress=False,
+                             doc_name="TmmSharedTc")
+        tc = first.op.ToolController
+        second = run_surface(None, job=first, tool="endmill", diameter=10.0, horiz_feed=1200.0, tool_controller=tc,
+                             stepover=4.0, sample_step=1.0, progress=False)
+        self.assertIs(second.op.ToolController, tc)
+        self.assertEqual(len(first.job.Tools.Group), 1)
+        ops = len(first.job.Operations.Group)
+        other = run_roughing(str(SPHERE_ON_PLATE), diameter=6.0, step_down=6.0, progress=False, doc_name="TmmOtherTc")
+        cases = [(dict(job=first, diameter=8.0, horiz_feed=1200.0), "holds a flat D10"),
+                 (dict(job=first, diameter=10.0), "horiz_feed 1000 is not tool_controller"),
+                 (dict(diameter=10.0, horiz_feed=1200.0), "give job= as well"),
+                 (dict(job=other, diameter=10.0, horiz_feed=1200.0), "is not a tool controller of Job")]
+        for kwargs, said in cases:
+            with self.subTest(said=said), self.assertRaises(TmmError) as ctx:
+                run_surface(None, tool="endmill", tool_controller=tc, stepover=4.0, progress=False, **kwargs)
+            self.assertIn(said, str(ctx.exception))
+        self.assertEqual(len(first.job.Operations.Group), ops)
+
+
 class FaceOpByName(FreeCADTestCase):
     def test_multipoint_by_its_properties_is_run_multipoint(self) -> None:
         from tmm_workbench.app.api import run_multipoint

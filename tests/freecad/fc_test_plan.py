@@ -18,7 +18,7 @@ import FreeCAD
 import numpy as np
 
 from fc_helpers import OUT, FreeCADTestCase, close_all, parse_gcode
-from tmm_workbench.app import plan_run
+from tmm_workbench.app import op_base, plan_run
 from tmm_workbench.core.plan import launch, progress_note
 from tmm_workbench.core.plan.job_file import read_job
 
@@ -69,12 +69,23 @@ class PlanBeet(FreeCADTestCase):
         (folder / "plan.json").write_text(json.dumps(doc))
         os.environ["TMM_PLAN_FILE"] = str(folder / "plan.json")
         os.environ[progress_note.ENV] = str(folder / "progress.json")
+        computed: dict = {}
+        real = op_base.TmmOp.execute
+
+        def counted(proxy: Any, obj: Any) -> None:
+            computed[obj.Name] = computed.get(obj.Name, 0) + 1
+            real(proxy, obj)
+
+        op_base.TmmOp.execute = counted
         try:
             self.assertEqual(plan_run.main(), 0)
         finally:
+            op_base.TmmOp.execute = real
             del os.environ[progress_note.ENV]
         verified = json.loads((folder / "verify.json").read_text())
         self.assertTrue(verified["passed"], verified["problems"])
+        # each op computed once, with its library tool (no second computation once the controller is set)
+        self.assertEqual(sorted(computed.values()), [1] * len(plan.ops))
         last = progress_note.read(folder / "progress.json")   # the run's last progress note: its last step
         self.assertEqual(last, {"step": len(plan.ops) + 4, "steps": len(plan.ops) + 4, "doing": "saving the document"})
         self.assertLess(verified["deepest_gouge_mm"], job.finish.tolerance)

@@ -179,9 +179,10 @@ def add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, 
 def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
            horiz_feed: float, vert_feed: float, spindle_speed: float, post: Optional[str], gcode_path: Any,
-           fcstd_path: Any, doc_name: str, progress: Any) -> SurfaceResult:
+           fcstd_path: Any, doc_name: str, progress: Any, tool_controller: Any = None) -> SurfaceResult:
     """The op (property `values`) in a new Job for `model` (a mesh op's box stock; a face op's face) or in `job`
-    with a further tool controller; computed, posted, saved. A document opened here is closed on failure."""
+    with a further tool controller (or `tool_controller`, one of the Job's: run checked it); computed, posted,
+    saved. A document opened here is closed on failure."""
     job = getattr(job, "job", None) or job
     if job is None and model is None:
         raise TmmError("model: give an STL path, a Mesh or a Part object (or a job to add the op to)")
@@ -202,8 +203,8 @@ def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, s
         else:  # the Job's stock and model stay; the op machines `model` when one is given
             values.update(mesh_values(model))
             top = max(m.Shape.BoundBox.ZMax for m in job.Model.Group)
-            tc = add_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0, vert_feed / 60.0,
-                          spindle_speed)
+            tc = tool_controller or add_tool(job, bit(doc, shape, diameter, corner_radius), horiz_feed / 60.0,
+                                             vert_feed / 60.0, spindle_speed)
         values.update(heights(job, top, safe_height, clearance_height))
         values["ToolController"] = tc
         op = registry.create(op_name, job, values)
@@ -268,16 +269,44 @@ def checked_post(op: str, post: Optional[str]) -> Optional[str]:
     return post
 
 
+def check_controller(tc: Any, job: Any, shape: Union[str, Cutter], diameter: float, corner_radius: float,
+                     feeds: dict[str, float]) -> None:
+    """`tc` a tool controller of `job` whose tool and feeds are the ones the call names: several ops of one tool
+    share its controller (the G-code changes tools only where the tool changes), and the call's tool arguments
+    are checked against it, never dropped for it."""
+    job = getattr(job, "job", None) or job
+    if job is None:
+        raise TmmError("tool_controller: give job= as well (the Job the tool controller belongs to)")
+    if tc not in job.Tools.Group:
+        raise TmmError(f"tool_controller {getattr(tc, 'Label', tc)!r} is not a tool controller of Job "
+                       f"'{job.Label}'")
+    has = tools.cutter_from_tool(tc.Tool)
+    asked = shape if isinstance(shape, Cutter) else named_cutter(shape, diameter, corner_radius)
+    sizes = ("diameter", "corner_radius", "bottom_angle_deg", "taper_angle_deg")
+    if not all(math.isclose(getattr(has, k), getattr(asked, k), abs_tol=1e-6) for k in sizes):
+        raise TmmError(f"tool_controller {tc.Label!r} holds a {has.describe()}, the call asks for a "
+                       f"{asked.describe()}: give the controller's tool (or no tool_controller)")
+    for name, prop, scale in (("horiz_feed", "HorizFeed", 60.0), ("vert_feed", "VertFeed", 60.0),
+                              ("spindle_speed", "SpindleSpeed", 1.0)):
+        value = scale * float(getattr(getattr(tc, prop), "Value", getattr(tc, prop)))
+        if not math.isclose(value, feeds[name], rel_tol=1e-6, abs_tol=1e-6):
+            raise TmmError(f"{name} {feeds[name]:g} is not tool_controller {tc.Label!r}'s {value:g}: give the "
+                           f"controller's (or no tool_controller)")
+
+
+def named_cutter(shape: str, diameter: float, corner_radius: float) -> Cutter:
+    """The cutter a tool named by shape ('ballend', 'bullnose', 'endmill') and size is."""
+    return (Cutter.ball(diameter) if shape == "ballend" else
+            Cutter.bull(diameter, corner_radius) if shape == "bullnose" and corner_radius > 0 else
+            Cutter.flat(diameter))
+
+
 def check_tool_taken(op: str, shape: Union[str, Cutter], diameter: float, corner_radius: float) -> None:
     """The op's strategy's own tool check (core check_tool, where it has one), before a document is made."""
     check = getattr(registry.entry(op).core(), "check_tool", None)
     if check is None:
         return
-    if not isinstance(shape, Cutter):
-        shape = (Cutter.ball(diameter) if shape == "ballend" else
-                 Cutter.bull(diameter, corner_radius) if shape == "bullnose" and corner_radius > 0 else
-                 Cutter.flat(diameter))
-    check(shape)
+    check(shape if isinstance(shape, Cutter) else named_cutter(shape, diameter, corner_radius))
 
 
 def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter] = "ballend", diameter: float = 6.0,
@@ -286,7 +315,7 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
         clearance_height: Optional[float] = None, horiz_feed: float = 1000.0, vert_feed: float = 300.0,
         spindle_speed: float = 10000.0, post: Optional[str] = AUTO_POST, gcode_path: Any = None,
         fcstd_path: Any = None, doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
-        **properties: Any) -> SurfaceResult:
+        tool_controller: Any = None, **properties: Any) -> SurfaceResult:
     """The op registered as `op` on `model` with `properties` (the op's property names and values: StepOver=0.5,
     Pattern="OneWay"), computed, posted (`post` None: not posted; AUTO_POST: linuxcnc, or tarus for a 5-axis op,
     which takes only tarus or apt_cl), saved (as app.api.run_surface).
@@ -312,6 +341,9 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
                                                           sorted(set(tools.SHAPE_ALIASES.values())))
     post = checked_post(op, post)
     check_tool_taken(op, shape, diameter, corner_radius)
+    if tool_controller is not None:
+        check_controller(tool_controller, job, shape, diameter, corner_radius,
+                         {"horiz_feed": horiz_feed, "vert_feed": vert_feed, "spindle_speed": spindle_speed})
     if stock is not None:
         stock_box_checked(stock)
     given = stock is not None or stock_margin is not None or stock_above is not None
@@ -319,4 +351,4 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
                  1.0 if stock_above is None else stock_above) if given else None
     return run_op(op, model, job, properties, stock_ext, shape, diameter, corner_radius, safe_height,
                   clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, fcstd_path, doc_name,
-                  progress)
+                  progress, tool_controller)

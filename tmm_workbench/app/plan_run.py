@@ -22,11 +22,12 @@ FAILED = 3
 
 
 def run_ops(plan: dict, model: Any = None, progress: Any = False, left_out: Optional[list] = None) -> list:
-    """The plan's ops in order, the first making the Job around the model and its box stock (`model`, a Mesh or
-    Part object: its Job in the object's document; None: the plan's STL in a new document), the others added; a
-    cylinder or solid stock's Job made first (app.plan_stock), every op added to it. An optional op (a rest, a
-    pencil, a clean-up) that fails to compute (e.g. its Region 'Rest' is empty: the ops before it left nothing it
-    reaches) is removed again and named with its reason in `left_out`; any other op's failure stops the run."""
+    """The plan's ops in order in one Job made first around the model (`model`, a Mesh or Part object: the Job in
+    its document; None: the plan's STL in a new document) with the plan's stock (app.plan_stock) and the machine's
+    rapids; each op cut with its library tool's controller (library_controller: made before its first op, so
+    every op computes once, with the tool's lengths and holder). An optional op (a rest, a pencil, a clean-up)
+    that fails to compute (e.g. its Region 'Rest' is empty: the ops before it left nothing it reaches) is removed
+    again and named with its reason in `left_out`; any other op's failure stops the run."""
     from tmm_workbench.app import api
     from tmm_workbench.app.plan_stock import new_job
     from tmm_workbench.core.errors import TmmError
@@ -36,64 +37,52 @@ def run_ops(plan: dict, model: Any = None, progress: Any = False, left_out: Opti
              "run_mesh5": api.run_mesh5}
     results: list = []
     controllers: dict = {}
-    job = None if plan.get("stock", {}).get("type", "box") == "box" else new_job(plan, model)
+    job = new_job(plan, model)
+    if plan.get("rapid_mm_min") is not None:   # the machine's: every tool controller's by its expression
+        job.SetupSheet.HorizRapid, job.SetupSheet.VertRapid = (v / 60.0 for v in plan["rapid_mm_min"])
     for i, op in enumerate(plan["ops"]):
         progress_note.note(2 + i, steps(plan), f"computing {op['label']}")
-        kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items()}
-        call = calls[op["api"]]
-        if results or job is not None:
-            kwargs.pop("stock", None)   # the Job's stock (the roughing's box: only for a new Job)
-            into = results[0].job if results else job
-            try:
-                r = call(None, job=into, progress=progress, **kwargs)
-            except TmmError as exc:
-                if not op.get("optional") or left_out is None:
-                    raise
-                left_out.append(f"left out {op['label']}: {exc}")
-                remove_unused(into, results, controllers)
-                continue
-        elif model is not None:
-            r = call(model, progress=progress, **kwargs)
-        else:
-            r = call(plan["model_file"], doc_name=plan["name"], progress=False, **kwargs)
+        kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items() if k != "stock"}
+        tc = controllers.get(op["tool"]) or library_controller(job, op["tool"], plan["tools"][op["tool"]], kwargs)
+        try:
+            r = calls[op["api"]](None, job=job, tool_controller=tc, progress=progress, **kwargs)
+        except TmmError as exc:
+            if not op.get("optional") or left_out is None:
+                raise
+            left_out.append(f"left out {op['label']}: {exc}")
+            remove_unused(job, results, controllers)
+            continue
         r.op.Label = op["label"]
-        share_tool_controller(r.op, op["tool"], plan["tools"][op["tool"]], controllers)
+        controllers[op["tool"]] = tc
         results.append(r)
-    if plan.get("rapid_mm_min") is not None:   # the machine's: every tool controller's by its expression
-        sheet = results[0].job.SetupSheet
-        sheet.HorizRapid, sheet.VertRapid = (v / 60.0 for v in plan["rapid_mm_min"])
-    results[0].doc.recompute()   # the ops with the library's tools (lengths, holders) and shared controllers
+    if not results:
+        raise RuntimeError("no op of the plan computed a tool path")
     for r in results:
         if not r.op.isValid():
             raise RuntimeError(f"{r.op.Label}: {r.op.getStatusString()}")
     return results
 
 
-def share_tool_controller(op: Any, tool: str, spec: dict, controllers: dict) -> None:
-    """One tool controller per library tool: an op of a tool already used takes that tool's controller (the same
-    feeds: they are the tool's) and the one the API made for it is removed, so the G-code changes tools only
-    when the tool changes. The kept controller and its ToolBit are named after the library's tool and given its
-    flute length, overall length, shank and holder (the API makes a bit of standard proportions; the ops use the
-    controller's holder: their Holder is FromToolController)."""
-    from tmm_workbench.app import compat
+def library_controller(job: Any, tool: str, spec: dict, kwargs: dict) -> Any:
+    """A tool controller in `job` for the library's `tool` (one per library tool, shared by its ops: the G-code
+    changes tools only when the tool changes): the ToolBit of the op's tool shape and size (`kwargs`, the op's API
+    arguments) and feeds, named after the library's tool and given its flute length, overall length, shank and
+    holder (the ops use the controller's holder: their Holder is FromToolController)."""
     from tmm_workbench.app.api import set_holder
+    from tmm_workbench.app.api_run import add_tool, bit
 
-    made = op.ToolController
-    if tool not in controllers:
-        made.Label = f"TC: {tool}"
-        made.Tool.Label = tool
-        made.Tool.CuttingEdgeHeight = float(spec["flute_length"])
-        made.Tool.Length = float(spec["length"])
-        if spec.get("shank_diameter") is not None:
-            made.Tool.ShankDiameter = float(spec["shank_diameter"])
-        if spec["holder"] is not None:
-            set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
-        controllers[tool] = made
-        return
-    op.ToolController = controllers[tool]
-    bit = made.Tool
-    op.Document.removeObject(made.Name)
-    compat.remove_toolbit(bit)
+    made = add_tool(job, bit(job.Document, kwargs["tool"], float(kwargs["diameter"]),
+                             float(kwargs.get("corner_radius", 0.0))),
+                    kwargs["horiz_feed"] / 60.0, kwargs["vert_feed"] / 60.0, kwargs["spindle_speed"])
+    made.Label = f"TC: {tool}"
+    made.Tool.Label = tool
+    made.Tool.CuttingEdgeHeight = float(spec["flute_length"])
+    made.Tool.Length = float(spec["length"])
+    if spec.get("shank_diameter") is not None:
+        made.Tool.ShankDiameter = float(spec["shank_diameter"])
+    if spec["holder"] is not None:
+        set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
+    return made
 
 
 def remove_unused(job: Any, results: list, controllers: Optional[dict] = None) -> None:

@@ -1,6 +1,6 @@
-"""The planner's stock in its FreeCAD Job (core.plan.stock: the plan's `stock`): a box stock is the one the first
-op's API call makes (FreeCAD's stock from the base, its extents set); for a cylinder or a solid the Job is made
-here first, with FreeCAD's own stocks: `CreateCylinder` (axis Z, its placement at the centre of its bottom) or,
+"""The planner's Job and its stock (core.plan.stock: the plan's `stock`), made here before any op: a box is
+FreeCAD's stock from the base, its extents set (as the API sets them); a cylinder or a solid FreeCAD's own stocks:
+`CreateCylinder` (axis Z, its placement at the centre of its bottom) or,
 for a solid, a clone of the file's shape as FreeCAD's Job editor makes an "existing solid" stock
 (`createResourceClone`, the same on 0.20, 1.0 and 1.1). The ops are then added to that Job; its roughing and its
 simulation take the stock solid's top as heights (app.op_roughing, app.simulation)."""
@@ -40,12 +40,17 @@ def new_job(plan: dict, model: Any = None) -> Any:
 
 
 def set_job_stock(job: Any, stock: dict) -> None:
-    """The Job's stock replaced by the plan's cylinder or solid (`stock`: core.plan.stock.PlannedStock.as_dict)."""
+    """The Job's stock: the plan's box its extents, or replaced by the plan's cylinder or solid (`stock`:
+    core.plan.stock.PlannedStock.as_dict)."""
     from tmm_workbench.app import compat
+    from tmm_workbench.app.api_run import set_stock
 
     doc = job.Document
     FreeCAD.setActiveDocument(doc.Name)
     lo, hi = stock["box_mm"][:3], stock["box_mm"][3:]
+    if stock["type"] == "box":
+        set_stock(job, tuple(stock["box_mm"]), 0.0, 0.0)
+        return
     if stock["type"] == "cylinder":
         cx, cy = stock["centre_mm"]
         new = compat.PathStock.CreateCylinder(job, stock["radius_mm"], hi[2] - lo[2],
@@ -58,7 +63,7 @@ def set_job_stock(job: Any, stock: dict) -> None:
             source.ViewObject.Visibility = False
         new = compat.PathJob.createResourceClone(job, source, "Stock", "Stock")
     else:
-        raise ValueError(f"stock type {stock['type']!r}: the API makes a box stock itself")
+        raise ValueError(f"stock type {stock['type']!r}: a box, a cylinder or a solid")
     old = job.Stock
     job.Stock = new
     if old is not None:

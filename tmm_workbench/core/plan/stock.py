@@ -3,7 +3,7 @@ its axis along Z through the centre of the model's XY bounds (its diameter and h
 margins, or given), or a solid (a STEP or STL file of the stock's shape, in the model file's frame). Its bounds
 are checked against the machine's travels and the model against the stock: a model not inside it is bad input.
 Without FreeCAD: a STEP stock is read through its tessellation (core.plan.launch). The FreeCAD Job gets the
-matching stock (app.plan_run.set_job_stock); its simulation and the roughing take the stock solid's top as
+matching stock (app.plan_stock.set_job_stock); its simulation and the roughing take the stock solid's top as
 heights, so a cylinder's outside and the air over a solid's top are never cut."""
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ class PlannedStock:
         return f"solid {self.file.name}, {size} mm over all" if self.type == "solid" else f"box {size} mm"
 
     def as_dict(self) -> dict:
-        """For the report and the FreeCAD side (app.plan_run.set_job_stock)."""
+        """For the report and the FreeCAD side (app.plan_stock.set_job_stock)."""
         out: dict = {"type": self.type, "box_mm": [round(v, 4) for v in self.box], "describe": self.describe()}
         if self.type == "cylinder":
             out |= {"centre_mm": [round(v, 4) for v in self.centre], "radius_mm": round(self.radius, 4)}
