@@ -24,5 +24,6 @@ USER_DIR="$(freecadcmd -c 'import FreeCAD; print("TMM_USER_DIR=" + FreeCAD.getUs
 [ -n "$USER_DIR" ] || { echo "[env_test] FreeCAD did not give its user folder" >&2; exit 1; }
 mkdir -p "$USER_DIR/Mod"
 ln -sfn "$PWD" "$USER_DIR/Mod/TMM"
+export OPENBLAS_NUM_THREADS=1   # the workers side by side: no BLAS threads spinning against them (scripts/test.sh)
 xvfb-run -a python3 -m pytest -p no:cacheprovider -n "${TMM_TEST_WORKERS:-$(($(nproc) + 1))}" --dist loadgroup --durations=10 \
   tests/freecad tests/gui "$@"

@@ -141,8 +141,9 @@ class WorkEstimate(FreeCADTestCase):
         ball = doc.addObject("Part::Feature", "Ball")
         ball.Shape = Part.makeSphere(200.0)
         doc.recompute()
-        job, _, op = job_with_op(doc, ball, diameter=6.0,
-                                 values={"StepOver": 5.0, "SampleStep": 5.0, "BoundaryShape": "Model"})
+        job, _, op = job_with_op(doc, ball, diameter=6.0,   # valid with a coarse tessellation (seconds, not 30)
+                                 values={"StepOver": 5.0, "SampleStep": 5.0, "BoundaryShape": "Model",
+                                         "LinearDeflection": 0.5})
         self.assertTrue(op.isValid(), op.getStatusString())
         for prop, value, fragment in (("LinearDeflection", 1e-6, "tessellation tolerance must be in [0.001, 10] mm"),
                                       ("SampleStep", 1e-4, "CL points")):
