@@ -11,9 +11,10 @@ tilt is the least one that keeps the bottom's heel (2 R behind its lowest point)
 the feed (sin(lambda) >= R kappa_f) and its sides off one curving up across (sin(lambda) >= R kappa), within the
 tilt limits. The width across, seen from above, is the width on the surface x cos(slope across).
 
-Passes. A pass is as wide as its narrowest place along the feed (the plan advances each pass by the least level
-it finishes along it); the planes are placed across the model as the step-over places them (predict_passes),
-from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model).
+Passes. The planes are placed across the model as the step-over places them (step_replay.replay_planes: each next
+plane half the GAP_QUANTILE of the widths the last pass finished beyond the least level it finished), on these
+widths from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model), per
+node step along the feed (the step-over keeps a finished level per bin of the feed coordinate).
 """
 from __future__ import annotations
 
@@ -26,10 +27,9 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.height_sample import CELLS, HeightSample
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies.mesh5.step_replay import WidthField, replay_planes
 from tmm_workbench.core.strategies.mesh5.stepover import MARGIN
 from tmm_workbench.core.tools.cutter import Cutter
-
-GROWTH = 1.1    # the step-over asks this much more of each next pass while they meet it
 
 
 def surface_sample(mesh: TriMesh, cells: int = CELLS) -> HeightSample:
@@ -63,42 +63,32 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
     return 2.0 * np.minimum(half, cutter.radius) / np.sqrt(1.0 + slope * slope)
 
 
-def least_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
-                 tilt_deg: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """(m, w): the sample's nodes binned across the feed (m, mm along the drive planes' normal, a node step
-    apart) and the least width one pass finishes in each bin (module doc); empty where none is known."""
+def width_field(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
+                tilt_deg: tuple[float, float]) -> Optional[WidthField]:
+    """The half-widths one pass finishes (pass_widths / 2, both sides alike) on the model's nodes, binned a node
+    step apart along the drive planes' normal and the feed (WidthField.binned: the model's rim, with no
+    curvature, the nearest inner width across). None where the sample holds no width."""
     w = pass_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
-    ok = np.isfinite(w)
-    if not ok.any():
-        return np.zeros(0), np.zeros(0)
+    model = np.isfinite(sample.z)
+    if not np.isfinite(w[model]).any():
+        return None
     a = math.radians(feed_angle_deg)
     X, Y = np.meshgrid(sample.xs, sample.ys)
-    m = (-X * math.sin(a) + Y * math.cos(a))[ok]
+    m, f = -X * math.sin(a) + Y * math.cos(a), X * math.cos(a) + Y * math.sin(a)
     step = max(sample.step, 1e-9)
-    bins = np.floor((m - m.min()) / step).astype(np.int64)
-    least = np.full(int(bins.max()) + 1, np.inf)
-    np.minimum.at(least, bins, w[ok])
-    keep = np.isfinite(least)
-    return (m.min() + step * (np.arange(len(least)) + 0.5))[keep], least[keep]
+    return WidthField.binned(m[model], f[model], 0.5 * w[model], step, step)
 
 
 def predict_passes(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
-                   tilt_deg: tuple[float, float]) -> Optional[int]:
+                   tilt_deg: tuple[float, float], forward_step: float = 2.0) -> Optional[int]:
     """The passes across the sampled model, None when the sample holds no width (a model smaller than its
-    nodes), placed as the step-over places them: the first plane 0.125 D inside its edge, each next one the
-    last one's left half-width beyond it and a gap more, the gap what its right half-width reaches back and at
-    most what the step-over asks (0.25 D first, eq. 3.22-3.23, then GROWTH times the last, up to D)."""
-    m, w = least_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
-    if not len(m):
+    nodes): the step-over's step control (step_replay.replay_planes) on the widths of width_field.
+    `forward_step`: the op's (Mesh5Params.forward_step)."""
+    field = width_field(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
+    if field is None:
         return None
-    edge = 0.5 * max(sample.step, 1e-9)
-    at, end, ask, passes = m[0] - edge + 0.125 * cutter.diameter, m[-1] + edge, 0.25 * cutter.diameter, 1
-    while at + 0.5 * float(np.interp(at, m, w)) < end:
-        half = 0.5 * float(np.interp(at, m, w))
-        at += half + min(ask, half)
-        ask = min(GROWTH * ask, cutter.diameter)
-        passes += 1
-    return passes
+    lo, hi = field.extent()
+    return len(replay_planes(field, lo, hi, cutter.radius, field.dm, forward_step)) or None
 
 
 def climb(sample: HeightSample, feed_angle_deg: float) -> float:
