@@ -9,7 +9,10 @@ section across curves up (concave) or down (convex) as kappa. The remaining heig
 width within the tolerance is sqrt(2 tau / (sin(lambda) / R - kappa)), at most R (the profile's end). The lead
 tilt is the least one that keeps the bottom's heel (2 R behind its lowest point) off a surface curving up along
 the feed (sin(lambda) >= R kappa_f) and its sides off one curving up across (sin(lambda) >= R kappa), within the
-tilt limits. The width across, seen from above, is the width on the surface x cos(slope across).
+tilt limits. Where the surface's normal tilts near or past the machine's tilt limit C (the axis cannot follow it),
+the tool leans back from the normal across the feed and the flat bottom finishes far less: there the half width is
+the best of the op's postures the machine reaches over a parabola of that curvature (steep_halves). The width
+across, seen from above, is the width on the surface x cos(slope across).
 
 Passes. The planes are placed across the model as the step-over places them (step_replay.replay_planes: each next
 plane half the GAP_QUANTILE of the widths the last pass finished beyond the least level it finished), on these
@@ -25,11 +28,16 @@ import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.height_sample import CELLS, HeightSample
+from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, tool_rotation
 from tmm_workbench.core.strategies.mesh5.step_replay import WidthField, replay_planes
 from tmm_workbench.core.strategies.mesh5.stepover import MARGIN
+from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile
 from tmm_workbench.core.tools.cutter import Cutter
+
+STEEP_DEG = 3.0     # nodes whose normal tilts within this of the machine's tilt limit C or past it: steep_halves
 
 
 def surface_sample(mesh: TriMesh, cells: int = CELLS) -> HeightSample:
@@ -52,7 +60,7 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
                 tilt_deg: tuple[float, float]) -> np.ndarray:
     """(ny, nx) the width across the feed, seen from above, that one pass finishes within `tolerance` at each
     node (module doc; NaN off the model and at its rim)."""
-    _, slope = sample.slopes(feed_angle_deg)
+    along_slope, slope = sample.slopes(feed_angle_deg)
     across = sample.curvature(feed_angle_deg)            # the section across the passes
     along = sample.curvature(feed_angle_deg - 90.0)      # the section along the feed
     sin_lead = lead_tilt(cutter, along, across, tilt_deg)
@@ -60,7 +68,47 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
     with np.errstate(divide="ignore", invalid="ignore"):
         wide = np.where(np.isnan(bend), np.nan, np.inf)       # off the model / no curvature left to bound it
         half = np.where(bend > 0, np.sqrt(2.0 * MARGIN * tolerance / bend), wide)
-    return 2.0 * np.minimum(half, cutter.radius) / np.sqrt(1.0 + slope * slope)
+    half = np.minimum(half, cutter.radius)
+    theta = np.arctan(np.hypot(along_slope, slope))
+    steep = np.isfinite(half) & np.isfinite(across) & (theta > TarusMachine().c_limits[1] - math.radians(STEEP_DEG))
+    if steep.any():
+        half[steep] = np.minimum(half[steep], steep_halves(cutter, MARGIN * tolerance, tilt_deg, across[steep],
+                                                           theta[steep]))
+    return 2.0 * half / np.sqrt(1.0 + slope * slope)
+
+
+def steep_halves(cutter: Cutter, tolerance: float, tilt_deg: tuple[float, float], kappa: np.ndarray,
+                 theta: np.ndarray) -> np.ndarray:
+    """(n,) half-widths within `tolerance` at nodes whose normal tilts `theta` (rad, from the vertical) near or past
+    the machine's tilt limit C, their section across curving as `kappa`: the best narrower side of the op's
+    postures (the default grid within `tilt_deg`) whose axis the machine reaches, the tool leaning back from the
+    normal across the feed (its bottom's profile over a parabola, lifted clear of it; on a table of kappa and
+    theta, linear between)."""
+    lam, omg = (g.ravel() for g in PostureGrid.degrees(tilt_deg).mesh())
+    py, pz = lower_profile(cutter, lam, omg, 401)
+    axis = tool_rotation(lam, omg)[:, 2, :]
+    ys = np.linspace(0.0, 2.0 * cutter.radius, 101)
+    lateral = np.concatenate([ys, -ys[1:]])
+    Z = np.array([np.interp(lateral, py[p], pz[p], left=np.inf, right=np.inf) for p in range(len(lam))])
+    ks = np.linspace(float(kappa.min()), float(kappa.max()) + 1e-12, 17)
+    ts = np.linspace(float(theta.min()), float(theta.max()) + 1e-12, 17)
+    reached = axis @ np.stack([np.zeros_like(ts), np.sin(ts), np.cos(ts)]) >= math.cos(TarusMachine().c_limits[1])
+    table = np.zeros((len(ks), len(ts)))
+    for i, k in enumerate(ks):
+        s = 0.5 * k * lateral ** 2
+        h = Z + np.maximum(np.max(np.where(np.isfinite(Z), s - Z, -np.inf), axis=1), 0.0)[:, None] - s
+        sides = []
+        for sl in (slice(0, len(ys)), np.r_[0, len(ys):len(lateral)]):
+            over = ~(h[:, sl] <= tolerance)
+            first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
+            sides.append(np.where(first > 0, ys[np.maximum(first - 1, 0)], 0.0))
+        table[i] = np.where(reached, np.minimum(*sides)[:, None], 0.0).max(axis=0)
+    u = np.clip((kappa - ks[0]) / (ks[1] - ks[0]), 0, len(ks) - 1.001)
+    v = np.clip((theta - ts[0]) / (ts[1] - ts[0]), 0, len(ts) - 1.001)
+    i, j = u.astype(np.int64), v.astype(np.int64)
+    a, b = u - i, v - j
+    return ((1 - a) * (1 - b) * table[i, j] + a * (1 - b) * table[i + 1, j] + (1 - a) * b * table[i, j + 1]
+            + a * b * table[i + 1, j + 1])
 
 
 def width_field(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
