@@ -73,17 +73,28 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
     steep = np.isfinite(half) & np.isfinite(across) & (theta > TarusMachine().c_limits[1] - math.radians(STEEP_DEG))
     if steep.any():
         half[steep] = np.minimum(half[steep], steep_halves(cutter, MARGIN * tolerance, tilt_deg, across[steep],
-                                                           theta[steep]))
+                                                           along[steep], _vertical(sample, feed_angle_deg)[steep]))
     return 2.0 * half / np.sqrt(1.0 + slope * slope)
 
 
+def _vertical(sample: HeightSample, feed_angle_deg: float) -> np.ndarray:
+    """(ny, nx, 3) the world's Z in each node's LCS (LX along the feed on the surface, LZ its normal; LY's sign
+    left out: the posture grid's yaw is symmetric)."""
+    gy, gx = np.gradient(sample.z, max(sample.step, 1e-9))
+    a = math.radians(feed_angle_deg)
+    g_along = gx * math.cos(a) + gy * math.sin(a)
+    lx = g_along / np.sqrt(1.0 + g_along ** 2)
+    lz = 1.0 / np.sqrt(1.0 + gx ** 2 + gy ** 2)
+    return np.stack([lx, np.sqrt(np.clip(1.0 - lx ** 2 - lz ** 2, 0.0, 1.0)), lz], axis=-1)
+
+
 def steep_halves(cutter: Cutter, tolerance: float, tilt_deg: tuple[float, float], kappa: np.ndarray,
-                 theta: np.ndarray) -> np.ndarray:
-    """(n,) half-widths within `tolerance` at nodes whose normal tilts `theta` (rad, from the vertical) near or past
-    the machine's tilt limit C, their section across curving as `kappa`: the best narrower side of the op's
-    postures (the default grid within `tilt_deg`) whose axis the machine reaches, the tool leaning back from the
-    normal across the feed (its bottom's profile over a parabola, lifted clear of it; on a table of kappa and
-    theta, linear between)."""
+                 kappa_along: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """(n,) half-widths within `tolerance` at n nodes whose normal tilts near or past the machine's tilt limit C:
+    the best narrower side of the op's postures (the default grid within `tilt_deg`) whose axis the machine
+    reaches (`vertical` (n, 3): the world's Z in the node's LCS) and whose lead along the feed keeps the bottom's
+    heel off the section along it (curving as `kappa_along`), over the section across (a parabola curving as
+    `kappa`; the bottom's profile lifted clear of it; linear between 17 curvatures)."""
     lam, omg = (g.ravel() for g in PostureGrid.degrees(tilt_deg).mesh())
     py, pz = lower_profile(cutter, lam, omg, 401)
     axis = tool_rotation(lam, omg)[:, 2, :]
@@ -91,9 +102,7 @@ def steep_halves(cutter: Cutter, tolerance: float, tilt_deg: tuple[float, float]
     lateral = np.concatenate([ys, -ys[1:]])
     Z = np.array([np.interp(lateral, py[p], pz[p], left=np.inf, right=np.inf) for p in range(len(lam))])
     ks = np.linspace(float(kappa.min()), float(kappa.max()) + 1e-12, 17)
-    ts = np.linspace(float(theta.min()), float(theta.max()) + 1e-12, 17)
-    reached = axis @ np.stack([np.zeros_like(ts), np.sin(ts), np.cos(ts)]) >= math.cos(TarusMachine().c_limits[1])
-    table = np.zeros((len(ks), len(ts)))
+    table = np.zeros((len(ks), len(lam)))
     for i, k in enumerate(ks):
         s = 0.5 * k * lateral ** 2
         h = Z + np.maximum(np.max(np.where(np.isfinite(Z), s - Z, -np.inf), axis=1), 0.0)[:, None] - s
@@ -102,13 +111,13 @@ def steep_halves(cutter: Cutter, tolerance: float, tilt_deg: tuple[float, float]
             over = ~(h[:, sl] <= tolerance)
             first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
             sides.append(np.where(first > 0, ys[np.maximum(first - 1, 0)], 0.0))
-        table[i] = np.where(reached, np.minimum(*sides)[:, None], 0.0).max(axis=0)
+        table[i] = np.minimum(*sides)
     u = np.clip((kappa - ks[0]) / (ks[1] - ks[0]), 0, len(ks) - 1.001)
-    v = np.clip((theta - ts[0]) / (ts[1] - ts[0]), 0, len(ts) - 1.001)
-    i, j = u.astype(np.int64), v.astype(np.int64)
-    a, b = u - i, v - j
-    return ((1 - a) * (1 - b) * table[i, j] + a * (1 - b) * table[i + 1, j] + (1 - a) * b * table[i, j + 1]
-            + a * b * table[i + 1, j + 1])
+    i = u.astype(np.int64)
+    half = (1 - (u - i))[:, None] * table[i] + (u - i)[:, None] * table[i + 1]          # (n, P)
+    reached = (vertical @ axis.T >= math.cos(TarusMachine().c_limits[1]) - 1e-9) & \
+        (axis[None, :, 0] >= cutter.radius * kappa_along[:, None] - 1e-9)
+    return np.where(reached, half, 0.0).max(axis=1)
 
 
 def width_field(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
