@@ -94,7 +94,8 @@ def test_the_step_overs_planes_are_replayed_from_the_widths_its_passes_finished(
         _, left, right = passes[int(np.argmin(np.abs(offsets - offset)))]
         return left, right
 
-    replayed = replay_planes(reach, cover.lo, cover.hi, cutter.radius, params.forward_step, params.forward_step)
+    replayed = replay_planes(reach, cover.lo, cover.hi, cutter.radius, params.forward_step, params.forward_step,
+                             widest=False)
     assert len(plan.passes) >= 4, plan.report()
     assert len(replayed) == len(offsets), (replayed, offsets)
     assert np.allclose(replayed, offsets, atol=1e-3 * cutter.radius), (replayed, offsets)

@@ -1,7 +1,8 @@
 """The adaptive step-over's step control (stepover.adaptive_passes, its _Planes and _give_up_lagging) replayed on
 widths known beforehand, for the estimates that tell the passes without planning them (mesh5.estimate, the op's
-work; core.plan.mesh5_estimate, the planner's cycle time). One replay, the step-over's constants imported: a
-change of its rule there is a change here.
+work; core.plan.mesh5_estimate, the planner's cycle time). One replay, the step-over's named constants imported
+(they change with it); a change of its rule's steps must be made here too, which
+tests/core/test_mesh5_step_replay.py tells (the step-over's own offsets replayed from what its passes finished).
 
 What it replays, per bin of the feed coordinate (the step-over's Coverage keeps one level per forward step; here
 a bin is the width field's column): the first plane 0.125 D inside the model; each next one a gap beyond the
@@ -23,10 +24,10 @@ from typing import Callable, Optional
 import numpy as np
 
 from tmm_workbench.core.strategies.mesh5.stepover import (AHEAD_SHARE, GAP_QUANTILE, LAGGING, MAX_TRIES, REPEAT,
-                                                          SHRINK)
+                                                          SHRINK, WIDE_QUANTILE)
 
-# the step-over's literals (adaptive_passes): the first plane and the first left step asked (seed 000 eq.
-# 3.22-3.23), the gap's range, and the strip skipped where no pass advances, in cutter radii
+# the step-over's literals (adaptive_passes writes them in place, nothing to import): the first plane and the first
+# left step asked (seed 000 eq. 3.22-3.23), the gap's range, and the strip skipped where no pass advances, in radii
 FIRST_GAP, FIRST_AHEAD, LEAST_GAP, MOST_GAP, SKIP = 0.25, 0.5, 0.05, 2.0, 0.5
 EDGE = 1e-3             # Coverage's edge: a bin within this many radii of its top is finished
 # the right side step the C-space asks (stepover._side_steps): this share of the way back to the level, and mm more
@@ -100,11 +101,14 @@ class WidthField:
 
 
 def replay_planes(reach: Reach, lo: np.ndarray, hi: np.ndarray, radius: float, bin_width: float,
-                  forward_step: float, max_planes: int = 10_000) -> np.ndarray:
+                  forward_step: float, widest: bool = True, max_planes: int = 10_000) -> np.ndarray:
     """The drive planes' offsets (along m) the step-over places over the model spanning lo..hi (nb,) along m
     in each bin of the feed (`bin_width` mm; NaN: no model there), where `reach(offset)` tells the half-widths
     (left +m, right -m; (nb,) each, NaN where the plane misses the bin, inf: to the model's edge) a pass at
-    `offset` finishes (module doc). `forward_step`: the op's (its bins' width, in which LAGGING counts)."""
+    `offset` finishes (module doc). `forward_step`: the op's (its bins' width, in which LAGGING counts).
+    `widest`: reach tells the widest each place allows, of which a pass finishes no more than its WIDE_QUANTILE
+    place's (stepover.widest_cspace keeps the postures reaching that far, or a place's own widest where less,
+    and chooses among them for the motion time); False: what the pass finishes itself."""
     if not (radius > 0 and bin_width > 0 and forward_step > 0):
         raise ValueError(f"radius, bin_width and forward_step must be > 0 mm, got {radius}, {bin_width}, "
                          f"{forward_step}")
@@ -112,7 +116,7 @@ def replay_planes(reach: Reach, lo: np.ndarray, hi: np.ndarray, radius: float, b
     if not on.any():
         return np.zeros(0)
     lo_b, hi_b = np.asarray(lo, dtype=float)[on], np.asarray(hi, dtype=float)[on]
-    state = _Replay(reach, on, lo_b, hi_b, radius, max(1, round(LAGGING * forward_step / bin_width)))
+    state = _Replay(reach, on, lo_b, hi_b, radius, max(1, round(LAGGING * forward_step / bin_width)), widest)
     return state.run(max_planes)
 
 
@@ -120,8 +124,9 @@ class _Replay:
     """The replay's finished levels per bin and its loop (adaptive_passes' own, on known widths)."""
 
     def __init__(self, reach: Reach, on: np.ndarray, lo: np.ndarray, hi: np.ndarray, radius: float,
-                 lagging: int):
+                 lagging: int, widest: bool):
         self.reach, self.on, self.lo, self.hi, self.radius, self.lagging = reach, on, lo, hi, radius, lagging
+        self.widest = widest
         self.level = lo.copy()
         self.edge = EDGE * radius
 
@@ -165,6 +170,11 @@ class _Replay:
         need = np.where(fresh, -np.inf, BACK_SHARE * (offset - self.level) + BACK_MORE)
         if not run.any() or (run & ((right < need) | (left < 0.25 * ahead))).any():
             return None
+        if self.widest:                                            # the pass as wide as nearly all its places
+            fin = left[run & np.isfinite(left)]
+            target = float(np.quantile(fin, WIDE_QUANTILE)) if fin.size else np.inf
+            left = np.where(np.isinf(left), left, np.minimum(left, target))   # to the edge: those kept
+            right = np.maximum(np.minimum(right, target), need)
         reached = np.where(offset + left >= self.hi - self.edge, np.inf, offset + left)
         level = np.where(run & self.open, np.maximum(self.level, reached), self.level)
         total = np.minimum(left, self.hi.max() - offset) + np.minimum(right, offset - self.lo.min())
