@@ -99,3 +99,20 @@ def test_the_step_overs_planes_are_replayed_from_the_widths_its_passes_finished(
     assert len(plan.passes) >= 4, plan.report()
     assert len(replayed) == len(offsets), (replayed, offsets)
     assert np.allclose(replayed, offsets, atol=1e-3 * cutter.radius), (replayed, offsets)
+
+
+def test_points_binned_into_a_width_field() -> None:
+    # points on rows 1 mm apart across and columns 2 mm apart along the feed, the least in each cell; a point
+    # with no width known takes the nearest known across in its column; off the points: no model
+    m, f = np.meshgrid(np.arange(5.0), np.arange(0.0, 8.0, 2.0), indexing="ij")
+    half = np.full(m.shape, 2.0)
+    half[1:3, 1] = np.nan
+    half[3, 1] = 0.5
+    field = WidthField.binned(m, f, half, 1.0, 2.0)
+    assert field.left.shape == (5, 4)
+    assert field.left[2, 1] == pytest.approx(0.5) and field.left[1, 1] == pytest.approx(2.0)
+    lo, hi = field.extent()
+    assert np.allclose(lo, -0.5) and np.allclose(hi, 4.5)
+    left, right = field(2.5)
+    assert left[1] == pytest.approx(0.5) and right[0] == pytest.approx(2.0)
+    assert np.all(np.isnan(field(6.0)[0]))
