@@ -1,9 +1,8 @@
 """The 5-axis mesh op's cycle time estimated without planning it (core.plan.mesh5_estimate), against the op itself
 planned and timed by the Tarus post (core.plan.five_axis's former way, what the FreeCAD op then computes): on a
-small window of each of seed 000's convex and concave surfaces. The step control replayed on given half steps."""
+small window of each of seed 000's convex and concave surfaces (the step control replayed: test_mesh5_step_replay)."""
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from benchmarks.seed000_surfaces import seed000_mesh
@@ -12,7 +11,6 @@ from tmm_workbench.core.linking import link
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.plan import decide, five_axis, materials
 from tmm_workbench.core.plan.job_file import ToolSpec
-from tmm_workbench.core.plan.mesh5_estimate import plane_offsets
 from tmm_workbench.core.post import Operation, ToolInfo
 from tmm_workbench.core.post.tarus_writer import write_tarus
 from tmm_workbench.core.strategies.mesh5 import finish
@@ -57,14 +55,3 @@ def test_estimate_near_the_built_op(surface: str) -> None:
     # the estimate runs low: the op tilts and yaws the tool for its motion time, which turns A more at the links
     # (measured -27 % and -12 % here, -0 % to -24 % on the 51 x 53 mm windows: docs/planner.md)
     assert -0.35 * seconds < est.seconds - seconds < 0.1 * seconds, (est.seconds, seconds)
-
-
-def test_step_control_replayed() -> None:
-    """Half steps of 1 mm everywhere on 0..20 mm, radius 4: the first plane 1 mm in, asked 2 mm first (a quarter
-    diameter: wider than the 1 mm there, so the near side shrinks to it), then steps of two half steps."""
-    probes = np.linspace(0.5, 19.5, 20)
-    planes = plane_offsets(probes, np.full(20, 1.0), 0.0, 20.0, 4.0)
-    assert planes[0] == pytest.approx(1.0)
-    steps = np.diff(planes)
-    assert np.all(steps <= 2.0 + 1e-9) and np.all(steps > 1.0)
-    assert planes[-1] + 1.0 >= 20.0 - 1e-6 > planes[-2] + 1.0   # the last plane's far side reaches the edge

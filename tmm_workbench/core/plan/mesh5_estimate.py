@@ -5,12 +5,13 @@ Strip width. Drive planes a few mm apart across the model are cut into CC points
 (mesh5.cc_paths); at each, the few least tilts of the op's posture grid along the feed are lifted clear of the
 mesh by the C-space's own exact drop (mesh5.lift.lifts) and their half-widths at the op's tolerance measured as
 the op measures them (stepover.half_widths: the tilted tool's effective cutting profile over the surface's
-cross-section, at the op's MARGIN of the tolerance). A CC point's half step is the best posture's narrower side;
-a plane's is its narrowest CC point's (the op places each pass by its worst CC point), seen along the plane normal
-(the section's slope across the feed shortens it there).
+cross-section, at the op's MARGIN of the tolerance). A CC point's half step is the best posture's narrower side,
+seen along the plane normal (the section's slope across the feed shortens it there); a probe plane's, per bin of the
+feed, its narrowest CC point's there (the op keeps a finished level per bin, advanced by its worst CC point).
 
-Passes. From 0.125 D inside the mesh (the op's first plane, seed 000 eq. 3.22), each next plane two half steps
-beyond the last (read from the nearest probe plane) until a half step reaches the far side.
+Passes. The op's step control (mesh5.step_replay, the step-over's own rule: each next plane half the
+GAP_QUANTILE of the widths the last pass finished beyond the least level it finished, per bin of the feed)
+replayed on those half steps, binned by probe plane across and the op's forward step along the feed.
 
 Time. Those planes are cut into CC paths, the tool placed at the probes' most common tilt (lift 0), each path
 with a radius of overrun at both ends, zig-zag, linked as the op links (multipoint.link_policy), and the result
@@ -34,7 +35,8 @@ from tmm_workbench.core.strategies.mesh5 import finish
 from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths, plane_normal
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import world_placement
-from tmm_workbench.core.strategies.mesh5.stepover import MARGIN, SHRINK, half_widths
+from tmm_workbench.core.strategies.mesh5.step_replay import WidthField, replay_planes
+from tmm_workbench.core.strategies.mesh5.stepover import MARGIN, half_widths
 from tmm_workbench.core.tools.cutter import Cutter
 
 PROBE_SPACING = 3.0   # mm between the probe planes (at least MIN_PROBES across the model)
@@ -80,23 +82,19 @@ def half_steps(reach: MeshReach, cutter: Cutter, params: finish.Mesh5Params, poi
     return best, tilt
 
 
-def plane_offsets(probes: np.ndarray, steps: np.ndarray, lo: float, hi: float, radius: float) -> np.ndarray:
-    """The op's drive planes (module doc, Passes) over lo..hi, the probe planes at `probes` with half steps
-    `steps` (> 0): its step control replayed on them."""
-    out = [lo + 0.25 * radius]                              # the first plane; it finishes back to the edge
-    ahead = 0.5 * radius                                    # the op's first asked step: a quarter diameter
-    level = out[0]
-    while len(out) < 10_000:
-        width = float(steps[np.argmin(np.abs(probes - out[-1]))])
-        if out[-1] + width >= hi - 1e-6:                    # its far side reaches the edge: the last pass
-            break
-        level = out[-1] + min(ahead, width)
-        ahead = float(np.clip(ahead * (0.95 if width < ahead else 1.1), 0.05 * radius, 2.0 * radius))
-        gap = ahead
-        while gap > width and gap > 0.05 * radius:          # a near side too wide for a CC point: nearer
-            gap *= SHRINK
-        out.append(level + gap)
-    return np.array(out)
+def _planes(at: list, across: list, halves: list, probes: np.ndarray, forward_step: float, radius: float
+            ) -> np.ndarray:
+    """The op's drive planes from the probes' CC points (their plane offsets, feed coordinates and half steps,
+    NaN where blocked): its step control replayed on them (step_replay), a quarter diameter apart where
+    nothing clears anywhere."""
+    half = np.concatenate(halves) if halves else np.zeros(0)
+    if not np.isfinite(half).any():
+        lo = probes[0] - 0.5 * (probes[1] - probes[0])
+        return np.arange(lo + 0.25 * radius, probes[-1] + 0.5 * (probes[1] - probes[0]), 0.5 * radius)
+    field = WidthField.binned(np.concatenate(at), np.concatenate(across), half, float(probes[1] - probes[0]),
+                              forward_step)
+    lo, hi = field.extent()
+    return replay_planes(field, lo, hi, radius, forward_step, forward_step)
 
 
 def segments(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, offsets: np.ndarray, tilt: float) -> list:
@@ -139,24 +137,19 @@ def estimate(mesh: TriMesh, cutter: Cutter, params: finish.Mesh5Params, tool_inf
     lo, hi = float(s.min()), float(s.max())
     count = max(MIN_PROBES, math.ceil((hi - lo) / PROBE_SPACING))
     probes = lo + (hi - lo) * (np.arange(count) + 0.5) / count
-    steps, tilts, blocked, probed = np.full(count, np.nan), [], 0, 0
+    feed_dir = np.array([m[1], -m[0], 0.0])                                  # the op's (mesh5.coverage)
+    at, across, halves, tilts, blocked, probed = [], [], [], [], 0, 0
     for p in cc_paths(mesh, params.direction(), probes, params.forward_step, params.chord_tol):
         half, tilt = half_steps(reach, cutter, params, p.points, p.frames)
-        along = np.abs(p.frames[:, 1] @ m)                                    # LY seen along the plane normal
         ok = half > 0
         blocked += int((~ok).sum())
         probed += len(half)
         tilts.extend(tilt[ok])
-        if ok.any():
-            h = float((half * along)[ok].min())
-            steps[p.plane] = h if np.isnan(steps[p.plane]) else min(steps[p.plane], h)
-    known = np.isfinite(steps) & (steps > 0)
-    if not known.any():
-        steps[:] = 0.25 * cutter.diameter      # nothing clears anywhere: the op's first guess
-    else:
-        steps = np.interp(probes, probes[known], steps[known])
-    steps = np.maximum(steps, 0.05 * cutter.radius)                          # the op's least step
-    offsets = plane_offsets(probes, steps, lo, hi, cutter.radius)
+        at.append(np.full(len(half), probes[p.plane]))
+        across.append(p.points @ feed_dir)
+        # LY seen along the plane normal (the section's slope across the feed shortens it)
+        halves.append(np.where(ok, np.maximum(half * np.abs(p.frames[:, 1] @ m), 0.05 * cutter.radius), np.nan))
+    offsets = _planes(at, across, halves, probes, params.forward_step, cutter.radius)
     values, counts = np.unique(np.round(tilts, 9), return_counts=True)
     tilt = float(values[np.argmax(counts)]) if len(values) else 0.0
     segs = segments(mesh, cutter, params, offsets, tilt)

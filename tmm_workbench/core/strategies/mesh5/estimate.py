@@ -9,11 +9,15 @@ section across curves up (concave) or down (convex) as kappa. The remaining heig
 width within the tolerance is sqrt(2 tau / (sin(lambda) / R - kappa)), at most R (the profile's end). The lead
 tilt is the least one that keeps the bottom's heel (2 R behind its lowest point) off a surface curving up along
 the feed (sin(lambda) >= R kappa_f) and its sides off one curving up across (sin(lambda) >= R kappa), within the
-tilt limits. The width across, seen from above, is the width on the surface x cos(slope across).
+tilt limits. Where the surface's normal tilts near or past the machine's tilt limit C (the axis cannot follow it),
+the tool leans back from the normal across the feed and the flat bottom finishes far less: there the half width is
+the best of the op's postures the machine reaches over a parabola of that curvature (steep_halves). The width
+across, seen from above, is the width on the surface x cos(slope across).
 
-Passes. A pass is as wide as its narrowest place along the feed (the plan advances each pass by the least level
-it finishes along it); the planes are placed across the model as the step-over places them (predict_passes),
-from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model).
+Passes. The planes are placed across the model as the step-over places them (step_replay.replay_planes: each next
+plane half the GAP_QUANTILE of the widths the last pass finished beyond the least level it finished), on these
+widths from a coarse needle sample of the model (core.query.height_sample.HeightSample, NaN off the model), per
+node step along the feed (the step-over keeps a finished level per bin of the feed coordinate).
 """
 from __future__ import annotations
 
@@ -24,12 +28,16 @@ import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.height_sample import CELLS, HeightSample
+from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, tool_rotation
+from tmm_workbench.core.strategies.mesh5.step_replay import WidthField, replay_planes
 from tmm_workbench.core.strategies.mesh5.stepover import MARGIN
+from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile
 from tmm_workbench.core.tools.cutter import Cutter
 
-GROWTH = 1.1    # the step-over asks this much more of each next pass while they meet it
+STEEP_DEG = 3.0     # nodes whose normal tilts within this of the machine's tilt limit C or past it: steep_halves
 
 
 def surface_sample(mesh: TriMesh, cells: int = CELLS) -> HeightSample:
@@ -52,7 +60,7 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
                 tilt_deg: tuple[float, float]) -> np.ndarray:
     """(ny, nx) the width across the feed, seen from above, that one pass finishes within `tolerance` at each
     node (module doc; NaN off the model and at its rim)."""
-    _, slope = sample.slopes(feed_angle_deg)
+    along_slope, slope = sample.slopes(feed_angle_deg)
     across = sample.curvature(feed_angle_deg)            # the section across the passes
     along = sample.curvature(feed_angle_deg - 90.0)      # the section along the feed
     sin_lead = lead_tilt(cutter, along, across, tilt_deg)
@@ -60,45 +68,84 @@ def pass_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_ang
     with np.errstate(divide="ignore", invalid="ignore"):
         wide = np.where(np.isnan(bend), np.nan, np.inf)       # off the model / no curvature left to bound it
         half = np.where(bend > 0, np.sqrt(2.0 * MARGIN * tolerance / bend), wide)
-    return 2.0 * np.minimum(half, cutter.radius) / np.sqrt(1.0 + slope * slope)
+    half = np.minimum(half, cutter.radius)
+    theta = np.arctan(np.hypot(along_slope, slope))
+    steep = np.isfinite(half) & np.isfinite(across) & (theta > TarusMachine().c_limits[1] - math.radians(STEEP_DEG))
+    if steep.any():
+        half[steep] = np.minimum(half[steep], steep_halves(cutter, MARGIN * tolerance, tilt_deg, across[steep],
+                                                           along[steep], _vertical(sample, feed_angle_deg)[steep]))
+    return 2.0 * half / np.sqrt(1.0 + slope * slope)
 
 
-def least_widths(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
-                 tilt_deg: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
-    """(m, w): the sample's nodes binned across the feed (m, mm along the drive planes' normal, a node step
-    apart) and the least width one pass finishes in each bin (module doc); empty where none is known."""
+def _vertical(sample: HeightSample, feed_angle_deg: float) -> np.ndarray:
+    """(ny, nx, 3) the world's Z in each node's LCS (LX along the feed on the surface, LZ its normal; LY's sign
+    left out: the posture grid's yaw is symmetric)."""
+    gy, gx = np.gradient(sample.z, max(sample.step, 1e-9))
+    a = math.radians(feed_angle_deg)
+    g_along = gx * math.cos(a) + gy * math.sin(a)
+    lx = g_along / np.sqrt(1.0 + g_along ** 2)
+    lz = 1.0 / np.sqrt(1.0 + gx ** 2 + gy ** 2)
+    return np.stack([lx, np.sqrt(np.clip(1.0 - lx ** 2 - lz ** 2, 0.0, 1.0)), lz], axis=-1)
+
+
+def steep_halves(cutter: Cutter, tolerance: float, tilt_deg: tuple[float, float], kappa: np.ndarray,
+                 kappa_along: np.ndarray, vertical: np.ndarray) -> np.ndarray:
+    """(n,) half-widths within `tolerance` at n nodes whose normal tilts near or past the machine's tilt limit C:
+    the best narrower side of the op's postures (the default grid within `tilt_deg`) whose axis the machine
+    reaches (`vertical` (n, 3): the world's Z in the node's LCS) and whose lead along the feed keeps the bottom's
+    heel off the section along it (curving as `kappa_along`), over the section across (a parabola curving as
+    `kappa`; the bottom's profile lifted clear of it; linear between 17 curvatures)."""
+    lam, omg = (g.ravel() for g in PostureGrid.degrees(tilt_deg).mesh())
+    py, pz = lower_profile(cutter, lam, omg, 401)
+    axis = tool_rotation(lam, omg)[:, 2, :]
+    ys = np.linspace(0.0, 2.0 * cutter.radius, 101)
+    lateral = np.concatenate([ys, -ys[1:]])
+    Z = np.array([np.interp(lateral, py[p], pz[p], left=np.inf, right=np.inf) for p in range(len(lam))])
+    ks = np.linspace(float(kappa.min()), float(kappa.max()) + 1e-12, 17)
+    table = np.zeros((len(ks), len(lam)))
+    for i, k in enumerate(ks):
+        s = 0.5 * k * lateral ** 2
+        h = Z + np.maximum(np.max(np.where(np.isfinite(Z), s - Z, -np.inf), axis=1), 0.0)[:, None] - s
+        sides = []
+        for sl in (slice(0, len(ys)), np.r_[0, len(ys):len(lateral)]):
+            over = ~(h[:, sl] <= tolerance)
+            first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
+            sides.append(np.where(first > 0, ys[np.maximum(first - 1, 0)], 0.0))
+        table[i] = np.minimum(*sides)
+    u = np.clip((kappa - ks[0]) / (ks[1] - ks[0]), 0, len(ks) - 1.001)
+    i = u.astype(np.int64)
+    half = (1 - (u - i))[:, None] * table[i] + (u - i)[:, None] * table[i + 1]          # (n, P)
+    reached = (vertical @ axis.T >= math.cos(TarusMachine().c_limits[1]) - 1e-9) & \
+        (axis[None, :, 0] >= cutter.radius * kappa_along[:, None] - 1e-9)
+    return np.where(reached, half, 0.0).max(axis=1)
+
+
+def width_field(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
+                tilt_deg: tuple[float, float]) -> Optional[WidthField]:
+    """The half-widths one pass finishes (pass_widths / 2, both sides alike) on the model's nodes, binned a node
+    step apart along the drive planes' normal and the feed (WidthField.binned: the model's rim, with no
+    curvature, the nearest inner width across). None where the sample holds no width."""
     w = pass_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
-    ok = np.isfinite(w)
-    if not ok.any():
-        return np.zeros(0), np.zeros(0)
+    model = np.isfinite(sample.z)
+    if not np.isfinite(w[model]).any():
+        return None
     a = math.radians(feed_angle_deg)
     X, Y = np.meshgrid(sample.xs, sample.ys)
-    m = (-X * math.sin(a) + Y * math.cos(a))[ok]
+    m, f = -X * math.sin(a) + Y * math.cos(a), X * math.cos(a) + Y * math.sin(a)
     step = max(sample.step, 1e-9)
-    bins = np.floor((m - m.min()) / step).astype(np.int64)
-    least = np.full(int(bins.max()) + 1, np.inf)
-    np.minimum.at(least, bins, w[ok])
-    keep = np.isfinite(least)
-    return (m.min() + step * (np.arange(len(least)) + 0.5))[keep], least[keep]
+    return WidthField.binned(m[model], f[model], 0.5 * w[model], step, step)
 
 
 def predict_passes(sample: HeightSample, cutter: Cutter, tolerance: float, feed_angle_deg: float,
-                   tilt_deg: tuple[float, float]) -> Optional[int]:
+                   tilt_deg: tuple[float, float], forward_step: float = 2.0) -> Optional[int]:
     """The passes across the sampled model, None when the sample holds no width (a model smaller than its
-    nodes), placed as the step-over places them: the first plane 0.125 D inside its edge, each next one the
-    last one's left half-width beyond it and a gap more, the gap what its right half-width reaches back and at
-    most what the step-over asks (0.25 D first, eq. 3.22-3.23, then GROWTH times the last, up to D)."""
-    m, w = least_widths(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
-    if not len(m):
+    nodes): the step-over's step control (step_replay.replay_planes) on the widths of width_field.
+    `forward_step`: the op's (Mesh5Params.forward_step)."""
+    field = width_field(sample, cutter, tolerance, feed_angle_deg, tilt_deg)
+    if field is None:
         return None
-    edge = 0.5 * max(sample.step, 1e-9)
-    at, end, ask, passes = m[0] - edge + 0.125 * cutter.diameter, m[-1] + edge, 0.25 * cutter.diameter, 1
-    while at + 0.5 * float(np.interp(at, m, w)) < end:
-        half = 0.5 * float(np.interp(at, m, w))
-        at += half + min(ask, half)
-        ask = min(GROWTH * ask, cutter.diameter)
-        passes += 1
-    return passes
+    lo, hi = field.extent()
+    return len(replay_planes(field, lo, hi, cutter.radius, field.dm, forward_step)) or None
 
 
 def climb(sample: HeightSample, feed_angle_deg: float) -> float:
