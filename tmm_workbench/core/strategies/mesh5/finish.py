@@ -132,7 +132,8 @@ def estimate_work(params: Mesh5Params, cutter: Cutter, bounds: Box, sample: Opti
     across, along = _extents(np.array(bounds[:3]), np.array(bounds[3:]), params)
     count, passes = count_points(across, along, params, cutter)
     told = None if sample is None else estimate.predict_passes(
-        sample, cutter, params.tolerance, params.feed_angle_deg, (params.tilt_min_deg, params.tilt_max_deg))
+        sample, cutter, params.tolerance, params.feed_angle_deg, (params.tilt_min_deg, params.tilt_max_deg),
+        params.forward_step)
     climb = 1.0
     if told is not None:
         climb = estimate.climb(sample, params.feed_angle_deg)
