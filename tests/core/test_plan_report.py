@@ -105,3 +105,22 @@ def test_tarus_on_the_setup_sheet(planned) -> None:
         in page
     page = report_html(launch.report(job, an, plan, verification(plan), ["beet_mm.ngc"]), "beet_mm")
     assert "linuxcnc post, travels 300 x 200 x 100 mm" in page and "Tarus" not in page
+
+
+def test_outcome_lines_say_the_changes_the_verdict_and_each_op() -> None:
+    """The outcome `tmm plan` prints and TMM Auto's result box shows: what the run changed first, the verdict with
+    its numbers, each op's cycle time only when asked; a failed run names its problems."""
+    verified = {"passed": True, "problems": [], "deepest_gouge_mm": 0.0012, "most_material_left_mm": 0.25,
+                "cycle_seconds": 754.0, "replanned": ["left out Rest T4 ball D3: shank too close"],
+                "ops": [{"label": "Roughing T1 flat D8", "cycle_seconds": 600.5},
+                        {"label": "Finish T2 ball D6", "cycle_seconds": 153.5}]}
+    assert launch.outcome_lines(verified) == [
+        "plan changed: left out Rest T4 ball D3: shank too close",
+        "verified; deepest gouge 0.0012 mm, most left 0.25 mm, cycle 12.6 min"]
+    assert launch.outcome_lines(verified, ops=True)[2:] == ["  Roughing T1 flat D8: 600.5 s",
+                                                            "  Finish T2 ball D6: 153.5 s"]
+    failed = dict(verified, passed=False, problems=["gouged 0.0300 mm below the model", "2 rapids through stock"],
+                  replanned=[])
+    assert launch.outcome_lines(failed) == [
+        "verification FAILED: gouged 0.0300 mm below the model; 2 rapids through stock; deepest gouge 0.0012 mm, "
+        "most left 0.25 mm, cycle 12.6 min"]

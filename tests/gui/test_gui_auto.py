@@ -5,11 +5,13 @@ planned ops (each computed) in the document, selected, a result box naming the o
 folder with report.html naming every op. Screenshots in out/gui."""
 from __future__ import annotations
 
+import json
 import re
 from pathlib import Path
 
 from tests.conftest import SHARED_STL
 from tests.gui.launch import SHOTS, check_shots, run_session
+from tmm_workbench.core.plan.launch import outcome_lines
 
 TIMEOUT_S = 300
 
@@ -32,11 +34,14 @@ def test_gui_auto(tmp_path: Path) -> None:
     assert labels[0].startswith("Roughing") and any(label.startswith("Finish") for label in labels), labels
     assert all(valid and moves > 10 for _, valid, moves in info["ops"]), info["ops"]
     assert info["selected"] == [info["job_name"]], info
-    assert info["box"].splitlines()[2] == "Verified", info["box"]
+    # the box says what the report says, as `tmm plan` says it: the verdict with its numbers, each op's time
+    report = json.loads((out / "report.json").read_text())
+    box = info["box"].splitlines()
+    assert box[2:] == outcome_lines(report["verification"], ops=True) + [f"Report: {out / 'report.html'}"], box
+    assert any(line.startswith("verified; deepest gouge") for line in box), box
     for label in labels:
-        assert label in info["box"], (label, info["box"])
+        assert any(line.startswith(f"  {label}: ") and line.endswith(" s") for line in box), (label, box)
         assert f"<td>{label}</td>" in info["html"], label
-    assert str(out / "report.html") in info["box"], info["box"]
     assert {"beet_mm_model.stl", "job.json", "beet_mm.ngc", "beet_mm_sim.png", "beet_mm_toolpath.png",
             "report.html", "report.json"} <= set(info["files"]), info["files"]
     assert not [f for f in info["files"] if f.endswith(".FCStd")], info["files"]   # the Job stays in the open doc

@@ -201,15 +201,11 @@ class AutoPanel:
 
 
 def result_text(report: dict, out: Path) -> str:
-    """The box's words: the verdict, the numbers, the ops with their times, what the run changed in the plan (a
-    5-axis op's fallback to the 3-axis plan, an optional op left out), where the report is."""
-    v = report["verification"]
-    verdict = "Verified" if report["passed"] else "Verification failed: " + "; ".join(report["problems"])
-    ops = "\n".join(f"  {o['label']}: {o['cycle_seconds']:g} s" for o in v["ops"])
-    changed = "".join(f"Plan changed: {r}\n" for r in v.get("replanned", []))
-    return (f"{verdict}\ndeepest gouge {v['deepest_gouge_mm']:g} mm, most material left "
-            f"{v['most_material_left_mm']:g} mm, cycle time {v['cycle_seconds'] / 60:.1f} min\n{ops}\n{changed}"
-            f"Report: {out / 'report.html'}")
+    """The box's words: the run's outcome as `tmm plan` says it (core.plan.launch.outcome_lines: what the run
+    changed in the plan, the verdict, the numbers, each op's time), where the report is."""
+    from tmm_workbench.core.plan.launch import outcome_lines
+
+    return "\n".join(outcome_lines(report["verification"], ops=True) + [f"Report: {out / 'report.html'}"])
 
 
 def show_result(job: Any, report: dict, out: Path) -> None:

@@ -314,12 +314,24 @@ def run(job_path: str, freecad: str = "freecadcmd", quiet: bool = False, out_dir
     return VERIFIED if verified["passed"] else FAILED
 
 
-def say_outcome(verified: dict, out_dir: Path, seconds: float, quiet: bool) -> None:
-    for change in verified.get("replanned", []):
-        say(f"plan changed: {change}", quiet)
+def outcome_lines(verified: dict, ops: bool = False) -> list[str]:
+    """A run's outcome for people (the terminal's last lines, TMM Auto's result box): what the run changed in the
+    plan (a 5-axis op's fallback, an optional op changed or left out), the verdict with the numbers, and with
+    `ops` each op's cycle time."""
+    lines = [f"plan changed: {change}" for change in verified.get("replanned", [])]
     state = "verified" if verified["passed"] else "verification FAILED: " + "; ".join(verified["problems"])
-    say(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left {verified['most_material_left_mm']:g}"
-        f" mm, cycle {verified['cycle_seconds'] / 60:.1f} min; written to {out_dir} ({seconds:.0f} s)", quiet)
+    lines.append(f"{state}; deepest gouge {verified['deepest_gouge_mm']:g} mm, most left "
+                 f"{verified['most_material_left_mm']:g} mm, cycle {verified['cycle_seconds'] / 60:.1f} min")
+    if ops:
+        lines += [f"  {o['label']}: {o['cycle_seconds']:g} s" for o in verified["ops"]]
+    return lines
+
+
+def say_outcome(verified: dict, out_dir: Path, seconds: float, quiet: bool) -> None:
+    lines = outcome_lines(verified)
+    for line in lines[:-1]:
+        say(line, quiet)
+    say(f"{lines[-1]}; written to {out_dir} ({seconds:.0f} s)", quiet)
 
 
 def tessellated(job: JobSpec, freecad: str, quiet: bool) -> tuple[JobSpec, Optional[Path]]:
