@@ -367,14 +367,14 @@ def mesh5(proxy: Any, obj: Any, ov: Mapping[str, float], load_stl: bool) -> Inpu
     if b is None:
         return None
     mesh = _mesh_at_hand(proxy, obj, load_stl)
-    if mesh is not None and (not _needles or _needles[0] is not mesh):
-        _needles[:] = [mesh, estimate.surface_sample(mesh)]
+    sample = None
+    if mesh is not None:   # kept on the op with its mesh: the panel asks on every value entered
+        kept = getattr(proxy, "needle_sample", None)
+        if kept is None or kept[0] is not mesh:
+            kept = proxy.needle_sample = (mesh, estimate.surface_sample(mesh))
+        sample = kept[1]
     left = cleanup.MAX_CELL if getattr(obj, "SimulateLeft", False) else None
-    return (_params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b,
-            _needles[1] if mesh is not None else None, left)
-
-
-_needles: list[Any] = []   # [mesh, its needle sample]: the last model's (the panel asks on every value entered)
+    return _params(proxy, obj, ov, assembly=tool_assembly.assembly_of(obj)), _cutter(obj), b, sample, left
 
 
 def of_work(work: Work, feed: Optional[float], vert_feed: Optional[float] = None, plunge_deg: float = 45.0) -> Estimate:
