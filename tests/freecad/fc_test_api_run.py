@@ -69,8 +69,10 @@ class SharedToolController(FreeCADTestCase):
                              doc_name="TmmSharedTc")
         tc = first.op.ToolController
         second = run_surface(None, job=first, tool="endmill", diameter=10.0, horiz_feed=1200.0, tool_controller=tc,
-                             stepover=4.0, sample_step=1.0, progress=False)
+                             stepover=4.0, sample_step=1.0, progress=False, label="Finish with the roughing's tool")
         self.assertIs(second.op.ToolController, tc)
+        self.assertEqual(second.op.Label, "Finish with the roughing's tool")
+        self.assertIn("(Finish with the roughing's tool)", second.gcode)   # named before it computed
         self.assertEqual(len(first.job.Tools.Group), 1)
         ops = len(first.job.Operations.Group)
         other = run_roughing(str(SPHERE_ON_PLATE), diameter=6.0, step_down=6.0, progress=False, doc_name="TmmOtherTc")

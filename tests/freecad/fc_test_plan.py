@@ -107,6 +107,8 @@ class PlanBeet(FreeCADTestCase):
             op = next(o for o in plan.ops if o.tool == name)
             for line in (f"M6 T{number}", f"(begin operation: TC: {name})", f"M3 S{op.kwargs['spindle_speed']}"):
                 self.assertTrue(line in gcode, line)   # (assertIn would print the whole G-code)
+        for op in plan.ops:   # each op's Path opens with its planned label (set before it computed)
+            self.assertTrue(f"({op.label})" in gcode, op.label)
         feeds = {f for *_, f in parse_gcode(gcode) if f is not None}
         self.assertIn(plan.ops[0].kwargs["horiz_feed"], feeds)
         self.assertTrue((folder / "beet_mm_sim.png").stat().st_size > 10_000)

@@ -61,7 +61,7 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
                  stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
                  job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                  horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
-                 tool_controller: Any = None, post: str = "linuxcnc",
+                 tool_controller: Any = None, label: Optional[str] = None, post: str = "linuxcnc",
                  gcode_path: Optional[Union[str, os.PathLike]] = None,
                  fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                  progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
@@ -78,7 +78,8 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
     eq. 3.11); pattern 'offset' | 'zigzag'; direction 'climb' | 'conventional'; entry 'helix' | 'ramp' |
     'plunge'. stock_to_leave_axial: None follows stock_to_leave. final_z: None roughs down to the model's
     lowest point. None for the other optional numbers keeps the op's defaults. Heights, feeds (mm/min),
-    tool_controller, post, files and progress as run_surface; the result is a SurfaceResult (op: the roughing op).
+    tool_controller, label, post, files and progress as run_surface; the result is a SurfaceResult (op: the
+    roughing op).
     The whole tool (holder, stick_out, shank_clearance, holder_clearance, holder_collision) as run_surface.
     """
     whole_tool = dict(holder=holder, stick_out=stick_out, shank_clearance=shank_clearance,
@@ -111,7 +112,7 @@ def run_roughing(model: Union[str, os.PathLike, Any, None] = None, *, tool: Unio
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
-               doc_name=doc_name, progress=progress, tool_controller=tool_controller, **values)
+               doc_name=doc_name, progress=progress, tool_controller=tool_controller, label=label, **values)
 
 
 @plain_numbers
@@ -123,7 +124,7 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
                   stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
                   job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                   horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
-                  tool_controller: Any = None, post: str = "linuxcnc",
+                  tool_controller: Any = None, label: Optional[str] = None, post: str = "linuxcnc",
                   gcode_path: Optional[Union[str, os.PathLike]] = None,
                   fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
                   progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
@@ -138,7 +139,7 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
     boundary: 'model' (its XY box grown by the tool radius) | 'stock', grown by `margin`. top_z, bottom_z:
     the highest and lowest level (both or neither; default the model's top and lowest point). sample_step:
     None automatic. direction 'climb' | 'conventional'. The stock of a new Job as run_roughing's. Heights,
-    feeds (mm/min), tool_controller, post, files and progress as run_surface; the result is a SurfaceResult (op:
+    feeds (mm/min), tool_controller, label, post, files and progress as run_surface; the result is a SurfaceResult (op:
     the waterline op).
     The whole tool (holder, stick_out, shank_clearance, holder_clearance, holder_collision) as run_surface.
     rest=True: the loops only where the `job`'s earlier ops (or rest_reference) left more than rest_tolerance that
@@ -171,7 +172,7 @@ def run_waterline(model: Union[str, os.PathLike, Any, None] = None, *, tool: Uni
                stock_margin=stock_margin, stock_above=stock_above, safe_height=safe_height,
                clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
-               doc_name=doc_name, progress=progress, tool_controller=tool_controller, **values)
+               doc_name=doc_name, progress=progress, tool_controller=tool_controller, label=label, **values)
 
 
 def _specs(params_class: type, **values: Any) -> dict[str, tuple[Any, Spec]]:

@@ -27,7 +27,7 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
               stock: Optional[StockBox] = None, stock_margin: float = 1.0, stock_above: float = 1.0,
               job: Any = None, safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
               horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
-              tool_controller: Any = None, post: Optional[str] = "tarus",
+              tool_controller: Any = None, label: Optional[str] = None, post: Optional[str] = "tarus",
               gcode_path: Optional[Union[str, os.PathLike]] = None,
               fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
               progress: Union[bool, Callable[[float], bool]] = True, holder: Optional[str] = None,
@@ -43,8 +43,8 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
     the tool axis's inclination from the surface normal, both within the machine's C range; yaw_limit_deg,
     grid_step_deg: the posture grid; None keeps the op's defaults (the seed's 0..45 deg, +-45 deg, 3 deg).
     post 'tarus' | 'apt_cl' | None (a 3-axis post would drop the tool axes: refused). The stock of a new Job
-    as run_roughing's (the simulation cuts it). Heights, feeds (mm/min), tool_controller, files and progress as
-    run_surface; the result is a SurfaceResult (op: the 5-axis mesh op; what was left for clean-up: its
+    as run_roughing's (the simulation cuts it). Heights, feeds (mm/min), tool_controller, label, files and
+    progress as run_surface; the result is a SurfaceResult (op: the 5-axis mesh op; what was left for clean-up: its
     Mesh5Summary and CleanupRegions).
     The whole tool (holder, stick_out, shank_clearance, holder_clearance) as run_surface: the shank and holder
     bound every C-space, so the tool tilts away where they would come closer, or the place is left for
@@ -84,7 +84,7 @@ def run_mesh5(model: Union[str, os.PathLike, Any, None] = None, *, tool: Union[s
             clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
             spindle_speed=spindle_speed, post=None if later else post, gcode_path=None if later else gcode_path,
             fcstd_path=None if later else fcstd_path, doc_name=doc_name, progress=progress,
-            tool_controller=tool_controller, **values)
+            tool_controller=tool_controller, label=label, **values)
     if not later:
         return r
     try:

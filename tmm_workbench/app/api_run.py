@@ -179,7 +179,8 @@ def add_tool(job: Any, bit: Any, horiz_feed_mm_s: float, vert_feed_mm_s: float, 
 def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, shape: Union[str, Cutter],
            diameter: float, corner_radius: float, safe_height: Optional[float], clearance_height: Optional[float],
            horiz_feed: float, vert_feed: float, spindle_speed: float, post: Optional[str], gcode_path: Any,
-           fcstd_path: Any, doc_name: str, progress: Any, tool_controller: Any = None) -> SurfaceResult:
+           fcstd_path: Any, doc_name: str, progress: Any, tool_controller: Any = None,
+           label: Optional[str] = None) -> SurfaceResult:
     """The op (property `values`) in a new Job for `model` (a mesh op's box stock; a face op's face) or in `job`
     with a further tool controller (or `tool_controller`, one of the Job's: run checked it); computed, posted,
     saved. A document opened here is closed on failure."""
@@ -208,6 +209,8 @@ def run_op(op_name: str, model: Any, job: Any, values: dict, stock_ext: tuple, s
         values.update(heights(job, top, safe_height, clearance_height))
         values["ToolController"] = tc
         op = registry.create(op_name, job, values)
+        if label:   # before it computes: its Path (and G-code) opens with its label
+            op.Label = label
         result = post_op(doc, job, tc, op, post, gcode_path, progress)
     return result
 
@@ -315,13 +318,15 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
         clearance_height: Optional[float] = None, horiz_feed: float = 1000.0, vert_feed: float = 300.0,
         spindle_speed: float = 10000.0, post: Optional[str] = AUTO_POST, gcode_path: Any = None,
         fcstd_path: Any = None, doc_name: str = "TMM", progress: Union[bool, Callable[[float], bool]] = True,
-        tool_controller: Any = None, **properties: Any) -> SurfaceResult:
+        tool_controller: Any = None, label: Optional[str] = None, **properties: Any) -> SurfaceResult:
     """The op registered as `op` on `model` with `properties` (the op's property names and values: StepOver=0.5,
     Pattern="OneWay"), computed, posted (`post` None: not posted; AUTO_POST: linuxcnc, or tarus for a 5-axis op,
     which takes only tarus or apt_cl), saved (as app.api.run_surface).
     A mesh op (MESH_OPS): `model` an STL path, a Mesh or a Part object (None with `job`: the Job's model), in a new
-    Job or added to `job` with its own tool controller; the Job's stock: FreeCAD's default for a new Job unless
-    `stock` (a box) or `stock_margin` / `stock_above` (mm around the model) is given.
+    Job or added to `job` with its own tool controller (or `tool_controller`, one of the Job's: its tool and feeds
+    those the call names); the Job's stock: FreeCAD's default for a new Job unless `stock` (a box) or
+    `stock_margin` / `stock_above` (mm around the model) is given. `label`: the op's label (in the Job and in its
+    G-code; None: the op's own).
     A face op (FACE_OPS): `model` a face source (app.face_source), in a new Job around it.
     TmmError names a property the op does not have, a choice it does not offer, a number out of its range, an
     argument the op would ignore."""
@@ -351,4 +356,4 @@ def run(op: str, model: Any = None, *, job: Any = None, tool: Union[str, Cutter]
                  1.0 if stock_above is None else stock_above) if given else None
     return run_op(op, model, job, properties, stock_ext, shape, diameter, corner_radius, safe_height,
                   clearance_height, horiz_feed, vert_feed, spindle_speed, post, gcode_path, fcstd_path, doc_name,
-                  progress, tool_controller)
+                  progress, tool_controller, label)

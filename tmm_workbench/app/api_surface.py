@@ -26,7 +26,8 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
                 spiral_direction: Optional[str] = None, region_tolerance: Optional[float] = None,
                 safe_height: Optional[float] = None, clearance_height: Optional[float] = None,
                 horiz_feed: float = 1000.0, vert_feed: float = 300.0, spindle_speed: float = 10000.0,
-                tool_controller: Any = None, forward_step: str = "tolerance", arcs: bool = False,
+                tool_controller: Any = None, label: Optional[str] = None, forward_step: str = "tolerance",
+                arcs: bool = False,
                 verify_cusp: bool = False,
                 post: str = "linuxcnc", gcode_path: Optional[Union[str, os.PathLike]] = None,
                 fcstd_path: Optional[Union[str, os.PathLike]] = None, doc_name: str = "TMM",
@@ -88,7 +89,8 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
     of its field between two loops), zigzag or oneway over the box.
     Feeds in mm/min. tool_controller (with `job`): one of the Job's tool controllers to cut with instead of a new
     one (several ops, one tool: one controller, no tool change between them); its tool and feeds must be the
-    ones the call names (checked, not dropped). progress: True (progress bar / text lines), False (quiet), or a callable
+    ones the call names (checked, not dropped). label: the op's label (in the Job and in its G-code; None: the
+    op's own). progress: True (progress bar / text lines), False (quiet), or a callable
     `f(fraction) -> bool` returning False to cancel.
     Depths (app.surface_passes, as the op's panel): stepover_percent (of the tool diameter, in (0, 100], instead
     of `stepover`); final_depth (mm, no tool tip below it); finish_passes (1-50: the first ones leave
@@ -110,4 +112,4 @@ def run_surface(model: Union[str, os.PathLike, Any, None] = None, *, job: Any = 
     return run("TMM_Surface", model, job=job, tool=tool, diameter=diameter, corner_radius=corner_radius,
                safe_height=safe_height, clearance_height=clearance_height, horiz_feed=horiz_feed, vert_feed=vert_feed,
                spindle_speed=spindle_speed, post=post, gcode_path=gcode_path, fcstd_path=fcstd_path,
-               doc_name=doc_name, progress=progress, tool_controller=tool_controller, **values)
+               doc_name=doc_name, progress=progress, tool_controller=tool_controller, label=label, **values)

@@ -45,14 +45,13 @@ def run_ops(plan: dict, model: Any = None, progress: Any = False, left_out: Opti
         kwargs = {k: tuple(v) if k in TUPLES else v for k, v in op["kwargs"].items() if k != "stock"}
         tc = controllers.get(op["tool"]) or library_controller(job, op["tool"], plan["tools"][op["tool"]], kwargs)
         try:
-            r = calls[op["api"]](None, job=job, tool_controller=tc, progress=progress, **kwargs)
+            r = calls[op["api"]](None, job=job, tool_controller=tc, label=op["label"], progress=progress, **kwargs)
         except TmmError as exc:
             if not op.get("optional") or left_out is None:
                 raise
             left_out.append(f"left out {op['label']}: {exc}")
             remove_unused(job, results, controllers)
             continue
-        r.op.Label = op["label"]
         controllers[op["tool"]] = tc
         results.append(r)
     if not results:
