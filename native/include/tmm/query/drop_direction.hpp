@@ -149,10 +149,16 @@ class AlongCutter {
     Eigen::Vector3d plane;      // the normal (tool frame) that last proved it clear of a start, or zero
   };
   struct Candidates {
-    // By decreasing key: the height over the plane under K along its axis (a flat end, which a tilted holder
-    // meets first), so that a start stops where the rest lie below that plane and meets the likely contacts
-    // first. Without that plane (axis level): by decreasing highest point.
+    // In runs of one first plane (h[0]'s slope), each by decreasing h[0]: a start leaves a run at its first
+    // entry below that plane (the rest lie lower), so most of a list is passed over a run at a time.
     std::vector<Candidate> list;
+    struct Run {
+      double gx, gy;
+      std::size_t begin, end;
+    };
+    std::vector<Run> runs;
+    // The plane under K along its axis (a flat end, which a tilted holder meets first; the key is the height
+    // over it); without one (axis level) K's lowest point, the key the highest point.
     Plane key_plane{0.0, 0.0, 0.0};
     std::vector<double> offsets;  // per plane under K: the lowest over the starts of top + g . tip
     std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
@@ -200,7 +206,7 @@ class AlongCutter {
   void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr) const;
   // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
   // planes at every start; else `best` gets the two planes nearest to that.
-  bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
+  bool below_everywhere(const IndexedTriangle& t, Candidates& g, Candidate& best) const;
   double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
   Plane plane_under(const Eigen::Vector3d& n) const;  // n: unit, index frame, n.z > 0
   // True when one of the planes, with the tip `top` high over the XY' point (x, y), has all of t's corners
