@@ -286,7 +286,8 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   auto cleared = [&](const Candidate& c) {
     return under(c.h[0], c.gx[0], c.gy[0]) || under(c.h[1], c.gx[1], c.gy[1]);
   };
-  std::vector<std::pair<double, Candidate*>> open;  // the candidates left, by their bound
+  auto& open = cands.open;  // the candidates left, by their bound
+  open.clear();
   for (const Candidates::Run& run : cands.runs) {
     for (std::size_t e = run.begin; e < run.end; ++e) {
       Candidate& c = cands.list[e];
@@ -336,9 +337,10 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, Cand
       }
     return false;
   };
+  // With fine planes the coarse ones (among them at a few azimuths) are left to the node bounds.
   std::size_t k = 0;
   for (const Plane& p : planes_)
-    if (try_plane(p, offsets[k++])) return true;
+    if (fine_.empty() ? try_plane(p, offsets[k++]) : (++k, false)) return true;
   for (const Plane& p : axial_)
     if (try_plane(p, offsets[k++])) return true;
   if (fine_.empty()) return false;

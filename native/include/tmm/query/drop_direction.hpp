@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -164,6 +165,7 @@ class AlongCutter {
     std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
     Eigen::Vector3d centre;             // their mean
     std::vector<char> fine_done;        // per azimuth: its fine planes' offsets are in
+    std::vector<std::pair<double, Candidate*>> open;  // a start's scratch: the entries left, by their bound
   };
   // One walk of the index for m starts (model frame) with their caps (finite): into `out` every triangle
   // that may stop K before its cap from one of them, less those below one of K's planes at every start.
