@@ -291,7 +291,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   for (const Candidates::Run& run : cands.runs) {
     for (std::size_t e = run.begin; e < run.end; ++e) {
       Candidate& c = cands.list[e];
-      // By decreasing h[0]: once one lies below its first plane at this start, so do the rest of the run (the
+      // By decreasing h[1]: once one lies below the run's plane at this start, so do the rest of the run (the
       // margin grows slower than the gap).
       if (under(c.h[1], run.gx, run.gy)) break;
       if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
@@ -337,15 +337,18 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, Cand
       }
     return false;
   };
-  // With fine planes the coarse ones (among them at a few azimuths) are left to the node bounds.
   std::size_t k = 0;
-  for (const Plane& p : planes_)
-    if (fine_.empty() ? try_plane(p, offsets[k++]) : (++k, false)) return true;
+  if (fine_.empty()) {
+    for (const Plane& p : planes_)
+      if (try_plane(p, offsets[k++])) return true;
+  } else {
+    k = planes_.size();  // the coarse planes (fine ones at a few azimuths) are left to the node bounds
+  }
   for (const Plane& p : axial_)
     if (try_plane(p, offsets[k++])) return true;
   if (fine_.empty()) return false;
   // The fine planes leaning away from the triangle, seen from the starts' centre (found only for a triangle
-  // the coarse planes leave: most are below the flat end's).
+  // the flat end's plane leaves).
   const int fine_azimuth =
       azimuth(g.centre - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0);
   if (!g.fine_done[fine_azimuth]) {  // the azimuth's offsets, once a gather needs them
@@ -431,7 +434,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       out.list.push_back(c);
     }
   }
-  // Runs of one first plane, each by decreasing h[0] (a list without planes: one run that no plane clears).
+  // Runs of one centre plane, each by decreasing h[1] (an entry without one first in the run of slope 0:
+  // no start leaves a run before it).
   std::sort(out.list.begin(), out.list.end(), [](const Candidate& a, const Candidate& b) {
     if (a.gx[1] != b.gx[1]) return a.gx[1] < b.gx[1];
     if (a.gy[1] != b.gy[1]) return a.gy[1] < b.gy[1];

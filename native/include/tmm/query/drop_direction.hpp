@@ -150,7 +150,7 @@ class AlongCutter {
     Eigen::Vector3d plane;      // the normal (tool frame) that last proved it clear of a start, or zero
   };
   struct Candidates {
-    // In runs of one first plane (h[0]'s slope), each by decreasing h[0]: a start leaves a run at its first
+    // In runs of one centre plane (h[1]'s slope), each by decreasing h[1]: a start leaves a run at its first
     // entry below that plane (the rest lie lower), so most of a list is passed over a run at a time.
     std::vector<Candidate> list;
     struct Run {
