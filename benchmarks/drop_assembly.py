@@ -130,8 +130,9 @@ def main() -> None:
     clock = time.process_time if args.threads == 1 else time.perf_counter
     head = f"{'case':62s} {'tri':>7s} {'points':>8s} {'cutter s':>9s} {'assembly s':>10s} {'ratio':>6s} " \
            f"{'lifted':>7s} {'max lift':>8s}"
-    print(head)
-    print("-" * len(head))
+    if not args.tilted:
+        print(head)
+        print("-" * len(head))
     along = []
     for name, v, f, cutter, bodies, step in cases(args.quick):
         lo, hi = v.min(axis=0), v.max(axis=0)
