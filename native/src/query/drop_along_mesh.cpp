@@ -111,6 +111,10 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   // K's shadow on the XY' plane lies within this distance of the tip.
   axis_xy_ = std::hypot(a_.x(), a_.y());
   reach_ = (cutter.max_radius() + cutter.cutting_length() * axis_xy_) * (1 + 1e-12) + 1e-12;
+  // Tighter about the axis's midpoint: a long body leaning one way reaches no farther than its radius beside it.
+  const double half = 0.5 * cutter.cutting_length();
+  mid_x_ = half * a_.x(), mid_y_ = half * a_.y();
+  mid_reach_ = (cutter.max_radius() + half * axis_xy_) * (1 + 1e-12) + 1e-12;
   // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
   for (const double deg : kPlaneAngles) {
     const double th = deg * M_PI / 180.0;
@@ -275,7 +279,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
     consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
-  const double r2 = reach_ * reach_;
+  const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
   // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
@@ -295,8 +299,8 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       // margin grows slower than the gap).
       if (under(c.h[1], run.gx, run.gy)) break;
       if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
-      const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
-      const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
+      const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
+      const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
       if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
       if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
       double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
@@ -381,7 +385,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     const Vector3d s = index_->rotation() * starts[j];
     const double top = s.z() - caps[j];
     floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
-    x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()), y1 = std::max(y1, s.y());
+    const double mx = s.x() + mid_x_, my = s.y() + mid_y_;
+    x0 = std::min(x0, mx), x1 = std::max(x1, mx), y0 = std::min(y0, my), y1 = std::max(y1, my);
     out.tips.emplace_back(s.x(), s.y(), top);
     out.centre = centre += out.tips.back() / static_cast<double>(m);
     std::size_t k = 0;
@@ -391,7 +396,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
         ++k;
       }
   }
-  const double r2 = reach_ * reach_;
+  const double r2 = mid_reach_ * mid_reach_;
   auto far = [&](double xmin, double ymin, double xmax, double ymax) {
     const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
     return dx * dx + dy * dy > r2;

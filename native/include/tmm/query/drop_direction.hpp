@@ -224,6 +224,8 @@ class AlongCutter {
   ToolFrame frame_;
   Eigen::Vector3d W_;   // the motion in tool coordinates
   double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
+  // K's shadow on XY' lies within mid_reach_ of the tip offset by (mid_x_, mid_y_) (its axis's midpoint).
+  double mid_x_ = 0, mid_y_ = 0, mid_reach_ = 0;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
   // With fine planes: those along the axis (facing down), then kFineAzimuths per tilt from the axis
