@@ -3,6 +3,7 @@
     .venv/bin/python benchmarks/drop_assembly.py              # the table (about a minute)
     .venv/bin/python benchmarks/drop_assembly.py --quick      # coarser rasters
     .venv/bin/python benchmarks/drop_assembly.py --threads 0  # all cores, wall-clock time
+    .venv/bin/python benchmarks/drop_assembly.py --tilted     # only the tilted axis (3+2), a few seconds
 
 Per case: the same raster of CL points dropped with native.drop_cutter (the cutter alone) and with
 native.drop_assembly (cutter, shank and holder), the median of a few runs each; their ratio (the target: at most
@@ -71,8 +72,9 @@ def rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock) -> list[str]:
-    """Cutter alone against the assembly along a direction 20 deg off -Z, the axis against it and tilted."""
+def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock, tilted_only=False) -> list[str]:
+    """Cutter alone against the assembly along a direction 20 deg off -Z, the axis against it and tilted (or
+    the tilted axis alone)."""
     direction = rotation([1.0, 0.3, 0.0], np.radians(20)) @ np.array([0.0, 0.0, -1.0])
     index = native.DirectionalIndex(v, f, direction)
     starts = np.column_stack([xy, np.full(len(xy), float(v[:, 2].max()) + 10.0)])
@@ -80,7 +82,8 @@ def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock) -> l
     # Along a tilted axis the cutter is a solid up to where the first body starts (as in the assembly).
     finite = native.Cutter.apt(cutter.radius, cutter.corner_radius, float(bodies[0][0]), 0.0, 0.0)
     rows = []
-    for label, axis, alone in (("axis -V", -direction, cutter), ("axis tilted 15", tilted, finite)):
+    axes = (("axis -V", -direction, cutter), ("axis tilted 15", tilted, finite))
+    for label, axis, alone in axes[1:] if tilted_only else axes:
         t0, c = median_time(lambda: native.drop_along(index, alone, starts, axis, np.inf, threads), repeats, clock)
         t1, (a, by) = median_time(lambda: native.drop_assembly_along(index, cutter, bodies, starts, axis,
                                                                      threads=threads), repeats, clock)
@@ -122,16 +125,22 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--threads", type=int, default=1, help="0: all cores (then wall-clock time)")
     ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--tilted", action="store_true", help="only the drop along a direction with the axis tilted")
     args = ap.parse_args()
     clock = time.process_time if args.threads == 1 else time.perf_counter
     head = f"{'case':62s} {'tri':>7s} {'points':>8s} {'cutter s':>9s} {'assembly s':>10s} {'ratio':>6s} " \
            f"{'lifted':>7s} {'max lift':>8s}"
-    print(head)
-    print("-" * len(head))
+    if not args.tilted:
+        print(head)
+        print("-" * len(head))
     along = []
     for name, v, f, cutter, bodies, step in cases(args.quick):
-        index = native.MeshIndex(v, f)
         lo, hi = v.min(axis=0), v.max(axis=0)
+        if args.tilted:
+            along += direction_rows(name, v, f, cutter, bodies, raster(lo[:2], hi[:2], 4 * step), args.repeats,
+                                    args.threads, clock, tilted_only=True)
+            continue
+        index = native.MeshIndex(v, f)
         xy = raster(lo[:2], hi[:2], step)
         floor = float(lo[2]) - 1.0
         t0, z0 = median_time(lambda: native.drop_cutter(index, cutter, xy, floor, args.threads), args.repeats, clock)

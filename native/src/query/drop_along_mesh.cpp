@@ -111,6 +111,10 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   // K's shadow on the XY' plane lies within this distance of the tip.
   axis_xy_ = std::hypot(a_.x(), a_.y());
   reach_ = (cutter.max_radius() + cutter.cutting_length() * axis_xy_) * (1 + 1e-12) + 1e-12;
+  // Tighter about the axis's midpoint: a long body leaning one way reaches no farther than its radius beside it.
+  const double half = 0.5 * cutter.cutting_length();
+  mid_x_ = half * a_.x(), mid_y_ = half * a_.y();
+  mid_reach_ = (cutter.max_radius() + half * axis_xy_) * (1 + 1e-12) + 1e-12;
   // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
   for (const double deg : kPlaneAngles) {
     const double th = deg * M_PI / 180.0;
@@ -275,7 +279,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
     consider(q, tris[*hint], *hint);
   const int32_t skip = hint ? *hint : -1;
-  const double r2 = reach_ * reach_;
+  const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
   // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
@@ -286,19 +290,23 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   auto cleared = [&](const Candidate& c) {
     return under(c.h[0], c.gx[0], c.gy[0]) || under(c.h[1], c.gx[1], c.gy[1]);
   };
-  std::vector<std::pair<double, Candidate*>> open;  // the candidates left, by their bound
-  for (Candidate& c : cands.list) {
-    // By decreasing key: once one lies below the key plane at this start, so do the rest (the margin grows
-    // slower than the gap).
-    if (under(c.key, kp.gx, kp.gy)) break;
-    if (c.zmax <= q.floor) continue;
-    const double dx = std::max(std::max(c.xmin - q.s.x(), q.s.x() - c.xmax), 0.0);
-    const double dy = std::max(std::max(c.ymin - q.s.y(), q.s.y() - c.ymax), 0.0);
-    if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || cleared(c)) continue;
-    if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
-    double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
-    for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
-    open.emplace_back(bound, &c);
+  auto& open = cands.open;  // the candidates left, by their bound
+  open.clear();
+  for (const Candidates::Run& run : cands.runs) {
+    for (std::size_t e = run.begin; e < run.end; ++e) {
+      Candidate& c = cands.list[e];
+      // By decreasing h[1]: once one lies below the run's plane at this start, so do the rest of the run (the
+      // margin grows slower than the gap).
+      if (under(c.h[1], run.gx, run.gy)) break;
+      if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
+      const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
+      const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
+      if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
+      if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
+      double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
+      for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
+      open.emplace_back(bound, &c);
+    }
   }
   // The likely first contacts first: each lowers the best, which clears more of the rest on their planes.
   std::sort(open.begin(), open.end(), [](const auto& a, const auto& b) {
@@ -314,8 +322,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
 // Over a group of starts, a plane under K sits at each start's tip at its cap; `offsets` holds per plane the
 // lowest of top + g . tip over the starts, so that a point X lies below the plane at every start when
 // X.z + g . X.xy < c + offset (the per-start test of below(), the tip's terms gathered).
-bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth,
-                                   Candidate& best) const {
+bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, Candidate& best) const {
   const double* offsets = g.offsets.data();
   double slack[2] = {-kInfinity, -kInfinity};  // at the worst start, at the centre
   best.h[0] = best.h[1] = kInfinity;  // no plane: never below
@@ -335,11 +342,20 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int 
     return false;
   };
   std::size_t k = 0;
-  for (const Plane& p : planes_)
-    if (try_plane(p, offsets[k++])) return true;
+  if (fine_.empty()) {
+    for (const Plane& p : planes_)
+      if (try_plane(p, offsets[k++])) return true;
+  } else {
+    k = planes_.size();  // the coarse planes (fine ones at a few azimuths) are left to the node bounds
+  }
   for (const Plane& p : axial_)
     if (try_plane(p, offsets[k++])) return true;
-  if (!fine_.empty() && !g.fine_done[fine_azimuth]) {  // the azimuth's offsets, once a gather needs them
+  if (fine_.empty()) return false;
+  // The fine planes leaning away from the triangle, seen from the starts' centre (found only for a triangle
+  // the flat end's plane leaves).
+  const int fine_azimuth =
+      azimuth(g.centre - (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0);
+  if (!g.fine_done[fine_azimuth]) {  // the azimuth's offsets, once a gather needs them
     g.fine_done[fine_azimuth] = 1;
     for (int j = 0; j < kFineTilts; ++j) {
       const Plane& p = fine_[fine_azimuth * kFineTilts + j];
@@ -347,7 +363,7 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int 
       for (const Vector3d& tip : g.tips) o = std::min(o, tip.z() + p.gx * tip.x() + p.gy * tip.y());
     }
   }
-  for (int j = 0; j < (fine_.empty() ? 0 : kFineTilts); ++j) {
+  for (int j = 0; j < kFineTilts; ++j) {
     const std::size_t f = static_cast<std::size_t>(fine_azimuth * kFineTilts + j);
     if (try_plane(fine_[f], offsets[k + f])) return true;
   }
@@ -357,6 +373,7 @@ bool AlongCutter::below_everywhere(const IndexedTriangle& t, Candidates& g, int 
 bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t m, Candidates& out,
                          std::size_t limit) const {
   out.list.clear();
+  out.runs.clear();
   if (m == 0) return true;
   const std::size_t coarse = planes_.size() + axial_.size();
   out.offsets.assign(coarse + fine_.size(), kInfinity);
@@ -368,7 +385,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     const Vector3d s = index_->rotation() * starts[j];
     const double top = s.z() - caps[j];
     floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
-    x0 = std::min(x0, s.x()), x1 = std::max(x1, s.x()), y0 = std::min(y0, s.y()), y1 = std::max(y1, s.y());
+    const double mx = s.x() + mid_x_, my = s.y() + mid_y_;
+    x0 = std::min(x0, mx), x1 = std::max(x1, mx), y0 = std::min(y0, my), y1 = std::max(y1, my);
     out.tips.emplace_back(s.x(), s.y(), top);
     out.centre = centre += out.tips.back() / static_cast<double>(m);
     std::size_t k = 0;
@@ -378,7 +396,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
         ++k;
       }
   }
-  const double r2 = reach_ * reach_;
+  const double r2 = mid_reach_ * mid_reach_;
   auto far = [&](double xmin, double ymin, double xmax, double ymax) {
     const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
     return dx * dx + dy * dy > r2;
@@ -412,10 +430,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
-      const Vector3d mid = (Vector3d(t.p[0]) + Vector3d(t.p[1]) + Vector3d(t.p[2])) / 3.0;
-      const int az = fine_.empty() ? 0 : azimuth(centre - mid);
       Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, Vector3d::Zero()};
-      if (below_everywhere(t, out, az, c)) continue;
+      if (below_everywhere(t, out, c)) continue;
       if (out.list.size() == limit) return false;
       double h = -kInfinity;
       for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + kp.gx * t.p[k][0] + kp.gy * t.p[k][1]);
@@ -423,9 +439,20 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       out.list.push_back(c);
     }
   }
+  // Runs of one centre plane, each by decreasing h[1] (an entry without one first in the run of slope 0:
+  // no start leaves a run before it).
   std::sort(out.list.begin(), out.list.end(), [](const Candidate& a, const Candidate& b) {
-    return a.key != b.key ? a.key > b.key : a.tri < b.tri;
+    if (a.gx[1] != b.gx[1]) return a.gx[1] < b.gx[1];
+    if (a.gy[1] != b.gy[1]) return a.gy[1] < b.gy[1];
+    return a.h[1] != b.h[1] ? a.h[1] > b.h[1] : a.tri < b.tri;
   });
+  out.runs.clear();
+  for (std::size_t e = 0; e < out.list.size(); ++e) {
+    const Candidate& c = out.list[e];
+    if (e == 0 || c.gx[1] != out.runs.back().gx || c.gy[1] != out.runs.back().gy)
+      out.runs.push_back({c.gx[1], c.gy[1], e, e});
+    out.runs.back().end = e + 1;
+  }
   return true;
 }
 

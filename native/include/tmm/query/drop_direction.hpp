@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -149,15 +150,22 @@ class AlongCutter {
     Eigen::Vector3d plane;      // the normal (tool frame) that last proved it clear of a start, or zero
   };
   struct Candidates {
-    // By decreasing key: the height over the plane under K along its axis (a flat end, which a tilted holder
-    // meets first), so that a start stops where the rest lie below that plane and meets the likely contacts
-    // first. Without that plane (axis level): by decreasing highest point.
+    // In runs of one centre plane (h[1]'s slope), each by decreasing h[1]: a start leaves a run at its first
+    // entry below that plane (the rest lie lower), so most of a list is passed over a run at a time.
     std::vector<Candidate> list;
+    struct Run {
+      double gx, gy;
+      std::size_t begin, end;
+    };
+    std::vector<Run> runs;
+    // The plane under K along its axis (a flat end, which a tilted holder meets first; the key is the height
+    // over it); without one (axis level) K's lowest point, the key the highest point.
     Plane key_plane{0.0, 0.0, 0.0};
     std::vector<double> offsets;  // per plane under K: the lowest over the starts of top + g . tip
     std::vector<Eigen::Vector3d> tips;  // the starts' tips at their caps (index frame)
     Eigen::Vector3d centre;             // their mean
     std::vector<char> fine_done;        // per azimuth: its fine planes' offsets are in
+    std::vector<std::pair<double, Candidate*>> open;  // a start's scratch: the entries left, by their bound
   };
   // One walk of the index for m starts (model frame) with their caps (finite): into `out` every triangle
   // that may stop K before its cap from one of them, less those below one of K's planes at every start.
@@ -200,7 +208,7 @@ class AlongCutter {
   void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr) const;
   // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
   // planes at every start; else `best` gets the two planes nearest to that.
-  bool below_everywhere(const IndexedTriangle& t, Candidates& g, int fine_azimuth, Candidate& best) const;
+  bool below_everywhere(const IndexedTriangle& t, Candidates& g, Candidate& best) const;
   double rise(double d, double x0, double x1, double y0, double y1, double enough) const;
   Plane plane_under(const Eigen::Vector3d& n) const;  // n: unit, index frame, n.z > 0
   // True when one of the planes, with the tip `top` high over the XY' point (x, y), has all of t's corners
@@ -216,6 +224,8 @@ class AlongCutter {
   ToolFrame frame_;
   Eigen::Vector3d W_;   // the motion in tool coordinates
   double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
+  // K's shadow on XY' lies within mid_reach_ of the tip offset by (mid_x_, mid_y_) (its axis's midpoint).
+  double mid_x_ = 0, mid_y_ = 0, mid_reach_ = 0;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
   // With fine planes: those along the axis (facing down), then kFineAzimuths per tilt from the axis
