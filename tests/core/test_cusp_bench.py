@@ -17,6 +17,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 
 from cusp_item7 import BASE, model_rows, ratios, table  # noqa: E402
 
+# the three tests share the module's table (a minute of benchmark): one worker runs them all (--dist loadgroup),
+# which builds it once
+pytestmark = pytest.mark.xdist_group("cusp_bench")
+
 ROWS = [BASE, "constant cusp mode", "adaptive", "adaptive + verify", "3D offset", "3D offset + verify"]
 
 

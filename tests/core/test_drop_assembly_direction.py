@@ -81,6 +81,44 @@ def convex_entry(poly, clearance, q, w, before=np.inf, lo=-150.0, hi=150.0):
     return out
 
 
+def cylinder_entry(poly, clearance, q, w):
+    """A lower bound of each line's entry into the solid grown by `clearance` (inf where it passes by): its entry
+    into the capped cylinder around it (1e-6 wider, as the bounding ball)."""
+    (zs, rs) = zip(*[(z, abs(x)) for x, z in poly])
+    grow = clearance + 1e-6
+    r, z0, z1 = max(rs) + grow, min(zs) - grow, max(zs) + grow
+    a, b = w[0] * w[0] + w[1] * w[1], q[:, 0] * w[0] + q[:, 1] * w[1]
+    c = q[:, 0] ** 2 + q[:, 1] ** 2 - r * r
+    if a < 1e-12:   # along the axis: in the cylinder for every t or none
+        r_lo, r_hi = np.where(c <= 0.0, -np.inf, np.inf), np.where(c <= 0.0, np.inf, -np.inf)
+    else:
+        root = np.sqrt(np.maximum(b * b - a * c, 0.0))
+        r_lo, r_hi = np.where(b * b >= a * c, (b - root) / a, np.inf), (b + root) / a
+    if w[2] == 0.0:
+        inside = (q[:, 2] >= z0) & (q[:, 2] <= z1)
+        z_lo, z_hi = np.where(inside, -np.inf, np.inf), np.where(inside, np.inf, -np.inf)
+    else:
+        t0, t1 = (q[:, 2] - z1) / w[2], (q[:, 2] - z0) / w[2]
+        z_lo, z_hi = np.minimum(t0, t1), np.maximum(t0, t1)
+    lo, hi = np.maximum(r_lo, z_lo), np.minimum(r_hi, z_hi)
+    return np.where(lo <= hi, lo, np.inf)
+
+
+def first_entry(poly, clearance, q, w, before=np.inf, chunk=4096):
+    """The least of convex_entry over the samples: solved in the order of their cylinder_entry (a lower bound),
+    until the next one's bound is past the best so far (the same least: a sample's entry is its own)."""
+    bound = cylinder_entry(poly, clearance, q, w)
+    order = np.argsort(bound, kind="stable")
+    order = order[np.isfinite(bound[order])]
+    best = np.inf
+    for k in range(0, len(order), chunk):
+        part = order[k:k + chunk]
+        if bound[part[0]] > best:
+            break
+        best = min(best, convex_entry(poly, clearance, q[part], w, before).min(initial=np.inf))
+    return best
+
+
 def ball_entry(q, w):
     """First t with q - t w in the ball of radius BALL centred BALL up the axis (a quadratic)."""
     d = q - np.array([0.0, 0.0, BALL])
@@ -95,11 +133,10 @@ def reference(samples, start, axis, direction):
     f = frame(axis)
     q, w = (samples - start) @ f.T, f @ direction
     ball = ball_entry(q, w).min(initial=np.inf)
-    best = [min(ball, convex_entry([(-BALL, BALL), (BALL, BALL), (BALL, BODIES[0, 0]), (-BALL, BODIES[0, 0])],
-                                   0.0, q, w, ball + 1.0).min(initial=np.inf))]
+    best = [min(ball, first_entry([(-BALL, BALL), (BALL, BALL), (BALL, BODIES[0, 0]), (-BALL, BODIES[0, 0])],
+                                  0.0, q, w, ball + 1.0))]
     for z0, z1, r0, r1, c in BODIES:  # samples met 1 mm past the best so far cannot win nor come second close
-        best.append(convex_entry([(-r0, z0), (r0, z0), (r1, z1), (-r1, z1)], c, q, w, min(best) + 1.0)
-                    .min(initial=np.inf))
+        best.append(first_entry([(-r0, z0), (r0, z0), (r1, z1), (-r1, z1)], c, q, w, min(best) + 1.0))
     best = np.array(best)
     return best.min(), int(np.argmin(best)) - 1, np.sort(best)
 

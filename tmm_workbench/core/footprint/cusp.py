@@ -19,6 +19,7 @@ rule; it undershoots where the surface bends across the passes (seed 000's conca
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -122,9 +123,17 @@ def stepover_for_cusp(cutter: Cutter, cusp: float, slope_deg: float = 0.0,
                       max_stepover: float | None = None) -> float:
     """The largest step-over (mm, at most `max_stepover`, default the diameter at the widest) whose cusp
     over a plane rising at `slope_deg` across the passes is at most `cusp` mm (along the normal)."""
-    r_max = cutter.native.max_radius
     if not (math.isfinite(cusp) and 0 < cusp <= cutter.radius):  # a derived cusp (a rule's margin) may be < MIN_CUSP
         raise TmmError(f"cusp height must be in (0, {cutter.radius:g}] mm (the tool radius), got {cusp!r}")
+    return _stepover_for_cusp(cutter, float(cusp), float(slope_deg),
+                              None if max_stepover is None else float(max_stepover))
+
+
+@functools.lru_cache(maxsize=4096)
+def _stepover_for_cusp(cutter: Cutter, cusp: float, slope_deg: float, max_stepover: float | None) -> float:
+    """stepover_for_cusp, remembered: a pure function of its arguments (Cutter is a frozen value), asked again
+    and again with the same ones (the section rule's levels at every search, offset3d's slope table)."""
+    r_max = cutter.native.max_radius
     hi = 2 * r_max if max_stepover is None else min(float(max_stepover), 2 * r_max)
     if plane_cusp(cutter, hi * (1 - 1e-12), slope_deg) <= cusp:
         return hi

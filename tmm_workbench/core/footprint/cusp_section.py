@@ -61,6 +61,7 @@ _POINTS_MOST = 400_000    # CL points of the drop grid at most (sections x sampl
 _CREASE_RAD = 0.1         # slope turn (rad) between neighbouring samples beyond which the CL surface has a crease
 _RIDGE_HALVINGS = 26      # the ridge within 2 R / 2^26
 _STEP_HALVINGS = 18       # the step within (s_max - s_min) / 2^18
+_HEAD_PAIRS = 256         # pairs checked first, alone, at each step of the search (the worst at the last)
 _SEARCH_ROUNDS = 8        # step searches on growing subsets of the pairs before one on all of them
 _AROUND_MOST = 64         # failing pairs whose section neighbours (within a step) join the subset, the worst first
 _BYTES_PER_POINT = 200    # the grid's heights, design, envelope and pair arrays per sample
@@ -233,16 +234,27 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         inner = polygons.offset(region, -cutter.radius)
         counted &= polygons.points_inside(inner, world.reshape(-1, 2)).reshape(c.shape) if inner else False
 
-    def at(field: np.ndarray, y: np.ndarray, rows: np.ndarray) -> np.ndarray:
-        """`field` (sections, samples) linearly between samples at y (the rows' sections)."""
+    def between(y: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where y falls in the raveled fields (sections, samples) of the rows' sections: the sample before it
+        and the weight of the one after."""
         f = np.clip((y - ys[0]) / spacing, 0.0, len(ys) - 1.000001)
         i = f.astype(int)
-        w = f - i
-        return field[rows, i] * (1 - w) + field[rows, i + 1] * w
+        return rows * len(ys) + i, f - i
+
+    def at(field: np.ndarray, y: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """`field` (sections, samples) linearly between samples at y (the rows' sections)."""
+        k, w = between(y, rows)
+        flat = field.ravel()
+        return flat[k] * (1 - w) + flat[k + 1] * w
 
     def tips(y: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """(layers, n): the tips of the passes at y (the rows' sections) at each offset along them."""
-        return np.stack([at(layer, y, rows) for layer in layers])
+        k, w = between(y, rows)
+        out = np.empty((len(layers), len(k)))
+        for layer, row in zip(layers, out):
+            flat = layer.ravel()
+            np.add(flat[k] * (1 - w), flat[k + 1] * w, out=row)
+        return out
 
     # creases of the CL surface (a concave edge of the model the tool rides across, the foot of a wall): its
     # slope turns by more than _CREASE_RAD from one sample to the next, which the samples cannot resolve (their
@@ -329,14 +341,21 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
             i = np.nonzero(over)[0]
             redo = np.zeros(len(i))
             for y, h, good, (e, cs) in values:
-                y, h = y[i], h[i].copy()
-                for k in range(-k_most, k_most + 1):
+                j = i[good[i]]          # (a pair not counted at this point adds nothing)
+                if not len(j):
+                    continue
+                y, h = y[j], h[j]
+                # the passes that reach y at all (a margin of a step for the rounding): the others leave inf
+                off = y - ay[j]
+                k_lo = max(-k_most, math.floor((float(off.min()) - r_max) / s) - 1)
+                k_hi = min(k_most, math.ceil((float(off.max()) + r_max) / s) + 1)
+                for k in range(k_lo, k_hi + 1):
                     if k not in (-1, 0, 1, 2):   # a - s, a, b, b + s are in h already
-                        axis = ay[i] + k * s
-                        h = np.minimum(h, lower(tips(axis, rows[i]), axis, y))
+                        axis = ay[j] + k * s
+                        h = np.minimum(h, lower(tips(axis, rows[j]), axis, y))
                 with np.errstate(invalid="ignore"):
-                    v = (h - e[i]) * cs[i]
-                redo = np.maximum(redo, np.where(good[i] & np.isfinite(v), v, 0.0))
+                    v = (h - e[j]) * cs[j]
+                redo[good[i]] = np.maximum(redo[good[i]], np.where(np.isfinite(v), v, 0.0))
             out[i] = redo
         return out
 
@@ -348,6 +367,22 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         return np.maximum(worst(s, rows, ay, ca), worst(s, rows, ay - s, tips(ay - s, rows)))
 
     all_rows = a_rows
+
+    def worst_first(mask: np.ndarray) -> np.ndarray:
+        """The pairs of `mask`, the worst at the last step checked (`values`) first."""
+        pick = np.nonzero(mask)[0]
+        return pick[np.argsort(-values[pick], kind="stable")]
+
+    def fits(s: float, pick: np.ndarray) -> bool:
+        """Whether none of the pairs `pick` leaves more than the aim at step s: the worst few first, alone, so
+        that a step too wide (half the search's) is refused at their cost (the same answer: a pair's cusp is
+        its own)."""
+        head = max(_HEAD_PAIRS, len(pick) // 32)
+        for part in (pick[:head], pick[head:]):
+            if len(part) and float(both(s, all_rows[part], a_y[part], c_a[:, part]).max()) > target:
+                return False
+        return True
+
     # the worst pairs at one step stay the worst near it: search the step on those, then check all of them. Not
     # always: at a free border of the model the worst pair is the one whose b has just rolled over the edge
     # down onto the floor beyond it (the foot of the roll), a different a for every step (seed 000's whole convex
@@ -364,8 +399,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         if len(values):
             keep |= (values >= 0.5 * values.max()) if values.max() > 0 else keep
             keep |= values >= np.quantile(values, 0.99)
-        rows, ay, ca = all_rows[keep], a_y[keep], c_a[:, keep]
-        s = _largest_step(lambda t: both(t, rows, ay, ca), s_min, s_hi, target)
+        s = _largest_step(lambda t, pick=worst_first(keep): fits(t, pick), s_min, s_hi)
         values = both(s, all_rows, a_y, c_a)
         if values.max(initial=0.0) <= target or s <= s_min:
             break
@@ -373,7 +407,7 @@ def _section_step(mesh: TriMesh, cutter: Cutter, boundary: Rect, cusp: float, fl
         failing = np.argsort(values)[-_AROUND_MOST:]
         keep |= _around(failing[values[failing] > target], all_rows, int(math.ceil(s / spacing)))
     else:  # not settled on the subsets: the same search on every pair (exact; ~20 passes over all of them)
-        s = _largest_step(lambda t: both(t, all_rows, a_y, c_a), s_min, s_hi, target)
+        s = _largest_step(lambda t, pick=worst_first(np.ones(len(values), dtype=bool)): fits(t, pick), s_min, s_hi)
         values = both(s, all_rows, a_y, c_a)
     worst_cusp = float(values.max(initial=0.0))
     # the worst sections at this step (a section's worst pair), to look at again between their neighbours
@@ -399,21 +433,17 @@ def _along_lift(cutter: Cutter, slope: np.ndarray) -> np.ndarray:
     return flat * t + corner * (np.sqrt(1.0 + t * t) - 1.0)
 
 
-def _largest_step(cusps, s_min: float, s_max: float, target: float) -> float:
-    """The largest step in [s_min, s_max] whose pairs' worst cusp (`cusps(step)`: one value a pair) is at most
-    `target` (bisection: the worst over all phases grows with the step); s_min when even that leaves more."""
-    def peak(s: float) -> float:
-        v = cusps(s)
-        return float(v.max()) if len(v) else 0.0
-
-    if peak(s_max) <= target:
+def _largest_step(fits, s_min: float, s_max: float) -> float:
+    """The largest step in [s_min, s_max] that `fits(step)` (its pairs' worst cusp at most the aim; bisection:
+    the worst over all phases grows with the step); s_min when even that leaves more."""
+    if fits(s_max):
         return s_max
-    if peak(s_min) > target:
+    if not fits(s_min):
         return s_min
     lo, hi = s_min, s_max
     for _ in range(_STEP_HALVINGS):
         mid = 0.5 * (lo + hi)
-        if peak(mid) <= target:
+        if fits(mid):
             lo = mid
         else:
             hi = mid
