@@ -209,11 +209,21 @@ def nearest_reach(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray,
     drops over the tool's width, then REFINE rounds of 5 x 5 around the nearest so far, each half the last's
     spacing; the distance is the 3D one from the point to the cutter's profile (profile_distance)."""
     cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    if not len(cells):
-        return np.zeros(0)
     surface = surface or DropSurface(mesh)
     drop = AssemblyDrop(mesh, assembly, surface) if assembly is not None else None
-    floor = float(mesh.vertices[:, 2].min())
+    batches = [cells[k:k + NEAREST_BATCH] for k in range(0, len(cells), NEAREST_BATCH)]
+    return np.concatenate([np.zeros(0)] + [pattern_search(mesh, cutter, grid, design, b, surface, drop)
+                                           for b in batches])
+
+
+NEAREST_BATCH = 4096   # cells searched at once (49 drops each in the first round: the memory stays small)
+
+
+def pattern_search(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray, cells: np.ndarray,
+                   surface: DropSurface, drop: Optional[AssemblyDrop]) -> np.ndarray:
+    """nearest_reach on one batch of cells (`drop`: the whole tool's, None for the cutter alone); the tips may go a
+    radius under the model's lowest point (reach_envelope: beyond a rim there)."""
+    floor = float(mesh.vertices[:, 2].min()) - float(cutter.native.max_radius)
     iy, ix = cells[:, 0], cells[:, 1]
     point = np.column_stack([grid.xs()[ix], grid.ys()[iy], design[iy, ix]])
     centre = point[:, :2].copy()
