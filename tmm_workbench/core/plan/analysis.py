@@ -29,6 +29,9 @@ STEEP_DEG = 60.0         # a face sloping more is a wall for the report's count
 FAR_MM = 1.0             # a tool staying this far above the design leaves it to the next (a roughing tool's reach)
 SPECK_SHARE = 0.001      # unreached area below this share of the design's is the grid's noise
 STEEPEST_DEG = 80.0      # the grid's own cusp is judged at most at this slope (on a wall it grows without bound)
+FIRST_SAMPLES = 7        # nearest_reach: the first round's drops per side over the tool's width,
+REFINE = 6               # then 5 x 5 rounds: a D1's positions 0.003 mm apart at the end (0.016 mm on an 80 deg wall)
+NEAREST_BATCH = 4096     # cells searched at once (49 drops each in the first round: the memory stays small)
 
 
 @dataclass
@@ -216,9 +219,6 @@ def nearest_reach(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray,
                                            for b in batches])
 
 
-NEAREST_BATCH = 4096   # cells searched at once (49 drops each in the first round: the memory stays small)
-
-
 def pattern_search(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray, cells: np.ndarray,
                    surface: DropSurface, drop: Optional[AssemblyDrop]) -> np.ndarray:
     """nearest_reach on one batch of cells (`drop`: the whole tool's, None for the cutter alone); the tips may go a
@@ -242,10 +242,6 @@ def pattern_search(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray
         centre[better] = xy.reshape(len(cells), -1, 2)[rows, k][better]
         half, samples = 2.0 * half / (samples - 1), 5   # the next round spans the last one's spacing each side
     return np.maximum(best, 0.0)
-
-
-FIRST_SAMPLES = 7   # the first round's drops per side over the tool's width
-REFINE = 6          # then 5 x 5 rounds: a D1's positions 0.003 mm apart at the end (0.016 mm along an 80 deg wall)
 
 
 def profile_distance(cutter: Cutter, point: np.ndarray, xy: np.ndarray, tip: np.ndarray) -> np.ndarray:
