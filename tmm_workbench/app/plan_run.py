@@ -12,6 +12,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+import time
 import traceback
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -101,31 +102,31 @@ def remove_unused(job: Any, results: list, controllers: Optional[dict] = None) -
     doc.recompute()
 
 
-def change_failing(results: list, plan: dict, folder: Path, report: dict, replanned: list,
+def change_failing(results: list, plan: dict, folder: Path, report: dict, replanned: list, first: float,
                    progress: Any = False) -> dict:
     """Each failing optional op changed by core.plan.replan's changes in turn, the Job verified after each, until
     it no longer fails (the change kept, said in `replanned`) or none is left (the op as planned again, for the
-    caller to leave out). The ops after a changed one are recomputed: a rest reads the stock its earlier ops
-    leave. Returns the last verification."""
+    caller to leave out), within the re-plan's budget (replan.Budget; `first`: s the first verification took).
+    The ops after a changed one are recomputed: a rest reads the stock its earlier ops leave. Returns the last
+    verification."""
     from tmm_workbench.core.plan import replan
 
-    ops = {op["label"]: op for op in plan["ops"]}
-    for label in list(report["failing_ops"]):
-        changes = replan.retries(ops[label])
-        if not changes:
-            continue
+    last = {"report": report}
+
+    def attempt(label: str, change: dict) -> bool:
         index = next(i for i, r in enumerate(results) if r.op.Label == label)
         planned = op_properties(results[index].op, {})
-        for change, why in changes:
-            set_properties(results[index:], op_properties(results[index].op, change))
-            report = verify(results, plan, folder, progress)
-            if label not in report["failing_ops"] and not report["gouged"]:
-                replanned.append(f"changed {label}: {why}")
-                break
-        else:
-            set_properties(results[index:], planned)
-            report = verify(results, plan, folder, progress)
-    return report
+        set_properties(results[index:], op_properties(results[index].op, change))
+        last["report"] = verify(results, plan, folder, progress)
+        if label not in last["report"]["failing_ops"] and not last["report"]["gouged"]:
+            return True
+        set_properties(results[index:], planned)
+        last["report"] = verify(results, plan, folder, progress)
+        return False
+
+    ops = {op["label"]: op for op in plan["ops"]}
+    replanned += replan.change_failing(list(report["failing_ops"]), ops, attempt, replan.Budget(first))
+    return last["report"]
 
 
 def op_properties(op: Any, change: dict) -> dict:
@@ -230,13 +231,15 @@ def run_plan(plan: dict, folder: Path, model: Any = None, progress: Any = False)
 
     replanned: list = []
     results = run_ops(plan, model, progress, replanned)
+    start = time.monotonic()
     report = verify(results, plan, folder, progress)
+    first = time.monotonic() - start
     optional = {op["label"] for op in plan["ops"] if op.get("optional")}
     if not report["passed"] and not report["gouged"] and set(report["failing_ops"]) <= optional:
         # an optional op (a rest, a pencil) failing the verification alone is changed (core.plan.replan) and
         # verified again; one no change clears is left out, its material reported as left; a failing roughing or
         # finishing op stops the plan with the reason (exit 1)
-        report = change_failing(results, plan, folder, report, replanned, progress)
+        report = change_failing(results, plan, folder, report, replanned, first, progress)
     dropping = set(report["failing_ops"])
     if not report["passed"] and not report["gouged"] and dropping and dropping <= optional:
         replanned += [f"left out {label}: " + "; ".join(p for p in report["problems"] if p.startswith(label))

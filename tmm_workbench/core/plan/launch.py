@@ -66,8 +66,8 @@ def make_plan(job: JobSpec, quiet: bool = True) -> tuple[TriMesh, bool, analysis
     stock = planned_stock(job, mesh)   # a model outside its stock refused before the analysis
     say(f"model {job.model.file.name}: {len(mesh.triangles)} triangles; analysing", quiet)
     # each tool reach-tested whole: its shank and holder as the simulation checks them
-    tools = [(t.name, decide.cutter_of(t), left_check.whole_tool(decide.cutter_of(t), tool_entry(t)))
-             for t in job.tools]
+    cutters = [(t, decide.cutter_of(t)) for t in job.tools]
+    tools = [(t.name, c, left_check.whole_tool(c, tool_entry(t))) for t, c in cutters]
     an = analysis.analyse(mesh, job.planner.analysis_cell, tools, job.finish.tolerance)
     compare = None
     if job.planner.compare_cutters:

@@ -3,7 +3,9 @@ wherever the smallest library tool reaches, the rest reported): the simulated de
 radiused library tool reaches from above, against the tolerance.
 
 A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: dropped at every cell) comes within
-the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess).
+the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess);
+where more than the tolerance is left it is told again by the tool dropped between the grid's positions (analysis.nearest_reach: on a steep wall the grid's
+positions lie farther apart along it than a small ball's width, and the grid's cusp allowance there is 0.3 mm).
 The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
 vertical measure of a wall's cusps is many times their depth.
 What no library tool reaches from above (sharp inner corners, undercuts) is reported as its area, not judged. Where
@@ -15,10 +17,9 @@ from typing import Optional
 
 import numpy as np
 
-from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.plan.analysis import reach_excess, whole_tool_tips
+from tmm_workbench.core.plan.analysis import nearest_reach, reach_envelope, reach_excess
 from tmm_workbench.core.sim.compare import slope_cosine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.tools.assembly import ToolAssembly
@@ -35,14 +36,19 @@ def left_in_reach(mesh: TriMesh, grid: Grid, design: np.ndarray, deviation: np.n
     clearance (a 4 mm flute does not reach a floor 5 mm down beside a wall); None: the cutter alone."""
     finite = np.isfinite(design) & np.isfinite(deviation)
     surface = DropSurface(mesh)
-    tips = None if assembly is None else whole_tool_tips(mesh, assembly, grid, surface)
-    envelope = tool_envelope(mesh, cutter, grid, surface, tips=tips)
+    envelope = reach_envelope(mesh, cutter, grid, surface, assembly)
     radius = max(cutter.corner_radius, cutter.radius)
     with np.errstate(invalid="ignore"):
         reached = finite & (reach_excess(envelope, design, grid.cell, radius) <= tolerance)
     # along the normal of the stock left (its vertical deviation times the cosine of its slope)
     stock = np.where(finite, design + np.where(finite, deviation, 0.0), np.nan)
-    left = np.where(reached, deviation, 0.0) * slope_cosine(stock, grid.cell)
+    left = np.where(finite, deviation, 0.0) * slope_cosine(stock, grid.cell)
+    # the grid's test told again between its positions where more than the tolerance is left: whether the tool
+    # reaches those cells decides what is judged
+    doubt = finite & (left > tolerance)
+    near = nearest_reach(mesh, cutter, grid, design, np.argwhere(doubt), surface, assembly)
+    reached[doubt] = near <= tolerance
+    left = np.where(reached, left, 0.0)
     above = reached & (left > tolerance)
     allowance = max(tolerance, cusp)
     inside = left[reached]
