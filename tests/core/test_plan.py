@@ -321,9 +321,7 @@ def test_launcher_failed_run_writes_nothing(tmp_path: Path, capsys) -> None:
 def test_tools_file_and_candidates(tmp_path: Path) -> None:
     data = good(tmp_path)
     library = data["tools"] + [{"name": "T4 ball D2", "type": "ball", "diameter": 2, "flute_length": 10},
-                               {"name": "T5 ball D4 short", "type": "ball", "diameter": 4, "flute_length": 5},
-                               {"name": "T6 ball D1 held", "type": "ball", "diameter": 1, "flute_length": 3,
-                                "holder": "ER11 nut", "stick_out": 6}]
+                               {"name": "T5 ball D4 short", "type": "ball", "diameter": 4, "flute_length": 5}]
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump({"tools": library}))
     data["tools"] = "shop.yaml"
     _, _, an, plan = plan_of(tmp_path, data)
@@ -333,10 +331,6 @@ def test_tools_file_and_candidates(tmp_path: Path) -> None:
     assert d["finishing candidates"].reason.endswith("left for the rest: T4 ball D2")
     assert d["tools left out"].choice == "T5 ball D4 short (5 mm)"
     assert "T5 ball D4 short" not in {o.tool for o in plan.ops}
-    # a short tool in a holder: no finishing, its whole-tool reach test judges where it reaches for the rest
-    assert d["tools for the rest only"].choice == "T6 ball D1 held (6 mm)"
-    assert "T6 ball D1 held" not in d["finishing candidates"].reason
-    assert an.reach["T6 ball D1 held"].unreached_area > 0
     (tmp_path / "shop.yaml").write_text(yaml.safe_dump(library))
     with pytest.raises(PlanInputError, match="tools file shop.yaml: got .*one field, tools"):
         job_from_dict(data, tmp_path / "job.yaml")

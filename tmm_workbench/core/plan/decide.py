@@ -208,28 +208,19 @@ def transition_of(cmp: Any, tool: ToolSpec, ball: ToolSpec) -> tuple[float, str]
         f"comparison), kept within {TRANSITION_RANGE[0]:g}-{TRANSITION_RANGE[1]:g} deg")
 
 
-def reaching(plan: Plan, an: Analysis, radiused: list) -> tuple[list, list]:
-    """(finishing, rest): the radiused tools that reach the model's lowest point from its top (the finishing
-    tools), and those with the shorter ones that have a holder (the rest and pencil tools): their reach tests drop
-    them with the shank and holder, so they are judged where they reach (the shallow parts of a deep model), and
-    the holder guard keeps their shank and holder clear where they do not. A shorter tool without a holder is
-    left out: no shank of it is checked."""
+def reaching(plan: Plan, an: Analysis, radiused: list) -> list:
+    """The radiused tools that reach the model's lowest point from its top (the finishing and rest tools)."""
     height = an.size[2]
     out = [t for t in radiused if reach_length(t) >= height]
     if not out:
         longest = max(radiused, key=reach_length)
         raise PlanInputError(f"tools: no ball or bull-nose tool reaches the model's height {height:.1f} mm; the "
                              f"longest, {longest.name}, reaches {reach_length(longest):g} mm")
-    partly = [t for t in radiused if t not in out and t.holder is not None]
-    short = [f"{t.name} ({reach_length(t):g} mm)" for t in radiused if t not in out and t not in partly]
+    short = [f"{t.name} ({reach_length(t):g} mm)" for t in radiused if t not in out]
     if short:
         plan.decide("tools left out", ", ".join(short), f"they do not reach the model's {height:.1f} mm height "
-                    "(the flute length; no holder: no shank of theirs is checked)")
-    if partly:
-        plan.decide("tools for the rest only", ", ".join(f"{t.name} ({reach_length(t):g} mm)" for t in partly),
-                    f"their stick-out does not reach the model's {height:.1f} mm height: no finishing; their reach "
-                    "tests (with the shank and holder) judge where they reach for the rest and the pencil")
-    return out, [t for t in radiused if t in out or t in partly]
+                    "(stick-out from the holder, else the flute length)")
+    return out
 
 
 def finishing_candidates(plan: Plan, an: Analysis, radiused: list) -> list:
@@ -471,10 +462,10 @@ def plan_job(job: JobSpec, mesh: TriMesh, an: Analysis, compare: Any = None,
                 f"slope shares {an.slope_area}, flat {an.flat_share * 100:.0f} %, facing down "
                 f"{an.down_share * 100:.1f} % (never reached from above)")
     choose_roughing(plan, job, an)
-    full, radiused = reaching(plan, an, radiused)
+    radiused = reaching(plan, an, radiused)
     plan.reach_tool = min(radiused, key=lambda t: (an.reach[t.name].unreached_area, t.corner_radius,
                                                    radiused.index(t))).name
-    shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, full),
+    shallow, steep, transition = choose_finishing(plan, job, an, mesh, finishing_candidates(plan, an, radiused),
                                                   compare)
     finishing_ops(plan, job, an, shallow, steep, transition)
     walls_op(plan, job, an, [shallow, steep])
