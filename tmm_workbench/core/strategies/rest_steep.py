@@ -161,8 +161,11 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     the sloped rest cells they leave above the tolerance, joined (rest_joins; diagnostics "joins"); what they leave
     (params.rest) as a SteepReport appended to params.verify_notes (the op's RestReport) when it is a list."""
     rest = getattr(params, "rest", None)
-    if rest is None or rest.design is None or params.pattern == "pencil":
+    if rest is None or rest.design is None:
         return segments
+    if params.pattern == "pencil":   # no loops along creases: its pieces (either way) in order, joined
+        return _joined(mesh, cutter, params, rest_order.ordered(segments, {id(seg) for seg in segments}),
+                       surface or DropSurface(mesh), diagnostics)
     sloped = of_params(params, cutter)
     left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
@@ -174,11 +177,7 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     # crossed line by line (a link over the gaps between the pieces on every pass: the sign's clean-up, 12 pieces)
     # (the pattern's passes either way but a one-way raster's, the touch-ups either way; the loops keep their sense)
     either = {id(seg) for seg in touch + (segments if params.pattern != ONEWAY else [])}
-    pieces = rest_order.ordered(segments + loops + touch, either)
-    # the pieces reached with the tool down where a join from the one before passes its checks
-    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, pieces, surface)
-    if cut:   # a join lifted over a ridge between two pieces may stand above both
-        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
+    cut = _joined(mesh, cutter, params, rest_order.ordered(segments + loops + touch, either), surface, diagnostics)
     if params.verify_notes is not None:
         a = rest.grid.cell_area
         after = residue(rest, cut, cutter)
@@ -192,6 +191,16 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
             float(np.sum(still & flat) * a), float(np.sum(still & edge) * a), len(touch)))
+    return cut
+
+
+def _joined(mesh: TriMesh, cutter: Cutter, params: Any, pieces: list[CutSegment], surface: DropSurface,
+            diagnostics: dict) -> list[CutSegment]:
+    """The pieces reached with the tool down where a join from the one before passes its checks (rest_joins;
+    diagnostics "joins", "top")."""
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, pieces, surface)
+    if cut:   # a join lifted over a ridge between two pieces may stand above both
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     return cut
 
 
