@@ -5,11 +5,12 @@ of pieces: its linking is what this measures.
 
     .venv/bin/python benchmarks/rest_linking.py out/plan/sign [out/plan/wheel_in_box ...] [--rapid 5000]
     OPENBLAS_NUM_THREADS=1 .venv/bin/python benchmarks/rest_linking.py --ops /tmp/sign_ops [--feed 960 --plunge 320]
+        [--set rest_joins.JOIN_MM=2 ...]
 
 --ops: the rest, pencil and clean-up ops of a planned Job computed again in the core alone, from their inputs
 pickled by benchmarks/rest_linking_dump.py (under freecadcmd), with the code as it is now: the same table from
 their tool paths (feed and plunge rates as given: the tool's, from the report), the compute's wall seconds, and
-their checks: the deepest cut into the model along every fed move (the kernel's drop, core.verify.linear_moves),
+their checks (--set: a constant of a core.strategies module changed for the run, to compare): the deepest cut into the model along every fed move (the kernel's drop, core.verify.linear_moves),
 the rapids that meet the stock (the simulation from the earlier ops' stock) and the simulated deviation's low.
 
 Times: each fed move its length at its F; each rapid its slowest axis at the rapid rate (mm/min, XY and Z alike,
@@ -212,8 +213,23 @@ def option(args: list[str], name: str, default: float) -> float:
     return value
 
 
+def set_constants(args: list[str]) -> None:
+    """--set module.NAME=value (a core.strategies module's constant), taken out of `args`."""
+    import importlib
+
+    while "--set" in args:
+        k = args.index("--set")
+        name, value = args[k + 1].split("=")
+        module, const = name.rsplit(".", 1)
+        mod = importlib.import_module(f"tmm_workbench.core.strategies.{module}")
+        setattr(mod, const, type(getattr(mod, const))(value))
+        print(f"{name} = {getattr(mod, const)!r}")
+        del args[k:k + 2]
+
+
 def main() -> None:
     args = sys.argv[1:]
+    set_constants(args)
     rapid, feed, plunge = option(args, "--rapid", 5000.0), option(args, "--feed", 960.0), option(args, "--plunge", 320.0)
     if args[:1] == ["--ops"]:
         for folder in args[1:]:

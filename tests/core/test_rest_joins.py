@@ -58,7 +58,7 @@ def test_a_join_across_a_ridge_is_lifted_over_it_and_never_below_the_model() -> 
 def test_a_piece_farther_than_the_longest_join_is_left_to_the_linker() -> None:
     mesh = ridge()
     surface = DropSurface(mesh)
-    far = rest_joins.JOIN_DIAMETERS * D3.diameter + 0.5
+    far = rest_joins.longest_join(D3) + 0.5
     a, b = piece(surface, 2.0, 2.0, 5.0), piece(surface, 2.0 + far, 5.0, 2.0)
     out, joins = rest_joins.join_pieces(mesh, D3, PARAMS, [a, b], surface)
     assert joins == 0 and not b.joined and len(out) == 2
