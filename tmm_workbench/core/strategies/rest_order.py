@@ -15,7 +15,10 @@ import numpy as np
 from tmm_workbench.core.segments import CutSegment
 
 UPHILL = 3.0       # a move up counts this many times its height more than a move down in choosing the next piece
-SWEEPS = 30        # 2-opt rounds over the whole order at most (each finds the best reversal from every position)
+SWEEPS = 5         # 2-opt rounds over the whole order at most (each makes the best reversal from every position;
+#                    on 3,000 random pieces 3 rounds took 8 % off the greedy order, 10 rounds 10 %)
+WINDOW = 100       # reversals of runs up to this many chains (a greedy order's detours are local; all pairs of
+#                    3,000 pieces took 26 s)
 GAIN_MM = 1e-6     # a reversal is made when it shortens the moves by more than this
 
 
@@ -91,48 +94,44 @@ def _nearest_first(starts: np.ndarray, ends: np.ndarray, turnable: np.ndarray) -
 
 def _two_opt(order: list[int], turned: list[bool], starts: np.ndarray, ends: np.ndarray,
              turnable: np.ndarray) -> tuple[list[int], list[bool]]:
-    """2-opt on the order: a run of turnable chains [i, j] cut in reverse order, each backwards, where that
-    lowers the sum of `cost` over the moves between the chains (the first chain's start is free: the op begins
-    there). Each sweep makes, from every position i, the best such reversal."""
+    """2-opt on the order: a run of turnable chains [i, j] (at most WINDOW long) cut in reverse order, each
+    backwards, where that lowers the sum of `cost` over the moves between the chains (the first chain's start is
+    free: the op begins there). Each sweep makes, from every position i, the best such reversal."""
     order, turned = list(order), list(turned)
     n = len(order)
+    s, e, ok = _oriented(order, turned, starts, ends, turnable)
     for _ in range(SWEEPS):
         better = False
-        s, e, ok, f, g = _moves(order, turned, starts, ends, turnable)
+        fixed = np.append(np.flatnonzero(~ok), n)   # the run [i, j] holds turnable chains only
         for i in range(n - 1):
-            if not ok[i]:
-                continue
-            stop = i + 1   # the run [i, j] holds turnable chains only
-            while stop < n and ok[stop]:
-                stop += 1
+            stop = min(int(fixed[np.searchsorted(fixed, i)]), i + WINDOW)
             if stop - i < 2:
                 continue
-            j = np.arange(i + 1, stop)
-            delta = g[j] - g[i]
-            if i > 0:
-                delta += cost(e[i - 1], e[j]) - f[i - 1]
-            inner = j < n - 1
-            delta[inner] += cost(s[i], s[j[inner] + 1]) - f[j[inner]]
-            best = int(np.argmin(delta))
-            if delta[best] < -GAIN_MM:
-                b = int(j[best])
-                order[i:b + 1] = order[i:b + 1][::-1]
-                turned[i:b + 1] = [not t for t in turned[i:b + 1][::-1]]
-                better = True
-                s, e, ok, f, g = _moves(order, turned, starts, ends, turnable)
+            b = _best_reversal(s, e, i, stop, n)
+            if b is None:
+                continue
+            order[i:b + 1] = order[i:b + 1][::-1]
+            turned[i:b + 1] = [not t for t in turned[i:b + 1][::-1]]
+            s[i:b + 1], e[i:b + 1] = e[i:b + 1][::-1].copy(), s[i:b + 1][::-1].copy()
+            better = True
         if not better:
             break
     return order, turned
 
 
-def _moves(order: list[int], turned: list[bool], starts: np.ndarray, ends: np.ndarray, turnable: np.ndarray
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Per position where its chain is entered and left, whether it may turn; the moves' costs f[k] (k -> k + 1)
-    and g, the running sum of what turning them (inside a reversed run) adds."""
-    s, e, ok = _oriented(order, turned, starts, ends, turnable)
-    f = cost(e[:-1], s[1:])
-    g = np.concatenate([[0.0], np.cumsum(cost(s[1:], e[:-1]) - f)])
-    return s, e, ok, f, g
+def _best_reversal(s: np.ndarray, e: np.ndarray, i: int, stop: int, n: int) -> Optional[int]:
+    """The j in (i, stop) whose reversal of [i, j] lowers the moves' cost most, None when none does."""
+    f = cost(e[i:stop - 1], s[i + 1:stop])                      # the moves inside the run as they are
+    inside = np.concatenate([[0.0], np.cumsum(cost(s[i + 1:stop], e[i:stop - 1]) - f)])[1:]   # turned
+    j = np.arange(i + 1, stop)
+    delta = inside.copy()
+    if i > 0:
+        delta += cost(e[i - 1], e[j]) - cost(e[i - 1], s[i])
+    inner = j < n - 1
+    jj = j[inner]
+    delta[inner] += cost(s[i], s[jj + 1]) - cost(e[jj], s[jj + 1])
+    best = int(np.argmin(delta))
+    return int(j[best]) if delta[best] < -GAIN_MM else None
 
 
 def _oriented(order: list[int], turned: list[bool], starts: np.ndarray, ends: np.ndarray,
