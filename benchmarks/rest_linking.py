@@ -173,7 +173,23 @@ def ops(folder: Path, rapid: float, feed: float, plunge: float) -> None:
     import pickle
     import time
 
+    from tmm_workbench.core.segments import SegmentKind
+    from tmm_workbench.core.strategies import finish_passes, raster_drop
     from tmm_workbench.core.strategies.finish_passes import compute_finish_toolpath
+
+    linked = []
+
+    def keep(link):   # the segments the op links: its joins (LINK) and pieces (PASS)
+        def linking(segments, policy):
+            linked[:] = list(segments)
+            return link(segments, policy)
+        return linking
+
+    finish_passes.link, raster_drop.link = keep(finish_passes.link), keep(raster_drop.link)
+
+    def length(kind) -> float:
+        return sum(float(np.linalg.norm(np.diff(seg.tips, axis=0), axis=1).sum()) for seg in linked
+                   if seg.kind is kind)
 
     print(f"{folder}: computed again (feed {feed:g}, plunge {plunge:g}, rapids {rapid:g} mm/min)")
     print(HEAD)
@@ -188,7 +204,10 @@ def ops(folder: Path, rapid: float, feed: float, plunge: float) -> None:
         wall = time.perf_counter() - t0
         op = OpLinks(data["label"], moves=toolpath_moves(tp, feed, plunge))
         row(measure(op, rapid))
-        notes.append(f"{data['label']}: compute {wall:.0f} s; {checks(data, tp)}")
+        pieces = sum(1 for seg in linked if seg.kind is SegmentKind.PASS and not seg.joined)
+        notes.append(f"{data['label']}: compute {wall:.0f} s; {len(linked)} segments ({pieces} entered from above), "
+                     f"pieces {length(SegmentKind.PASS):.0f} mm, joins {length(SegmentKind.LINK):.0f} mm in "
+                     f"{sum(1 for seg in linked if seg.kind is SegmentKind.LINK)}; {checks(data, tp)}")
     for n in notes:
         print(n)
 
