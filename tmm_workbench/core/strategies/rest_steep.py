@@ -157,9 +157,10 @@ def residue(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> Opti
 
 def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment], surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
-    """A rest's passes (`segments`, the Surface's pattern but the pencil) and after them the waterline loops over
-    the sloped rest cells they leave above the tolerance, joined (rest_joins; diagnostics "joins"); what they leave
-    (params.rest) as a SteepReport appended to params.verify_notes (the op's RestReport) when it is a list."""
+    """A rest's passes (`segments`, the Surface's pattern) and after them the waterline loops over the sloped rest
+    cells they leave above the tolerance (not after a pencil's), ordered (rest_order) and joined (rest_joins;
+    diagnostics "joins"); what they leave (params.rest) as a SteepReport appended to params.verify_notes (the op's
+    RestReport) when it is a list."""
     rest = getattr(params, "rest", None)
     if rest is None or rest.design is None:
         return segments
@@ -173,7 +174,7 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     surface = surface or DropSurface(mesh)
     touch = rest_touchup.pieces(mesh, cutter, params, _reached(residue(rest, segments + loops, cutter)), surface)
     diagnostics["touch_ups"] = len(touch)
-    # passes, loops and touch-ups in one nearest-first order: in the raster's own order a rest of many pieces was
+    # passes, loops and touch-ups in one order (nearest-first, then 2-opt): in the raster's own order a rest of many pieces was
     # crossed line by line (a link over the gaps between the pieces on every pass: the sign's clean-up, 12 pieces)
     # (the pattern's passes either way but a one-way raster's, the touch-ups either way; the loops keep their sense)
     either = {id(seg) for seg in touch + (segments if params.pattern != ONEWAY else [])}
