@@ -169,7 +169,6 @@ def checks(data: dict, tp) -> str:
 
 
 def ops(folder: Path, rapid: float, feed: float, plunge: float) -> None:
-    import copy
     import pickle
     import time
 
@@ -196,8 +195,8 @@ def ops(folder: Path, rapid: float, feed: float, plunge: float) -> None:
     print("-" * len(HEAD))
     notes = []
     for pkl in sorted(folder.glob("*.pkl")):
-        data = pickle.loads(pkl.read_bytes())
-        fresh = copy.deepcopy(data)   # the linker cuts the stock heights as it links
+        raw = pkl.read_bytes()
+        data, fresh = pickle.loads(raw), pickle.loads(raw)   # the linker cuts the stock heights as it links
         t0 = time.perf_counter()
         tp = compute_finish_toolpath(fresh["mesh"], fresh["cutter"], fresh["params"], fresh["finish"],
                                      fresh["policy"])
