@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from tests.conftest import grid_mesh
-from tests.core.test_rest_steep import TOL, WALL_H, WALL_X, wall_mesh
+from tests.core.test_rest_steep import TOL, WALL_X, wall_mesh
 from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
 from tmm_workbench.core.query.drop import DropSurface
