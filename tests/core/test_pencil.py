@@ -128,7 +128,8 @@ def test_the_estimate_counts_the_creases_grid_before_it_runs() -> None:
 def test_a_clean_up_of_a_finish_is_a_multi_pencil_over_its_rest() -> None:
     """Seed 000's clean-up (section 3.6) as Region Rest with the pencil: the creases inside the strips a D10 finish
     left, as many passes around them as cover the strips (pencil_passes 0): most of what the D3 reaches is then
-    within the tolerance, with no gouge, on a path shorter than the rest raster's."""
+    within the tolerance, with no gouge, on a path shorter than the rest raster's; its pieces joined as a rest
+    raster's are."""
     from tmm_workbench.core.footprint import rest
     from tmm_workbench.core.linking import StockHeights
 
@@ -145,8 +146,9 @@ def test_a_clean_up_of_a_finish_is_a_multi_pencil_over_its_rest() -> None:
     policy = LinkPolicy(5.0, 10.0, material_top=StockHeights(grid, left, d3), low_links=True)
     common = dict(boundary=polygons.bounds(area.region), region=area.region, rest=area.stock(left), stepover=0.31,
                   sample_step=0.25)
-    cleanup = link(raster_drop.compute(mesh, d3, SurfaceParams(pattern="pencil", pencil_passes=0, **common)).segments,
-                   policy)
+    pencil = raster_drop.compute(mesh, d3, SurfaceParams(pattern="pencil", pencil_passes=0, **common))
+    assert pencil.diagnostics["joins"] > 0   # its pieces reached with the tool down where a join passes its checks
+    cleanup = link(pencil.segments, policy)
     raster = link(raster_drop.compute(mesh, d3, SurfaceParams(**common)).segments,
                   LinkPolicy(5.0, 10.0, material_top=StockHeights(grid, left, d3), low_links=True))
     reach = np.isfinite(design) & (envelope - design <= 0.01)

@@ -202,21 +202,28 @@ def _descent(seg: CutSegment, policy: LinkPolicy, name: str) -> np.ndarray:
     return make(dataclasses.replace(seg, entry_z=max(top, float(seg.tips[0, 2]))), policy)
 
 
-def _known_top(seg: CutSegment, policy: LinkPolicy, x: float, y: float) -> Optional[float]:
+def _known_top(seg: CutSegment, policy: LinkPolicy, x: float, y: float, plunge: bool = False) -> Optional[float]:
     """The material's top over the entry at (x, y): the lower of the segment's entry_z and the policy's
-    material_top (each an upper bound); -inf: none there; None: not known."""
+    material_top (each an upper bound; a `plunge` onto the segment's first tip: what stands off the design, see
+    _approach); -inf: none there; None: not known."""
     tops = [] if seg.entry_z is None else [float(seg.entry_z)]
     if policy.material_top is not None:
-        tops.append(float(np.max(policy.material_top(np.array([[x, y]], dtype=float)))))
+        top = policy.material_top
+        if plunge:
+            top = getattr(top, "above_design", top)
+        tops.append(float(np.max(top(np.array([[x, y]], dtype=float)))))
     top = min(tops, default=math.inf)
     return None if math.isnan(top) or top == math.inf else top
 
 
 def _approach(tp: Toolpath, seg: CutSegment, policy: LinkPolicy, descent: np.ndarray) -> float:
     """Rapids down from the safe height to `entry_clearance` above the known material top at the descent's start
-    (or above the start, when higher); the height reached."""
+    (or above the start, when higher); the height reached. Straight down onto the first tip (a plunge), what
+    stands off the design is the top where the material top knows the design (StockHeights.above_design): the
+    tip is a drop onto the model, so the tool clears the model all the way down to it (beside a wall the
+    whole material top is the wall's top: a rest's entries at the walls' feet were fed from there)."""
     x0, y0, start = (float(v) for v in descent[0])
-    top = _known_top(seg, policy, x0, y0)
+    top = _known_top(seg, policy, x0, y0, len(descent) == 1)
     if top is None:
         return policy.safe_height
     z = max(start, top) + policy.entry_clearance
@@ -304,15 +311,44 @@ class StockHeights:
     """The stock as heights on a grid (what earlier ops left: core.sim), a MaterialTop for a cutter that the
     linker keeps up to date as it cuts (`cut`, after each segment): an op's later entries then rapid down to
     just above what its own earlier passes left (a waterline's level above, a verification's finished surface).
-    The grid's cells are updated in place; off the grid lies `outside` (-inf: nothing, +inf: not known)."""
+    The grid's cells are updated in place; off the grid lies `outside` (-inf: nothing, +inf: not known).
+    With the design's heights on the grid (`know_design`), `above_design` is the top of the material standing
+    more than a tolerance off the design only: what a tool coming straight down onto a tip at or above its drop
+    onto the model can meet (the model itself it clears all the way down)."""
 
     def __init__(self, grid: Any, heights: np.ndarray, cutter: Any, outside: float = -math.inf) -> None:
-        self.grid, self.cutter = grid, cutter
+        self.grid, self.cutter, self.outside = grid, cutter, outside
         self.heights = np.array(heights, dtype=float)
         self._top = heights_top(grid, self.heights, cutter.radius, cutter.native.height, outside)
+        self.design: Optional[np.ndarray] = None
+        self._excess: Optional[np.ndarray] = None
+        self._excess_top: Optional[MaterialTop] = None
+        self.within = 0.0
 
     def __call__(self, xy: np.ndarray) -> np.ndarray:
         return self._top(xy)
+
+    def know_design(self, design: np.ndarray, within: float) -> None:
+        """The design's heights at the grid's cells (NaN: none there); a cell within `within` of them (either
+        way: a cell the stock stands well below was not sampled where the model is, a wall's top beside its
+        foot) holds no material but the model's."""
+        design = np.asarray(design, dtype=float)
+        if design.shape != self.heights.shape:
+            raise TmmError(f"design heights have shape {design.shape}, the stock's grid {self.heights.shape}")
+        self.design, self.within = design, float(within)
+        self._excess = np.empty_like(self.heights)
+        self._update_excess(slice(None), slice(None))
+        self._excess_top = heights_top(self.grid, self._excess, self.cutter.radius, self.cutter.native.height,
+                                       self.outside)
+
+    def _update_excess(self, rows: slice, cols: slice) -> None:
+        h, d = self.heights[rows, cols], self.design[rows, cols]
+        model = np.abs(h - d) <= self.within    # NaN (no design) compares False: material
+        self._excess[rows, cols] = np.where(model, -math.inf, h)
+
+    def above_design(self, xy: np.ndarray) -> np.ndarray:
+        """The MaterialTop of what stands off the design (all of the stock before `know_design`)."""
+        return self._top(xy) if self._excess_top is None else self._excess_top(xy)
 
     def cut(self, path: Toolpath) -> None:
         """`path`'s moves cut into the heights (the cells within the tool's reach of them only)."""
@@ -330,6 +366,8 @@ class StockHeights:
             return
         sub = type(g)(g.x0 + i0 * g.cell, g.y0 + j0 * g.cell, g.cell, i1 - i0, j1 - j0)
         self.heights[j0:j1, i0:i1] = simulate(path, self.cutter, sub, self.heights[j0:j1, i0:i1]).heights
+        if self._excess is not None:
+            self._update_excess(slice(j0, j1), slice(i0, i1))
 
 
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:

@@ -3,11 +3,13 @@ reached with the tool down, by a fed move, instead of a lift, a hop and a plunge
 
 A large tool's rest on a slope is a scatter of short loop pieces (mount_rush: 1,467 pieces, median 0.4 mm, each
 entered by a hop and a 1.6 mm plunge at the plunge feed: a third of the rest's time). The move from one piece's
-end a to the next one's start b, at most JOIN_DIAMETERS tool diameters apart and a level up or down, is the
+end a to the next one's start b, at most longest_join apart (JOIN_DIAMETERS tool diameters, at least JOIN_MM) and a
+level up or down, is the
 straight line a -> b lifted where the surface stands above it: sampled SAMPLE_MM apart along it, each sample at
 the higher of the line and the tool's drop there (plus the stock to leave), midpoints inserted where a steep wall
 rises between two, then thinned by chords that pass no lower than any sample (surface.segments.reduce_chords). It stays on or above the surface: it cuts the rest
-material it crosses, never the model. Before it is kept, its cut is checked: the moves against the model
+material it crosses, never the model. One longer than longest_join so lifted (over a letter between two pieces at its
+feet) is not made: the hop is quicker. Before it is kept, its cut is checked: the moves against the model
 (core.verify.linear_moves, DEEPEST_MM) and, with a tool assembly and a join longer than the tool radius (a
 shorter one stays within the pieces' own reach), the neck, shank and holder against it along every sample
 (core.query.drop_assembly, the holder guard's clearance). A join that fails is not made: the linker enters the
@@ -21,13 +23,16 @@ from typing import Any
 import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
+from tmm_workbench.core.linking import LinkPolicy, StockHeights
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.strategies.surface.segments import reduce_chords
 from tmm_workbench.core.tools.cutter import Cutter
 
-JOIN_DIAMETERS = 2.0   # the longest join (XY and rise), in tool diameters: a 2 mm plunge at 300 mm/min and the hop
-#                        take as long as about 6 mm at 1000 mm/min
+JOIN_DIAMETERS = 2.0   # the longest join (XY and rise; its length lifted onto the surface too), in tool diameters:
+#                        a 2 mm plunge at 300 mm/min and the hop take as long as about 6 mm at 1000 mm/min
+JOIN_MM = 4.0          # and at least this long: the hop and its plunge of the clearance (1 mm at a third of the feed,
+#                        the rapids) do not shrink with the tool (a D1's 2 mm left the sign's clean-up 600 entries)
 SAMPLE_MM = 0.05       # the join's samples along the line (linear_moves' step)
 CHORD_MM = 0.002       # a thinned join passes at most this far above its samples
 DEEPEST_MM = 1e-3      # a join whose moves come this far below the model's drop between samples is not made
@@ -43,13 +48,14 @@ def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSe
     joins made."""
     s = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0)
     grown = cutter.offset(s)
-    longest = JOIN_DIAMETERS * cutter.diameter
+    longest = longest_join(cutter)
     candidates = [k for k in range(1, len(segments)) if not segments[k].joined
                   and _near(segments[k - 1].tips[-1], segments[k].tips[0], longest)]
     if not candidates:
         return segments, 0
     joins = {k: lifted(segments[k - 1].tips[-1], segments[k].tips[0], surface, grown, s) for k in candidates}
-    joins = {k: p for k, p in joins.items() if _clear_of_model(p, surface, grown, s)}
+    # no longer than the hop's time (a join lifted over a letter between two pieces beside it is not)
+    joins = {k: p for k, p in joins.items() if _length(p) <= longest and _clear_of_model(p, surface, grown, s)}
     assembly = getattr(params, "assembly", None)
     if assembly is not None:
         from tmm_workbench.core.query.drop_assembly import AssemblyDrop
@@ -65,6 +71,11 @@ def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSe
             seg.joined = True
         out.append(seg)
     return out, len(joins)
+
+
+def longest_join(cutter: Cutter) -> float:
+    """The longest join for `cutter`, mm (see JOIN_DIAMETERS, JOIN_MM)."""
+    return max(JOIN_DIAMETERS * cutter.diameter, JOIN_MM)
 
 
 def _near(a: np.ndarray, b: np.ndarray, longest: float) -> bool:
@@ -113,3 +124,23 @@ def _clear_of_bodies(bodies: Any, path: np.ndarray) -> bool:
     pts, _ = move_samples(CutSegment(path), SAMPLE_MM)
     zb, owner = bodies.heights_of(BODIES, pts[:, :2])
     return not bool(np.any((zb - pts[:, 2] > TOLERANCE_MM) & (owner >= 0)))
+
+
+def know_design(mesh: TriMesh, params: Any, policy: LinkPolicy) -> None:
+    """A rest's entries rapid down to just above what stands off the design (StockHeights.above_design), not above
+    the highest stock within the tool's reach: at the walls' feet, where a rest's pieces start, that is the wall's
+    top, and the plunge was fed from there (the sign's clean-up: 3.7 mm a plunge, 6.9 of its 27 min). Only with the
+    rest's design (its grid's, or the mesh's heights on the stock's grid) and no negative stock to leave (a tip
+    then lies below the model)."""
+    rest, top = getattr(params, "rest", None), policy.material_top
+    if (rest is None or rest.design is None or not isinstance(top, StockHeights)
+            or float(getattr(params, "stock_to_leave", 0.0)) < 0):
+        return
+    g, h = rest.grid, top.grid
+    if (g.x0, g.y0, g.cell, g.nx, g.ny) == (h.x0, h.y0, h.cell, h.nx, h.ny):
+        design = rest.design
+    else:
+        from tmm_workbench.core.sim.stock import mesh_heights
+
+        design = mesh_heights(mesh, h)
+    top.know_design(design, rest.within)

@@ -34,7 +34,8 @@ from tmm_workbench.core.kernel import native
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.simulate import CUT, RAPID
-from tmm_workbench.core.strategies import rest_joins, rest_touchup, waterline
+from tmm_workbench.core.strategies import rest_joins, rest_order, rest_touchup, waterline
+from tmm_workbench.core.strategies.surface.params import ONEWAY
 from tmm_workbench.core.tools.cutter import Cutter
 
 FLATTEST_DEG = 15.0    # the waterline's levels on flatter cells would be too close: what passes leave there stays
@@ -156,12 +157,16 @@ def residue(rest: RestStock, segments: list[CutSegment], cutter: Cutter) -> Opti
 
 def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment], surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
-    """A rest's passes (`segments`, the Surface's pattern but the pencil) and after them the waterline loops over
-    the sloped rest cells they leave above the tolerance, joined (rest_joins; diagnostics "joins"); what they leave
-    (params.rest) as a SteepReport appended to params.verify_notes (the op's RestReport) when it is a list."""
+    """A rest's passes (`segments`, the Surface's pattern) and after them the waterline loops over the sloped rest
+    cells they leave above the tolerance (not after a pencil's), ordered (rest_order) and joined (rest_joins;
+    diagnostics "joins"); what they leave (params.rest) as a SteepReport appended to params.verify_notes (the op's
+    RestReport) when it is a list."""
     rest = getattr(params, "rest", None)
-    if rest is None or rest.design is None or params.pattern == "pencil":
+    if rest is None or rest.design is None:
         return segments
+    if params.pattern == "pencil":   # no loops along creases: its pieces (either way) in order, joined
+        return _joined(mesh, cutter, params, rest_order.ordered(segments, {id(seg) for seg in segments}),
+                       surface or DropSurface(mesh), diagnostics)
     sloped = of_params(params, cutter)
     left = None if sloped is None else residue(sloped, segments, cutter)
     loops = [] if left is None else passes(mesh, cutter, params, left, surface, diagnostics)
@@ -169,13 +174,11 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
     surface = surface or DropSurface(mesh)
     touch = rest_touchup.pieces(mesh, cutter, params, _reached(residue(rest, segments + loops, cutter)), surface)
     diagnostics["touch_ups"] = len(touch)
-    # passes, loops and touch-ups in one nearest-first order: in the raster's own order a rest of many pieces was
+    # passes, loops and touch-ups in one order (nearest-first, then 2-opt): in the raster's own order a rest of many pieces was
     # crossed line by line (a link over the gaps between the pieces on every pass: the sign's clean-up, 12 pieces)
-    pieces = ordered(segments + loops + touch)
-    # the pieces reached with the tool down where a join from the one before passes its checks
-    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, pieces, surface)
-    if cut:   # a join lifted over a ridge between two pieces may stand above both
-        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
+    # (the pattern's passes either way but a one-way raster's, the touch-ups either way; the loops keep their sense)
+    either = {id(seg) for seg in touch + (segments if params.pattern != ONEWAY else [])}
+    cut = _joined(mesh, cutter, params, rest_order.ordered(segments + loops + touch, either), surface, diagnostics)
     if params.verify_notes is not None:
         a = rest.grid.cell_area
         after = residue(rest, cut, cutter)
@@ -189,6 +192,16 @@ def finish(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSegment
             rest.within, 0.0 if left is None else float(np.isfinite(left.heights).sum() * a),
             int(steep.get("groups", 0)), int(steep.get("levels", 0)), float(np.sum(still & ~flat) * a),
             float(np.sum(still & flat) * a), float(np.sum(still & edge) * a), len(touch)))
+    return cut
+
+
+def _joined(mesh: TriMesh, cutter: Cutter, params: Any, pieces: list[CutSegment], surface: DropSurface,
+            diagnostics: dict) -> list[CutSegment]:
+    """The pieces reached with the tool down where a join from the one before passes its checks (rest_joins;
+    diagnostics "joins", "top")."""
+    cut, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, pieces, surface)
+    if cut:   # a join lifted over a ridge between two pieces may stand above both
+        diagnostics["top"] = max(diagnostics.get("top", -math.inf), max(float(seg.tips[:, 2].max()) for seg in cut))
     return cut
 
 
@@ -247,34 +260,7 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
     return segments
 
 
-UPHILL = 3.0   # a move up counts this many times its height more than a move down in choosing the next piece
-
-
-def ordered(segments: list[CutSegment]) -> list[CutSegment]:
-    """The loops' pieces in the order a tool going from each to the nearest next (a rise counted UPHILL + 1
-    times its height, a descent once) takes, a piece joined to the one before it (reached with the tool down) kept after it: level by level over a
-    large group the tool would cross the group at every level."""
-    chains: list[list[CutSegment]] = []
-    for seg in segments:
-        if seg.joined and chains:
-            chains[-1].append(seg)
-        else:
-            chains.append([seg])
-    if len(chains) < 3:
-        return segments
-    starts = np.array([c[0].tips[0] for c in chains])
-    ends = np.array([c[-1].tips[-1] for c in chains])
-    left = np.ones(len(chains), dtype=bool)
-    order, k = [0], 0
-    left[0] = False
-    while left.any():
-        d = starts - ends[k]
-        cost = np.hypot(d[:, 0], d[:, 1]) + UPHILL * np.maximum(d[:, 2], 0.0) + np.abs(d[:, 2])
-        cost[~left] = np.inf
-        k = int(np.argmin(cost))
-        left[k] = False
-        order.append(k)
-    return [seg for i in order for seg in chains[i]]
+ordered = rest_order.ordered   # (the loops' pieces: each keeps its sense)
 
 
 def estimate(params: Any, cutter: Cutter) -> Optional[tuple[float, float, int]]:
