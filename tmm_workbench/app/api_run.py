@@ -109,9 +109,9 @@ def compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
     op.Proxy.progress_enabled = bool(progress)
     with progress_mod.using(factory):
         op.touch()
-        # the op and what it depends on (its tool controller): a whole-document recompute made FreeCAD 1.1
-        # compute the Job's previous op again with each new one
-        op.Document.recompute([op])
+        # the whole document: FreeCAD 1.1 marks the Job's previous op touched when a new one computes (a recompute
+        # of the new op alone left it so: a rest op after it then found its earlier ops waiting for a recompute)
+        op.Document.recompute()
     if op.isValid() and getattr(op.Proxy, "cancelled", False):
         raise TmmError(f"{op.Label}: tool path computation cancelled")
     if not op.isValid() or op.Proxy.toolpath is None:
