@@ -349,7 +349,7 @@ def test_the_half_widths_follow_what_the_tool_sweeps_along_a_bending_pass():
     i = int(np.argmin(np.abs(path.points[:, 0])))
     args = (reach, cutter, path.points[i:i + 1], path.frames[i:i + 1], lam[:1], np.zeros(1), np.zeros(1), tol)
     straight = half_widths(*args)[0][0]
-    bent = half_widths(*args, bend=path_bending([path])[i:i + 1], rates=np.zeros((1, 3)))[0][0]
+    bent = half_widths(*args, bend=path_bending([path])[i:i + 1])[0][0]
     assert (straight - bent > 0.3).all()
     st, sa = swept_positions(tips, axes, 64)
     p = path.points[i]

@@ -13,10 +13,12 @@ the CC point (behind it for a forward tilt, up to R cos(lambda)): the section is
 when it has gone -x further along the pass. Straight, that tool is the same one moved along LX; along a
 pass that bends (the normal turning along the feed by kappa per mm, LX turning within the tangent plane by
 kappa_g, LY turning about LX by the twist t) it stands, in the CC point's LCS and to second order in x,
-raised by kappa x^2 / 2 - t x y and moved across by -kappa_g x^2 / 2 + t x z; and where the posture turns
-along the pass (lambda, omega, delta per mm), its profile is the posture's there (bent_profile). A convex
-bend along the feed raises the profile's flanks (seed 000's convex surface, 1/76 mm: 0.07 mm at 0.9 R, of a
-0.1 mm tolerance); the straight profile read the finished strip too wide there.
+raised by kappa x^2 / 2 - t x y and moved across by -kappa_g x^2 / 2 + t x z (bent_profile; a raise below 0
+not taken: the tool that would sweep lower is lifted clear there by its own C-space), and its flat bottom's
+lowest raised point along its chord can lie nearer the CC point than the profile's (bottom_low). Where the
+posture turns between CC points it is not counted (the widest postures are chosen before it is known). A bend
+of 1/40 mm along the feed raises a flat end's flank at 0.7 R by 0.045 mm at lambda 3 deg, of a 0.1 mm
+tolerance: the straight profile read the finished strip too wide there.
 """
 from __future__ import annotations
 
@@ -27,13 +29,11 @@ import numpy as np
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath
 from tmm_workbench.core.strategies.mesh5.cspace import CSpace
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach
-from tmm_workbench.core.strategies.mesh5.optimal import PassPostures
 from tmm_workbench.core.strategies.mesh5.posture import require_plain, tool_rotation, touch_tip
 from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile, surface_heights
 from tmm_workbench.core.tools.cutter import Cutter
 
 WIDTH_SAMPLES = 97      # lateral samples per side out to 2 R (the section is linear between them)
-RATE_STEP = 1.0         # mm along the pass over which a posture's rate of turn is taken (a secant)
 
 
 def _neighbours(paths: List[CCPath]) -> tuple[np.ndarray, np.ndarray]:
@@ -73,17 +73,6 @@ def _within_path(px: np.ndarray, bend: np.ndarray) -> np.ndarray:
     """The lead px (..., S) of the profile's points kept to the path: the tool that forms a point at px has
     gone -px along the pass, at most to its end (ahead, px < 0) or back to its start."""
     return np.clip(px, -bend[..., 3:4], bend[..., 4:5])
-
-
-def posture_rates(paths: List[CCPath], postures: List[PassPostures]) -> np.ndarray:
-    """(n, 3) d(lambda, omega, delta)/ds per mm of each CC point's chosen posture along its pass (rad, mm),
-    central differences as path_bending."""
-    pts = np.concatenate([p.points for p in paths])
-    i0, i1 = _neighbours(paths)
-    ds = np.linalg.norm(pts[i1] - pts[i0], axis=1)
-    inv = np.where(ds > 1e-9, 1.0 / np.maximum(ds, 1e-9), 0.0)
-    v = np.column_stack([np.concatenate([getattr(q, k) for q in postures]) for k in ("lam", "omg", "delta")])
-    return (v[i1] - v[i0]) * inv[:, None]
 
 
 def raise_of(px: np.ndarray, py: np.ndarray, bend: np.ndarray) -> np.ndarray:
@@ -143,18 +132,10 @@ def _lifted(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, delta: np.ndarray)
 
 
 def swept_profiles(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, delta: np.ndarray,
-                   bend: Optional[np.ndarray] = None, rates: Optional[np.ndarray] = None
-                   ) -> tuple[np.ndarray, np.ndarray]:
-    """(n, S) LY, LZ of each posture's profile lifted by delta, as the pass sweeps it: straight (bend and
-    rates None), bent by `bend` (n, 5) (path_bending) and with the posture turning at `rates` (n, 3)
-    (posture_rates: the tool -x along the pass, forming the profile's point at x, has the posture there;
-    with `bend` only, to the path's ends)."""
+                   bend: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
+    """(n, S) LY, LZ of each posture's profile lifted by delta, as the pass sweeps it: straight (bend None)
+    or bent by `bend` (n, 5) (path_bending)."""
     py, pz, px = _lifted(cutter, lam, omg, delta)
-    if rates is not None and bend is not None:
-        h = RATE_STEP
-        qy, qz, _ = _lifted(cutter, lam + h * rates[:, 0], omg + h * rates[:, 1], delta + h * rates[:, 2])
-        z2 = np.array([np.interp(py[i], qy[i], qz[i]) for i in range(len(py))])
-        pz = pz + np.maximum(-_within_path(px, bend) * (z2 - pz) / h, 0.0)       # lower: lifted clear
     if bend is not None:
         py, pz = bent_profile(py, pz, px, bend)
         c = _chord_matters(lam, bend, cutter.radius)
@@ -176,12 +157,12 @@ def _chord_matters(lam: np.ndarray, bend: np.ndarray, radius: float) -> np.ndarr
 
 
 def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
-                omg: np.ndarray, delta: np.ndarray, tolerance: float, bend: Optional[np.ndarray] = None,
-                rates: Optional[np.ndarray] = None) -> tuple[np.ndarray, np.ndarray]:
+                omg: np.ndarray, delta: np.ndarray, tolerance: float, bend: Optional[np.ndarray] = None
+                ) -> tuple[np.ndarray, np.ndarray]:
     """For n CC points with their postures (lam, omg rad, delta mm, each (n,)): the half-widths (n, 2) (left
     +LY, right -LY; inf where the mesh ends first) within which the remaining height stays <= `tolerance`,
-    and the world points of the section at those widths (n, 2, 3) (NaN where inf). `bend` (n, 5), `rates`
-    (n, 3): the profile as the curving pass sweeps it (swept_profiles); None: swept straight along LX."""
+    and the world points of the section at those widths (n, 2, 3) (NaN where inf). `bend` (n, 5): the
+    profile as the curving pass sweeps it (swept_profiles); None: swept straight along LX."""
     require_plain(cutter)
     pts = np.asarray(points, dtype=float).reshape(-1, 3)
     frm = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
@@ -190,7 +171,7 @@ def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np
     ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
     lateral = np.concatenate([ys, -ys[1:]])
     S = surface_heights(reach, pts, frm, np.tile(lateral, (n, 1)), 3.0 * cutter.radius)
-    py, pz = swept_profiles(cutter, lam, omg, delta, bend, rates)
+    py, pz = swept_profiles(cutter, lam, omg, delta, bend)
     widths = np.zeros((n, 2))
     ends = np.full((n, 2, 3), np.nan)
     for i in range(n):
