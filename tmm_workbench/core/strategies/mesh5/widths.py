@@ -13,8 +13,8 @@ the CC point (behind it for a forward tilt, up to R cos(lambda)): the section is
 when it has gone -x further along the pass. Straight, that tool is the same one moved along LX; along a
 pass that bends (the normal turning along the feed by kappa per mm, LX turning within the tangent plane by
 kappa_g, LY turning about LX by the twist t) it stands, in the CC point's LCS and to second order in x,
-raised by kappa x^2 / 2 - t x y and moved across by -kappa_g x^2 / 2 + t x z (bent_profile; a raise below 0
-not taken: the tool that would sweep lower is lifted clear there by its own C-space), and its flat bottom's
+raised by kappa x^2 / 2 - t x y (bent_profile; a raise below 0 not taken: the tool that would sweep lower is
+lifted clear there by its own C-space; moved across by -kappa_g x^2 / 2 + t x z too, not taken), and its flat bottom's
 lowest raised point along its chord can lie nearer the CC point than the profile's (bottom_low). Where the
 posture turns between CC points it is not counted (the widest postures are chosen before it is known). A bend
 of 1/40 mm along the feed raises a flat end's flank at 0.7 R by 0.045 mm at lambda 3 deg, of a 0.1 mm
@@ -85,11 +85,10 @@ def raise_of(px: np.ndarray, py: np.ndarray, bend: np.ndarray) -> np.ndarray:
 
 def bent_profile(py: np.ndarray, pz: np.ndarray, px: np.ndarray, bend: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The profile (LY, LZ; (..., S)) whose points are formed LX = px along the feed, as a pass bending by
-    `bend` (..., 5) (path_bending) sweeps it (module doc): LY kept increasing."""
-    kg, t = bend[..., 1:2], bend[..., 2:3]
-    x = _within_path(px, bend)
-    y = py - 0.5 * kg * x * x + t * x * pz
-    return np.maximum.accumulate(y, axis=-1), pz + raise_of(px, py, bend)
+    `bend` (..., 5) (path_bending) sweeps it (module doc): raised, not moved across (the widest postures are
+    chosen on the lateral samples, raised alone: a measure that moved the profile across came out narrower
+    than the choice, and held the bins back)."""
+    return py, pz + raise_of(px, py, bend)
 
 
 def bottom_low(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, delta: np.ndarray, y: np.ndarray,
