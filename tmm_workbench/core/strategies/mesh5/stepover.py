@@ -22,8 +22,9 @@ pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real
 bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
 keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
 pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
-tolerance (the bends of the pass are measured: widths.path_bending). The tools go on an overrun of a radius beyond the ends of each path, each position lifted clear of
-the mesh (tool_moves.overrun_positions), which the bins count (coverage.Coverage).
+tolerance (the bends of the pass are measured: widths.path_bending). The tools go on an overrun of a radius
+beyond the ends of each path, each position lifted clear of the mesh (tool_moves.overrun_positions), which the
+bins count (coverage.Coverage).
 """
 from __future__ import annotations
 

@@ -14,8 +14,8 @@ when it has gone -x further along the pass. Straight, that tool is the same one 
 pass that bends (the normal turning along the feed by kappa per mm, LX turning within the tangent plane by
 kappa_g, LY turning about LX by the twist t) it stands, in the CC point's LCS and to second order in x,
 raised by kappa x^2 / 2 - t x y (bent_profile; a raise below 0 not taken: the tool that would sweep lower is
-lifted clear there by its own C-space; moved across by -kappa_g x^2 / 2 + t x z too, not taken), and its flat bottom's
-lowest raised point along its chord can lie nearer the CC point than the profile's (bottom_low). Where the
+lifted clear there by its own C-space; moved across by -kappa_g x^2 / 2 + t x z too, not taken), and its flat
+bottom's lowest raised point along its chord can lie nearer the CC point than the profile's (bottom_low). Where the
 posture turns between CC points it is not counted (the widest postures are chosen before it is known). A bend
 of 1/40 mm along the feed raises a flat end's flank at 0.7 R by 0.045 mm at lambda 3 deg, of a 0.1 mm
 tolerance: the straight profile read the finished strip too wide there.
