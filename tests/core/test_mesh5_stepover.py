@@ -15,14 +15,15 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
-from tmm_workbench.core.strategies.mesh5.posture import PostureGrid
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, world_placement
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
 from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
 from tmm_workbench.core.strategies.mesh5.coverage import Coverage
-from tmm_workbench.core.strategies.mesh5.stepover import (adaptive_passes, half_widths, reach_widths, tilt_reached,
-                                                        widest_cspace)
+from tmm_workbench.core.strategies.mesh5.stepover import (_on_mesh, _split, adaptive_passes, half_widths, reach_widths,
+                                                        tilt_reached, widest_cspace)
 from tmm_workbench.core.strategies.mesh5.tool_moves import (BETWEEN_TOL, OVERRUN_STEPS, between_positions,
                                                            clear_lifts, overrun_positions)
+from tmm_workbench.core.strategies.mesh5.widths import path_bending
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -260,7 +261,8 @@ def test_cc_points_beyond_the_machine_tilt_are_left_out_and_their_bins_reported(
     assert pts[:, 0].max() < 6.0                                            # none on the slope
     assert all(p.cut_short == (False, True) for q in plan.passes for p in q.paths)
     strips = np.array(plan.unfinished)
-    assert len(strips) and (strips[:, 1] > 6.0).all() and (strips[:, 0] >= 2.0).all()    # on the slope
+    # on the slope (or in the bin of the crease, x 3-6, whose ends the pass sweeps bent over it)
+    assert len(strips) and (strips[:, 1] >= 6.0).all() and (strips[:, 0] >= 2.0).all()
     assert strips[:, 2].min() <= -9.0 and strips[:, 3].max() >= 9.0        # all across
     assert plan.passes[-1].band[1] == pytest.approx(10.0)                  # the flat part finished
 
@@ -329,3 +331,56 @@ def test_every_postures_reach_is_its_half_widths_and_the_widest_are_kept():
         assert k.any() and (k <= cs.available[i].ravel()).all()
         assert left[i, k].min() >= 0.97 * np.nanmax(left[i]) - 1e-9 or left[i, k].min() >= 0.97 * np.nanmin(
             np.nanmax(left, axis=1)) - 1e-9
+
+
+def test_the_half_widths_follow_what_the_tool_sweeps_along_a_bending_pass():
+    # a cylinder convex along the feed (axis across it, radius 40 mm): the tool's point that forms the profile
+    # at 0.7 R lies ~1.9 mm behind the CC point, swept there by the tool 1.9 mm further on, raised by kappa x^2
+    # / 2 ~ 0.045 mm against the straight sweep; the widths measured with the pass's bending end where the slow
+    # reference (the tool at dense positions along the real pass) leaves tau, the straight ones where it leaves
+    # 0.045 mm more
+    tol, R, rho = 0.1, 6.35, 40.0
+    mesh = grid_mesh(lambda x, y: np.sqrt(rho * rho - x * x), 80, 40, (-20, -20, 20, 20), "bend")
+    reach, cutter = MeshReach(mesh), Cutter.flat(2 * R)
+    path = cc_paths(mesh, (1, 0), np.array([0.0]), 1.0, 0.001)[0]
+    n = len(path)
+    lam = np.full(n, math.radians(3.0))
+    tips, axes = world_placement(cutter, path.points, path.frames, lam, np.zeros(n), np.zeros(n))
+    i = int(np.argmin(np.abs(path.points[:, 0])))
+    args = (reach, cutter, path.points[i:i + 1], path.frames[i:i + 1], lam[:1], np.zeros(1), np.zeros(1), tol)
+    straight = half_widths(*args)[0][0]
+    bent = half_widths(*args, bend=path_bending([path])[i:i + 1])[0][0]
+    assert (straight - bent > 0.3).all()
+    st, sa = swept_positions(tips, axes, 64)
+    p = path.points[i]
+    for w, expect in ((bent, tol), (straight, tol + 0.045)):
+        q = np.array([[p[0], y, p[2]] for y in (w[0], -w[1])])
+        left = remaining(q, np.tile([0.0, 0.0, 1.0], (2, 1)), st, sa, R, 4 * R)
+        assert left == pytest.approx([expect, expect], abs=0.008)
+
+
+def test_a_path_is_split_where_cc_points_are_left_out_and_the_pieces_cut_short_there():
+    mesh = grid_mesh(lambda x, y: 0.0 * x, 20, 4, (-20, -2, 20, 2), "strip")
+    path = cc_paths(mesh, (1, 0), np.array([0.0]), 2.0, 0.01)[0]
+    n = len(path)
+    drop = np.zeros(n, dtype=bool)
+    drop[[1, 5, 6]] = True                                                  # a lone point, a pair inside
+    pieces, keep = _split([path], drop)
+    assert [len(p) for p in pieces] == [3, n - 7] and keep.tolist() == [2, 3, 4] + list(range(7, n))
+    assert [p.cut_short for p in pieces] == [(True, True), (True, False)]  # the first point alone: dropped
+    assert np.array_equal(np.concatenate([p.points for p in pieces]), path.points[keep])
+
+
+def test_the_right_step_reaches_a_slanted_edge_of_the_mesh_to_the_bisection():
+    # a plane whose edge runs slanted (y = -5 - 0.3 x): from CC points at y = 0 the section along -LY leaves
+    # the mesh at the edge, found to d / 8 / 2^14, not at the last of 8 samples before it
+    mesh = grid_mesh(lambda x, y: 0.0 * x, 20, 20, (-10, -10, 10, 10), "plane")
+    v = mesh.vertices.copy()
+    below = v[:, 1] < 0                                                     # the lower half squeezed to the edge
+    v[below, 1] = (-5 - 0.3 * v[below, 0]) * (1 - (v[below, 1] + 10) / 10)
+    mesh = TriMesh(v, mesh.triangles, "slanted")
+    x = np.array([-6.0, -1.3, 0.0, 4.7])
+    pts = np.column_stack([x, np.zeros(4), np.zeros(4)])
+    frm = np.repeat(np.eye(3)[None], 4, axis=0)
+    got = _on_mesh(MeshReach(mesh), pts, frm, np.full(4, 12.0))
+    assert got == pytest.approx(5 + 0.3 * x, abs=1e-3)

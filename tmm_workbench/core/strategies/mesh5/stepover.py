@@ -1,15 +1,10 @@
 """Adaptive 5-axis step-over from the tilted cutter's effective cutting profile (seed 000 section 3.5.3,
 eq. 3.21-3.33, generalised from the flat end mill to the bull-nose).
 
-Half-widths. At each CC point, the chosen posture's effective cutting profile (the tool swept along the feed
-LX, seen in the LY-LZ plane: top_bound.lower_profile, lifted by delta along the axis) stands over the
-surface's cross-section S(y) (the mesh's height along LZ at LX = 0, LY = y); the remaining height is their
-difference. The left (+LY) half-width is the largest d with the remaining height <= the tolerance on all of
-[0, d], the right one the same on [-d, 0]: the seed's eq. 3.29-3.32 solve the same for one rim point of the
-flat end mill (alpha); here it is the whole profile, for any posture and the bull-nose too, at the posture
-that will be cut (the seed estimates it by CM2 first, and takes 0.9 of the result, eq. 3.33). Where the mesh
-ends first, that side is covered to the edge (inf) when the tool is there beyond the last section sample on
-the mesh too; else it ends at that sample (the bin stays open: no sliver left along the edge silently).
+Half-widths (widths.half_widths): how far to each side of a CC point the posture's effective cutting profile
+over the surface's cross-section leaves at most the tolerance, as the curving pass sweeps it (widths module
+doc); the seed solves the same for one rim point of the flat end mill (eq. 3.29-3.32) at a CM2 guess and takes
+0.9 of it (eq. 3.33), here at the posture that will be cut.
 
 Passes. The drive planes are placed one after another across the mesh (along their normal m); how far
 across the surface is finished is kept per 2 mm bin of the feed coordinate (passes end where the mesh's
@@ -18,7 +13,8 @@ plane goes a gap beyond the least finished level of the open bins its own path r
 than the top of any open bin. Its C-space is built with, per CC point, the right side step reaching back to
 the level of its bins and the left one a share of the gap; a CC point with no posture for its left step gets a
 smaller one, a CC point with none for its right step moves the plane nearer (next to a path's end it is left
-out instead, its bins for clean-up). In the C-space each CC point keeps the postures that finish the widest
+out instead, its bins for clean-up; after SPLIT_AFTER tries, a few inside a path are too, the path split
+there). In the C-space each CC point keeps the postures that finish the widest
 strip (widest_cspace: the right side back to its bins' level, the left as far along the plane normal as the
 pass can reach at nearly all its CC points; the seed measures the half-widths at its ideal posture), and among
 them the postures are chosen for the motion time (optimal.smooth_postures); the next gap is half the width the
@@ -26,8 +22,9 @@ pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real
 bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
 keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
 pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
-tolerance. The tools go on an overrun of a radius beyond the ends of each path, each position lifted clear of
-the mesh (tool_moves.overrun_positions), which the bins count (coverage.Coverage).
+tolerance (the bends of the pass are measured: widths.path_bending). The tools go on an overrun of a radius
+beyond the ends of each path, each position lifted clear of the mesh (tool_moves.overrun_positions), which the
+bins count (coverage.Coverage).
 """
 from __future__ import annotations
 
@@ -48,12 +45,12 @@ from tmm_workbench.core.strategies.mesh5.lift import MeshReach
 from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_postures
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
 from tmm_workbench.core.strategies.mesh5.tool_moves import between_positions, overrun_positions
-from tmm_workbench.core.strategies.mesh5.top_bound import lower_profile, surface_heights
+from tmm_workbench.core.strategies.mesh5.top_bound import surface_heights
+from tmm_workbench.core.strategies.mesh5.widths import half_widths, path_bending, reach_widths
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
 Progress = Callable[[float], bool]
-WIDTH_SAMPLES = 97      # lateral samples per side out to 2 R (the section is linear between them)
 SHRINK = 0.8            # gap factor when a pass must be rebuilt
 MAX_TRIES = 12
 # the passes are planned for this share of the tolerance: the profile is swept straight along LX with the
@@ -72,6 +69,9 @@ WIDE_QUANTILE = 0.05
 # for clean-up, up to END_PEEL of them at each end: kept, it held every next plane back to its bins
 NARROW = 0.5
 END_PEEL = 3
+# from this try on (the gap shrunk twice), runs of up to END_PEEL CC points with no posture inside a path are
+# left out too, the path split there and their bins for clean-up (kept, they refused every pass there)
+SPLIT_AFTER = 2
 # a plane that would come back to less than REPEAT x the gap beyond the last one, pulled back by at most LAGGING
 # bins, leaves those for clean-up instead (each such plane cut a sliver: 8 passes for 5 mm)
 REPEAT = 0.3
@@ -80,131 +80,9 @@ GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next 
 AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
 
 
-def half_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, lam: np.ndarray,
-                omg: np.ndarray, delta: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
-    """For n CC points with their postures (lam, omg rad, delta mm, each (n,)): the half-widths (n, 2) (left
-    +LY, right -LY; inf where the mesh ends first) within which the remaining height stays <= `tolerance`,
-    and the world points of the section at those widths (n, 2, 3) (NaN where inf)."""
-    require_plain(cutter)
-    pts = np.asarray(points, dtype=float).reshape(-1, 3)
-    frm = np.asarray(frames, dtype=float).reshape(-1, 3, 3)
-    lam, omg, delta = (np.asarray(v, dtype=float).reshape(-1) for v in (lam, omg, delta))
-    n = len(pts)
-    ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
-    lateral = np.concatenate([ys, -ys[1:]])
-    S = surface_heights(reach, pts, frm, np.tile(lateral, (n, 1)), 3.0 * cutter.radius)
-    py, pz = lower_profile(cutter, lam, omg, 2001)
-    a = tool_rotation(lam, omg)[:, 2, 1:]                                   # lift direction (LY, LZ)
-    py = py + delta[:, None] * a[:, :1]
-    pz = pz + delta[:, None] * a[:, 1:]
-    widths = np.zeros((n, 2))
-    ends = np.full((n, 2, 3), np.nan)
-    for i in range(n):
-        z = np.interp(lateral, py[i], pz[i], left=np.inf, right=np.inf)
-        h = z - S[i]
-        for side, sl in ((0, slice(0, len(ys))), (1, np.r_[0, len(ys):len(lateral)])):
-            y, hs = np.abs(lateral[sl]), h[sl]
-            over = np.flatnonzero(~(hs <= tolerance))                       # NaN (mesh ended) counts too
-            if over.size == 0:
-                widths[i, side] = np.inf if np.isnan(hs).any() else y[-1]
-                continue
-            k = int(over[0])
-            sgn = 1.0 if side == 0 else -1.0
-            if np.isnan(hs[k]) and _past_edge(py[i], pz[i], y, S[i][sl], sgn, k, tolerance):
-                widths[i, side] = np.inf
-                continue
-            d = 0.0 if k == 0 else y[k - 1] if np.isnan(hs[k]) else _crossing(py[i], pz[i], y, S[i][sl], sgn, y[k - 1], y[k], tolerance)
-            widths[i, side] = d
-            s_d = S[i][sl][k - 1] if np.isnan(hs[k]) else np.interp(d, y, S[i][sl])
-            ends[i, side] = pts[i] + sgn * d * frm[i, 1] + s_d * frm[i, 2]
-    return widths, ends
-
-
-def _past_edge(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, k: int,
-               tolerance: float) -> bool:
-    """Whether the profile covers the section beyond its last sample on the mesh (k - 1): at sample k (off
-    the mesh, the section extrapolated from the two before) the tool is there within the tolerance. Else the
-    side ends at that sample, short of the mesh's edge (a sliver the next pass or the clean-up takes)."""
-    if k == 0:
-        return True                                                         # the CC point itself: as before
-    z = np.interp(sgn * y[k], py, pz, left=np.inf, right=np.inf)
-    return bool(z - (s[0] if k == 1 else 2 * s[k - 1] - s[k - 2]) <= tolerance)
-
-
-def _crossing(py: np.ndarray, pz: np.ndarray, y: np.ndarray, s: np.ndarray, sgn: float, a: float, b: float,
-              tolerance: float) -> float:
-    """The lateral distance in [a, b] where the remaining height (profile over the section, linear between
-    the section's samples) reaches the tolerance, by bisection (the profile curves between samples)."""
-    for _ in range(30):
-        mid = 0.5 * (a + b)
-        # beyond the profile's ends the tool is not there (its side wall): never within the tolerance
-        if np.interp(sgn * mid, py, pz, left=np.inf, right=np.inf) - np.interp(mid, y, s) <= tolerance:
-            a = mid
-        else:
-            b = mid
-    return 0.5 * (a + b)
-
-
-def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: np.ndarray, cs: CSpace,
-                 tolerance: float, m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(n, P) how far along the plane normal m each available posture of the C-space at its lift S2
-    finishes on the left (+m) and back on the right (-m) (the half-widths as half_widths, to the section's
-    samples, the crossing linear between two, and their section points' share of m; inf where the mesh ends
-    first, NaN where the posture is not available): what each posture would finish, to choose from."""
-    n = len(points)
-    lam, omg = (g.ravel() for g in cs.grid.mesh())
-    ys = np.linspace(0.0, 2.0 * cutter.radius, WIDTH_SAMPLES)
-    lateral = np.concatenate([ys, -ys[1:]])
-    S = surface_heights(reach, points, frames, np.tile(lateral, (n, 1)), 3.0 * cutter.radius)
-    py, pz = lower_profile(cutter, lam, omg, 2001)
-    h = 0.01 * cutter.radius
-    g = np.arange(-3.0 * cutter.radius, 3.0 * cutter.radius + h, h)
-    # the profile on a uniform grid (far above beyond its ends: the side wall is no cutting edge)
-    Z = np.array([np.interp(g, py[p], pz[p], left=1e9, right=1e9) for p in range(len(lam))])
-    a = tool_rotation(lam, omg)[:, 2, 1:]
-    avail = cs.available.reshape(n, -1)
-    lift = cs.lift.reshape(n, -1)
-    out = np.full((2, n, len(lam)), np.nan)
-    sides = (np.arange(len(ys)), np.r_[0, len(ys):len(lateral)])
-    ly, lz = frames[:, 1] @ m, frames[:, 2] @ m
-    for i in range(n):
-        ps = np.flatnonzero(avail[i])
-        if ps.size == 0:
-            continue
-        d = lift[i, ps][:, None]
-        u = np.clip((lateral[None, :] - d * a[ps, :1] - g[0]) / h, 0.0, len(g) - 1.001)
-        k = u.astype(np.int64)
-        t = u - k
-        z = Z[ps[:, None], k] * (1 - t) + Z[ps[:, None], k + 1] * t + d * a[ps, 1:]
-        rem = z - S[i][None, :]
-        for side, sl in enumerate(sides):
-            r = rem[:, sl]
-            over = ~(r <= tolerance)
-            first = np.where(over.any(axis=1), over.argmax(axis=1), len(ys))
-            rows = np.arange(len(ps))
-            k1 = np.minimum(first, len(ys) - 1)
-            k0 = np.maximum(first - 1, 0)
-            r0, r1 = r[rows, k0], r[rows, k1]
-            frac = np.clip((tolerance - r0) / np.where(r1 > r0, r1 - r0, np.inf), 0.0, 1.0)
-            w = np.where(first == 0, 0.0, ys[k0] + frac * (ys[k1] - ys[k0]))
-            w = np.where(first >= len(ys), ys[-1], w)
-            # the mesh ended first: the whole side when the tool is there beyond the last sample on the mesh
-            # too (the section there extrapolated), else only up to that sample (the edge left a sliver)
-            k2 = np.maximum(first - 2, 0)
-            s_sl = S[i][sl]
-            ext = 2 * s_sl[k0] - s_sl[k2]
-            zk = z[rows, sl[k1]]
-            covered = (zk < 1e8) & (zk - ext <= tolerance)
-            w = np.where((first < len(ys)) & np.isnan(r1), np.where(covered, np.inf, ys[k0]), w)
-            s0, s1 = s_sl[k0], s_sl[k1]
-            s_w = np.where(first >= len(ys), s_sl[-1], np.where(np.isnan(s1), s0, s0 + frac * (s1 - s0)))
-            sgn = 1.0 if side == 0 else -1.0
-            out[side, i, ps] = np.where(np.isinf(w), w, w * ly[i] + sgn * s_w * lz[i])
-    return out[0], out[1]
-
-
 def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
-                  cs: CSpace, back: np.ndarray, m: np.ndarray) -> tuple[CSpace, np.ndarray]:
+                  cs: CSpace, back: np.ndarray, m: np.ndarray, bend: Optional[np.ndarray] = None
+                  ) -> tuple[CSpace, np.ndarray]:
     """The C-space kept to the postures that finish the widest strip: at each CC point those whose right
     half-width reaches `back` (n,) along -m (the level of its bins; all that reach furthest where none does)
     and whose left one reaches, along the plane normal m, as far as the pass can uniformly
@@ -212,7 +90,7 @@ def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np
     at the ideal posture; chosen for the motion time alone, the postures only just meet the side steps asked,
     and the passes are no wider than the guess. Also (n,): the CC points that fall short, their right side
     short of its step or their left reach below NARROW of the pass's."""
-    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance, m)
+    left, rgt = reach_widths(reach, cutter, points, frames, cs, tolerance, m, bend)
     ok = rgt >= back[:, None] - 1e-6
     none = ~ok.any(axis=1)
     best_r = np.nanmax(np.where(np.isnan(rgt), -np.inf, rgt), axis=1)
@@ -305,23 +183,29 @@ def _cspace(reach: MeshReach, cutter: Cutter, tolerance: float, pts: np.ndarray,
 
 def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], side: np.ndarray,
                grid: PostureGrid, machine: TarusMachine, ideal_weight: float, m: np.ndarray, back: np.ndarray,
-               assembly: Optional[ToolAssembly] = None):
+               assembly: Optional[ToolAssembly] = None, split: bool = False):
     """The pass along `paths` with the side steps `side` (n, 2) (left, right) of its CC points (the left
     ones relaxed where no posture meets them), each CC point's postures kept to the widest (widest_cspace:
     `back` (n,) the reach along -m to its bins' level, inf at the mesh's own edge): (postures, widths, ends,
-    side steps, paths), or None where some CC point still has no posture. CC points with no posture, or
-    narrow, at a path's end are left out (_peel; next to an end cut short by the machine's tilt, all with no
-    posture: the tool there reaches the slope)."""
+    side steps, paths, the CC points left out inside the paths (k, 3)), or None where some CC point still has
+    no posture. CC points with no posture, or narrow, at a path's end are left out (_peel; next to an end cut
+    short by the machine's tilt, all with no posture: the tool there reaches the slope); with `split`, runs of
+    up to END_PEEL with no posture inside a path too (the path split there, its bins for clean-up)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
     cs, side = _cspace(reach, cutter, tolerance, pts, frm, side, grid, machine, assembly)
+    dropped = np.zeros((0, 3))
     if cs.empty.any():
         paths, keep = _peel(paths, cs.empty)
+        if paths and split and cs.empty[keep].any() and _runs(cs.empty[keep]).max() <= END_PEEL:
+            dropped = pts[keep][cs.empty[keep]]
+            paths, inner = _split(paths, cs.empty[keep])
+            keep = keep[inner]
         if not paths or cs.empty[keep].any():
             return None
         pts, frm, side, back = pts[keep], frm[keep], side[keep], back[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
-    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, back, m)
+    cs, narrow = widest_cspace(reach, cutter, tolerance, pts, frm, cs, back, m, path_bending(paths))
     narrow &= np.isfinite(back)                            # not for the mesh's own edge alone
     if narrow.any():
         paths, keep = _peel(paths, narrow, through_cut=False)
@@ -339,8 +223,30 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
             return None                                                     # out of the machine's reach
         start += len(p)
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
-    widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance)
-    return postures, widths, ends, side, paths
+    widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance,
+                               path_bending(paths))
+    return postures, widths, ends, side, paths, dropped
+
+
+def _runs(mask: np.ndarray) -> np.ndarray:
+    """The lengths of the runs of True in `mask` (0 where none)."""
+    e = np.flatnonzero(np.diff(np.r_[0, mask.astype(np.int8), 0]))
+    return e[1::2] - e[::2] if e.size else np.zeros(1, dtype=np.int64)
+
+
+def _split(paths: List[CCPath], drop: np.ndarray) -> tuple[List[CCPath], np.ndarray]:
+    """The paths split where CC points are in `drop` (n,), those left out (the pieces' ends there cut short),
+    pieces of fewer than 2 CC points dropped; and the kept CC points' indices (all paths in order)."""
+    out, keep, start = [], [], 0
+    for p in paths:
+        e = np.flatnonzero(np.diff(np.r_[0, (~drop[start:start + len(p)]).astype(np.int8), 0]))
+        for a, b in zip(e[::2], e[1::2]):
+            if b - a >= 2:
+                cut = (p.cut_short[0] or bool(a > 0), p.cut_short[1] or bool(b < len(p)))
+                out.append(p if (a, b) == (0, len(p)) else p.take(slice(a, b), cut_short=cut))
+                keep.append(np.arange(start + a, start + b))
+        start += len(p)
+    return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
 
 
 def _peel(paths: List[CCPath], drop: np.ndarray, through_cut: bool = True) -> tuple[List[CCPath], np.ndarray]:
@@ -383,12 +289,7 @@ class _Planes:
         for p in cc_paths(self.mesh, self.direction, np.array([offset]), self.forward_step,
                           self.chord_tolerance):
             ok = tilt_reached(self.machine, p.frames, self.grid).any(axis=(1, 2)) if trim else True
-            if np.all(ok):
-                out.append(p)
-                continue
-            edges = np.flatnonzero(np.diff(np.r_[0, ok.astype(np.int8), 0]))
-            out += [p.take(slice(a, b), cut_short=(bool(a > 0), bool(b < len(ok))))
-                    for a, b in zip(edges[::2], edges[1::2]) if b - a >= 2]
+            out += [p] if np.all(ok) else _split([p], ~ok)[0]
         return out
 
     def paths(self, offset: float, trim: bool = True) -> List[CCPath]:
@@ -447,30 +348,39 @@ def _side_steps(reach: MeshReach, paths: List[CCPath], need: tuple[np.ndarray, n
     return np.column_stack([np.full(len(right), min(gap, limit)), right])
 
 
-def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, samples: int = 8) -> np.ndarray:
-    """(n,) how far (<= d) along -LY each CC point's section stays on the mesh, to d / samples^2."""
-    lo, hi = np.zeros(len(pts)), d.copy()
-    for _ in range(2):
-        t = lo[:, None] + (hi - lo)[:, None] * np.arange(1, samples + 1) / samples
-        S = surface_heights(reach, pts, frm, -t, 3.0 * float(d.max()) + 1.0)
-        off = np.isnan(S)
-        first = np.where(off.any(axis=1), off.argmax(axis=1), samples)
-        rows = np.arange(len(pts))
-        last_on = np.where(first > 0, t[rows, np.maximum(first - 1, 0)], lo)
-        hi = np.where(first < samples, t[rows, np.minimum(first, samples - 1)], hi)
-        lo = last_on
+def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, samples: int = 8,
+             rounds: int = 14) -> np.ndarray:
+    """(n,) how far (<= d) along -LY each CC point's section stays on the mesh: the first of `samples` off it,
+    then the edge's crossing bisected (to d / samples / 2^rounds; the last sample on the mesh left the top
+    bound unchecked up to d / samples short of the edge, and slivers along a slanted edge)."""
+    t = d[:, None] * np.arange(1, samples + 1) / samples
+    radius = 3.0 * float(d.max()) + 1.0
+    off = np.isnan(surface_heights(reach, pts, frm, -t, radius))
+    first = np.where(off.any(axis=1), off.argmax(axis=1), samples)
+    rows = np.arange(len(pts))
+    lo = np.where(first > 0, t[rows, np.maximum(first - 1, 0)], 0.0)
+    hi = t[rows, np.minimum(first, samples - 1)]
+    k = np.flatnonzero(first < samples)
+    for _ in range(rounds if k.size else 0):
+        mid = 0.5 * (lo[k] + hi[k])
+        on = ~np.isnan(surface_heights(reach, pts[k], frm[k], -mid[:, None], radius)[:, 0])
+        lo[k] = np.where(on, mid, lo[k])
+        hi[k] = np.where(on, hi[k], mid)
     return lo
 
 
 def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: List[CCPath],
-                 paths: List[CCPath], offset: float) -> None:
+                 paths: List[CCPath], offset: float, dropped: np.ndarray) -> None:
     """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
     the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
     reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of
-    coming back for them (or being held back by them)."""
+    coming back for them (or being held back by them); so are the bins of the CC points `dropped` (k, 3)
+    inside a path (no posture there: _plan_pass), whether their neighbours advanced them or not."""
     gained = level > cover.level + 1e-9
     reached = float(level[gained].min()) if gained.any() else offset
-    hole = cover.spanned(whole) & ~cover.spanned(paths) & cover.open & ~gained & (cover.level < reached)
+    inner = np.zeros(len(level), dtype=bool)
+    inner[cover.bin(dropped @ cover.feed)] = True
+    hole = (cover.spanned(whole) & ~cover.spanned(paths) & ~gained | inner) & cover.open & (cover.level < reached)
     if hole.any():
         for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
             f0 = cover.f0 + cover.width * a
@@ -526,7 +436,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
     guess = lo + gap
     while cover.open.any():
-        for _ in range(MAX_TRIES):
+        for tries in range(MAX_TRIES):
             offset, paths, base = planes.place(guess, gap)
             if plan.passes and offset < plan.passes[-1].offset + REPEAT * gap and \
                     _give_up_lagging(plan, cover, paths, base, gap):
@@ -535,7 +445,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             need = cover.needed(paths)
             side = _side_steps(reach, paths, need, offset, m, ahead, 2 * cutter.radius)
             got = _plan_pass(reach, cutter, MARGIN * tolerance, paths, side, grid, machine, ideal_weight, m,
-                             np.where(need[1], np.inf, offset - need[0]), assembly)
+                             np.where(need[1], np.inf, offset - need[0]), assembly, split=tries >= SPLIT_AFTER)
             if got is not None:
                 paths = got[4]
                 level, short = cover.advanced(paths, got[2])
@@ -556,7 +466,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             gap = skip
             guess = base + 2 * skip
             continue
-        postures, widths, ends, used, paths = got
+        postures, widths, ends, used, paths, dropped = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
         runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun,
@@ -565,7 +475,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
                                        gap, runs))
         plan.partial += short > 0
-        _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset)
+        _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset, dropped)
         # the next pass's right side step as this one's left one (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
         # the postures being the widest: half the width this pass finished (left + right along m) at most CC
         # points, so that the next one splits it evenly

@@ -48,13 +48,16 @@ def profile_arcs(cutter: Cutter, lam: np.ndarray, omg: np.ndarray,
     return _profile_arcs(cutter, lam.tobytes(), omg.tobytes(), int(samples))
 
 
-def _support(cutter: Cutter, rot: np.ndarray, ny: np.ndarray, nz: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _support(cutter: Cutter, rot: np.ndarray, ny: np.ndarray, nz: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(LY, LZ) (P, S) of the profile's support points for the unit normals (ny, nz) (P, S), at delta = 0:
-    the ellipse (the disc of radius R - r seen along LX) grown by a disc of radius r."""
+    the ellipse (the disc of radius R - r seen along LX) grown by a disc of radius r; and their LX (P, S)
+    (where along the feed the tool's point that forms the profile lies)."""
     r = cutter.corner_radius
     rp = cutter.radius - r
     tip = touch_tip(cutter, rot)
-    c2 = (tip + r * rot[:, 2, :])[:, 1:]                                  # disc centre (LY, LZ)
+    c3 = tip + r * rot[:, 2, :]                                            # disc centre (LX, LY, LZ)
+    c2 = c3[:, 1:]
     M = rp * np.stack([rot[:, 0, 1:], rot[:, 1, 1:]], axis=-1)            # (P, 2, 2): columns TX, TY seen
     m = [[M[:, i, j][:, None] for j in range(2)] for i in range(2)]
     s0 = m[0][0] * ny + m[1][0] * nz                                       # M^T n
@@ -65,7 +68,8 @@ def _support(cutter: Cutter, rot: np.ndarray, ny: np.ndarray, nz: np.ndarray) ->
     s1 *= inv
     py = c2[:, :1] + m[0][0] * s0 + m[0][1] * s1 + r * ny
     pz = c2[:, 1:] + m[1][0] * s0 + m[1][1] * s1 + r * nz
-    return py, pz
+    px = c3[:, :1] + rp * (rot[:, 0, :1] * s0 + rot[:, 1, :1] * s1)
+    return py, pz, px
 
 
 @lru_cache(maxsize=4)
@@ -77,8 +81,8 @@ def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: i
     bu = np.stack([au[:, 1], -au[:, 0]], axis=1)                           # across the lift, towards +LY
     th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
     # outward normals of the arc that faces against the lift: n = -cos(th) a + sin(th) b
-    py, pz = _support(cutter, rot, -np.cos(th) * au[:, :1] + np.sin(th) * bu[:, :1],
-                      -np.cos(th) * au[:, 1:] + np.sin(th) * bu[:, 1:])
+    py, pz, _ = _support(cutter, rot, -np.cos(th) * au[:, :1] + np.sin(th) * bu[:, :1],
+                         -np.cos(th) * au[:, 1:] + np.sin(th) * bu[:, 1:])
     across = py * bu[:, :1] + pz * bu[:, 1:]
     along = py * au[:, :1] + pz * au[:, 1:]
     arcs = (a2, np.maximum.accumulate(across, axis=1), along)
@@ -87,16 +91,19 @@ def _profile_arcs(cutter: Cutter, lam_bytes: bytes, omg_bytes: bytes, samples: i
     return arcs
 
 
-def lower_profile(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, samples: int = PROFILE_SAMPLES
-                  ) -> tuple[np.ndarray, np.ndarray]:
+def lower_profile(cutter: Cutter, lam: np.ndarray, omg: np.ndarray, samples: int = PROFILE_SAMPLES,
+                  lead: bool = False) -> tuple[np.ndarray, ...]:
     """The effective cutting profile's lower boundary along LZ for P postures (lam, omg radians) at delta =
-    0: LY (P, samples, increasing) and LZ (P, samples) in the CC point's LCS."""
+    0: LY (P, samples, increasing) and LZ (P, samples) in the CC point's LCS; with `lead` also the LX (P,
+    samples) of the tool's point that forms it (behind the CC point < 0: the swept tool forms the profile
+    there when it has gone that far beyond, which a curving pass bends: mesh5.widths.bent_profile)."""
     lam = np.asarray(lam, dtype=float).reshape(-1)
     rot = tool_rotation(lam, np.asarray(omg, dtype=float).reshape(-1))
     th = np.linspace(-0.5 * math.pi, 0.5 * math.pi, samples)[None, :]
     ny = np.repeat(np.sin(th), len(lam), axis=0)
-    py, pz = _support(cutter, rot, ny, -np.cos(th) + 0 * ny)
-    return np.maximum.accumulate(py, axis=1), pz
+    py, pz, px = _support(cutter, rot, ny, -np.cos(th) + 0 * ny)
+    py = np.maximum.accumulate(py, axis=1)
+    return (py, pz, px) if lead else (py, pz)
 
 
 def surface_heights(reach: MeshReach, points: np.ndarray, frames: np.ndarray, lateral: np.ndarray,
