@@ -23,15 +23,9 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from tmm_workbench.core.strategies.mesh5.stepover import (AHEAD_SHARE, GAP_QUANTILE, LAGGING, MAX_TRIES, REPEAT,
-                                                          SHRINK, WIDE_QUANTILE)
-
-# the step-over's literals (adaptive_passes writes them in place, nothing to import): the first plane and the first
-# left step asked (seed 000 eq. 3.22-3.23), the gap's range, and the strip skipped where no pass advances, in radii
-FIRST_GAP, FIRST_AHEAD, LEAST_GAP, MOST_GAP, SKIP = 0.25, 0.5, 0.05, 2.0, 0.5
-EDGE = 1e-3             # Coverage's edge: a bin within this many radii of its top is finished
-# the right side step the C-space asks (stepover._side_steps): this share of the way back to the level, and mm more
-BACK_SHARE, BACK_MORE = 1.01, 1e-3
+from tmm_workbench.core.strategies.mesh5.stepover import (AHEAD_SHARE, BACK_MORE, BACK_SHARE, EDGE, FIRST_AHEAD,
+                                                          FIRST_GAP, GAP_QUANTILE, LAGGING, LEAST_GAP, MAX_TRIES,
+                                                          MOST_GAP, REPEAT, SHRINK, SKIP, WIDE_QUANTILE)
 
 Reach = Callable[[float], tuple[np.ndarray, np.ndarray]]
 

@@ -78,6 +78,12 @@ REPEAT = 0.3
 LAGGING = 6
 GAP_QUANTILE = 0.25     # of the pass's finished widths, whose half is the next gap
 AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the widest posture is chosen in it)
+# in radii: the first plane and the first left step asked (seed 000 eq. 3.22-3.23: 0.125 D, 0.25 D), the next
+# gap's range, and the strip skipped where no pass advances the least finished bins (a quarter diameter)
+FIRST_GAP, FIRST_AHEAD, LEAST_GAP, MOST_GAP, SKIP = 0.25, 0.5, 0.05, 2.0, 0.5
+EDGE = 1e-3             # Coverage's edge: a bin within this many radii of its top is finished
+# the right side step the C-space asks: this share of the way back to the level its bins are finished to, and mm more
+BACK_SHARE, BACK_MORE = 1.01, 1e-3
 
 
 def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
@@ -340,7 +346,7 @@ def _side_steps(reach: MeshReach, paths: List[CCPath], need: tuple[np.ndarray, n
     level, edge = need
     frm = np.concatenate([p.frames for p in paths])
     across = np.maximum(frm[:, 1] @ m, 0.2)                                 # LY's share of m
-    right = np.clip(1.01 * (offset - level) / across + 1e-3, 1e-3, limit)
+    right = np.clip(BACK_SHARE * (offset - level) / across + BACK_MORE, 1e-3, limit)
     k = np.flatnonzero(edge)
     if k.size:
         pts = np.concatenate([p.points for p in paths])
@@ -430,10 +436,10 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
     s = mesh.vertices @ m
     lo, hi = float(s.min()), float(s.max())
     plan = AdaptivePlan(extent=(lo, hi), overrun=cutter.radius)
-    cover = Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, 1e-3 * cutter.radius, plan.overrun)
+    cover = Coverage(mesh, m, np.array([m[1], -m[0], 0.0]), forward_step, EDGE * cutter.radius, plan.overrun)
     planes = _Planes(mesh, direction, cover, forward_step, chord_tolerance, cutter.radius, machine, grid)
-    gap = 0.125 * cutter.diameter                                           # eq. 3.22: the first plane
-    ahead = 0.25 * cutter.diameter                                          # eq. 3.23: d = 0.25 D
+    gap = FIRST_GAP * cutter.radius                                         # eq. 3.22: the first plane
+    ahead = FIRST_AHEAD * cutter.radius                                     # eq. 3.23: d = 0.25 D
     guess = lo + gap
     while cover.open.any():
         for tries in range(MAX_TRIES):
@@ -460,7 +466,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             # (reported for clean-up) and the passes go on past it
             stuck = cover.open & (cover.level <= base + 1e-9)
             f = cover.f0 + cover.width * np.flatnonzero(stuck)
-            skip = 0.25 * cutter.diameter
+            skip = SKIP * cutter.radius
             plan.unfinished.append((float(f.min()), float(f.max() + cover.width), base, base + skip))
             cover.level[stuck] = base + skip
             gap = skip
@@ -480,7 +486,8 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         # the postures being the widest: half the width this pass finished (left + right along m) at most CC
         # points, so that the next one splits it evenly
         total = (left - offset) + (offset - right)
-        gap = float(np.clip(0.5 * np.quantile(total, GAP_QUANTILE), 0.05 * cutter.radius, 2 * cutter.radius))
+        gap = float(np.clip(0.5 * np.quantile(total, GAP_QUANTILE), LEAST_GAP * cutter.radius,
+                            MOST_GAP * cutter.radius))
         ahead = AHEAD_SHARE * gap
         guess = offset + 2 * gap
         if progress is not None and progress(1.0 - float(np.mean(cover.open))) is False:
