@@ -109,15 +109,14 @@ def compute(op: Any, progress: Union[bool, Callable[[float], bool]]) -> None:
     op.Proxy.progress_enabled = bool(progress)
     with progress_mod.using(factory):
         op.touch()
-        # the whole document: FreeCAD 1.1 marks the Job's previous op touched when a new one computes (a recompute
-        # of the new op alone left it so: a rest op after it then found its earlier ops waiting for a recompute)
+        # the whole document: whatever an earlier op depends on and was touched since (on FreeCAD 1.1, a ToolBit
+        # whose dimension changed rebuilds its shape body after a recompute, touching its ops' inputs again;
+        # compat.settle_toolbit rebuilds it before an op uses it) is brought up to date with this op
         op.Document.recompute()
     if op.isValid() and getattr(op.Proxy, "cancelled", False):
         raise TmmError(f"{op.Label}: tool path computation cancelled")
     if not op.isValid() or op.Proxy.toolpath is None:
         raise TmmError(op.getStatusString() if not op.isValid() else f"{op.Label}: no tool path computed")
-
-
 
 
 def stock_box_checked(stock: Any) -> StockBox:

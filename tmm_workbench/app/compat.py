@@ -235,6 +235,22 @@ def make_toolbit(doc: Any, shape: str, parameters: dict[str, str], label: str) -
     return bit.attach_to_doc(doc, label)
 
 
+def settle_toolbit(tool_controller: Any) -> None:
+    """Rebuilds now the shape body that FreeCAD 1.1's ToolBit rebuilds after the next document recompute when one
+    of its dimensions changed (its queued visual update): that rebuild leaves the new body touched, so the
+    recompute after it computes the bit, its tool controller and every op cutting with it again. Called once the
+    controller's bit is set up and before an op uses it, the rebuild costs the bit's own objects only. Nothing to
+    do on 0.20 and 1.0 (no queue)."""
+    bit = getattr(tool_controller, "Tool", None)
+    proxy = getattr(bit, "Proxy", None)
+    if not getattr(proxy, "_visual_update_queued", False) or not hasattr(proxy, "_process_queued_visual_update"):
+        return
+    proxy._process_queued_visual_update()
+    body = getattr(bit, "BitBody", None)
+    parts = [body, *body.OutListRecursive] if body is not None else []
+    bit.Document.recompute([*parts, bit, tool_controller])
+
+
 def remove_toolbit(bit: Any) -> None:
     """Deletes a ToolBit object and its shape body (0.20/1.0: unloadBitBody; 1.1: _removeBitBody)."""
     proxy = getattr(bit, "Proxy", None)

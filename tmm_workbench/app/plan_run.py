@@ -68,6 +68,7 @@ def library_controller(job: Any, tool: str, spec: dict, kwargs: dict) -> Any:
     changes tools only when the tool changes): the ToolBit of the op's tool shape and size (`kwargs`, the op's API
     arguments) and feeds, named after the library's tool and given its flute length, overall length, shank and
     holder (the ops use the controller's holder: their Holder is FromToolController)."""
+    from tmm_workbench.app import compat
     from tmm_workbench.app.api import set_holder
     from tmm_workbench.app.api_run import add_tool, bit
 
@@ -82,6 +83,7 @@ def library_controller(job: Any, tool: str, spec: dict, kwargs: dict) -> Any:
         made.Tool.ShankDiameter = float(spec["shank_diameter"])
     if spec["holder"] is not None:
         set_holder(made, spec["holder"], float(spec["stick_out"] or 0.0))
+    compat.settle_toolbit(made)
     return made
 
 
