@@ -240,6 +240,15 @@ class PlanBeet(FreeCADTestCase):
             self.assertTrue(f"<td>{op['label']}</td>" in page, op["label"])
         self.assertEqual(page.count("data:image/png;base64,"), 2)
         self.assertGreater((out / "beet_mm_toolpath.png").stat().st_size, 10_000)
+        # the same job file again: the same files byte for byte (but the document, where FreeCAD stores times)
+        data["outputs"]["dir"] = str(OUT / "plan_command" / "again")
+        job_file.write_text(yaml.safe_dump(data))
+        self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
+        again = OUT / "plan_command" / "again"
+        for name in report["files"]:
+            if name.endswith(".FCStd"):
+                continue
+            self.assertEqual((out / name).read_bytes(), (again / name).read_bytes(), name)
 
 
 def block_on_plate() -> Any:
