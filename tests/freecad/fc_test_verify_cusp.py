@@ -6,7 +6,7 @@ from __future__ import annotations
 import unittest
 
 
-from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
+from fc_helpers import FreeCADTestCase, bump_stl, close_all, core_work, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.strategies.surface.reference import cusp_field
@@ -64,6 +64,8 @@ class VerifyCusp(FreeCADTestCase):
         self.assertEqual(moves(op), plain)
         close_all()
 
+    # the API's keyword and the core's verification: the op's VerifyCusp through FreeCAD is the first test's
+    @core_work
     def test_run_surface_verify_cusp(self) -> None:
         kw = dict(diameter=4.0, stepover=0.4, sample_step=0.5, cusp=TOL, progress=False)
         plain = run_surface(str(bump_stl()), doc_name="TmmApiPlain", diameter=4.0, stepover=0.4, sample_step=0.5,
@@ -77,6 +79,7 @@ class VerifyCusp(FreeCADTestCase):
             run_surface(str(bump_stl()), doc_name="TmmApiBad", verify_cusp="yes", **kw)
         close_all()
 
+    @core_work
     def test_run_surface_verify_cusp_on_the_3d_offset(self) -> None:
         """The 3D offset's loops verified (their gaps read from the arrival field): the op computes, the path holds
         the cusp, the report is in the diagnostics."""
