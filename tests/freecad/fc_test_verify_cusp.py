@@ -17,10 +17,19 @@ TOL = 0.01
 VALUES = {"StepOver": 0.4, "SampleStep": 0.5, "CuspHeight": TOL, "BoundaryShape": "Model"}
 
 
+_FIELDS: dict = {}
+
+
 def simulated_max_cusp(op) -> float:
-    """The op's tool path cut into a z-map of 0.03 mm cells (the verification used 0.05) against a dense raster."""
+    """The op's tool path cut into a z-map of 0.03 mm cells (the verification used 0.05) against a dense raster.
+    The field (the dense raster's envelope: most of the time) depends on the mesh and the boundary only, not on the
+    path: made once for each, every path measured against it (CuspField.cut starts from a fresh stock)."""
     mesh = op.Proxy.mesh
-    field = cusp_field(mesh, Cutter.ball(4.0), op.Proxy.boundary(op, mesh), TOL, 0.03, sample_step=0.03)
+    boundary = tuple(float(v) for v in op.Proxy.boundary(op, mesh))
+    key = (mesh.vertices.tobytes(), mesh.triangles.tobytes(), boundary)
+    if key not in _FIELDS:
+        _FIELDS[key] = cusp_field(mesh, Cutter.ball(4.0), boundary, TOL, 0.03, sample_step=0.03)
+    field = _FIELDS[key]
     return field.max_cusp(field.cut(op.Proxy.toolpath, Cutter.ball(4.0)))
 
 
