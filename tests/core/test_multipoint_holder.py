@@ -118,6 +118,12 @@ def reference(face):
     return pts, cKDTree(pts)
 
 
+@pytest.fixture(scope="module")
+def bare(face):
+    """The path without a holder (read only: two tests compare against it)."""
+    return compute(face, CUTTER, params())
+
+
 def test_frustum_distance_reference():
     """The reference's own distance on cases worked by hand."""
     tip, axis = np.zeros(3), np.array([0.0, 0.0, 1.0])
@@ -129,9 +135,8 @@ def test_frustum_distance_reference():
 
 
 # --- the guard ------------------------------------------------------------------------------------------------
-def test_tilt_away_keeps_the_holder_clear(face, reference):
+def test_tilt_away_keeps_the_holder_clear(face, reference, bare):
     asm = assembly()
-    bare = compute(face, CUTTER, params())
     pts, tree = reference
     before, _ = closest_approach(pts, tree, asm, np.vstack([s.tips for s in bare.segments]),
                                  np.vstack([s.axes for s in bare.segments]))
@@ -201,9 +206,8 @@ def test_leave_out_cuts_nothing_too_close(face, reference):
     assert worst >= -1e-9
 
 
-def test_a_holder_that_never_comes_close_changes_nothing(face):
+def test_a_holder_that_never_comes_close_changes_nothing(face, bare):
     """A long stick-out: the guard checks and keeps every position and segment bit for bit."""
-    bare = compute(face, CUTTER, params())
     notes: list = []
     result = compute(face, CUTTER, params(assembly=assembly(stick_out=120.0), holder_notes=notes))
     assert notes == [result.diagnostics["holder"]] and notes[0].affected == 0 and not notes[0].pieces

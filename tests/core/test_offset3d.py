@@ -149,18 +149,19 @@ def test_flat_plate_path_through_the_strategy():
     assert max(float(np.hypot(*(s.tips[-1, :2] - s.tips[0, :2]))) for s in links) <= 3 * d["stepover"]
 
 
-def _path(mesh, cutter, params):
+def _path(mesh, cutter, params, result=None):
+    """The linked path of `params` (of `result`, when the test computed it already)."""
     top = float(mesh.bounds[1][2])
-    return link(compute(mesh, cutter, params).segments, LinkPolicy(top + 5, top + 10))
+    return link((result or compute(mesh, cutter, params)).segments, LinkPolicy(top + 5, top + 10))
 
 
-def _cut_and_dense(mesh, params, cell=0.02):
-    """The stock (cells `cell` mm, clear of the boundary's edges by the radius) cut by the path of `params` and by a
-    dense raster (passes a cell apart: what the tool can reach), and the grid."""
+def _cut_and_dense(mesh, params, cell=0.02, result=None):
+    """The stock (cells `cell` mm, clear of the boundary's edges by the radius) cut by the path of `params` (of
+    `result`, its computation) and by a dense raster (passes a cell apart: what the tool can reach), and the grid."""
     box, r = params.boundary, BALL.radius
     grid = Grid.covering(box[0] + r, box[1] + r, box[2] - r, box[3] - r, cell)
     stock = box_heights(grid, 10)
-    cut = simulate(_path(mesh, BALL, params), BALL, grid, stock).heights
+    cut = simulate(_path(mesh, BALL, params, result), BALL, grid, stock).heights
     dense = simulate(_path(mesh, BALL, SurfaceParams(boundary=(box[0], box[1] - r, box[2], box[3] + r),
                                                      sample_step=0.1, stepover=cell)), BALL, grid, stock).heights
     return cut, dense, grid
@@ -173,7 +174,7 @@ def test_dome_cusp_within_the_height_and_no_gouge_in_the_simulated_stock():
     # gouge_tol: how deep a straight move may pass below the exact drop between CL points (raster_refine)
     params = SurfaceParams(boundary=box, sample_step=0.25, stepover_mode=OFFSET3D, cusp=tol, gouge_tol=5e-4)
     result = compute(mesh, BALL, params)
-    cut, dense, grid = _cut_and_dense(mesh, params)
+    cut, dense, grid = _cut_and_dense(mesh, params, result=result)
     design = mesh_heights(mesh, grid)
     cos = np.cos(np.radians(slope_deg(dense, grid.cell)))
     assert np.abs(dense - design).max() < 0.5 * tol               # reachable everywhere here
@@ -364,7 +365,7 @@ def test_relief_patch_holds_the_cusp_with_long_loops_and_no_gouge():
     tol, box = 0.01, (-8.0, 0.0, 4.0, 12.0)
     params = SurfaceParams(boundary=box, sample_step=0.25, stepover_mode=OFFSET3D, cusp=tol, gouge_tol=5e-4)
     result = compute(mesh, BALL, params)
-    path = _path(mesh, BALL, params)
+    path = _path(mesh, BALL, params, result)
     field = cusp_field(mesh, BALL, box, tol, 0.05, 75.0, sample_step=0.25)
     heights = field.cut(path, BALL)
     cusp = field.cusp(heights)

@@ -65,7 +65,9 @@ def test_lowest_on_vertical_matches_the_reference():
 @pytest.mark.parametrize("shape", ["round_insert", "bull_nose"])
 def test_tilted_moves_agree_with_zmap_py(shape):
     """A few tilted moves (the axis turning) on a 0.25 mm grid: the kernel and zmap.simulate on the same
-    needles, same max_step (same instances), agree far inside the stated bound."""
+    needles, same max_step (same instances), agree far inside the stated bound. The reference is measured on every
+    other needle of every other row (a needle's height depends on the tool's instances only, not on its
+    neighbours: the same values there as on the whole grid, a quarter of the Python work)."""
     tips = np.array([[0.0, 0.0, 2.0], [6.0, 2.0, 1.0], [11.0, 7.0, 1.5], [14.0, 14.0, 0.5]])
     axes = np.array([tilted(10, 30), tilted(22, 60), tilted(15, 120), tilted(5, 200)])
     stock = nat.ZMap(-12.0, -12.0, 0.25, 152, 152, 4.0)
@@ -73,13 +75,15 @@ def test_tilted_moves_agree_with_zmap_py(shape):
     x = stock.x0 + (np.arange(stock.nx) + 0.5) * stock.cell
     y = stock.y0 + (np.arange(stock.ny) + 0.5) * stock.cell
     X, Y = np.meshgrid(x, y)
-    ref = zmap.simulate(zmap.ZTool(RO, RI, shape), np.column_stack([X.ravel(), Y.ravel()]), 4.0, [(tips, axes)],
-                        max_step=MAX_STEP, verify_tol=None)
-    z = np.array(stock.heights).ravel()
+    sample = (slice(None, None, 2), slice(None, None, 2))
+    ref = zmap.simulate(zmap.ZTool(RO, RI, shape), np.column_stack([X[sample].ravel(), Y[sample].ravel()]), 4.0,
+                        [(tips, axes)], max_step=MAX_STEP, verify_tol=None)
+    z = np.array(stock.heights)
     assert r["instances"] == ref.instances
     assert r["moves_cut"] == 3 and len(r["collisions"]) == 0
-    assert r["cells_lowered"] == int((ref.z < 4.0).sum()) > 10000
-    assert np.max(np.abs(z - ref.z)) < min(1e-6, BOUND)
+    assert r["cells_lowered"] == int((z < 4.0).sum()) > 10000
+    assert int((ref.z < 4.0).sum()) == int((z[sample] < 4.0).sum()) > 2500
+    assert np.max(np.abs(z[sample].ravel() - ref.z)) < min(1e-6, BOUND)
 
 
 def test_rapid_collisions_and_refusals():

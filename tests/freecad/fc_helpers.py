@@ -149,6 +149,18 @@ def reopened(doc: Any, obj: Any, filename: str) -> Any:
     close_all()
     return FreeCAD.openDocument(str(path)).getObject(name)
 
+# A test whose outcome depends on TMM's core, not on FreeCAD's version: what it does through FreeCAD (a Job, an op,
+# save and reopen) other tests of its module do on every version, its weight is the core's computing. It runs on
+# the host's FreeCAD; scripts/env_test.sh (FreeCAD 1.0 and 1.1) sets TMM_FC_VERSIONED=1, and fc_runner leaves it out.
+CORE_WORK = "_tmm_core_work"
+
+
+def core_work(test: Any) -> Any:
+    """Marks `test` as core work done through FreeCAD (see CORE_WORK)."""
+    setattr(test, CORE_WORK, True)
+    return test
+
+
 class FreeCADTestCase(unittest.TestCase):
     def tearDown(self) -> None:
         close_all()

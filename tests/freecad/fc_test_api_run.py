@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import FreeCAD
 
-from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase, seed_net
+from fc_helpers import OUT, SPHERE_ON_PLATE, FreeCADTestCase, core_work, seed_net
 from tmm_workbench.app.api import run_roughing, run_surface
 from tmm_workbench.app.api_run import run
 from tmm_workbench.core.errors import TmmError
@@ -88,6 +88,8 @@ class SharedToolController(FreeCADTestCase):
 
 
 class FaceOpByName(FreeCADTestCase):
+    # TMM's registry against its API (the 5-axis op in a Job, its post: fc_test_multipoint, fc_test_posts5)
+    @core_work
     def test_multipoint_by_its_properties_is_run_multipoint(self) -> None:
         from tmm_workbench.app.api import run_multipoint
         from tmm_workbench.core.tools.cutter import Cutter

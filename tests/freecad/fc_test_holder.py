@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import FreeCAD
 
-from fc_helpers import OUT, FreeCADTestCase, reopened, write_ascii_stl
+from fc_helpers import OUT, FreeCADTestCase, core_work, reopened, write_ascii_stl
 from tests.core.cavity import cavity_mesh
 from tmm_workbench.app import tool_assembly
 from tmm_workbench.app.api import run_surface
@@ -45,6 +45,8 @@ class HolderInTheSurface(FreeCADTestCase):
                                                tolerance=0.05).ok)
         self.assertIn("points left out", left.op.HolderReport)
 
+    # the core's holder check on the simulated Job (the same Jobs simulated with a holder: fc_test_sim_holder)
+    @core_work
     def test_the_simulation_shows_the_holder_hitting_a_job_computed_without_it(self) -> None:
         from tmm_workbench.app.api import simulate
 

@@ -3,7 +3,8 @@ ToolBit in an ER16 nut at a 32 mm stick-out finishing a floor that ends at a 60 
 shank and holder bound the op's C-space: the tool tilts away from the wall (HolderReport, HolderRegions), what no
 posture reaches is marked for clean-up (CleanupRegions, Mesh5Summary); the Job's simulation checks the shank
 and holder at every move, against the design and the stock, and finds them clear, with no gouge; the same op
-without its holder drives the nut into the wall (found by the same check)."""
+without its holder drives the nut into the wall (found by the same check); a ball clean-up op after it takes most
+of what it left beside the wall."""
 from __future__ import annotations
 
 import FreeCAD
@@ -33,8 +34,12 @@ def floor_and_wall_stl() -> str:
 
 
 class HolderInTheMesh5Op(FreeCADTestCase):
-    def test_the_op_tilts_away_marks_what_it_leaves_and_its_holder_never_hits(self) -> None:
-        r = run_mesh5(floor_and_wall_stl(), holder=HOLDER, stick_out=STICK_OUT, doc_name="TmmMesh5Holder", **ARGS)
+    # One run_mesh5 (the 5-axis op with its ball clean-up after it, posted) for both halves: the op's C-space
+    # computed once (most of the time); the op alone and the Job (both ops) simulated once each.
+    def test_the_op_tilts_away_its_holder_never_hits_and_a_ball_cleans_up_what_it_left(self) -> None:
+        gcode = OUT / "mesh5_cleanup.tarus.ngc"
+        r = run_mesh5(floor_and_wall_stl(), holder=HOLDER, stick_out=STICK_OUT, doc_name="TmmMesh5Holder",
+                      cleanup_diameter=4.0, gcode_path=gcode, **ARGS)
         op = r.op
         self.assertTrue(op.isValid(), op.getStatusString())
         self.assertEqual((op.Holder, op.StickOut.Value), (HOLDER, STICK_OUT))
@@ -48,11 +53,27 @@ class HolderInTheMesh5Op(FreeCADTestCase):
         self.assertEqual(op.getEditorMode("CleanupRegions"), ["ReadOnly"])
         tilt_away = min(a[1] for s in op.Proxy.segments for a in s.axes)
         self.assertLess(tilt_away, -np.sin(np.radians(10.0)))
+        # the ball clean-up op after it, reading it
+        c = r.cleanup
+        self.assertTrue(c.isValid(), c.getStatusString())
+        self.assertEqual((c.Region, c.RestFrom), ("Rest", "EarlierOps"))
+        self.assertAlmostEqual(c.RestTolerance.Value, ARGS["tolerance"])
+        self.assertIn("rest", c.RestReport)
+        ops = r.job.Operations.Group
+        self.assertLess(ops.index(r.op), ops.index(c))               # after the 5-axis op, which it reads
+        self.assertEqual(c.ToolController.Tool.Diameter.Value, 4.0)
+        self.assertTrue(gcode.is_file())
+        self.assertEqual(r.gcode.count("M6"), 2)                      # both ops, a tool change before each
+        # the Job's simulation: the shank and holder along every move, against the design
         report = simulate(r.job, cell=0.25, tolerance=0.01, progress=False)
         self.assertEqual(report.holder_collisions, [])   # along every move, against the design
         self.assertEqual(report.stock_collisions, [])    # and against the stock as the cut leaves it
         self.assertEqual(report.collisions, [])
         self.assertGreaterEqual(report.min_deviation, -0.01)
+        # the material the 5-axis op left beside the wall (simulated on the Job's stock) is taken by the ball
+        alone = simulate(r.op, cell=0.25, tolerance=0.01, progress=False)
+        self.assertGreater(alone.remaining_volume, 30.0)
+        self.assertLess(report.remaining_volume, 0.3 * alone.remaining_volume)
         held = work_estimate.estimate(op)   # the estimate counts the holder's dearer C-spaces
         self.assertIn("shank and holder", held.note)
         # the same op without the holder: the path brings the nut into the wall
@@ -64,29 +85,6 @@ class HolderInTheMesh5Op(FreeCADTestCase):
         self.assertNotIn("shank and holder", bare_estimate.note)
         self.assertLess(bare_estimate.compute_seconds, held.compute_seconds)
         self.assertLess(abs(min(a[1] for s in op.Proxy.segments for a in s.axes)), 1e-9)   # upright throughout
-        bare = simulate(r.job, cell=0.25, tolerance=0.01, progress=False, holder=HOLDER, stick_out=STICK_OUT)
+        bare = simulate(r.op, cell=0.25, tolerance=0.01, progress=False, holder=HOLDER, stick_out=STICK_OUT)
         self.assertTrue(bare.holder_collisions, "the bare path should drive the holder into the wall")
-        FreeCAD.closeDocument(r.doc.Name)
-
-    def test_the_ball_clean_up_op_finishes_what_the_5_axis_op_left_beside_the_wall(self) -> None:
-        gcode = OUT / "mesh5_cleanup.tarus.ngc"
-        r = run_mesh5(floor_and_wall_stl(), holder=HOLDER, stick_out=STICK_OUT, doc_name="TmmMesh5Cleanup",
-                      cleanup_diameter=4.0, gcode_path=gcode, **ARGS)
-        c = r.cleanup
-        self.assertTrue(c.isValid(), c.getStatusString())
-        self.assertEqual((c.Region, c.RestFrom), ("Rest", "EarlierOps"))
-        self.assertAlmostEqual(c.RestTolerance.Value, ARGS["tolerance"])
-        self.assertIn("rest", c.RestReport)
-        ops = r.job.Operations.Group
-        self.assertLess(ops.index(r.op), ops.index(c))               # after the 5-axis op, which it reads
-        self.assertEqual(c.ToolController.Tool.Diameter.Value, 4.0)
-        self.assertTrue(gcode.is_file())
-        self.assertEqual(r.gcode.count("M6"), 2)                      # both ops, a tool change before each
-        # the material the 5-axis op left beside the wall (simulated on the Job's stock) is taken by the ball
-        alone = simulate(r.op, cell=0.25, tolerance=0.01, progress=False)
-        both = simulate(r.job, cell=0.25, tolerance=0.01, progress=False)
-        self.assertGreater(alone.remaining_volume, 30.0)
-        self.assertLess(both.remaining_volume, 0.3 * alone.remaining_volume)
-        self.assertGreaterEqual(both.min_deviation, -0.01)
-        self.assertEqual(both.collisions, [])
         FreeCAD.closeDocument(r.doc.Name)

@@ -11,7 +11,7 @@ import FreeCAD
 import Part
 import numpy as np
 
-from fc_helpers import OUT, FreeCADTestCase, close_all, new_doc, seed_net
+from fc_helpers import OUT, FreeCADTestCase, close_all, core_work, new_doc, seed_net
 from tmm_workbench.app.api import run_multipoint
 from tmm_workbench.app import tools
 from tmm_workbench.app.compat import load_post
@@ -26,6 +26,17 @@ SEED = benchmark_file("seed_surfaces.json")
 # even spacing: these cases test positioning, posts and documents, not the scallop rule (the API's default)
 FAST = dict(side_step=18.0, forward_step=4.0, progress=False, pass_spacing="even")
 DRD = dict(side_step=37.5, forward_step=10.0, progress=False, method="drd", pass_spacing="even")  # DRD is ~20x slower than VCRF
+_DRD_TIPS: list = []
+
+
+def drd_bezier_tips() -> np.ndarray:
+    """The G1 tips of DRD (the footprint's positions only, gouge_tolerance 0) on the seed's Bézier face, computed
+    once for the two tests that compare a path with it (its own document, closed: a read-only array)."""
+    if not _DRD_TIPS:
+        r = run_multipoint(seed_net(), doc_name="MpBez", **DRD, gouge_tolerance=0.0)
+        _DRD_TIPS.append(g1_tips(r.op))
+        FreeCAD.closeDocument(r.doc.Name)
+    return _DRD_TIPS[0]
 
 
 
@@ -120,6 +131,7 @@ class MultipointOp(FreeCADTestCase):
         text = processor.export([r.job.Tools.Group[0], op], str(OUT / "mp_direct.ngc"), "--no-show-editor")
         self.assertIn(" A", text if isinstance(text, str) else (OUT / "mp_direct.ngc").read_text())
 
+    @core_work  # the op's properties to the core: the same on every FreeCAD (the other tests read the op there)
     def test_surface_extension_and_tip_anchor(self) -> None:
         """The op's SurfaceExtension and FootprintAnchor reach the core: on the concave patch the passes on
         the rims touch the continued bowl, and the tilted tips lie on the footprint points."""
@@ -138,6 +150,7 @@ class MultipointOp(FreeCADTestCase):
         with self.assertRaises(TmmError):
             run_multipoint(net, footprint_anchor="contact", **FAST)
 
+    @core_work  # the core's positions at the seed's footprint, read through the op
     def test_fixed_pass_spacing_machines_the_seeds_footprint(self) -> None:
         """PassSpacing Fixed, 18 / 2 mm: the op positions the tool at the seed's 760 footprint points
         (x = 0, 18, ..., 144, 150), with the same contacts as the core at that footprint."""
@@ -172,7 +185,7 @@ class MultipointOp(FreeCADTestCase):
         doc.recompute()
         for method, opts in (("drd", DRD), ("vcrf", FAST)):
             opts = dict(opts, gouge_tolerance=0.0)  # the footprint's positions only: the same on both faces
-            ref = g1_tips(run_multipoint(net, doc_name="MpBez", **opts).op)
+            ref = drd_bezier_tips() if method == "drd" else g1_tips(run_multipoint(net, doc_name="MpBez", **opts).op)
             r = run_multipoint((obj, "Face1"), **opts)
             self.assertTrue(r.op.isValid(), r.op.getStatusString())
             self.assertEqual(type(r.face[0].Shape.Faces[0].Surface).__name__, "BSplineSurface")
@@ -187,13 +200,13 @@ class MultipointOp(FreeCADTestCase):
 
     def test_placement_moves_the_path(self) -> None:
         net = seed_net()
-        ref = g1_tips(run_multipoint(net, doc_name="MpRef", **DRD).op)
+        ref = drd_bezier_tips()  # the footprint's positions (gouge_tolerance 0): the placement moves them all
         doc = new_doc("MpPlaced")
         obj = doc.addObject("Part::Feature", "Patch")
         obj.Shape = bezier_surface(net).toShape()
         obj.Placement.Base = FreeCAD.Vector(100, -50, 7)
         doc.recompute()
-        r = run_multipoint((obj, "Face1"), **DRD)
+        r = run_multipoint((obj, "Face1"), **DRD, gouge_tolerance=0.0)
         self.assertTrue(r.op.isValid(), r.op.getStatusString())
         np.testing.assert_allclose(g1_tips(r.op), ref + [100, -50, 7], atol=1e-6)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import FreeCAD
 
-from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
+from fc_helpers import FreeCADTestCase, bump_stl, close_all, core_work, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
 
@@ -57,6 +57,7 @@ class Offset3D(FreeCADTestCase):
         self.assertIn("Offset3D", op.getEnumerationsOfProperty("StepOverMode"))
         close_all()
 
+    @core_work  # the API's keywords to the core's loops; the op's Offset3D in a Job: test_loops_save_and_reopen
     def test_run_surface(self) -> None:
         r = run_surface(bump_stl(), sample_step=0.5, stepover_mode="offset3d", cusp=0.02,
                         progress=False, doc_name="TmmApiOffset3D")
@@ -199,6 +200,7 @@ class Offset3DFromCurve(FreeCADTestCase):
 
 
 class Offset3DEstimate(FreeCADTestCase):
+    @core_work  # the estimate against the core's computation (the op and its Job: the tests above)
     def test_estimate_is_what_the_op_computes(self) -> None:
         """The panel's estimate for StepOverMode Offset3D (not the raster's): the passes' points and cutting time
         within 0.5-2x of what the op computes."""

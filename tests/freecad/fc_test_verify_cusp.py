@@ -6,7 +6,7 @@ from __future__ import annotations
 import unittest
 
 
-from fc_helpers import FreeCADTestCase, bump_stl, close_all, job_with_op, moves, new_doc, reopened
+from fc_helpers import FreeCADTestCase, bump_stl, close_all, core_work, job_with_op, moves, new_doc, reopened
 from tmm_workbench.app.api import run_surface
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.strategies.surface.reference import cusp_field
@@ -17,10 +17,19 @@ TOL = 0.01
 VALUES = {"StepOver": 0.4, "SampleStep": 0.5, "CuspHeight": TOL, "BoundaryShape": "Model"}
 
 
+_FIELDS: dict = {}
+
+
 def simulated_max_cusp(op) -> float:
-    """The op's tool path cut into a z-map of 0.03 mm cells (the verification used 0.05) against a dense raster."""
+    """The op's tool path cut into a z-map of 0.03 mm cells (the verification used 0.05) against a dense raster.
+    The field (the dense raster's envelope: most of the time) depends on the mesh and the boundary only, not on the
+    path: made once for each, every path measured against it (CuspField.cut starts from a fresh stock)."""
     mesh = op.Proxy.mesh
-    field = cusp_field(mesh, Cutter.ball(4.0), op.Proxy.boundary(op, mesh), TOL, 0.03, sample_step=0.03)
+    boundary = tuple(float(v) for v in op.Proxy.boundary(op, mesh))
+    key = (mesh.vertices.tobytes(), mesh.triangles.tobytes(), boundary)
+    if key not in _FIELDS:
+        _FIELDS[key] = cusp_field(mesh, Cutter.ball(4.0), boundary, TOL, 0.03, sample_step=0.03)
+    field = _FIELDS[key]
     return field.max_cusp(field.cut(op.Proxy.toolpath, Cutter.ball(4.0)))
 
 
@@ -64,6 +73,8 @@ class VerifyCusp(FreeCADTestCase):
         self.assertEqual(moves(op), plain)
         close_all()
 
+    # the API's keyword and the core's verification: the op's VerifyCusp through FreeCAD is the first test's
+    @core_work
     def test_run_surface_verify_cusp(self) -> None:
         kw = dict(diameter=4.0, stepover=0.4, sample_step=0.5, cusp=TOL, progress=False)
         plain = run_surface(str(bump_stl()), doc_name="TmmApiPlain", diameter=4.0, stepover=0.4, sample_step=0.5,
@@ -77,6 +88,7 @@ class VerifyCusp(FreeCADTestCase):
             run_surface(str(bump_stl()), doc_name="TmmApiBad", verify_cusp="yes", **kw)
         close_all()
 
+    @core_work
     def test_run_surface_verify_cusp_on_the_3d_offset(self) -> None:
         """The 3D offset's loops verified (their gaps read from the arrival field): the op computes, the path holds
         the cusp, the report is in the diagnostics."""
