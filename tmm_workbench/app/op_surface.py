@@ -115,8 +115,9 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         finish = surface_passes.finish_params(obj)
         check_final_depth(obj, finish.final_depth)
         # entries rapid to just above what the Job's earlier ops left and feed from there
+        # and between pieces hop just over the material along the way, not up to the safe height
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, material_top=left,
-                            low_links=rest is not None)   # a rest's many short pieces: hop over, not up
+                            low_links=left is not None)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
         with self.reporting(obj) as cb:

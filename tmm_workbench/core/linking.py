@@ -370,6 +370,41 @@ class StockHeights:
             self._update_excess(slice(j0, j1), slice(i0, i1))
 
 
+def know_design(policy: LinkPolicy, mesh: Any, within: float, stock_to_leave: float = 0.0,
+                known: Optional[tuple[Any, np.ndarray]] = None) -> bool:
+    """Gives the policy's StockHeights the design (StockHeights.know_design), so that plunges onto tips (drops onto
+    the model) rapid down to just above what stands off it: at a wall's foot, and on a waterline's wall under the
+    loops above, the highest stock within the tool's reach is the wall's top, and the plunge was fed from there
+    (ktoolcav's waterline: 22 mm at the plunge feed per loop). `known`: the design already on a grid (grid,
+    heights; a rest's), used when it is the stock's grid, else the mesh's heights on the stock's grid. Material
+    within `within` of the design (either way) counts as the design: at most the stock to leave and what the op's
+    own cuts leave on it (its chord tolerance), which the tool coming down onto its tip clears. Not with a negative
+    stock to leave (a tip then lies below the model) nor without a StockHeights; whether it was given."""
+    top = policy.material_top
+    if not isinstance(top, StockHeights) or stock_to_leave < 0:
+        return False
+    g = top.grid
+    if known is not None and known[1] is not None:
+        k = known[0]
+        if (k.x0, k.y0, k.cell, k.nx, k.ny) == (g.x0, g.y0, g.cell, g.nx, g.ny):
+            top.know_design(known[1], within)
+            return True
+    from tmm_workbench.core.sim.stock import mesh_heights   # imported when used, as the simulation in cut
+
+    top.know_design(mesh_heights(mesh, g), within)
+    return True
+
+
+def know_op_design(policy: LinkPolicy, mesh: Any, params: Any) -> bool:
+    """know_design for an op's strategy parameters: a rest's design and rest tolerance (params.rest), else the
+    mesh's heights within the stock to leave and the op's chord tolerance."""
+    s = float(getattr(params, "stock_to_leave", 0.0))
+    rest = getattr(params, "rest", None)
+    if rest is not None and getattr(rest, "design", None) is not None:
+        return know_design(policy, mesh, rest.within, s, (rest.grid, rest.design))
+    return know_design(policy, mesh, max(s, 0.0) + float(getattr(params, "chord_tol", 0.0)), s)
+
+
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:
     """The tool path through `segments` in order (see the module doc). No segments: an empty path."""
     policy.validate()

@@ -23,7 +23,6 @@ from typing import Any
 import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import LinkPolicy, StockHeights
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.strategies.surface.segments import reduce_chords
@@ -125,22 +124,3 @@ def _clear_of_bodies(bodies: Any, path: np.ndarray) -> bool:
     zb, owner = bodies.heights_of(BODIES, pts[:, :2])
     return not bool(np.any((zb - pts[:, 2] > TOLERANCE_MM) & (owner >= 0)))
 
-
-def know_design(mesh: TriMesh, params: Any, policy: LinkPolicy) -> None:
-    """A rest's entries rapid down to just above what stands off the design (StockHeights.above_design), not above
-    the highest stock within the tool's reach: at the walls' feet, where a rest's pieces start, that is the wall's
-    top, and the plunge was fed from there (the sign's clean-up: 3.7 mm a plunge, 6.9 of its 27 min). Only with the
-    rest's design (its grid's, or the mesh's heights on the stock's grid) and no negative stock to leave (a tip
-    then lies below the model)."""
-    rest, top = getattr(params, "rest", None), policy.material_top
-    if (rest is None or rest.design is None or not isinstance(top, StockHeights)
-            or float(getattr(params, "stock_to_leave", 0.0)) < 0):
-        return
-    g, h = rest.grid, top.grid
-    if (g.x0, g.y0, g.cell, g.nx, g.ny) == (h.x0, h.y0, h.cell, h.nx, h.ny):
-        design = rest.design
-    else:
-        from tmm_workbench.core.sim.stock import mesh_heights
-
-        design = mesh_heights(mesh, h)
-    top.know_design(design, rest.within)

@@ -1,0 +1,81 @@
+"""The linker's design (core.linking.know_design): a waterline's loops on a wall entered from just above what
+stands off the design, not from the wall's top; and the waterline's repeated pieces left out."""
+from __future__ import annotations
+
+import numpy as np
+
+from tests.conftest import grid_mesh
+from tmm_workbench.core.linking import LinkPolicy, StockHeights, know_design, know_op_design, link
+from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.grid import Grid
+from tmm_workbench.core.sim.simulate import simulate
+from tmm_workbench.core.sim.stock import mesh_heights
+from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.strategies.waterline import WaterlineParams
+from tmm_workbench.core.toolpath import MoveKind
+from tmm_workbench.core.tools.cutter import Cutter
+
+D4 = Cutter.ball(4)
+TOP, ROUGH = 10.0, 0.5
+
+
+def boss():
+    """A round boss 10 mm high with a steep (about 80 deg) side on a floor at 0."""
+    return grid_mesh(lambda x, y: TOP * np.clip((9.0 - np.hypot(x - 15, y - 15)) / 1.8, 0.0, 1.0), 120, 120,
+                     (0.0, 0.0, 30.0, 30.0))
+
+
+def plunges(tp) -> list[float]:
+    return [tp.moves[i - 1].z - m.z for i, m in enumerate(tp.moves) if i and m.kind is MoveKind.PLUNGE]
+
+
+def test_waterline_entries_come_down_to_the_loop_above_not_the_walls_top() -> None:
+    """The boss's top and floor finished, its side as a roughing left it (0.5 mm over the design): without the
+    design each loop's entry is fed from 1 mm above the boss's top (within the tool's reach); with it from
+    1 mm above what stands off the design (what the loops above left). The same cut, no rapid into material,
+    no gouge."""
+    mesh = boss()
+    grid = Grid.covering(0.0, 0.0, 30.0, 30.0, 0.25)
+    design = mesh_heights(mesh, grid)
+    side = (design > 0.01) & (design < TOP - 0.01)
+    left = np.where(side, design + ROUGH, design)
+    params = WaterlineParams(boundary=(0.0, 0.0, 30.0, 30.0), step_down=1.0, bottom_z=1.0, top_z=TOP,
+                             chord_tol=0.01)
+    segments = waterline.compute(mesh, D4, params).segments
+    found = []
+    for know in (False, True):
+        policy = LinkPolicy(15.0, 20.0, material_top=StockHeights(grid, left, D4), low_links=True)
+        if know:
+            assert know_op_design(policy, mesh, params)
+        tp = link(segments, policy)
+        sim = simulate(tp, D4, grid, left)
+        assert len(sim.collisions) == 0
+        assert np.nanmin(sim.heights - design) > -0.01
+        found.append((plunges(tp), sim.heights))
+    (before, cut_before), (after, cut_after) = found
+    print(before, after)
+    assert len(after) == len(before) >= 5
+    assert max(before) > 5.0 and sum(after) < 0.5 * sum(before)
+    assert np.array_equal(cut_after, cut_before)
+
+
+def test_the_design_is_not_given_without_stock_heights_or_below_the_model() -> None:
+    mesh = boss()
+    grid = Grid.covering(0.0, 0.0, 30.0, 30.0, 1.0)
+    assert not know_design(LinkPolicy(15.0, 20.0), mesh, 0.01)
+    top = StockHeights(grid, mesh_heights(mesh, grid), D4)
+    assert not know_design(LinkPolicy(15.0, 20.0, material_top=top), mesh, 0.01, stock_to_leave=-0.1)
+    assert top.design is None
+    assert know_design(LinkPolicy(15.0, 20.0, material_top=top), mesh, 0.01)
+    assert top.design is not None and top.within == 0.01
+
+
+def test_a_piece_repeating_an_earlier_one_is_left_out_and_the_one_joined_to_it_entered() -> None:
+    a = CutSegment(np.array([[0.0, 0.0, 1.0], [5.0, 0.0, 1.0]]))
+    b = CutSegment(np.array([[0.0, 1.0, 1.0], [5.0, 1.0, 1.0]]))
+    again = CutSegment(a.tips.copy())
+    after = CutSegment(np.array([[5.0, 0.5, 0.5], [0.0, 0.5, 0.5]]), joined=True)
+    near = CutSegment(a.tips + [0.0, 0.0, 1e-3])     # not the same: cuts 1 um lower than a lifted copy would
+    out, count = waterline.without_repeats([a, b, again, after, near])
+    assert count == 1 and out == [a, b, after, near]
+    assert not after.joined
