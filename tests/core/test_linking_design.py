@@ -15,14 +15,17 @@ from tmm_workbench.core.strategies.waterline import WaterlineParams
 from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.core.tools.cutter import Cutter
 
-D4 = Cutter.ball(4)
+D4 = Cutter.flat(4)
 TOP, ROUGH = 10.0, 0.5
 
 
-def boss():
-    """A round boss 10 mm high with a steep (about 80 deg) side on a floor at 0."""
-    return grid_mesh(lambda x, y: TOP * np.clip((9.0 - np.hypot(x - 15, y - 15)) / 1.8, 0.0, 1.0), 120, 120,
-                     (0.0, 0.0, 30.0, 30.0))
+def bosses():
+    """Two round bosses 10 mm high with sides as steep as the mesh can make them (one 0.25 mm triangle: 88 deg) on a floor at 0: the loops of a level go
+    from one to the other, and each level's first loop is entered beside the wall it finishes."""
+    def z(x, y):
+        r = np.minimum(np.hypot(x - 12, y - 15), np.hypot(x - 38, y - 15))
+        return TOP * np.clip((8.0 - r) / 0.01, 0.0, 1.0)
+    return grid_mesh(z, 200, 120, (0.0, 0.0, 50.0, 30.0))
 
 
 def plunges(tp) -> list[float]:
@@ -34,12 +37,12 @@ def test_waterline_entries_come_down_to_the_loop_above_not_the_walls_top() -> No
     design each loop's entry is fed from 1 mm above the boss's top (within the tool's reach); with it from
     1 mm above what stands off the design (what the loops above left). The same cut, no rapid into material,
     no gouge."""
-    mesh = boss()
-    grid = Grid.covering(0.0, 0.0, 30.0, 30.0, 0.25)
+    mesh = bosses()
+    grid = Grid.covering(0.0, 0.0, 50.0, 30.0, 0.25)
     design = mesh_heights(mesh, grid)
     side = (design > 0.01) & (design < TOP - 0.01)
     left = np.where(side, design + ROUGH, design)
-    params = WaterlineParams(boundary=(0.0, 0.0, 30.0, 30.0), step_down=1.0, bottom_z=1.0, top_z=TOP,
+    params = WaterlineParams(boundary=(0.0, 0.0, 50.0, 30.0), step_down=1.0, bottom_z=1.0, top_z=TOP,
                              chord_tol=0.01)
     segments = waterline.compute(mesh, D4, params).segments
     found = []
@@ -53,15 +56,14 @@ def test_waterline_entries_come_down_to_the_loop_above_not_the_walls_top() -> No
         assert np.nanmin(sim.heights - design) > -0.01
         found.append((plunges(tp), sim.heights))
     (before, cut_before), (after, cut_after) = found
-    print(before, after)
     assert len(after) == len(before) >= 5
-    assert max(before) > 5.0 and sum(after) < 0.5 * sum(before)
+    assert max(before) > 5.0 and sum(after) < 0.6 * sum(before) and min(after) < 1.01
     assert np.array_equal(cut_after, cut_before)
 
 
 def test_the_design_is_not_given_without_stock_heights_or_below_the_model() -> None:
-    mesh = boss()
-    grid = Grid.covering(0.0, 0.0, 30.0, 30.0, 1.0)
+    mesh = bosses()
+    grid = Grid.covering(0.0, 0.0, 50.0, 30.0, 1.0)
     assert not know_design(LinkPolicy(15.0, 20.0), mesh, 0.01)
     top = StockHeights(grid, mesh_heights(mesh, grid), D4)
     assert not know_design(LinkPolicy(15.0, 20.0, material_top=top), mesh, 0.01, stock_to_leave=-0.1)
