@@ -72,12 +72,18 @@ def test_the_design_is_not_given_without_stock_heights_or_below_the_model() -> N
     assert top.design is not None and top.within == 0.01
 
 
-def test_a_piece_repeating_an_earlier_one_is_left_out_and_the_one_joined_to_it_entered() -> None:
-    a = CutSegment(np.array([[0.0, 0.0, 1.0], [5.0, 0.0, 1.0]]))
-    b = CutSegment(np.array([[0.0, 1.0, 1.0], [5.0, 1.0, 1.0]]))
-    again = CutSegment(a.tips.copy())
+def test_moves_repeating_an_earlier_lifted_piece_are_left_out_and_the_rest_entered() -> None:
+    x = np.linspace(0.0, 5.0, 11)
+    lifted = CutSegment(np.column_stack([x, np.zeros_like(x), 1.0 + 0.1 * x]))   # a piece the guard lifted
+    other = CutSegment(np.array([[0.0, 3.0, 1.0], [5.0, 3.0, 1.0]]))
+    again = CutSegment(lifted.tips + [0.0, 0.0, 5e-4])                          # the same, a hair higher
     after = CutSegment(np.array([[5.0, 0.5, 0.5], [0.0, 0.5, 0.5]]), joined=True)
-    near = CutSegment(a.tips + [0.0, 0.0, 1e-3])     # not the same: cuts 1 um lower than a lifted copy would
-    out, count = waterline.without_repeats([a, b, again, after, near])
-    assert count == 1 and out == [a, b, after, near]
-    assert not after.joined
+    end_lower = lifted.tips.copy()
+    end_lower[-1, 2] -= 0.4                                                      # its last tip at its level
+    tail = CutSegment(end_lower)
+    lower = CutSegment(lifted.tips - [0.0, 0.0, 0.01])                          # cuts 10 um deeper: new
+    out, count = waterline.without_repeats([lifted, other, again, after, tail, lower])
+    assert count == 2
+    assert out[:3] == [lifted, other, after] and not after.joined
+    assert np.array_equal(out[3].tips, end_lower[-2:]) and not out[3].joined    # only its last move, entered
+    assert out[4] is lower and len(out) == 5

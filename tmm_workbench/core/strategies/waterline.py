@@ -18,6 +18,7 @@ clockwise and a pocket loop counter-clockwise; with "conventional" the other way
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, fields
 from typing import Optional
@@ -42,7 +43,8 @@ from tmm_workbench.core.work import Box, Work
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 CLIMB, CONVENTIONAL = "climb", "conventional"
 _LEVEL_EPS_MM = 1e-9  # a level this close above the bottom is the bottom
-REPEAT_MM = 1e-6      # a piece whose tips all lie this close to an earlier piece's is a repeat of it
+REPEAT_MM = 1e-3      # a move within this of an earlier lifted piece's, no lower, repeats it (what it cuts more
+#                       is within the loops' chord tolerance)
 # The chord tolerance is shared: the kernel's loops within 0.4 of it of the exact loop (inside it, on convex
 # stretches), then grown by 0.5 of it (core.polygons, mitred): no move inside the exact loop, none more than 0.9
 # of the tolerance outside it (a sharp convex corner's mitre a little more).
@@ -193,26 +195,59 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     return StrategyResult(segments, diagnostics)
 
 
-def without_repeats(segments: list[CutSegment]) -> tuple[list[CutSegment], int]:
-    """`segments` without those whose tips are those of an earlier one (to REPEAT_MM): on a vertical wall the
-    holder guard lifts the loops of every level below where the holder would meet the stock to the same
-    height, and the same piece was entered and cut again at each of them, cutting nothing (ktoolcav: 536 of
-    the waterline's 792 entries, each fed 26 mm down); the count left out. A segment joined to a left-out one
-    is entered instead."""
-    seen: set[bytes] = set()
+def without_repeats(segments: list[CutSegment], tol: float = REPEAT_MM) -> tuple[list[CutSegment], int]:
+    """`segments` without the moves that repeat an earlier piece's: on a vertical wall the holder guard lifts the
+    loops of every level below where the holder would meet the stock to the same heights, and the same lifted
+    piece was entered and cut again at each of them, cutting nothing (ktoolcav: 536 of the waterline's 792
+    entries, each fed 26 mm down). A move repeats one when both its ends lie within `tol` (XY) of two
+    consecutive tips of one earlier lifted piece (tips not all at one height), neither more than `tol` lower;
+    a piece keeps the runs of its other moves (each entered; a segment joined to a left-out end entered too).
+    The pieces left whole or in part, and the count of pieces changed."""
+    seen: dict[tuple[int, int], list[tuple[int, int, float]]] = {}
     out: list[CutSegment] = []
-    dropped = False
-    for seg in segments:
-        key = np.round(seg.tips / REPEAT_MM).astype(np.int64).tobytes()
-        if key in seen:
-            dropped = True
+    changed, entered = 0, False
+    for k, seg in enumerate(segments):
+        tips = seg.tips
+        lifted = len(tips) > 1 and float(np.ptp(tips[:, 2])) > tol
+        keep = _new_moves(seen, tips, tol) if lifted and seen else np.ones(max(len(tips) - 1, 1), dtype=bool)
+        if lifted:
+            for i, (x, y, z) in enumerate(tips.tolist()):
+                seen.setdefault((round(x / tol), round(y / tol)), []).append((k, i, z))
+        if keep.all():
+            if entered and seg.joined:
+                seg.joined = False
+            out.append(seg)
+            entered = False
             continue
-        seen.add(key)
-        if dropped and seg.joined:
-            seg.joined = False
-        dropped = False
-        out.append(seg)
-    return out, len(segments) - len(out)
+        changed += 1
+        runs = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(np.int8), [0]])))
+        for a, b in zip(runs[::2], runs[1::2]):    # moves a..b-1: tips a..b
+            part = dataclasses.replace(seg, tips=tips[a:b + 1].copy(), closed=False, entry_z=None,
+                                       helix_centre=None, joined=seg.joined and a == 0 and not entered,
+                                       arcs=None if seg.arcs is None else seg.arcs[a:b + 1])
+            out.append(part)
+        entered = not keep[-1]
+    return out, changed
+
+
+def _new_moves(seen: dict, tips: np.ndarray, tol: float) -> np.ndarray:
+    """Which of the moves between `tips` repeat no earlier lifted piece's (see without_repeats)."""
+    def matches(p: list) -> set:
+        x, y, z = p
+        ix, iy = round(x / tol), round(y / tol)
+        found = set()
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for k, i, z0 in seen.get((ix + dx, iy + dy), ()):
+                    if z >= z0 - tol:
+                        found.add((k, i))
+        return found
+    at = [matches(p) for p in tips.tolist()]
+    keep = np.ones(len(tips) - 1, dtype=bool)
+    for i in range(len(tips) - 1):
+        if at[i] and at[i + 1]:
+            keep[i] = not any((k, j + d) in at[i + 1] for k, j in at[i] for d in (-1, 0, 1))
+    return keep
 
 
 def join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
