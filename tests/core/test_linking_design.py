@@ -20,8 +20,8 @@ TOP, ROUGH = 10.0, 0.5
 
 
 def bosses():
-    """Two round bosses 10 mm high with sides as steep as the mesh can make them (one 0.25 mm triangle: 88 deg) on a floor at 0: the loops of a level go
-    from one to the other, and each level's first loop is entered beside the wall it finishes."""
+    """Two round bosses 10 mm high on a floor at 0, their sides as steep as the mesh makes them (a 0.25 mm
+    triangle: 88 deg): the boss's top within the tool's reach at every loop."""
     def z(x, y):
         r = np.minimum(np.hypot(x - 12, y - 15), np.hypot(x - 38, y - 15))
         return TOP * np.clip((8.0 - r) / 0.01, 0.0, 1.0)
@@ -45,6 +45,8 @@ def test_waterline_entries_come_down_to_the_loop_above_not_the_walls_top() -> No
     params = WaterlineParams(boundary=(0.0, 0.0, 50.0, 30.0), step_down=1.0, bottom_z=1.0, top_z=TOP,
                              chord_tol=0.01)
     segments = waterline.compute(mesh, D4, params).segments
+    for seg in segments:   # each loop entered (the loops below one another are joined by straight moves)
+        seg.joined = False
     found = []
     for know in (False, True):
         policy = LinkPolicy(15.0, 20.0, material_top=StockHeights(grid, left, D4), low_links=True)

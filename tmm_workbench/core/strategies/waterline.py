@@ -5,8 +5,9 @@ one closed pass at its height; the linker (core.linking, VERTICAL) makes the too
     path = link(result.segments, LinkPolicy(safe_height=40, clearance_height=45))
 
 Levels run top-down from `top_z` - `step_down` (default top: the model's highest point) to `bottom_z` (the
-last level exactly there; default: the model's lowest point), within the stock (`stock_z`). Within a level the
-loops are cut nearest-first, each closed loop starting at its point nearest to where the tool is; a loop that
+last level exactly there; default: the model's lowest point), within the stock (`stock_z`). The loops are cut
+nearest-first, each closed loop starting at its point nearest to where the tool is, a loop only after those of the
+level above within a tool diameter of it (region_order: down one wall at a time); a loop that
 starts within a tool radius below where the previous one ended is reached with the tool down when that move
 clears the model. Where the blocked region runs past the
 boundary, the loop's points on the boundary split it: those pieces are not cut, the rest are open passes.
@@ -21,7 +22,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, fields
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -156,23 +157,16 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                                chord_tol=_LOOP_CHORD * params.chord_tol, progress=progress)
     found = [_clear_of_chords(level, b, _GROWTH * params.chord_tol) for level in found]
     segments: list[CutSegment] = []
-    where: Optional[np.ndarray] = None
-    loops = points = 0
-    for k, (z, level) in enumerate(zip(zs, found)):
-        pieces = [p for loop in level for p in _pieces(loop, params.direction == CLIMB)]
-        loops += len(level)
-        while pieces:
-            j, start = _nearest(pieces, where)
-            xy, closed = pieces.pop(j)
-            if closed:
-                xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
-            tips = np.column_stack([xy, np.full(len(xy), z)])
-            # The linker enters each segment from above onto its first tip (gouge-free, since every loop
-            # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
-            extra = {"closed": closed} if _HAS_CLOSED else {}
-            segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
-            points += len(tips)
-            where = xy[-1]
+    points = 0
+    found_pieces = [[p for loop in level for p in _pieces(loop, params.direction == CLIMB)] for level in found]
+    loops = sum(len(level) for level in found)
+    for k, xy, closed in region_order(found_pieces, zs, 2.0 * cutter.radius):
+        tips = np.column_stack([xy, np.full(len(xy), zs[k])])
+        # The linker enters each segment from above onto its first tip (gouge-free, since every loop
+        # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
+        extra = {"closed": closed} if _HAS_CLOSED else {}
+        segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
+        points += len(tips)
     joined = join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     if not segments and params.empty_ok:
         return StrategyResult([], {"levels": len(zs), "loops": loops, "points": 0, "joined": 0, "top": zs[0]})
@@ -311,14 +305,61 @@ def _pieces(loop: wl.WaterlineLoop, climb: bool) -> list[tuple[np.ndarray, bool]
     return [(xy[r], False) for r in runs if len(r) >= 2]
 
 
-def _nearest(pieces: list[tuple[np.ndarray, bool]], where: Optional[np.ndarray]) -> tuple[int, int]:
-    """(piece, start point) nearest to `where`: any point of a closed loop, the first of an open piece."""
-    if where is None:
-        return 0, 0
-    best = (math.inf, 0, 0)
-    for j, (xy, closed) in enumerate(pieces):
-        d = np.hypot(*(xy - where).T) if closed else np.array([math.hypot(*(xy[0] - where))])
-        i = int(np.argmin(d))
-        if d[i] < best[0]:
-            best = (float(d[i]), j, i)
-    return best[1], best[2]
+def region_order(levels: list[list[tuple[np.ndarray, bool]]], zs: list[float],
+                 near: float) -> list[tuple[int, np.ndarray, bool]]:
+    """The pieces of all levels (per level: (xy, closed)) in cutting order, (level, xy, closed), a closed loop
+    rotated to start at its point nearest to where the tool is (its first point repeated at its end): nearest
+    first (core.strategies.rest_order.cost: a rise counts more than a descent), a piece only after each piece of
+    the level above that comes within `near` of it (the loop above on its wall). So the tool goes down one wall
+    or pocket level after level rather than across the model at every level (ktoolcav: 80 moves of 110 mm
+    between its two sides), and no loop is cut under the stock its wall still carries above it."""
+    from scipy.spatial import cKDTree
+
+    from tmm_workbench.core.strategies.rest_order import cost
+
+    ids = [(k, i) for k, level in enumerate(levels) for i in range(len(level))]
+    waiting = {key: 0 for key in ids}
+    children: dict[tuple[int, int], list[tuple[int, int]]] = {key: [] for key in ids}
+    for k in range(1, len(levels)):
+        above, here = levels[k - 1], levels[k]
+        if not above or not here:
+            continue
+        boxes = [(xy.min(axis=0) - near, xy.max(axis=0) + near) for xy, _ in above]
+        trees: dict[int, Any] = {}
+        for i, (xy, _) in enumerate(here):
+            lo, hi = xy.min(axis=0), xy.max(axis=0)
+            for j, (blo, bhi) in enumerate(boxes):
+                if np.any(lo > bhi) or np.any(hi < blo):
+                    continue
+                if j not in trees:
+                    trees[j] = cKDTree(above[j][0])
+                if np.isfinite(trees[j].query(xy, distance_upper_bound=near)[0]).any():
+                    children[(k - 1, j)].append((k, i))
+                    waiting[(k, i)] += 1
+    ready = [key for key in ids if waiting[key] == 0]
+    out: list[tuple[int, np.ndarray, bool]] = []
+    where: Optional[np.ndarray] = None
+    while ready:
+        best = (math.inf, 0, 0)
+        for r, (k, i) in enumerate(ready):
+            xy, closed = levels[k][i]
+            if where is None:
+                best = (0.0, r, 0)
+                break
+            heads = xy if closed else xy[:1]
+            c = cost(where, np.column_stack([heads, np.full(len(heads), zs[k])]))
+            m = int(np.argmin(c))
+            if c[m] < best[0]:
+                best = (float(c[m]), r, m)
+        _, r, start = best
+        k, i = ready.pop(r)
+        xy, closed = levels[k][i]
+        if closed:
+            xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])
+        out.append((k, xy, closed))
+        where = np.array([xy[-1, 0], xy[-1, 1], zs[k]])
+        for child in children[(k, i)]:
+            waiting[child] -= 1
+            if waiting[child] == 0:
+                ready.append(child)
+    return out
