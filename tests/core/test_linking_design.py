@@ -84,8 +84,13 @@ def test_moves_repeating_an_earlier_lifted_piece_are_left_out_and_the_rest_enter
     end_lower[-1, 2] -= 0.4                                                      # its last tip at its level
     tail = CutSegment(end_lower)
     lower = CutSegment(lifted.tips - [0.0, 0.0, 0.01])                          # cuts 10 um deeper: new
-    out, count = waterline.without_repeats([lifted, other, again, after, tail, lower])
-    assert count == 2
+    flat = CutSegment(np.column_stack([x, np.full_like(x, 2.0), np.full_like(x, 3.0)]))   # lifted whole
+    flat_again = CutSegment(flat.tips.copy())
+    level = CutSegment(np.column_stack([x, np.full_like(x, 2.0), np.full_like(x, 1.0)]))  # at its level
+    out, count = waterline.without_repeats([lifted, other, again, after, tail, lower, flat, flat_again, level,
+                                            CutSegment(level.tips.copy())], [1.0])
+    assert count == 3
     assert out[:3] == [lifted, other, after] and not after.joined
     assert np.array_equal(out[3].tips, end_lower[-2:]) and not out[3].joined    # only its last move, entered
-    assert out[4] is lower and len(out) == 5
+    # a piece at its level is never a repeat (every level's loops are cut once; only the guard's lifts repeat)
+    assert out[4] is lower and out[5] is flat and out[6] is level and len(out) == 8

@@ -185,16 +185,18 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
         # the rest leaves short pieces of loops: the next one reached with the tool down where a join is clear
         segments, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments, surface)
     segments = holder_guard.apply(mesh, params, segments, step, surface, diagnostics)
-    segments, diagnostics["repeats"] = without_repeats(segments)
+    segments, diagnostics["repeats"] = without_repeats(segments, zs)
     return StrategyResult(segments, diagnostics)
 
 
-def without_repeats(segments: list[CutSegment], tol: float = REPEAT_MM) -> tuple[list[CutSegment], int]:
+def without_repeats(segments: list[CutSegment], zs: list[float],
+                    tol: float = REPEAT_MM) -> tuple[list[CutSegment], int]:
     """`segments` without the moves that repeat an earlier piece's: on a vertical wall the holder guard lifts the
     loops of every level below where the holder would meet the stock to the same heights, and the same lifted
     piece was entered and cut again at each of them, cutting nothing (ktoolcav: 536 of the waterline's 792
     entries, each fed 26 mm down). A move repeats one when both its ends lie within `tol` (XY) of two
-    consecutive tips of one earlier lifted piece (tips not all at one height), neither more than `tol` lower;
+    consecutive tips of one earlier lifted piece (a tip above its level `zs[pass_index]`: wheel_in_box's corners
+    lifted whole to one height, 117 times), neither more than `tol` lower;
     a piece keeps the runs of its other moves (each entered; a segment joined to a left-out end entered too).
     The pieces left whole or in part, and the count of pieces changed."""
     seen: dict[tuple[int, int], list[tuple[int, int, float]]] = {}
@@ -202,7 +204,7 @@ def without_repeats(segments: list[CutSegment], tol: float = REPEAT_MM) -> tuple
     changed, entered = 0, False
     for k, seg in enumerate(segments):
         tips = seg.tips
-        lifted = len(tips) > 1 and float(np.ptp(tips[:, 2])) > tol
+        lifted = len(tips) > 1 and float(tips[:, 2].max()) > zs[seg.pass_index] + tol
         keep = _new_moves(seen, tips, tol) if lifted and seen else np.ones(max(len(tips) - 1, 1), dtype=bool)
         if lifted:
             for i, (x, y, z) in enumerate(tips.tolist()):
