@@ -1,5 +1,6 @@
 """The linker's design (core.linking.know_design): a waterline's loops on a wall entered from just above what
-stands off the design, not from the wall's top; and the waterline's repeated pieces left out."""
+stands off the design, not from the wall's top; the waterline's repeated pieces left out; a raster's pieces in the
+rest's order."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,7 +11,8 @@ from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.sim.stock import mesh_heights
-from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.strategies import raster_drop, waterline
+from tmm_workbench.core.strategies.surface.params import ONEWAY, SurfaceParams
 from tmm_workbench.core.strategies.waterline import WaterlineParams
 from tmm_workbench.core.toolpath import MoveKind
 from tmm_workbench.core.tools.cutter import Cutter
@@ -94,3 +96,24 @@ def test_moves_repeating_an_earlier_lifted_piece_are_left_out_and_the_rest_enter
     assert np.array_equal(out[3].tips, end_lower[-2:]) and not out[3].joined    # only its last move, entered
     # a piece at its level is never a repeat (every level's loops are cut once; only the guard's lifts repeat)
     assert out[4] is lower and out[5] is flat and out[6] is level and len(out) == 8
+
+
+def gaps(segments: list[CutSegment]) -> float:
+    return float(sum(np.hypot(*(b.tips[0, :2] - a.tips[-1, :2])) for a, b in zip(segments, segments[1:])))
+
+
+def test_a_zigzag_rasters_pieces_are_cut_region_by_region() -> None:
+    """Two regions 40 mm apart, pass by pass: the tool crossed between them at every pass; in the rest's order
+    (nearest-first, nearer end, 2-opt) it crosses about once. The same pieces; a one-way raster keeps its order."""
+    pieces = []
+    for j in range(10):
+        for x0 in (0.0, 50.0):
+            xs = [x0, x0 + 10.0][:: 1 if j % 2 == 0 else -1]
+            pieces.append(CutSegment(np.array([[xs[0], j * 0.5, 1.0], [xs[1], j * 0.5, 1.0]])))
+    params = SurfaceParams(boundary=(0.0, 0.0, 60.0, 5.0), stepover=0.5)
+    out = raster_drop.pieces_ordered(params, list(pieces))
+    assert gaps(out) < 0.25 * gaps(pieces)
+    key = lambda seg: tuple(sorted(map(tuple, seg.tips.tolist())))   # noqa: E731
+    assert sorted(map(key, out)) == sorted(map(key, pieces))
+    oneway = SurfaceParams(boundary=(0.0, 0.0, 60.0, 5.0), stepover=0.5, pattern=ONEWAY)
+    assert raster_drop.pieces_ordered(oneway, list(pieces)) == pieces
