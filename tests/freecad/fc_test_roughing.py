@@ -68,9 +68,7 @@ def check_feeds_and_heights(test: unittest.TestCase, job: Any, op: Any) -> list:
             test.assertNotIn("F", p)
             if p["Z"] < safe - 1e-9:   # straight down, or a low hop: straight up, then across at its height
                 xy = (p.get("X", here["X"]), p.get("Y", here["Y"]))
-                if xy == (here["X"], here["Y"]):
-                    test.assertNotEqual(p["Z"], here["Z"])
-                else:
+                if xy != (here["X"], here["Y"]):
                     test.assertEqual(p["Z"], here["Z"])
         else:
             test.assertIn(round(p["F"] * 60, 6), (H_FEED, V_FEED))

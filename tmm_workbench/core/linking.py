@@ -76,6 +76,9 @@ class LinkPolicy:
     # 3-axis with a material top: hop from one segment to the next just above the material between them (a rapid
     # at entry_clearance over the highest of it along the way) when that is below the safe height
     low_links: bool = False
+    # low links with a tool assembly: whether the hop's straight move ((2, 3): its two ends at its height) keeps the
+    # shank and holder clear of the model (beyond the tool's reach a wall may rise above them; None: not checked)
+    hop_clear: Optional[Callable[[np.ndarray], bool]] = None
 
     def validate(self) -> None:
         check(Spec("safe height", "mm"), self.safe_height)
@@ -238,8 +241,8 @@ def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float, start: float 
     the highest material top along the straight line, sampled a tenth of the tool's reach apart (the top is the
     tool dropped on the material, so the samples' footprints overlap), and over the entry's `start` (a start the
     holder guard lifted above the material: crossing lower and rising there drove the shank into a wall beside
-    it); None when the policy keeps links at the safe height, the top is not known, or the hop would not be
-    lower."""
+    it); None when the policy keeps links at the safe height, the top is not known, the hop would not be
+    lower, or its straight move would bring the shank or holder too near the model (`hop_clear`)."""
     top = policy.material_top
     if not policy.low_links or top is None:
         return None
@@ -248,7 +251,11 @@ def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float, start: float 
     n = max(2, int(math.ceil(math.hypot(x - last.x, y - last.y) / step)) + 1)
     xy = np.column_stack([np.linspace(last.x, x, n), np.linspace(last.y, y, n)])
     hop = max(float(np.max(top(xy))), last.z, start) + max(policy.entry_clearance, 1.0)
-    return hop if math.isfinite(hop) and hop < policy.safe_height else None
+    if not (math.isfinite(hop) and hop < policy.safe_height):
+        return None
+    if policy.hop_clear is not None and not policy.hop_clear(np.array([[last.x, last.y, hop], [x, y, hop]])):
+        return None   # the shank or holder would meet a wall beside the way: up to the safe height
+    return hop
 
 
 def heights_top(grid: Any, heights: np.ndarray, radius: float,
