@@ -186,6 +186,13 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
         segments, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments, surface)
     segments = holder_guard.apply(mesh, params, segments, step, surface, diagnostics)
     segments, diagnostics["repeats"] = without_repeats(segments, zs)
+    if params.assembly is not None:   # a move down to the loop below: the shank and holder clear of the walls too
+        clear = rest_joins.bodies_clear(mesh, params.assembly, surface)
+        for prev, seg in zip(segments, segments[1:]):
+            if (seg.joined and prev.kind is seg.kind is SegmentKind.PASS
+                    and not clear(np.vstack([prev.tips[-1], seg.tips[0]]))):
+                seg.joined = False
+                diagnostics["joined"] -= 1
     return StrategyResult(segments, diagnostics)
 
 
