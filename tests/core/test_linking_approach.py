@@ -154,3 +154,27 @@ def test_a_low_link_crosses_above_an_entry_lifted_over_the_material():
     up, across = tp.moves[end + 1], tp.moves[end + 2]
     assert (up.x, up.y) == (15.0, 18.0) and (across.x, across.y) == (25.0, 22.0)
     assert up.z == across.z >= 12.0 + 1.0 - 1e-9
+
+
+def test_a_low_link_the_shank_would_not_clear_goes_up_to_the_safe_height():
+    """The same passes, with a hop check (LinkPolicy.hop_clear: a shank or holder beside a wall) that refuses
+    the hop over the rib only: that link lifts to the safe height, the other stays low."""
+    grid = Grid.covering(0, 0, 40, 40, 0.25)
+    stock = box_heights(grid, 10.0)
+    X, Y = np.meshgrid(grid.xs(), grid.ys())
+    stock[np.abs(Y - 20.0) < 8.0] = 4.0
+    tool = Cutter.ball(4)
+    segs = [CutSegment(line(3.0, 5.0, 15.0, 18.0)), CutSegment(line(3.0, 25.0, 35.0, 22.0)),
+            CutSegment(line(3.0, 35.0, 25.0, 20.0))]
+    asked = []
+
+    def clear(path: np.ndarray) -> bool:
+        asked.append(path.copy())
+        return not (path[0, 0] < 20.0 < path[1, 0])          # the move across x = 20
+    policy = LinkPolicy(30.0, 35.0, material_top=StockHeights(grid, stock, tool), low_links=True, hop_clear=clear)
+    tp = link(segs, policy)
+    assert len(asked) == 2 and all(p.shape == (2, 3) and p[0, 2] == p[1, 2] for p in asked)
+    end = next(i for i, m in enumerate(tp.moves) if (m.x, m.y, m.z) == (15.0, 18.0, 3.0))
+    assert tp.moves[end + 1].z == 30.0                       # up to the safe height over x = 20
+    second = next(i for i, m in enumerate(tp.moves) if (m.x, m.y, m.z) == (35.0, 22.0, 3.0))
+    assert tp.moves[second + 1].z < 9.0                      # the other hop stays low

@@ -9,7 +9,7 @@ import numpy as np
 from tests.conftest import grid_mesh
 from tests.core.test_rest_steep import TOL, WALL_X, wall_mesh
 from tmm_workbench.core.footprint.rest import RestStock
-from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
+from tmm_workbench.core.linking import LinkPolicy, StockHeights, know_op_design, link
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.sim.grid import Grid
@@ -102,7 +102,7 @@ def test_a_rest_entry_beside_a_wall_is_fed_from_above_what_stands_off_the_design
     for know in (False, True):
         policy = LinkPolicy(10.0, 12.0, material_top=StockHeights(grid, left, D3), low_links=True)
         if know:
-            rest_joins.know_design(mesh, params, policy)
+            know_op_design(policy, mesh, params)
         tp = link(segments, policy)
         sim = simulate(tp, D3, grid, left)
         assert len(sim.collisions) == 0 and np.nanmin(sim.heights - design) > -0.005

@@ -43,7 +43,7 @@ def test_levels_run_top_down_to_the_bottom_exactly():
         levels(1.0, 2.0, 0.5)
 
 
-def test_passes_are_closed_at_their_levels_top_down_and_nearest_first():
+def test_passes_are_closed_at_their_levels_below_the_loops_above_and_nearest_first():
     mesh = bumps()
     p = WaterlineParams(boundary=(-5, -5, 45, 35), step_down=1.0, bottom_z=0.5, chord_tol=0.005)
     result = compute(mesh, Cutter.ball(4), p)
@@ -53,7 +53,13 @@ def test_passes_are_closed_at_their_levels_top_down_and_nearest_first():
     assert d["levels"] == len(zs) and d["points"] == sum(len(s) for s in result.segments)
     assert d["top"] == pytest.approx(zs[0]) and d["loops"] >= len(zs)
     seen = [float(s.tips[0, 2]) for s in result.segments]
-    assert seen == sorted(seen, reverse=True) and set(seen) == set(zs)
+    assert set(seen) == set(zs)
+    # a loop only after every loop of the level above within a tool diameter of it (region_order)
+    for k, seg in enumerate(result.segments):
+        for above in result.segments[k + 1:]:
+            if above.pass_index == seg.pass_index - 1:
+                gap = np.hypot(*(seg.tips[:, None, :2] - above.tips[None, :, :2]).T).min()
+                assert gap > 4.0
     counts = {z: seen.count(z) for z in zs}
     assert max(counts.values()) == 2 and counts[zs[-1]] == 1   # two islands high up, one round both below
     surface = DropSurface(mesh)

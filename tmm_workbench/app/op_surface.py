@@ -27,7 +27,7 @@ from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import LinkPolicy
 from tmm_workbench.core.stage import Field, Stage
-from tmm_workbench.core.strategies import finish_passes, raster_drop
+from tmm_workbench.core.strategies import finish_passes, raster_drop, rest_joins
 from tmm_workbench.core.strategies.surface import forward_step, pattern, positioning
 from tmm_workbench.core.strategies.surface.estimate import tool_fit
 from tmm_workbench.core.strategies.surface.params import OFFSET3D, SAMPLED, SurfaceParams
@@ -115,10 +115,13 @@ class ObjectTmmSurface(op_mesh.MeshOp):
         finish = surface_passes.finish_params(obj)
         check_final_depth(obj, finish.final_depth)
         # entries rapid to just above what the Job's earlier ops left and feed from there
+        # and between pieces hop just over the material along the way, not up to the safe height
         policy = LinkPolicy(obj.SafeHeight.Value, obj.ClearanceHeight.Value, material_top=left,
-                            low_links=rest is not None)   # a rest's many short pieces: hop over, not up
+                            low_links=left is not None)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
+        if policy.low_links and params.assembly is not None:   # its hops too, of walls beside them
+            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly)
         with self.reporting(obj) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy,
                                                              progress.phase(cb, 0.0, progress.KERNEL_SHARE))

@@ -9,7 +9,8 @@ Levels: a step-down below the model's top, then `StepDown` apart down to its low
 there), or the same from TopZ down to BottomZ (UseZRange), within the Job's stock: a bottom below the stock's
 bottom is refused. Heights: FreeCAD's SafeHeight and ClearanceHeight (their SetupSheet defaults put them above
 the stock top); each loop is entered by a rapid down to 1 mm above what the earlier ops and the loops above left
-(`app.simulation.material_left`), then fed. The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight.
+standing off the design (`app.simulation.material_left`, core.linking.know_design), then fed; between loops the
+tool hops 1 mm over the material along the way where that is below the safe height. The step-down is refused when it is deeper than the ToolBit's CuttingEdgeHeight.
 Feeds from the tool controller as the Surface op's (op_surface.commands). Errors never leave a partial path.
 """
 from __future__ import annotations
@@ -21,8 +22,8 @@ from tmm_workbench.app.compat import PathSetupSheet
 from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
 from tmm_workbench.core.errors import TmmError
-from tmm_workbench.core.linking import VERTICAL, LinkPolicy, link
-from tmm_workbench.core.strategies import waterline
+from tmm_workbench.core.linking import VERTICAL, LinkPolicy, know_op_design, link
+from tmm_workbench.core.strategies import rest_joins, waterline
 from tmm_workbench.core.strategies.waterline import WaterlineParams
 
 OP_NAME = "TMM_Waterline"
@@ -100,7 +101,12 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         rest = rest_source.rest_of_op(obj, simulation.job_of(obj), mesh, cutter, policy.material_top,
                                       extra["boundary"])
         params.rest = None if rest is None else rest.stock
-        policy.low_links = rest is not None
+        # between loops the tool hops just above the material along the way, not up to the safe height; each loop
+        # is entered by a rapid to just above what stands off the design (the loops above cut the wall down to it)
+        policy.low_links = policy.material_top is not None
+        if policy.low_links and params.assembly is not None:   # and the shank and holder clear of walls beside them
+            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly)
+        know_op_design(policy, mesh, params)
         with self.reporting(obj) as cb:
             result = waterline.compute(mesh, cutter, params, progress.phase(cb, 0.0, progress.KERNEL_SHARE))
             top = result.diagnostics.get("top")

@@ -76,6 +76,9 @@ class LinkPolicy:
     # 3-axis with a material top: hop from one segment to the next just above the material between them (a rapid
     # at entry_clearance over the highest of it along the way) when that is below the safe height
     low_links: bool = False
+    # low links with a tool assembly: whether the hop's straight move ((2, 3): its two ends at its height) keeps the
+    # shank and holder clear of the model (beyond the tool's reach a wall may rise above them; None: not checked)
+    hop_clear: Optional[Callable[[np.ndarray], bool]] = None
 
     def validate(self) -> None:
         check(Spec("safe height", "mm"), self.safe_height)
@@ -238,8 +241,8 @@ def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float, start: float 
     the highest material top along the straight line, sampled a tenth of the tool's reach apart (the top is the
     tool dropped on the material, so the samples' footprints overlap), and over the entry's `start` (a start the
     holder guard lifted above the material: crossing lower and rising there drove the shank into a wall beside
-    it); None when the policy keeps links at the safe height, the top is not known, or the hop would not be
-    lower."""
+    it); None when the policy keeps links at the safe height, the top is not known, the hop would not be
+    lower, or its straight move would bring the shank or holder too near the model (`hop_clear`)."""
     top = policy.material_top
     if not policy.low_links or top is None:
         return None
@@ -248,7 +251,11 @@ def _hop_height(policy: LinkPolicy, last: Any, x: float, y: float, start: float 
     n = max(2, int(math.ceil(math.hypot(x - last.x, y - last.y) / step)) + 1)
     xy = np.column_stack([np.linspace(last.x, x, n), np.linspace(last.y, y, n)])
     hop = max(float(np.max(top(xy))), last.z, start) + max(policy.entry_clearance, 1.0)
-    return hop if math.isfinite(hop) and hop < policy.safe_height else None
+    if not (math.isfinite(hop) and hop < policy.safe_height):
+        return None
+    if policy.hop_clear is not None and not policy.hop_clear(np.array([[last.x, last.y, hop], [x, y, hop]])):
+        return None   # the shank or holder would meet a wall beside the way: up to the safe height
+    return hop
 
 
 def heights_top(grid: Any, heights: np.ndarray, radius: float,
@@ -368,6 +375,41 @@ class StockHeights:
         self.heights[j0:j1, i0:i1] = simulate(path, self.cutter, sub, self.heights[j0:j1, i0:i1]).heights
         if self._excess is not None:
             self._update_excess(slice(j0, j1), slice(i0, i1))
+
+
+def know_design(policy: LinkPolicy, mesh: Any, within: float, stock_to_leave: float = 0.0,
+                known: Optional[tuple[Any, np.ndarray]] = None) -> bool:
+    """Gives the policy's StockHeights the design (StockHeights.know_design), so that plunges onto tips (drops onto
+    the model) rapid down to just above what stands off it: at a wall's foot, and on a waterline's wall under the
+    loops above, the highest stock within the tool's reach is the wall's top, and the plunge was fed from there
+    (ktoolcav's waterline: 22 mm at the plunge feed per loop). `known`: the design already on a grid (grid,
+    heights; a rest's), used when it is the stock's grid, else the mesh's heights on the stock's grid. Material
+    within `within` of the design (either way) counts as the design: at most the stock to leave and what the op's
+    own cuts leave on it (its chord tolerance), which the tool coming down onto its tip clears. Not with a negative
+    stock to leave (a tip then lies below the model) nor without a StockHeights; whether it was given."""
+    top = policy.material_top
+    if not isinstance(top, StockHeights) or stock_to_leave < 0:
+        return False
+    g = top.grid
+    if known is not None and known[1] is not None:
+        k = known[0]
+        if (k.x0, k.y0, k.cell, k.nx, k.ny) == (g.x0, g.y0, g.cell, g.nx, g.ny):
+            top.know_design(known[1], within)
+            return True
+    from tmm_workbench.core.sim.stock import mesh_heights   # imported when used, as the simulation in cut
+
+    top.know_design(mesh_heights(mesh, g), within)
+    return True
+
+
+def know_op_design(policy: LinkPolicy, mesh: Any, params: Any) -> bool:
+    """know_design for an op's strategy parameters: a rest's design and rest tolerance (params.rest), else the
+    mesh's heights within the stock to leave and the op's chord tolerance."""
+    s = float(getattr(params, "stock_to_leave", 0.0))
+    rest = getattr(params, "rest", None)
+    if rest is not None and getattr(rest, "design", None) is not None:
+        return know_design(policy, mesh, rest.within, s, (rest.grid, rest.design))
+    return know_design(policy, mesh, max(s, 0.0) + float(getattr(params, "chord_tol", 0.0)), s)
 
 
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:

@@ -18,11 +18,11 @@ import numpy as np
 from tmm_workbench.core.arcs import Arc
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.limits import check_work
-from tmm_workbench.core.linking import LinkPolicy, link
+from tmm_workbench.core.linking import LinkPolicy, know_op_design, link
 from tmm_workbench.core.params import Spec, StrategyParams, check_finite, param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import CutSegment, StrategyResult
-from tmm_workbench.core.strategies import raster_drop, rest_joins
+from tmm_workbench.core.strategies import raster_drop
 from tmm_workbench.core.strategies.raster_drop import STEPOVER, SurfaceParams
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.toolpath import Toolpath
@@ -127,7 +127,7 @@ def compute_finish_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParams
     params.validate()
     finish.validate()
     policy.validate()
-    rest_joins.know_design(mesh, params, policy)   # a rest's entries fed only through what stands off the design
+    know_op_design(policy, mesh, params)   # plunges fed only through what stands off the design
     if finish.passes == 1 and finish.final_depth is None and finish.start_xy is None:
         return raster_drop.compute_surface_toolpath(mesh, cutter, params, policy, progress, surface)  # as before
     estimate_work(params, finish)

@@ -27,7 +27,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, link
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.segments import StrategyResult
-from tmm_workbench.core.strategies import holder_guard, rest_filter, rest_steep
+from tmm_workbench.core.strategies import holder_guard, rest_filter, rest_order, rest_steep
 from tmm_workbench.core.strategies.surface.params import (  # noqa: F401 - the Surface's names, used from here
     _BYTES_PER_POINT, ADAPTIVE, CUSP, INWARD, OFF_MODEL_FLOOR, OFF_MODEL_SKIP, OFFSET3D, ONEWAY, OUTWARD, SAMPLED,
     SPIRAL, STEPOVER, TOLERANCE, ZIGZAG, SurfaceParams, raster_points)
@@ -122,4 +122,15 @@ def compute_surface_toolpath(mesh: TriMesh, cutter: Cutter, params: SurfaceParam
     if policy.safe_height <= top:
         raise TmmError(f"safe height {policy.safe_height:g} mm is not above the highest tool position "
                        f"{top:.4g} mm")
-    return link(result.segments, policy)
+    return link(pieces_ordered(params, result.segments), policy)
+
+
+def pieces_ordered(params: SurfaceParams, segments: list) -> list:
+    """A zig-zag raster broken into pieces (a region's, a slope range's, the model's outline with off-model skip)
+    in the rest's order (core.strategies.rest_order: nearest-first, each piece entered at its nearer end, 2-opt):
+    pass by pass the tool crossed the steep parts between the pieces at every pass, lifted to the safe height
+    (wheel_in_box's shallow raster: 1,434 entries, 58 m of rapids). A rest orders its own (rest_steep); offset
+    passes (OFFSET3D) and one-way or spiral patterns keep theirs."""
+    if params.pattern != ZIGZAG or params.stepover_mode == OFFSET3D or getattr(params, "rest", None) is not None:
+        return segments
+    return rest_order.ordered(segments, {id(seg) for seg in segments})

@@ -18,12 +18,11 @@ piece as before.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, Callable, Optional
 
 import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
-from tmm_workbench.core.linking import LinkPolicy, StockHeights
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.segments import CutSegment, SegmentKind
 from tmm_workbench.core.strategies.surface.segments import reduce_chords
@@ -34,6 +33,8 @@ JOIN_DIAMETERS = 2.0   # the longest join (XY and rise; its length lifted onto t
 JOIN_MM = 4.0          # and at least this long: the hop and its plunge of the clearance (1 mm at a third of the feed,
 #                        the rapids) do not shrink with the tool (a D1's 2 mm left the sign's clean-up 600 entries)
 SAMPLE_MM = 0.05       # the join's samples along the line (linear_moves' step)
+HOP_SAMPLE_MM = 0.25   # a low hop's, for the shank and holder only (each wider than a millimetre: a wall they meet
+#                        stands under several samples)
 CHORD_MM = 0.002       # a thinned join passes at most this far above its samples
 DEEPEST_MM = 1e-3      # a join whose moves come this far below the model's drop between samples is not made
 REFINE_ROUNDS = 8      # halvings of a move between samples where the midpoint's drop stands above it
@@ -116,31 +117,21 @@ def _clear_of_model(path: np.ndarray, surface: DropSurface, grown: Cutter, s: fl
     return deepest_cut(surface, grown, moves, np.ones(len(moves), dtype=bool), SAMPLE_MM / 2)[0] <= DEEPEST_MM
 
 
-def _clear_of_bodies(bodies: Any, path: np.ndarray) -> bool:
+def _clear_of_bodies(bodies: Any, path: np.ndarray, step: float = SAMPLE_MM) -> bool:
     """Whether the neck, shank and holder (an AssemblyDrop) keep their clearance along the join's samples."""
     from tmm_workbench.core.strategies.holder_guard import BODIES, TOLERANCE_MM
     from tmm_workbench.core.strategies.segment_split import move_samples
 
-    pts, _ = move_samples(CutSegment(path), SAMPLE_MM)
+    pts, _ = move_samples(CutSegment(path), step)
     zb, owner = bodies.heights_of(BODIES, pts[:, :2])
     return not bool(np.any((zb - pts[:, 2] > TOLERANCE_MM) & (owner >= 0)))
 
 
-def know_design(mesh: TriMesh, params: Any, policy: LinkPolicy) -> None:
-    """A rest's entries rapid down to just above what stands off the design (StockHeights.above_design), not above
-    the highest stock within the tool's reach: at the walls' feet, where a rest's pieces start, that is the wall's
-    top, and the plunge was fed from there (the sign's clean-up: 3.7 mm a plunge, 6.9 of its 27 min). Only with the
-    rest's design (its grid's, or the mesh's heights on the stock's grid) and no negative stock to leave (a tip
-    then lies below the model)."""
-    rest, top = getattr(params, "rest", None), policy.material_top
-    if (rest is None or rest.design is None or not isinstance(top, StockHeights)
-            or float(getattr(params, "stock_to_leave", 0.0)) < 0):
-        return
-    g, h = rest.grid, top.grid
-    if (g.x0, g.y0, g.cell, g.nx, g.ny) == (h.x0, h.y0, h.cell, h.nx, h.ny):
-        design = rest.design
-    else:
-        from tmm_workbench.core.sim.stock import mesh_heights
+def bodies_clear(mesh: TriMesh, assembly: Any, surface: Optional[DropSurface] = None) -> Callable[[np.ndarray], bool]:
+    """Whether a straight move ((k, 3) tips, sampled HOP_SAMPLE_MM apart) keeps the neck, shank and holder of
+    `assembly` their clearance from `mesh` (the holder guard's): the linker's check of its low hops
+    (LinkPolicy.hop_clear)."""
+    from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 
-        design = mesh_heights(mesh, h)
-    top.know_design(design, rest.within)
+    bodies = AssemblyDrop(mesh, assembly, surface or DropSurface(mesh))
+    return lambda path: _clear_of_bodies(bodies, np.asarray(path, dtype=float), HOP_SAMPLE_MM)

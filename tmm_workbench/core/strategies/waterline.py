@@ -5,8 +5,9 @@ one closed pass at its height; the linker (core.linking, VERTICAL) makes the too
     path = link(result.segments, LinkPolicy(safe_height=40, clearance_height=45))
 
 Levels run top-down from `top_z` - `step_down` (default top: the model's highest point) to `bottom_z` (the
-last level exactly there; default: the model's lowest point), within the stock (`stock_z`). Within a level the
-loops are cut nearest-first, each closed loop starting at its point nearest to where the tool is; a loop that
+last level exactly there; default: the model's lowest point), within the stock (`stock_z`). The loops are cut
+nearest-first, each closed loop starting at its point nearest to where the tool is, a loop only after those of the
+level above within a tool diameter of it (region_order: down one wall at a time); a loop that
 starts within a tool radius below where the previous one ended is reached with the tool down when that move
 clears the model. Where the blocked region runs past the
 boundary, the loop's points on the boundary split it: those pieces are not cut, the rest are open passes.
@@ -18,9 +19,10 @@ clockwise and a pocket loop counter-clockwise; with "conventional" the other way
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, fields
-from typing import Optional
+from typing import Any, Optional
 
 import numpy as np
 
@@ -42,6 +44,8 @@ from tmm_workbench.core.work import Box, Work
 SUPPORTED_TOOLS = ("ball", "flat", "bull", "general")  # Cutter.kind values: any APT cutter drops
 CLIMB, CONVENTIONAL = "climb", "conventional"
 _LEVEL_EPS_MM = 1e-9  # a level this close above the bottom is the bottom
+REPEAT_MM = 1e-3      # a move within this of an earlier lifted piece's, no lower, repeats it (what it cuts more
+#                       is within the loops' chord tolerance)
 # The chord tolerance is shared: the kernel's loops within 0.4 of it of the exact loop (inside it, on convex
 # stretches), then grown by 0.5 of it (core.polygons, mitred): no move inside the exact loop, none more than 0.9
 # of the tolerance outside it (a sharp convex corner's mitre a little more).
@@ -133,7 +137,7 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
             surface: Optional[DropSurface] = None) -> StrategyResult:
     """Gouge-free waterline finishing of `mesh` with `cutter` (tip positions; Z up) as cut segments, levels
     top-down. diagnostics: "levels" (count), "loops", "points", "joined" (pieces reached with the tool down
-    from the previous one), "top" (highest tip)."""
+    from the previous one), "top" (highest tip), "repeats" (pieces left out: the same as one cut before)."""
     params.validate()
     if cutter.kind not in SUPPORTED_TOOLS:
         raise TmmError(f"the {cutter.describe()} cutter is not supported by waterline finishing")
@@ -153,23 +157,16 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
                                chord_tol=_LOOP_CHORD * params.chord_tol, progress=progress)
     found = [_clear_of_chords(level, b, _GROWTH * params.chord_tol) for level in found]
     segments: list[CutSegment] = []
-    where: Optional[np.ndarray] = None
-    loops = points = 0
-    for k, (z, level) in enumerate(zip(zs, found)):
-        pieces = [p for loop in level for p in _pieces(loop, params.direction == CLIMB)]
-        loops += len(level)
-        while pieces:
-            j, start = _nearest(pieces, where)
-            xy, closed = pieces.pop(j)
-            if closed:
-                xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])  # first point repeated at the end
-            tips = np.column_stack([xy, np.full(len(xy), z)])
-            # The linker enters each segment from above onto its first tip (gouge-free, since every loop
-            # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
-            extra = {"closed": closed} if _HAS_CLOSED else {}
-            segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
-            points += len(tips)
-            where = xy[-1]
+    points = 0
+    found_pieces = [[p for loop in level for p in _pieces(loop, params.direction == CLIMB)] for level in found]
+    loops = sum(len(level) for level in found)
+    for k, xy, closed in region_order(found_pieces, zs, 2.0 * cutter.radius):
+        tips = np.column_stack([xy, np.full(len(xy), zs[k])])
+        # The linker enters each segment from above onto its first tip (gouge-free, since every loop
+        # point is free: its drop height is at most z), unless join_levels reaches it with the tool down.
+        extra = {"closed": closed} if _HAS_CLOSED else {}
+        segments.append(CutSegment(tips, SegmentKind.PASS, joined=False, pass_index=k, **extra))
+        points += len(tips)
     joined = join_levels(segments, surface, cutter.offset(s), s, cutter.radius)
     if not segments and params.empty_ok:
         return StrategyResult([], {"levels": len(zs), "loops": loops, "points": 0, "joined": 0, "top": zs[0]})
@@ -187,7 +184,73 @@ def compute(mesh: TriMesh, cutter: Cutter, params: WaterlineParams, progress: Op
     if getattr(params, "rest", None) is not None and params.join_rest:
         # the rest leaves short pieces of loops: the next one reached with the tool down where a join is clear
         segments, diagnostics["joins"] = rest_joins.join_pieces(mesh, cutter, params, segments, surface)
-    return StrategyResult(holder_guard.apply(mesh, params, segments, step, surface, diagnostics), diagnostics)
+    segments = holder_guard.apply(mesh, params, segments, step, surface, diagnostics)
+    segments, diagnostics["repeats"] = without_repeats(segments, zs)
+    if params.assembly is not None:   # a move down to the loop below: the shank and holder clear of the walls too
+        clear = rest_joins.bodies_clear(mesh, params.assembly, surface)
+        for prev, seg in zip(segments, segments[1:]):
+            if (seg.joined and prev.kind is seg.kind is SegmentKind.PASS
+                    and not clear(np.vstack([prev.tips[-1], seg.tips[0]]))):
+                seg.joined = False
+                diagnostics["joined"] -= 1
+    return StrategyResult(segments, diagnostics)
+
+
+def without_repeats(segments: list[CutSegment], zs: list[float],
+                    tol: float = REPEAT_MM) -> tuple[list[CutSegment], int]:
+    """`segments` without the moves that repeat an earlier piece's: on a vertical wall the holder guard lifts the
+    loops of every level below where the holder would meet the stock to the same heights, and the same lifted
+    piece was entered and cut again at each of them, cutting nothing (ktoolcav: 536 of the waterline's 792
+    entries, each fed 26 mm down). A move repeats one when both its ends lie within `tol` (XY) of two
+    consecutive tips of one earlier lifted piece (a tip above its level `zs[pass_index]`: wheel_in_box's corners
+    lifted whole to one height, 117 times), neither more than `tol` lower;
+    a piece keeps the runs of its other moves (each entered; a segment joined to a left-out end entered too).
+    The pieces left whole or in part, and the count of pieces changed."""
+    seen: dict[tuple[int, int], list[tuple[int, int, float]]] = {}
+    out: list[CutSegment] = []
+    changed, entered = 0, False
+    for k, seg in enumerate(segments):
+        tips = seg.tips
+        lifted = len(tips) > 1 and float(tips[:, 2].max()) > zs[seg.pass_index] + tol
+        keep = _new_moves(seen, tips, tol) if lifted and seen else np.ones(max(len(tips) - 1, 1), dtype=bool)
+        if lifted:
+            for i, (x, y, z) in enumerate(tips.tolist()):
+                seen.setdefault((round(x / tol), round(y / tol)), []).append((k, i, z))
+        if keep.all():
+            if entered and seg.joined:
+                seg.joined = False
+            out.append(seg)
+            entered = False
+            continue
+        changed += 1
+        runs = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(np.int8), [0]])))
+        for a, b in zip(runs[::2], runs[1::2]):    # moves a..b-1: tips a..b
+            part = dataclasses.replace(seg, tips=tips[a:b + 1].copy(), closed=False, entry_z=None,
+                                       helix_centre=None, joined=seg.joined and a == 0 and not entered,
+                                       arcs=None if seg.arcs is None else seg.arcs[a:b + 1])
+            out.append(part)
+        entered = not keep[-1]
+    return out, changed
+
+
+def _new_moves(seen: dict, tips: np.ndarray, tol: float) -> np.ndarray:
+    """Which of the moves between `tips` repeat no earlier lifted piece's (see without_repeats)."""
+    def matches(p: list) -> set:
+        x, y, z = p
+        ix, iy = round(x / tol), round(y / tol)
+        found = set()
+        for dx in (-1, 0, 1):
+            for dy in (-1, 0, 1):
+                for k, i, z0 in seen.get((ix + dx, iy + dy), ()):
+                    if z >= z0 - tol:
+                        found.add((k, i))
+        return found
+    at = [matches(p) for p in tips.tolist()]
+    keep = np.ones(len(tips) - 1, dtype=bool)
+    for i in range(len(tips) - 1):
+        if at[i] and at[i + 1]:
+            keep[i] = not any((k, j + d) in at[i + 1] for k, j in at[i] for d in (-1, 0, 1))
+    return keep
 
 
 def join_levels(segments: list[CutSegment], surface: DropSurface, grown: Cutter, s: float, radius: float) -> int:
@@ -251,14 +314,61 @@ def _pieces(loop: wl.WaterlineLoop, climb: bool) -> list[tuple[np.ndarray, bool]
     return [(xy[r], False) for r in runs if len(r) >= 2]
 
 
-def _nearest(pieces: list[tuple[np.ndarray, bool]], where: Optional[np.ndarray]) -> tuple[int, int]:
-    """(piece, start point) nearest to `where`: any point of a closed loop, the first of an open piece."""
-    if where is None:
-        return 0, 0
-    best = (math.inf, 0, 0)
-    for j, (xy, closed) in enumerate(pieces):
-        d = np.hypot(*(xy - where).T) if closed else np.array([math.hypot(*(xy[0] - where))])
-        i = int(np.argmin(d))
-        if d[i] < best[0]:
-            best = (float(d[i]), j, i)
-    return best[1], best[2]
+def region_order(levels: list[list[tuple[np.ndarray, bool]]], zs: list[float],
+                 near: float) -> list[tuple[int, np.ndarray, bool]]:
+    """The pieces of all levels (per level: (xy, closed)) in cutting order, (level, xy, closed), a closed loop
+    rotated to start at its point nearest to where the tool is (its first point repeated at its end): nearest
+    first (core.strategies.rest_order.cost: a rise counts more than a descent), a piece only after each piece of
+    the level above that comes within `near` of it (the loop above on its wall). So the tool goes down one wall
+    or pocket level after level rather than across the model at every level (ktoolcav: 80 moves of 110 mm
+    between its two sides), and no loop is cut under the stock its wall still carries above it."""
+    from scipy.spatial import cKDTree
+
+    from tmm_workbench.core.strategies.rest_order import cost
+
+    ids = [(k, i) for k, level in enumerate(levels) for i in range(len(level))]
+    waiting = {key: 0 for key in ids}
+    children: dict[tuple[int, int], list[tuple[int, int]]] = {key: [] for key in ids}
+    for k in range(1, len(levels)):
+        above, here = levels[k - 1], levels[k]
+        if not above or not here:
+            continue
+        boxes = [(xy.min(axis=0) - near, xy.max(axis=0) + near) for xy, _ in above]
+        trees: dict[int, Any] = {}
+        for i, (xy, _) in enumerate(here):
+            lo, hi = xy.min(axis=0), xy.max(axis=0)
+            for j, (blo, bhi) in enumerate(boxes):
+                if np.any(lo > bhi) or np.any(hi < blo):
+                    continue
+                if j not in trees:
+                    trees[j] = cKDTree(above[j][0])
+                if np.isfinite(trees[j].query(xy, distance_upper_bound=near)[0]).any():
+                    children[(k - 1, j)].append((k, i))
+                    waiting[(k, i)] += 1
+    ready = [key for key in ids if waiting[key] == 0]
+    out: list[tuple[int, np.ndarray, bool]] = []
+    where: Optional[np.ndarray] = None
+    while ready:
+        best = (math.inf, 0, 0)
+        for r, (k, i) in enumerate(ready):
+            xy, closed = levels[k][i]
+            if where is None:
+                best = (0.0, r, 0)
+                break
+            heads = xy if closed else xy[:1]
+            c = cost(where, np.column_stack([heads, np.full(len(heads), zs[k])]))
+            m = int(np.argmin(c))
+            if c[m] < best[0]:
+                best = (float(c[m]), r, m)
+        _, r, start = best
+        k, i = ready.pop(r)
+        xy, closed = levels[k][i]
+        if closed:
+            xy = np.vstack([xy[start:], xy[:start], xy[start:start + 1]])
+        out.append((k, xy, closed))
+        where = np.array([xy[-1, 0], xy[-1, 1], zs[k]])
+        for child in children[(k, i)]:
+            waiting[child] -= 1
+            if waiting[child] == 0:
+                ready.append(child)
+    return out
