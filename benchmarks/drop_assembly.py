@@ -4,6 +4,8 @@
     .venv/bin/python benchmarks/drop_assembly.py --quick      # coarser rasters
     .venv/bin/python benchmarks/drop_assembly.py --threads 0  # all cores, wall-clock time
     .venv/bin/python benchmarks/drop_assembly.py --tilted     # only the tilted axis (3+2), a few seconds
+    .venv/bin/python benchmarks/drop_assembly.py --tilted --repeats 1 --save before.npz   # then, with a new build:
+    .venv/bin/python benchmarks/drop_assembly.py --tilted --repeats 1 --compare before.npz
 
 Per case: the same raster of CL points dropped with native.drop_cutter (the cutter alone) and with
 native.drop_assembly (cutter, shank and holder), the median of a few runs each; their ratio (the target: at most
@@ -72,9 +74,10 @@ def rotation(axis, angle: float) -> np.ndarray:
     return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
 
 
-def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock, tilted_only=False) -> list[str]:
+def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock, tilted_only=False,
+                   arrays=None) -> list[str]:
     """Cutter alone against the assembly along a direction 20 deg off -Z, the axis against it and tilted (or
-    the tilted axis alone)."""
+    the tilted axis alone). `arrays` (or None): each drop's travels and owners stored under the row's label."""
     direction = rotation([1.0, 0.3, 0.0], np.radians(20)) @ np.array([0.0, 0.0, -1.0])
     index = native.DirectionalIndex(v, f, direction)
     starts = np.column_stack([xy, np.full(len(xy), float(v[:, 2].max()) + 10.0)])
@@ -90,6 +93,8 @@ def direction_rows(name, v, f, cutter, bodies, xy, repeats, threads, clock, tilt
         lifted = by >= 0
         assert np.all(a <= c + 1e-9), "the assembly travels further than its cutter"
         short = f"{name.split(', ')[0]}, {name.split(', ')[-1]}, {label}"
+        if arrays is not None:
+            arrays.update({f"{short} cutter": c, f"{short} travel": a, f"{short} owner": by})
         rows.append(f"{short:62s} {len(f):7d} {len(xy):8d} {t0:9.3f} {t1:10.3f} {t1 / t0:6.2f} "
                     f"{lifted.mean():7.1%} {np.max(np.where(np.isfinite(c), c - a, 0.0)):8.2f}")
     return rows
@@ -126,7 +131,10 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=1, help="0: all cores (then wall-clock time)")
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--tilted", action="store_true", help="only the drop along a direction with the axis tilted")
+    ap.add_argument("--save", metavar="NPZ", help="store the drops along the direction (travels, owners)")
+    ap.add_argument("--compare", metavar="NPZ", help="check them array for array against a --save of another build")
     args = ap.parse_args()
+    arrays = {} if args.save or args.compare else None
     clock = time.process_time if args.threads == 1 else time.perf_counter
     head = f"{'case':62s} {'tri':>7s} {'points':>8s} {'cutter s':>9s} {'assembly s':>10s} {'ratio':>6s} " \
            f"{'lifted':>7s} {'max lift':>8s}"
@@ -138,7 +146,7 @@ def main() -> None:
         lo, hi = v.min(axis=0), v.max(axis=0)
         if args.tilted:
             along += direction_rows(name, v, f, cutter, bodies, raster(lo[:2], hi[:2], 4 * step), args.repeats,
-                                    args.threads, clock, tilted_only=True)
+                                    args.threads, clock, tilted_only=True, arrays=arrays)
             continue
         index = native.MeshIndex(v, f)
         xy = raster(lo[:2], hi[:2], step)
@@ -151,12 +159,28 @@ def main() -> None:
         print(f"{name:62s} {len(f):7d} {len(xy):8d} {t0:9.3f} {t1:10.3f} {t1 / t0:6.2f} "
               f"{lifted.mean():7.1%} {np.max(z1 - z0):8.2f}", flush=True)
         along += direction_rows(name, v, f, cutter, bodies, raster(lo[:2], hi[:2], 4 * step),
-                                max(3, args.repeats // 2), args.threads, clock)
+                                max(3, args.repeats // 2), args.threads, clock, arrays=arrays)
     print("\nalong a direction 20 deg off -Z (travel; 'max lift' = how much earlier the assembly stops)")
     print(head)
     print("-" * len(head))
     for row in along:
         print(row)
+    if args.save:
+        np.savez(args.save, **arrays)
+    if args.compare:
+        compare(arrays, args.compare)
+
+
+def compare(arrays: dict, path: str) -> None:
+    """Exits with an error naming every array that differs from (or is missing in) the saved file."""
+    saved = np.load(path)
+    differ = [k for k in arrays if k not in saved or not np.array_equal(saved[k], arrays[k])]
+    for k in differ:
+        n = "missing" if k not in saved else f"{int(np.sum(saved[k] != arrays[k]))} of {arrays[k].size} differ"
+        print(f"differs from {path}: {k} ({n})")
+    if differ:
+        sys.exit(1)
+    print(f"all {len(arrays)} arrays identical to {path}")
 
 
 if __name__ == "__main__":

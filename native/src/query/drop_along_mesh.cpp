@@ -205,7 +205,8 @@ inline bool AlongCutter::beyond(const Search& q, const IndexedTriangle& t) {
          q.tangent.dot(Vector3d(t.p[2])) >= q.level;
 }
 
-inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i, Vector3d* plane) const {
+inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i, Vector3d* plane,
+                                  bool certify) const {
   // Most candidates are not touched before the best contact so far: a plane under K that has the whole
   // triangle below it proves it in a few products; else the plane that cleared the triangle from a nearby
   // start (one support point), else a separating plane found by the clearance certificate, at a fraction of
@@ -220,7 +221,7 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     if (t0 >= q.best) return;
     const double low = t0 - 1e-9 * (1 + std::fabs(t0));
     if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
-    if (direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
+    if (certify && direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
   Vector3d n;
   const double tr = direction_detail::triangle_travel(cutter_, q0, q1, q2, W_, q.best, t.owned_edges, &n);
@@ -276,8 +277,10 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   Search q = search(start, max_travel);
   if (tangent) q.tangent = tangent->head<3>(), q.level = (*tangent)[3];  // proves no contact before a later travel
   const auto& tris = index_->index().triangles();
+  // The last start's winner comes close again: its clearance certificate would nearly always fail before the
+  // exact contact (the holder's on sphere_on_plate: at 1,728 of 1,738 starts), so it is solved at once.
   if (hint && *hint >= 0 && *hint != known && static_cast<std::size_t>(*hint) < tris.size())
-    consider(q, tris[*hint], *hint);
+    consider(q, tris[*hint], *hint, nullptr, false);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
   const Plane& kp = cands.key_plane;

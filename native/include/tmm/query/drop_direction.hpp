@@ -204,8 +204,10 @@ class AlongCutter {
   static bool beyond(const Search& q, const IndexedTriangle& t);
   // q's tangent plane from K's outward normal n (tool frame) at its best contact.
   void set_tangent(Search& q, const Eigen::Vector3d& n) const;
-  // plane (or null): a candidate's last separating normal, tried first and updated.
-  void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr) const;
+  // plane (or null): a candidate's last separating normal, tried first and updated. certify: false for a
+  // triangle likely to touch (the clearance certificate would only fail before the exact contact).
+  void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr,
+                bool certify = true) const;
   // Over a gather's starts (g's offsets, filled for t's fine azimuth here): true when t lies below one of K's
   // planes at every start; else `best` gets the two planes nearest to that.
   bool below_everywhere(const IndexedTriangle& t, Candidates& g, Candidate& best) const;
