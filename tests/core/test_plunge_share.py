@@ -24,8 +24,9 @@ def test_sphere_cavity_roughed_then_waterlined():
 
 
 def test_random_field_roughed_then_waterlined():
-    # short loops round many bumps: each entry still feeds the clearance and the step (13 % measured)
-    check(ps.roughed_then_waterlined("random field", ps.random_field(30.0, 60)), 0.15)
+    # short loops round many bumps: each entry still feeds the clearance and the step (16 % measured: the loops
+    # taken wall by wall, nearest first, enter 46 times where the level-by-level order entered 40 (14 %))
+    check(ps.roughed_then_waterlined("random field", ps.random_field(30.0, 60)), 0.17)
 
 
 def test_adaptive_with_verify_cusp():
