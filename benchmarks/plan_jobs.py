@@ -72,6 +72,9 @@ def decisions(paths: list[Path]) -> None:
 def main() -> None:
     from tmm_workbench.core.plan.job_file import read_job
 
+    if sys.argv[1:2] in (["--help"], ["-h"]):   # (a job path that is not there is refused by name below)
+        print(__doc__)
+        return
     make_sign_model()
     if sys.argv[1:2] == ["--decisions"]:
         decisions(jobs(sys.argv[2:]))

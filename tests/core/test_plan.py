@@ -15,6 +15,7 @@ import pytest
 import yaml
 
 from tests.conftest import SHARED_STL, grid_mesh
+from tmm_workbench.core.footprint import reach
 from tmm_workbench.core.plan import analysis, decide, launch, materials
 from tmm_workbench.core.plan.job_file import PlanInputError, job_from_dict, read_job
 from tmm_workbench.core.tools.cutter import Cutter
@@ -186,15 +187,15 @@ def test_reach_excess_reads_a_step_beside_a_cell_as_the_flat_side() -> None:
     envelope[:, 6] = 0.042
     envelope[:, 7] = 0.2
     envelope[:, 8:] = 5.0
-    excess = analysis.reach_excess(envelope, design, cell, 0.5)
+    excess = reach.reach_excess(envelope, design, cell, 0.5)
     assert excess[2, 7] > 0.1               # out of reach (the central difference read the step's slope: reached)
     assert excess[2, 3] <= 0.0              # on the floor it plunges to
     # a smooth 75 deg flank the envelope stands 0.03 mm above vertically: 0.03 cos 75 along the normal, as before
     ramp = np.tile(np.arange(12) * cell * math.tan(math.radians(75.0)), (5, 1))
-    flank = analysis.reach_excess(ramp + 0.03, ramp, cell, 0.5)
+    flank = reach.reach_excess(ramp + 0.03, ramp, cell, 0.5)
     assert flank[2, 5] == pytest.approx(0.03 * math.cos(math.radians(75.0)) -
                                         cell ** 2 / (8 * 0.5 * math.cos(math.radians(75.0)) ** 2), rel=1e-6)
-    assert np.allclose(analysis.gentle_cosine(ramp, cell)[:, 1:-1], math.cos(math.radians(75.0)))
+    assert np.allclose(reach.gentle_cosine(ramp, cell)[:, 1:-1], math.cos(math.radians(75.0)))
 
 
 def plan_of(tmp_path: Path, data: dict):

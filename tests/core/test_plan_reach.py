@@ -1,4 +1,4 @@
-"""The planner's reach tests between the grid's positions (core.plan.analysis.nearest_reach, profile_distance) and
+"""The planner's reach tests between the grid's positions (core.footprint.reach.nearest_reach, profile_distance) and
 beyond the model's box (reach_envelope: an open sheet's rim), and the left check that uses them."""
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ import pytest
 
 from tests.conftest import grid_mesh
 from tmm_workbench.core.footprint.rest import tool_envelope
+from tmm_workbench.core.footprint import reach
 from tmm_workbench.core.plan import analysis
 from tmm_workbench.core.plan.left_check import left_in_reach
 from tmm_workbench.core.query.drop import DropSurface
@@ -30,11 +31,11 @@ def test_profile_distance_of_ball_bull_and_flat() -> None:
     below = np.array([[0.0, 0.0, -0.2]])
     beside = np.array([[3.0, 0.0, 5.0]])     # beside the flutes, above the corner
     for cutter in (Cutter.ball(2.0), Cutter.bull(4.0, 0.5), Cutter.flat(4.0)):
-        assert analysis.profile_distance(cutter, below, xy, tip)[0] == pytest.approx(0.2)
-        assert analysis.profile_distance(cutter, beside, xy, tip)[0] == pytest.approx(3.0 - cutter.radius)
+        assert reach.profile_distance(cutter, below, xy, tip)[0] == pytest.approx(0.2)
+        assert reach.profile_distance(cutter, beside, xy, tip)[0] == pytest.approx(3.0 - cutter.radius)
     # a point level with the ball's centre, 0.3 mm out: 0.3 mm from the sphere; below a bull's corner, from its torus
-    assert analysis.profile_distance(Cutter.ball(2.0), np.array([[1.3, 0.0, 1.0]]), xy, tip)[0] == pytest.approx(0.3)
-    corner = analysis.profile_distance(Cutter.bull(4.0, 0.5), np.array([[2.0, 0.0, 0.0]]), xy, tip)[0]
+    assert reach.profile_distance(Cutter.ball(2.0), np.array([[1.3, 0.0, 1.0]]), xy, tip)[0] == pytest.approx(0.3)
+    corner = reach.profile_distance(Cutter.bull(4.0, 0.5), np.array([[2.0, 0.0, 0.0]]), xy, tip)[0]
     assert corner == pytest.approx(math.hypot(0.5, 0.5) - 0.5)
 
 
@@ -54,11 +55,11 @@ def test_nearest_reach_tells_a_steep_wall_the_grid_cannot() -> None:
     on_wall = np.flatnonzero((xs > 10.1) & (xs < 10.0 + 5.5 / STEEP))
     cos = math.cos(math.radians(80.0))
     assert np.max((envelope - design)[row, on_wall]) * cos > 0.01        # the grid's envelope: not within it
-    near = analysis.nearest_reach(mesh, ball, grid, design, np.column_stack([np.full(len(on_wall), row), on_wall]),
+    near = reach.nearest_reach(mesh, ball, grid, design, np.column_stack([np.full(len(on_wall), row), on_wall]),
                                   surface)
     assert np.all(near < 0.003)
     foot = int(np.argmin(np.abs(xs - 9.9)))      # 0.1 mm off the foot: 0.094 mm under the fillet the ball leaves
-    floor = analysis.nearest_reach(mesh, ball, grid, design, np.array([[row, foot], [row, 5]]), surface)
+    floor = reach.nearest_reach(mesh, ball, grid, design, np.array([[row, foot], [row, 5]]), surface)
     assert floor[0] == pytest.approx(math.hypot(0.5 / math.tan(math.radians(50.0)) - 0.1, 0.5) - 0.5, abs=0.003)
     assert floor[1] < 1e-6                      # mid-floor: the tip touches it
 

@@ -9,6 +9,7 @@ import numpy as np
 from tests.conftest import grid_mesh
 from tests.core.rest_case import after_d10
 from tests.core.test_rest_steep import D3, TOL, WALL_X, wall_mesh
+from tmm_workbench.core.footprint.reach import gentle_cosine
 from tmm_workbench.core import polygons
 from tmm_workbench.core.footprint import rest
 from tmm_workbench.core.footprint.rest import RestStock
@@ -40,7 +41,7 @@ def test_the_foot_of_a_wall_the_passes_and_loops_leave_is_touched_up_within_the_
     def left_over(result) -> np.ndarray:
         after = simulate(link(result.segments, policy), D3, grid, left).heights
         assert np.nanmin(after - design) > -0.005
-        return np.where(reach, after - design, np.nan)
+        return np.where(reach, (after - design) * gentle_cosine(design, grid.cell), np.nan)   # along the normal
 
     touched = raster_drop.compute(mesh, D3, params)
     assert touched.diagnostics["touch_ups"] > 0
@@ -51,7 +52,7 @@ def test_the_foot_of_a_wall_the_passes_and_loops_leave_is_touched_up_within_the_
     monkeypatch.setattr(rest_touchup, "pieces", lambda *args, **kwargs: [])
     plain = left_over(raster_drop.compute(mesh, D3, params))
     feet = np.argwhere(plain > TOL)   # the passes and loops alone leave cells at the wall's foot
-    assert len(feet) >= 3 and np.all(np.abs(grid.xs()[feet[:, 1]] - WALL_X) < D3.radius)
+    assert len(feet) >= 2 and np.all(np.abs(grid.xs()[feet[:, 1]] - WALL_X) < D3.radius)
 
 
 def flat_mesh() -> TriMesh:

@@ -13,6 +13,7 @@ from typing import Optional
 
 import numpy as np
 
+from tmm_workbench.core.footprint.reach import reach_excess
 from tmm_workbench.core.footprint.rest import tool_envelope
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
@@ -28,10 +29,6 @@ FLAT_DEG = 1.0           # a face sloping less is a flat (a floor, a plateau)
 STEEP_DEG = 60.0         # a face sloping more is a wall for the report's count
 FAR_MM = 1.0             # a tool staying this far above the design leaves it to the next (a roughing tool's reach)
 SPECK_SHARE = 0.001      # unreached area below this share of the design's is the grid's noise
-STEEPEST_DEG = 80.0      # the grid's own cusp is judged at most at this slope (on a wall it grows without bound)
-FIRST_SAMPLES = 7        # nearest_reach: the first round's drops per side over the tool's width,
-REFINE = 6               # then 5 x 5 rounds: a D1's positions 0.003 mm apart at the end (0.016 mm on an 80 deg wall)
-NEAREST_BATCH = 4096     # cells searched at once (49 drops each in the first round: the memory stays small)
 
 
 @dataclass
@@ -168,92 +165,6 @@ def whole_tool_tips(mesh: TriMesh, assembly: ToolAssembly, grid: Grid, surface: 
     return z.reshape(grid.ny, grid.nx)
 
 
-def reach_excess(envelope: np.ndarray, design: np.ndarray, cell: float, radius: float) -> np.ndarray:
-    """How far a tool's envelope (core.footprint.rest.tool_envelope, its corner `radius`) stays above the design
-    beyond what the grid itself leaves, along the envelope's normal (the vertical gap times the cosine of the
-    envelope's slope: a wall's vertical gap is many times its depth): between the grid's positions the envelope
-    on a slope a keeps cusps of cell^2 / (8 r cos^2 a) along its normal. A cell is out of the tool's reach where
-    this exceeds the tolerance (NaN where there is no design)."""
-    cos = np.maximum(gentle_cosine(envelope, cell), math.cos(math.radians(STEEPEST_DEG)))
-    return (envelope - design) * cos - cell * cell / (8.0 * radius * cos * cos)
-
-
-def gentle_cosine(z: np.ndarray, cell: float) -> np.ndarray:
-    """(ny, nx) cos of the slope of heights `z`, each axis' slope the gentler of its two one-sided differences (a
-    smooth slope reads as with central ones; a step beside a cell, as the side without it). A central difference
-    across a step reads the step's slope: the envelope of a D1 held up by its shank beside a letter rises 5 mm
-    one cell off a floor cell it stands 0.2 mm above (at least 0.14 mm along the normal), and that cell was
-    counted reached (pycam_textbox: 153 of the 154 mm2 left "in reach"); so was a ball's fillet at a wall's foot.
-    1 where no slope is known (no neighbour with a height)."""
-    z = np.asarray(z, dtype=float)
-    out = []
-    for axis in (0, 1):
-        if z.shape[axis] < 2:
-            out.append(np.zeros_like(z))
-            continue
-        step = np.diff(z, axis=axis) / cell
-        pad = [(0, 0), (0, 0)]
-        pad[axis] = (1, 0)
-        back = np.abs(np.pad(step, pad, constant_values=np.nan))
-        pad[axis] = (0, 1)
-        ahead = np.abs(np.pad(step, pad, constant_values=np.nan))
-        with np.errstate(invalid="ignore"):
-            out.append(np.fmin(back, ahead))
-    cos = 1.0 / np.sqrt(1.0 + out[0] ** 2 + out[1] ** 2)
-    return np.where(np.isfinite(cos), cos, 1.0)
-
-
-def nearest_reach(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray, cells: np.ndarray,
-                  surface: Optional[DropSurface] = None, assembly: Optional[ToolAssembly] = None) -> np.ndarray:
-    """(n,) mm: how near the tool (its whole `assembly` when given) comes to the design point of each of `cells`
-    ((n, 2) row, column on `grid`) when dropped anywhere within its radius of it, not only at the grid's positions:
-    on a wall of slope a these lie cell / cos a apart along it (1.15 mm on an 80 deg wall at 0.2 mm: more than a
-    D1), so the envelope of those alone cannot tell what the tool reaches there. A pattern search: FIRST_SAMPLES^2
-    drops over the tool's width, then REFINE rounds of 5 x 5 around the nearest so far, each half the last's
-    spacing; the distance is the 3D one from the point to the cutter's profile (profile_distance)."""
-    cells = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
-    surface = surface or DropSurface(mesh)
-    drop = AssemblyDrop(mesh, assembly, surface) if assembly is not None else None
-    batches = [cells[k:k + NEAREST_BATCH] for k in range(0, len(cells), NEAREST_BATCH)]
-    return np.concatenate([np.zeros(0)] + [pattern_search(mesh, cutter, grid, design, b, surface, drop)
-                                           for b in batches])
-
-
-def pattern_search(mesh: TriMesh, cutter: Cutter, grid: Grid, design: np.ndarray, cells: np.ndarray,
-                   surface: DropSurface, drop: Optional[AssemblyDrop]) -> np.ndarray:
-    """nearest_reach on one batch of cells (`drop`: the whole tool's, None for the cutter alone); the tips may go a
-    radius under the model's lowest point (reach_envelope: beyond a rim there)."""
-    floor = float(mesh.vertices[:, 2].min()) - float(cutter.native.max_radius)
-    iy, ix = cells[:, 0], cells[:, 1]
-    point = np.column_stack([grid.xs()[ix], grid.ys()[iy], design[iy, ix]])
-    centre = point[:, :2].copy()
-    best = np.full(len(cells), np.inf)
-    half, samples = float(cutter.native.max_radius), FIRST_SAMPLES
-    rows = np.arange(len(cells))
-    for _ in range(REFINE + 1):
-        u = np.linspace(-half, half, samples)
-        offsets = np.column_stack([np.repeat(u, samples), np.tile(u, samples)])
-        xy = (centre[:, None, :] + offsets[None, :, :]).reshape(-1, 2)
-        tip = surface.drop(cutter, xy, floor) if drop is None else drop.heights(xy, floor)[0]
-        gap = profile_distance(cutter, point[:, None, :], xy.reshape(len(cells), -1, 2), tip.reshape(len(cells), -1))
-        k = np.argmin(gap, axis=1)
-        better = gap[rows, k] < best
-        best = np.where(better, gap[rows, k], best)
-        centre[better] = xy.reshape(len(cells), -1, 2)[rows, k][better]
-        half, samples = 2.0 * half / (samples - 1), 5   # the next round spans the last one's spacing each side
-    return np.maximum(best, 0.0)
-
-
-def profile_distance(cutter: Cutter, point: np.ndarray, xy: np.ndarray, tip: np.ndarray) -> np.ndarray:
-    """The 3D distance from `point` (.., 3) to the cutter's surface with its tip at (`xy`, `tip`): its flat bottom,
-    its corner's torus (a ball: the sphere) or its flutes' side above the corner (negative inside the tool)."""
-    outer = cutter.radius
-    r = cutter.corner_radius
-    rho = np.linalg.norm(point[..., :2] - xy, axis=-1)
-    z = point[..., 2] - tip
-    torus = np.hypot(np.maximum(rho - (outer - r), 0.0), z - r) - r
-    side = np.where(z > r, rho - outer, torus)
-    return np.where(rho < outer - r, -z, side)   # under the flat bottom: straight down from it
 
 
 def concave_bracket(reach: dict, cutters: dict) -> tuple[float, float]:

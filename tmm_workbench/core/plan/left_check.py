@@ -3,9 +3,10 @@ wherever the smallest library tool reaches, the rest reported): the simulated de
 radiused library tool reaches from above, against the tolerance.
 
 A cell is reached when that tool's envelope (core.footprint.rest.tool_envelope: dropped at every cell) comes within
-the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge (analysis.reach_excess);
-where more than the tolerance is left it is told again by the tool dropped between the grid's positions (analysis.nearest_reach: on a steep wall the grid's
-positions lie farther apart along it than a small ball's width, and the grid's cusp allowance there is 0.3 mm).
+the tolerance of the design beyond the grid's own cusp, as the planner's reach tests judge
+(core.footprint.reach.reach_excess); where more than the tolerance is left it is told again by the tool dropped
+between the grid's positions (core.footprint.reach.nearest_reach: on a steep wall the grid's positions lie farther
+apart along it than a small ball's width, and the grid's cusp allowance there is 0.3 mm).
 The deviation is taken along the normal of the stock left (the vertical one times the cosine of its slope): the
 vertical measure of a wall's cusps is many times their depth.
 What no library tool reaches from above (sharp inner corners, undercuts) is reported as its area, not judged. Where
@@ -19,7 +20,8 @@ import numpy as np
 
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
-from tmm_workbench.core.plan.analysis import nearest_reach, reach_envelope, reach_excess
+from tmm_workbench.core.footprint.reach import nearest_reach, reach_excess
+from tmm_workbench.core.plan.analysis import reach_envelope
 from tmm_workbench.core.sim.compare import slope_cosine
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.tools.assembly import ToolAssembly
