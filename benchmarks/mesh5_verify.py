@@ -1,9 +1,10 @@
 """The 5-axis mesh finish verified over the whole area by the 5-axis stock simulation (core.sim.simulate, the
 kernel's sweep5): seed 000's convex surface at 0.004 in with a flat end mill D 0.5 in (the op's strategy,
 core.strategies.mesh5.finish, linked as the op links it), cut from a stock 0.5 mm (or 3 tau, where more) above
-the design; every cell of the grid compared with the design (the needle drop of core.sim.stock.mesh_heights): the least deviation (a
-gouge below 0) and the largest remaining height along the normal (vertical deviation x cos(slope)), inside the
-CC paths' area (cells within half the widest gap between planes of a CC point) and over the whole surface.
+the design; every cell of the grid compared with the design (the needle drop of core.sim.stock.mesh_heights):
+the least deviation (a gouge below 0) and the largest remaining height along the normal (vertical deviation x
+cos(slope)), inside the CC paths' area (cells within half the widest gap between planes of a CC point) and over
+the whole surface.
 
     .venv/bin/python benchmarks/mesh5_verify.py [--surface convex] [--cell 0.2] [--png docs/mesh5_verify.png]
         [--max-step 0.05] [--plan /tmp/plan.pkl] [--cleanup-diameter 6.35]

@@ -18,8 +18,8 @@ there). In the C-space each CC point keeps the postures that finish the widest
 strip (widest_cspace: the right side back to its bins' level, the left as far along the plane normal as the
 pass can reach at nearly all its CC points; the seed measures the half-widths at its ideal posture), and among
 them the postures are chosen for the motion time (optimal.smooth_postures); the next gap is half the width the
-pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured (a left
-side that runs off the mesh again under the pass's own tools: widths.edge_by_tools); a
+pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured (a side
+that runs off the mesh again under the pass's own tools, the slivers they leave listed: widths.edge_by_tools); a
 bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
 keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
 pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
@@ -239,12 +239,12 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance,
                                path_bending(paths))
-    # the left side run off the mesh, under the pass's own tools (the right one at the mesh's own edge is
-    # the C-space's: _on_mesh): the slivers they leave at the edge are listed for clean-up, the bins counted
-    # finished (held open, they brought the next planes back for them, whose postures turn as much: seed
-    # 000's concave surface took 85 passes for 62 and still left 318 cells above tau)
-    _, tools, short = edge_by_tools(reach, cutter, paths, cat("tips"), cat("axes"), widths, ends, tolerance, (0,))
-    return postures, widths, ends, side, paths, dropped, tools[short > 0, 0]
+    # a side run off the mesh, under the pass's own tools: the slivers they leave at the edge are listed for
+    # clean-up, the bins counted finished (held open, they brought the next planes back for them, whose
+    # postures turn as much: seed 000's concave surface took 85 passes for 62 and still left 318 cells above)
+    _, tools, short = edge_by_tools(reach, cutter, paths, cat("tips"), cat("axes"), widths, ends, tolerance)
+    cut = [np.isinf(widths[:, k]) & ~np.isnan(tools[:, k, 0]) & (short > 0) for k in (0, 1)]
+    return postures, widths, ends, side, paths, dropped, (tools[cut[0], 0], tools[cut[1], 1])
 
 
 def _runs(mask: np.ndarray) -> np.ndarray:
@@ -409,22 +409,26 @@ def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: 
     cover.level = level
 
 
-def _list_slivers(plan: AdaptivePlan, cover: Coverage, edge: np.ndarray, run: int = 4) -> None:
-    """The slivers a pass's tools left along the mesh's edge (`edge` (k, 3): where they stop, _plan_pass)
-    listed in plan.unfinished: per run of up to `run` adjacent bins, from the least of them to the bins' top."""
-    if len(edge) == 0:
-        return
-    lo = cover.bin(edge @ cover.feed - 0.5 * cover.width)
-    hi = cover.bin(edge @ cover.feed + 0.5 * cover.width)
-    across = np.full(len(cover.lo), np.inf)
-    for a, b, s in zip(lo, hi, edge @ cover.m):
-        across[a:b + 1] = np.minimum(across[a:b + 1], s)
-    bins = np.flatnonzero(np.isfinite(across))
-    for part in np.split(bins, np.flatnonzero(np.diff(bins) > 1) + 1):
-        for k in range(0, len(part), run):
-            q = part[k:k + run]
-            plan.unfinished.append((float(cover.f0 + cover.width * q[0]), float(cover.f0 + cover.width * (q[-1] + 1)),
-                                    float(across[q].min()), float(cover.hi[q].max())))
+def _list_slivers(plan: AdaptivePlan, cover: Coverage, edges: tuple[np.ndarray, np.ndarray], run: int = 4) -> None:
+    """The slivers a pass's tools left along the mesh's edge (`edges`: where they stop on the left and on the
+    right, (k, 3) each, _plan_pass) listed in plan.unfinished: per run of up to `run` adjacent bins, from
+    where they stop to the bins' top (left) or from the bins' bottom (right)."""
+    for side, edge in enumerate(edges):
+        if len(edge) == 0:
+            continue
+        sgn = 1.0 if side == 0 else -1.0
+        lo = cover.bin(edge @ cover.feed - 0.5 * cover.width)
+        hi = cover.bin(edge @ cover.feed + 0.5 * cover.width)
+        across = np.full(len(cover.lo), np.inf)
+        for a, b, s in zip(lo, hi, sgn * (edge @ cover.m)):
+            across[a:b + 1] = np.minimum(across[a:b + 1], s)
+        bins = np.flatnonzero(np.isfinite(across))
+        for part in np.split(bins, np.flatnonzero(np.diff(bins) > 1) + 1):
+            for k in range(0, len(part), run):
+                q = part[k:k + run]
+                f0, f1 = float(cover.f0 + cover.width * q[0]), float(cover.f0 + cover.width * (q[-1] + 1))
+                plan.unfinished.append((f0, f1, float(across[q].min()), float(cover.hi[q].max())) if side == 0 else
+                                       (f0, f1, float(cover.lo[q].min()), float(-across[q].min())))
 
 
 def _give_up_lagging(plan: AdaptivePlan, cover: Coverage, paths: List[CCPath], base: float, gap: float) -> bool:

@@ -296,9 +296,9 @@ def edge_by_tools(reach: MeshReach, cutter: Cutter, paths: List[CCPath], tips: n
     the flat end's bottom disc at each, cut by the CC point's section. The profile there is formed by the rim
     up to a radius along the pass, where the posture has turned (on seed 000's concave upper edge omega swings
     4 deg between CC points: the profile covered the edge, the tools stopped 0.2-0.5 mm short of it). A side
-    the tools do not cover to the edge gets the width they do (and its end point). The bull-nose's torus is not modelled: its
-    widths are returned as they are. Also (n,) how far (mm, along LY) the tools stop short of the mesh's edge
-    where they do (0 elsewhere)."""
+    the tools do not cover to the edge gets the width they do (and its end point). The bull-nose's torus is
+    not modelled: its widths are returned as they are. Also (n,) how far (mm, along LY) the tools stop short
+    of the mesh's edge where they do (0 elsewhere)."""
     pts = np.concatenate([p.points for p in paths])
     frm = np.concatenate([p.frames for p in paths])
     idx = np.flatnonzero(np.isinf(widths[:, list(sides)]).any(axis=1))
