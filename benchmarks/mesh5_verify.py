@@ -4,7 +4,8 @@ core.strategies.mesh5.finish, linked as the op links it), cut from a stock 0.5 m
 the design; every cell of the grid compared with the design (the needle drop of core.sim.stock.mesh_heights):
 the least deviation (a gouge below 0) and the largest remaining height along the normal (vertical deviation x
 cos(slope)), inside the CC paths' area (cells within half the widest gap between planes of a CC point) and over
-the whole surface.
+the whole surface; and the cells above tau + 0.002 mm outside the strips the plan lists for clean-up
+(grown by a radius).
 
     .venv/bin/python benchmarks/mesh5_verify.py [--surface convex] [--cell 0.2] [--png docs/mesh5_verify.png]
         [--max-step 0.05] [--plan /tmp/plan.pkl] [--cleanup-diameter 6.35]
@@ -141,6 +142,13 @@ def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, 
           f"{int((rim.flat[over] <= 1.0).sum())}, within 3 mm {int((rim.flat[over] <= 3.0).sum())}")
     for i in over[np.argsort(-normal.flat[over])][:12]:
         print(f"  ({X.flat[i]:.1f}, {Y.flat[i]:.1f}): {normal.flat[i]:.4f} mm, {rim.flat[i]:.1f} mm from the boundary")
+    strip = np.zeros(X.shape, dtype=bool)
+    for f0, f1, c0, c1 in info.get("unfinished", ()):                   # listed for clean-up, grown by R
+        g = cutter.radius
+        strip |= (X >= f0 - g) & (X <= f1 + g) & (Y >= min(c0, c1) - g) & (Y <= max(c0, c1) + g)
+    out = (normal > tol + 0.002) & np.isfinite(design) & ~strip
+    print(f"above tau + 0.002 mm outside the {len(info.get('unfinished', ()))} strips listed for clean-up (grown by "
+          f"R): {int(out.sum())}, of them more than 1 mm inside the boundary {int((out & (rim > 1.0)).sum())}")
     deep = inside & (rim > 1.0)
     print(f"more than 1 mm inside the boundary: {deep.sum()} cells, max scallop {normal[deep].max():.4f} mm, "
           f"above tau + 0.002 mm {int((normal[deep] > tol + 0.002).sum())}, least {dev[deep].min():.4f} mm")
