@@ -1,9 +1,11 @@
 """The 5-axis mesh finish verified over the whole area by the 5-axis stock simulation (core.sim.simulate, the
 kernel's sweep5): seed 000's convex surface at 0.004 in with a flat end mill D 0.5 in (the op's strategy,
-core.strategies.mesh5.finish, linked as the op links it), cut from a stock 0.5 mm above the design; every cell
-of the grid compared with the design (the needle drop of core.sim.stock.mesh_heights): the least deviation (a
-gouge below 0) and the largest remaining height along the normal (vertical deviation x cos(slope)), inside the
-CC paths' area (cells within half the widest gap between planes of a CC point) and over the whole surface.
+core.strategies.mesh5.finish, linked as the op links it), cut from a stock 0.5 mm (or 3 tau, where more) above
+the design; every cell of the grid compared with the design (the needle drop of core.sim.stock.mesh_heights):
+the least deviation (a gouge below 0) and the largest remaining height along the normal (vertical deviation x
+cos(slope)), inside the CC paths' area (cells within half the widest gap between planes of a CC point) and over
+the whole surface; and the cells above tau + 0.002 mm outside the strips the plan lists for clean-up
+(grown by a radius).
 
     .venv/bin/python benchmarks/mesh5_verify.py [--surface convex] [--cell 0.2] [--png docs/mesh5_verify.png]
         [--max-step 0.05] [--plan /tmp/plan.pkl] [--cleanup-diameter 6.35]
@@ -36,6 +38,12 @@ from tmm_workbench.core.strategies.multipoint import link_policy  # noqa: E402
 from tmm_workbench.core.tools.cutter import Cutter  # noqa: E402
 
 STOCK_ABOVE = 0.5   # mm of stock over the design before the finish (as after a roughing)
+
+
+def stock_above(tol: float) -> float:
+    """mm of stock over the design: STOCK_ABOVE, or 3 tau where more (the complex surface at 0.03 in: tau
+    0.762 mm; under 0.5 mm of stock no cell can read above tau, an uncut one included)."""
+    return max(STOCK_ABOVE, 3.0 * tol)
 
 
 def planned(mesh, cutter, tol: float, store: Path | None):
@@ -73,13 +81,14 @@ def main() -> None:
     segments, info, plan_s = planned(mesh, cutter, tol, a.plan)
     print(f"seed 000 {a.surface}, tau {tol:.4f} mm: {info['report']} (plan {plan_s:.1f} s)")
     lo, hi = mesh.bounds
-    top = float(hi[2]) + STOCK_ABOVE
+    above = stock_above(tol)
+    top = float(hi[2]) + above
     path = link(segments, link_policy(cutter, top + 5.0, top + 10.0, 5.0))
     grid = Grid.covering(float(lo[0]) - 1, float(lo[1]) - 1, float(hi[0]) + 1, float(hi[1]) + 1, a.cell)
     t0 = time.perf_counter()
     design = mesh_heights(mesh, grid)
     t1 = time.perf_counter()
-    stock = np.where(np.isnan(design), float(lo[2]) - 1.0, design + STOCK_ABOVE)
+    stock = np.where(np.isnan(design), float(lo[2]) - 1.0, design + above)
     sim = simulate(path, cutter, grid, stock, max_step=a.max_step)
     t2 = time.perf_counter()
     print(f"grid {grid.nx} x {grid.ny} cells of {a.cell:g} mm; design heights {t1 - t0:.1f} s, simulation "
@@ -90,7 +99,7 @@ def main() -> None:
         ball = Cutter.ball(a.cleanup_diameter)
         t0 = time.perf_counter()
         segs, note = cleanup.cleanup(mesh, cutter, path, ball, tol, strips=info.get("strip_corners", ()),
-                                     stock_above=STOCK_ABOVE)
+                                     stock_above=above)
         t1 = time.perf_counter()
         print(f"{note.summary()} ({t1 - t0:.1f} s)")
         after = simulate(link(segs, LinkPolicy(top + 5.0, top + 10.0)), ball, grid, sim.heights.copy()).heights
@@ -120,7 +129,7 @@ def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, 
         j = int(np.argmax(np.where(mask, normal, -np.inf)))
         rows.append((name, mask.sum(), d.min(), (X[mask][k], Y[mask][k]), n.max(), (X.flat[j], Y.flat[j]),
                      int((n > tol).sum()), int((n > tol + 0.002).sum()), int((d < -0.01).sum()),
-                     int((n >= STOCK_ABOVE * 0.99).sum())))
+                     int((n >= stock_above(tol) * 0.99).sum())))
     print("| area | cells | least deviation (mm, vertical) | at (x, y) | max scallop along the normal (mm) | at "
           "(x, y) | cells above tau | above tau + 0.002 | below -0.01 mm | uncut (stock left) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
@@ -133,6 +142,13 @@ def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, 
           f"{int((rim.flat[over] <= 1.0).sum())}, within 3 mm {int((rim.flat[over] <= 3.0).sum())}")
     for i in over[np.argsort(-normal.flat[over])][:12]:
         print(f"  ({X.flat[i]:.1f}, {Y.flat[i]:.1f}): {normal.flat[i]:.4f} mm, {rim.flat[i]:.1f} mm from the boundary")
+    strip = np.zeros(X.shape, dtype=bool)
+    for f0, f1, c0, c1 in info.get("unfinished", ()):                   # listed for clean-up, grown by R
+        g = cutter.radius
+        strip |= (X >= f0 - g) & (X <= f1 + g) & (Y >= min(c0, c1) - g) & (Y <= max(c0, c1) + g)
+    out = (normal > tol + 0.002) & np.isfinite(design) & ~strip
+    print(f"above tau + 0.002 mm outside the {len(info.get('unfinished', ()))} strips listed for clean-up (grown by "
+          f"R): {int(out.sum())}, of them more than 1 mm inside the boundary {int((out & (rim > 1.0)).sum())}")
     deep = inside & (rim > 1.0)
     print(f"more than 1 mm inside the boundary: {deep.sum()} cells, max scallop {normal[deep].max():.4f} mm, "
           f"above tau + 0.002 mm {int((normal[deep] > tol + 0.002).sum())}, least {dev[deep].min():.4f} mm")

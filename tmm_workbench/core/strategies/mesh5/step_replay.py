@@ -25,7 +25,8 @@ import numpy as np
 
 from tmm_workbench.core.strategies.mesh5.stepover import (AHEAD_SHARE, BACK_MORE, BACK_SHARE, EDGE, FIRST_AHEAD,
                                                           FIRST_GAP, GAP_QUANTILE, LAGGING, LEAST_GAP, MAX_TRIES,
-                                                          MOST_GAP, REPEAT, SHRINK, SKIP, WIDE_QUANTILE)
+                                                          MOST_GAP, REPEAT, SHRINK, SKIP, WIDE_QUANTILE,
+                                                          settled)
 
 Reach = Callable[[float], tuple[np.ndarray, np.ndarray]]
 
@@ -141,7 +142,7 @@ class _Replay:
             span = ~np.isnan(self.widths(offset)[0]) & opened
             base = float(self.level[span].min()) if span.any() else float(self.level[opened].min())
             nxt = min(base + gap, top)
-            if abs(nxt - offset) < 1e-3 * gap and span.any():
+            if settled(nxt, offset, gap) and span.any():
                 break
             offset = nxt
         return offset, base, span

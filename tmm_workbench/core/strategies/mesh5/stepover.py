@@ -18,7 +18,8 @@ there). In the C-space each CC point keeps the postures that finish the widest
 strip (widest_cspace: the right side back to its bins' level, the left as far along the plane normal as the
 pass can reach at nearly all its CC points; the seed measures the half-widths at its ideal posture), and among
 them the postures are chosen for the motion time (optimal.smooth_postures); the next gap is half the width the
-pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured; a
+pass finished (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}, split evenly). The real half-widths are measured (a side
+that runs off the mesh again under the pass's own tools, the slivers they leave listed: widths.edge_by_tools); a
 bin advances to the least left boundary of its CC points where their right boundaries reach its level, and
 keeps its level (for the next pass) where they do not. A plane that would come back to the last one's offset,
 pulled back by a few such bins, leaves them for clean-up instead. The passes are planned at MARGIN of the
@@ -46,7 +47,7 @@ from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_pos
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
 from tmm_workbench.core.strategies.mesh5.tool_moves import between_positions, overrun_positions
 from tmm_workbench.core.strategies.mesh5.top_bound import surface_heights
-from tmm_workbench.core.strategies.mesh5.widths import half_widths, path_bending, reach_widths
+from tmm_workbench.core.strategies.mesh5.widths import edge_by_tools, half_widths, path_bending, reach_widths
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -55,8 +56,9 @@ SHRINK = 0.8            # gap factor when a pass must be rebuilt
 MAX_TRIES = 12
 # the passes are planned for this share of the tolerance: the profile is swept straight along LX with the
 # posture of its CC point, while the path curves along the feed and the posture turns between CC points (the
-# slow check on seed 000's convex surface found up to 1.26 tau where the full tolerance was planned)
-MARGIN = 0.85
+# slow check on seed 000's convex surface found up to 1.26 tau where the full tolerance was planned; 0.85 until
+# the pass's bends were measured, widths.path_bending: at 0.9 the complex surface simulated leaves none inside)
+MARGIN = 0.9
 # points checked inside each side step by the C-space's top bound: where the section curves up between the
 # CC point and the side step, the ends alone pass postures that leave more there
 INTERIOR = 3
@@ -84,6 +86,12 @@ FIRST_GAP, FIRST_AHEAD, LEAST_GAP, MOST_GAP, SKIP = 0.25, 0.5, 0.05, 2.0, 0.5
 EDGE = 1e-3             # Coverage's edge: a bin within this many radii of its top is finished
 # the right side step the C-space asks: this share of the way back to the level its bins are finished to, and mm more
 BACK_SHARE, BACK_MORE = 1.01, 1e-3
+
+
+def settled(nxt: float, offset: float, gap: float) -> bool:
+    """Whether a plane's placement has come to rest: the offset its paths' bins ask (`nxt`) within a
+    thousandth of the gap of where it was cut (`offset`)."""
+    return abs(nxt - offset) < 1e-3 * gap
 
 
 def widest_cspace(reach: MeshReach, cutter: Cutter, tolerance: float, points: np.ndarray, frames: np.ndarray,
@@ -231,7 +239,12 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance,
                                path_bending(paths))
-    return postures, widths, ends, side, paths, dropped
+    # a side run off the mesh, under the pass's own tools: the slivers they leave at the edge are listed for
+    # clean-up, the bins counted finished (held open, they brought the next planes back for them, whose
+    # postures turn as much: seed 000's concave surface took 85 passes for 62 and still left 318 cells above)
+    _, tools, short = edge_by_tools(reach, cutter, paths, cat("tips"), cat("axes"), widths, ends, tolerance)
+    cut = [np.isinf(widths[:, k]) & ~np.isnan(tools[:, k, 0]) & (short > 0) for k in (0, 1)]
+    return postures, widths, ends, side, paths, dropped, (tools[cut[0], 0], tools[cut[1], 1])
 
 
 def _runs(mask: np.ndarray) -> np.ndarray:
@@ -327,7 +340,7 @@ class _Planes:
             span = cover.spanned(paths) & cover.open if paths else cover.open
             base = float(cover.level[span].min()) if span.any() else float(cover.level[cover.open].min())
             nxt = min(base + gap, top)
-            if abs(nxt - offset) < 1e-3 * gap and paths:
+            if settled(nxt, offset, gap) and paths:
                 break
             offset = nxt
         else:
@@ -394,6 +407,28 @@ def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: 
                                     reached))
         level = np.where(hole, np.maximum(level, reached), level)
     cover.level = level
+
+
+def _list_slivers(plan: AdaptivePlan, cover: Coverage, edges: tuple[np.ndarray, np.ndarray], run: int = 4) -> None:
+    """The slivers a pass's tools left along the mesh's edge (`edges`: where they stop on the left and on the
+    right, (k, 3) each, _plan_pass) listed in plan.unfinished: per run of up to `run` adjacent bins, from
+    where they stop to the bins' top (left) or from the bins' bottom (right)."""
+    for side, edge in enumerate(edges):
+        if len(edge) == 0:
+            continue
+        sgn = 1.0 if side == 0 else -1.0
+        lo = cover.bin(edge @ cover.feed - 0.5 * cover.width)
+        hi = cover.bin(edge @ cover.feed + 0.5 * cover.width)
+        across = np.full(len(cover.lo), np.inf)
+        for a, b, s in zip(lo, hi, sgn * (edge @ cover.m)):
+            across[a:b + 1] = np.minimum(across[a:b + 1], s)
+        bins = np.flatnonzero(np.isfinite(across))
+        for part in np.split(bins, np.flatnonzero(np.diff(bins) > 1) + 1):
+            for k in range(0, len(part), run):
+                q = part[k:k + run]
+                f0, f1 = float(cover.f0 + cover.width * q[0]), float(cover.f0 + cover.width * (q[-1] + 1))
+                plan.unfinished.append((f0, f1, float(across[q].min()), float(cover.hi[q].max())) if side == 0 else
+                                       (f0, f1, float(cover.lo[q].min()), float(-across[q].min())))
 
 
 def _give_up_lagging(plan: AdaptivePlan, cover: Coverage, paths: List[CCPath], base: float, gap: float) -> bool:
@@ -472,7 +507,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
             gap = skip
             guess = base + 2 * skip
             continue
-        postures, widths, ends, used, paths, dropped = got
+        postures, widths, ends, used, paths, dropped, edge = got
         left = np.where(np.isnan(ends[:, 0, 0]), hi, ends[:, 0] @ m)
         right = np.where(np.isnan(ends[:, 1, 0]), lo, ends[:, 1] @ m)
         runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun,
@@ -482,6 +517,7 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
                                        gap, runs))
         plan.partial += short > 0
         _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset, dropped)
+        _list_slivers(plan, cover, edge)
         # the next pass's right side step as this one's left one (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
         # the postures being the widest: half the width this pass finished (left + right along m) at most CC
         # points, so that the next one splits it evenly

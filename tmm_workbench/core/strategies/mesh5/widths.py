@@ -285,3 +285,101 @@ def reach_widths(reach: MeshReach, cutter: Cutter, points: np.ndarray, frames: n
             sgn = 1.0 if side == 0 else -1.0
             out[side, i, ps] = np.where(np.isinf(w), w, w * ly[i] + sgn * s_w * lz[i])
     return out[0], out[1]
+
+
+def edge_by_tools(reach: MeshReach, cutter: Cutter, paths: List[CCPath], tips: np.ndarray, axes: np.ndarray,
+                  widths: np.ndarray, ends: np.ndarray, tolerance: float, sides: tuple[int, ...] = (0, 1),
+                  sub: int = 8) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The `sides` (0 left, 1 right) found covered to the mesh's edge (inf in `widths` (n, 2), half_widths)
+    measured again under the pass's own tool positions (`tips`, `axes` (n, 3), all paths in order; `sub` - 1
+    between each two, tip linear, axis lerp; beyond a path's end its last tool straight along LX a radius on):
+    the flat end's bottom disc at each, cut by the CC point's section. The profile there is formed by the rim
+    up to a radius along the pass, where the posture has turned (on seed 000's concave upper edge omega swings
+    4 deg between CC points: the profile covered the edge, the tools stopped 0.2-0.5 mm short of it). A side
+    the tools do not cover to the edge gets the width they do (and its end point). The bull-nose's torus is
+    not modelled: its widths are returned as they are. Also (n,) how far (mm, along LY) the tools stop short
+    of the mesh's edge where they do (0 elsewhere)."""
+    pts = np.concatenate([p.points for p in paths])
+    frm = np.concatenate([p.frames for p in paths])
+    idx = np.flatnonzero(np.isinf(widths[:, list(sides)]).any(axis=1))
+    short = np.zeros(len(widths))
+    if idx.size == 0 or cutter.corner_radius > 0:
+        return widths, ends, short
+    widths, ends = widths.copy(), ends.copy()
+    R = cutter.radius
+    ys = np.linspace(0.0, 2.0 * R, WIDTH_SAMPLES)
+    first = np.cumsum([0] + [len(p) for p in paths])
+    along = np.concatenate([np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p.points, axis=0), axis=1))] for p in paths])
+    for i in idx:
+        q = int(np.searchsorted(first, i, side="right")) - 1
+        a, b = first[q], first[q + 1]
+        near = np.flatnonzero(np.abs(along[a:b] - along[i]) <= 1.5 * R) + a
+        lo, hi = max(int(near.min()) - 1, a), min(int(near.max()) + 1, b - 1)
+        T, A = _sub_positions(tips[lo:hi + 1], axes[lo:hi + 1], sub)
+        for k, sgn in ((a, -1.0), (b - 1, 1.0)):
+            if k in (lo, hi):                      # the path's end within reach: the tool goes on along LX
+                s = np.linspace(0.0, R, sub + 1)[1:, None]
+                T, A = np.vstack([T, tips[k] + sgn * s * frm[k, 0]]), np.vstack([A, np.repeat(axes[k][None], sub, 0)])
+        z = _disc_heights(pts[i], frm[i], T, A, R, np.concatenate([ys, -ys[1:]]))
+        S = surface_heights(reach, pts[i:i + 1], frm[i:i + 1], np.concatenate([ys, -ys[1:]])[None], 3.0 * R)[0]
+        for side, sl in ((0, slice(0, len(ys))), (1, np.r_[0, len(ys):2 * len(ys) - 1])):
+            if side not in sides or not np.isinf(widths[i, side]):
+                continue
+            d, s_d = _covered_to(ys, z[sl], S[sl], tolerance)
+            if np.isfinite(d):
+                sgn = 1.0 if side == 0 else -1.0
+                widths[i, side] = d
+                ends[i, side] = pts[i] + sgn * d * frm[i, 1] + s_d * frm[i, 2]
+                on = np.flatnonzero(~np.isnan(S[sl]))
+                short[i] = max(short[i], float(ys[on.max()]) - d if on.size else 0.0)
+    return widths, ends, short
+
+
+def _sub_positions(tips: np.ndarray, axes: np.ndarray, sub: int) -> tuple[np.ndarray, np.ndarray]:
+    """The tool positions with `sub` - 1 between each two (tip linear, axis lerp normalised)."""
+    if len(tips) < 2:
+        return tips.copy(), axes.copy()
+    t = (np.arange(sub) / sub)[None, :, None]
+    T = (tips[:-1, None] + t * (tips[1:, None] - tips[:-1, None])).reshape(-1, 3)
+    A = (axes[:-1, None] + t * (axes[1:, None] - axes[:-1, None])).reshape(-1, 3)
+    A /= np.linalg.norm(A, axis=1, keepdims=True)
+    return np.vstack([T, tips[-1:]]), np.vstack([A, axes[-1:]])
+
+
+def _disc_heights(p: np.ndarray, f: np.ndarray, tips: np.ndarray, axes: np.ndarray, radius: float,
+                  lateral: np.ndarray) -> np.ndarray:
+    """(L,) the lowest LZ, over the flat bottoms (discs of `radius` at `tips` normal to `axes`), of the
+    CC point p's section (LX = 0, LY = lateral) in its LCS `f`; inf where no disc is there."""
+    c, a = (tips - p) @ f.T, axes @ f.T
+    u = np.cross(a, np.where(np.abs(a[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    v = np.cross(a, u)
+    det = u[:, :1] * v[:, 1:2] - v[:, :1] * u[:, 1:2]                       # a's LZ share: > 0 here
+    ok = np.abs(det) > 1e-9
+    det = np.where(ok, det, 1.0)
+    rx, ry = -c[:, :1], lateral[None, :] - c[:, 1:2]
+    s = (rx * v[:, 1:2] - v[:, :1] * ry) / det
+    t = (u[:, :1] * ry - u[:, 1:2] * rx) / det
+    z = c[:, 2:] + s * u[:, 2:] + t * v[:, 2:]
+    z = np.where(ok & (s * s + t * t <= radius * radius), z, np.inf)
+    return z.min(axis=0)
+
+
+def _covered_to(ys: np.ndarray, z: np.ndarray, s: np.ndarray, tolerance: float) -> tuple[float, float]:
+    """(how far along the lateral samples `ys` the tools' heights `z` stay within `tolerance` of the section
+    `s` (inf: to the mesh's edge, the tools there beyond its last sample on it too, as _past_edge), the
+    section's height there)."""
+    h = z - s
+    over = np.flatnonzero(~(h <= tolerance))
+    if over.size == 0:
+        return (np.inf, np.nan) if np.isnan(s).any() else (float(ys[-1]), float(s[-1]))
+    k = int(over[0])
+    if k == 0:
+        return 0.0, float(s[0])
+    if np.isnan(s[k]):
+        ext = s[0] if k == 1 else 2 * s[k - 1] - s[k - 2]
+        return (np.inf, np.nan) if z[k] - ext <= tolerance else (float(ys[k - 1]), float(s[k - 1]))
+    if not np.isfinite(h[k]):
+        return float(ys[k - 1]), float(s[k - 1])
+    f = (tolerance - h[k - 1]) / (h[k] - h[k - 1])
+    return float(ys[k - 1] + f * (ys[k] - ys[k - 1])), float(s[k - 1] + f * (s[k] - s[k - 1]))
