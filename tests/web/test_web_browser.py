@@ -68,6 +68,7 @@ def _plan_on_page(driver, server) -> tuple[str, list[str]]:
         return driver.execute_script("return document.body.dataset.state || ''")
 
     _wait(ended, 120, f"the page shows no end: {shown}, error {driver.find_element(By.ID, 'error').text!r}")
+    ended()   # the status the page shows at the end (it may change between the last read of the text and the state)
     return driver.execute_script("return document.body.dataset.job"), shown
 
 
