@@ -130,8 +130,15 @@ def _clear_of_bodies(bodies: Any, path: np.ndarray, step: float = SAMPLE_MM) -> 
 def bodies_clear(mesh: TriMesh, assembly: Any, surface: Optional[DropSurface] = None) -> Callable[[np.ndarray], bool]:
     """Whether a straight move ((k, 3) tips, sampled HOP_SAMPLE_MM apart) keeps the neck, shank and holder of
     `assembly` their clearance from `mesh` (the holder guard's): the linker's check of its low hops
-    (LinkPolicy.hop_clear)."""
+    (LinkPolicy.hop_clear). The bodies' drop (and, without `surface`, the mesh's index) is built at the first
+    move asked: an op sets the check up before it computes, and most ops hop seldom or never; built there, it
+    indexed the mesh a second time outside the op's progress and cancel."""
     from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 
-    bodies = AssemblyDrop(mesh, assembly, surface or DropSurface(mesh))
-    return lambda path: _clear_of_bodies(bodies, np.asarray(path, dtype=float), HOP_SAMPLE_MM)
+    bodies: list = []
+
+    def clear(path: np.ndarray) -> bool:
+        if not bodies:
+            bodies.append(AssemblyDrop(mesh, assembly, surface or DropSurface(mesh)))
+        return _clear_of_bodies(bodies[0], np.asarray(path, dtype=float), HOP_SAMPLE_MM)
+    return clear
