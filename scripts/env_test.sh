@@ -16,7 +16,7 @@ echo "[env_test] $ENV_NAME: $(freecadcmd --version 2>/dev/null | head -1), $(pyt
 # tests; then its module in place for FreeCAD
 if command -v ccache >/dev/null; then
   export CCACHE_DIR="${CCACHE_DIR:-/var/cache/ccache}" CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-1G}" \
-    CMAKE_CXX_COMPILER_LAUNCHER=ccache
+    CMAKE_CXX_COMPILER_LAUNCHER=ccache CCACHE_BASEDIR="$PWD"  # a clone at another path hits too
 fi
 bash native/wheel_test.sh python3 --in-place
 USER_DIR="$(freecadcmd -c 'import FreeCAD; print("TMM_USER_DIR=" + FreeCAD.getUserAppDataDir())' 2>/dev/null \

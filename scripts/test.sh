@@ -28,6 +28,8 @@ CACHE="${TMM_ENV_CACHE:-/var/cache/tmm-envs}"
 if [ -z "${CCACHE_DIR:-}" ] && mkdir -p "$CACHE/ccache" 2>/dev/null && [ -w "$CACHE/ccache" ]; then
   export CCACHE_DIR="$CACHE/ccache" CCACHE_MAXSIZE="${CCACHE_MAXSIZE:-3G}"
 fi
+# paths under the checkout hashed relative to it: a clone at another path (CI's) hits the objects of this one's
+export CCACHE_BASEDIR="$PWD"
 step setup bash scripts/setup.sh
 # the side builds below (UBSan, fuzz, the wheel) through ccache too, when there is a cache (setup installed it)
 [ -n "${CCACHE_DIR:-}" ] && command -v ccache >/dev/null && export CMAKE_CXX_COMPILER_LAUNCHER=ccache
