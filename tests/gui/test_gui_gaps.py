@@ -17,7 +17,8 @@ HERE = Path(__file__).resolve().parent
 FREECAD = fc_process.find("freecad", "FreeCAD")
 XVFB_RUN = fc_process.find("xvfb-run")
 TIMEOUT_S = 300
-MAX_GAP_S = 0.5   # issue 31: the event loop runs at least every half second
+MAX_GAP_S = 0.5   # the event loop runs at least every half second (FreeCAD ahead of the other test workers:
+                  # under their load on 2 cores one gap read 0.51 s where the idle machine's longest is 0.15-0.25)
 
 
 def test_gui_gaps(tmp_path: Path) -> None:
@@ -25,7 +26,7 @@ def test_gui_gaps(tmp_path: Path) -> None:
     result = tmp_path / "gui_gaps.json"
     code, out = fc_process.run(
         [XVFB_RUN, "-a", "-s", "-screen 0 1280x1024x24", FREECAD, str(HERE / "gui_gaps.py")],
-        cwd=tmp_path, timeout=TIMEOUT_S, TMM_GUI_RESULT=str(result), QTWEBENGINE_DISABLE_SANDBOX="1",
+        cwd=tmp_path, timeout=TIMEOUT_S, ahead=True, TMM_GUI_RESULT=str(result), QTWEBENGINE_DISABLE_SANDBOX="1",
         TMM_GAPS_STL=str(SHARED_STL / "mount_rush.stl"), TMM_GAPS_STEPOVER="0.3", TMM_GAPS_SAMPLE="0.1")
     info = json.loads(result.read_text()) if result.is_file() else {}
     assert code == 0 and info.get("ok"), \
