@@ -220,6 +220,12 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
     if (t0 >= q.best) return;
     const double low = t0 - 1e-9 * (1 + std::fabs(t0));
+    // A corner inside K at the best: the triangle is met before it, no plane can separate them (the proofs
+    // below would fail, often after many steps), so it goes straight to its contact.
+    if (inside_at(q0, q.best) || inside_at(q1, q.best) || inside_at(q2, q.best) ||
+        inside_at((q0 + q1 + q2) / 3.0, q.best) || inside_at(0.5 * (q0 + q1), q.best) ||
+        inside_at(0.5 * (q1 + q2), q.best) || inside_at(0.5 * (q2 + q0), q.best))
+      certify = false, plane = nullptr;
     if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
     if (certify && direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
@@ -231,6 +237,15 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     q.floor = q.s.z() - tr + lowest_ - 1e-9;
     set_tangent(q, n);
   }
+}
+
+// Whether the point p (tool frame, the start at the origin) lies inside K moved by `travel`, clear of its
+// surface by more than rounding.
+inline bool AlongCutter::inside_at(const Vector3d& p, double travel) const {
+  const double z = p.z() - travel * W_.z(), x = p.x() - travel * W_.x(), y = p.y() - travel * W_.y();
+  const double rho2 = x * x + y * y, rmax = cutter_.max_radius(), eps = 1e-6;
+  if (!(z > eps && z < cutter_.cutting_length() - eps && rho2 < (rmax - eps) * (rmax - eps))) return false;
+  return cutter_.height(std::sqrt(rho2)) < z - eps;
 }
 
 void AlongCutter::set_tangent(Search& q, const Vector3d& n) const {
