@@ -308,6 +308,11 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   auto cleared = [&](const Candidate& c) {
     return under(c.h[0], c.gx[0], c.gy[0]) || under(c.h[1], c.gx[1], c.gy[1]);
   };
+  // A plane of support set by the hint just now, at the best: K at travel t lies below level + (t - best) n.W
+  // along it, so a triangle's corners nearest that plane bound its travel (tight about the contact, where the
+  // next winner lies).
+  const bool local = q.winner >= 0 && q.level < kInfinity;
+  const double nw = -q.tangent.z();  // n.W, the motion along -Z in the index frame
   auto& open = cands.open;  // the candidates left, by their bound
   open.clear();
   for (const Candidates::Run& run : cands.runs) {
@@ -320,9 +325,18 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
       const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
       if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
-      if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
+      double nearest = -kInfinity;  // the corners' lowest level along the local plane
+      if (local) {
+        const IndexedTriangle& t = tris[c.tri];
+        nearest = std::min({q.tangent.dot(Vector3d(t.p[0])), q.tangent.dot(Vector3d(t.p[1])),
+                            q.tangent.dot(Vector3d(t.p[2]))});
+        if (nearest >= q.level) continue;  // beyond the plane: missed before the best
+      } else if (q.level < kInfinity && beyond(q, tris[c.tri])) {
+        continue;
+      }
       double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
       for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
+      if (local) bound = std::max(bound, q.best + (nearest - q.level) / nw);
       open.emplace_back(bound, &c);
     }
   }
