@@ -220,8 +220,9 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
     if (t0 >= q.best) return;
     const double low = t0 - 1e-9 * (1 + std::fabs(t0));
-    // A corner inside K at the best: the triangle is met before it, no plane can separate them (the proofs
-    // below would fail, often after many steps), so it goes straight to its contact.
+    // A corner, the centre or an edge's midpoint inside K at the best or touching it (a tie at a touched
+    // vertex): no plane separates the triangle from K by the proofs' margin, or only after many steps of
+    // the certificate, so it goes straight to its contact.
     if (inside_at(q0, q.best) || inside_at(q1, q.best) || inside_at(q2, q.best) ||
         inside_at((q0 + q1 + q2) / 3.0, q.best) || inside_at(0.5 * (q0 + q1), q.best) ||
         inside_at(0.5 * (q1 + q2), q.best) || inside_at(0.5 * (q2 + q0), q.best))
@@ -239,13 +240,14 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
   }
 }
 
-// Whether the point p (tool frame, the start at the origin) lies inside K moved by `travel`, clear of its
-// surface by more than rounding.
+// Whether the point p (tool frame, the start at the origin) lies inside K moved by `travel` or within `near` of
+// its surface (the profile tested at the point's radius, at most K's).
 inline bool AlongCutter::inside_at(const Vector3d& p, double travel) const {
+  constexpr double near = 1e-6;  // mm
   const double z = p.z() - travel * W_.z(), x = p.x() - travel * W_.x(), y = p.y() - travel * W_.y();
-  const double rho2 = x * x + y * y, rmax = cutter_.max_radius(), eps = 1e-6;
-  if (!(z > eps && z < cutter_.cutting_length() - eps && rho2 < (rmax - eps) * (rmax - eps))) return false;
-  return cutter_.height(std::sqrt(rho2)) < z - eps;
+  const double rho2 = x * x + y * y, rmax = cutter_.max_radius();
+  if (!(z > -near && z < cutter_.cutting_length() + near && rho2 < (rmax + near) * (rmax + near))) return false;
+  return cutter_.height(std::min(std::sqrt(rho2), rmax)) < z + near;
 }
 
 void AlongCutter::set_tangent(Search& q, const Vector3d& n) const {
