@@ -220,6 +220,13 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     const double t0 = std::min({q0.dot(W_), q1.dot(W_), q2.dot(W_)}) - ahead_;
     if (t0 >= q.best) return;
     const double low = t0 - 1e-9 * (1 + std::fabs(t0));
+    // A corner, the centre or an edge's midpoint inside K at the best or touching it (a tie at a touched
+    // vertex): no plane separates the triangle from K by the proofs' margin, or only after many steps of
+    // the certificate, so it goes straight to its contact.
+    if (inside_at(q0, q.best) || inside_at(q1, q.best) || inside_at(q2, q.best) ||
+        inside_at((q0 + q1 + q2) / 3.0, q.best) || inside_at(0.5 * (q0 + q1), q.best) ||
+        inside_at(0.5 * (q1 + q2), q.best) || inside_at(0.5 * (q2 + q0), q.best))
+      certify = false, plane = nullptr;
     if (plane && direction_detail::plane_clears(cutter_, q0, q1, q2, W_, low, q.best, *plane)) return;
     if (certify && direction_detail::triangle_clear(cutter_, q0, q1, q2, W_, low, q.best, plane)) return;
   }
@@ -231,6 +238,16 @@ inline void AlongCutter::consider(Search& q, const IndexedTriangle& t, int32_t i
     q.floor = q.s.z() - tr + lowest_ - 1e-9;
     set_tangent(q, n);
   }
+}
+
+// Whether the point p (tool frame, the start at the origin) lies inside K moved by `travel` or within `near` of
+// its surface (the profile tested at the point's radius, at most K's).
+inline bool AlongCutter::inside_at(const Vector3d& p, double travel) const {
+  constexpr double near = 1e-6;  // mm
+  const double z = p.z() - travel * W_.z(), x = p.x() - travel * W_.x(), y = p.y() - travel * W_.y();
+  const double rho2 = x * x + y * y, rmax = cutter_.max_radius();
+  if (!(z > -near && z < cutter_.cutting_length() + near && rho2 < (rmax + near) * (rmax + near))) return false;
+  return cutter_.height(std::min(std::sqrt(rho2), rmax)) < z + near;
 }
 
 void AlongCutter::set_tangent(Search& q, const Vector3d& n) const {
@@ -293,6 +310,11 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   auto cleared = [&](const Candidate& c) {
     return under(c.h[0], c.gx[0], c.gy[0]) || under(c.h[1], c.gx[1], c.gy[1]);
   };
+  // A plane of support set by the hint just now, at the best: K at travel t lies below level + (t - best) n.W
+  // along it, so a triangle's corners nearest that plane bound its travel (tight about the contact, where the
+  // next winner lies).
+  const bool local = q.winner >= 0 && q.level < kInfinity;
+  const double nw = -q.tangent.z();  // n.W, the motion along -Z in the index frame
   auto& open = cands.open;  // the candidates left, by their bound
   open.clear();
   for (const Candidates::Run& run : cands.runs) {
@@ -305,9 +327,18 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
       const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
       if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
-      if (q.level < kInfinity && beyond(q, tris[c.tri])) continue;
+      double nearest = -kInfinity;  // the corners' lowest level along the local plane
+      if (local) {
+        const IndexedTriangle& t = tris[c.tri];
+        nearest = std::min({q.tangent.dot(Vector3d(t.p[0])), q.tangent.dot(Vector3d(t.p[1])),
+                            q.tangent.dot(Vector3d(t.p[2]))});
+        if (nearest >= q.level) continue;  // beyond the plane: missed before the best
+      } else if (q.level < kInfinity && beyond(q, tris[c.tri])) {
+        continue;
+      }
       double bound = q.s.z() + kp.gx * q.s.x() + kp.gy * q.s.y() - c.key;
       for (int w = 0; w < 2; ++w) bound = std::max(bound, q.s.z() + c.gx[w] * q.s.x() + c.gy[w] * q.s.y() - c.h[w]);
+      if (local) bound = std::max(bound, q.best + (nearest - q.level) / nw);
       open.emplace_back(bound, &c);
     }
   }

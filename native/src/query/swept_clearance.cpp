@@ -17,7 +17,7 @@ using Eigen::Vector3d;
 
 namespace {
 
-constexpr int kMaxSteps = 32;
+constexpr int kMaxSteps = 20;
 constexpr double kSeparation = 1e-9;  // mm: a plane closer than this proves nothing
 
 struct Simplex {
@@ -149,7 +149,9 @@ bool triangle_clear(const Cutter& c, const Vector3d& q0, const Vector3d& q1, con
   if (!sweep_valid(c, t0, cap)) return false;
   auto lowest = [&](const Vector3d& d) { return lowest_along(c, q0, q1, q2, W, t0, cap, d); };
   Simplex s;
-  Vector3d v = lowest(W);
+  // From the plane that last separated the triangle from a nearby start, where there is one (the search
+  // then starts near its answer), else from the motion's direction.
+  Vector3d v = lowest(plane && plane->squaredNorm() > 0 ? *plane : W);
   s.y[0] = v;
   s.n = 1;
   for (int step = 0; step < kMaxSteps; ++step) {

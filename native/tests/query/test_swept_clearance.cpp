@@ -133,6 +133,15 @@ TEST(SweptClearance, TheSeparatingPlaneProvesTheCaseAgain) {
   EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 7.01, v));
   EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 7.0, v));
   EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, 6.5, Vector3d::Zero()));
+  // The search starts from a given plane, a good one or a poor one: the same answers.
+  for (const Vector3d& from : {v, Vector3d(-W), Vector3d(0.3, -2.0, 0.7)}) {
+    Vector3d u = from;
+    EXPECT_TRUE(triangle_clear(flat, q0, q1, q2, W, t0, 6.5, &u));
+    EXPECT_TRUE(plane_clears(flat, q0, q1, q2, W, t0, 6.5, u));
+    u = from;
+    EXPECT_FALSE(triangle_clear(flat, q0, q1, q2, W, t0, 7.0, &u));
+    EXPECT_EQ(u, from);  // unchanged when nothing is proven
+  }
   EXPECT_FALSE(plane_clears(flat, q0, q1, q2, W, t0, kInf, v));
 }
 

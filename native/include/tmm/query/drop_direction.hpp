@@ -204,6 +204,8 @@ class AlongCutter {
   static bool beyond(const Search& q, const IndexedTriangle& t);
   // q's tangent plane from K's outward normal n (tool frame) at its best contact.
   void set_tangent(Search& q, const Eigen::Vector3d& n) const;
+  // Whether the point p (tool frame, the start at the origin) lies inside K at that travel or touches it.
+  bool inside_at(const Eigen::Vector3d& p, double travel) const;
   // plane (or null): a candidate's last separating normal, tried first and updated. certify: false for a
   // triangle likely to touch (the clearance certificate would only fail before the exact contact).
   void consider(Search& q, const IndexedTriangle& t, int32_t i, Eigen::Vector3d* plane = nullptr,

@@ -14,8 +14,9 @@ namespace tmm::direction_detail {
 // true when a plane is found that separates the triangle q0 q1 q2 from K swept over the travels [t0, cap],
 // by more than 1e-9 mm, so that the triangle's first contact is later than cap. t0 must be a lower bound of
 // that contact (e.g. min q . W - max_K X . W). Searched by GJK on the Minkowski difference (a few support
-// points of K); false when it is not found in a few dozen steps (touching, too close or degenerate), and
-// always for an unbounded K or sweep: the caller then solves the contact. Every true answer is checked on
+// points of K), from `plane` where it is given and not zero (e.g. the plane that cleared the triangle from a
+// nearby start), else from W; false when it is not found in 20 steps (touching, too close or degenerate),
+// and always for an unbounded K or sweep: the caller then solves the contact. Every true answer is checked on
 // the separating plane itself, so it never depends on the search converging. `plane` (or null): set to that
 // plane's normal when the answer is true.
 bool triangle_clear(const Cutter& c, const Eigen::Vector3d& q0, const Eigen::Vector3d& q1,
