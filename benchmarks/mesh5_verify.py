@@ -149,6 +149,10 @@ def compare(a, grid: Grid, design: np.ndarray, heights: np.ndarray, info: dict, 
     out = (normal > tol + 0.002) & np.isfinite(design) & ~strip
     print(f"above tau + 0.002 mm outside the {len(info.get('unfinished', ()))} strips listed for clean-up (grown by "
           f"R): {int(out.sum())}, of them more than 1 mm inside the boundary {int((out & (rim > 1.0)).sum())}")
+    deep_out = np.flatnonzero((out & (rim > 1.0)).ravel())
+    for i in deep_out[np.argsort(-normal.flat[deep_out])][:12]:
+        print(f"  outside the strips, inside: ({X.flat[i]:.1f}, {Y.flat[i]:.1f}): {normal.flat[i]:.4f} mm, "
+              f"{rim.flat[i]:.1f} mm from the boundary")
     deep = inside & (rim > 1.0)
     print(f"more than 1 mm inside the boundary: {deep.sum()} cells, max scallop {normal[deep].max():.4f} mm, "
           f"above tau + 0.002 mm {int((normal[deep] > tol + 0.002).sum())}, least {dev[deep].min():.4f} mm")

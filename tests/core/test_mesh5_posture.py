@@ -16,7 +16,7 @@ from tmm_workbench.core.strategies.mesh5.cc_paths import cc_paths
 from tmm_workbench.core.strategies.mesh5.cspace import build_cspace
 from tmm_workbench.core.strategies.mesh5.optimal import (nearest_ideal, pair_times, pass_motion_time,
                                                          smooth_postures)
-from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, world_placement
+from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, tool_rotation, world_placement
 from tmm_workbench.core.tools.cutter import Cutter
 
 CUTTER = Cutter.flat(10.0)
@@ -87,3 +87,21 @@ def test_the_machines_tilt_limit_bounds_the_choice_and_an_unreachable_point_is_n
         smooth_postures(cs, CUTTER, path.points, path.frames, TarusMachine(c_limits=(0.0, math.radians(1.0))))
     with pytest.raises(TmmError, match="ideal weight"):
         smooth_postures(cs, CUTTER, path.points, path.frames, ideal_weight=-1.0)
+
+
+def test_a_held_pass_turns_its_posture_against_the_surface_less(wavy):
+    # the motion time alone keeps the machine's joints steady while the surface turns under the pass; held,
+    # the posture keeps to the surface (where a side's edge is formed a radius along the pass: stepover._hold)
+    _, path, cs = wavy
+    m = TarusMachine()
+
+    def turned(p) -> float:
+        a = tool_rotation(p.lam, p.omg)[:, 2, :]
+        return float(np.arccos(np.clip(np.einsum("ij,ij->i", a[:-1], a[1:]), -1.0, 1.0)).sum())
+
+    free = smooth_postures(cs, CUTTER, path.points, path.frames, m)
+    zero = smooth_postures(cs, CUTTER, path.points, path.frames, m, hold=np.zeros(len(path)))
+    held = smooth_postures(cs, CUTTER, path.points, path.frames, m, hold=np.full(len(path), 100.0))
+    assert np.array_equal(zero.index, free.index)
+    assert turned(free) > 0.05 and turned(held) < 0.5 * turned(free)
+    assert cs.available[np.arange(len(path)), held.index[:, 0], held.index[:, 1]].all()

@@ -4,6 +4,7 @@ slow reference (the solid cylinder swept between the CL points, material measure
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -17,13 +18,15 @@ from tmm_workbench.core.machine.tarus import TarusMachine
 from tmm_workbench.core.strategies.mesh5.lift import MeshReach, lifts
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, world_placement
 from tmm_workbench.core.strategies.mesh5.cc_paths import CCPath, cc_paths
-from tmm_workbench.core.strategies.mesh5.optimal import smooth_postures
+from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_postures
 from tmm_workbench.core.strategies.mesh5.coverage import Coverage
-from tmm_workbench.core.strategies.mesh5.stepover import (_on_mesh, _split, adaptive_passes, half_widths, reach_widths,
+from tmm_workbench.core.strategies.mesh5.stepover import (HOLD, _hold, _Planes, _on_mesh, _split, adaptive_passes,
+                                                        half_widths, reach_widths,
                                                         tilt_reached, widest_cspace)
 from tmm_workbench.core.strategies.mesh5.tool_moves import (BETWEEN_TOL, OVERRUN_STEPS, between_positions,
                                                            clear_lifts, overrun_positions)
-from tmm_workbench.core.strategies.mesh5.widths import path_bending
+from tmm_workbench.core.strategies.mesh5.unfinished import list_ends
+from tmm_workbench.core.strategies.mesh5.widths import end_by_tools, path_bending
 from tmm_workbench.core.tools.cutter import Cutter
 
 TOL = 0.05
@@ -102,10 +105,12 @@ def test_the_tools_go_on_an_overrun_beyond_the_ends_along_the_feed(cylinder_plan
         for path, q, (tips, axes) in zip(p.paths, p.postures, p.tool_positions()):
             assert len(tips) == len(q.tips) + 2 * n and np.array_equal(tips[n:-n], q.tips)
             # on this convex patch nothing rises beyond the ends: straight on along the end tangents
-            for end, cc, lx in ((tips[:n][::-1], q.tips[0], -path.frames[0, 0]),
-                                (tips[-n:], q.tips[-1], path.frames[-1, 0])):
+            # (a radius and as far as the end was moved inside the mesh)
+            for end, cc, lx, inset in ((tips[:n][::-1], q.tips[0], -path.frames[0, 0], path.inset[0]),
+                                       (tips[-n:], q.tips[-1], path.frames[-1, 0], path.inset[1])):
                 along = (end - cc) @ lx
-                assert along == pytest.approx(5.0 * np.arange(1, n + 1) / n, abs=0.05)
+                assert 0.0 < inset < 0.5
+                assert along == pytest.approx((5.0 + inset) * np.arange(1, n + 1) / n, abs=0.01)
                 assert np.linalg.norm(end - cc - along[:, None] * lx, axis=1).max() <= 0.05
             assert np.array_equal(axes[:n + 1], np.repeat(q.axes[:1], n + 1, 0))
             assert np.array_equal(axes[-n - 1:], np.repeat(q.axes[-1:], n + 1, 0))
@@ -389,3 +394,83 @@ def test_the_right_step_reaches_a_slanted_edge_of_the_mesh_to_the_bisection():
     frm = np.repeat(np.eye(3)[None], 4, axis=0)
     got = _on_mesh(MeshReach(mesh), pts, frm, np.full(4, 12.0))
     assert got == pytest.approx(5 + 0.3 * x, abs=1e-3)
+
+
+def ramp_end():
+    """A plane falling 40 deg along the feed (x), its plane-0 path as the planner moves its ends in, and a flat
+    D 10 at lambda 1 deg (the bottom near the surface) at every CC point: (mesh, cutter, reach, cover, path,
+    postures)."""
+    slope = math.tan(math.radians(40.0))
+    mesh = grid_mesh(lambda x, y: -slope * x, 40, 20, (-20, -10, 20, 10), "ramp")
+    cutter, reach = Cutter.flat(10.0), MeshReach(mesh)
+    cover = Coverage(mesh, np.array([0.0, 1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 2.0, 5e-3, 5.0)
+    grid = PostureGrid.degrees((0, 24), (-30, 30))
+    path = _Planes(mesh, (1, 0), cover, 1.0, 0.01, 5.0, TarusMachine(), grid).paths(0.0)[0]
+    n = len(path)
+    lam, omg = np.full(n, math.radians(1.0)), np.zeros(n)
+    tips, axes = world_placement(cutter, path.points, path.frames, lam, omg, np.zeros(n))
+    q = PassPostures(np.zeros((n, 2), dtype=np.int64), lam, omg, np.zeros(n), tips, axes, np.zeros((n, 5)))
+    return mesh, cutter, reach, cover, path, q
+
+
+def test_an_end_moved_inside_passes_no_cc_point_and_its_overrun_reaches_the_edge():
+    # a plane falling 40 deg along the feed: the planner moves each path's end in by the section's drift (LZ's
+    # share of the feed, 0.64 R), past CC points 1 mm apart. Before: those points kept (the tool went on, back,
+    # on again) and the overrun a radius from the moved end: the tool's centre stopped short of the mesh's edge
+    # and its bottom's chord there reached short of 4.4 of 5 mm to the side (seed 000's complex surface: 1.69 mm
+    # left between two passes at the path ends)
+    mesh, cutter, reach, _, path, q = ramp_end()
+    feed = path.points[:, 0]
+    assert np.all(np.diff(feed) > 0)                                        # no CC point passed
+    assert path.inset == pytest.approx((0.1 + 5.0 * math.sin(math.radians(40.0)),) * 2, abs=0.05)
+    assert feed[-1] < 20.0 - 2.0 and not any(path.cut_short)
+    run_t, run_a, _ = overrun_positions(reach, cutter, path, q, 5.0)
+    xs, ys = np.meshgrid(np.arange(16.0, 19.8, 0.25), (-4.4, 4.4), indexing="ij")
+    pts, nrm, hit = surface_samples(mesh, np.column_stack([xs.ravel(), ys.ravel()]))
+    st, sa = swept_positions(run_t, run_a, 8)
+    h = remaining(pts[hit], nrm[hit], st, sa, 5.0, 20.0)
+    # the corners at the edge cut within the tolerance (before: 9 mm, and uncut, over the last 0.75 mm)
+    assert hit.all() and h.min() >= -2e-3 and h.max() <= TOL + 2e-3
+
+
+def test_the_stretch_beyond_a_moved_in_end_is_measured_under_the_tools():
+    # the ramp above: the overrun carried to the edge finishes the 4.4 mm each side the end CC point claims;
+    # one a radius from the moved end leaves the corners where the tool's centre trails its CC point (the last
+    # end: the bottom tilted forward touches with its front rim), and the sections between that end and the
+    # edge find them, on both sides; the first end's overrun leads with the centre and finishes it
+    _, cutter, reach, cover, path, q = ramp_end()
+    claim = np.full((2, 2), 4.4)
+    full = overrun_positions(reach, cutter, path, q, 5.0)
+    assert end_by_tools(reach, cutter, path, full[0], full[1], claim, TOL) == []
+    short = overrun_positions(reach, cutter, replace(path, inset=(0.0, 0.0)), q, 5.0)
+    found = end_by_tools(reach, cutter, path, short[0], short[1], claim, TOL)
+    assert {(e, side) for e, side, _, _ in found} == {(1, 0), (1, 1)}
+    for e, side, p, stop in found:
+        assert p[0] > 20.0 - path.inset[1] * math.cos(math.radians(40.0)) - 1e-6   # between the end and the edge
+        assert 0.0 <= abs(stop[1]) < 4.4 and (stop[1] - p[1]) * (1 if side == 0 else -1) >= 0.0
+    ball = overrun_positions(reach, Cutter.bull(10.0, 1.0), path, q, 5.0)
+    assert end_by_tools(reach, Cutter.bull(10.0, 1.0), path, ball[0], ball[1], claim, TOL) == []
+
+
+def test_the_posture_is_held_near_the_cc_points_whose_edge_side_the_tools_leave_short():
+    pts = np.column_stack([np.arange(0.0, 30.0, 2.0), np.zeros(15), np.zeros(15)])
+    a, b = CCPath(0, 0.0, pts[:8], np.tile([0, 0, 1.0], (8, 1)), np.tile(np.eye(3), (8, 1, 1))), \
+        CCPath(0, 0.0, pts[8:], np.tile([0, 0, 1.0], (7, 1)), np.tile(np.eye(3), (7, 1, 1)))
+    short = np.zeros(15)
+    short[3] = 0.4                                                          # x = 6 on the first path
+    hold = _hold([a, b], short, 5.0)
+    assert np.array_equal(np.flatnonzero(hold), [0, 1, 2, 3, 4, 5, 6])    # within 7.5 mm along its own path
+    assert np.all(hold[:7] == HOLD) and not _hold([a, b], np.zeros(15), 5.0).any()
+
+
+def test_the_stretch_the_tools_leave_at_a_moved_in_end_is_listed_to_the_edge():
+    _, cutter, reach, cover, path, q = ramp_end()
+    short = overrun_positions(reach, cutter, replace(path, inset=(0.0, 0.0)), q, 5.0)
+    widths = np.full((len(path), 2), 4.4)
+    ends = np.stack([path.points + 4.4 * path.frames[:, 1], path.points - 4.4 * path.frames[:, 1]], axis=1)
+    listed = []
+    list_ends(listed, cover, reach, cutter, [path], [short[:2]], widths, ends, TOL)
+    assert len(listed) == 2                                                 # the last end, both sides
+    for f0, f1, c0, c1 in listed:
+        assert f0 <= 20.0 - path.inset[1] * math.cos(math.radians(40.0)) + 2.0 and f1 >= 20.0
+        assert c0 < c1 and (c1 == pytest.approx(4.4, abs=0.01) or c0 == pytest.approx(-4.4, abs=0.01))

@@ -33,6 +33,10 @@ class CCPath:
     # the path stops inside the mesh at its start / end (the planner left out CC points beyond the machine's
     # tilt there), not where the plane leaves the mesh
     cut_short: tuple[bool, bool] = (False, False)
+    # mm along the feed its start / end lie inside the place where the plane leaves the mesh (the planner
+    # moves them in: stepover._Planes.paths); the overrun beyond an end that is not cut short goes this much
+    # further, so that the tool reaches the mesh's edge (tool_moves.overrun_positions)
+    inset: tuple[float, float] = (0.0, 0.0)
 
     def __len__(self) -> int:
         return len(self.points)

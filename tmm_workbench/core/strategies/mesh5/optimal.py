@@ -29,7 +29,7 @@ from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.machine.rotary import solve_path
 from tmm_workbench.core.machine.tarus import JointLimitError, TarusMachine
 from tmm_workbench.core.strategies.mesh5.cspace import CSpace
-from tmm_workbench.core.strategies.mesh5.posture import world_placement
+from tmm_workbench.core.strategies.mesh5.posture import tool_rotation, world_placement
 from tmm_workbench.core.tools.cutter import Cutter
 
 TWO_PI = 2.0 * math.pi
@@ -134,11 +134,23 @@ def nearest_ideal(cs: CSpace, cutter: Cutter, points: np.ndarray, frames: np.nda
     return _pick(cs, cutter, points, frames, states, chosen)
 
 
+def _turns(cs: CSpace, s0: _States, s1: _States) -> np.ndarray:
+    """(p, q) rad between the tool axes of two CC points' states, each in its own LCS (how far the posture
+    turns against the surface from one CC point to the next)."""
+    lam, omg = (g.ravel() for g in cs.grid.mesh())
+    a0, a1 = (tool_rotation(lam[s.flat], omg[s.flat])[:, 2, :] for s in (s0, s1))
+    return np.arccos(np.clip(a0 @ a1.T, -1.0, 1.0))
+
+
 def smooth_postures(cs: CSpace, cutter: Cutter, points: np.ndarray, frames: np.ndarray,
-                    machine: Optional[TarusMachine] = None, ideal_weight: float = 0.1) -> PassPostures:
+                    machine: Optional[TarusMachine] = None, ideal_weight: float = 0.1,
+                    hold: Optional[np.ndarray] = None) -> PassPostures:
     """The postures of a pass (CC points in feed order) with the least sum of Tarus motion times between
-    neighbours plus `ideal_weight` x the motion times to the ideal postures (module doc). TmmError naming the
-    CC points that have no reachable available posture."""
+    neighbours plus `ideal_weight` x the motion times to the ideal postures (module doc). `hold` (n,) s/rad:
+    plus, into each CC point, that weight x the angle its posture turns against the surface from the one
+    before (in their LCSs): where the strip's edge is formed by the tool a radius along the pass, a posture
+    that turns there leaves what the CC point's own swept profile covered (stepover: a side run to the
+    mesh's edge). TmmError naming the CC points that have no reachable available posture."""
     if not (isinstance(ideal_weight, (int, float)) and math.isfinite(ideal_weight) and ideal_weight >= 0):
         raise TmmError(f"ideal weight must be a finite number >= 0, got {ideal_weight!r}")
     machine = TarusMachine() if machine is None else machine
@@ -148,6 +160,8 @@ def smooth_postures(cs: CSpace, cutter: Cutter, points: np.ndarray, frames: np.n
     back: List[np.ndarray] = []
     for k in range(1, len(states)):
         step = pair_times(machine, states[k - 1].joints, states[k].joints) + cost[:, None]
+        if hold is not None and hold[k] > 0:
+            step = step + hold[k] * _turns(cs, states[k - 1], states[k])
         arg = np.argmin(step, axis=0)
         back.append(arg)
         cost = step[arg, np.arange(step.shape[1])] + \

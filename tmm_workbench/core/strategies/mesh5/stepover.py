@@ -47,6 +47,7 @@ from tmm_workbench.core.strategies.mesh5.optimal import PassPostures, smooth_pos
 from tmm_workbench.core.strategies.mesh5.posture import PostureGrid, require_plain, tool_rotation
 from tmm_workbench.core.strategies.mesh5.tool_moves import between_positions, overrun_positions
 from tmm_workbench.core.strategies.mesh5.top_bound import surface_heights
+from tmm_workbench.core.strategies.mesh5.unfinished import beyond_tilt, list_ends, list_slivers
 from tmm_workbench.core.strategies.mesh5.widths import edge_by_tools, half_widths, path_bending, reach_widths
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.tools.cutter import Cutter
@@ -84,6 +85,9 @@ AHEAD_SHARE = 0.75      # the left side step the C-space asks, of the gap (the w
 # gap's range, and the strip skipped where no pass advances the least finished bins (a quarter diameter)
 FIRST_GAP, FIRST_AHEAD, LEAST_GAP, MOST_GAP, SKIP = 0.25, 0.5, 0.05, 2.0, 0.5
 EDGE = 1e-3             # Coverage's edge: a bin within this many radii of its top is finished
+# s/rad the posture's turn against the surface costs in the motion-time choice near a side the tools leave short of
+# the mesh's edge (_hold; the Tarus's moves between CC points take ~0.01-0.1 s)
+HOLD = 2.0
 # the right side step the C-space asks: this share of the way back to the level its bins are finished to, and mm more
 BACK_SHARE, BACK_MORE = 1.01, 1e-3
 
@@ -227,24 +231,66 @@ def _plan_pass(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[C
             return None
         pts, frm, side = pts[keep], frm[keep], side[keep]
         cs = CSpace(cs.grid, cs.lift[keep], cs.top[keep])
+    postures = _choose(cs, cutter, paths, machine, ideal_weight)
+    if postures is None:
+        return None                                                         # out of the machine's reach
+    widths, ends, tools, short = _measure(reach, cutter, tolerance, paths, postures)
+    if short.any():
+        # a side run to the mesh's edge that the tools leave short of it: the posture turned along the pass
+        # there (seed 000's concave upper edge: omega -7.6 -> 30 deg over 7 CC points); chosen again, held
+        held = _choose(cs, cutter, paths, machine, ideal_weight, _hold(paths, short, cutter.radius))
+        if held is not None:
+            again = _measure(reach, cutter, tolerance, paths, held)
+            # taken where it leaves less short and covers no fewer sides to the edge (a side that no longer
+            # reaches it would hold its bins for the next planes)
+            if again[3].sum() < short.sum() and np.isinf(again[0]).sum() >= np.isinf(widths).sum():
+                postures, (widths, ends, tools, short) = held, again
+    cut = [np.isinf(widths[:, k]) & ~np.isnan(tools[:, k, 0]) & (short > 0) for k in (0, 1)]
+    return postures, widths, ends, side, paths, dropped, (tools[cut[0], 0], tools[cut[1], 1])
+
+
+def _choose(cs: CSpace, cutter: Cutter, paths: List[CCPath], machine: TarusMachine, ideal_weight: float,
+            hold: Optional[np.ndarray] = None) -> Optional[List[PassPostures]]:
+    """The postures of each path (optimal.smooth_postures; `hold` (n,) all paths in order), None where some
+    CC point has none within the machine's reach."""
     postures, start = [], 0
     for p in paths:
         part = slice(start, start + len(p))
         sub = CSpace(cs.grid, cs.lift[part], cs.top[part])
         try:
-            postures.append(smooth_postures(sub, cutter, p.points, p.frames, machine, ideal_weight))
+            postures.append(smooth_postures(sub, cutter, p.points, p.frames, machine, ideal_weight,
+                                            None if hold is None else hold[part]))
         except TmmError:
-            return None                                                     # out of the machine's reach
+            return None
         start += len(p)
+    return postures
+
+
+def _measure(reach: MeshReach, cutter: Cutter, tolerance: float, paths: List[CCPath], postures: List[PassPostures]):
+    """(widths, ends, where the tools stop at the mesh's edge, how far short of it) of the chosen postures:
+    the half-widths, and a side run off the mesh under the pass's own tools (the slivers they leave at the
+    edge are listed for clean-up, the bins counted finished: held open, they brought the next planes back
+    for them, whose postures turned as much: seed 000's concave surface took 85 passes for 62)."""
+    pts = np.concatenate([p.points for p in paths])
+    frm = np.concatenate([p.frames for p in paths])
     cat = lambda name: np.concatenate([getattr(q, name) for q in postures])  # noqa: E731
     widths, ends = half_widths(reach, cutter, pts, frm, cat("lam"), cat("omg"), cat("delta"), tolerance,
                                path_bending(paths))
-    # a side run off the mesh, under the pass's own tools: the slivers they leave at the edge are listed for
-    # clean-up, the bins counted finished (held open, they brought the next planes back for them, whose
-    # postures turn as much: seed 000's concave surface took 85 passes for 62 and still left 318 cells above)
     _, tools, short = edge_by_tools(reach, cutter, paths, cat("tips"), cat("axes"), widths, ends, tolerance)
-    cut = [np.isinf(widths[:, k]) & ~np.isnan(tools[:, k, 0]) & (short > 0) for k in (0, 1)]
-    return postures, widths, ends, side, paths, dropped, (tools[cut[0], 0], tools[cut[1], 1])
+    return widths, ends, tools, short
+
+
+def _hold(paths: List[CCPath], short: np.ndarray, radius: float) -> np.ndarray:
+    """(n,) HOLD s/rad at the CC points within 1.5 radii along their path of one whose edge side the tools
+    leave `short` (n,) (those whose tools form its profile), 0 elsewhere."""
+    out, start = [], 0
+    for p in paths:
+        s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(p.points, axis=0), axis=1))]
+        bad = s[short[start:start + len(p)] > 0]
+        near = (np.abs(s[:, None] - bad[None, :]) <= 1.5 * radius).any(axis=1) if bad.size else np.zeros(len(p), bool)
+        out.append(np.where(near, HOLD, 0.0))
+        start += len(p)
+    return np.concatenate(out)
 
 
 def _runs(mask: np.ndarray) -> np.ndarray:
@@ -270,7 +316,7 @@ def _split(paths: List[CCPath], drop: np.ndarray) -> tuple[List[CCPath], np.ndar
 
 def _peel(paths: List[CCPath], drop: np.ndarray, through_cut: bool = True) -> tuple[List[CCPath], np.ndarray]:
     """The paths without the runs of CC points in `drop` (n,) at their ends: up to END_PEEL at any end (that
-    end then cut short, its bins left for clean-up: _beyond_tilt), and with `through_cut` all of a run next
+    end then cut short, its bins left for clean-up: unfinished.beyond_tilt), and with `through_cut` all of a run next
     to an end already cut short (beyond the machine's tilt: the tool there reaches the slope); and the kept CC
     points' indices (all paths in order). A path left with fewer than 2 CC points is dropped."""
     out, keep, start = [], [], 0
@@ -287,6 +333,25 @@ def _peel(paths: List[CCPath], drop: np.ndarray, through_cut: bool = True) -> tu
             keep.append(np.arange(start + a, start + b))
         start += len(p)
     return out, np.concatenate(keep) if keep else np.zeros(0, dtype=np.int64)
+
+
+def _unfolded(path: CCPath) -> CCPath:
+    """The path without the CC points its moved-in ends (_Planes.paths) went past along the end's feed LX (an
+    end moved a radius in passed several: the tool went on, back and on again, and the overrun from the moved
+    end stopped short of the mesh's edge by the points it passed); at least its two ends kept."""
+    if len(path) < 3:
+        return path
+    d0 = (path.points - path.points[0]) @ path.frames[0, 0]
+    d1 = (path.points[-1] - path.points) @ path.frames[-1, 0]
+    a, b = 1, len(path) - 1                                 # the runs next to each end that lie beyond it
+    while a < b and d0[a] <= 0:
+        a += 1
+    while b > a and d1[b - 1] <= 0:
+        b -= 1
+    keep = np.zeros(len(path), dtype=bool)
+    keep[[0, -1]] = True
+    keep[a:b] = True
+    return path if keep.all() else path.take(keep)
 
 
 class _Planes:
@@ -319,14 +384,15 @@ class _Planes:
         over a diameter across (at most a radius; the overrun covers it). `trim` False: not split."""
         out = []
         for p in self._reachable(offset, trim):
-            pts = p.points.copy()
+            pts, inset = p.points.copy(), [0.0, 0.0]
             if len(pts) > 1:
                 most = min(self.radius, float(np.linalg.norm(pts[-1] - pts[0])) / 3)
                 for k, sgn in ((0, 1.0), (-1, -1.0)):
                     f, feed = p.frames[k], self.cover.feed
                     drift = 2 * self.radius * abs(f[1] @ feed) + self.radius * abs(f[2] @ feed)
-                    pts[k] += sgn * min(0.02 * self.radius + drift, most) * f[0]
-            out.append(replace(p, points=pts))
+                    inset[k] = min(0.02 * self.radius + drift, most)
+                    pts[k] += sgn * inset[k] * f[0]
+            out.append(_unfolded(replace(p, points=pts, inset=(inset[0], inset[1]))))
         return out
 
     def place(self, guess: float, gap: float) -> tuple[float, List[CCPath], float]:
@@ -386,49 +452,6 @@ def _on_mesh(reach: MeshReach, pts: np.ndarray, frm: np.ndarray, d: np.ndarray, 
         lo[k] = np.where(on, mid, lo[k])
         hi[k] = np.where(on, hi[k], mid)
     return lo
-
-
-def _beyond_tilt(plan: AdaptivePlan, cover: Coverage, level: np.ndarray, whole: List[CCPath],
-                 paths: List[CCPath], offset: float, dropped: np.ndarray) -> None:
-    """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
-    the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
-    reached elsewhere (added to plan.unfinished), so that the next passes go on beside them instead of
-    coming back for them (or being held back by them); so are the bins of the CC points `dropped` (k, 3)
-    inside a path (no posture there: _plan_pass), whether their neighbours advanced them or not."""
-    gained = level > cover.level + 1e-9
-    reached = float(level[gained].min()) if gained.any() else offset
-    inner = np.zeros(len(level), dtype=bool)
-    inner[cover.bin(dropped @ cover.feed)] = True
-    hole = (cover.spanned(whole) & ~cover.spanned(paths) & ~gained | inner) & cover.open & (cover.level < reached)
-    if hole.any():
-        for a, b in zip(*(np.flatnonzero(np.diff(np.r_[0, hole.astype(np.int8), 0]))[k::2] for k in (0, 1))):
-            f0 = cover.f0 + cover.width * a
-            plan.unfinished.append((float(f0), float(cover.f0 + cover.width * b), float(cover.level[a:b].min()),
-                                    reached))
-        level = np.where(hole, np.maximum(level, reached), level)
-    cover.level = level
-
-
-def _list_slivers(plan: AdaptivePlan, cover: Coverage, edges: tuple[np.ndarray, np.ndarray], run: int = 4) -> None:
-    """The slivers a pass's tools left along the mesh's edge (`edges`: where they stop on the left and on the
-    right, (k, 3) each, _plan_pass) listed in plan.unfinished: per run of up to `run` adjacent bins, from
-    where they stop to the bins' top (left) or from the bins' bottom (right)."""
-    for side, edge in enumerate(edges):
-        if len(edge) == 0:
-            continue
-        sgn = 1.0 if side == 0 else -1.0
-        lo = cover.bin(edge @ cover.feed - 0.5 * cover.width)
-        hi = cover.bin(edge @ cover.feed + 0.5 * cover.width)
-        across = np.full(len(cover.lo), np.inf)
-        for a, b, s in zip(lo, hi, sgn * (edge @ cover.m)):
-            across[a:b + 1] = np.minimum(across[a:b + 1], s)
-        bins = np.flatnonzero(np.isfinite(across))
-        for part in np.split(bins, np.flatnonzero(np.diff(bins) > 1) + 1):
-            for k in range(0, len(part), run):
-                q = part[k:k + run]
-                f0, f1 = float(cover.f0 + cover.width * q[0]), float(cover.f0 + cover.width * (q[-1] + 1))
-                plan.unfinished.append((f0, f1, float(across[q].min()), float(cover.hi[q].max())) if side == 0 else
-                                       (f0, f1, float(cover.lo[q].min()), float(-across[q].min())))
 
 
 def _give_up_lagging(plan: AdaptivePlan, cover: Coverage, paths: List[CCPath], base: float, gap: float) -> bool:
@@ -513,11 +536,12 @@ def adaptive_passes(mesh: TriMesh, cutter: Cutter, tolerance: float, direction: 
         runs = [between_positions(reach, cutter, *overrun_positions(reach, cutter, p, q, plan.overrun,
                                                                     assembly=assembly), assembly=assembly)
                 for p, q in zip(paths, postures)]
+        list_ends(plan.unfinished, cover, reach, cutter, paths, runs, widths, ends, tolerance)
         plan.passes.append(PlannedPass(offset, paths, postures, widths, (float(right.max()), float(left.min())),
                                        gap, runs))
         plan.partial += short > 0
-        _beyond_tilt(plan, cover, level, planes.paths(offset, trim=False), paths, offset, dropped)
-        _list_slivers(plan, cover, edge)
+        beyond_tilt(plan.unfinished, cover, level, planes.paths(offset, trim=False), paths, offset, dropped)
+        list_slivers(plan.unfinished, cover, edge)
         # the next pass's right side step as this one's left one (eq. 3.21's d_step_{i+1,R} = d_step_{i,L}),
         # the postures being the widest: half the width this pass finished (left + right along m) at most CC
         # points, so that the next one splits it evenly

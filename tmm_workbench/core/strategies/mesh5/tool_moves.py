@@ -31,16 +31,21 @@ def overrun_positions(reach: MeshReach, cutter: Cutter, path: CCPath, postures: 
     LX at the end's own lift, the tool ran into the mesh where it goes on beyond the path's end (a boundary
     slanted across the planes, the tool's body yawed over the surface beside the path: 0.07 mm deep on seed
     000's concave surface). An overrun stops before a position no lift within the tool's radius clears."""
-    s = overrun * np.arange(1, steps + 1) / steps
     ends = []
     for k, sgn in ((0, -1.0), (-1, 1.0)):
+        # an end moved inside the mesh (CCPath.inset): the overrun goes that much further (from the moved end,
+        # a radius on left the tool's centre short of the mesh's edge by the inset, and its bottom's chord
+        # there too short to reach the scallop between two passes: seed 000's complex surface, 1.69 mm)
+        run = overrun + (0.0 if path.cut_short[k] else path.inset[k])
+        n = max(steps, int(round(steps * run / overrun))) if overrun > 0 else steps
+        s = run * np.arange(1, n + 1) / n
         frame = path.frames[k]
         pts = path.points[k] + sgn * s[:, None] * frame[0]
-        frm = np.repeat(frame[None], steps, 0)
+        frm = np.repeat(frame[None], n, 0)
         lam, omg = np.array([postures.lam[k]]), np.array([postures.omg[k]])
         lift = lifts(reach, cutter, pts, frm, lam, omg, cutter.radius, assembly=assembly)[:, 0]
         blocked = np.flatnonzero(~np.isfinite(lift))
-        keep = int(blocked[0]) if blocked.size else steps
+        keep = int(blocked[0]) if blocked.size else n
         tips, axes = world_placement(cutter, pts[:keep], frm[:keep], np.repeat(lam, keep),
                                      np.repeat(omg, keep), lift[:keep])
         ends.append((tips, axes, frm[:keep]))

@@ -383,3 +383,45 @@ def _covered_to(ys: np.ndarray, z: np.ndarray, s: np.ndarray, tolerance: float) 
         return float(ys[k - 1]), float(s[k - 1])
     f = (tolerance - h[k - 1]) / (h[k] - h[k - 1])
     return float(ys[k - 1] + f * (ys[k] - ys[k - 1])), float(s[k - 1] + f * (s[k] - s[k - 1]))
+
+
+def end_by_tools(reach: MeshReach, cutter: Cutter, path: CCPath, tips: np.ndarray, axes: np.ndarray,
+                 widths: np.ndarray, tolerance: float, sections: int = 4, sub: int = 8) -> List[tuple]:
+    """The stretch between each end CC point of `path` and the mesh's edge it was moved in from
+    (CCPath.inset), measured under the path's own tool positions (`tips`, `axes`: its run with the overruns;
+    `sub` - 1 between each two) at `sections` sections along the end's LX: where the flat bottoms there finish
+    less of a side than the end CC point's half-width (`widths` (2, 2): first and last CC point, left and right;
+    inf: to the mesh's edge), (end 0 / 1, side, the section's point, where the tools stop on it (3,)). The
+    C-space and the half-widths are only asked at the CC points; beyond the end one the tool goes on straight at its
+    posture while the surface twists under it (seed 000's complex surface: 0.8-1.7 mm left 1-2 mm from the x = 228.6
+    edge between two passes). The bull-nose's torus is not modelled: none for it. An end cut short has none."""
+    out: List[tuple] = []
+    R = cutter.radius
+    if cutter.corner_radius > 0:
+        return out
+    ys = np.linspace(0.0, 2.0 * R, WIDTH_SAMPLES)
+    lateral = np.concatenate([ys, -ys[1:]])
+    for e, (k, sgn) in enumerate(((0, -1.0), (-1, 1.0))):
+        inset = path.inset[k]
+        if path.cut_short[k] or inset < 0.05 * R:
+            continue
+        f = path.frames[k]
+        t = inset * np.r_[np.arange(1, sections) / sections, 1.0 - 0.01 * R / inset]
+        pts = path.points[k] + sgn * t[:, None] * f[0]
+        frm = np.repeat(f[None], len(t), 0)
+        h = surface_heights(reach, pts, frm, np.zeros((len(t), 1)), 3.0 * R)[:, 0]
+        for p in pts[np.isfinite(h)] + h[np.isfinite(h), None] * f[2]:
+            near = np.flatnonzero(np.linalg.norm(tips - p, axis=1) <= 2.0 * R)
+            if near.size == 0:
+                out += [(e, side, p, p.copy()) for side in (0, 1) if widths[e, side] > 0]
+                continue
+            lo, hi = max(int(near.min()) - 1, 0), min(int(near.max()) + 1, len(tips) - 1)
+            T, A = _sub_positions(tips[lo:hi + 1], axes[lo:hi + 1], sub)
+            z = _disc_heights(p, f, T, A, R, lateral)
+            S = surface_heights(reach, p[None], f[None], lateral[None], 3.0 * R)[0]
+            for side, sl in ((0, slice(0, len(ys))), (1, np.r_[0, len(ys):2 * len(ys) - 1])):
+                d, s_d = _covered_to(ys, z[sl], S[sl], tolerance)
+                if d < widths[e, side] - 1e-3 * R:
+                    sg = 1.0 if side == 0 else -1.0
+                    out.append((e, side, p, p + sg * d * f[1] + (0.0 if np.isnan(s_d) else s_d) * f[2]))
+    return out
