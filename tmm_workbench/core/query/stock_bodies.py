@@ -8,12 +8,13 @@ model's drop and the stock's:
 
 - only the material standing more than `within` off the design counts (cells within it are the model, which the
   mesh drop sees exactly): no stock known, or none off the design, gives the model's heights unchanged;
-- a cell is the vertical line through its centre with the material up to its height, as in the body check; the
-  body is the frustum grown by its clearance (its lower envelope over the distance from the axis: the flat bottom
-  lowered by the clearance, the rounded rim, the side's offset line); cells finer than CELL_MM are gathered into
-  CELL_MM cells (their highest) taken nearer by half a diagonal, which only raises the heights;
-- a cell within the cutter's radius that the flutes reach is cut by the tool at the point itself (the body check
-  stamps the cutter before it tests the bodies): it counts only above the flutes' top;
+- a cell's material may stand anywhere within it (the verification samples the stock on a grid of its own: on
+  the same material the op's cells' centres alone left the shank 0.002 mm short of a 0.5 mm grid's), so it is
+  taken half a diagonal nearer the axis; the body is the frustum grown by its clearance (its lower envelope over
+  the distance from the axis: the flat bottom lowered by the clearance, the rounded rim, the side's offset line);
+  cells finer than CELL_MM are gathered into CELL_MM cells (their highest);
+- a cell wholly within the cutter's radius that the flutes reach is cut by the tool at the point itself (the body
+  check stamps the cutter before it tests the bodies): it counts only above the flutes' top;
 - cost: per body the highest stock over coarse blocks, dilated by the body's reach, bounds every point's height
   at once; only points that bound lifts above the model's height are dropped onto the cells, body by body.
 
@@ -127,7 +128,7 @@ class StockBodies:
         self.h = padded.reshape(ny, k, nx, k).max(axis=(1, 3))
         self.cell = g.cell * k
         self.x0, self.y0 = g.x0, g.y0
-        self.pad = 0.0 if k == 1 else self.cell * math.sqrt(0.5)
+        self.pad = self.cell * math.sqrt(0.5)
         self.bodies = assembly.bodies()
         self.pieces = body_pieces(assembly)
         self.radius = float(assembly.cutter.radius)
@@ -196,10 +197,10 @@ class StockBodies:
             return -math.inf
         cx = self.x0 + (i0 + ii + 0.5) * self.cell - x
         cy = self.y0 + (j0 + jj + 0.5) * self.cell - y
-        rho = np.maximum(np.hypot(cx, cy) - self.pad, 0.0)
-        env = lower_envelope(self.bodies[i], rho)
+        d = np.hypot(cx, cy)
+        env = lower_envelope(self.bodies[i], np.maximum(d - self.pad, 0.0))
         # within the cutter's radius the flutes cut what stands below their top
-        env = np.where(rho < self.radius, np.maximum(env, self.flute_top), env)
+        env = np.where(d + self.pad < self.radius, np.maximum(env, self.flute_top), env)
         return float(np.max(w[jj, ii] - env))
 
 
