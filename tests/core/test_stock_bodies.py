@@ -1,4 +1,4 @@
-"""The shank and holder against the in-process stock (core.query.stock_bodies): a flat plate with a block of stock
+"""The shank and holder against the in-process stock (core.sim.stock_bodies): a flat plate with a block of stock
 an earlier op left standing beside the passes, taller than the flutes. The model-only guard passes the shank
 through the block (the simulation's body check finds it); with the stock known the guard lifts the tool there or
 leaves those moves out, and the body check is clean; the linker's hop check sees the block too. Where nothing
@@ -15,7 +15,7 @@ from tests.conftest import grid_mesh
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import LinkPolicy, StockHeights
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
-from tmm_workbench.core.query.stock_bodies import InProcessStock, StockAwareDrop, give, lower_envelope
+from tmm_workbench.core.sim.stock_bodies import InProcessStock, StockAwareDrop, give, lower_envelope
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
 from tmm_workbench.core.strategies import holder_guard, raster_drop, rest_joins

@@ -1,4 +1,4 @@
-"""The holder guard against the in-process stock (core.query.stock_bodies) in a Job: a plate roughed only down to
+"""The holder guard against the in-process stock (core.sim.stock_bodies) in a Job: a plate roughed only down to
 20 mm above it (final_z), so that 20 mm of stock stands over the whole plate, far from any wall of the model;
 then a ball D4 on a 20 mm stick-out in an ER32 collet chuck finishes it. The model alone never brings the shank
 near (the same op in a Job of its own keeps its clearance everywhere); after the roughing the op lifts the tool

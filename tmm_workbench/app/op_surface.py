@@ -26,7 +26,7 @@ from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import LinkPolicy
-from tmm_workbench.core.query import stock_bodies
+from tmm_workbench.core.sim import stock_bodies
 from tmm_workbench.core.stage import Field, Stage
 from tmm_workbench.core.strategies import finish_passes, raster_drop, rest_joins
 from tmm_workbench.core.strategies.surface import forward_step, pattern, positioning

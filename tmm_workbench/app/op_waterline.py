@@ -23,7 +23,7 @@ from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import VERTICAL, LinkPolicy, know_op_design, link
-from tmm_workbench.core.query import stock_bodies
+from tmm_workbench.core.sim import stock_bodies
 from tmm_workbench.core.strategies import rest_joins, waterline
 from tmm_workbench.core.strategies.waterline import WaterlineParams
 

@@ -23,7 +23,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
-from tmm_workbench.core.query.stock_bodies import bodies_drop
+from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
 from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
@@ -48,7 +48,7 @@ class WholeToolParams:
     assembly: Any = None
     holder_collision: str = param(LIFT, "holder collision", choices=(LIFT, LEAVE_OUT))
     holder_notes: Optional[list] = None
-    # what the Job's earlier ops left (core.query.stock_bodies.InProcessStock): the bodies keep their clearance
+    # what the Job's earlier ops left (core.sim.stock_bodies.InProcessStock): the bodies keep their clearance
     # from it too (None: from the model only)
     stock: Any = None
 
@@ -99,7 +99,7 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
           surface: Optional[DropSurface] = None, progress: Optional[Progress] = None, stock: Any = None
           ) -> tuple[list[CutSegment], HolderReport]:
     """The segments made safe for the shank and holder (see the module) and what was changed; `stock`: the
-    in-process stock they keep clear of as well (core.query.stock_bodies.InProcessStock; None: the model only)."""
+    in-process stock they keep clear of as well (core.sim.stock_bodies.InProcessStock; None: the model only)."""
     if mode not in (LIFT, LEAVE_OUT):
         raise TmmError(f"holder collision must be '{LIFT}' or '{LEAVE_OUT}', got {mode!r}")
     if not step > 0:
