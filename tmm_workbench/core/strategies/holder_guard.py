@@ -10,7 +10,8 @@ edge rolling over a sharp rim: 0.19 mm under it halfway along a 0.5 mm step was 
 points inserted (a staircase where they climb or fall) until they pass at most BETWEEN_MM under it, inside the
 clearance; so do moves clear at both ends that pass under it in between (a raster's lean move climbing past a
 wall's top). What it changed is reported with the shortest stick-out that cuts everything
-(core.verify.holder_clearance.minimum_stick_out)."""
+(core.verify.holder_clearance.minimum_stick_out). With the params' `stock` (what the Job's earlier ops left:
+core.sim.stock_bodies) the bodies keep their clearance from the material standing off the design as well."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
