@@ -26,7 +26,6 @@ from tmm_workbench.app.op_base import Prop
 from tmm_workbench.core import polygons
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import LinkPolicy
-from tmm_workbench.core.sim import stock_bodies
 from tmm_workbench.core.stage import Field, Stage
 from tmm_workbench.core.strategies import finish_passes, raster_drop, rest_joins
 from tmm_workbench.core.strategies.surface import forward_step, pattern, positioning
@@ -121,7 +120,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                             low_links=left is not None)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
-        stock_bodies.give(params, left, mesh)   # of the model and of what the earlier ops left above it
+        tool_assembly.know_stock(obj, params, left, mesh)   # and of what the earlier ops left above the model
         if policy.low_links and params.assembly is not None:   # its hops too, of walls beside them
             policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly, stock=params.stock)
         with self.reporting(obj) as cb:

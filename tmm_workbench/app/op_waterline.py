@@ -23,7 +23,6 @@ from tmm_workbench.app.op_base import Prop
 from tmm_workbench.app.op_roughing import STEEP_DESCENT_DEG, check_step_down
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.linking import VERTICAL, LinkPolicy, know_op_design, link
-from tmm_workbench.core.sim import stock_bodies
 from tmm_workbench.core.strategies import rest_joins, waterline
 from tmm_workbench.core.strategies.waterline import WaterlineParams
 
@@ -105,7 +104,7 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         # between loops the tool hops just above the material along the way, not up to the safe height; each loop
         # is entered by a rapid to just above what stands off the design (the loops above cut the wall down to it)
         policy.low_links = policy.material_top is not None
-        stock_bodies.give(params, policy.material_top, mesh)   # the shank and holder clear of what is left too
+        tool_assembly.know_stock(obj, params, policy.material_top, mesh)   # clear of what is left too
         if policy.low_links and params.assembly is not None:   # and the shank and holder clear of walls beside them
             policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly, stock=params.stock)
         know_op_design(policy, mesh, params)
