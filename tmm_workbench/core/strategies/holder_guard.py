@@ -24,9 +24,9 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.params import param
 from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
-from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.verify.holder_clearance import StickOut, minimum_stick_out

@@ -27,8 +27,8 @@ from tmm_workbench.core.footprint.rest import RestStock
 from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
-from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.strategies import holder_guard, rest_joins
 from tmm_workbench.core.tools.cutter import Cutter
 
