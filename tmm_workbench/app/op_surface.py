@@ -120,7 +120,7 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                             low_links=left is not None)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
-        tool_assembly.know_stock(obj, params, left, mesh)   # and of what the earlier ops left above the model
+        rest_source.know_stock(obj, params, left, mesh)   # and of what the earlier ops left above the model
         if policy.low_links and params.assembly is not None:   # its hops too, of walls beside them
             policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly, stock=params.stock)
         with self.reporting(obj) as cb:

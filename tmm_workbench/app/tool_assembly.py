@@ -147,17 +147,6 @@ def prepare(obj: Any, params: Any) -> None:
     params.holder_notes = [] if params.assembly is not None else None
 
 
-def know_stock(obj: Any, params: Any, left: Any, mesh: Any) -> None:
-    """The stock the Job's earlier ops leave (`left`: app.simulation.material_left) given to the op's holder guard
-    (core.sim.stock_bodies.give) when an earlier op has a path: its shank and holder keep their clearance from
-    what those ops left standing off the design too. A Job's first op keeps it from the model only (finishing
-    from the raw block, only the Job's simulation sees the shank in the block: fc_test_sim_holder)."""
-    from tmm_workbench.app import simulation
-    from tmm_workbench.core.sim import stock_bodies
-
-    stock_bodies.give(params, left if left is not None and simulation.earlier_paths(obj) else None, mesh)
-
-
 def report(obj: Any, params: Any) -> None:
     """What the holder guard changed (core.strategies.holder_guard): in the read-only HolderReport, the places it
     left material in HolderRegions (the view draws them), and a warning when it left any (with the stick-out
