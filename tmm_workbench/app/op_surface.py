@@ -120,8 +120,9 @@ class ObjectTmmSurface(op_mesh.MeshOp):
                             low_links=left is not None)
         notes = surface_verify.notes_for(params)  # VerifyCusp's reports
         tool_assembly.prepare(obj, params)  # the shank and holder kept clear (no holder: the cutter alone)
+        rest_source.know_stock(obj, params, left, mesh)   # and of what the earlier ops left above the model
         if policy.low_links and params.assembly is not None:   # its hops too, of walls beside them
-            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly)
+            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly, stock=params.stock)
         with self.reporting(obj) as cb:
             toolpath = finish_passes.compute_finish_toolpath(mesh, cutter, params, finish, policy,
                                                              progress.phase(cb, 0.0, progress.KERNEL_SHARE))

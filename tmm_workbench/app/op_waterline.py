@@ -104,8 +104,9 @@ class ObjectTmmWaterline(op_mesh.MeshOp):
         # between loops the tool hops just above the material along the way, not up to the safe height; each loop
         # is entered by a rapid to just above what stands off the design (the loops above cut the wall down to it)
         policy.low_links = policy.material_top is not None
+        rest_source.know_stock(obj, params, policy.material_top, mesh)   # clear of what is left too
         if policy.low_links and params.assembly is not None:   # and the shank and holder clear of walls beside them
-            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly)
+            policy.hop_clear = rest_joins.bodies_clear(mesh, params.assembly, stock=params.stock)
         know_op_design(policy, mesh, params)
         with self.reporting(obj) as cb:
             result = waterline.compute(mesh, cutter, params, progress.phase(cb, 0.0, progress.KERNEL_SHARE))

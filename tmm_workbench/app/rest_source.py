@@ -147,6 +147,16 @@ def material_left(obj: Any, cutter: Cutter) -> Any:
     return simulation.material_left(obj, cutter, simulation.REST_SHARE if is_rest(obj) else 4.0)
 
 
+def know_stock(obj: Any, params: Any, left: Any, mesh: TriMesh) -> None:
+    """The stock the Job's earlier ops leave (`left`: material_left) given to the op's holder guard
+    (core.sim.stock_bodies.give) when an earlier op has a path: its shank and holder keep their clearance from what
+    those ops left standing off the design too. A Job's first op keeps it from the model only (finishing from the
+    raw block, only the Job's simulation sees the shank in the block: fc_test_sim_holder)."""
+    from tmm_workbench.core.sim import stock_bodies
+
+    stock_bodies.give(params, left if left is not None and simulation.earlier_paths(obj) else None, mesh)
+
+
 def rest_of_op(obj: Any, job: Any, mesh: TriMesh, cutter: Cutter, left: Any, box: tuple) -> Optional[Rest]:
     """The op's rest when it machines only the rest (Region 'Rest', or the waterline's RestOnly), else None."""
     if is_rest(obj):

@@ -10,7 +10,8 @@ edge rolling over a sharp rim: 0.19 mm under it halfway along a 0.5 mm step was 
 points inserted (a staircase where they climb or fall) until they pass at most BETWEEN_MM under it, inside the
 clearance; so do moves clear at both ends that pass under it in between (a raster's lean move climbing past a
 wall's top). What it changed is reported with the shortest stick-out that cuts everything
-(core.verify.holder_clearance.minimum_stick_out)."""
+(core.verify.holder_clearance.minimum_stick_out). With the params' `stock` (what the Job's earlier ops left:
+core.sim.stock_bodies) the bodies keep their clearance from the material standing off the design as well."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
@@ -25,6 +26,7 @@ from tmm_workbench.core.query.drop import DropSurface, Progress
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.report_text import within
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.strategies.segment_split import keep_runs, keeps_end, move_samples
 from tmm_workbench.core.tools.assembly import ToolAssembly
 from tmm_workbench.core.verify.holder_clearance import StickOut, minimum_stick_out
@@ -47,6 +49,9 @@ class WholeToolParams:
     assembly: Any = None
     holder_collision: str = param(LIFT, "holder collision", choices=(LIFT, LEAVE_OUT))
     holder_notes: Optional[list] = None
+    # what the Job's earlier ops left (core.sim.stock_bodies.InProcessStock): the bodies keep their clearance
+    # from it too (None: from the model only)
+    stock: Any = None
 
 
 def apply(mesh: TriMesh, params: WholeToolParams, segments: list[CutSegment], step: float,
@@ -55,7 +60,8 @@ def apply(mesh: TriMesh, params: WholeToolParams, segments: list[CutSegment], st
     report, also appended to params.holder_notes) and "top" raised to the highest lifted tip."""
     if params.assembly is None:
         return segments
-    segments, report = guard(mesh, params.assembly, segments, params.holder_collision, step, surface)
+    segments, report = guard(mesh, params.assembly, segments, params.holder_collision, step, surface,
+                             stock=getattr(params, "stock", None))
     diagnostics["holder"] = report
     if "top" in diagnostics:
         diagnostics["top"] = max([diagnostics["top"]] + [float(seg.tips[:, 2].max()) for seg in segments if len(seg)])
@@ -91,9 +97,10 @@ class HolderReport:
 
 
 def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mode: str, step: float,
-          surface: Optional[DropSurface] = None, progress: Optional[Progress] = None
+          surface: Optional[DropSurface] = None, progress: Optional[Progress] = None, stock: Any = None
           ) -> tuple[list[CutSegment], HolderReport]:
-    """The segments made safe for the shank and holder (see the module) and what was changed."""
+    """The segments made safe for the shank and holder (see the module) and what was changed; `stock`: the
+    in-process stock they keep clear of as well (core.sim.stock_bodies.InProcessStock; None: the model only)."""
     if mode not in (LIFT, LEAVE_OUT):
         raise TmmError(f"holder collision must be '{LIFT}' or '{LEAVE_OUT}', got {mode!r}")
     if not step > 0:
@@ -101,7 +108,7 @@ def guard(mesh: TriMesh, assembly: ToolAssembly, segments: list[CutSegment], mod
     if any(seg.axes is not None for seg in segments):
         raise TmmError("the holder guard takes 3-axis segments (a vertical tool); 5-axis moves are checked by "
                        "core.verify.holder_clearance")
-    drop = AssemblyDrop(mesh, assembly, surface)
+    drop = bodies_drop(mesh, assembly, surface, stock)
     sampled = [move_samples(seg, step) for seg in segments]
     allpts = np.vstack([p for p, _ in sampled]) if sampled else np.zeros((0, 3))
     zb, owner = drop.heights_of(BODIES, allpts[:, :2], progress=progress)

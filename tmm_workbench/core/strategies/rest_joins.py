@@ -59,9 +59,9 @@ def join_pieces(mesh: TriMesh, cutter: Cutter, params: Any, segments: list[CutSe
     joins = {k: p for k, p in joins.items() if _length(p) <= longest and _clear_of_model(p, surface, grown, s)}
     assembly = getattr(params, "assembly", None)
     if assembly is not None:
-        from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+        from tmm_workbench.core.sim.stock_bodies import bodies_drop
 
-        bodies = AssemblyDrop(mesh, assembly, surface)
+        bodies = bodies_drop(mesh, assembly, surface, getattr(params, "stock", None))
         joins = {k: p for k, p in joins.items() if _length(p) <= cutter.radius or _clear_of_bodies(bodies, p)}
     out: list[CutSegment] = []
     for k, seg in enumerate(segments):
@@ -127,18 +127,20 @@ def _clear_of_bodies(bodies: Any, path: np.ndarray, step: float = SAMPLE_MM) -> 
     return not bool(np.any((zb - pts[:, 2] > TOLERANCE_MM) & (owner >= 0)))
 
 
-def bodies_clear(mesh: TriMesh, assembly: Any, surface: Optional[DropSurface] = None) -> Callable[[np.ndarray], bool]:
+def bodies_clear(mesh: TriMesh, assembly: Any, surface: Optional[DropSurface] = None, stock: Any = None
+                 ) -> Callable[[np.ndarray], bool]:
     """Whether a straight move ((k, 3) tips, sampled HOP_SAMPLE_MM apart) keeps the neck, shank and holder of
-    `assembly` their clearance from `mesh` (the holder guard's): the linker's check of its low hops
+    `assembly` their clearance from `mesh` and from `stock` (the in-process stock the op starts from:
+    core.sim.stock_bodies; None: the model only), the holder guard's: the linker's check of its low hops
     (LinkPolicy.hop_clear). The bodies' drop (and, without `surface`, the mesh's index) is built at the first
     move asked: an op sets the check up before it computes, and most ops hop seldom or never; built there, it
     indexed the mesh a second time outside the op's progress and cancel."""
-    from tmm_workbench.core.query.drop_assembly import AssemblyDrop
+    from tmm_workbench.core.sim.stock_bodies import bodies_drop
 
     bodies: list = []
 
     def clear(path: np.ndarray) -> bool:
         if not bodies:
-            bodies.append(AssemblyDrop(mesh, assembly, surface or DropSurface(mesh)))
+            bodies.append(bodies_drop(mesh, assembly, surface or DropSurface(mesh), stock))
         return _clear_of_bodies(bodies[0], np.asarray(path, dtype=float), HOP_SAMPLE_MM)
     return clear

@@ -28,6 +28,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.query.drop import DropSurface
 from tmm_workbench.core.query.drop_assembly import AssemblyDrop
 from tmm_workbench.core.segments import CutSegment
+from tmm_workbench.core.sim.stock_bodies import bodies_drop
 from tmm_workbench.core.strategies import holder_guard, rest_joins
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -45,7 +46,8 @@ def pieces(mesh: TriMesh, cutter: Cutter, params: Any, left: Optional[RestStock]
     if left is None:
         return []
     s = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0)
-    bodies = None if getattr(params, "assembly", None) is None else AssemblyDrop(mesh, params.assembly, surface)
+    bodies = None if getattr(params, "assembly", None) is None else bodies_drop(mesh, params.assembly, surface,
+                                                                                 getattr(params, "stock", None))
     points = _best_positions(left, cutter, surface, s, bodies)
     if not len(points):
         return []
