@@ -115,6 +115,12 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   const double half = 0.5 * cutter.cutting_length();
   mid_x_ = half * a_.x(), mid_y_ = half * a_.y();
   mid_reach_ = (cutter.max_radius() + half * axis_xy_) * (1 + 1e-12) + 1e-12;
+  // Tighter still across the lean: X = tip + z a + r (r square to a, |r| <= max_radius) has across . (X - tip)
+  // = across . r_xy (across is square to a's XY' part), at most max_radius whatever z, and the motion along
+  // -Z' leaves it unchanged. A triangle whose XY' box lies off that strip is never touched from this tip; the
+  // disc clips the strip's ends, the strip the disc's sides, where a tilted holder's rim reaches farthest.
+  if (axis_xy_ > 0) across_x_ = -a_.y() / axis_xy_, across_y_ = a_.x() / axis_xy_;
+  side_ = cutter.max_radius() * (1 + 1e-12) + 1e-12;
   // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
   for (const double deg : kPlaneAngles) {
     const double th = deg * M_PI / 180.0;
@@ -143,6 +149,17 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
 AlongCutter::Plane AlongCutter::plane_under(const Vector3d& n) const {
   const double h = direction_detail::support(cutter_, frame_.to_tool(-n)).value;
   return {-h / n.z(), n.x() / n.z(), n.y() / n.z()};
+}
+
+inline void AlongCutter::across_range(double xmin, double xmax, double ymin, double ymax, double& lo,
+                                      double& hi) const {
+  lo = std::min(across_x_ * xmin, across_x_ * xmax) + std::min(across_y_ * ymin, across_y_ * ymax);
+  hi = std::max(across_x_ * xmin, across_x_ * xmax) + std::max(across_y_ * ymin, across_y_ * ymax);
+}
+
+inline bool AlongCutter::off_strip(double blo, double bhi, double lo, double hi) const {
+  const double margin = 1e-9 * (1.0 + std::fabs(lo) + std::fabs(hi));  // against rounding
+  return blo - hi > side_ + margin || lo - bhi > side_ + margin;
 }
 
 double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
@@ -300,6 +317,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     consider(q, tris[*hint], *hint, nullptr, false);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
+  const double tw = across_x_ * q.s.x() + across_y_ * q.s.y();  // the tip across the lean
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
   // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
@@ -326,7 +344,9 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
       const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
       const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
-      if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
+      if (dx * dx + dy * dy > r2 || off_strip(c.wlo, c.whi, tw, tw) || c.tri == skip || c.tri == known ||
+          under(c.h[0], c.gx[0], c.gy[0]))
+        continue;
       double nearest = -kInfinity;  // the corners' lowest level along the local plane
       if (local) {
         const IndexedTriangle& t = tris[c.tri];
@@ -412,6 +432,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
   const std::size_t coarse = planes_.size() + axial_.size();
   out.offsets.assign(coarse + fine_.size(), kInfinity);
   double x0 = kInfinity, x1 = -kInfinity, y0 = kInfinity, y1 = -kInfinity, floor = kInfinity;
+  double w0 = kInfinity, w1 = -kInfinity;  // the tips' range across the lean
   out.fine_done.assign(kFineAzimuths, 0);
   out.tips.clear();
   Vector3d centre = Vector3d::Zero();
@@ -421,6 +442,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
     const double mx = s.x() + mid_x_, my = s.y() + mid_y_;
     x0 = std::min(x0, mx), x1 = std::max(x1, mx), y0 = std::min(y0, my), y1 = std::max(y1, my);
+    const double w = across_x_ * s.x() + across_y_ * s.y();
+    w0 = std::min(w0, w), w1 = std::max(w1, w);
     out.tips.emplace_back(s.x(), s.y(), top);
     out.centre = centre += out.tips.back() / static_cast<double>(m);
     std::size_t k = 0;
@@ -431,9 +454,13 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       }
   }
   const double r2 = mid_reach_ * mid_reach_;
+  // Off every start's disc about its axis's midpoint, or off the strip across the lean about every tip.
+  double wlo = 0.0, whi = 0.0;  // the last box's range across the lean
   auto far = [&](double xmin, double ymin, double xmax, double ymax) {
     const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
-    return dx * dx + dy * dy > r2;
+    if (dx * dx + dy * dy > r2) return true;
+    across_range(xmin, xmax, ymin, ymax, wlo, whi);
+    return off_strip(wlo, whi, w0, w1);
   };
   // A box whose highest corner under a plane's slope is below that plane at every start.
   auto box_below = [&](const BvhNode& b) {
@@ -464,7 +491,7 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
-      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, Vector3d::Zero()};
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, wlo, whi, Vector3d::Zero()};
       if (below_everywhere(t, out, c)) continue;
       if (out.list.size() == limit) return false;
       double h = -kInfinity;
