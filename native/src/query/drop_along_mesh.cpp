@@ -317,7 +317,10 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     consider(q, tris[*hint], *hint, nullptr, false);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
-  const double tw = across_x_ * q.s.x() + across_y_ * q.s.y();  // the tip across the lean
+  // The strip about this tip across the lean (two comparisons an entry).
+  const double tw = across_x_ * q.s.x() + across_y_ * q.s.y();
+  const double slack = side_ + 1e-9 * (1.0 + 2.0 * std::fabs(tw));  // rounding, as off_strip's
+  const double w_lo = tw - slack, w_hi = tw + slack;
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
   // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
@@ -342,11 +345,10 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       // margin grows slower than the gap).
       if (under(c.h[1], run.gx, run.gy)) break;
       if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
+      if (c.wlo > w_hi || c.whi < w_lo) continue;
       const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
       const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
-      if (dx * dx + dy * dy > r2 || off_strip(c.wlo, c.whi, tw, tw) || c.tri == skip || c.tri == known ||
-          under(c.h[0], c.gx[0], c.gy[0]))
-        continue;
+      if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
       double nearest = -kInfinity;  // the corners' lowest level along the local plane
       if (local) {
         const IndexedTriangle& t = tris[c.tri];
