@@ -119,6 +119,7 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   // = across . r_xy (across is square to a's XY' part), at most max_radius whatever z, and the motion along
   // -Z' leaves it unchanged. A triangle whose XY' box lies off that strip is never touched from this tip; the
   // disc clips the strip's ends, the strip the disc's sides, where a tilted holder's rim reaches farthest.
+  // Each start's scan tests it (not the gather: a tile's strip is wider and its test per box cost more).
   if (axis_xy_ > 0) across_x_ = -a_.y() / axis_xy_, across_y_ = a_.x() / axis_xy_;
   side_ = cutter.max_radius() * (1 + 1e-12) + 1e-12;
   // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
@@ -155,11 +156,6 @@ inline void AlongCutter::across_range(double xmin, double xmax, double ymin, dou
                                       double& hi) const {
   lo = std::min(across_x_ * xmin, across_x_ * xmax) + std::min(across_y_ * ymin, across_y_ * ymax);
   hi = std::max(across_x_ * xmin, across_x_ * xmax) + std::max(across_y_ * ymin, across_y_ * ymax);
-}
-
-inline bool AlongCutter::off_strip(double blo, double bhi, double lo, double hi) const {
-  const double margin = 1e-9 * (1.0 + std::fabs(lo) + std::fabs(hi));  // against rounding
-  return blo - hi > side_ + margin || lo - bhi > side_ + margin;
 }
 
 double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
@@ -319,7 +315,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
   const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
   // The strip about this tip across the lean (two comparisons an entry).
   const double tw = across_x_ * q.s.x() + across_y_ * q.s.y();
-  const double slack = side_ + 1e-9 * (1.0 + 2.0 * std::fabs(tw));  // rounding, as off_strip's
+  const double slack = side_ + 1e-9 * (1.0 + 2.0 * std::fabs(tw));  // against rounding
   const double w_lo = tw - slack, w_hi = tw + slack;
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
@@ -434,7 +430,6 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
   const std::size_t coarse = planes_.size() + axial_.size();
   out.offsets.assign(coarse + fine_.size(), kInfinity);
   double x0 = kInfinity, x1 = -kInfinity, y0 = kInfinity, y1 = -kInfinity, floor = kInfinity;
-  double w0 = kInfinity, w1 = -kInfinity;  // the tips' range across the lean
   out.fine_done.assign(kFineAzimuths, 0);
   out.tips.clear();
   Vector3d centre = Vector3d::Zero();
@@ -444,8 +439,6 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     floor = std::min(floor, top + lowest_ - 1e-9);  // as search()'s, the margin against rounding
     const double mx = s.x() + mid_x_, my = s.y() + mid_y_;
     x0 = std::min(x0, mx), x1 = std::max(x1, mx), y0 = std::min(y0, my), y1 = std::max(y1, my);
-    const double w = across_x_ * s.x() + across_y_ * s.y();
-    w0 = std::min(w0, w), w1 = std::max(w1, w);
     out.tips.emplace_back(s.x(), s.y(), top);
     out.centre = centre += out.tips.back() / static_cast<double>(m);
     std::size_t k = 0;
@@ -456,13 +449,11 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       }
   }
   const double r2 = mid_reach_ * mid_reach_;
-  // Off every start's disc about its axis's midpoint, or off the strip across the lean about every tip.
-  double wlo = 0.0, whi = 0.0;  // the last box's range across the lean
+  // Off every start's disc about its axis's midpoint. (The strip across the lean about every tip, tested here
+  // too, cost more than it saved: each start's scan tests its own, tighter one.)
   auto far = [&](double xmin, double ymin, double xmax, double ymax) {
     const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
-    if (dx * dx + dy * dy > r2) return true;
-    across_range(xmin, xmax, ymin, ymax, wlo, whi);
-    return off_strip(wlo, whi, w0, w1);
+    return dx * dx + dy * dy > r2;
   };
   // A box whose highest corner under a plane's slope is below that plane at every start.
   auto box_below = [&](const BvhNode& b) {
@@ -493,8 +484,9 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
-      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, wlo, whi, Vector3d::Zero()};
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, 0.0, 0.0, Vector3d::Zero()};
       if (below_everywhere(t, out, c)) continue;
+      across_range(t.xmin, t.xmax, t.ymin, t.ymax, c.wlo, c.whi);
       if (out.list.size() == limit) return false;
       double h = -kInfinity;
       for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + kp.gx * t.p[k][0] + kp.gy * t.p[k][1]);

@@ -234,9 +234,8 @@ class AlongCutter {
   // And within the strip of half-width side_ about the axis's shadow: across = (across_x_, across_y_) . xy,
   // the XY' direction square to the axis's lean, is within side_ of the tip's (any XY' point of K).
   double across_x_ = 1, across_y_ = 0, side_ = 0;
-  // The range of across over an XY' box, and whether it lies farther than side_ from [lo, hi] (the tips').
+  // The range of across over an XY' box.
   void across_range(double xmin, double xmax, double ymin, double ymax, double& lo, double& hi) const;
-  bool off_strip(double blo, double bhi, double lo, double hi) const;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
   // With fine planes: those along the axis (facing down), then kFineAzimuths per tilt from the axis
