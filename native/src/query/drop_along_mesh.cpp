@@ -115,6 +115,13 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
   const double half = 0.5 * cutter.cutting_length();
   mid_x_ = half * a_.x(), mid_y_ = half * a_.y();
   mid_reach_ = (cutter.max_radius() + half * axis_xy_) * (1 + 1e-12) + 1e-12;
+  // Tighter still across the lean: X = tip + z a + r (r square to a, |r| <= max_radius) has across . (X - tip)
+  // = across . r_xy (across is square to a's XY' part), at most max_radius whatever z, and the motion along
+  // -Z' leaves it unchanged. A triangle whose XY' box lies off that strip is never touched from this tip; the
+  // disc clips the strip's ends, the strip the disc's sides, where a tilted holder's rim reaches farthest.
+  // Each start's scan tests it (not the gather: a tile's strip is wider and its test per box cost more).
+  if (axis_xy_ > 0) across_x_ = -a_.y() / axis_xy_, across_y_ = a_.x() / axis_xy_;
+  side_ = cutter.max_radius() * (1 + 1e-12) + 1e-12;
   // A plane under K with normal n (n.z > 0, index frame): n . X >= -h_K(-n) for X in K about the tip.
   for (const double deg : kPlaneAngles) {
     const double th = deg * M_PI / 180.0;
@@ -143,6 +150,12 @@ AlongCutter::AlongCutter(const DirectionalIndex& index, const Cutter& cutter, co
 AlongCutter::Plane AlongCutter::plane_under(const Vector3d& n) const {
   const double h = direction_detail::support(cutter_, frame_.to_tool(-n)).value;
   return {-h / n.z(), n.x() / n.z(), n.y() / n.z()};
+}
+
+inline void AlongCutter::across_range(double xmin, double xmax, double ymin, double ymax, double& lo,
+                                      double& hi) const {
+  lo = std::min(across_x_ * xmin, across_x_ * xmax) + std::min(across_y_ * ymin, across_y_ * ymax);
+  hi = std::max(across_x_ * xmin, across_x_ * xmax) + std::max(across_y_ * ymin, across_y_ * ymax);
 }
 
 double AlongCutter::rise(double d, double x0, double x1, double y0, double y1, double enough) const {
@@ -300,6 +313,10 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
     consider(q, tris[*hint], *hint, nullptr, false);
   const int32_t skip = hint ? *hint : -1;
   const double r2 = mid_reach_ * mid_reach_, mx = q.s.x() + mid_x_, my = q.s.y() + mid_y_;
+  // The strip about this tip across the lean (two comparisons an entry).
+  const double tw = across_x_ * q.s.x() + across_y_ * q.s.y();
+  const double slack = side_ + 1e-9 * (1.0 + 2.0 * std::fabs(tw));  // against rounding
+  const double w_lo = tw - slack, w_hi = tw + slack;
   const Plane& kp = cands.key_plane;
   // Below one of the gather's planes at this start's tip (below_everywhere for one start): missed before the
   // best. Each plane also bounds the travel from below (s.z + g . s.xy - h).
@@ -324,6 +341,7 @@ double AlongCutter::drop_listed(const Vector3d& start, double max_travel, Candid
       // margin grows slower than the gap).
       if (under(c.h[1], run.gx, run.gy)) break;
       if (c.zmax <= q.floor || under(c.key, kp.gx, kp.gy)) continue;
+      if (c.wlo > w_hi || c.whi < w_lo) continue;
       const double dx = std::max(std::max(c.xmin - mx, mx - c.xmax), 0.0);
       const double dy = std::max(std::max(c.ymin - my, my - c.ymax), 0.0);
       if (dx * dx + dy * dy > r2 || c.tri == skip || c.tri == known || under(c.h[0], c.gx[0], c.gy[0])) continue;
@@ -431,6 +449,8 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
       }
   }
   const double r2 = mid_reach_ * mid_reach_;
+  // Off every start's disc about its axis's midpoint. (The strip across the lean about every tip, tested here
+  // too, cost more than it saved: each start's scan tests its own, tighter one.)
   auto far = [&](double xmin, double ymin, double xmax, double ymax) {
     const double dx = std::max(std::max(xmin - x1, x0 - xmax), 0.0), dy = std::max(std::max(ymin - y1, y0 - ymax), 0.0);
     return dx * dx + dy * dy > r2;
@@ -464,8 +484,9 @@ bool AlongCutter::gather(const Vector3d* starts, const double* caps, std::size_t
     for (int32_t i = node.first, end = node.first + node.count; i < end; ++i) {
       const IndexedTriangle& t = tris[i];
       if (t.zmax <= floor || far(t.xmin, t.ymin, t.xmax, t.ymax)) continue;
-      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, Vector3d::Zero()};
+      Candidate c{i, t.zmax, t.xmin, t.xmax, t.ymin, t.ymax, {}, {}, {}, 0.0, 0.0, 0.0, Vector3d::Zero()};
       if (below_everywhere(t, out, c)) continue;
+      across_range(t.xmin, t.xmax, t.ymin, t.ymax, c.wlo, c.whi);
       if (out.list.size() == limit) return false;
       double h = -kInfinity;
       for (int k = 0; k < 3; ++k) h = std::max(h, t.p[k][2] + kp.gx * t.p[k][0] + kp.gy * t.p[k][1]);

@@ -147,6 +147,7 @@ class AlongCutter {
     double zmax, xmin, xmax, ymin, ymax;
     double h[2], gx[2], gy[2];  // planes under K, c - g . p: max over the corners of z + g . xy, less c
     double key;                 // h of the key plane
+    double wlo, whi;            // the XY' bounds' range across the axis's shadow (AlongCutter::across)
     Eigen::Vector3d plane;      // the normal (tool frame) that last proved it clear of a start, or zero
   };
   struct Candidates {
@@ -230,6 +231,11 @@ class AlongCutter {
   double lowest_ = 0, reach_ = 0, axis_xy_ = 0;
   // K's shadow on XY' lies within mid_reach_ of the tip offset by (mid_x_, mid_y_) (its axis's midpoint).
   double mid_x_ = 0, mid_y_ = 0, mid_reach_ = 0;
+  // And within the strip of half-width side_ about the axis's shadow: across = (across_x_, across_y_) . xy,
+  // the XY' direction square to the axis's lean, is within side_ of the tip's (any XY' point of K).
+  double across_x_ = 1, across_y_ = 0, side_ = 0;
+  // The range of across over an XY' box.
+  void across_range(double xmin, double xmax, double ymin, double ymax, double& lo, double& hi) const;
   double ahead_ = 0;  // max over K of X . W: a triangle's travel is at least min q . W - ahead_
   std::vector<Plane> planes_;
   // With fine planes: those along the axis (facing down), then kFineAzimuths per tilt from the axis
