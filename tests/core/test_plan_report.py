@@ -124,3 +124,15 @@ def test_outcome_lines_say_the_changes_the_verdict_and_each_op() -> None:
     assert launch.outcome_lines(failed) == [
         "verification FAILED: gouged 0.0300 mm below the model; 2 rapids through stock; deepest gouge 0.0012 mm, "
         "most left 0.25 mm, cycle 12.6 min"]
+
+
+def test_rapids_through_stock_are_named_by_their_op():
+    """The re-plan takes an op's problems by its label: a rapid through stock is one of its op's (it was one
+    problem for the whole Job, and the op the re-plan left out for it was named with no reason)."""
+    from tmm_workbench.app.plan_run import rapid_problems
+
+    problems = rapid_problems([("Clean-up T6 ball D1", 10, 0.5), ("Rest T3", 3, 1.296),
+                               ("Clean-up T6 ball D1", 12, 0.7)])
+    assert problems == ["Clean-up T6 ball D1: 2 rapids through stock (deepest 0.700 mm)",
+                        "Rest T3: 1 rapid through stock (deepest 1.296 mm)"]
+    assert rapid_problems([]) == []

@@ -219,7 +219,8 @@ class PlanBeet(FreeCADTestCase):
         data["model"]["file"] = str(read_job(JOB).model.file)
         data["outputs"]["dir"] = str(OUT / "plan_command" / "out")
         job_file = OUT / "plan_command" / "job.yaml"
-        job_file.parent.mkdir(parents=True, exist_ok=True)
+        shutil.rmtree(job_file.parent, ignore_errors=True)   # a run before in the same output folder left its files
+        job_file.parent.mkdir(parents=True)
         job_file.write_text(yaml.safe_dump(data))
         self.assertEqual(launch.run(str(job_file), freecadcmd(), quiet=True), launch.VERIFIED)
         out = OUT / "plan_command" / "out"

@@ -170,6 +170,16 @@ def steps(plan: dict) -> int:
     return 1 + len(plan["ops"]) + 1 + bool(plan["gcode"]) + bool(plan["fcstd"])
 
 
+def rapid_problems(collisions: list) -> list[str]:
+    """The rapids through stock of (op label, move, depth mm), a problem per op led by its label: the re-plan
+    names an op's problems by that prefix."""
+    by_op: dict[str, list[float]] = {}
+    for label, _move, depth in collisions:
+        by_op.setdefault(label, []).append(float(depth))
+    return [f"{label}: {len(d)} rapid{'s' if len(d) > 1 else ''} through stock (deepest {max(d):.3f} mm)"
+            for label, d in by_op.items()]
+
+
 def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> dict:
     from tmm_workbench.app.api import simulate
     from tmm_workbench.core.plan import progress_note
@@ -184,8 +194,7 @@ def verify(results: list, plan: dict, folder: Path, progress: Any = False) -> di
     problems = []
     if sim.gouged:
         problems.append(f"gouged {-sim.min_deviation:.4f} mm below the model (tolerance {plan['tolerance']:g} mm)")
-    if sim.collisions:
-        problems.append(f"{len(sim.collisions)} rapids through stock")
+    problems += rapid_problems(sim.collisions)
     problems += [f"{label}: {check.summary()}" for label, check in sim.holder_collisions]
     problems += [f"{label}: {found.summary()}" for label, found in sim.stock_collisions]
     failing = {c[0] for c in sim.collisions} | {label for label, _ in sim.holder_collisions + sim.stock_collisions}
