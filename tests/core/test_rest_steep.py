@@ -20,7 +20,7 @@ from tmm_workbench.core.geometry.mesh import TriMesh
 from tmm_workbench.core.linking import LinkPolicy, StockHeights, link
 from tmm_workbench.core.sim.grid import Grid
 from tmm_workbench.core.sim.simulate import simulate
-from tmm_workbench.core.strategies import raster_drop, rest_steep
+from tmm_workbench.core.strategies import raster_drop, rest_order, rest_steep
 from tmm_workbench.core.strategies.surface.params import SurfaceParams
 from tmm_workbench.core.tools.cutter import Cutter
 
@@ -123,7 +123,7 @@ def test_the_pieces_go_nearest_first_and_downhill_keeping_joined_ones_together()
 
     a, far, b, b2, up = piece(0.0, 5.0), piece(50.0, 5.0), piece(1.5, 4.8), piece(2.6, 4.7, True), piece(2.0, 6.0)
     # from a's end (1, 0, 5): b 0.5 away and 0.2 down; the piece 1 mm away but 1 mm up costs 1 + 4; far last
-    assert rest_steep.ordered([a, far, up, b, b2]) == [a, b, b2, up, far]
+    assert rest_order.ordered([a, far, up, b, b2]) == [a, b, b2, up, far]
 
 
 def test_the_work_estimate_counts_the_loops_over_the_rest_slopes() -> None:

@@ -246,7 +246,7 @@ def patches(steep: RestStock, reach: float) -> list[RestStock]:
 def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface: Optional[DropSurface],
            diagnostics: dict) -> list[CutSegment]:
     """Waterline loops over the steep rest cells, group by group (each group's levels top-down), within the
-    Surface params' boundary, kept where they cut that material, in the order `ordered` takes them, none joined
+    Surface params' boundary, kept where they cut that material, in the order `rest_order.ordered` takes them, none joined
     (finish joins them) (diagnostics "steep": levels, segments, cells, groups)."""
     surface = surface or DropSurface(mesh)
     segments: list[CutSegment] = []
@@ -257,7 +257,7 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
         found = _group_passes(mesh, cutter, params, group, surface)
         count += len(found[1])
         segments += found[0]
-    segments = ordered(segments)
+    segments = rest_order.ordered(segments)   # the loops' pieces: each keeps its sense
     for seg in segments:   # joined again in the new order (rest_joins: finish)
         seg.joined = False
     diagnostics["steep"] = {"levels": count, "segments": len(segments), "groups": len(groups),
@@ -267,8 +267,6 @@ def passes(mesh: TriMesh, cutter: Cutter, params: Any, steep: RestStock, surface
                                                                          for seg in segments))
     return segments
 
-
-ordered = rest_order.ordered   # (the loops' pieces: each keeps its sense)
 
 
 def estimate(params: Any, cutter: Cutter) -> Optional[tuple[float, float, int]]:
