@@ -124,6 +124,21 @@ def test_give_sets_the_stock_only_with_an_assembly_and_a_known_stock(plate) -> N
     assert q.stock is None
 
 
+def test_the_design_the_linker_knows_is_taken_not_dropped_again(plate) -> None:
+    """An op's linker drops the mesh's heights onto the same grid (know_op_design) before the guard asks: the
+    stock takes those, and its material off the design is what the mesh's own drop gives."""
+    from tmm_workbench.core.linking import know_op_design
+
+    own = params()
+    give(own, StockHeights(GRID, stock_heights(), BALL), plate)
+    left = StockHeights(GRID, stock_heights(), BALL)
+    p, policy = params(), LinkPolicy(safe_height=40.0, clearance_height=45.0, material_top=left)
+    give(p, left, plate)
+    assert know_op_design(policy, plate, p) and left.design is not None
+    assert np.array_equal(p.stock.excess(), own.stock.excess())
+    assert p.stock.design is left.design
+
+
 @pytest.mark.parametrize("body", [(8.0, 30.0, 2.0, 2.0, 1.0), (8.0, 12.0, 1.0, 3.0, 0.5), (5.0, 9.0, 3.0, 1.5, 0.8),
                                   (30.0, 60.0, 10.0, 10.0, 1.0)])
 def test_the_grown_bodys_lower_envelope_against_brute_force(body) -> None:

@@ -404,12 +404,14 @@ def know_design(policy: LinkPolicy, mesh: Any, within: float, stock_to_leave: fl
 
 def know_op_design(policy: LinkPolicy, mesh: Any, params: Any) -> bool:
     """know_design for an op's strategy parameters: a rest's design and rest tolerance (params.rest), else the
-    mesh's heights within the stock to leave and the op's chord tolerance."""
+    mesh's heights within core.sim.stock.op_within."""
+    from tmm_workbench.core.sim.stock import op_within   # imported when used, as in know_design
+
     s = float(getattr(params, "stock_to_leave", 0.0))
     rest = getattr(params, "rest", None)
     if rest is not None and getattr(rest, "design", None) is not None:
         return know_design(policy, mesh, rest.within, s, (rest.grid, rest.design))
-    return know_design(policy, mesh, max(s, 0.0) + float(getattr(params, "chord_tol", 0.0)), s)
+    return know_design(policy, mesh, op_within(params), s)
 
 
 def link(segments: Sequence[CutSegment], policy: LinkPolicy) -> Toolpath:

@@ -39,6 +39,12 @@ def cylinder_heights(grid: Grid, centre: tuple[float, float], radius: float, top
 _BLOCK_CELLS = 250_000  # cells per needle batch (about 0.1-0.3 s)
 
 
+def op_within(params: object) -> float:
+    """How near the mesh's heights an op's material is the design's (without a rest's design): the stock to
+    leave (not below 0) and what the op's own cuts leave on it (its chord tolerance)."""
+    return max(float(getattr(params, "stock_to_leave", 0.0)), 0.0) + float(getattr(params, "chord_tol", 0.0))
+
+
 def mesh_heights(mesh: TriMesh, grid: Grid, surface: DropSurface | None = None, progress=None,
                  threads: int = 0) -> np.ndarray:
     """(ny, nx) highest point of the mesh on each cell centre's vertical line (a disc of NEEDLE_RADIUS

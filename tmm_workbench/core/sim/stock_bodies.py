@@ -30,6 +30,7 @@ import numpy as np
 
 from tmm_workbench.core.errors import TmmError
 from tmm_workbench.core.query.drop_assembly import PIECES, AssemblyDrop, body_pieces
+from tmm_workbench.core.sim.stock import mesh_heights, op_within
 
 CELL_MM = 0.25      # the stock's cells gathered up to this size for the bodies (a shank is 1 mm wide or more)
 BLOCK_MM = 2.0      # the coarse blocks of the bound
@@ -39,13 +40,15 @@ TOLERANCE_MM = 1e-9
 @dataclass
 class InProcessStock:
     """The stock an op starts from: `heights` (ny, nx) at the centres of `grid` (core.sim's Grid: x0, y0, cell,
-    nx, ny), `design` the model's heights there (NaN: none; None: taken from `mesh` when first asked), `within`:
-    material this near the design is the model's."""
+    nx, ny), `design` the model's heights there (NaN: none; None: taken when first asked from `source`, the op's
+    core.linking.StockHeights, once its linker knows them (know_op_design: the same mesh heights on the same
+    grid), else from `mesh`), `within`: material this near the design is the model's."""
     grid: Any
     heights: np.ndarray
     within: float = 0.0
     design: Optional[np.ndarray] = None
     mesh: Any = None
+    source: Any = field(default=None, repr=False)
     _excess: Optional[np.ndarray] = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
@@ -61,9 +64,10 @@ class InProcessStock:
     def excess(self) -> np.ndarray:
         """(ny, nx) the stock's height where it stands more than `within` above the design, else -inf."""
         if self._excess is None:
+            known = getattr(self.source, "design", None)
+            if self.design is None and known is not None and np.shape(known) == self.heights.shape:
+                self.design = known   # the linker's: not dropped onto the mesh a second time
             if self.design is None:
-                from tmm_workbench.core.sim.stock import mesh_heights   # the simulation's: imported when used
-
                 self.design = mesh_heights(self.mesh, self.grid)
             d = np.nan_to_num(np.asarray(self.design, dtype=float), nan=-math.inf)
             self._excess = np.where(self.heights > d + self.within, self.heights, -math.inf)
@@ -73,8 +77,8 @@ class InProcessStock:
 def give(params: Any, left: Any, mesh: Any) -> None:
     """Sets `params.stock` (core.strategies.holder_guard.WholeToolParams) to what the Job's earlier ops left
     (`left`: a core.linking.StockHeights, None: not known) when the params carry a tool assembly; material
-    within the op's stock to leave and chord tolerance of the design (a rest's tolerance) is the design's, as for
-    the linker's entries (core.linking.know_op_design)."""
+    within core.sim.stock.op_within of the design (a rest's tolerance) is the design's, as for the linker's entries
+    (core.linking.know_op_design)."""
     if left is None or getattr(params, "assembly", None) is None:
         params.stock = None
         return
@@ -82,8 +86,7 @@ def give(params: Any, left: Any, mesh: Any) -> None:
     if rest is not None and getattr(rest, "design", None) is not None and rest.grid == left.grid:
         params.stock = InProcessStock(left.grid, left.heights, float(rest.within), rest.design)
         return
-    within = max(float(getattr(params, "stock_to_leave", 0.0)), 0.0) + float(getattr(params, "chord_tol", 0.0))
-    params.stock = InProcessStock(left.grid, left.heights, within, mesh=mesh)
+    params.stock = InProcessStock(left.grid, left.heights, op_within(params), mesh=mesh, source=left)
 
 
 def lower_envelope(body: tuple, rho: np.ndarray) -> np.ndarray:
