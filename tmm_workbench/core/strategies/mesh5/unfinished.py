@@ -17,7 +17,7 @@ Strips = List[tuple[float, float, float, float]]   # (feed from, to, across from
 
 
 def beyond_tilt(listed: Strips, cover: Coverage, level: np.ndarray, whole: List[CCPath],
-                 paths: List[CCPath], offset: float, dropped: np.ndarray) -> None:
+                paths: List[CCPath], offset: float, dropped: np.ndarray) -> None:
     """Takes the pass's new `level`; the open bins the plane's whole paths run through but its paths within
     the machine's tilt do not (_Planes._reachable) are left for clean-up up to the least level the pass
     reached elsewhere (added to `listed`, the plan's unfinished), so that the next passes go on beside them
@@ -55,12 +55,12 @@ def list_slivers(listed: Strips, cover: Coverage, edges: tuple[np.ndarray, np.nd
                 q = part[k:k + run]
                 f0, f1 = float(cover.f0 + cover.width * q[0]), float(cover.f0 + cover.width * (q[-1] + 1))
                 listed.append((f0, f1, float(across[q].min()), float(cover.hi[q].max())) if side == 0 else
-                                       (f0, f1, float(cover.lo[q].min()), float(-across[q].min())))
+                              (f0, f1, float(cover.lo[q].min()), float(-across[q].min())))
 
 
 def list_ends(listed: Strips, cover: Coverage, reach: MeshReach, cutter: Cutter, paths: List[CCPath],
-               runs: List[tuple[np.ndarray, np.ndarray]], widths: np.ndarray, ends: np.ndarray,
-               tolerance: float) -> None:
+              runs: List[tuple[np.ndarray, np.ndarray]], widths: np.ndarray, ends: np.ndarray,
+              tolerance: float) -> None:
     """What a pass's tools leave above `tolerance` between each path's end CC point and the mesh's edge it was
     moved in from (widths.end_by_tools) listed in listed, per end and side: along the feed from the
     first section short of the end's half-width to the edge, across from where the tools stop to the level

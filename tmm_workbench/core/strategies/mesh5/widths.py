@@ -320,19 +320,28 @@ def edge_by_tools(reach: MeshReach, cutter: Cutter, paths: List[CCPath], tips: n
             if k in (lo, hi):                      # the path's end within reach: the tool goes on along LX
                 s = np.linspace(0.0, R, sub + 1)[1:, None]
                 T, A = np.vstack([T, tips[k] + sgn * s * frm[k, 0]]), np.vstack([A, np.repeat(axes[k][None], sub, 0)])
-        z = _disc_heights(pts[i], frm[i], T, A, R, np.concatenate([ys, -ys[1:]]))
-        S = surface_heights(reach, pts[i:i + 1], frm[i:i + 1], np.concatenate([ys, -ys[1:]])[None], 3.0 * R)[0]
-        for side, sl in ((0, slice(0, len(ys))), (1, np.r_[0, len(ys):2 * len(ys) - 1])):
+        for side, (d, s_d, S) in enumerate(_sides_covered(reach, pts[i], frm[i], T, A, R, ys, tolerance)):
             if side not in sides or not np.isinf(widths[i, side]):
                 continue
-            d, s_d = _covered_to(ys, z[sl], S[sl], tolerance)
             if np.isfinite(d):
                 sgn = 1.0 if side == 0 else -1.0
                 widths[i, side] = d
                 ends[i, side] = pts[i] + sgn * d * frm[i, 1] + s_d * frm[i, 2]
-                on = np.flatnonzero(~np.isnan(S[sl]))
+                on = np.flatnonzero(~np.isnan(S))
                 short[i] = max(short[i], float(ys[on.max()]) - d if on.size else 0.0)
     return widths, ends, short
+
+
+def _sides_covered(reach: MeshReach, point: np.ndarray, frame: np.ndarray, T: np.ndarray, A: np.ndarray,
+                   radius: float, ys: np.ndarray, tolerance: float) -> list[tuple[float, float, np.ndarray]]:
+    """Per side (0 left along LY, 1 right) of `point`'s section (`frame`: LX, LY, normal) cut by the flat
+    bottoms of radius at the tool positions `T`, `A`: how far they finish it within `tolerance` and the height
+    there (_covered_to), and the surface's heights at `ys` along that side (NaN off the mesh)."""
+    lateral = np.concatenate([ys, -ys[1:]])
+    z = _disc_heights(point, frame, T, A, radius, lateral)
+    S = surface_heights(reach, point[None], frame[None], lateral[None], 3.0 * radius)[0]
+    return [(*_covered_to(ys, z[sl], S[sl], tolerance), S[sl])
+            for sl in (slice(0, len(ys)), np.r_[0, len(ys):2 * len(ys) - 1])]
 
 
 def _sub_positions(tips: np.ndarray, axes: np.ndarray, sub: int) -> tuple[np.ndarray, np.ndarray]:
@@ -400,7 +409,6 @@ def end_by_tools(reach: MeshReach, cutter: Cutter, path: CCPath, tips: np.ndarra
     if cutter.corner_radius > 0:
         return out
     ys = np.linspace(0.0, 2.0 * R, WIDTH_SAMPLES)
-    lateral = np.concatenate([ys, -ys[1:]])
     for e, (k, sgn) in enumerate(((0, -1.0), (-1, 1.0))):
         inset = path.inset[k]
         if path.cut_short[k] or inset < 0.05 * R:
@@ -417,10 +425,7 @@ def end_by_tools(reach: MeshReach, cutter: Cutter, path: CCPath, tips: np.ndarra
                 continue
             lo, hi = max(int(near.min()) - 1, 0), min(int(near.max()) + 1, len(tips) - 1)
             T, A = _sub_positions(tips[lo:hi + 1], axes[lo:hi + 1], sub)
-            z = _disc_heights(p, f, T, A, R, lateral)
-            S = surface_heights(reach, p[None], f[None], lateral[None], 3.0 * R)[0]
-            for side, sl in ((0, slice(0, len(ys))), (1, np.r_[0, len(ys):2 * len(ys) - 1])):
-                d, s_d = _covered_to(ys, z[sl], S[sl], tolerance)
+            for side, (d, s_d, _) in enumerate(_sides_covered(reach, p, f, T, A, R, ys, tolerance)):
                 if d < widths[e, side] - 1e-3 * R:
                     sg = 1.0 if side == 0 else -1.0
                     out.append((e, side, p, p + sg * d * f[1] + (0.0 if np.isnan(s_d) else s_d) * f[2]))
