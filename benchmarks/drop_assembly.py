@@ -223,5 +223,6 @@ def compare(arrays: dict, path: str, tol: float = 1e-9) -> None:
         sys.exit(1)
     print(f"all {len(arrays)} arrays identical to {path} or within {tol:g} mm")
 
+
 if __name__ == "__main__":
     main()
